@@ -1,0 +1,21 @@
+"""om_redundant: exact inverse kinematics with configuration control by offset modification."""
+
+from .arm import Arm as Arm
+from .arm import arm_names as arm_names
+from .arm import load_arm as load_arm
+from .configuration import Configuration as Configuration
+from .exceptions import ArmFileError as ArmFileError
+from .exceptions import InvalidInput as InvalidInput
+from .exceptions import ModelError as ModelError
+from .exceptions import OMError as OMError
+from .exceptions import UnknownArm as UnknownArm
+from .kinematics import DHRow as DHRow
+from .kinematics import JointKind as JointKind
+from .kinematics import KinematicChain as KinematicChain
+from .model import ModelArm as ModelArm
+from .model import derive_model as derive_model
+from .solver import BatchSolution as BatchSolution
+from .solver import OMSolver as OMSolver
+from .solver import Solution as Solution
+
+__version__ = "0.1.0"

@@ -1,0 +1,290 @@
+"""Arms: a kinematic chain with joint names, limits and the MuJoCo frame it matches.
+
+Arm files (``arms/*.toml``) describe real arms in readable form; :func:`load_arm` reads one
+by name or path and :func:`arm_names` lists the built-in ones. The file format::
+
+    name = "ur5e"
+    description = "Universal Robots UR5e"
+    convention = "standard"        # or "modified" (Craig)
+
+    [mujoco]                       # optional: the model this arm matches
+    model = "universal_robots_ur5e/ur5e.xml"   # path under MuJoCo Menagerie
+    frame = "wrist_3_link"
+    frame_type = "body"            # "body" or "site"
+
+    [base]                         # pose of DH frame 0 in the arm's root frame
+    xyz = [0, 0, 0]
+    quat = [1, 0, 0, 0]            # w, x, y, z as in MJCF
+
+    [tool]                         # pose of the end-effector frame in the last DH frame
+    xyz = [0, 0, 0]
+    quat = [1, 0, 0, 0]
+
+    [[rows]]                       # one per DH row, in order
+    joint = "shoulder_pan_joint"   # absent for a fixed row
+    type = "revolute"              # revolute | prismatic | fixed
+    a = 0.0                        # metres
+    d = 0.163
+    alpha_deg = 90.0               # degrees
+    theta_deg = 0.0
+    range = [-6.28319, 6.28319]    # radians (metres if prismatic); absent = unlimited
+
+Units: metres for lengths and limits of prismatic joints, radians for revolute limits,
+degrees for the DH angles (their key says so).
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .exceptions import ArmFileError, UnknownArm
+from .kinematics import DHRow, JointKind, KinematicChain, standard_rows_from_modified
+from .validation import as_joint_vector
+
+
+@dataclass(frozen=True, eq=False)
+class Arm:
+    """A serial arm: kinematic chain, joint names and limits.
+
+    Attributes:
+        name: Short name, e.g. ``"ur5e"``.
+        chain: The kinematic chain (standard DH rows, base and tool transforms).
+        joint_names: Joint names, as in the MuJoCo model the arm matches.
+        lower: Lower joint limits (dof,); ``-inf`` where unlimited.
+        upper: Upper joint limits (dof,); ``+inf`` where unlimited.
+        description: Human-readable description.
+        mujoco_model: Path of the matching MuJoCo Menagerie model, relative to Menagerie's root.
+        frame_name: Name of the end-effector frame in that model.
+        frame_type: ``"body"`` or ``"site"``.
+        source: File the arm was read from.
+    """
+
+    name: str
+    chain: KinematicChain
+    joint_names: tuple[str, ...]
+    lower: np.ndarray
+    upper: np.ndarray
+    description: str = ""
+    mujoco_model: str | None = None
+    frame_name: str | None = None
+    frame_type: str | None = None
+    source: str | None = None
+    revolute: np.ndarray = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        kinds = [self.chain.rows[i].kind for i in self.chain.joint_rows]
+        object.__setattr__(self, "revolute", np.array([k is JointKind.REVOLUTE for k in kinds]))
+
+    @property
+    def dof(self) -> int:
+        return self.chain.dof
+
+    def fk(self, q: np.ndarray) -> np.ndarray:
+        """Pose (4, 4) of the end-effector frame in the root frame; (M, 4, 4) for (M, dof)."""
+        return self.chain.fk(q)
+
+    def jacobian(self, q: np.ndarray) -> np.ndarray:
+        """Geometric Jacobian (6, dof), rows ``[v; omega]``, in the root frame."""
+        return self.chain.jacobian(q)
+
+    def within_limits(self, q: np.ndarray, tolerance: float = 0.0) -> bool | np.ndarray:
+        """Whether q (dof,) or each row of q (M, dof) lies within the joint limits."""
+        q = as_joint_vector(q, self.dof)
+        inside = ((q >= self.lower - tolerance) & (q <= self.upper + tolerance)).all(axis=-1)
+        return bool(inside) if q.ndim == 1 else inside
+
+    def with_chain(self, chain: KinematicChain, name: str) -> Arm:
+        """The same arm (names, limits) on another chain, e.g. an offset-modified model."""
+        return Arm(
+            name, chain, self.joint_names, self.lower, self.upper, self.description,
+            self.mujoco_model, self.frame_name, self.frame_type, self.source,
+        )
+
+
+def arm_names() -> list[str]:
+    """Names of the arms shipped with the package, in the order of the design card."""
+    order = ["spherical", "ur5e", "panda", "fr3", "iiwa14", "gen3", "xarm7", "sawyer"]
+    names = [p.name.removesuffix(".toml") for p in _arm_dir().iterdir() if p.name.endswith(".toml")]
+    return sorted(names, key=lambda n: (order.index(n) if n in order else len(order), n))
+
+
+def load_arm(name_or_path: str | Path) -> Arm:
+    """Load an arm by built-in name (see :func:`arm_names`) or from a TOML arm file.
+
+    Raises:
+        UnknownArm: The name is neither a built-in arm nor an existing file.
+        ArmFileError: The file is malformed; the message names file, field and problem.
+    """
+    text_name = str(name_or_path)
+    builtin = _arm_dir() / f"{text_name}.toml"
+    if isinstance(name_or_path, str) and "/" not in text_name and not text_name.endswith(".toml"):
+        if not builtin.is_file():
+            raise UnknownArm(text_name, arm_names())
+        return _parse(builtin.read_text(), str(builtin))
+    path = Path(name_or_path)
+    if not path.is_file():
+        raise ArmFileError(str(path), "<file>", "no such file")
+    return _parse(path.read_text(), str(path))
+
+
+def _arm_dir() -> Any:
+    return resources.files("om_redundant.arms")
+
+
+# ---------------------------------------------------------------------------------------
+# Parsing, strict: unknown keys are errors, so that a typo never silently means zero.
+
+_TOP_KEYS = {"name", "description", "convention", "mujoco", "base", "tool", "rows"}
+_ROW_KEYS = {"joint", "type", "a", "d", "alpha_deg", "theta_deg", "range"}
+
+
+def _parse(text: str, path: str) -> Arm:
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ArmFileError(path, "<file>", f"not valid TOML: {exc}") from None
+    f = _Fields(path)
+    f.no_unknown(data, _TOP_KEYS, "")
+    name = f.string(data, "name")
+    convention = f.string(data, "convention")
+    if convention not in ("standard", "modified"):
+        raise ArmFileError(path, "convention", f"must be 'standard' or 'modified', got '{convention}'")
+    raw_rows = data.get("rows")
+    if not isinstance(raw_rows, list) or not raw_rows:
+        raise ArmFileError(path, "rows", "must be a non-empty array of tables ([[rows]])")
+
+    rows, joint_names, lower, upper = [], [], [], []
+    for i, raw in enumerate(raw_rows):
+        where = f"rows[{i}]"
+        if not isinstance(raw, dict):
+            raise ArmFileError(path, where, "must be a table")
+        f.no_unknown(raw, _ROW_KEYS, where + ".")
+        kind_text = f.string(raw, "type", where + ".")
+        try:
+            kind = JointKind(kind_text)
+        except ValueError:
+            raise ArmFileError(
+                path, f"{where}.type", f"must be revolute, prismatic or fixed, got '{kind_text}'"
+            ) from None
+        row = DHRow(
+            a=f.number(raw, "a", where + ".", 0.0),
+            alpha=math.radians(f.number(raw, "alpha_deg", where + ".", 0.0)),
+            d=f.number(raw, "d", where + ".", 0.0),
+            theta=math.radians(f.number(raw, "theta_deg", where + ".", 0.0)),
+            kind=kind,
+        )
+        rows.append(row)
+        if kind is JointKind.FIXED:
+            for key in ("joint", "range"):
+                if key in raw:
+                    raise ArmFileError(path, f"{where}.{key}", "a fixed row has no joint")
+            continue
+        joint_names.append(f.string(raw, "joint", where + "."))
+        lo, hi = f.limits(raw, where)
+        lower.append(lo)
+        upper.append(hi)
+    if len(set(joint_names)) != len(joint_names):
+        raise ArmFileError(path, "rows", f"joint names repeat: {joint_names}")
+
+    if convention == "modified":
+        rows = standard_rows_from_modified(rows)
+    mujoco = data.get("mujoco", {})
+    if not isinstance(mujoco, dict):
+        raise ArmFileError(path, "mujoco", "must be a table")
+    f.no_unknown(mujoco, {"model", "frame", "frame_type"}, "mujoco.")
+    frame_type = mujoco.get("frame_type")
+    if frame_type not in (None, "body", "site"):
+        raise ArmFileError(path, "mujoco.frame_type", f"must be 'body' or 'site', got '{frame_type}'")
+    chain = KinematicChain(tuple(rows), f.transform(data, "base"), f.transform(data, "tool"))
+    return Arm(
+        name=name,
+        chain=chain,
+        joint_names=tuple(joint_names),
+        lower=np.array(lower),
+        upper=np.array(upper),
+        description=data.get("description", ""),
+        mujoco_model=mujoco.get("model"),
+        frame_name=mujoco.get("frame"),
+        frame_type=frame_type,
+        source=path,
+    )
+
+
+@dataclass
+class _Fields:
+    path: str
+
+    def no_unknown(self, table: dict, allowed: set[str], prefix: str) -> None:
+        for key in table:
+            if key not in allowed:
+                raise ArmFileError(self.path, prefix + key, f"unknown field; allowed: {sorted(allowed)}")
+
+    def string(self, table: dict, key: str, prefix: str = "") -> str:
+        if key not in table:
+            raise ArmFileError(self.path, prefix + key, "missing")
+        if not isinstance(table[key], str) or not table[key]:
+            raise ArmFileError(self.path, prefix + key, f"must be a non-empty string, got {table[key]!r}")
+        return table[key]
+
+    def number(self, table: dict, key: str, prefix: str = "", default: float | None = None) -> float:
+        if key not in table:
+            if default is None:
+                raise ArmFileError(self.path, prefix + key, "missing")
+            return default
+        value = table[key]
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise ArmFileError(self.path, prefix + key, f"must be a finite number, got {value!r}")
+        return float(value)
+
+    def vector(self, table: dict, key: str, prefix: str, size: int, default: list[float]) -> np.ndarray:
+        value = table.get(key, default)
+        if (
+            not isinstance(value, list)
+            or len(value) != size
+            or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
+            or not all(math.isfinite(v) for v in value)
+        ):
+            raise ArmFileError(self.path, prefix + key, f"must be {size} finite numbers, got {value!r}")
+        return np.array(value, dtype=np.float64)
+
+    def limits(self, raw: dict, where: str) -> tuple[float, float]:
+        if "range" not in raw:
+            return -np.inf, np.inf
+        lo, hi = self.vector(raw, "range", where + ".", 2, [])
+        if not lo < hi:
+            raise ArmFileError(self.path, f"{where}.range", f"lower limit {lo} must be below upper {hi}")
+        return lo, hi
+
+    def transform(self, data: dict, key: str) -> np.ndarray:
+        table = data.get(key, {})
+        if not isinstance(table, dict):
+            raise ArmFileError(self.path, key, "must be a table with xyz and quat")
+        self.no_unknown(table, {"xyz", "quat"}, key + ".")
+        xyz = self.vector(table, "xyz", key + ".", 3, [0.0, 0.0, 0.0])
+        quat = self.vector(table, "quat", key + ".", 4, [1.0, 0.0, 0.0, 0.0])
+        norm = np.linalg.norm(quat)
+        if norm < 1e-9:
+            raise ArmFileError(self.path, key + ".quat", "quaternion has zero norm")
+        T = np.eye(4)
+        T[:3, :3] = rotation_from_quat(quat / norm)
+        T[:3, 3] = xyz
+        return T
+
+
+def rotation_from_quat(wxyz: np.ndarray) -> np.ndarray:
+    """Rotation matrix of a unit quaternion (w, x, y, z)."""
+    w, x, y, z = wxyz
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+        ]
+    )

@@ -1,0 +1,239 @@
+r"""Denavit-Hartenberg kinematic chains: forward kinematics and the geometric Jacobian.
+
+A chain is a list of DH rows between a base transform and a tool transform:
+
+.. math::
+
+    T_{root,ee}(q) = T_{root,0} \; \prod_i A_i(q) \; T_{flange,ee}
+
+Rows are stored in the standard convention,
+:math:`A_i = R_z(\theta_i) T_z(d_i) T_x(a_i) R_x(\alpha_i)`, with the joint variable added
+to :math:`\theta_i` (revolute) or :math:`d_i` (prismatic); a fixed row has no variable.
+A table in the modified (Craig) convention,
+:math:`A_i = R_x(\alpha_{i-1}) T_x(a_{i-1}) R_z(\theta_i) T_z(d_i)`, is converted exactly by
+:func:`standard_rows_from_modified`: since :math:`R_x` and :math:`T_x` commute, the product
+regroups into a fixed row :math:`T_x(a_0) R_x(\alpha_0)` followed by standard rows. One
+internal convention keeps one code path for FK, Jacobians and the OM model.
+
+The numeric kernels are compiled with numba; :class:`KinematicChain` is the typed front.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from enum import Enum
+
+import numba as nb
+import numpy as np
+
+from .validation import as_joint_vector
+
+
+class JointKind(str, Enum):
+    """What a DH row's variable is."""
+
+    REVOLUTE = "revolute"
+    PRISMATIC = "prismatic"
+    FIXED = "fixed"
+
+
+_KIND_CODE = {JointKind.REVOLUTE: 0, JointKind.PRISMATIC: 1, JointKind.FIXED: 2}
+
+
+@dataclass(frozen=True)
+class DHRow:
+    """One standard-convention DH row: ``Rz(theta) Tz(d) Tx(a) Rx(alpha)``.
+
+    Attributes:
+        a: Link length along x (m).
+        alpha: Link twist about x (rad).
+        d: Link offset along z (m); the joint variable is added to it for prismatic rows.
+        theta: Joint angle offset about z (rad); the variable is added for revolute rows.
+        kind: Revolute, prismatic or fixed.
+    """
+
+    a: float = 0.0
+    alpha: float = 0.0
+    d: float = 0.0
+    theta: float = 0.0
+    kind: JointKind = JointKind.REVOLUTE
+
+    @property
+    def is_joint(self) -> bool:
+        return self.kind is not JointKind.FIXED
+
+
+def standard_rows_from_modified(rows: list[DHRow]) -> list[DHRow]:
+    """Convert rows read in the modified convention into equivalent standard rows.
+
+    Each input row holds ``(a_{i-1}, alpha_{i-1}, d_i, theta_i)`` as ``(a, alpha, d, theta)``.
+    The result starts with the fixed row ``Tx(a_0) Rx(alpha_0)`` (omitted when zero) and
+    then row i becomes ``(a_i, alpha_i, d_i, theta_i)``, taking ``a_i, alpha_i`` from the
+    next input row (zero after the last).
+    """
+    out: list[DHRow] = []
+    if rows and (rows[0].a != 0.0 or rows[0].alpha != 0.0):
+        out.append(DHRow(a=rows[0].a, alpha=rows[0].alpha, kind=JointKind.FIXED))
+    for i, row in enumerate(rows):
+        nxt = rows[i + 1] if i + 1 < len(rows) else DHRow()
+        out.append(DHRow(a=nxt.a, alpha=nxt.alpha, d=row.d, theta=row.theta, kind=row.kind))
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class KinematicChain:
+    """Standard DH rows between a base and a tool transform.
+
+    Attributes:
+        rows: The rows, standard convention, fixed rows included.
+        T_root_base: Pose of DH frame 0 in the arm's root frame (4x4).
+        T_flange_tool: Pose of the end-effector frame in the last DH frame (4x4).
+    """
+
+    rows: tuple[DHRow, ...]
+    T_root_base: np.ndarray = field(default_factory=lambda: np.eye(4))
+    T_flange_tool: np.ndarray = field(default_factory=lambda: np.eye(4))
+    table: np.ndarray = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        table = np.array(
+            [
+                (r.a, r.d, r.theta, np.cos(r.alpha), np.sin(r.alpha), _KIND_CODE[r.kind])
+                for r in self.rows
+            ],
+            dtype=np.float64,
+        ).reshape(-1, 6)
+        object.__setattr__(self, "table", table)
+        for name in ("T_root_base", "T_flange_tool"):
+            object.__setattr__(self, name, np.ascontiguousarray(getattr(self, name), dtype=np.float64))
+
+    @property
+    def dof(self) -> int:
+        return sum(r.is_joint for r in self.rows)
+
+    @property
+    def joint_rows(self) -> list[int]:
+        """Index in :attr:`rows` of each joint's row, in joint order."""
+        return [i for i, r in enumerate(self.rows) if r.is_joint]
+
+    def replace_rows(self, rows: list[DHRow]) -> KinematicChain:
+        """The same chain with other rows (same base and tool)."""
+        return KinematicChain(tuple(rows), self.T_root_base, self.T_flange_tool)
+
+    def fk(self, q: np.ndarray) -> np.ndarray:
+        """Pose of the end-effector frame in the root frame.
+
+        Args:
+            q: Joint vector (dof,) or stack (M, dof).
+
+        Returns:
+            (4, 4) transform, or (M, 4, 4) for a stack.
+        """
+        q = as_joint_vector(q, self.dof)
+        if q.ndim == 1:
+            return fk_kernel(self.table, self.T_root_base, self.T_flange_tool, q)
+        return fk_batch_kernel(self.table, self.T_root_base, self.T_flange_tool, q)
+
+    def jacobian(self, q: np.ndarray) -> np.ndarray:
+        r"""Geometric Jacobian of the end-effector frame, in the root frame.
+
+        Rows are ``[v; omega]`` (linear velocity of the end-effector origin, then angular
+        velocity): :math:`J_i = [z_i \times (p_{ee} - o_i);\ z_i]` for a revolute joint and
+        :math:`[z_i;\ 0]` for a prismatic one, with :math:`z_i, o_i` the joint's axis and origin.
+
+        Args:
+            q: Joint vector (dof,).
+
+        Returns:
+            (6, dof) array.
+        """
+        q = as_joint_vector(q, self.dof)
+        if q.ndim != 1:
+            raise ValueError("jacobian takes one joint vector")
+        return jacobian_kernel(self.table, self.T_root_base, self.T_flange_tool, q)
+
+
+# ---------------------------------------------------------------------------------------
+# numba kernels. ``table`` columns: a, d, theta, cos(alpha), sin(alpha), kind code.
+
+
+@nb.njit(cache=True, inline="always")
+def _apply_row(R, p, row, qi):
+    """Right-multiply the frame (R, p) in place by the standard DH row with variable qi."""
+    kind = row[5]
+    theta = row[2] + qi if kind == 0.0 else row[2]
+    d = row[1] + qi if kind == 1.0 else row[1]
+    ct, st, ca, sa, a = np.cos(theta), np.sin(theta), row[3], row[4], row[0]
+    for i in range(3):
+        r0, r1, r2 = R[i, 0], R[i, 1], R[i, 2]
+        p[i] += r0 * a * ct + r1 * a * st + r2 * d
+        R[i, 0] = r0 * ct + r1 * st
+        R[i, 1] = -r0 * st * ca + r1 * ct * ca + r2 * sa
+        R[i, 2] = r0 * st * sa - r1 * ct * sa + r2 * ca
+
+
+@nb.njit(cache=True)
+def flange_kernel(table, q, R, p):
+    """Write the pose of the last DH frame in DH frame 0 into (R, p)."""
+    R[:, :] = 0.0
+    R[0, 0] = R[1, 1] = R[2, 2] = 1.0
+    p[:] = 0.0
+    j = 0
+    for k in range(table.shape[0]):
+        if table[k, 5] == 2.0:
+            _apply_row(R, p, table[k], 0.0)
+        else:
+            _apply_row(R, p, table[k], q[j])
+            j += 1
+
+
+@nb.njit(cache=True)
+def fk_kernel(table, base, tool, q):
+    R = np.empty((3, 3))
+    p = np.empty(3)
+    flange_kernel(table, q, R, p)
+    T = np.eye(4)
+    T[:3, :3] = R
+    T[:3, 3] = p
+    return base @ T @ tool
+
+
+@nb.njit(cache=True, parallel=True)
+def fk_batch_kernel(table, base, tool, Q):
+    out = np.empty((Q.shape[0], 4, 4))
+    for m in nb.prange(Q.shape[0]):
+        out[m] = fk_kernel(table, base, tool, Q[m])
+    return out
+
+
+@nb.njit(cache=True)
+def jacobian_kernel(table, base, tool, q):
+    dof = q.shape[0]
+    axes = np.empty((dof, 3))
+    origins = np.empty((dof, 3))
+    kinds = np.empty(dof)
+    R = np.eye(3)
+    p = np.zeros(3)
+    j = 0
+    for k in range(table.shape[0]):
+        if table[k, 5] == 2.0:
+            _apply_row(R, p, table[k], 0.0)
+            continue
+        # A standard row's joint acts about the z-axis of the frame it starts from.
+        axes[j] = R[:, 2]
+        origins[j] = p
+        kinds[j] = table[k, 5]
+        _apply_row(R, p, table[k], q[j])
+        j += 1
+    Rb = np.ascontiguousarray(base[:3, :3])
+    p_ee = Rb @ (p + R @ np.ascontiguousarray(tool[:3, 3])) + base[:3, 3]
+    J = np.zeros((6, dof))
+    for j in range(dof):
+        z = Rb @ axes[j]
+        if kinds[j] == 1.0:
+            J[:3, j] = z
+        else:
+            o = Rb @ origins[j] + base[:3, 3]
+            J[:3, j] = np.cross(z, p_ee - o)
+            J[3:, j] = z
+    return J

@@ -1,0 +1,435 @@
+r"""The OM system (9) and its solvers, as numba kernels.
+
+System (9) asks for the model's hand position :math:`p_m` with
+
+.. math::  p_m = p_d + \Delta p\big(\mathrm{IK}_{model}(R_d, p_m, c)\big).
+
+Every solution has the form :math:`p_m = p_d + R_d\,\delta(w)`, where :math:`\delta` is dp
+seen from the flange and depends on one wrist joint, :math:`w = q_J` (see
+:mod:`om_redundant.model`). So the three equations reduce exactly to one on the circle,
+
+.. math::  g(w) = \mathrm{wrap}\big(\mathrm{IK}_{model}(R_d, p_d + R_d\,\delta(w), c)_J - w\big) = 0,
+
+and a root gives the real arm's joints :math:`q = \mathrm{IK}_{model}(\ldots)` with
+:math:`|p_{real}(q) - p_d| = |\delta(w) - \delta(q_J)| \le \Delta p_{max}\,|g(w)|`.
+
+* Local solve: Broyden's method, which in one unknown is the secant method, started with a
+  finite-difference slope, from the joint of the paper's fixed-point start
+  (:math:`p_m = p_d`) or of a hint.
+* Bounded search, the paper's guarantee: g is sampled on a grid over the whole circle (the
+  image of the ball :math:`|p_m - p_d| \le \Delta p_{max}` that can hold solutions); each sign
+  change is refined; near the edges of the model's reach, at local minima of |g| and on
+  small islands of reach, where roots come in close pairs, 1-D extremum searches find
+  them. Every candidate is verified with the REAL arm's forward kinematics.
+
+All kernels work in DH frame 0 with the flange pose; base and tool are removed outside.
+"""
+
+from __future__ import annotations
+
+import numba as nb
+import numpy as np
+
+from .closed_form import REACH_SLACK, branch_values, model_ik
+from .kinematics import flange_kernel
+
+OK = 0
+UNREACHABLE = 1
+NO_SOLUTION_IN_CONFIGURATION = 2
+STATUS_NAMES = ("ok", "unreachable", "no solution in this configuration")
+
+MAX_ROOTS = 16
+_ROOT_TOL = 1e-13  # |g| accepted as a root before verification
+_SAME_ROOT = 1e-9  # joint-space distance under which two roots are one
+_PAIR_SEARCH = 1.0  # |g| (rad) below which a local minimum is searched for a root pair
+
+
+@nb.njit(cache=True, inline="always")
+def _wrap(x):
+    return x - 2.0 * np.pi * np.floor((x + np.pi) / (2.0 * np.pi))
+
+
+@nb.njit(cache=True)
+def _delta(mtab, rtab, J, w, dof):
+    """dp seen from the flange, delta(w): the same for every q with q_J = w."""
+    q = np.zeros(dof)
+    if J >= 0:
+        q[J] = w
+    Rm, pm, Rr, pr = np.empty((3, 3)), np.empty(3), np.empty((3, 3)), np.empty(3)
+    flange_kernel(mtab, q, Rm, pm)
+    flange_kernel(rtab, q, Rr, pr)
+    return Rr.T @ (pm - pr)
+
+
+@nb.njit(cache=True)
+def _g_margin(family, P, mtab, rtab, J, R, p, signs, q_prev, w, q):
+    """Residual g(w) (NaN if unreachable) and the model's reach margin; writes the IK into q."""
+    pm = p + R @ _delta(mtab, rtab, J, w, q.shape[0])
+    margin = model_ik(family, P, mtab, R, pm, signs, q_prev, q)
+    if margin < -REACH_SLACK:
+        return np.nan, margin
+    if J < 0:
+        return 0.0, margin
+    return _wrap(q[J] - w), margin
+
+
+@nb.njit(cache=True)
+def _g(family, P, mtab, rtab, J, R, p, signs, q_prev, w, q):
+    """Residual g(w) of the reduced system; writes the model IK into q. NaN if unreachable."""
+    return _g_margin(family, P, mtab, rtab, J, R, p, signs, q_prev, w, q)[0]
+
+
+@nb.njit(cache=True)
+def _broyden(family, P, mtab, rtab, J, R, p, signs, q_prev, w0, q):
+    """Secant (1-D Broyden) iteration from w0 with a finite-difference slope.
+
+    Returns (|g| at the end, evaluations); q holds the model IK at the last iterate.
+    """
+    g0 = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, w0, q)
+    if J < 0 or np.isnan(g0):
+        return abs(g0), 1
+    h = 1e-7
+    g1 = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, w0 + h, q)
+    evals = 2
+    slope = (g1 - g0) / h if not np.isnan(g1) else -1.0
+    w, g = w0, g0
+    for _ in range(40):
+        if g == 0.0 or slope == 0.0 or np.isnan(slope):
+            break
+        step = -g / slope
+        if abs(step) > 0.5:
+            step = 0.5 * np.sign(step)
+        g_new = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, w + step, q)
+        evals += 1
+        if np.isnan(g_new):
+            break
+        slope = (g_new - g) / step
+        w, g = w + step, g_new
+        if abs(step) < 1e-15 * max(1.0, abs(w)) or abs(g) < 1e-16:
+            break
+    # q must belong to the final iterate.
+    g = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, w, q)
+    return abs(g), evals + 1
+
+
+@nb.njit(cache=True)
+def _refine_bracket(family, P, mtab, rtab, J, R, p, signs, q_prev, a, ga, b, gb, q):
+    """Illinois regula falsi on a sign-changing bracket; returns the root estimate."""
+    side = 0
+    for _ in range(100):
+        c = (a * gb - b * ga) / (gb - ga)
+        gc = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, c, q)
+        if np.isnan(gc) or gc == 0.0 or abs(b - a) < 1e-15:
+            return c
+        if np.sign(gc) == np.sign(gb):
+            b, gb = c, gc
+            if side == -1:
+                ga *= 0.5
+            side = -1
+        else:
+            a, ga = c, gc
+            if side == 1:
+                gb *= 0.5
+            side = 1
+    return 0.5 * (a + b)
+
+
+@nb.njit(cache=True)
+def _reach_edge(family, P, mtab, rtab, J, R, p, signs, q_prev, inside, outside, q):
+    """Bisect towards the edge of the model's reach; returns a reachable point next to it."""
+    for _ in range(52):
+        mid = 0.5 * (inside + outside)
+        if np.isnan(_g(family, P, mtab, rtab, J, R, p, signs, q_prev, mid, q)):
+            outside = mid
+        else:
+            inside = mid
+    return inside
+
+
+@nb.njit(cache=True)
+def verify(family, P, rtab, R, p, signs, q, tol_pos, tol_ori):
+    """Position and orientation error of the REAL arm at q and the branch check.
+
+    Returns (position error, orientation error, accepted).
+    """
+    Rr, pr = np.empty((3, 3)), np.empty(3)
+    flange_kernel(rtab, q, Rr, pr)
+    d = pr - p
+    pos = np.sqrt(d @ d)
+    E = R.T @ Rr
+    s = 0.5 * np.sqrt((E[2, 1] - E[1, 2]) ** 2 + (E[0, 2] - E[2, 0]) ** 2 + (E[1, 0] - E[0, 1]) ** 2)
+    ori = np.arctan2(s, 0.5 * (E[0, 0] + E[1, 1] + E[2, 2] - 1.0))
+    values = np.empty(signs.shape[0])
+    branch_values(family, P, q, values)
+    same = True
+    for i in range(signs.shape[0]):
+        # A branch quantity at zero (a singular joint) belongs to both branches.
+        if values[i] * signs[i] < -1e-12:
+            same = False
+    return pos, ori, same and pos <= tol_pos and ori <= tol_ori
+
+
+@nb.njit(cache=True)
+def _extremum(family, P, mtab, rtab, J, R, p, signs, q_prev, a, b, sign, of_margin, q):
+    """Golden-section search for the maximum of sign * g (or of the reach margin) on [a, b].
+
+    Unreachable points count as -inf for g. Returns (argmax, g there, margin there).
+    """
+    inv_phi = 0.6180339887498949
+    c = b - inv_phi * (b - a)
+    d = a + inv_phi * (b - a)
+    gc, mc = _g_margin(family, P, mtab, rtab, J, R, p, signs, q_prev, c, q)
+    gd, md = _g_margin(family, P, mtab, rtab, J, R, p, signs, q_prev, d, q)
+    for _ in range(45):
+        fc = mc if of_margin else (-np.inf if np.isnan(gc) else sign * gc)
+        fd = md if of_margin else (-np.inf if np.isnan(gd) else sign * gd)
+        if fc > fd:
+            b, d, gd, md = d, c, gc, mc
+            c = b - inv_phi * (b - a)
+            gc, mc = _g_margin(family, P, mtab, rtab, J, R, p, signs, q_prev, c, q)
+        else:
+            a, c, gc, mc = c, d, gd, md
+            d = a + inv_phi * (b - a)
+            gd, md = _g_margin(family, P, mtab, rtab, J, R, p, signs, q_prev, d, q)
+    return c, gc, mc
+
+
+@nb.njit(cache=True)
+def _brackets(family, P, mtab, rtab, J, R, p, signs, q_prev, a, ga, b, gb, search, q, out, n):
+    """Add the roots of g on [a, b] (both ends reachable) to out[n:]; returns the new count.
+
+    A sign change is one root. With ``search``, an interval without one is searched for an
+    extremum of g that crosses zero, which gives two roots (a close pair).
+    """
+    if ga == 0.0:
+        out[n] = a
+        return n + 1
+    if abs(ga - gb) > np.pi:  # g wraps between a and b
+        return n
+    if ga * gb < 0.0:
+        out[n] = _refine_bracket(family, P, mtab, rtab, J, R, p, signs, q_prev, a, ga, b, gb, q)
+        return n + 1
+    if not search:
+        return n
+    w, g, _ = _extremum(family, P, mtab, rtab, J, R, p, signs, q_prev, a, b, -np.sign(ga), False, q)
+    if np.isnan(g) or g * ga > 0.0:
+        return n
+    if g == 0.0:
+        out[n] = w
+        return n + 1
+    out[n] = _refine_bracket(family, P, mtab, rtab, J, R, p, signs, q_prev, a, ga, w, g, q)
+    out[n + 1] = _refine_bracket(family, P, mtab, rtab, J, R, p, signs, q_prev, w, g, b, gb, q)
+    return n + 2
+
+
+@nb.njit(cache=True)
+def _run_roots(family, P, mtab, rtab, J, R, p, signs, q_prev, pw, pg, L, cyclic, q, out, n):
+    """Add the roots on a run of reachable points (w ascending) to out[n:]; returns the count.
+
+    Consecutive points with a sign change bracket a root. At each local minimum of |g| with
+    no sign change on either side, an extremum search between its neighbours looks for a
+    close pair of roots. A cyclic run covers the whole circle.
+    """
+    for i in range(L - 1 + cyclic):
+        j = (i + 1) % L
+        wj = pw[j] + (2.0 * np.pi if j == 0 else 0.0)
+        n = _brackets(family, P, mtab, rtab, J, R, p, signs, q_prev, pw[i], pg[i], wj, pg[j], False, q, out, n)
+    for i in range(L):
+        has_prev, has_next = i > 0 or cyclic, i < L - 1 or cyclic
+        gi = pg[i]
+        lo, glo, hi, ghi = pw[i], gi, pw[i], gi
+        if has_prev:
+            lo, glo = pw[(i - 1) % L] - (2.0 * np.pi if i == 0 else 0.0), pg[(i - 1) % L]
+        if has_next:
+            hi, ghi = pw[(i + 1) % L] + (2.0 * np.pi if i == L - 1 else 0.0), pg[(i + 1) % L]
+        if abs(gi) > _PAIR_SEARCH or abs(glo) < abs(gi) or abs(ghi) < abs(gi) or lo == hi:
+            continue
+        if glo * gi <= 0.0 or ghi * gi <= 0.0:  # bracketed already
+            continue
+        n = _brackets(family, P, mtab, rtab, J, R, p, signs, q_prev, lo, glo, hi, ghi, True, q, out, n)
+    return n
+
+
+@nb.njit(cache=True)
+def all_roots(family, P, mtab, rtab, J, R, p, signs, q_prev, n_scan, tol_pos, tol_ori, roots):
+    """Bounded search: every verified solution in this configuration. Returns the count.
+
+    g and the model's reach margin are sampled at ``n_scan`` points of the circle. Each run
+    of reachable samples, extended to the edges of reach (found by bisection), is searched
+    by :func:`_run_roots`. Between unreachable samples, each local maximum of the margin is
+    searched for a small island of reach, which is then searched the same way.
+    """
+    dof = q_prev.shape[0]
+    q = np.empty(dof)
+    if J < 0:
+        g = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, 0.0, q)
+        if not np.isnan(g) and verify(family, P, rtab, R, p, signs, q, tol_pos, tol_ori)[2]:
+            roots[0] = q
+            return 1
+        return 0
+    h = 2.0 * np.pi / n_scan
+    ws = np.empty(n_scan)
+    gs = np.empty(n_scan)
+    ms = np.empty(n_scan)
+    start = -1
+    for k in range(n_scan):
+        ws[k] = -np.pi + h * k
+        gs[k], ms[k] = _g_margin(family, P, mtab, rtab, J, R, p, signs, q_prev, ws[k], q)
+        if start < 0 and np.isnan(gs[k]):
+            start = k
+    cands = np.empty(8 * n_scan)
+    n = 0
+    pw = np.empty(n_scan + 2)
+    pg = np.empty(n_scan + 2)
+    if start < 0:  # reachable everywhere: one cyclic run
+        n = _run_roots(family, P, mtab, rtab, J, R, p, signs, q_prev, ws, gs, n_scan, True, q, cands, n)
+    else:
+        L = 0
+        for i in range(1, n_scan + 1):
+            k = (start + i) % n_scan
+            w = ws[start] + h * i  # unwrapped, ascending
+            if not np.isnan(gs[k]):
+                if L == 0:
+                    pw[0] = _reach_edge(family, P, mtab, rtab, J, R, p, signs, q_prev, w, w - h, q)
+                    pg[0] = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, pw[0], q)
+                    L = 1
+                pw[L], pg[L] = w, gs[k]
+                L += 1
+                continue
+            if L > 0:
+                pw[L] = _reach_edge(family, P, mtab, rtab, J, R, p, signs, q_prev, pw[L - 1], w, q)
+                pg[L] = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, pw[L], q)
+                n = _run_roots(family, P, mtab, rtab, J, R, p, signs, q_prev, pw, pg, L + 1, False, q, cands, n)
+                L = 0
+            k0, k2 = (k - 1) % n_scan, (k + 1) % n_scan
+            if np.isnan(gs[k0]) and np.isnan(gs[k2]) and ms[k] >= ms[k0] and ms[k] >= ms[k2]:
+                c, gc, _ = _extremum(family, P, mtab, rtab, J, R, p, signs, q_prev, w - h, w + h, 1.0, True, q)
+                if not np.isnan(gc):  # an island of reach around c
+                    pw[0] = _reach_edge(family, P, mtab, rtab, J, R, p, signs, q_prev, c, w - h, q)
+                    pw[1], pg[1] = c, gc
+                    pw[2] = _reach_edge(family, P, mtab, rtab, J, R, p, signs, q_prev, c, w + h, q)
+                    pg[0] = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, pw[0], q)
+                    pg[2] = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, pw[2], q)
+                    n = _run_roots(family, P, mtab, rtab, J, R, p, signs, q_prev, pw, pg, 3, False, q, cands, n)
+    count = 0
+    for i in range(n):
+        g = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, cands[i], q)
+        if not np.isnan(g) and abs(g) > _ROOT_TOL:  # polish the bracket's estimate
+            _broyden(family, P, mtab, rtab, J, R, p, signs, q_prev, cands[i], q)
+        if not verify(family, P, rtab, R, p, signs, q, tol_pos, tol_ori)[2]:
+            continue
+        duplicate = False
+        for r in range(count):
+            diff = 0.0
+            for j in range(dof):
+                diff = max(diff, abs(_wrap(q[j] - roots[r, j])))
+            if diff < _SAME_ROOT:
+                duplicate = True
+        if not duplicate and count < roots.shape[0]:
+            roots[count] = q
+            count += 1
+    return count
+
+
+@nb.njit(cache=True)
+def representative(q, revolute, lower, upper, hint, has_hint):
+    """Shift revolute joints by multiples of 2 pi into the limits, nearest to the hint.
+
+    Without a hint the shift nearest to zero is taken. Returns whether q is within limits.
+    """
+    inside = True
+    for j in range(q.shape[0]):
+        if not revolute[j]:
+            inside = inside and lower[j] <= q[j] <= upper[j]
+            continue
+        target = hint[j] if has_hint else 0.0
+        best = _wrap(q[j] - target) + target
+        found = lower[j] <= best <= upper[j]
+        if not found:
+            base = _wrap(q[j])
+            best_dist = np.inf
+            for k in range(-3, 4):
+                cand = base + 2.0 * np.pi * k
+                if lower[j] <= cand <= upper[j] and abs(cand - target) < best_dist:
+                    best, best_dist, found = cand, abs(cand - target), True
+        q[j] = best
+        inside = inside and found
+    return inside
+
+
+@nb.njit(cache=True)
+def _exists_other(family, P, mtab, rtab, J, R, p, signs, q_prev, n_scan, tol_pos, tol_ori):
+    """Whether any configuration other than ``signs`` has a solution."""
+    k = signs.shape[0]
+    other = np.empty(k, dtype=np.int64)
+    roots = np.empty((MAX_ROOTS, q_prev.shape[0]))
+    for code in range(2**k):
+        same = True
+        for i in range(k):
+            other[i] = 1 if (code >> i) & 1 else -1
+            same = same and other[i] == signs[i]
+        if same:
+            continue
+        if all_roots(family, P, mtab, rtab, J, R, p, other, q_prev, n_scan, tol_pos, tol_ori, roots):
+            return True
+    return False
+
+
+@nb.njit(cache=True)
+def solve_one(
+    family, P, mtab, rtab, J, R, p, signs, hint, has_hint,
+    revolute, lower, upper, n_scan, tol_pos, tol_ori, q_out,
+):
+    """One OM solve: local Broyden, then the bounded search. Returns (status, pos, ori, evals)."""
+    dof = q_out.shape[0]
+    q_prev = hint if has_hint else np.zeros(dof)
+    q = np.empty(dof)
+    evals = 0
+    if has_hint:
+        w0 = hint[J] if J >= 0 else 0.0
+    else:  # the paper's fixed-point start, p_m = p_d
+        reach = model_ik(family, P, mtab, R, p, signs, q_prev, q) >= -REACH_SLACK
+        w0 = q[J] if (reach and J >= 0) else np.nan
+    if not np.isnan(w0):
+        _, evals = _broyden(family, P, mtab, rtab, J, R, p, signs, q_prev, w0, q)
+        if verify(family, P, rtab, R, p, signs, q, tol_pos, tol_ori)[2]:
+            q_out[:] = q
+            representative(q_out, revolute, lower, upper, hint, has_hint)
+            pos, ori, _ = verify(family, P, rtab, R, p, signs, q_out, tol_pos, tol_ori)
+            return OK, pos, ori, evals
+    roots = np.empty((MAX_ROOTS, dof))
+    n = all_roots(family, P, mtab, rtab, J, R, p, signs, q_prev, n_scan, tol_pos, tol_ori, roots)
+    evals += 2 * n_scan
+    if n == 0:
+        q_out[:] = np.nan
+        if _exists_other(family, P, mtab, rtab, J, R, p, signs, q_prev, n_scan, tol_pos, tol_ori):
+            return NO_SOLUTION_IN_CONFIGURATION, np.nan, np.nan, evals
+        return UNREACHABLE, np.nan, np.nan, evals
+    # The root nearest the hint; without one, nearest the fixed-point start's joint J.
+    best, best_dist = 0, np.inf
+    for r in range(n):
+        dist = 0.0
+        if has_hint:
+            for j in range(dof):
+                dist += _wrap(roots[r, j] - hint[j]) ** 2
+        elif J >= 0 and not np.isnan(w0):
+            dist = abs(_wrap(roots[r, J] - w0))
+        if dist < best_dist:
+            best, best_dist = r, dist
+    q_out[:] = roots[best]
+    representative(q_out, revolute, lower, upper, hint, has_hint)
+    pos, ori, _ = verify(family, P, rtab, R, p, signs, q_out, tol_pos, tol_ori)
+    return OK, pos, ori, evals
+
+
+@nb.njit(cache=True, parallel=True)
+def solve_batch_kernel(
+    family, P, mtab, rtab, J, Rs, ps, signs, hints, has_hint,
+    revolute, lower, upper, n_scan, tol_pos, tol_ori, q_out, status, pos, ori, evals,
+):
+    for m in nb.prange(Rs.shape[0]):
+        st, e_pos, e_ori, ev = solve_one(
+            family, P, mtab, rtab, J, Rs[m], ps[m], signs[m], hints[m], has_hint,
+            revolute, lower, upper, n_scan, tol_pos, tol_ori, q_out[m],
+        )
+        status[m], pos[m], ori[m], evals[m] = st, e_pos, e_ori, ev

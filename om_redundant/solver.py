@@ -1,0 +1,270 @@
+"""The OM solver: exact inverse kinematics of a real arm in a chosen configuration."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from . import om_system
+from .arm import Arm, load_arm
+from .configuration import Configuration
+from .exceptions import InvalidInput
+from .model import ModelArm, derive_model
+from .validation import as_joint_vector, as_pose, as_poses, as_signs
+
+DEFAULT_POSITION_TOLERANCE = 1e-10
+DEFAULT_ORIENTATION_TOLERANCE = 1e-9
+DEFAULT_SCAN_POINTS = 64
+
+
+@dataclass(frozen=True, eq=False)
+class Solution:
+    """The outcome of one solve.
+
+    Attributes:
+        q: Joint vector of the REAL arm (NaN when no solution). Revolute joints are
+            shifted by multiples of 2 pi into the limits, nearest to the hint.
+        ok: True only if the real arm reaches the pose within tolerance in the requested
+            configuration.
+        status: ``"ok"``, ``"unreachable"`` (no configuration reaches the pose) or
+            ``"no solution in this configuration"``.
+        configuration: The configuration asked for.
+        position_error: |p_real(q) - p_d| in metres.
+        orientation_error: Angle of R_d^T R_real(q) in radians.
+        iterations: Residual evaluations spent.
+        within_limits: Whether q is within the joint limits.
+    """
+
+    q: np.ndarray
+    ok: bool
+    status: str
+    configuration: Configuration
+    position_error: float
+    orientation_error: float
+    iterations: int
+    within_limits: bool
+
+
+@dataclass(frozen=True, eq=False)
+class BatchSolution:
+    """Outcomes of :meth:`OMSolver.solve_batch`, one row per target.
+
+    Attributes:
+        q: (M, dof) joint vectors (NaN rows where no solution).
+        ok: (M,) bool.
+        status_code: (M,) int; :attr:`status` gives the names.
+        position_error: (M,) metres.
+        orientation_error: (M,) radians.
+        iterations: (M,) residual evaluations.
+        within_limits: (M,) bool.
+    """
+
+    q: np.ndarray
+    ok: np.ndarray
+    status_code: np.ndarray
+    position_error: np.ndarray
+    orientation_error: np.ndarray
+    iterations: np.ndarray
+    within_limits: np.ndarray
+
+    @property
+    def status(self) -> list[str]:
+        return [om_system.STATUS_NAMES[c] for c in self.status_code]
+
+
+class OMSolver:
+    """Exact IK of a real arm by the offset modification method.
+
+    Args:
+        arm: An :class:`Arm` or the name of a built-in arm.
+        position_tolerance: Largest accepted position error (m).
+        orientation_tolerance: Largest accepted orientation error (rad).
+        scan_points: Grid points of the bounded search over the dp circle.
+
+    Example::
+
+        solver = om.OMSolver("ur5e")
+        sol = solver.solve(T_base_target, om.Configuration((1, -1, 1)))
+        if sol.ok:
+            print(sol.q)
+    """
+
+    def __init__(
+        self,
+        arm: Arm | str,
+        *,
+        position_tolerance: float = DEFAULT_POSITION_TOLERANCE,
+        orientation_tolerance: float = DEFAULT_ORIENTATION_TOLERANCE,
+        scan_points: int = DEFAULT_SCAN_POINTS,
+    ):
+        self.arm = load_arm(arm) if isinstance(arm, str) else arm
+        for name, value in (("position_tolerance", position_tolerance), ("orientation_tolerance", orientation_tolerance)):
+            if not np.isfinite(value) or value <= 0.0:
+                raise InvalidInput(f"{name} must be a positive number, got {value}")
+        if int(scan_points) < 8:
+            raise InvalidInput(f"scan_points must be at least 8, got {scan_points}")
+        self.tolerances = (float(position_tolerance), float(orientation_tolerance))
+        self.scan_points = int(scan_points)
+        self.om: ModelArm = derive_model(self.arm)
+        chain = self.arm.chain
+        self._base_inv = np.linalg.inv(chain.T_root_base)
+        self._tool_inv = np.linalg.inv(chain.T_flange_tool)
+        self._static = (
+            self.om.family,
+            self.om.params,
+            self.om.model.chain.table,
+            chain.table,
+            self.om.dp_joint,
+        )
+        self._limits = (self.arm.revolute, self.arm.lower, self.arm.upper)
+
+    @property
+    def model(self) -> Arm:
+        """The offset-modified model arm."""
+        return self.om.model
+
+    @property
+    def dp_max(self) -> float:
+        """Radius of the ball that holds every solution p_m of system (9), in metres."""
+        return self.om.dp_max
+
+    @property
+    def sign_names(self) -> tuple[str, ...]:
+        return self.om.sign_names
+
+    def configurations(self) -> list[Configuration]:
+        """Every branch-sign combination this arm's model distinguishes."""
+        return Configuration.all_signs(len(self.sign_names))
+
+    def configuration_of(self, q: np.ndarray) -> Configuration:
+        """The configuration of joint vector q: the model's branch signs at q.
+
+        A branch quantity that is exactly zero (a singular joint) counts as +1.
+        """
+        q = as_joint_vector(q, self.arm.dof)
+        if q.ndim != 1:
+            raise InvalidInput("configuration_of takes one joint vector")
+        values = np.empty(len(self.sign_names))
+        om_system.branch_values(self.om.family, self.om.params, q, values)
+        return Configuration(tuple(np.where(values < 0.0, -1, 1)))
+
+    def solve(self, T: Any, configuration: Configuration, q_hint: np.ndarray | None = None) -> Solution:
+        """Joint vector reaching pose T in the given configuration.
+
+        Args:
+            T: Target pose of the end-effector frame in the root frame: 4x4 or ``mink.SE3``.
+            configuration: Branch signs (and redundancy values for redundant arms).
+            q_hint: Optional joint vector; among several solutions the nearest is returned,
+                and 2 pi shifts are chosen nearest to it.
+
+        Returns:
+            A :class:`Solution`; ``ok`` is False (with a status saying why) when no solution
+            exists in this configuration.
+        """
+        R, p = self._chain_target(as_pose(T))
+        signs = self._signs(configuration)
+        hint, has_hint = self._hint(q_hint)
+        q = np.empty(self.arm.dof)
+        status, pos, ori, evals = om_system.solve_one(
+            *self._static, R, p, signs, hint, has_hint, *self._limits,
+            self.scan_points, *self.tolerances, q,
+        )
+        return self._solution(q, status, configuration, pos, ori, evals)
+
+    def solve_all(self, T: Any, configuration: Configuration) -> list[Solution]:
+        """Every real solution with this configuration (the bounded search), possibly none."""
+        R, p = self._chain_target(as_pose(T))
+        signs = self._signs(configuration)
+        roots = np.empty((om_system.MAX_ROOTS, self.arm.dof))
+        zeros = np.zeros(self.arm.dof)
+        n = om_system.all_roots(*self._static, R, p, signs, zeros, self.scan_points, *self.tolerances, roots)
+        solutions = []
+        for q in roots[:n]:
+            om_system.representative(q, *self._limits, zeros, False)
+            pos, ori, _ = om_system.verify(self.om.family, self.om.params, self.arm.chain.table, R, p, signs, q, *self.tolerances)
+            solutions.append(self._solution(q, om_system.OK, configuration, pos, ori, 2 * self.scan_points))
+        return solutions
+
+    def solve_batch(
+        self,
+        T: Any,
+        signs: Any,
+        redundancy: Any = None,
+        q_hint: Any = None,
+    ) -> BatchSolution:
+        """Solve many targets at once, in parallel.
+
+        Args:
+            T: (M, 4, 4) target poses.
+            signs: (M, k) branch signs, or (k,) for the same configuration everywhere.
+            redundancy: Redundancy values (M, r); must be None or empty for 6-DOF arms.
+            q_hint: Optional (M, dof) hints.
+        """
+        T = as_poses(T)
+        m = len(T)
+        k = len(self.sign_names)
+        signs = np.ascontiguousarray(np.broadcast_to(as_signs(signs, k), (m, k)))
+        if redundancy is not None and np.size(redundancy) > 0:
+            raise InvalidInput(f"arm '{self.arm.name}' takes no redundancy values")
+        TT = self._base_inv @ T @ self._tool_inv
+        Rs, ps = np.ascontiguousarray(TT[:, :3, :3]), np.ascontiguousarray(TT[:, :3, 3])
+        if q_hint is None:
+            hints, has_hint = np.zeros((m, self.arm.dof)), False
+        else:
+            hints = as_joint_vector(q_hint, self.arm.dof, "q_hint").reshape(-1, self.arm.dof)
+            if len(hints) != m:
+                raise InvalidInput(f"q_hint must have {m} rows, got {len(hints)}")
+            hints, has_hint = np.ascontiguousarray(hints), True
+        q = np.empty((m, self.arm.dof))
+        status = np.empty(m, dtype=np.int64)
+        pos, ori, evals = np.empty(m), np.empty(m), np.empty(m, dtype=np.int64)
+        om_system.solve_batch_kernel(
+            *self._static, Rs, ps, signs, hints, has_hint, *self._limits,
+            self.scan_points, *self.tolerances, q, status, pos, ori, evals,
+        )
+        ok = status == om_system.OK
+        within = np.zeros(m, dtype=bool)
+        within[ok] = self.arm.within_limits(q[ok]) if ok.any() else []
+        return BatchSolution(q, ok, status, pos, ori, evals, within)
+
+    # -----------------------------------------------------------------------------------
+
+    def _chain_target(self, T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        TT = self._base_inv @ T @ self._tool_inv
+        return np.ascontiguousarray(TT[:3, :3]), np.ascontiguousarray(TT[:3, 3])
+
+    def _signs(self, configuration: Configuration) -> np.ndarray:
+        if not isinstance(configuration, Configuration):
+            raise InvalidInput(f"configuration must be a Configuration, got {type(configuration).__name__}")
+        k = len(self.sign_names)
+        if len(configuration.signs) != k:
+            raise InvalidInput(
+                f"arm '{self.arm.name}' needs {k} configuration signs {self.sign_names}, "
+                f"got {len(configuration.signs)}"
+            )
+        if configuration.redundancy:
+            raise InvalidInput(f"arm '{self.arm.name}' takes no redundancy values, got {configuration.redundancy}")
+        return np.array(configuration.signs, dtype=np.int64)
+
+    def _hint(self, q_hint: np.ndarray | None) -> tuple[np.ndarray, bool]:
+        if q_hint is None:
+            return np.zeros(self.arm.dof), False
+        hint = as_joint_vector(q_hint, self.arm.dof, "q_hint")
+        if hint.ndim != 1:
+            raise InvalidInput("q_hint must be one joint vector")
+        return hint, True
+
+    def _solution(self, q, status, configuration, pos, ori, evals) -> Solution:
+        ok = status == om_system.OK
+        return Solution(
+            q=q,
+            ok=ok,
+            status=om_system.STATUS_NAMES[status],
+            configuration=configuration,
+            position_error=float(pos),
+            orientation_error=float(ori),
+            iterations=int(evals),
+            within_limits=bool(ok and self.arm.within_limits(q)),
+        )
