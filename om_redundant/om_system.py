@@ -376,11 +376,22 @@ def _exists_other(family, P, mtab, rtab, J, R, p, signs, q_prev, n_scan, tol_pos
 
 
 @nb.njit(cache=True)
+def flange_target(T, base_inv, tool_inv):
+    """The flange pose in DH frame 0 for an end-effector pose T in the root frame."""
+    F = base_inv @ T @ tool_inv
+    return np.ascontiguousarray(F[:3, :3]), np.ascontiguousarray(F[:3, 3])
+
+
+@nb.njit(cache=True)
 def solve_one(
-    family, P, mtab, rtab, J, R, p, signs, hint, has_hint,
+    family, P, mtab, rtab, J, base_inv, tool_inv, T, signs, hint, has_hint,
     revolute, lower, upper, n_scan, tol_pos, tol_ori, q_out,
 ):
-    """One OM solve: local Broyden, then the bounded search. Returns (status, pos, ori, evals)."""
+    """One OM solve: local Broyden, then the bounded search.
+
+    Returns (status, position error, orientation error, evaluations, within limits).
+    """
+    R, p = flange_target(T, base_inv, tool_inv)
     dof = q_out.shape[0]
     q_prev = hint if has_hint else np.zeros(dof)
     q = np.empty(dof)
@@ -394,17 +405,17 @@ def solve_one(
         _, evals = _broyden(family, P, mtab, rtab, J, R, p, signs, q_prev, w0, q)
         if verify(family, P, rtab, R, p, signs, q, tol_pos, tol_ori)[2]:
             q_out[:] = q
-            representative(q_out, revolute, lower, upper, hint, has_hint)
+            inside = representative(q_out, revolute, lower, upper, hint, has_hint)
             pos, ori, _ = verify(family, P, rtab, R, p, signs, q_out, tol_pos, tol_ori)
-            return OK, pos, ori, evals
+            return OK, pos, ori, evals, inside
     roots = np.empty((MAX_ROOTS, dof))
     n = all_roots(family, P, mtab, rtab, J, R, p, signs, q_prev, n_scan, tol_pos, tol_ori, roots)
     evals += 2 * n_scan
     if n == 0:
         q_out[:] = np.nan
         if _exists_other(family, P, mtab, rtab, J, R, p, signs, q_prev, n_scan, tol_pos, tol_ori):
-            return NO_SOLUTION_IN_CONFIGURATION, np.nan, np.nan, evals
-        return UNREACHABLE, np.nan, np.nan, evals
+            return NO_SOLUTION_IN_CONFIGURATION, np.nan, np.nan, evals, False
+        return UNREACHABLE, np.nan, np.nan, evals, False
     # The root nearest the hint; without one, nearest the fixed-point start's joint J.
     best, best_dist = 0, np.inf
     for r in range(n):
@@ -417,19 +428,19 @@ def solve_one(
         if dist < best_dist:
             best, best_dist = r, dist
     q_out[:] = roots[best]
-    representative(q_out, revolute, lower, upper, hint, has_hint)
+    inside = representative(q_out, revolute, lower, upper, hint, has_hint)
     pos, ori, _ = verify(family, P, rtab, R, p, signs, q_out, tol_pos, tol_ori)
-    return OK, pos, ori, evals
+    return OK, pos, ori, evals, inside
 
 
 @nb.njit(cache=True, parallel=True)
 def solve_batch_kernel(
-    family, P, mtab, rtab, J, Rs, ps, signs, hints, has_hint,
-    revolute, lower, upper, n_scan, tol_pos, tol_ori, q_out, status, pos, ori, evals,
+    family, P, mtab, rtab, J, base_inv, tool_inv, Ts, signs, hints, has_hint,
+    revolute, lower, upper, n_scan, tol_pos, tol_ori, q_out, status, pos, ori, evals, within,
 ):
-    for m in nb.prange(Rs.shape[0]):
-        st, e_pos, e_ori, ev = solve_one(
-            family, P, mtab, rtab, J, Rs[m], ps[m], signs[m], hints[m], has_hint,
+    for m in nb.prange(Ts.shape[0]):
+        st, e_pos, e_ori, ev, inside = solve_one(
+            family, P, mtab, rtab, J, base_inv, tool_inv, Ts[m], signs[m], hints[m], has_hint,
             revolute, lower, upper, n_scan, tol_pos, tol_ori, q_out[m],
         )
-        status[m], pos[m], ori[m], evals[m] = st, e_pos, e_ori, ev
+        status[m], pos[m], ori[m], evals[m], within[m] = st, e_pos, e_ori, ev, inside

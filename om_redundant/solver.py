@@ -109,14 +109,14 @@ class OMSolver:
         self.scan_points = int(scan_points)
         self.om: ModelArm = derive_model(self.arm)
         chain = self.arm.chain
-        self._base_inv = np.linalg.inv(chain.T_root_base)
-        self._tool_inv = np.linalg.inv(chain.T_flange_tool)
         self._static = (
             self.om.family,
             self.om.params,
             self.om.model.chain.table,
             chain.table,
             self.om.dp_joint,
+            np.linalg.inv(chain.T_root_base),
+            np.linalg.inv(chain.T_flange_tool),
         )
         self._limits = (self.arm.revolute, self.arm.lower, self.arm.upper)
 
@@ -163,28 +163,30 @@ class OMSolver:
             A :class:`Solution`; ``ok`` is False (with a status saying why) when no solution
             exists in this configuration.
         """
-        R, p = self._chain_target(as_pose(T))
+        T = as_pose(T)
         signs = self._signs(configuration)
         hint, has_hint = self._hint(q_hint)
         q = np.empty(self.arm.dof)
-        status, pos, ori, evals = om_system.solve_one(
-            *self._static, R, p, signs, hint, has_hint, *self._limits,
+        status, pos, ori, evals, within = om_system.solve_one(
+            *self._static, T, signs, hint, has_hint, *self._limits,
             self.scan_points, *self.tolerances, q,
         )
-        return self._solution(q, status, configuration, pos, ori, evals)
+        return Solution(q, status == om_system.OK, om_system.STATUS_NAMES[status], configuration, pos, ori, evals, within)
 
     def solve_all(self, T: Any, configuration: Configuration) -> list[Solution]:
         """Every real solution with this configuration (the bounded search), possibly none."""
-        R, p = self._chain_target(as_pose(T))
+        R, p = om_system.flange_target(as_pose(T), *self._static[5:])
         signs = self._signs(configuration)
         roots = np.empty((om_system.MAX_ROOTS, self.arm.dof))
         zeros = np.zeros(self.arm.dof)
-        n = om_system.all_roots(*self._static, R, p, signs, zeros, self.scan_points, *self.tolerances, roots)
+        n = om_system.all_roots(*self._static[:5], R, p, signs, zeros, self.scan_points, *self.tolerances, roots)
         solutions = []
         for q in roots[:n]:
-            om_system.representative(q, *self._limits, zeros, False)
-            pos, ori, _ = om_system.verify(self.om.family, self.om.params, self.arm.chain.table, R, p, signs, q, *self.tolerances)
-            solutions.append(self._solution(q, om_system.OK, configuration, pos, ori, 2 * self.scan_points))
+            within = om_system.representative(q, *self._limits, zeros, False)
+            pos, ori, _ = om_system.verify(
+                self.om.family, self.om.params, self.arm.chain.table, R, p, signs, q, *self.tolerances
+            )
+            solutions.append(Solution(q, True, "ok", configuration, pos, ori, self.scan_points, within))
         return solutions
 
     def solve_batch(
@@ -208,8 +210,6 @@ class OMSolver:
         signs = np.ascontiguousarray(np.broadcast_to(as_signs(signs, k), (m, k)))
         if redundancy is not None and np.size(redundancy) > 0:
             raise InvalidInput(f"arm '{self.arm.name}' takes no redundancy values")
-        TT = self._base_inv @ T @ self._tool_inv
-        Rs, ps = np.ascontiguousarray(TT[:, :3, :3]), np.ascontiguousarray(TT[:, :3, 3])
         if q_hint is None:
             hints, has_hint = np.zeros((m, self.arm.dof)), False
         else:
@@ -220,20 +220,14 @@ class OMSolver:
         q = np.empty((m, self.arm.dof))
         status = np.empty(m, dtype=np.int64)
         pos, ori, evals = np.empty(m), np.empty(m), np.empty(m, dtype=np.int64)
+        within = np.empty(m, dtype=np.bool_)
         om_system.solve_batch_kernel(
-            *self._static, Rs, ps, signs, hints, has_hint, *self._limits,
-            self.scan_points, *self.tolerances, q, status, pos, ori, evals,
+            *self._static, T, signs, hints, has_hint, *self._limits,
+            self.scan_points, *self.tolerances, q, status, pos, ori, evals, within,
         )
-        ok = status == om_system.OK
-        within = np.zeros(m, dtype=bool)
-        within[ok] = self.arm.within_limits(q[ok]) if ok.any() else []
-        return BatchSolution(q, ok, status, pos, ori, evals, within)
+        return BatchSolution(q, status == om_system.OK, status, pos, ori, evals, within)
 
     # -----------------------------------------------------------------------------------
-
-    def _chain_target(self, T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        TT = self._base_inv @ T @ self._tool_inv
-        return np.ascontiguousarray(TT[:3, :3]), np.ascontiguousarray(TT[:3, 3])
 
     def _signs(self, configuration: Configuration) -> np.ndarray:
         if not isinstance(configuration, Configuration):
@@ -255,16 +249,3 @@ class OMSolver:
         if hint.ndim != 1:
             raise InvalidInput("q_hint must be one joint vector")
         return hint, True
-
-    def _solution(self, q, status, configuration, pos, ori, evals) -> Solution:
-        ok = status == om_system.OK
-        return Solution(
-            q=q,
-            ok=ok,
-            status=om_system.STATUS_NAMES[status],
-            configuration=configuration,
-            position_error=float(pos),
-            orientation_error=float(ori),
-            iterations=int(evals),
-            within_limits=bool(ok and self.arm.within_limits(q)),
-        )

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from typing import Any
 
+import numba as nb
 import numpy as np
 
 from .exceptions import InvalidInput
@@ -24,8 +25,31 @@ def as_pose(T: Any, name: str = "T") -> np.ndarray:
     T = np.asarray(T, dtype=np.float64)
     if T.shape != (4, 4):
         raise InvalidInput(f"{name} must be a (4, 4) homogeneous transform, got shape {T.shape}")
+    if _pose_is_valid(T):  # fast path; the full check below names the problem
+        return T
     _check_poses(T[None], name)
-    return T
+    raise AssertionError("unreachable: _pose_is_valid and _check_poses disagree")
+
+
+@nb.njit(cache=True)
+def _pose_is_valid(T):
+    for i in range(4):
+        for j in range(4):
+            if not np.isfinite(T[i, j]):
+                return False
+    if T[3, 0] != 0.0 or T[3, 1] != 0.0 or T[3, 2] != 0.0 or T[3, 3] != 1.0:
+        return False
+    for i in range(3):
+        for j in range(3):
+            dot = T[0, i] * T[0, j] + T[1, i] * T[1, j] + T[2, i] * T[2, j]
+            if abs(dot - (1.0 if i == j else 0.0)) > ORTHONORMALITY_TOLERANCE:
+                return False
+    det = (
+        T[0, 0] * (T[1, 1] * T[2, 2] - T[1, 2] * T[2, 1])
+        - T[0, 1] * (T[1, 0] * T[2, 2] - T[1, 2] * T[2, 0])
+        + T[0, 2] * (T[1, 0] * T[2, 1] - T[1, 1] * T[2, 0])
+    )
+    return det > 0.0
 
 
 def as_poses(T: Any, name: str = "T") -> np.ndarray:

@@ -1,0 +1,112 @@
+"""Arm files: loading, the built-in arms, and errors that name file, field and problem."""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import pytest
+
+import om_redundant as om
+from tests.conftest import load_reference_model, random_q
+
+UR5E_ROWS = """
+[[rows]]
+joint = "j1"
+type = "revolute"
+d = 0.1
+alpha_deg = 90
+"""
+
+
+def write(tmp_path, text):
+    path = tmp_path / "arm.toml"
+    path.write_text(text)
+    return path
+
+
+def test_builtin_arms_are_listed_and_load():
+    names = om.arm_names()
+    assert names[:2] == ["spherical", "ur5e"]
+    for name in names:
+        arm = om.load_arm(name)
+        assert arm.name == name and len(arm.joint_names) == arm.dof
+
+
+def test_load_by_path_equals_load_by_name(tmp_path):
+    by_name = om.load_arm("ur5e")
+    by_path = om.load_arm(by_name.source)
+    q = np.linspace(-1, 1, 6)
+    np.testing.assert_array_equal(by_name.fk(q), by_path.fk(q))
+
+
+def test_unknown_arm_names_the_arm_and_the_choices():
+    with pytest.raises(om.UnknownArm, match=r"unknown arm 'ur10'.*ur5e"):
+        om.load_arm("ur10")
+
+
+@pytest.mark.parametrize(
+    "text, field, problem",
+    [
+        ('name = "x"\nconvention = "standard"\n', "rows", "non-empty array"),
+        ('name = "x"\nconvention = "dh"\n' + UR5E_ROWS, "convention", "'standard' or 'modified'"),
+        ('convention = "standard"\n' + UR5E_ROWS, "name", "missing"),
+        ('name = "x"\nconvention = "standard"\n' + UR5E_ROWS.replace("d = 0.1", 'd = "0.1"'), "rows[0].d", "finite number"),
+        ('name = "x"\nconvention = "standard"\n' + UR5E_ROWS.replace("d = 0.1", "dd = 0.1"), "rows[0].dd", "unknown field"),
+        ('name = "x"\nconvention = "standard"\n' + UR5E_ROWS.replace('"revolute"', '"helical"'), "rows[0].type", "revolute, prismatic or fixed"),
+        ('name = "x"\nconvention = "standard"\n' + UR5E_ROWS + "range = [1.0, -1.0]\n", "rows[0].range", "below upper"),
+        ('name = "x"\nconvention = "standard"\n' + UR5E_ROWS + "range = [1.0]\n", "rows[0].range", "2 finite numbers"),
+        ('name = "x"\nconvention = "standard"\n[base]\nquat = [0, 0, 0, 0]\n' + UR5E_ROWS, "base.quat", "zero norm"),
+        ('name = "x"\nconvention = "standard"\n' + UR5E_ROWS.replace('joint = "j1"\n', ""), "rows[0].joint", "missing"),
+        ('name = "x"\nconvention = "standard"\n[[rows]]\ntype = "fixed"\njoint = "j"\n', "rows[0].joint", "fixed row"),
+        ('name = "x"\nconvention = "standard"\n' + UR5E_ROWS + UR5E_ROWS, "rows", "repeat"),
+        ("name = \n", "<file>", "not valid TOML"),
+    ],
+)
+def test_malformed_file_names_file_field_and_problem(tmp_path, text, field, problem):
+    path = write(tmp_path, text)
+    with pytest.raises(om.ArmFileError) as info:
+        om.load_arm(path)
+    assert info.value.field == field
+    assert problem in info.value.problem
+    assert str(path) in str(info.value)
+
+
+def test_missing_file_is_named(tmp_path):
+    with pytest.raises(om.ArmFileError, match="no such file"):
+        om.load_arm(tmp_path / "nope.toml")
+
+
+def test_ur5e_matches_menagerie():
+    """arm.fk equals MuJoCo's pose of body wrist_3_link for 1,000 random q = qpos."""
+    arm = om.load_arm("ur5e")
+    model = load_reference_model(arm.mujoco_model)
+    data = mujoco.MjData(model)
+    assert arm.joint_names == tuple(model.joint(j).name for j in range(model.njnt))
+    np.testing.assert_array_equal(arm.lower, model.jnt_range[:, 0])
+    np.testing.assert_array_equal(arm.upper, model.jnt_range[:, 1])
+    body = model.body(arm.frame_name).id
+    Q = random_q(arm, 1000, np.random.default_rng(1))
+    T = arm.fk(Q)
+    for q, T_arm in zip(Q, T, strict=True):
+        data.qpos[:] = q
+        mujoco.mj_kinematics(model, data)
+        np.testing.assert_allclose(T_arm[:3, 3], data.xpos[body], atol=1e-9)
+        np.testing.assert_allclose(T_arm[:3, :3], data.xmat[body].reshape(3, 3), atol=1e-9)
+
+
+def test_spherical_arm_reproduces_the_papers_delta_p():
+    """Equation (12) of the paper, for the documented reading of Table III's fixed row."""
+    solver = om.OMSolver("spherical")
+    Q = random_q(solver.arm, 200, np.random.default_rng(2))
+    C, S = np.cos(Q), np.sin(Q)
+    d5 = 0.02
+    expected = d5 * np.stack(
+        [
+            C[:, 0] * S[:, 1] * S[:, 3] - C[:, 0] * C[:, 1] * C[:, 3],
+            S[:, 0] * S[:, 1] * S[:, 3] - S[:, 0] * C[:, 1] * C[:, 3],
+            -C[:, 1] * S[:, 3] - S[:, 1] * C[:, 3],
+        ],
+        axis=1,
+    )
+    np.testing.assert_allclose(solver.om.dp(Q), expected, atol=1e-15)
+    assert solver.dp_max == pytest.approx(d5, abs=1e-15)
