@@ -103,8 +103,16 @@ class Arm:
     def with_chain(self, chain: KinematicChain, name: str) -> Arm:
         """The same arm (names, limits) on another chain, e.g. an offset-modified model."""
         return Arm(
-            name, chain, self.joint_names, self.lower, self.upper, self.description,
-            self.mujoco_model, self.frame_name, self.frame_type, self.source,
+            name,
+            chain,
+            self.joint_names,
+            self.lower,
+            self.upper,
+            self.description,
+            self.mujoco_model,
+            self.frame_name,
+            self.frame_type,
+            self.source,
         )
 
 

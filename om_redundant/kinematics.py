@@ -21,7 +21,7 @@ The numeric kernels are compiled with numba; :class:`KinematicChain` is the type
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from enum import Enum
+from enum import StrEnum
 
 import numba as nb
 import numpy as np
@@ -29,7 +29,7 @@ import numpy as np
 from .validation import as_joint_vector
 
 
-class JointKind(str, Enum):
+class JointKind(StrEnum):
     """What a DH row's variable is."""
 
     REVOLUTE = "revolute"
@@ -97,10 +97,7 @@ class KinematicChain:
 
     def __post_init__(self) -> None:
         table = np.array(
-            [
-                (r.a, r.d, r.theta, np.cos(r.alpha), np.sin(r.alpha), _KIND_CODE[r.kind])
-                for r in self.rows
-            ],
+            [(r.a, r.d, r.theta, np.cos(r.alpha), np.sin(r.alpha), _KIND_CODE[r.kind]) for r in self.rows],
             dtype=np.float64,
         ).reshape(-1, 6)
         object.__setattr__(self, "table", table)

@@ -104,7 +104,7 @@ def derive_model(arm: Arm) -> ModelArm:
     for key, j in ((six_dof.THETA4, 3), (six_dof.THETA5, 4), (six_dof.THETA6, 5)):
         params[key] = rows[jr[j]].theta
     # E: from the frame after Rz(phi6) to the flange (row 6's twist and fixed rows after it).
-    tail = [dataclasses.replace(rows[jr[5]], theta=0.0, d=0.0, kind=JointKind.FIXED)] + rows[jr[5] + 1 :]
+    tail = [dataclasses.replace(rows[jr[5]], theta=0.0, d=0.0, kind=JointKind.FIXED), *rows[jr[5] + 1 :]]
     R_tail, _ = _pose(KinematicChain(tuple(tail)).table, np.zeros(0))
     params[six_dof.E_ROT : six_dof.E_ROT + 9] = R_tail.ravel()
     # Wrist centre in the flange frame: origin of joint 5's frame, the same for any q.

@@ -41,6 +41,7 @@ STATUS_NAMES = ("ok", "unreachable", "no solution in this configuration")
 MAX_ROOTS = 16
 _ROOT_TOL = 1e-13  # |g| accepted as a root before verification
 _SAME_ROOT = 1e-9  # joint-space distance under which two roots are one
+_WINDOW_POINTS = 8  # samples of the window searched around a hint
 _PAIR_SEARCH = 1.0  # |g| (rad) below which a local minimum is searched for a root pair
 
 
@@ -233,7 +234,9 @@ def _run_roots(family, P, mtab, rtab, J, R, p, signs, q_prev, pw, pg, L, cyclic,
     for i in range(L - 1 + cyclic):
         j = (i + 1) % L
         wj = pw[j] + (2.0 * np.pi if j == 0 else 0.0)
-        n = _brackets(family, P, mtab, rtab, J, R, p, signs, q_prev, pw[i], pg[i], wj, pg[j], False, q, out, n)
+        n = _brackets(
+            family, P, mtab, rtab, J, R, p, signs, q_prev, pw[i], pg[i], wj, pg[j], False, q, out, n
+        )
     for i in range(L):
         has_prev, has_next = i > 0 or cyclic, i < L - 1 or cyclic
         gi = pg[i]
@@ -251,13 +254,76 @@ def _run_roots(family, P, mtab, rtab, J, R, p, signs, q_prev, pw, pg, L, cyclic,
 
 
 @nb.njit(cache=True)
-def all_roots(family, P, mtab, rtab, J, R, p, signs, q_prev, n_scan, tol_pos, tol_ori, roots):
+def _scan(family, P, mtab, rtab, J, R, p, signs, q_prev, lo, hi, n_pts, full_circle, q, cands):
+    """Candidate roots of g on [lo, hi] (the whole circle if ``full_circle``); returns the count.
+
+    g and the model's reach margin are sampled at ``n_pts`` points. Each run of reachable
+    samples, extended to the edges of reach (found by bisection), is searched by
+    :func:`_run_roots`. Between unreachable samples, each local maximum of the margin is
+    searched for a small island of reach, which is then searched the same way.
+    """
+    h = (hi - lo) / (n_pts if full_circle else n_pts - 1)
+    ws = np.empty(n_pts + 1)
+    gs = np.empty(n_pts + 1)
+    ms = np.empty(n_pts + 1)
+    start = -1
+    for k in range(n_pts):
+        ws[k] = lo + h * k
+        gs[k], ms[k] = _g_margin(family, P, mtab, rtab, J, R, p, signs, q_prev, ws[k], q)
+        if start < 0 and np.isnan(gs[k]):
+            start = k
+    n = 0
+    if full_circle and start < 0:  # reachable everywhere: one cyclic run
+        return _run_roots(family, P, mtab, rtab, J, R, p, signs, q_prev, ws, gs, n_pts, True, q, cands, n)
+    if full_circle:  # rotate to start and end at the same unreachable sample
+        count = n_pts + 1
+        order = np.array([(start + i) % n_pts for i in range(count)])
+        ws, gs, ms = ws[order] + h * (np.arange(count) - order + start), gs[order], ms[order]
+        ws[0] = lo + h * start
+    else:
+        count = n_pts
+    pw = np.empty(count + 2)
+    pg = np.empty(count + 2)
+    L = 0
+    for i in range(count):
+        w = ws[i]
+        if not np.isnan(gs[i]):
+            if L == 0 and i > 0:  # entering reach
+                pw[0] = _reach_edge(family, P, mtab, rtab, J, R, p, signs, q_prev, w, ws[i - 1], q)
+                pg[0] = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, pw[0], q)
+                L = 1
+            pw[L], pg[L] = w, gs[i]
+            L += 1
+            continue
+        if L > 0:  # leaving reach
+            pw[L] = _reach_edge(family, P, mtab, rtab, J, R, p, signs, q_prev, pw[L - 1], w, q)
+            pg[L] = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, pw[L], q)
+            n = _run_roots(family, P, mtab, rtab, J, R, p, signs, q_prev, pw, pg, L + 1, False, q, cands, n)
+            L = 0
+        island = 0 < i < count - 1 and np.isnan(gs[i - 1]) and np.isnan(gs[i + 1])
+        if island and ms[i] >= ms[i - 1] and ms[i] >= ms[i + 1]:
+            c, gc, _ = _extremum(
+                family, P, mtab, rtab, J, R, p, signs, q_prev, ws[i - 1], ws[i + 1], 1.0, True, q
+            )
+            if not np.isnan(gc):  # an island of reach around c
+                pw[0] = _reach_edge(family, P, mtab, rtab, J, R, p, signs, q_prev, c, ws[i - 1], q)
+                pw[1], pg[1] = c, gc
+                pw[2] = _reach_edge(family, P, mtab, rtab, J, R, p, signs, q_prev, c, ws[i + 1], q)
+                pg[0] = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, pw[0], q)
+                pg[2] = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, pw[2], q)
+                n = _run_roots(family, P, mtab, rtab, J, R, p, signs, q_prev, pw, pg, 3, False, q, cands, n)
+    if L > 0:  # a run that reaches the end of the window
+        n = _run_roots(family, P, mtab, rtab, J, R, p, signs, q_prev, pw, pg, L, False, q, cands, n)
+    return n
+
+
+@nb.njit(cache=True)
+def all_roots(
+    family, P, mtab, rtab, J, R, p, signs, q_prev, n_scan, tol_pos, tol_ori, roots, lo=-np.pi, hi=np.pi
+):
     """Bounded search: every verified solution in this configuration. Returns the count.
 
-    g and the model's reach margin are sampled at ``n_scan`` points of the circle. Each run
-    of reachable samples, extended to the edges of reach (found by bisection), is searched
-    by :func:`_run_roots`. Between unreachable samples, each local maximum of the margin is
-    searched for a small island of reach, which is then searched the same way.
+    With ``lo, hi`` narrower than the circle, only roots with q_J in [lo, hi] are sought.
     """
     dof = q_prev.shape[0]
     q = np.empty(dof)
@@ -267,50 +333,25 @@ def all_roots(family, P, mtab, rtab, J, R, p, signs, q_prev, n_scan, tol_pos, to
             roots[0] = q
             return 1
         return 0
-    h = 2.0 * np.pi / n_scan
-    ws = np.empty(n_scan)
-    gs = np.empty(n_scan)
-    ms = np.empty(n_scan)
-    start = -1
-    for k in range(n_scan):
-        ws[k] = -np.pi + h * k
-        gs[k], ms[k] = _g_margin(family, P, mtab, rtab, J, R, p, signs, q_prev, ws[k], q)
-        if start < 0 and np.isnan(gs[k]):
-            start = k
-    cands = np.empty(8 * n_scan)
-    n = 0
-    pw = np.empty(n_scan + 2)
-    pg = np.empty(n_scan + 2)
-    if start < 0:  # reachable everywhere: one cyclic run
-        n = _run_roots(family, P, mtab, rtab, J, R, p, signs, q_prev, ws, gs, n_scan, True, q, cands, n)
-    else:
-        L = 0
-        for i in range(1, n_scan + 1):
-            k = (start + i) % n_scan
-            w = ws[start] + h * i  # unwrapped, ascending
-            if not np.isnan(gs[k]):
-                if L == 0:
-                    pw[0] = _reach_edge(family, P, mtab, rtab, J, R, p, signs, q_prev, w, w - h, q)
-                    pg[0] = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, pw[0], q)
-                    L = 1
-                pw[L], pg[L] = w, gs[k]
-                L += 1
-                continue
-            if L > 0:
-                pw[L] = _reach_edge(family, P, mtab, rtab, J, R, p, signs, q_prev, pw[L - 1], w, q)
-                pg[L] = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, pw[L], q)
-                n = _run_roots(family, P, mtab, rtab, J, R, p, signs, q_prev, pw, pg, L + 1, False, q, cands, n)
-                L = 0
-            k0, k2 = (k - 1) % n_scan, (k + 1) % n_scan
-            if np.isnan(gs[k0]) and np.isnan(gs[k2]) and ms[k] >= ms[k0] and ms[k] >= ms[k2]:
-                c, gc, _ = _extremum(family, P, mtab, rtab, J, R, p, signs, q_prev, w - h, w + h, 1.0, True, q)
-                if not np.isnan(gc):  # an island of reach around c
-                    pw[0] = _reach_edge(family, P, mtab, rtab, J, R, p, signs, q_prev, c, w - h, q)
-                    pw[1], pg[1] = c, gc
-                    pw[2] = _reach_edge(family, P, mtab, rtab, J, R, p, signs, q_prev, c, w + h, q)
-                    pg[0] = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, pw[0], q)
-                    pg[2] = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, pw[2], q)
-                    n = _run_roots(family, P, mtab, rtab, J, R, p, signs, q_prev, pw, pg, 3, False, q, cands, n)
+    cands = np.empty(8 * n_scan + 8)
+    full_circle = hi - lo >= 2.0 * np.pi
+    n = _scan(
+        family,
+        P,
+        mtab,
+        rtab,
+        J,
+        R,
+        p,
+        signs,
+        q_prev,
+        lo,
+        lo + 2.0 * np.pi if full_circle else hi,
+        n_scan,
+        full_circle,
+        q,
+        cands,
+    )
     count = 0
     for i in range(n):
         g = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, cands[i], q)
@@ -376,6 +417,46 @@ def _exists_other(family, P, mtab, rtab, J, R, p, signs, q_prev, n_scan, tol_pos
 
 
 @nb.njit(cache=True)
+def _nearest_in_window(family, P, mtab, rtab, J, R, p, signs, hint, tol_pos, tol_ori, q):
+    """Replace root q by any root nearer the hint.
+
+    A root nearer the hint than q in joint space has |q_J - hint_J| below that distance, so
+    scanning that window of the circle is enough.
+    """
+    d2 = 0.0
+    for j in range(q.shape[0]):
+        d2 += _wrap(q[j] - hint[j]) ** 2
+    radius = np.sqrt(d2)
+    if radius < 1e-12:
+        return
+    roots = np.empty((MAX_ROOTS, q.shape[0]))
+    n = all_roots(
+        family,
+        P,
+        mtab,
+        rtab,
+        J,
+        R,
+        p,
+        signs,
+        hint,
+        _WINDOW_POINTS,
+        tol_pos,
+        tol_ori,
+        roots,
+        hint[J] - radius,
+        hint[J] + radius,
+    )
+    for r in range(n):
+        e2 = 0.0
+        for j in range(q.shape[0]):
+            e2 += _wrap(roots[r, j] - hint[j]) ** 2
+        if e2 < d2:
+            d2 = e2
+            q[:] = roots[r]
+
+
+@nb.njit(cache=True)
 def flange_target(T, base_inv, tool_inv):
     """The flange pose in DH frame 0 for an end-effector pose T in the root frame."""
     F = base_inv @ T @ tool_inv
@@ -384,8 +465,24 @@ def flange_target(T, base_inv, tool_inv):
 
 @nb.njit(cache=True)
 def solve_one(
-    family, P, mtab, rtab, J, base_inv, tool_inv, T, signs, hint, has_hint,
-    revolute, lower, upper, n_scan, tol_pos, tol_ori, q_out,
+    family,
+    P,
+    mtab,
+    rtab,
+    J,
+    base_inv,
+    tool_inv,
+    T,
+    signs,
+    hint,
+    has_hint,
+    revolute,
+    lower,
+    upper,
+    n_scan,
+    tol_pos,
+    tol_ori,
+    q_out,
 ):
     """One OM solve: local Broyden, then the bounded search.
 
@@ -404,6 +501,9 @@ def solve_one(
     if not np.isnan(w0):
         _, evals = _broyden(family, P, mtab, rtab, J, R, p, signs, q_prev, w0, q)
         if verify(family, P, rtab, R, p, signs, q, tol_pos, tol_ori)[2]:
+            if has_hint and J >= 0:
+                _nearest_in_window(family, P, mtab, rtab, J, R, p, signs, hint, tol_pos, tol_ori, q)
+                evals += _WINDOW_POINTS
             q_out[:] = q
             inside = representative(q_out, revolute, lower, upper, hint, has_hint)
             pos, ori, _ = verify(family, P, rtab, R, p, signs, q_out, tol_pos, tol_ori)
@@ -435,12 +535,49 @@ def solve_one(
 
 @nb.njit(cache=True, parallel=True)
 def solve_batch_kernel(
-    family, P, mtab, rtab, J, base_inv, tool_inv, Ts, signs, hints, has_hint,
-    revolute, lower, upper, n_scan, tol_pos, tol_ori, q_out, status, pos, ori, evals, within,
+    family,
+    P,
+    mtab,
+    rtab,
+    J,
+    base_inv,
+    tool_inv,
+    Ts,
+    signs,
+    hints,
+    has_hint,
+    revolute,
+    lower,
+    upper,
+    n_scan,
+    tol_pos,
+    tol_ori,
+    q_out,
+    status,
+    pos,
+    ori,
+    evals,
+    within,
 ):
     for m in nb.prange(Ts.shape[0]):
         st, e_pos, e_ori, ev, inside = solve_one(
-            family, P, mtab, rtab, J, base_inv, tool_inv, Ts[m], signs[m], hints[m], has_hint,
-            revolute, lower, upper, n_scan, tol_pos, tol_ori, q_out[m],
+            family,
+            P,
+            mtab,
+            rtab,
+            J,
+            base_inv,
+            tool_inv,
+            Ts[m],
+            signs[m],
+            hints[m],
+            has_hint,
+            revolute,
+            lower,
+            upper,
+            n_scan,
+            tol_pos,
+            tol_ori,
+            q_out[m],
         )
         status[m], pos[m], ori[m], evals[m], within[m] = st, e_pos, e_ori, ev, inside

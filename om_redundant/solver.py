@@ -100,7 +100,10 @@ class OMSolver:
         scan_points: int = DEFAULT_SCAN_POINTS,
     ):
         self.arm = load_arm(arm) if isinstance(arm, str) else arm
-        for name, value in (("position_tolerance", position_tolerance), ("orientation_tolerance", orientation_tolerance)):
+        for name, value in (
+            ("position_tolerance", position_tolerance),
+            ("orientation_tolerance", orientation_tolerance),
+        ):
             if not np.isfinite(value) or value <= 0.0:
                 raise InvalidInput(f"{name} must be a positive number, got {value}")
         if int(scan_points) < 8:
@@ -168,10 +171,19 @@ class OMSolver:
         hint, has_hint = self._hint(q_hint)
         q = np.empty(self.arm.dof)
         status, pos, ori, evals, within = om_system.solve_one(
-            *self._static, T, signs, hint, has_hint, *self._limits,
-            self.scan_points, *self.tolerances, q,
+            *self._static,
+            T,
+            signs,
+            hint,
+            has_hint,
+            *self._limits,
+            self.scan_points,
+            *self.tolerances,
+            q,
         )
-        return Solution(q, status == om_system.OK, om_system.STATUS_NAMES[status], configuration, pos, ori, evals, within)
+        return Solution(
+            q, status == om_system.OK, om_system.STATUS_NAMES[status], configuration, pos, ori, evals, within
+        )
 
     def solve_all(self, T: Any, configuration: Configuration) -> list[Solution]:
         """Every real solution with this configuration (the bounded search), possibly none."""
@@ -179,7 +191,9 @@ class OMSolver:
         signs = self._signs(configuration)
         roots = np.empty((om_system.MAX_ROOTS, self.arm.dof))
         zeros = np.zeros(self.arm.dof)
-        n = om_system.all_roots(*self._static[:5], R, p, signs, zeros, self.scan_points, *self.tolerances, roots)
+        n = om_system.all_roots(
+            *self._static[:5], R, p, signs, zeros, self.scan_points, *self.tolerances, roots
+        )
         solutions = []
         for q in roots[:n]:
             within = om_system.representative(q, *self._limits, zeros, False)
@@ -222,8 +236,20 @@ class OMSolver:
         pos, ori, evals = np.empty(m), np.empty(m), np.empty(m, dtype=np.int64)
         within = np.empty(m, dtype=np.bool_)
         om_system.solve_batch_kernel(
-            *self._static, T, signs, hints, has_hint, *self._limits,
-            self.scan_points, *self.tolerances, q, status, pos, ori, evals, within,
+            *self._static,
+            T,
+            signs,
+            hints,
+            has_hint,
+            *self._limits,
+            self.scan_points,
+            *self.tolerances,
+            q,
+            status,
+            pos,
+            ori,
+            evals,
+            within,
         )
         return BatchSolution(q, status == om_system.OK, status, pos, ori, evals, within)
 
@@ -239,7 +265,9 @@ class OMSolver:
                 f"got {len(configuration.signs)}"
             )
         if configuration.redundancy:
-            raise InvalidInput(f"arm '{self.arm.name}' takes no redundancy values, got {configuration.redundancy}")
+            raise InvalidInput(
+                f"arm '{self.arm.name}' takes no redundancy values, got {configuration.redundancy}"
+            )
         return np.array(configuration.signs, dtype=np.int64)
 
     def _hint(self, q_hint: np.ndarray | None) -> tuple[np.ndarray, bool]:

@@ -36,7 +36,9 @@ def modified_tables(draw):
     rows = []
     for _ in range(n):
         kind = draw(st.sampled_from(list(om.JointKind)))
-        rows.append(om.DHRow(a=draw(lengths), alpha=draw(angles), d=draw(lengths), theta=draw(angles), kind=kind))
+        rows.append(
+            om.DHRow(a=draw(lengths), alpha=draw(angles), d=draw(lengths), theta=draw(angles), kind=kind)
+        )
     return rows
 
 

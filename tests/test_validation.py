@@ -66,7 +66,8 @@ def test_wrong_number_of_signs_or_redundancy(solver, pose):
 
 
 @pytest.mark.parametrize(
-    "q, message", [(np.zeros(5), r"shape \(6,\)"), (np.full(6, np.nan), "NaN or inf"), (np.zeros((2, 3)), "shape")]
+    "q, message",
+    [(np.zeros(5), r"shape \(6,\)"), (np.full(6, np.nan), "NaN or inf"), (np.zeros((2, 3)), "shape")],
 )
 def test_bad_joint_vectors(solver, pose, q, message):
     with pytest.raises(om.InvalidInput, match=message):

@@ -143,9 +143,9 @@ def model_ik(family, P, table, R, p, signs, q_prev, q):
         phi5 = np.arctan2(0.0, -s4 * s5 * az)
         # Rz(phi6) = (Rz(phi4) Rx(a4) Rz(phi5) Rx(a5))^T M; its first column is (C6, S6, 0).
         c4, n4, c5, n5 = np.cos(phi4), np.sin(phi4), np.cos(phi5), np.sin(phi5)
-        A = np.array(
-            [[c4, 0.0, n4 * s4], [n4, 0.0, -c4 * s4], [0.0, s4, 0.0]]
-        ) @ np.array([[c5, 0.0, n5 * s5], [n5, 0.0, -c5 * s5], [0.0, s5, 0.0]])
+        A = np.array([[c4, 0.0, n4 * s4], [n4, 0.0, -c4 * s4], [0.0, s4, 0.0]]) @ np.array(
+            [[c5, 0.0, n5 * s5], [n5, 0.0, -c5 * s5], [0.0, s5, 0.0]]
+        )
         X = A.T @ M
         phi6 = np.arctan2(X[1, 0], X[0, 0])
     q[3] = _wrap(phi4 - P[THETA4])
