@@ -41,6 +41,7 @@ STATUS_NAMES = ("ok", "unreachable", "no solution in this configuration")
 MAX_ROOTS = 16
 _ROOT_TOL = 1e-13  # |g| accepted as a root before verification
 _SAME_ROOT = 1e-9  # joint-space distance under which two roots are one
+_START_POINTS = 8  # samples of the dp circle tried when p_d is outside the model's reach
 _WINDOW_POINTS = 8  # samples of the window searched around a hint
 _PAIR_SEARCH = 1.0  # |g| (rad) below which a local minimum is searched for a root pair
 
@@ -498,6 +499,16 @@ def solve_one(
     else:  # the paper's fixed-point start, p_m = p_d
         reach = model_ik(family, P, mtab, R, p, signs, q_prev, q) >= -REACH_SLACK
         w0 = q[J] if (reach and J >= 0) else np.nan
+        if not reach and J >= 0:
+            # p_d is outside the model's reach: start from the point of the dp circle
+            # that the model reaches with the smallest residual.
+            best = np.inf
+            for k in range(_START_POINTS):
+                w = -np.pi + 2.0 * np.pi * k / _START_POINTS
+                g = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, w, q)
+                if abs(g) < best:  # False for NaN
+                    best, w0 = abs(g), w
+            evals += _START_POINTS
     if not np.isnan(w0):
         _, evals = _broyden(family, P, mtab, rtab, J, R, p, signs, q_prev, w0, q)
         if verify(family, P, rtab, R, p, signs, q, tol_pos, tol_ori)[2]:

@@ -25,13 +25,13 @@ Arm plane. :math:`(u, v) = (\rho - a_1,\ \sigma_1 (p_z - d_1))` is reached by a 
 
 Wrist. With :math:`M = R_{in}^T R_{flange} E^T = R_z(\varphi_4) R_x(\alpha_4) R_z(\varphi_5)
 R_x(\alpha_5) R_z(\varphi_6)` and :math:`\sigma_{4,5} = \sin\alpha_{4,5} = \pm 1`:
-:math:`M e_z = (\sigma_5 S_5 C_4,\ \sigma_5 S_5 S_4,\ -\sigma_4\sigma_5 C_5)` and
-:math:`e_z^T M = \sigma_4 (S_5 C_6,\ -S_5 S_6,\ \cdot)`, so with
-:math:`\mathrm{WRIST} = \mathrm{sign}(\sin\varphi_5)` every angle is an atan2 of entries of M.
-At :math:`\sin\varphi_5 = 0` (rule 3 of the paper) :math:`q_4` keeps its previous value and
-:math:`\varphi_6` absorbs the rest. Likewise :math:`q_1` (rule 1) when the wrist centre is on
-the axis of joint 1. Every angle comes from atan2, never acos, so that precision holds
-near singular joints.
+:math:`M e_z = (\sigma_5 S_5 C_4,\ \sigma_5 S_5 S_4,\ -\sigma_4\sigma_5 C_5)`, so with
+:math:`\mathrm{WRIST} = \mathrm{sign}(\sin\varphi_5)`,
+:math:`\varphi_4` and :math:`\varphi_5` are atan2s of entries of M, and :math:`\varphi_6` is the angle of the
+residual :math:`(R_z(\varphi_4) R_x(\alpha_4) R_z(\varphi_5) R_x(\alpha_5))^T M`.
+At :math:`\sin\varphi_5 = 0` (rule 3 of the paper) :math:`q_4` keeps its previous value;
+likewise :math:`q_1` (rule 1) when the wrist centre is on the axis of joint 1. Every angle
+comes from atan2, never acos, so that precision holds near singular joints.
 
 The parameter vector layout is given by the index constants below.
 """
@@ -137,17 +137,18 @@ def model_ik(family, P, table, R, p, signs, q_prev, q):
     if sin5 > _SINGULAR:
         phi4 = np.arctan2(s5 * w * ay, s5 * w * ax)
         phi5 = np.arctan2(w * sin5, -s4 * s5 * az)
-        phi6 = np.arctan2(-s4 * w * M[2, 1], s4 * w * M[2, 0])
-    else:  # rule 3: joints 4 and 6 aligned
+    else:  # rule 3: joints 4 and 6 aligned; q4 keeps its previous value
         phi4 = q_prev[3] + P[THETA4]
         phi5 = np.arctan2(0.0, -s4 * s5 * az)
-        # Rz(phi6) = (Rz(phi4) Rx(a4) Rz(phi5) Rx(a5))^T M; its first column is (C6, S6, 0).
-        c4, n4, c5, n5 = np.cos(phi4), np.sin(phi4), np.cos(phi5), np.sin(phi5)
-        A = np.array([[c4, 0.0, n4 * s4], [n4, 0.0, -c4 * s4], [0.0, s4, 0.0]]) @ np.array(
-            [[c5, 0.0, n5 * s5], [n5, 0.0, -c5 * s5], [0.0, s5, 0.0]]
-        )
-        X = A.T @ M
-        phi6 = np.arctan2(X[1, 0], X[0, 0])
+    # Rz(phi6) = (Rz(phi4) Rx(a4) Rz(phi5) Rx(a5))^T M. Taking phi6 from this residual rather
+    # than from M's last row makes the three angles consistent, so that their rounding errors
+    # cancel in the hand orientation even near the wrist singularity.
+    c4, n4, c5, n5 = np.cos(phi4), np.sin(phi4), np.cos(phi5), np.sin(phi5)
+    A = np.array([[c4, 0.0, n4 * s4], [n4, 0.0, -c4 * s4], [0.0, s4, 0.0]]) @ np.array(
+        [[c5, 0.0, n5 * s5], [n5, 0.0, -c5 * s5], [0.0, s5, 0.0]]
+    )
+    X = A.T @ M
+    phi6 = np.arctan2(X[1, 0], X[0, 0])
     q[3] = _wrap(phi4 - P[THETA4])
     q[4] = _wrap(phi5 - P[THETA5])
     q[5] = _wrap(phi6 - P[THETA6])
