@@ -260,8 +260,8 @@ def _scan(family, P, mtab, rtab, J, R, p, signs, q_prev, lo, hi, n_pts, full_cir
 
     g and the model's reach margin are sampled at ``n_pts`` points. Each run of reachable
     samples, extended to the edges of reach (found by bisection), is searched by
-    :func:`_run_roots`. Between unreachable samples, each local maximum of the margin is
-    searched for a small island of reach, which is then searched the same way.
+    :func:`_run_roots`. Between unreachable samples whose reach margin could peak above
+    zero, the margin is maximised to find small islands of reach, searched the same way.
     """
     h = (hi - lo) / (n_pts if full_circle else n_pts - 1)
     ws = np.empty(n_pts + 1)
@@ -301,18 +301,28 @@ def _scan(family, P, mtab, rtab, J, R, p, signs, q_prev, lo, hi, n_pts, full_cir
             pg[L] = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, pw[L], q)
             n = _run_roots(family, P, mtab, rtab, J, R, p, signs, q_prev, pw, pg, L + 1, False, q, cands, n)
             L = 0
-        island = 0 < i < count - 1 and np.isnan(gs[i - 1]) and np.isnan(gs[i + 1])
-        if island and ms[i] >= ms[i - 1] and ms[i] >= ms[i + 1]:
-            c, gc, _ = _extremum(
-                family, P, mtab, rtab, J, R, p, signs, q_prev, ws[i - 1], ws[i + 1], 1.0, True, q
-            )
-            if not np.isnan(gc):  # an island of reach around c
-                pw[0] = _reach_edge(family, P, mtab, rtab, J, R, p, signs, q_prev, c, ws[i - 1], q)
-                pw[1], pg[1] = c, gc
-                pw[2] = _reach_edge(family, P, mtab, rtab, J, R, p, signs, q_prev, c, ws[i + 1], q)
-                pg[0] = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, pw[0], q)
-                pg[2] = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, pw[2], q)
-                n = _run_roots(family, P, mtab, rtab, J, R, p, signs, q_prev, pw, pg, 3, False, q, cands, n)
+        if i + 1 < count and np.isnan(gs[i + 1]):
+            # Both ends of this cell are out of reach. The margin can peak between them by
+            # about half its change across a cell (estimated from this cell and its
+            # neighbours); if that could reach zero, look for an island of reach.
+            change = abs(ms[i + 1] - ms[i])
+            if i > 0:
+                change = max(change, abs(ms[i] - ms[i - 1]))
+            if i + 2 < count:
+                change = max(change, abs(ms[i + 2] - ms[i + 1]))
+            if max(ms[i], ms[i + 1]) + change > 0.0:
+                c, gc, _ = _extremum(
+                    family, P, mtab, rtab, J, R, p, signs, q_prev, w, ws[i + 1], 1.0, True, q
+                )
+                if not np.isnan(gc):  # an island of reach around c
+                    pw[0] = _reach_edge(family, P, mtab, rtab, J, R, p, signs, q_prev, c, w, q)
+                    pw[1], pg[1] = c, gc
+                    pw[2] = _reach_edge(family, P, mtab, rtab, J, R, p, signs, q_prev, c, ws[i + 1], q)
+                    pg[0] = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, pw[0], q)
+                    pg[2] = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, pw[2], q)
+                    n = _run_roots(
+                        family, P, mtab, rtab, J, R, p, signs, q_prev, pw, pg, 3, False, q, cands, n
+                    )
     if L > 0:  # a run that reaches the end of the window
         n = _run_roots(family, P, mtab, rtab, J, R, p, signs, q_prev, pw, pg, L, False, q, cands, n)
     return n
