@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -68,6 +69,14 @@ def test_paper_benchmark_small_run():
     assert result.converged == 1.0 and result.configuration_errors == 0
     assert result.max_position_error < 1e-10 and result.max_orientation_error < 1e-12
     assert "| converged | 100.000 % | 100 % |" in result.table()
+
+
+def test_readme_snippets_run():
+    text = (ROOT / "README.md").read_text()
+    blocks = re.findall(r"```python\n(.*?)```", text, flags=re.S)
+    assert blocks
+    for block in blocks:
+        exec(compile(block, "README.md", "exec"), {})
 
 
 @pytest.mark.parametrize("script", sorted((ROOT / "examples").glob("*.py")), ids=lambda p: p.name)
