@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-import mujoco
 import numpy as np
 import pytest
 
 import om_redundant as om
-from tests.conftest import load_reference_model, random_q
+from tests.conftest import random_q
 
 UR5E_ROWS = """
 [[rows]]
@@ -106,24 +105,6 @@ def test_malformed_file_names_file_field_and_problem(tmp_path, text, field, prob
 def test_missing_file_is_named(tmp_path):
     with pytest.raises(om.ArmFileError, match="no such file"):
         om.load_arm(tmp_path / "nope.toml")
-
-
-def test_ur5e_matches_menagerie():
-    """arm.fk equals MuJoCo's pose of body wrist_3_link for 1,000 random q = qpos."""
-    arm = om.load_arm("ur5e")
-    model = load_reference_model(arm.mujoco_model)
-    data = mujoco.MjData(model)
-    assert arm.joint_names == tuple(model.joint(j).name for j in range(model.njnt))
-    np.testing.assert_array_equal(arm.lower, model.jnt_range[:, 0])
-    np.testing.assert_array_equal(arm.upper, model.jnt_range[:, 1])
-    body = model.body(arm.frame_name).id
-    Q = random_q(arm, 1000, np.random.default_rng(1))
-    T = arm.fk(Q)
-    for q, T_arm in zip(Q, T, strict=True):
-        data.qpos[:] = q
-        mujoco.mj_kinematics(model, data)
-        np.testing.assert_allclose(T_arm[:3, 3], data.xpos[body], atol=1e-9)
-        np.testing.assert_allclose(T_arm[:3, :3], data.xmat[body].reshape(3, 3), atol=1e-9)
 
 
 def test_spherical_arm_reproduces_the_papers_delta_p():
