@@ -22,7 +22,8 @@ and a root gives the real arm's joints :math:`q = \mathrm{IK}_{model}(\ldots)` w
   small islands of reach, where roots come in close pairs, 1-D extremum searches find
   them. Every candidate is verified with the REAL arm's forward kinematics.
 
-All kernels work in DH frame 0 with the flange pose; base and tool are removed outside.
+All kernels work in DH frame 0 with the flange pose. One target's problem travels as one
+tuple, see :func:`make_problem`; its last entry counts the residual evaluations.
 """
 
 from __future__ import annotations
@@ -64,8 +65,25 @@ def _delta(mtab, rtab, J, w, dof):
 
 
 @nb.njit(cache=True)
-def _g_margin(family, P, mtab, rtab, J, R, p, signs, q_prev, w, q):
+def make_problem(family, P, mtab, rtab, J, R, p, signs, q_prev):
+    """Bundle one target's data: model family and parameters, model and real DH tables,
+    the joint J that dp depends on, the flange pose (R, p), the branch signs, the joints
+    kept at singularities (q_prev), and an evaluation counter."""
+    return (family, P, mtab, rtab, J, R, p, signs, q_prev, np.zeros(1, dtype=np.int64))
+
+
+@nb.njit(cache=True)
+def _with_signs(problem, signs):
+    """The same problem in another configuration, sharing the evaluation counter."""
+    family, P, mtab, rtab, J, R, p, _, q_prev, counter = problem
+    return (family, P, mtab, rtab, J, R, p, signs, q_prev, counter)
+
+
+@nb.njit(cache=True)
+def _g_margin(problem, w, q):
     """Residual g(w) (NaN if unreachable) and the model's reach margin; writes the IK into q."""
+    family, P, mtab, rtab, J, R, p, signs, q_prev, counter = problem
+    counter[0] += 1
     pm = p + R @ _delta(mtab, rtab, J, w, q.shape[0])
     margin = model_ik(family, P, mtab, R, pm, signs, q_prev, q)
     if margin < -REACH_SLACK:
@@ -76,23 +94,22 @@ def _g_margin(family, P, mtab, rtab, J, R, p, signs, q_prev, w, q):
 
 
 @nb.njit(cache=True)
-def _g(family, P, mtab, rtab, J, R, p, signs, q_prev, w, q):
+def _g(problem, w, q):
     """Residual g(w) of the reduced system; writes the model IK into q. NaN if unreachable."""
-    return _g_margin(family, P, mtab, rtab, J, R, p, signs, q_prev, w, q)[0]
+    return _g_margin(problem, w, q)[0]
 
 
 @nb.njit(cache=True)
-def _broyden(family, P, mtab, rtab, J, R, p, signs, q_prev, w0, q):
+def _broyden(problem, w0, q):
     """Secant (1-D Broyden) iteration from w0 with a finite-difference slope.
 
-    Returns (|g| at the end, evaluations); q holds the model IK at the last iterate.
+    Returns |g| at the end; q holds the model IK at the last iterate.
     """
-    g0 = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, w0, q)
-    if J < 0 or np.isnan(g0):
-        return abs(g0), 1
+    g0 = _g(problem, w0, q)
+    if problem[4] < 0 or np.isnan(g0):
+        return abs(g0)
     h = 1e-7
-    g1 = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, w0 + h, q)
-    evals = 2
+    g1 = _g(problem, w0 + h, q)
     slope = (g1 - g0) / h if not np.isnan(g1) else -1.0
     w, g = w0, g0
     for _ in range(40):
@@ -101,8 +118,7 @@ def _broyden(family, P, mtab, rtab, J, R, p, signs, q_prev, w0, q):
         step = -g / slope
         if abs(step) > 0.5:
             step = 0.5 * np.sign(step)
-        g_new = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, w + step, q)
-        evals += 1
+        g_new = _g(problem, w + step, q)
         if np.isnan(g_new):
             break
         slope = (g_new - g) / step
@@ -110,17 +126,16 @@ def _broyden(family, P, mtab, rtab, J, R, p, signs, q_prev, w0, q):
         if abs(step) < 1e-15 * max(1.0, abs(w)) or abs(g) < 1e-16:
             break
     # q must belong to the final iterate.
-    g = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, w, q)
-    return abs(g), evals + 1
+    return abs(_g(problem, w, q))
 
 
 @nb.njit(cache=True)
-def _refine_bracket(family, P, mtab, rtab, J, R, p, signs, q_prev, a, ga, b, gb, q):
+def _refine_bracket(problem, a, ga, b, gb, q):
     """Illinois regula falsi on a sign-changing bracket; returns the root estimate."""
     side = 0
     for _ in range(100):
         c = (a * gb - b * ga) / (gb - ga)
-        gc = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, c, q)
+        gc = _g(problem, c, q)
         if np.isnan(gc) or gc == 0.0 or abs(b - a) < 1e-15:
             return c
         if np.sign(gc) == np.sign(gb):
@@ -137,11 +152,11 @@ def _refine_bracket(family, P, mtab, rtab, J, R, p, signs, q_prev, a, ga, b, gb,
 
 
 @nb.njit(cache=True)
-def _reach_edge(family, P, mtab, rtab, J, R, p, signs, q_prev, inside, outside, q):
+def _reach_edge(problem, inside, outside, q):
     """Bisect towards the edge of the model's reach; returns a reachable point next to it."""
     for _ in range(52):
         mid = 0.5 * (inside + outside)
-        if np.isnan(_g(family, P, mtab, rtab, J, R, p, signs, q_prev, mid, q)):
+        if np.isnan(_g(problem, mid, q)):
             outside = mid
         else:
             inside = mid
@@ -149,11 +164,12 @@ def _reach_edge(family, P, mtab, rtab, J, R, p, signs, q_prev, inside, outside, 
 
 
 @nb.njit(cache=True)
-def verify(family, P, rtab, R, p, signs, q, tol_pos, tol_ori):
+def verify(problem, q, tol_pos, tol_ori):
     """Position and orientation error of the REAL arm at q and the branch check.
 
     Returns (position error, orientation error, accepted).
     """
+    family, P, _, rtab, _, R, p, signs, _, _ = problem
     Rr, pr = np.empty((3, 3)), np.empty(3)
     flange_kernel(rtab, q, Rr, pr)
     d = pr - p
@@ -172,7 +188,7 @@ def verify(family, P, rtab, R, p, signs, q, tol_pos, tol_ori):
 
 
 @nb.njit(cache=True)
-def _extremum(family, P, mtab, rtab, J, R, p, signs, q_prev, a, b, sign, of_margin, q):
+def _extremum(problem, a, b, sign, of_margin, q):
     """Golden-section search for the maximum of sign * g (or of the reach margin) on [a, b].
 
     Unreachable points count as -inf for g. Returns (argmax, g there, margin there).
@@ -180,24 +196,24 @@ def _extremum(family, P, mtab, rtab, J, R, p, signs, q_prev, a, b, sign, of_marg
     inv_phi = 0.6180339887498949
     c = b - inv_phi * (b - a)
     d = a + inv_phi * (b - a)
-    gc, mc = _g_margin(family, P, mtab, rtab, J, R, p, signs, q_prev, c, q)
-    gd, md = _g_margin(family, P, mtab, rtab, J, R, p, signs, q_prev, d, q)
+    gc, mc = _g_margin(problem, c, q)
+    gd, md = _g_margin(problem, d, q)
     for _ in range(45):
         fc = mc if of_margin else (-np.inf if np.isnan(gc) else sign * gc)
         fd = md if of_margin else (-np.inf if np.isnan(gd) else sign * gd)
         if fc > fd:
             b, d, gd, md = d, c, gc, mc
             c = b - inv_phi * (b - a)
-            gc, mc = _g_margin(family, P, mtab, rtab, J, R, p, signs, q_prev, c, q)
+            gc, mc = _g_margin(problem, c, q)
         else:
             a, c, gc, mc = c, d, gd, md
             d = a + inv_phi * (b - a)
-            gd, md = _g_margin(family, P, mtab, rtab, J, R, p, signs, q_prev, d, q)
+            gd, md = _g_margin(problem, d, q)
     return c, gc, mc
 
 
 @nb.njit(cache=True)
-def _brackets(family, P, mtab, rtab, J, R, p, signs, q_prev, a, ga, b, gb, search, q, out, n):
+def _brackets(problem, a, ga, b, gb, search, q, out, n):
     """Add the roots of g on [a, b] (both ends reachable) to out[n:]; returns the new count.
 
     A sign change is one root. With ``search``, an interval without one is searched for an
@@ -209,23 +225,23 @@ def _brackets(family, P, mtab, rtab, J, R, p, signs, q_prev, a, ga, b, gb, searc
     if abs(ga - gb) > np.pi:  # g wraps between a and b
         return n
     if ga * gb < 0.0:
-        out[n] = _refine_bracket(family, P, mtab, rtab, J, R, p, signs, q_prev, a, ga, b, gb, q)
+        out[n] = _refine_bracket(problem, a, ga, b, gb, q)
         return n + 1
     if not search:
         return n
-    w, g, _ = _extremum(family, P, mtab, rtab, J, R, p, signs, q_prev, a, b, -np.sign(ga), False, q)
+    w, g, _ = _extremum(problem, a, b, -np.sign(ga), False, q)
     if np.isnan(g) or g * ga > 0.0:
         return n
     if g == 0.0:
         out[n] = w
         return n + 1
-    out[n] = _refine_bracket(family, P, mtab, rtab, J, R, p, signs, q_prev, a, ga, w, g, q)
-    out[n + 1] = _refine_bracket(family, P, mtab, rtab, J, R, p, signs, q_prev, w, g, b, gb, q)
+    out[n] = _refine_bracket(problem, a, ga, w, g, q)
+    out[n + 1] = _refine_bracket(problem, w, g, b, gb, q)
     return n + 2
 
 
 @nb.njit(cache=True)
-def _run_roots(family, P, mtab, rtab, J, R, p, signs, q_prev, pw, pg, L, cyclic, q, out, n):
+def _run_roots(problem, pw, pg, L, cyclic, q, out, n):
     """Add the roots on a run of reachable points (w ascending) to out[n:]; returns the count.
 
     Consecutive points with a sign change bracket a root. At each local minimum of |g| with
@@ -235,9 +251,7 @@ def _run_roots(family, P, mtab, rtab, J, R, p, signs, q_prev, pw, pg, L, cyclic,
     for i in range(L - 1 + cyclic):
         j = (i + 1) % L
         wj = pw[j] + (2.0 * np.pi if j == 0 else 0.0)
-        n = _brackets(
-            family, P, mtab, rtab, J, R, p, signs, q_prev, pw[i], pg[i], wj, pg[j], False, q, out, n
-        )
+        n = _brackets(problem, pw[i], pg[i], wj, pg[j], False, q, out, n)
     for i in range(L):
         has_prev, has_next = i > 0 or cyclic, i < L - 1 or cyclic
         gi = pg[i]
@@ -250,12 +264,12 @@ def _run_roots(family, P, mtab, rtab, J, R, p, signs, q_prev, pw, pg, L, cyclic,
             continue
         if glo * gi <= 0.0 or ghi * gi <= 0.0:  # bracketed already
             continue
-        n = _brackets(family, P, mtab, rtab, J, R, p, signs, q_prev, lo, glo, hi, ghi, True, q, out, n)
+        n = _brackets(problem, lo, glo, hi, ghi, True, q, out, n)
     return n
 
 
 @nb.njit(cache=True)
-def _scan(family, P, mtab, rtab, J, R, p, signs, q_prev, lo, hi, n_pts, full_circle, q, cands):
+def _scan(problem, lo, hi, n_pts, full_circle, q, cands):
     """Candidate roots of g on [lo, hi] (the whole circle if ``full_circle``); returns the count.
 
     g and the model's reach margin are sampled at ``n_pts`` points. Each run of reachable
@@ -270,12 +284,12 @@ def _scan(family, P, mtab, rtab, J, R, p, signs, q_prev, lo, hi, n_pts, full_cir
     start = -1
     for k in range(n_pts):
         ws[k] = lo + h * k
-        gs[k], ms[k] = _g_margin(family, P, mtab, rtab, J, R, p, signs, q_prev, ws[k], q)
+        gs[k], ms[k] = _g_margin(problem, ws[k], q)
         if start < 0 and np.isnan(gs[k]):
             start = k
     n = 0
     if full_circle and start < 0:  # reachable everywhere: one cyclic run
-        return _run_roots(family, P, mtab, rtab, J, R, p, signs, q_prev, ws, gs, n_pts, True, q, cands, n)
+        return _run_roots(problem, ws, gs, n_pts, True, q, cands, n)
     if full_circle:  # rotate to start and end at the same unreachable sample
         count = n_pts + 1
         order = np.array([(start + i) % n_pts for i in range(count)])
@@ -290,16 +304,16 @@ def _scan(family, P, mtab, rtab, J, R, p, signs, q_prev, lo, hi, n_pts, full_cir
         w = ws[i]
         if not np.isnan(gs[i]):
             if L == 0 and i > 0:  # entering reach
-                pw[0] = _reach_edge(family, P, mtab, rtab, J, R, p, signs, q_prev, w, ws[i - 1], q)
-                pg[0] = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, pw[0], q)
+                pw[0] = _reach_edge(problem, w, ws[i - 1], q)
+                pg[0] = _g(problem, pw[0], q)
                 L = 1
             pw[L], pg[L] = w, gs[i]
             L += 1
             continue
         if L > 0:  # leaving reach
-            pw[L] = _reach_edge(family, P, mtab, rtab, J, R, p, signs, q_prev, pw[L - 1], w, q)
-            pg[L] = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, pw[L], q)
-            n = _run_roots(family, P, mtab, rtab, J, R, p, signs, q_prev, pw, pg, L + 1, False, q, cands, n)
+            pw[L] = _reach_edge(problem, pw[L - 1], w, q)
+            pg[L] = _g(problem, pw[L], q)
+            n = _run_roots(problem, pw, pg, L + 1, False, q, cands, n)
             L = 0
         if i + 1 < count and np.isnan(gs[i + 1]):
             # Both ends of this cell are out of reach. The margin can peak between them by
@@ -311,64 +325,42 @@ def _scan(family, P, mtab, rtab, J, R, p, signs, q_prev, lo, hi, n_pts, full_cir
             if i + 2 < count:
                 change = max(change, abs(ms[i + 2] - ms[i + 1]))
             if max(ms[i], ms[i + 1]) + change > 0.0:
-                c, gc, _ = _extremum(
-                    family, P, mtab, rtab, J, R, p, signs, q_prev, w, ws[i + 1], 1.0, True, q
-                )
+                c, gc, _ = _extremum(problem, w, ws[i + 1], 1.0, True, q)
                 if not np.isnan(gc):  # an island of reach around c
-                    pw[0] = _reach_edge(family, P, mtab, rtab, J, R, p, signs, q_prev, c, w, q)
+                    pw[0] = _reach_edge(problem, c, w, q)
                     pw[1], pg[1] = c, gc
-                    pw[2] = _reach_edge(family, P, mtab, rtab, J, R, p, signs, q_prev, c, ws[i + 1], q)
-                    pg[0] = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, pw[0], q)
-                    pg[2] = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, pw[2], q)
-                    n = _run_roots(
-                        family, P, mtab, rtab, J, R, p, signs, q_prev, pw, pg, 3, False, q, cands, n
-                    )
+                    pw[2] = _reach_edge(problem, c, ws[i + 1], q)
+                    pg[0] = _g(problem, pw[0], q)
+                    pg[2] = _g(problem, pw[2], q)
+                    n = _run_roots(problem, pw, pg, 3, False, q, cands, n)
     if L > 0:  # a run that reaches the end of the window
-        n = _run_roots(family, P, mtab, rtab, J, R, p, signs, q_prev, pw, pg, L, False, q, cands, n)
+        n = _run_roots(problem, pw, pg, L, False, q, cands, n)
     return n
 
 
 @nb.njit(cache=True)
-def all_roots(
-    family, P, mtab, rtab, J, R, p, signs, q_prev, n_scan, tol_pos, tol_ori, roots, lo=-np.pi, hi=np.pi
-):
+def all_roots(problem, n_scan, tol_pos, tol_ori, roots, lo=-np.pi, hi=np.pi):
     """Bounded search: every verified solution in this configuration. Returns the count.
 
     With ``lo, hi`` narrower than the circle, only roots with q_J in [lo, hi] are sought.
     """
-    dof = q_prev.shape[0]
+    dof = roots.shape[1]
     q = np.empty(dof)
-    if J < 0:
-        g = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, 0.0, q)
-        if not np.isnan(g) and verify(family, P, rtab, R, p, signs, q, tol_pos, tol_ori)[2]:
+    if problem[4] < 0:
+        g = _g(problem, 0.0, q)
+        if not np.isnan(g) and verify(problem, q, tol_pos, tol_ori)[2]:
             roots[0] = q
             return 1
         return 0
     cands = np.empty(8 * n_scan + 8)
     full_circle = hi - lo >= 2.0 * np.pi
-    n = _scan(
-        family,
-        P,
-        mtab,
-        rtab,
-        J,
-        R,
-        p,
-        signs,
-        q_prev,
-        lo,
-        lo + 2.0 * np.pi if full_circle else hi,
-        n_scan,
-        full_circle,
-        q,
-        cands,
-    )
+    n = _scan(problem, lo, lo + 2.0 * np.pi if full_circle else hi, n_scan, full_circle, q, cands)
     count = 0
     for i in range(n):
-        g = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, cands[i], q)
+        g = _g(problem, cands[i], q)
         if not np.isnan(g) and abs(g) > _ROOT_TOL:  # polish the bracket's estimate
-            _broyden(family, P, mtab, rtab, J, R, p, signs, q_prev, cands[i], q)
-        if not verify(family, P, rtab, R, p, signs, q, tol_pos, tol_ori)[2]:
+            _broyden(problem, cands[i], q)
+        if not verify(problem, q, tol_pos, tol_ori)[2]:
             continue
         duplicate = False
         for r in range(count):
@@ -410,11 +402,12 @@ def representative(q, revolute, lower, upper, hint, has_hint):
 
 
 @nb.njit(cache=True)
-def _exists_other(family, P, mtab, rtab, J, R, p, signs, q_prev, n_scan, tol_pos, tol_ori):
-    """Whether any configuration other than ``signs`` has a solution."""
+def _exists_other(problem, n_scan, tol_pos, tol_ori):
+    """Whether any configuration other than the problem's has a solution."""
+    signs = problem[7]
     k = signs.shape[0]
     other = np.empty(k, dtype=np.int64)
-    roots = np.empty((MAX_ROOTS, q_prev.shape[0]))
+    roots = np.empty((MAX_ROOTS, problem[8].shape[0]))
     for code in range(2**k):
         same = True
         for i in range(k):
@@ -422,13 +415,13 @@ def _exists_other(family, P, mtab, rtab, J, R, p, signs, q_prev, n_scan, tol_pos
             same = same and other[i] == signs[i]
         if same:
             continue
-        if all_roots(family, P, mtab, rtab, J, R, p, other, q_prev, n_scan, tol_pos, tol_ori, roots):
+        if all_roots(_with_signs(problem, other), n_scan, tol_pos, tol_ori, roots):
             return True
     return False
 
 
 @nb.njit(cache=True)
-def _nearest_in_window(family, P, mtab, rtab, J, R, p, signs, hint, tol_pos, tol_ori, q):
+def _nearest_in_window(problem, hint, tol_pos, tol_ori, q):
     """Replace root q by any root nearer the hint.
 
     A root nearer the hint than q in joint space has |q_J - hint_J| below that distance, so
@@ -441,23 +434,8 @@ def _nearest_in_window(family, P, mtab, rtab, J, R, p, signs, hint, tol_pos, tol
     if radius < 1e-12:
         return
     roots = np.empty((MAX_ROOTS, q.shape[0]))
-    n = all_roots(
-        family,
-        P,
-        mtab,
-        rtab,
-        J,
-        R,
-        p,
-        signs,
-        hint,
-        _WINDOW_POINTS,
-        tol_pos,
-        tol_ori,
-        roots,
-        hint[J] - radius,
-        hint[J] + radius,
-    )
+    J = problem[4]
+    n = all_roots(problem, _WINDOW_POINTS, tol_pos, tol_ori, roots, hint[J] - radius, hint[J] + radius)
     for r in range(n):
         e2 = 0.0
         for j in range(q.shape[0]):
@@ -475,39 +453,27 @@ def flange_target(T, base_inv, tool_inv):
 
 
 @nb.njit(cache=True)
-def solve_one(
-    family,
-    P,
-    mtab,
-    rtab,
-    J,
-    base_inv,
-    tool_inv,
-    T,
-    signs,
-    hint,
-    has_hint,
-    revolute,
-    lower,
-    upper,
-    n_scan,
-    tol_pos,
-    tol_ori,
-    q_out,
-):
+def solve_one(arm, settings, T, signs, hint, has_hint, q_out):
     """One OM solve: local Broyden, then the bounded search.
+
+    Args:
+        arm: (family, P, model table, real table, J, base^-1, tool^-1, revolute, lower,
+            upper), fixed per solver.
+        settings: (scan points, position tolerance, orientation tolerance).
 
     Returns (status, position error, orientation error, evaluations, within limits).
     """
+    family, P, mtab, rtab, J, base_inv, tool_inv, revolute, lower, upper = arm
+    n_scan, tol_pos, tol_ori = settings
     R, p = flange_target(T, base_inv, tool_inv)
     dof = q_out.shape[0]
-    q_prev = hint if has_hint else np.zeros(dof)
+    problem = make_problem(family, P, mtab, rtab, J, R, p, signs, hint if has_hint else np.zeros(dof))
+    counter = problem[9]
     q = np.empty(dof)
-    evals = 0
     if has_hint:
         w0 = hint[J] if J >= 0 else 0.0
     else:  # the paper's fixed-point start, p_m = p_d
-        reach = model_ik(family, P, mtab, R, p, signs, q_prev, q) >= -REACH_SLACK
+        reach = model_ik(family, P, mtab, R, p, signs, problem[8], q) >= -REACH_SLACK
         w0 = q[J] if (reach and J >= 0) else np.nan
         if not reach and J >= 0:
             # p_d is outside the model's reach: start from the point of the dp circle
@@ -515,28 +481,25 @@ def solve_one(
             best = np.inf
             for k in range(_START_POINTS):
                 w = -np.pi + 2.0 * np.pi * k / _START_POINTS
-                g = _g(family, P, mtab, rtab, J, R, p, signs, q_prev, w, q)
+                g = _g(problem, w, q)
                 if abs(g) < best:  # False for NaN
                     best, w0 = abs(g), w
-            evals += _START_POINTS
     if not np.isnan(w0):
-        _, evals = _broyden(family, P, mtab, rtab, J, R, p, signs, q_prev, w0, q)
-        if verify(family, P, rtab, R, p, signs, q, tol_pos, tol_ori)[2]:
+        _broyden(problem, w0, q)
+        if verify(problem, q, tol_pos, tol_ori)[2]:
             if has_hint and J >= 0:
-                _nearest_in_window(family, P, mtab, rtab, J, R, p, signs, hint, tol_pos, tol_ori, q)
-                evals += _WINDOW_POINTS
+                _nearest_in_window(problem, hint, tol_pos, tol_ori, q)
             q_out[:] = q
             inside = representative(q_out, revolute, lower, upper, hint, has_hint)
-            pos, ori, _ = verify(family, P, rtab, R, p, signs, q_out, tol_pos, tol_ori)
-            return OK, pos, ori, evals, inside
+            pos, ori, _ = verify(problem, q_out, tol_pos, tol_ori)
+            return OK, pos, ori, counter[0], inside
     roots = np.empty((MAX_ROOTS, dof))
-    n = all_roots(family, P, mtab, rtab, J, R, p, signs, q_prev, n_scan, tol_pos, tol_ori, roots)
-    evals += 2 * n_scan
+    n = all_roots(problem, n_scan, tol_pos, tol_ori, roots)
     if n == 0:
         q_out[:] = np.nan
-        if _exists_other(family, P, mtab, rtab, J, R, p, signs, q_prev, n_scan, tol_pos, tol_ori):
-            return NO_SOLUTION_IN_CONFIGURATION, np.nan, np.nan, evals, False
-        return UNREACHABLE, np.nan, np.nan, evals, False
+        if _exists_other(problem, n_scan, tol_pos, tol_ori):
+            return NO_SOLUTION_IN_CONFIGURATION, np.nan, np.nan, counter[0], False
+        return UNREACHABLE, np.nan, np.nan, counter[0], False
     # The root nearest the hint; without one, nearest the fixed-point start's joint J.
     best, best_dist = 0, np.inf
     for r in range(n):
@@ -550,55 +513,12 @@ def solve_one(
             best, best_dist = r, dist
     q_out[:] = roots[best]
     inside = representative(q_out, revolute, lower, upper, hint, has_hint)
-    pos, ori, _ = verify(family, P, rtab, R, p, signs, q_out, tol_pos, tol_ori)
-    return OK, pos, ori, evals, inside
+    pos, ori, _ = verify(problem, q_out, tol_pos, tol_ori)
+    return OK, pos, ori, counter[0], inside
 
 
 @nb.njit(cache=True, parallel=True)
-def solve_batch_kernel(
-    family,
-    P,
-    mtab,
-    rtab,
-    J,
-    base_inv,
-    tool_inv,
-    Ts,
-    signs,
-    hints,
-    has_hint,
-    revolute,
-    lower,
-    upper,
-    n_scan,
-    tol_pos,
-    tol_ori,
-    q_out,
-    status,
-    pos,
-    ori,
-    evals,
-    within,
-):
+def solve_batch_kernel(arm, settings, Ts, signs, hints, has_hint, q_out, status, pos, ori, evals, within):
     for m in nb.prange(Ts.shape[0]):
-        st, e_pos, e_ori, ev, inside = solve_one(
-            family,
-            P,
-            mtab,
-            rtab,
-            J,
-            base_inv,
-            tool_inv,
-            Ts[m],
-            signs[m],
-            hints[m],
-            has_hint,
-            revolute,
-            lower,
-            upper,
-            n_scan,
-            tol_pos,
-            tol_ori,
-            q_out[m],
-        )
+        st, e_pos, e_ori, ev, inside = solve_one(arm, settings, Ts[m], signs[m], hints[m], has_hint, q_out[m])
         status[m], pos[m], ori[m], evals[m], within[m] = st, e_pos, e_ori, ev, inside

@@ -112,7 +112,8 @@ class OMSolver:
         self.scan_points = int(scan_points)
         self.om: ModelArm = derive_model(self.arm)
         chain = self.arm.chain
-        self._static = (
+        # The data every kernel call needs, in the layout of om_system.solve_one.
+        self._kernel_arm = (
             self.om.family,
             self.om.params,
             self.om.model.chain.table,
@@ -120,8 +121,11 @@ class OMSolver:
             self.om.dp_joint,
             np.linalg.inv(chain.T_root_base),
             np.linalg.inv(chain.T_flange_tool),
+            self.arm.revolute,
+            self.arm.lower,
+            self.arm.upper,
         )
-        self._limits = (self.arm.revolute, self.arm.lower, self.arm.upper)
+        self._kernel_settings = (self.scan_points, *self.tolerances)
 
     @property
     def model(self) -> Arm:
@@ -171,15 +175,7 @@ class OMSolver:
         hint, has_hint = self._hint(q_hint)
         q = np.empty(self.arm.dof)
         status, pos, ori, evals, within = om_system.solve_one(
-            *self._static,
-            T,
-            signs,
-            hint,
-            has_hint,
-            *self._limits,
-            self.scan_points,
-            *self.tolerances,
-            q,
+            self._kernel_arm, self._kernel_settings, T, signs, hint, has_hint, q
         )
         return Solution(
             q, status == om_system.OK, om_system.STATUS_NAMES[status], configuration, pos, ori, evals, within
@@ -187,20 +183,18 @@ class OMSolver:
 
     def solve_all(self, T: Any, configuration: Configuration) -> list[Solution]:
         """Every real solution with this configuration (the bounded search), possibly none."""
-        R, p = om_system.flange_target(as_pose(T), *self._static[5:])
-        signs = self._signs(configuration)
-        roots = np.empty((om_system.MAX_ROOTS, self.arm.dof))
+        family, P, mtab, rtab, J, base_inv, tool_inv, revolute, lower, upper = self._kernel_arm
+        R, p = om_system.flange_target(as_pose(T), base_inv, tool_inv)
         zeros = np.zeros(self.arm.dof)
-        n = om_system.all_roots(
-            *self._static[:5], R, p, signs, zeros, self.scan_points, *self.tolerances, roots
-        )
+        problem = om_system.make_problem(family, P, mtab, rtab, J, R, p, self._signs(configuration), zeros)
+        roots = np.empty((om_system.MAX_ROOTS, self.arm.dof))
+        n = om_system.all_roots(problem, self.scan_points, *self.tolerances, roots)
+        evals = int(problem[9][0])
         solutions = []
         for q in roots[:n]:
-            within = om_system.representative(q, *self._limits, zeros, False)
-            pos, ori, _ = om_system.verify(
-                self.om.family, self.om.params, self.arm.chain.table, R, p, signs, q, *self.tolerances
-            )
-            solutions.append(Solution(q, True, "ok", configuration, pos, ori, self.scan_points, within))
+            within = om_system.representative(q, revolute, lower, upper, zeros, False)
+            pos, ori, _ = om_system.verify(problem, q, *self.tolerances)
+            solutions.append(Solution(q, True, "ok", configuration, pos, ori, evals, within))
         return solutions
 
     def solve_batch(
@@ -236,14 +230,12 @@ class OMSolver:
         pos, ori, evals = np.empty(m), np.empty(m), np.empty(m, dtype=np.int64)
         within = np.empty(m, dtype=np.bool_)
         om_system.solve_batch_kernel(
-            *self._static,
+            self._kernel_arm,
+            self._kernel_settings,
             T,
             signs,
             hints,
             has_hint,
-            *self._limits,
-            self.scan_points,
-            *self.tolerances,
             q,
             status,
             pos,
