@@ -117,6 +117,32 @@ class KinematicChain:
         """The same chain with other rows (same base and tool)."""
         return KinematicChain(tuple(rows), self.T_root_base, self.T_flange_tool)
 
+    def joint_placements(self) -> tuple[np.ndarray, np.ndarray]:
+        r"""The chain as joint motions between constant transforms, as MJCF and URDF want it.
+
+        A revolute row is :math:`R_z(q)\,C` and a prismatic one :math:`T_z(q)\,C` with
+        :math:`C = R_z(\theta) T_z(d) T_x(a) R_x(\alpha)` (:math:`T_z` commutes with
+        :math:`R_z`), so
+
+        .. math::  T_{root,ee}(q) = P_1\, M_1(q_1)\, P_2\, M_2(q_2) \cdots P_n\, M_n(q_n)\, P_{tail},
+
+        where :math:`M_i` moves about or along the local z-axis and every :math:`P` is
+        constant (fixed rows, base and tool folded in).
+
+        Returns:
+            ``(P, P_tail)``: (dof, 4, 4) placements of each joint frame in the previous
+            joint's moving frame (the first in the root frame), and (4, 4) the end-effector
+            frame in the last joint's moving frame.
+        """
+        placements = []
+        current = self.T_root_base.copy()
+        for row in self.rows:
+            if row.is_joint:
+                placements.append(current)
+                current = np.eye(4)
+            current = current @ _row_transform(row)
+        return np.array(placements).reshape(-1, 4, 4), current @ self.T_flange_tool
+
     def fk(self, q: np.ndarray) -> np.ndarray:
         """Pose of the end-effector frame in the root frame.
 
@@ -148,6 +174,19 @@ class KinematicChain:
         if q.ndim != 1:
             raise ValueError("jacobian takes one joint vector")
         return jacobian_kernel(self.table, self.T_root_base, self.T_flange_tool, q)
+
+
+def _row_transform(row: DHRow) -> np.ndarray:
+    """The constant part :math:`R_z(\\theta) T_z(d) T_x(a) R_x(\\alpha)` of a row (4x4)."""
+    ct, st, ca, sa = np.cos(row.theta), np.sin(row.theta), np.cos(row.alpha), np.sin(row.alpha)
+    return np.array(
+        [
+            [ct, -st * ca, st * sa, row.a * ct],
+            [st, ct * ca, -ct * sa, row.a * st],
+            [0.0, sa, ca, row.d],
+            [0.0, 0.0, 0.0, 1.0],
+        ]
+    )
 
 
 # ---------------------------------------------------------------------------------------

@@ -86,6 +86,17 @@ def test_standard_fk_is_the_product_of_rows(chain, data):
 
 @settings(max_examples=60, deadline=None)
 @given(chains(), st.data())
+def test_joint_placements_compose_to_fk(chain, data):
+    q = data.draw(arrays(np.float64, chain.dof, elements=st.floats(-3, 3)))
+    placements, tail = chain.joint_placements()
+    T = np.eye(4)
+    for P, qi, row in zip(placements, q, (r for r in chain.rows if r.is_joint), strict=True):
+        T = T @ P @ (rot_z(qi) if row.kind is om.JointKind.REVOLUTE else trans(0, 0, qi))
+    np.testing.assert_allclose(T @ tail, chain.fk(q), atol=1e-12)
+
+
+@settings(max_examples=60, deadline=None)
+@given(chains(), st.data())
 def test_jacobian_matches_finite_differences(chain, data):
     q = data.draw(arrays(np.float64, chain.dof, elements=st.floats(-3, 3)))
     J = chain.jacobian(q)
