@@ -12,6 +12,9 @@ from .exceptions import UnknownArm as UnknownArm
 from .kinematics import DHRow as DHRow
 from .kinematics import JointKind as JointKind
 from .kinematics import KinematicChain as KinematicChain
+from .mjcf import arm_mjcf as arm_mjcf
+from .mjcf import arm_model as arm_model
+from .mjcf import scene_mjcf as scene_mjcf
 from .model import ModelArm as ModelArm
 from .model import derive_model as derive_model
 from .solver import BatchSolution as BatchSolution

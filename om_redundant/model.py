@@ -1,18 +1,26 @@
 r"""Offset modification: the model arm of a real arm, and the position difference dp.
 
-For a 6-DOF arm satisfying the paper's Theorem 2 (joints 1-3 position joint 4's origin;
-joints 4-6 revolute, non-parallel, not intersecting) the model zeroes :math:`a_4, a_5, d_5`
-(standard DH, joint-indexed rows), which makes the wrist spherical. Both arms share all
-rotations, so for equal joints the hand orientations agree and the positions differ by
+The model keeps every rotation of the real arm (twists and joint offsets theta) and zeroes
+the few lengths that stand in the way of a closed form:
+
+* 6-DOF arms satisfying the paper's Theorem 2 (joints 1-3 position joint 4's origin; joints
+  4-6 revolute, non-parallel, not intersecting): :math:`a_4, a_5, d_5` (standard DH,
+  joint-indexed rows), which makes the wrist spherical.
+* 7-DOF arms: :math:`a_1, a_2, d_2` and :math:`a_5, a_6, d_6`, which make the shoulder and
+  the wrist spherical while the elbow keeps its offsets (a Hollerbach arm, see
+  :mod:`om_redundant.closed_form.srs`).
+
+For equal joints the hand orientations agree and the positions differ by
 
 .. math::
 
     \Delta p(q) = p_{model}(q) - p_{real}(q) = R_{flange}(q)\,\delta(q_J),
 
-where :math:`\delta`, dp seen from the flange, depends on a few wrist joints J only. For
-Theorem-2 arms with :math:`a_4 = 0` (UR5e, the Spherical arm), J is joint 6 alone and
-:math:`|\delta| = \sqrt{d_5^2 + a_5^2}`: the solutions of the OM system (9) lie on a circle
-in the ball :math:`|p_m - p_d| \le \Delta p_{max}`, which the solver scans exhaustively.
+where :math:`\delta`, dp seen from the flange, depends on one wrist joint J only for the
+arms handled here: joint 6 of UR5e and the Spherical arm (:math:`a_4 = 0`), joint 7 of the
+Panda, FR3 and xArm7 (their wrist offset :math:`a_6`); the iiwa14 has :math:`\Delta p = 0`.
+The solutions of the OM system (9) then lie on a circle in the ball
+:math:`|p_m - p_d| \le \Delta p_{max}`, which the solver scans exhaustively.
 """
 
 from __future__ import annotations
@@ -23,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .arm import Arm
-from .closed_form import six_dof
+from .closed_form import six_dof, srs
 from .exceptions import ModelError
 from .kinematics import DHRow, JointKind, KinematicChain, flange_kernel
 
@@ -41,7 +49,12 @@ class ModelArm:
         family_name: Human-readable family name.
         params: Parameter vector of the family kernel.
         sign_names: Names of the configuration's branch signs.
+        redundancy_names: Names of the configuration's redundancy values (``("psi",)`` for a
+            7-DOF arm, empty for 6-DOF).
         dp_joint: Index of the joint that :math:`\\delta` depends on, or -1 for none.
+        delta: (3, 3) coefficients of dp seen from the flange, rows :math:`D_0, D_1, D_2`:
+            :math:`\\delta(q_J) = D_0 + D_1 \\cos q_J + D_2 \\sin q_J` (a revolute joint's
+            angle enters the flange frame through one rotation about z).
         dp_max: :math:`\\max_q |\\Delta p(q)|` in metres.
     """
 
@@ -51,7 +64,9 @@ class ModelArm:
     family_name: str
     params: np.ndarray
     sign_names: tuple[str, ...]
+    redundancy_names: tuple[str, ...]
     dp_joint: int
+    delta: np.ndarray
     dp_max: float
 
     def dp(self, q: np.ndarray) -> np.ndarray:
@@ -62,15 +77,37 @@ class ModelArm:
 def derive_model(arm: Arm) -> ModelArm:
     """Derive the closed-form model arm of a real arm.
 
+    6-DOF arms get a spherical-wrist model (Theorem 2); 7-DOF arms a Hollerbach model with a
+    spherical shoulder and wrist (:mod:`om_redundant.closed_form.srs`), keeping the elbow's
+    offsets.
+
     Raises:
-        ModelError: The arm violates a condition of Theorem 2 or matches no family; the
+        ModelError: The arm matches no family, or dp depends on more than one joint; the
             message names the condition.
     """
-    if arm.dof != 6:
-        raise ModelError(
-            f"arm '{arm.name}' has {arm.dof} joints; the offset-modified model is built for "
-            "6-DOF arms (Theorem 2)"
-        )
+    if arm.dof == 6:
+        model_chain, family, family_name, params = _six_dof_model(arm)
+        sign_names, redundancy_names = ("ARM", "ELBOW", "WRIST"), ()
+    elif arm.dof == 7:
+        model_chain, params = _srs_model(arm)
+        family, family_name = srs.SRS, "S-R-S: spherical shoulder, elbow, spherical wrist"
+        sign_names, redundancy_names = ("SHOULDER", "ELBOW", "WRIST"), ("psi",)
+    else:
+        raise ModelError(f"arm '{arm.name}' has {arm.dof} joints; models exist for 6- and 7-DOF arms")
+    model = arm.with_chain(model_chain, f"{arm.name}-model")
+    dp_joint = _dp_joint(arm.name, arm.chain, model_chain)
+    delta = _delta_coefficients(arm, model_chain, dp_joint)
+    w = np.linspace(-np.pi, np.pi, 3601)
+    dp_max = float(
+        np.linalg.norm(delta[0] + np.outer(np.cos(w), delta[1]) + np.outer(np.sin(w), delta[2]), axis=1).max()
+    )
+    return ModelArm(
+        arm, model, family, family_name, params, sign_names, redundancy_names, dp_joint, delta, dp_max
+    )
+
+
+def _six_dof_model(arm: Arm) -> tuple[KinematicChain, int, str, np.ndarray]:
+    """Theorem 2: zero a4, a5, d5 for a spherical wrist."""
     rows = list(arm.chain.rows)
     jr = arm.chain.joint_rows
     for j in (3, 4, 5):
@@ -79,16 +116,7 @@ def derive_model(arm: Arm) -> ModelArm:
     if jr[5] - jr[3] != 2:
         raise ModelError(f"arm '{arm.name}': fixed rows between the wrist joints are not supported")
     for j in (3, 4):
-        if abs(np.sin(rows[jr[j]].alpha)) < _ANGLE_EPS:
-            raise ModelError(
-                f"arm '{arm.name}': Theorem 2 C3 needs wrist joints {j + 1} and {j + 2} non-parallel "
-                f"(alpha_{j + 1} = {np.degrees(rows[jr[j]].alpha):g} deg)"
-            )
-        if abs(abs(np.sin(rows[jr[j]].alpha)) - 1.0) > _ANGLE_EPS:
-            raise ModelError(
-                f"arm '{arm.name}': the spherical-wrist closed form needs alpha_{j + 1} = +-90 deg, "
-                f"got {np.degrees(rows[jr[j]].alpha):g} deg"
-            )
+        _check_right_angle(arm.name, rows[jr[j]], j)
     if abs(rows[jr[3]].a) > 0.0:
         raise ModelError(
             f"arm '{arm.name}': a4 = {rows[jr[3]].a:g} != 0 makes dp depend on joints 5 and 6; "
@@ -103,20 +131,118 @@ def derive_model(arm: Arm) -> ModelArm:
         params[key] = np.sign(np.sin(rows[jr[j]].alpha))
     for key, j in ((six_dof.THETA4, 3), (six_dof.THETA5, 4), (six_dof.THETA6, 5)):
         params[key] = rows[jr[j]].theta
-    # E: from the frame after Rz(phi6) to the flange (row 6's twist and fixed rows after it).
-    tail = [dataclasses.replace(rows[jr[5]], theta=0.0, d=0.0, kind=JointKind.FIXED), *rows[jr[5] + 1 :]]
-    R_tail, _ = _pose(KinematicChain(tuple(tail)).table, np.zeros(0))
-    params[six_dof.E_ROT : six_dof.E_ROT + 9] = R_tail.ravel()
+    params[six_dof.E_ROT : six_dof.E_ROT + 9] = _tail_rotation(rows, jr[5]).ravel()
     # Wrist centre in the flange frame: origin of joint 5's frame, the same for any q.
     q0 = np.zeros(6)
     _, o4 = _pose(model_chain.table[: jr[3] + 1], q0[:4])
     R_fl, p_fl = _pose(model_chain.table, q0)
     params[six_dof.WRIST_CENTRE : six_dof.WRIST_CENTRE + 3] = R_fl.T @ (o4 - p_fl)
+    return model_chain, family, family_name, params
 
-    model = arm.with_chain(model_chain, f"{arm.name}-model")
-    dp_joint = _dp_joint(arm.chain, model_chain)
-    dp_max = _dp_max(arm.chain, model_chain, dp_joint)
-    return ModelArm(arm, model, family, family_name, params, ("ARM", "ELBOW", "WRIST"), dp_joint, dp_max)
+
+def _srs_model(arm: Arm) -> tuple[KinematicChain, np.ndarray]:
+    r"""Zero the offsets that keep joints 1-3 (a1, a2, d2) and 5-7 (a5, a6, d6) from meeting.
+
+    In standard DH, joint i+1 turns about :math:`z_i` through :math:`o_i`. Axes 1 and 2 meet
+    (at S = :math:`o_1`) iff :math:`a_1 = 0`; axis 3 passes through S iff :math:`d_2 = a_2 = 0`;
+    likewise :math:`a_5 = 0` and :math:`d_6 = a_6 = 0` put axes 5-7 through W = :math:`o_5`.
+    The elbow's offsets (:math:`a_3, d_4, a_4`) are kept.
+    """
+    rows = list(arm.chain.rows)
+    jr = arm.chain.joint_rows
+    if any(rows[r].kind is not JointKind.REVOLUTE for r in jr):
+        raise ModelError(f"arm '{arm.name}': the 7-DOF model needs revolute joints")
+    if jr[-1] - jr[0] != 6:
+        raise ModelError(f"arm '{arm.name}': fixed rows between joints are not supported by the 7-DOF model")
+    for j in (0, 1, 4, 5):
+        _check_right_angle(arm.name, rows[jr[j]], j)
+    for j, fields in ((0, ("a",)), (1, ("a", "d")), (4, ("a",)), (5, ("a", "d"))):
+        rows[jr[j]] = dataclasses.replace(rows[jr[j]], **dict.fromkeys(fields, 0.0))
+    chain = arm.chain.replace_rows(rows)
+    table = chain.table
+
+    def frame(k: int, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return _pose(table[: jr[0] + k], q[:k])  # frame k, after joint k's row
+
+    _check_concurrent(arm.name, chain, "shoulder", (0, 1, 2))
+    _check_concurrent(arm.name, chain, "wrist", (4, 5, 6))
+    q0 = np.zeros(7)
+    (_, S), (R3, o3), (_, W) = (frame(k, q0) for k in (1, 3, 5))
+    R_fl, p_fl = _pose(table, q0)
+    s3 = R3.T @ (S - o3)
+    u = _rotz(-rows[jr[3]].theta) @ R3.T @ (W - o3)
+    k0 = u @ u + s3 @ s3 - 2.0 * s3[2] * u[2]
+    k1 = -2.0 * (s3[0] * u[0] + s3[1] * u[1])
+    k2 = -2.0 * (s3[1] * u[0] - s3[0] * u[1])
+    if np.hypot(k1, k2) < 1e-9:
+        raise ModelError(f"arm '{arm.name}': joint 4 does not change the shoulder-wrist distance")
+    P = np.zeros(srs.N_PARAMS)
+    P[srs.SIGMA1], P[srs.SIGMA2], P[srs.SIGMA5], P[srs.SIGMA6] = (
+        np.sign(np.sin(rows[jr[j]].alpha)) for j in (0, 1, 4, 5)
+    )
+    P[srs.THETA : srs.THETA + 7] = [rows[r].theta for r in jr]
+    P[srs.SHOULDER : srs.SHOULDER + 3] = S
+    P[srs.WRIST : srs.WRIST + 3] = R_fl.T @ (W - p_fl)
+    P[srs.S3 : srs.S3 + 3] = s3
+    P[srs.U : srs.U + 3] = u
+    P[srs.K0], P[srs.K], P[srs.PHI_STAR] = k0, np.hypot(k1, k2), np.arctan2(k2, k1)
+    P[srs.R_PRE : srs.R_PRE + 9] = _pose(table[: jr[0]], q0[:0])[0].ravel()
+    P[srs.X3 : srs.X3 + 9] = _rotx(rows[jr[2]].alpha).ravel()
+    P[srs.X4 : srs.X4 + 9] = _rotx(rows[jr[3]].alpha).ravel()
+    P[srs.E_ROT : srs.E_ROT + 9] = _tail_rotation(rows, jr[6]).ravel()
+    R_base = chain.T_root_base[:3, :3]
+    # sigma: with the elbow bent (phi4 = phi* + pi/2, ELBOW = +1), b3 points to the elbow -s3.
+    v = _rotz(P[srs.PHI_STAR] + np.pi / 2) @ u - s3
+    P[srs.BEND] = np.sign(np.cross([0.0, 0.0, 1.0], v) @ -s3)
+    P[srs.UP : srs.UP + 3] = R_base.T @ np.array([0.0, 0.0, 1.0])
+    P[srs.REF : srs.REF + 3] = R_base.T @ np.array([-1.0, 0.0, 0.0])
+    return chain, P
+
+
+def _check_right_angle(name: str, row: DHRow, j: int) -> None:
+    if abs(np.sin(row.alpha)) < _ANGLE_EPS:
+        raise ModelError(
+            f"arm '{name}': joints {j + 1} and {j + 2} are parallel; the spherical joint triple "
+            "needs them non-parallel (Theorem 2 C3)"
+        )
+    if abs(abs(np.sin(row.alpha)) - 1.0) > _ANGLE_EPS:
+        raise ModelError(
+            f"arm '{name}': the closed form needs joints {j + 1} and {j + 2} perpendicular "
+            f"(alpha_{j + 1} = +-90 deg), got {np.degrees(row.alpha):g} deg"
+        )
+
+
+def _check_concurrent(name: str, chain: KinematicChain, what: str, joints: tuple[int, ...]) -> None:
+    """Check that the axes of three consecutive joints pass through one point for any q.
+
+    The point is the origin of the first joint's DH frame; joint j turns about the z-axis of
+    the frame that ends the row before it.
+    """
+    jr = chain.joint_rows
+    rng = np.random.default_rng(0)
+    for _ in range(4):
+        q = rng.uniform(-np.pi, np.pi, chain.dof)
+        point = _pose(chain.table[: jr[joints[0]] + 1], q[: joints[0] + 1])[1]
+        for j in joints:
+            R, p = _pose(chain.table[: jr[j]], q[:j])
+            if np.linalg.norm(np.cross(point - p, R[:, 2])) > 1e-9:
+                raise ModelError(f"arm '{name}': the model's {what} axes do not meet in one point")
+
+
+def _rotx(alpha: float) -> np.ndarray:
+    c, s = np.cos(alpha), np.sin(alpha)
+    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+def _rotz(theta: float) -> np.ndarray:
+    c, s = np.cos(theta), np.sin(theta)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def _tail_rotation(rows: list[DHRow], last: int) -> np.ndarray:
+    """Rotation from the frame after the last joint's Rz(phi) to the flange."""
+    tail = [DHRow(alpha=rows[last].alpha, kind=JointKind.FIXED), *rows[last + 1 :]]
+    return _pose(KinematicChain(tuple(tail)).table, np.zeros(0))[0]
 
 
 def _position_family(name: str, rows: list[DHRow], jr: list[int]) -> tuple[int, str, np.ndarray]:
@@ -168,7 +294,7 @@ def _delta(real: KinematicChain, model: KinematicChain, q: np.ndarray) -> np.nda
     return R.T @ (p_model - p_real)
 
 
-def _dp_joint(real: KinematicChain, model: KinematicChain) -> int:
+def _dp_joint(name: str, real: KinematicChain, model: KinematicChain) -> int:
     """The joint that delta (dp in the flange frame) depends on; -1 if it is constant."""
     rng = np.random.default_rng(0)
     dependent = set()
@@ -181,16 +307,26 @@ def _dp_joint(real: KinematicChain, model: KinematicChain) -> int:
             if np.abs(_delta(real, model, moved) - base).max() > 1e-12:
                 dependent.add(j)
     if len(dependent) > 1:
-        raise ModelError(f"dp depends on joints {sorted(d + 1 for d in dependent)}; one is supported")
+        raise ModelError(
+            f"arm '{name}': dp seen from the flange depends on joints {sorted(d + 1 for d in dependent)}; "
+            "the bounded search handles one"
+        )
     return dependent.pop() if dependent else -1
 
 
-def _dp_max(real: KinematicChain, model: KinematicChain, dp_joint: int) -> float:
-    q = np.zeros(real.dof)
-    if dp_joint < 0:
-        return float(np.linalg.norm(_delta(real, model, q)))
-    norms = []
-    for w in np.linspace(-np.pi, np.pi, 721):
-        q[dp_joint] = w
-        norms.append(np.linalg.norm(_delta(real, model, q)))
-    return float(max(norms))
+def _delta_coefficients(arm: Arm, model: KinematicChain, dp_joint: int) -> np.ndarray:
+    """Fit delta(w) = D0 + D1 cos w + D2 sin w exactly from four angles, and check it at others."""
+    rng = np.random.default_rng(1)
+    q = rng.uniform(-np.pi, np.pi, arm.dof)
+
+    def delta(w: float) -> np.ndarray:
+        if dp_joint >= 0:
+            q[dp_joint] = w
+        return _delta(arm.chain, model, q)
+
+    d0, d1, d2, d3 = (delta(w) for w in (0.0, np.pi / 2, np.pi, -np.pi / 2))
+    D = np.array([(d0 + d2) / 2, (d0 - d2) / 2, (d1 - d3) / 2])
+    for w in rng.uniform(-np.pi, np.pi, 16):
+        if np.abs(D[0] + D[1] * np.cos(w) + D[2] * np.sin(w) - delta(w)).max() > 1e-13:
+            raise ModelError(f"arm '{arm.name}': dp seen from the flange is not affine in cos and sin of q_J")
+    return D

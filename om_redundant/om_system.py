@@ -31,7 +31,8 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from .closed_form import REACH_SLACK, branch_values, model_ik
+from .closed_form import REACH_SLACK, branch_values, model_ik, redundancy_values, wrap
+from .closed_form.common import dot, mtm
 from .kinematics import flange_kernel
 
 OK = 0
@@ -45,55 +46,54 @@ _SAME_ROOT = 1e-9  # joint-space distance under which two roots are one
 _START_POINTS = 8  # samples of the dp circle tried when p_d is outside the model's reach
 _WINDOW_POINTS = 8  # samples of the window searched around a hint
 _PAIR_SEARCH = 1.0  # |g| (rad) below which a local minimum is searched for a root pair
+_REDUNDANCY_TOL = 1e-9  # a solution's redundancy values (rad) must equal the requested ones
 
 
 @nb.njit(cache=True, inline="always")
-def _wrap(x):
-    return x - 2.0 * np.pi * np.floor((x + np.pi) / (2.0 * np.pi))
+def _delta(D, w):
+    """dp seen from the flange, delta(w) = D0 + D1 cos w + D2 sin w (see ModelArm.delta)."""
+    c, s = np.cos(w), np.sin(w)
+    return (
+        D[0, 0] + D[1, 0] * c + D[2, 0] * s,
+        D[0, 1] + D[1, 1] * c + D[2, 1] * s,
+        D[0, 2] + D[1, 2] * c + D[2, 2] * s,
+    )
 
 
 @nb.njit(cache=True)
-def _delta(mtab, rtab, J, w, dof):
-    """dp seen from the flange, delta(w): the same for every q with q_J = w."""
-    q = np.zeros(dof)
-    if J >= 0:
-        q[J] = w
-    Rm, pm, Rr, pr = np.empty((3, 3)), np.empty(3), np.empty((3, 3)), np.empty(3)
-    flange_kernel(mtab, q, Rm, pm)
-    flange_kernel(rtab, q, Rr, pr)
-    return Rr.T @ (pm - pr)
-
-
-@nb.njit(cache=True)
-def make_problem(family, P, mtab, rtab, J, R, p, signs, q_prev):
+def make_problem(family, P, mtab, rtab, J, D, R, p, signs, redundancy, q_prev):
     """Bundle one target's data: model family and parameters, model and real DH tables,
-    the joint J that dp depends on, the flange pose (R, p), the branch signs, the joints
-    kept at singularities (q_prev), and an evaluation counter."""
-    return (family, P, mtab, rtab, J, R, p, signs, q_prev, np.zeros(1, dtype=np.int64))
+    the joint J that dp depends on and the coefficients D of delta, the flange pose (R, p),
+    the configuration (branch signs and redundancy values), the joints kept at
+    singularities (q_prev), and an evaluation counter."""
+    return (family, P, mtab, rtab, J, D, R, p, signs, redundancy, q_prev, np.zeros(1, dtype=np.int64))
 
 
 @nb.njit(cache=True)
 def _with_signs(problem, signs):
     """The same problem in another configuration, sharing the evaluation counter."""
-    family, P, mtab, rtab, J, R, p, _, q_prev, counter = problem
-    return (family, P, mtab, rtab, J, R, p, signs, q_prev, counter)
+    family, P, mtab, rtab, J, D, R, p, _, redundancy, q_prev, counter = problem
+    return (family, P, mtab, rtab, J, D, R, p, signs, redundancy, q_prev, counter)
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def _g_margin(problem, w, q):
     """Residual g(w) (NaN if unreachable) and the model's reach margin; writes the IK into q."""
-    family, P, mtab, rtab, J, R, p, signs, q_prev, counter = problem
+    family, P, mtab, _, J, D, R, p, signs, redundancy, q_prev, counter = problem
     counter[0] += 1
-    pm = p + R @ _delta(mtab, rtab, J, w, q.shape[0])
-    margin = model_ik(family, P, mtab, R, pm, signs, q_prev, q)
+    d = _delta(D, w)
+    pm = np.empty(3)
+    for k in range(3):
+        pm[k] = p[k] + R[k, 0] * d[0] + R[k, 1] * d[1] + R[k, 2] * d[2]
+    margin = model_ik(family, P, mtab, R, pm, signs, redundancy, q_prev, q)
     if margin < -REACH_SLACK:
         return np.nan, margin
     if J < 0:
         return 0.0, margin
-    return _wrap(q[J] - w), margin
+    return wrap(q[J] - w), margin
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def _g(problem, w, q):
     """Residual g(w) of the reduced system; writes the model IK into q. NaN if unreachable."""
     return _g_margin(problem, w, q)[0]
@@ -153,36 +153,59 @@ def _refine_bracket(problem, a, ga, b, gb, q):
 
 @nb.njit(cache=True)
 def _reach_edge(problem, inside, outside, q):
-    """Bisect towards the edge of the model's reach; returns a reachable point next to it."""
-    for _ in range(52):
-        mid = 0.5 * (inside + outside)
-        if np.isnan(_g(problem, mid, q)):
-            outside = mid
+    """A reachable point next to the edge of the model's reach, between inside and outside.
+
+    Illinois regula falsi on the reach margin, which is smooth across the edge, keeping
+    margin(inside) >= -slack > margin(outside) until the two are adjacent.
+    """
+    fi = _g_margin(problem, inside, q)[1] + REACH_SLACK
+    fo = _g_margin(problem, outside, q)[1] + REACH_SLACK
+    side = 0
+    for _ in range(80):
+        if abs(outside - inside) <= 4e-16 * max(1.0, abs(inside)):
+            break
+        c = (inside * fo - outside * fi) / (fo - fi)
+        if not min(inside, outside) < c < max(inside, outside):
+            c = 0.5 * (inside + outside)
+        fc = _g_margin(problem, c, q)[1] + REACH_SLACK
+        if fc >= 0.0:
+            inside, fi = c, fc
+            if side == 1:
+                fo *= 0.5
+            side = 1
         else:
-            inside = mid
+            outside, fo = c, fc
+            if side == -1:
+                fi *= 0.5
+            side = -1
     return inside
 
 
 @nb.njit(cache=True)
 def verify(problem, q, tol_pos, tol_ori):
-    """Position and orientation error of the REAL arm at q and the branch check.
+    """Position and orientation error of the REAL arm at q, and the configuration check.
 
     Returns (position error, orientation error, accepted).
     """
-    family, P, _, rtab, _, R, p, signs, _, _ = problem
+    family, P, _, rtab, _, _, R, p, signs, redundancy, _, _ = problem
     Rr, pr = np.empty((3, 3)), np.empty(3)
     flange_kernel(rtab, q, Rr, pr)
     d = pr - p
-    pos = np.sqrt(d @ d)
-    E = R.T @ Rr
-    s = 0.5 * np.sqrt((E[2, 1] - E[1, 2]) ** 2 + (E[0, 2] - E[2, 0]) ** 2 + (E[1, 0] - E[0, 1]) ** 2)
-    ori = np.arctan2(s, 0.5 * (E[0, 0] + E[1, 1] + E[2, 2] - 1.0))
+    pos = np.sqrt(dot(d, d))
+    E = mtm(R, Rr)
+    s = 0.5 * np.sqrt((E[2][1] - E[1][2]) ** 2 + (E[0][2] - E[2][0]) ** 2 + (E[1][0] - E[0][1]) ** 2)
+    ori = np.arctan2(s, 0.5 * (E[0][0] + E[1][1] + E[2][2] - 1.0))
     values = np.empty(signs.shape[0])
     branch_values(family, P, q, values)
     same = True
     for i in range(signs.shape[0]):
         # A branch quantity at zero (a singular joint) belongs to both branches.
         if values[i] * signs[i] < -1e-12:
+            same = False
+    values = np.empty(redundancy.shape[0])
+    redundancy_values(family, P, q, values)
+    for i in range(redundancy.shape[0]):
+        if abs(wrap(values[i] - redundancy[i])) > _REDUNDANCY_TOL:
             same = False
     return pos, ori, same and pos <= tol_pos and ori <= tol_ori
 
@@ -366,7 +389,7 @@ def all_roots(problem, n_scan, tol_pos, tol_ori, roots, lo=-np.pi, hi=np.pi):
         for r in range(count):
             diff = 0.0
             for j in range(dof):
-                diff = max(diff, abs(_wrap(q[j] - roots[r, j])))
+                diff = max(diff, abs(wrap(q[j] - roots[r, j])))
             if diff < _SAME_ROOT:
                 duplicate = True
         if not duplicate and count < roots.shape[0]:
@@ -387,10 +410,10 @@ def representative(q, revolute, lower, upper, hint, has_hint):
             inside = inside and lower[j] <= q[j] <= upper[j]
             continue
         target = hint[j] if has_hint else 0.0
-        best = _wrap(q[j] - target) + target
+        best = wrap(q[j] - target) + target
         found = lower[j] <= best <= upper[j]
         if not found:
-            base = _wrap(q[j])
+            base = wrap(q[j])
             best_dist = np.inf
             for k in range(-3, 4):
                 cand = base + 2.0 * np.pi * k
@@ -404,10 +427,10 @@ def representative(q, revolute, lower, upper, hint, has_hint):
 @nb.njit(cache=True)
 def _exists_other(problem, n_scan, tol_pos, tol_ori):
     """Whether any configuration other than the problem's has a solution."""
-    signs = problem[7]
+    signs = problem[8]
     k = signs.shape[0]
     other = np.empty(k, dtype=np.int64)
-    roots = np.empty((MAX_ROOTS, problem[8].shape[0]))
+    roots = np.empty((MAX_ROOTS, problem[10].shape[0]))
     for code in range(2**k):
         same = True
         for i in range(k):
@@ -429,7 +452,7 @@ def _nearest_in_window(problem, hint, tol_pos, tol_ori, q):
     """
     d2 = 0.0
     for j in range(q.shape[0]):
-        d2 += _wrap(q[j] - hint[j]) ** 2
+        d2 += wrap(q[j] - hint[j]) ** 2
     radius = np.sqrt(d2)
     if radius < 1e-12:
         return
@@ -439,7 +462,7 @@ def _nearest_in_window(problem, hint, tol_pos, tol_ori, q):
     for r in range(n):
         e2 = 0.0
         for j in range(q.shape[0]):
-            e2 += _wrap(roots[r, j] - hint[j]) ** 2
+            e2 += wrap(roots[r, j] - hint[j]) ** 2
         if e2 < d2:
             d2 = e2
             q[:] = roots[r]
@@ -453,27 +476,28 @@ def flange_target(T, base_inv, tool_inv):
 
 
 @nb.njit(cache=True)
-def solve_one(arm, settings, T, signs, hint, has_hint, q_out):
+def solve_one(arm, settings, T, signs, redundancy, hint, has_hint, q_out):
     """One OM solve: local Broyden, then the bounded search.
 
     Args:
-        arm: (family, P, model table, real table, J, base^-1, tool^-1, revolute, lower,
+        arm: (family, P, model table, real table, J, D, base^-1, tool^-1, revolute, lower,
             upper), fixed per solver.
         settings: (scan points, position tolerance, orientation tolerance).
 
     Returns (status, position error, orientation error, evaluations, within limits).
     """
-    family, P, mtab, rtab, J, base_inv, tool_inv, revolute, lower, upper = arm
+    family, P, mtab, rtab, J, D, base_inv, tool_inv, revolute, lower, upper = arm
     n_scan, tol_pos, tol_ori = settings
     R, p = flange_target(T, base_inv, tool_inv)
     dof = q_out.shape[0]
-    problem = make_problem(family, P, mtab, rtab, J, R, p, signs, hint if has_hint else np.zeros(dof))
-    counter = problem[9]
+    q_prev = hint if has_hint else np.zeros(dof)
+    problem = make_problem(family, P, mtab, rtab, J, D, R, p, signs, redundancy, q_prev)
+    counter = problem[11]
     q = np.empty(dof)
     if has_hint:
         w0 = hint[J] if J >= 0 else 0.0
     else:  # the paper's fixed-point start, p_m = p_d
-        reach = model_ik(family, P, mtab, R, p, signs, problem[8], q) >= -REACH_SLACK
+        reach = model_ik(family, P, mtab, R, p, signs, redundancy, q_prev, q) >= -REACH_SLACK
         w0 = q[J] if (reach and J >= 0) else np.nan
         if not reach and J >= 0:
             # p_d is outside the model's reach: start from the point of the dp circle
@@ -506,9 +530,9 @@ def solve_one(arm, settings, T, signs, hint, has_hint, q_out):
         dist = 0.0
         if has_hint:
             for j in range(dof):
-                dist += _wrap(roots[r, j] - hint[j]) ** 2
+                dist += wrap(roots[r, j] - hint[j]) ** 2
         elif J >= 0 and not np.isnan(w0):
-            dist = abs(_wrap(roots[r, J] - w0))
+            dist = abs(wrap(roots[r, J] - w0))
         if dist < best_dist:
             best, best_dist = r, dist
     q_out[:] = roots[best]
@@ -518,7 +542,11 @@ def solve_one(arm, settings, T, signs, hint, has_hint, q_out):
 
 
 @nb.njit(cache=True, parallel=True)
-def solve_batch_kernel(arm, settings, Ts, signs, hints, has_hint, q_out, status, pos, ori, evals, within):
+def solve_batch_kernel(
+    arm, settings, Ts, signs, redundancy, hints, has_hint, q_out, status, pos, ori, evals, within
+):
     for m in nb.prange(Ts.shape[0]):
-        st, e_pos, e_ori, ev, inside = solve_one(arm, settings, Ts[m], signs[m], hints[m], has_hint, q_out[m])
+        st, e_pos, e_ori, ev, inside = solve_one(
+            arm, settings, Ts[m], signs[m], redundancy[m], hints[m], has_hint, q_out[m]
+        )
         status[m], pos[m], ori[m], evals[m], within[m] = st, e_pos, e_ori, ev, inside

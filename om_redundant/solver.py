@@ -119,6 +119,7 @@ class OMSolver:
             self.om.model.chain.table,
             chain.table,
             self.om.dp_joint,
+            self.om.delta,
             np.linalg.inv(chain.T_root_base),
             np.linalg.inv(chain.T_flange_tool),
             self.arm.revolute,
@@ -139,14 +140,22 @@ class OMSolver:
 
     @property
     def sign_names(self) -> tuple[str, ...]:
+        """Names of the configuration's branch signs, e.g. ``("SHOULDER", "ELBOW", "WRIST")``."""
         return self.om.sign_names
 
-    def configurations(self) -> list[Configuration]:
-        """Every branch-sign combination this arm's model distinguishes."""
-        return Configuration.all_signs(len(self.sign_names))
+    @property
+    def redundancy_names(self) -> tuple[str, ...]:
+        """Names of the configuration's redundancy values: ``("psi",)`` for 7-DOF arms."""
+        return self.om.redundancy_names
+
+    def configurations(self, redundancy: tuple[float, ...] = ()) -> list[Configuration]:
+        """Every branch-sign combination this arm's model distinguishes, with the given
+        redundancy values (a 7-DOF arm's arm angle; default 0)."""
+        redundancy = tuple(redundancy) or (0.0,) * len(self.redundancy_names)
+        return [Configuration(c.signs, redundancy) for c in Configuration.all_signs(len(self.sign_names))]
 
     def configuration_of(self, q: np.ndarray) -> Configuration:
-        """The configuration of joint vector q: the model's branch signs at q.
+        """The configuration of joint vector q: the model's branch signs and arm angle at q.
 
         A branch quantity that is exactly zero (a singular joint) counts as +1.
         """
@@ -155,7 +164,9 @@ class OMSolver:
             raise InvalidInput("configuration_of takes one joint vector")
         values = np.empty(len(self.sign_names))
         om_system.branch_values(self.om.family, self.om.params, q, values)
-        return Configuration(tuple(np.where(values < 0.0, -1, 1)))
+        redundancy = np.empty(len(self.redundancy_names))
+        om_system.redundancy_values(self.om.family, self.om.params, q, redundancy)
+        return Configuration(tuple(np.where(values < 0.0, -1, 1)), tuple(redundancy))
 
     def solve(self, T: Any, configuration: Configuration, q_hint: np.ndarray | None = None) -> Solution:
         """Joint vector reaching pose T in the given configuration.
@@ -171,11 +182,11 @@ class OMSolver:
             exists in this configuration.
         """
         T = as_pose(T)
-        signs = self._signs(configuration)
+        signs, redundancy = self._configuration(configuration)
         hint, has_hint = self._hint(q_hint)
         q = np.empty(self.arm.dof)
         status, pos, ori, evals, within = om_system.solve_one(
-            self._kernel_arm, self._kernel_settings, T, signs, hint, has_hint, q
+            self._kernel_arm, self._kernel_settings, T, signs, redundancy, hint, has_hint, q
         )
         return Solution(
             q, status == om_system.OK, om_system.STATUS_NAMES[status], configuration, pos, ori, evals, within
@@ -183,13 +194,14 @@ class OMSolver:
 
     def solve_all(self, T: Any, configuration: Configuration) -> list[Solution]:
         """Every real solution with this configuration (the bounded search), possibly none."""
-        family, P, mtab, rtab, J, base_inv, tool_inv, revolute, lower, upper = self._kernel_arm
+        family, P, mtab, rtab, J, D, base_inv, tool_inv, revolute, lower, upper = self._kernel_arm
         R, p = om_system.flange_target(as_pose(T), base_inv, tool_inv)
         zeros = np.zeros(self.arm.dof)
-        problem = om_system.make_problem(family, P, mtab, rtab, J, R, p, self._signs(configuration), zeros)
+        signs, redundancy = self._configuration(configuration)
+        problem = om_system.make_problem(family, P, mtab, rtab, J, D, R, p, signs, redundancy, zeros)
         roots = np.empty((om_system.MAX_ROOTS, self.arm.dof))
         n = om_system.all_roots(problem, self.scan_points, *self.tolerances, roots)
-        evals = int(problem[9][0])
+        evals = int(problem[11][0])
         solutions = []
         for q in roots[:n]:
             within = om_system.representative(q, revolute, lower, upper, zeros, False)
@@ -209,15 +221,15 @@ class OMSolver:
         Args:
             T: (M, 4, 4) target poses.
             signs: (M, k) branch signs, or (k,) for the same configuration everywhere.
-            redundancy: Redundancy values (M, r); must be None or empty for 6-DOF arms.
+            redundancy: Redundancy values (M, r) or (r,) (a 7-DOF arm's arm angle psi, r = 1);
+                None for 6-DOF arms.
             q_hint: Optional (M, dof) hints.
         """
         T = as_poses(T)
         m = len(T)
         k = len(self.sign_names)
         signs = np.ascontiguousarray(np.broadcast_to(as_signs(signs, k), (m, k)))
-        if redundancy is not None and np.size(redundancy) > 0:
-            raise InvalidInput(f"arm '{self.arm.name}' takes no redundancy values")
+        redundancy = self._redundancy_rows(redundancy, m)
         if q_hint is None:
             hints, has_hint = np.zeros((m, self.arm.dof)), False
         else:
@@ -234,6 +246,7 @@ class OMSolver:
             self._kernel_settings,
             T,
             signs,
+            redundancy,
             hints,
             has_hint,
             q,
@@ -247,20 +260,44 @@ class OMSolver:
 
     # -----------------------------------------------------------------------------------
 
-    def _signs(self, configuration: Configuration) -> np.ndarray:
+    def _configuration(self, configuration: Configuration) -> tuple[np.ndarray, np.ndarray]:
+        """Branch signs and redundancy values as kernel arrays, checked against the arm."""
         if not isinstance(configuration, Configuration):
             raise InvalidInput(f"configuration must be a Configuration, got {type(configuration).__name__}")
-        k = len(self.sign_names)
+        k, names = len(self.sign_names), self.redundancy_names
         if len(configuration.signs) != k:
             raise InvalidInput(
                 f"arm '{self.arm.name}' needs {k} configuration signs {self.sign_names}, "
                 f"got {len(configuration.signs)}"
             )
-        if configuration.redundancy:
+        if len(configuration.redundancy) != len(names):
             raise InvalidInput(
-                f"arm '{self.arm.name}' takes no redundancy values, got {configuration.redundancy}"
+                f"arm '{self.arm.name}' needs {len(names)} redundancy values {names}, "
+                f"got {len(configuration.redundancy)}"
             )
-        return np.array(configuration.signs, dtype=np.int64)
+        return np.array(configuration.signs, dtype=np.int64), np.array(configuration.redundancy)
+
+    def _redundancy_rows(self, redundancy: Any, m: int) -> np.ndarray:
+        """(M, r) redundancy values for a batch, checked: shape and finiteness, named."""
+        names = self.redundancy_names
+        if redundancy is None:
+            if names:
+                raise InvalidInput(f"arm '{self.arm.name}' needs redundancy values {names}")
+            return np.zeros((m, 0))
+        values = np.asarray(redundancy, dtype=np.float64)
+        if values.ndim == 1 and len(names) == 1 and values.shape[0] == m:
+            values = values[:, None]
+        try:
+            values = np.ascontiguousarray(np.broadcast_to(values, (m, len(names))))
+        except ValueError:
+            raise InvalidInput(
+                f"redundancy must have shape ({m}, {len(names)}) for {names}, got {values.shape}"
+            ) from None
+        bad = ~np.isfinite(values)
+        if bad.any():
+            row, col = np.argwhere(bad)[0]
+            raise InvalidInput(f"redundancy value {names[col]} is {values[row, col]} in row {row}")
+        return values
 
     def _hint(self, q_hint: np.ndarray | None) -> tuple[np.ndarray, bool]:
         if q_hint is None:

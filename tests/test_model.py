@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
-from om_redundant.closed_form import branch_values, model_ik
+from om_redundant.closed_form import REACH_SLACK, branch_values, model_ik, redundancy_values, srs
 from om_redundant.kinematics import flange_kernel
 from tests.conftest import random_q, wrap
 
@@ -65,12 +65,16 @@ def test_dp_depends_on_joint_6_alone_and_its_norm_is_dp_max(name, dp_max):
     np.testing.assert_allclose(om_arm.model.fk(Q)[:, :3, :3], om_arm.real.fk(Q)[:, :3, :3], atol=1e-15)
 
 
-@pytest.mark.parametrize("name", ["spherical", "ur5e"])
+SOLVABLE = ["spherical", "ur5e", "panda", "fr3", "iiwa14", "xarm7"]
+
+
+@pytest.mark.parametrize("name", SOLVABLE)
 @settings(max_examples=300, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1))
 def test_model_closed_form_inverts_model_fk(name, seed):
     """IK_model(FK_model(q), c(q)) = q, so the closed form is one-to-one off singularities."""
     om_arm = om.derive_model(om.load_arm(name))
+    dof = om_arm.real.dof
     q = random_q(om_arm.real, 1, np.random.default_rng(seed))[0]
     table = om_arm.model.chain.table
     R, p = np.empty((3, 3)), np.empty(3)
@@ -78,8 +82,87 @@ def test_model_closed_form_inverts_model_fk(name, seed):
     values = np.empty(3)
     branch_values(om_arm.family, om_arm.params, q, values)
     signs = np.where(values < 0, -1, 1)
-    out = np.empty(6)
-    assert model_ik(om_arm.family, om_arm.params, table, R, p, signs, np.zeros(6), out) >= 0.0
+    redundancy = np.empty(len(om_arm.redundancy_names))
+    redundancy_values(om_arm.family, om_arm.params, q, redundancy)
+    out = np.empty(dof)
+    margin = model_ik(om_arm.family, om_arm.params, table, R, p, signs, redundancy, np.zeros(dof), out)
+    assert margin >= -REACH_SLACK
     diff = out - q
     diff[om_arm.real.revolute] = wrap(diff[om_arm.real.revolute])
-    assert np.abs(diff).max() < 1e-9
+    # Joint-space agreement is ill-conditioned only within ~1e-5 rad of a singular joint.
+    assert np.abs(diff).max() < 1e-8
+
+
+@pytest.mark.parametrize("name, zeroed", [("panda", {5: ("a",)}), ("xarm7", {5: ("a",)}), ("iiwa14", {})])
+def test_seven_dof_model_zeroes_only_the_offsets_off_the_spherical_joints(name, zeroed):
+    arm = om.load_arm(name)
+    model = om.derive_model(arm).model
+    jr = arm.chain.joint_rows
+    for i, (real, mod) in enumerate(zip(arm.chain.rows, model.chain.rows, strict=True)):
+        fields = next((f for j, f in zeroed.items() if jr[j] == i), ())
+        for field in ("a", "d", "alpha", "theta"):
+            expected = 0.0 if field in fields else getattr(real, field)
+            assert getattr(mod, field) == expected
+
+
+@pytest.mark.parametrize(
+    "name, dp_max", [("panda", 0.088), ("fr3", 0.088), ("xarm7", 0.076), ("iiwa14", 0.0)]
+)
+def test_seven_dof_dp_depends_on_joint_7_alone(name, dp_max):
+    om_arm = om.derive_model(om.load_arm(name))
+    assert om_arm.dp_joint == (6 if dp_max else -1)
+    assert om_arm.dp_max == pytest.approx(dp_max, abs=1e-15)
+    Q = random_q(om_arm.real, 300, np.random.default_rng(4))
+    dp = om_arm.dp(Q)
+    np.testing.assert_allclose(np.linalg.norm(dp, axis=1), dp_max, atol=1e-14)
+    # delta = R_flange^T dp is D0 + D1 cos q7 + D2 sin q7.
+    R = om_arm.real.fk(Q)[:, :3, :3] @ np.linalg.inv(om_arm.real.chain.T_flange_tool[:3, :3])
+    delta = np.einsum("mji,mj->mi", R, dp @ om_arm.real.chain.T_root_base[:3, :3])
+    D = om_arm.delta
+    w = Q[:, 6]
+    np.testing.assert_allclose(
+        delta, D[0] + np.outer(np.cos(w), D[1]) + np.outer(np.sin(w), D[2]), atol=1e-14
+    )
+
+
+@pytest.mark.parametrize("name", ["panda", "iiwa14", "xarm7"])
+def test_arm_angle_is_the_elbow_bend_direction_about_the_shoulder_wrist_line(name):
+    """psi from the closed form's parameters equals psi computed from FK points directly."""
+    om_arm = om.derive_model(om.load_arm(name))
+    chain = om_arm.model.chain
+    Q = random_q(om_arm.real, 200, np.random.default_rng(5))
+    for q in Q:
+        frames = [np.eye(4)]
+        for row, qi in zip(chain.rows, q, strict=True):
+            frames.append(frames[-1] @ _row(row, qi))
+        T = chain.T_root_base
+        S, W = (T @ frames[1])[:3, 3], (T @ frames[5])[:3, 3]
+        z4 = (T @ frames[3])[:3, 2]  # joint 4 turns about z of frame 3
+        w_hat = (W - S) / np.linalg.norm(W - S)
+        values = np.empty(3)
+        branch_values(om_arm.family, om_arm.params, q, values)
+        bend = np.cross(z4, w_hat) * (1 if values[1] >= 0 else -1)
+        elbow = (T @ frames[3])[:3, 3] - S  # the elbow point lies on the bend side
+        assert np.dot(bend, elbow - np.dot(elbow, w_hat) * w_hat) * om_arm.params[srs.BEND] > 0
+        up, ref = np.array([0.0, 0.0, 1.0]), np.array([-1.0, 0.0, 0.0])
+        v, c = np.cross(up, w_hat), np.dot(up, w_hat)
+        K = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+        n = (np.eye(3) + K + K @ K / (1 + c)) @ ref
+        bend = bend * om_arm.params[srs.BEND]
+        psi = np.arctan2(np.dot(np.cross(w_hat, n), bend), np.dot(n, bend))
+        out = np.empty(1)
+        redundancy_values(om_arm.family, om_arm.params, q, out)
+        assert abs(wrap(out[0] - psi)) < 1e-12
+
+
+def _row(row: om.DHRow, qi: float) -> np.ndarray:
+    theta = row.theta + qi
+    ct, st, ca, sa = np.cos(theta), np.sin(theta), np.cos(row.alpha), np.sin(row.alpha)
+    return np.array(
+        [
+            [ct, -st * ca, st * sa, row.a * ct],
+            [st, ct * ca, -ct * sa, row.a * st],
+            [0, sa, ca, row.d],
+            [0, 0, 0, 1],
+        ]
+    )

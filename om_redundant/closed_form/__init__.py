@@ -1,12 +1,24 @@
 """Closed-form inverse kinematics of the model arms' families (numba kernels).
 
-A family kernel solves the MODEL arm exactly for a flange pose in DH frame 0 and a set
-of branch signs, and evaluates the branch quantities whose signs define the
-configuration of a joint vector. :mod:`om_redundant.model` recognises the family of a
-model arm and packs its parameters; the solver calls :func:`model_ik` and
-:func:`branch_values`, which dispatch on the family code.
+A family kernel solves the MODEL arm exactly for a flange pose in DH frame 0, a set of
+branch signs and (for redundant arms) redundancy values, and evaluates the branch
+quantities and redundancy values that define the configuration of a joint vector.
+:mod:`om_redundant.model` recognises the family of a model arm and packs its parameters;
+the solver calls the dispatchers in :mod:`.families`.
 """
 
-from .six_dof import REACH_SLACK, RRP_SPHERICAL_WRIST, RRR_SPHERICAL_WRIST, branch_values, model_ik
+from .common import REACH_SLACK, wrap
+from .families import branch_values, model_ik, redundancy_values
+from .six_dof import RRP_SPHERICAL_WRIST, RRR_SPHERICAL_WRIST
+from .srs import SRS
 
-__all__ = ["REACH_SLACK", "RRP_SPHERICAL_WRIST", "RRR_SPHERICAL_WRIST", "branch_values", "model_ik"]
+__all__ = [
+    "REACH_SLACK",
+    "RRP_SPHERICAL_WRIST",
+    "RRR_SPHERICAL_WRIST",
+    "SRS",
+    "branch_values",
+    "model_ik",
+    "redundancy_values",
+    "wrap",
+]

@@ -42,6 +42,7 @@ import numba as nb
 import numpy as np
 
 from ..kinematics import _apply_row
+from .common import REACH_SLACK, euler_zxzxz, wrap
 
 RRR_SPHERICAL_WRIST = 0
 RRP_SPHERICAL_WRIST = 1
@@ -55,15 +56,6 @@ WRIST_CENTRE = 15  # 3 entries: wrist centre in the flange frame
 E_ROT = 18  # 9 entries, row-major: rotation from the frame after Rz(phi6) to the flange
 WRIST_ROW = 27  # index in the table of joint 4's row
 N_PARAMS = 28
-
-# Relative slack under a square root before a target counts as outside the model's reach.
-REACH_SLACK = 1e-12
-_SINGULAR = 1e-12
-
-
-@nb.njit(cache=True, inline="always")
-def _wrap(x):
-    return x - 2.0 * np.pi * np.floor((x + np.pi) / (2.0 * np.pi))
 
 
 @nb.njit(cache=True)
@@ -89,7 +81,7 @@ def model_ik(family, P, table, R, p, signs, q_prev, q):
         phi1 = q_prev[0] + P[THETA1]
     else:
         phi1 = np.arctan2(pw[1], pw[0]) - np.arctan2(-P[SIGMA1] * h, rho)
-    q[0] = _wrap(phi1 - P[THETA1])
+    q[0] = wrap(phi1 - P[THETA1])
     u = np.cos(phi1) * pw[0] + np.sin(phi1) * pw[1] - P[A1]
     v = P[SIGMA1] * (pw[2] - P[D1])
     D = u * u + v * v
@@ -105,8 +97,8 @@ def model_ik(family, P, table, R, p, signs, q_prev, q):
             phi2 = q_prev[1] + P[THETA2]
         else:
             phi2 = np.arctan2(v, u) - np.arctan2(l3 * np.sin(gamma), a2 + l3 * np.cos(gamma))
-        q[1] = _wrap(phi2 - P[THETA2])
-        q[2] = _wrap(gamma - P[BETA] - P[THETA3])
+        q[1] = wrap(phi2 - P[THETA2])
+        q[2] = wrap(gamma - P[BETA] - P[THETA3])
     else:
         k = D - a2 * a2
         margin = min(margin, k / max(D, 1.0))
@@ -117,7 +109,7 @@ def model_ik(family, P, table, R, p, signs, q_prev, q):
             phi2 = q_prev[1] + P[THETA2]
         else:
             phi2 = np.arctan2(v, u) - np.arctan2(t, a2)
-        q[1] = _wrap(phi2 - P[THETA2])
+        q[1] = wrap(phi2 - P[THETA2])
         q[2] = -P[SIGMA2] * t - P[D3]
     # Wrist: M = R_in^T R E^T.
     Rin = np.eye(3)
@@ -131,28 +123,11 @@ def model_ik(family, P, table, R, p, signs, q_prev, q):
             j += 1
     E = P[E_ROT : E_ROT + 9].reshape(3, 3)
     M = Rin.T @ R @ E.T
-    s4, s5, w = P[SIGMA4], P[SIGMA5], signs[2]
-    ax, ay, az = M[0, 2], M[1, 2], M[2, 2]
-    sin5 = np.sqrt(ax * ax + ay * ay)
-    if sin5 > _SINGULAR:
-        phi4 = np.arctan2(s5 * w * ay, s5 * w * ax)
-        phi5 = np.arctan2(w * sin5, -s4 * s5 * az)
-    else:  # rule 3: joints 4 and 6 aligned; q4 keeps its previous value
-        phi4 = q_prev[3] + P[THETA4]
-        phi5 = np.arctan2(0.0, -s4 * s5 * az)
-    # Rz(phi6) = (Rz(phi4) Rx(a4) Rz(phi5) Rx(a5))^T M. Taking phi6 from this residual rather
-    # than from M's last row makes the three angles consistent, so that their rounding errors
-    # cancel in the hand orientation even near the wrist singularity.
-    c4, n4, c5, n5 = np.cos(phi4), np.sin(phi4), np.cos(phi5), np.sin(phi5)
-    A = np.array([[c4, 0.0, n4 * s4], [n4, 0.0, -c4 * s4], [0.0, s4, 0.0]]) @ np.array(
-        [[c5, 0.0, n5 * s5], [n5, 0.0, -c5 * s5], [0.0, s5, 0.0]]
-    )
-    X = A.T @ M
-    phi6 = np.arctan2(X[1, 0], X[0, 0])
-    q[3] = _wrap(phi4 - P[THETA4])
-    q[4] = _wrap(phi5 - P[THETA5])
-    q[5] = _wrap(phi6 - P[THETA6])
-    return max(margin, 0.0)
+    rows = ((M[0, 0], M[0, 1], M[0, 2]), (M[1, 0], M[1, 1], M[1, 2]), (M[2, 0], M[2, 1], M[2, 2]))
+    phi = euler_zxzxz(rows, P[SIGMA4], P[SIGMA5], signs[2], q_prev[3] + P[THETA4])
+    for k in range(3):
+        q[3 + k] = wrap(phi[k] - P[THETA4 + k])
+    return margin
 
 
 @nb.njit(cache=True)
