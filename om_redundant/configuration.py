@@ -34,6 +34,15 @@ class Configuration:
         object.__setattr__(self, "signs", tuple(int(s) for s in signs))
         object.__setattr__(self, "redundancy", redundancy)
 
+    def isclose(self, other: Configuration, atol: float = 1e-9) -> bool:
+        """Same signs, and redundancy values (angles) equal within ``atol`` modulo 2 pi."""
+        if self.signs != other.signs or len(self.redundancy) != len(other.redundancy):
+            return False
+        return all(
+            abs(math.remainder(a - b, 2.0 * math.pi)) <= atol
+            for a, b in zip(self.redundancy, other.redundancy, strict=True)
+        )
+
     @staticmethod
     def all_signs(count: int) -> list[Configuration]:
         """Every sign combination of ``count`` branches, without redundancy values."""

@@ -245,7 +245,23 @@ def _brackets(problem, a, ga, b, gb, search, q, out, n):
     if ga == 0.0:
         out[n] = a
         return n + 1
-    if abs(ga - gb) > np.pi:  # g wraps between a and b
+    # A jump of more than pi is a wrap of g (from about +pi to -pi) or a steep crossing of
+    # zero near a singular wrist: bisect until it is clearly one or the other.
+    for _ in range(60):
+        if abs(ga - gb) <= np.pi or abs(ga - gb) > 1.9 * np.pi:
+            break
+        c = 0.5 * (a + b)
+        gc = _g(problem, c, q)
+        if np.isnan(gc):
+            return n
+        if gc * ga > 0.0:
+            a, ga = c, gc
+        else:
+            b, gb = c, gc
+    if gb == 0.0:
+        out[n] = b
+        return n + 1
+    if abs(ga - gb) > np.pi:
         return n
     if ga * gb < 0.0:
         out[n] = _refine_bracket(problem, a, ga, b, gb, q)
@@ -267,27 +283,27 @@ def _brackets(problem, a, ga, b, gb, search, q, out, n):
 def _run_roots(problem, pw, pg, L, cyclic, q, out, n):
     """Add the roots on a run of reachable points (w ascending) to out[n:]; returns the count.
 
-    Consecutive points with a sign change bracket a root. At each local minimum of |g| with
-    no sign change on either side, an extremum search between its neighbours looks for a
-    close pair of roots. A cyclic run covers the whole circle.
+    Consecutive points with a sign change bracket a root. At each local minimum of |g|,
+    each adjacent cell without a sign change is searched for an extremum of g that crosses
+    zero: a close pair of roots. A cyclic run covers the whole circle.
     """
     for i in range(L - 1 + cyclic):
         j = (i + 1) % L
         wj = pw[j] + (2.0 * np.pi if j == 0 else 0.0)
         n = _brackets(problem, pw[i], pg[i], wj, pg[j], False, q, out, n)
     for i in range(L):
-        has_prev, has_next = i > 0 or cyclic, i < L - 1 or cyclic
         gi = pg[i]
-        lo, glo, hi, ghi = pw[i], gi, pw[i], gi
-        if has_prev:
-            lo, glo = pw[(i - 1) % L] - (2.0 * np.pi if i == 0 else 0.0), pg[(i - 1) % L]
-        if has_next:
-            hi, ghi = pw[(i + 1) % L] + (2.0 * np.pi if i == L - 1 else 0.0), pg[(i + 1) % L]
-        if abs(gi) > _PAIR_SEARCH or abs(glo) < abs(gi) or abs(ghi) < abs(gi) or lo == hi:
+        has_prev, has_next = i > 0 or cyclic, i < L - 1 or cyclic
+        glo = pg[(i - 1) % L] if has_prev else np.inf
+        ghi = pg[(i + 1) % L] if has_next else np.inf
+        if abs(gi) > _PAIR_SEARCH or abs(glo) < abs(gi) or abs(ghi) < abs(gi):
             continue
-        if glo * gi <= 0.0 or ghi * gi <= 0.0:  # bracketed already
-            continue
-        n = _brackets(problem, lo, glo, hi, ghi, True, q, out, n)
+        if has_prev and glo * gi > 0.0:
+            lo = pw[(i - 1) % L] - (2.0 * np.pi if i == 0 else 0.0)
+            n = _brackets(problem, lo, glo, pw[i], gi, True, q, out, n)
+        if has_next and ghi * gi > 0.0:
+            hi = pw[(i + 1) % L] + (2.0 * np.pi if i == L - 1 else 0.0)
+            n = _brackets(problem, pw[i], gi, hi, ghi, True, q, out, n)
     return n
 
 

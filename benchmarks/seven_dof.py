@@ -1,0 +1,167 @@
+"""7-DOF arms: recovery of random joint vectors, exactness, and speed; writes results/seven_dof.md.
+
+For each arm, N joint vectors q uniform within limits (unlimited joints in [-pi, pi]), with
+c = configuration_of(q) (SHOULDER, ELBOW, WRIST, psi):
+
+* q among ``solve_all(fk(q), c)``;
+* ``solve(fk(q), c, q_hint=q + U(+-0.01))`` returns q, or else another root nearer the hint;
+* every returned solution: position and orientation error, configuration equal to c.
+
+Speed (medians of single calls from Python, and batch throughput) on the first arm.
+
+Run: ``python -m benchmarks.seven_dof [--n 100000] [--arms panda fr3 iiwa14 xarm7]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import platform
+import time
+from pathlib import Path
+
+import numpy as np
+
+import om_redundant as om
+
+
+def _wrap(x: np.ndarray) -> np.ndarray:
+    return (x + np.pi) % (2 * np.pi) - np.pi
+
+
+def _random_q(arm: om.Arm, n: int, rng: np.random.Generator) -> np.ndarray:
+    lower = np.where(np.isfinite(arm.lower), arm.lower, -np.pi)
+    upper = np.where(np.isfinite(arm.upper), arm.upper, np.pi)
+    return rng.uniform(lower, upper, (n, arm.dof))
+
+
+def recovery(name: str, n: int, seed: int) -> dict[str, float]:
+    """The issue's checks over n random joint vectors of one arm."""
+    solver = om.OMSolver(name)
+    rng = np.random.default_rng(seed)
+    Q = _random_q(solver.arm, n, rng)
+    hints = Q + rng.uniform(-0.01, 0.01, Q.shape)
+    T = solver.arm.fk(Q)
+    configurations = [solver.configuration_of(q) for q in Q]
+    signs = np.array([c.signs for c in configurations])
+    psi = np.array([c.redundancy[0] for c in configurations])
+    batch = solver.solve_batch(T, signs, psi, q_hint=hints)
+    among = hinted_q = nearest = wrong_c = roots_total = 0
+    worst_pos = worst_ori = 0.0
+    for i, (q, c) in enumerate(zip(Q, configurations, strict=True)):
+        roots = solver.solve_all(T[i], c)
+        roots_total += len(roots)
+        among += any(np.abs(_wrap(r.q - q)).max() < 1e-9 for r in roots)
+        returned = [*roots, om.Solution(batch.q[i], bool(batch.ok[i]), "", c, *_errors(batch, i), 0, True)]
+        for r in returned:
+            worst_pos, worst_ori = max(worst_pos, r.position_error), max(worst_ori, r.orientation_error)
+            wrong_c += not (r.ok and solver.configuration_of(r.q).isclose(c))
+        hinted_q += np.abs(_wrap(batch.q[i] - q)).max() < 1e-9
+        to_hint = [np.linalg.norm(_wrap(r.q - hints[i])) for r in roots]
+        nearest += np.linalg.norm(_wrap(batch.q[i] - hints[i])) <= min(to_hint, default=np.inf) + 1e-9
+    return {
+        "arm": name,
+        "dp_max": solver.dp_max,
+        "n": n,
+        "among": among / n,
+        "hinted_q": hinted_q / n,
+        "nearest": nearest / n,
+        "roots": roots_total / n,
+        "wrong_c": wrong_c,
+        "pos": worst_pos,
+        "ori": worst_ori,
+    }
+
+
+def _errors(batch: om.BatchSolution, i: int) -> tuple[float, float]:
+    return float(batch.position_error[i]), float(batch.orientation_error[i])
+
+
+def speed(name: str, n: int, seed: int) -> dict[str, float]:
+    """Median time of solve and solve_all from Python, and solve_batch throughput."""
+    solver = om.OMSolver(name)
+    Q = _random_q(solver.arm, n, np.random.default_rng(seed + 1))
+    T = solver.arm.fk(Q)
+    configurations = [solver.configuration_of(q) for q in Q]
+    solver.solve(T[0], configurations[0])
+    solver.solve_all(T[0], configurations[0])
+
+    def median_us(call, count):
+        times = []
+        for i in range(count):
+            start = time.perf_counter()
+            call(T[i], configurations[i])
+            times.append(time.perf_counter() - start)
+        return 1e6 * float(np.median(times))
+
+    signs = np.array([c.signs for c in configurations])
+    psi = np.array([c.redundancy[0] for c in configurations])
+    solver.solve_batch(T[:8], signs[:8], psi[:8])
+    start = time.perf_counter()
+    solver.solve_batch(T, signs, psi)
+    throughput = n / (time.perf_counter() - start)
+    return {
+        "solve": median_us(solver.solve, n),
+        "solve_all": median_us(solver.solve_all, min(n, 5000)),
+        "batch": throughput,
+    }
+
+
+def report(rows: list[dict[str, float]], timing: dict[str, float], speed_arm: str, seed: int) -> str:
+    lines = [
+        f"# 7-DOF arms: {rows[0]['n']:,} random joint vectors per arm (seed {seed})",
+        "",
+        "| arm | dp_max (m) | q among solve_all | hinted solve returns q | ... or a root nearer the hint "
+        "| roots per (pose, c) | wrong configuration | max position error (m) "
+        "| max orientation error (rad) |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        lines.append(
+            f"| {r['arm']} | {r['dp_max']:.3f} | {100 * r['among']:.3f} % | {100 * r['hinted_q']:.3f} % "
+            f"| {100 * r['nearest']:.3f} % | {r['roots']:.3f} | {r['wrong_c']} | {r['pos']:.1e} "
+            f"| {r['ori']:.1e} |"
+        )
+    lines += [
+        "",
+        f"Speed, {speed_arm} ({platform.processor() or platform.machine()}, {_cores()} cores, "
+        f"Python {platform.python_version()}):",
+        "",
+        "| call | measured | goal |",
+        "|---|---|---|",
+        f"| `solve` median, from Python | {timing['solve']:.1f} us | <= 15 us |",
+        f"| `solve_all` median, from Python | {timing['solve_all']:.0f} us | <= 150 us |",
+        f"| `solve_batch` | {timing['batch']:,.0f} solves/s | >= 200,000 solves/s |",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def _cores() -> int:
+    import os
+
+    return len(os.sched_getaffinity(0))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument("--n", type=int, default=100_000)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--arms", nargs="+", default=["panda", "fr3", "iiwa14", "xarm7"])
+    args = parser.parse_args()
+    rows = []
+    for name in args.arms:
+        start = time.perf_counter()
+        rows.append(recovery(name, args.n, args.seed))
+        print(rows[-1], f"{time.perf_counter() - start:.0f} s", flush=True)
+    timing = speed(args.arms[0], min(args.n, 20_000), args.seed)
+    print(timing)
+    text = report(rows, timing, args.arms[0], args.seed)
+    print(text)
+    out = Path(__file__).parent / "results" / "seven_dof.md"
+    out.write_text(text)
+    print(f"written to {out}")
+
+
+if __name__ == "__main__":
+    main()
