@@ -6,8 +6,8 @@ the few lengths that stand in the way of a closed form:
 * 6-DOF arms satisfying the paper's Theorem 2 (joints 1-3 position joint 4's origin; joints
   4-6 revolute, non-parallel, not intersecting): :math:`a_4, a_5, d_5` (standard DH,
   joint-indexed rows), which makes the wrist spherical.
-* 7-DOF arms: :math:`a_1, a_2, d_2` and :math:`a_5, a_6, d_6`, which make the shoulder and
-  the wrist spherical while the elbow keeps its offsets (a Hollerbach arm, see
+* 7-DOF arms with a spherical shoulder: :math:`a_5, a_6, d_6`, which make the wrist
+  spherical while the elbow keeps its offsets (a Hollerbach arm, see
   :mod:`om_redundant.closed_form.srs`).
 
 For equal joints the hand orientations agree and the positions differ by
@@ -141,22 +141,30 @@ def _six_dof_model(arm: Arm) -> tuple[KinematicChain, int, str, np.ndarray]:
 
 
 def _srs_model(arm: Arm) -> tuple[KinematicChain, np.ndarray]:
-    r"""Zero the offsets that keep joints 1-3 (a1, a2, d2) and 5-7 (a5, a6, d6) from meeting.
+    r"""Zero the offsets that keep joints 5-7 (a5, a6, d6) from meeting; joints 1-3 must meet.
 
     In standard DH, joint i+1 turns about :math:`z_i` through :math:`o_i`. Axes 1 and 2 meet
     (at S = :math:`o_1`) iff :math:`a_1 = 0`; axis 3 passes through S iff :math:`d_2 = a_2 = 0`;
     likewise :math:`a_5 = 0` and :math:`d_6 = a_6 = 0` put axes 5-7 through W = :math:`o_5`.
-    The elbow's offsets (:math:`a_3, d_4, a_4`) are kept.
+    The elbow's offsets (:math:`a_3, d_4, a_4`) are kept. Zeroing shoulder offsets would make
+    dp depend on q1 too, which the bounded search does not cover yet.
     """
     rows = list(arm.chain.rows)
     jr = arm.chain.joint_rows
     if any(rows[r].kind is not JointKind.REVOLUTE for r in jr):
         raise ModelError(f"arm '{arm.name}': the 7-DOF model needs revolute joints")
+    shoulder = {f"{f}{j + 1}": getattr(rows[jr[j]], f) for j, f in ((0, "a"), (1, "a"), (1, "d"))}
+    offsets = ", ".join(f"{k} = {v:g} m" for k, v in shoulder.items() if v != 0.0)
+    if offsets:
+        raise ModelError(
+            f"arm '{arm.name}': shoulder offsets ({offsets}) make dp depend on q1 as well as q7; "
+            "the bounded search over (q1, q7) is not built yet"
+        )
     if jr[-1] - jr[0] != 6:
         raise ModelError(f"arm '{arm.name}': fixed rows between joints are not supported by the 7-DOF model")
     for j in (0, 1, 4, 5):
         _check_right_angle(arm.name, rows[jr[j]], j)
-    for j, fields in ((0, ("a",)), (1, ("a", "d")), (4, ("a",)), (5, ("a", "d"))):
+    for j, fields in ((4, ("a",)), (5, ("a", "d"))):
         rows[jr[j]] = dataclasses.replace(rows[jr[j]], **dict.fromkeys(fields, 0.0))
     chain = arm.chain.replace_rows(rows)
     table = chain.table

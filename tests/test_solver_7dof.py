@@ -138,5 +138,5 @@ def test_bad_configurations_are_named(panda):
 
 @pytest.mark.parametrize("name", ["gen3", "sawyer"])
 def test_arms_without_a_model_yet_are_refused_with_the_reason(name):
-    with pytest.raises(om.ModelError, match=name):
+    with pytest.raises(om.ModelError, match=rf"arm .{name}.: shoulder offsets .* q1 as well as q7"):
         om.OMSolver(name)
