@@ -531,8 +531,10 @@ def solve_one(arm, settings, T, signs, redundancy, hint, has_hint, q_out):
                 _nearest_in_window(problem, hint, tol_pos, tol_ori, q)
             q_out[:] = q
             inside = representative(q_out, revolute, lower, upper, hint, has_hint)
-            pos, ori, _ = verify(problem, q_out, tol_pos, tol_ori)
-            return OK, pos, ori, counter[0], inside
+            if inside or has_hint or J < 0:
+                pos, ori, _ = verify(problem, q_out, tol_pos, tol_ori)
+                return OK, pos, ori, counter[0], inside
+            # Without a hint, a root within the limits is preferred: search for one.
     roots = np.empty((MAX_ROOTS, dof))
     n = all_roots(problem, n_scan, tol_pos, tol_ori, roots)
     if n == 0:
@@ -540,15 +542,20 @@ def solve_one(arm, settings, T, signs, redundancy, hint, has_hint, q_out):
         if _exists_other(problem, n_scan, tol_pos, tol_ori):
             return NO_SOLUTION_IN_CONFIGURATION, np.nan, np.nan, counter[0], False
         return UNREACHABLE, np.nan, np.nan, counter[0], False
-    # The root nearest the hint; without one, nearest the fixed-point start's joint J.
+    # The root nearest the hint; without one, a root within the limits first, then the one
+    # nearest the fixed-point start's joint J.
     best, best_dist = 0, np.inf
     for r in range(n):
         dist = 0.0
         if has_hint:
             for j in range(dof):
                 dist += wrap(roots[r, j] - hint[j]) ** 2
-        elif J >= 0 and not np.isnan(w0):
-            dist = abs(wrap(roots[r, J] - w0))
+        else:
+            if J >= 0 and not np.isnan(w0):
+                dist = abs(wrap(roots[r, J] - w0))
+            shifted = roots[r].copy()
+            if not representative(shifted, revolute, lower, upper, hint, False):
+                dist += 4.0 * np.pi
         if dist < best_dist:
             best, best_dist = r, dist
     q_out[:] = roots[best]

@@ -175,7 +175,8 @@ class OMSolver:
             T: Target pose of the end-effector frame in the root frame: 4x4 or ``mink.SE3``.
             configuration: Branch signs (and redundancy values for redundant arms).
             q_hint: Optional joint vector; among several solutions the nearest is returned,
-                and 2 pi shifts are chosen nearest to it.
+                and 2 pi shifts are chosen nearest to it. Without a hint, a solution within
+                the joint limits is preferred.
 
         Returns:
             A :class:`Solution`; ``ok`` is False (with a status saying why) when no solution

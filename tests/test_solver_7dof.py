@@ -40,7 +40,8 @@ def test_the_original_joint_vector_is_recovered(solver):
     """q is among solve_all(fk(q), c(q)); solve with a hint returns the root nearest it.
 
     That root is q itself unless another root of the same configuration lies nearer the
-    hint (a close pair of roots near a singular elbow or wrist).
+    hint (a close pair of roots near a singular elbow or wrist). Without a hint, solve
+    prefers a root within the joint limits.
     """
     rng = np.random.default_rng(21)
     Q = random_q(solver.arm, 300, rng)
@@ -57,6 +58,9 @@ def test_the_original_joint_vector_is_recovered(solver):
         assert_exact(solver, hinted, T, c)
         assert distance(hinted.q, hint) <= min(distance(r.q, hint) for r in roots) + 1e-9
         recovered += distance(hinted.q, q) < 1e-9
+        plain = solver.solve(T, c)  # without a hint, a root within the limits comes first
+        assert_exact(solver, plain, T, c)
+        assert plain.within_limits or not any(r.within_limits for r in roots)
     assert recovered >= len(Q) - 3
 
 
