@@ -6,9 +6,10 @@ Run: ``python -m benchmarks.paper [--n 100000]`` (``om-redundant bench paper`` r
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 from om_redundant.paper_experiment import run
+
+from .report import write_page
 
 
 def main() -> None:
@@ -17,11 +18,7 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args()
     tables = [run(arm, args.n, args.seed).table() for arm in ("spherical", "ur5e")]
-    text = "\n\n".join(tables) + "\n"
-    print(text)
-    out = Path(__file__).parent / "results" / "paper.md"
-    out.write_text(text)
-    print(f"written to {out}")
+    write_page("paper.md", "\n\n".join(tables) + "\n")
 
 
 if __name__ == "__main__":

@@ -89,6 +89,18 @@ class Results:
     load: tuple[float, float] = (math.nan, math.nan)
 
 
+RESULTS = Path(__file__).parent / "results"
+
+
+def write_page(name: str, text: str) -> Path:
+    """Print a result page and write it to ``benchmarks/results/<name>``."""
+    print(text)
+    out = RESULTS / name
+    out.write_text(text)
+    print(f"written to {out}")
+    return out
+
+
 def cpu_model() -> str:
     """The CPU model named in /proc/cpuinfo (or what platform knows)."""
     try:

@@ -15,30 +15,27 @@ Run: ``python -m benchmarks.seven_dof [--n 100000] [--arms panda fr3 iiwa14 xarm
 from __future__ import annotations
 
 import argparse
+import os
 import platform
 import time
-from pathlib import Path
 
 import numpy as np
 
 import om_redundant as om
+
+from .report import cpu_model, write_page
+from .robots import random_joints
 
 
 def _wrap(x: np.ndarray) -> np.ndarray:
     return (x + np.pi) % (2 * np.pi) - np.pi
 
 
-def _random_q(arm: om.Arm, n: int, rng: np.random.Generator) -> np.ndarray:
-    lower = np.where(np.isfinite(arm.lower), arm.lower, -np.pi)
-    upper = np.where(np.isfinite(arm.upper), arm.upper, np.pi)
-    return rng.uniform(lower, upper, (n, arm.dof))
-
-
 def recovery(name: str, n: int, seed: int) -> dict[str, float]:
     """The issue's checks over n random joint vectors of one arm."""
     solver = om.OMSolver(name)
     rng = np.random.default_rng(seed)
-    Q = _random_q(solver.arm, n, rng)
+    Q = random_joints(solver.arm, n, rng)
     hints = Q + rng.uniform(-0.01, 0.01, Q.shape)
     T = solver.arm.fk(Q)
     configurations = [solver.configuration_of(q) for q in Q]
@@ -51,10 +48,12 @@ def recovery(name: str, n: int, seed: int) -> dict[str, float]:
         roots = solver.solve_all(T[i], c)
         roots_total += len(roots)
         among += any(np.abs(_wrap(r.q - q)).max() < 1e-9 for r in roots)
-        returned = [*roots, om.Solution(batch.q[i], bool(batch.ok[i]), "", c, *_errors(batch, i), 0, True)]
-        for r in returned:
-            worst_pos, worst_ori = max(worst_pos, r.position_error), max(worst_ori, r.orientation_error)
-            wrong_c += not (r.ok and solver.configuration_of(r.q).isclose(c))
+        # Every returned solution: the roots of solve_all and the hinted batch solve.
+        returned = [(r.ok, r.q, r.position_error, r.orientation_error) for r in roots]
+        returned.append((batch.ok[i], batch.q[i], batch.position_error[i], batch.orientation_error[i]))
+        for ok, q_returned, pos, ori in returned:
+            worst_pos, worst_ori = max(worst_pos, pos), max(worst_ori, ori)
+            wrong_c += not (ok and solver.configuration_of(q_returned).isclose(c))
         hinted_q += np.abs(_wrap(batch.q[i] - q)).max() < 1e-9
         to_hint = [np.linalg.norm(_wrap(r.q - hints[i])) for r in roots]
         nearest += np.linalg.norm(_wrap(batch.q[i] - hints[i])) <= min(to_hint, default=np.inf) + 1e-9
@@ -72,14 +71,10 @@ def recovery(name: str, n: int, seed: int) -> dict[str, float]:
     }
 
 
-def _errors(batch: om.BatchSolution, i: int) -> tuple[float, float]:
-    return float(batch.position_error[i]), float(batch.orientation_error[i])
-
-
 def speed(name: str, n: int, seed: int) -> dict[str, float]:
     """Median time of solve and solve_all from Python, and solve_batch throughput."""
     solver = om.OMSolver(name)
-    Q = _random_q(solver.arm, n, np.random.default_rng(seed + 1))
+    Q = random_joints(solver.arm, n, np.random.default_rng(seed + 1))
     T = solver.arm.fk(Q)
     configurations = [solver.configuration_of(q) for q in Q]
     solver.solve(T[0], configurations[0])
@@ -123,7 +118,7 @@ def report(rows: list[dict[str, float]], timing: dict[str, float], speed_arm: st
         )
     lines += [
         "",
-        f"Speed, {speed_arm} ({platform.processor() or platform.machine()}, {_cores()} cores, "
+        f"Speed, {speed_arm} ({cpu_model()}, {len(os.sched_getaffinity(0))} cores, "
         f"Python {platform.python_version()}):",
         "",
         "| call | measured | goal |",
@@ -133,12 +128,6 @@ def report(rows: list[dict[str, float]], timing: dict[str, float], speed_arm: st
         f"| `solve_batch` | {timing['batch']:,.0f} solves/s | >= 200,000 solves/s |",
     ]
     return "\n".join(lines) + "\n"
-
-
-def _cores() -> int:
-    import os
-
-    return len(os.sched_getaffinity(0))
 
 
 def main() -> None:
@@ -156,11 +145,7 @@ def main() -> None:
         print(rows[-1], f"{time.perf_counter() - start:.0f} s", flush=True)
     timing = speed(args.arms[0], min(args.n, 20_000), args.seed)
     print(timing)
-    text = report(rows, timing, args.arms[0], args.seed)
-    print(text)
-    out = Path(__file__).parent / "results" / "seven_dof.md"
-    out.write_text(text)
-    print(f"written to {out}")
+    write_page("seven_dof.md", report(rows, timing, args.arms[0], args.seed))
 
 
 if __name__ == "__main__":
