@@ -6,21 +6,23 @@ the few lengths that stand in the way of a closed form:
 * 6-DOF arms satisfying the paper's Theorem 2 (joints 1-3 position joint 4's origin; joints
   4-6 revolute, non-parallel, not intersecting): :math:`a_4, a_5, d_5` (standard DH,
   joint-indexed rows), which makes the wrist spherical.
-* 7-DOF arms with a spherical shoulder: :math:`a_5, a_6, d_6`, which make the wrist
-  spherical while the elbow keeps its offsets (a Hollerbach arm, see
-  :mod:`om_redundant.closed_form.srs`).
+* 7-DOF arms: :math:`a_1, d_2` (shoulder offsets, Gen3 and Sawyer) and
+  :math:`a_5, a_6, d_6` (wrist offsets), which make the shoulder and the wrist spherical
+  while the elbow keeps its offsets (a Hollerbach arm, see :mod:`om_redundant.closed_form.srs`).
 
 For equal joints the hand orientations agree and the positions differ by
 
 .. math::
 
-    \Delta p(q) = p_{model}(q) - p_{real}(q) = R_{flange}(q)\,\delta(q_J),
+    \Delta p(q) = p_{model}(q) - p_{real}(q) = R_{flange}(q)\,\delta(q_J) + a(q_1),
 
-where :math:`\delta`, dp seen from the flange, depends on one wrist joint J only for the
-arms handled here: joint 6 of UR5e and the Spherical arm (:math:`a_4 = 0`), joint 7 of the
-Panda, FR3 and xArm7 (their wrist offset :math:`a_6`); the iiwa14 has :math:`\Delta p = 0`.
-The solutions of the OM system (9) then lie on a circle in the ball
-:math:`|p_m - p_d| \le \Delta p_{max}`, which the solver scans exhaustively.
+where :math:`\delta`, the wrist offsets' dp seen from the flange, depends on one wrist joint
+J: joint 6 of UR5e and the Spherical arm (:math:`a_4 = 0`), joint 7 of the 7-DOF arms (the
+iiwa14 has :math:`\delta = 0`). The shoulder offsets' dp :math:`a(q_1)`, in DH frame 0,
+turns with joint 1 alone, because :math:`a_1` lies along :math:`x_1` and :math:`d_2` along
+joint 2's axis, both fixed in frame 1; it is zero when joints 1-3 meet. The solutions of
+the OM system (9) then lie on a circle (a torus with shoulder offsets) in the ball
+:math:`|p_m - p_d| \le \Delta p_{max}`, which the solver searches exhaustively.
 """
 
 from __future__ import annotations
@@ -55,7 +57,10 @@ class ModelArm:
         delta: (3, 3) coefficients of dp seen from the flange, rows :math:`D_0, D_1, D_2`:
             :math:`\\delta(q_J) = D_0 + D_1 \\cos q_J + D_2 \\sin q_J` (a revolute joint's
             angle enters the flange frame through one rotation about z).
-        dp_max: :math:`\\max_q |\\Delta p(q)|` in metres.
+        shoulder: (3, 3) coefficients of the shoulder offsets' dp in DH frame 0, rows
+            :math:`A_0, A_1, A_2`: :math:`a(q_1) = A_0 + A_1 \\cos q_1 + A_2 \\sin q_1`; zero
+            when joints 1-3 meet (every 6-DOF arm here, the Panda, FR3, iiwa14, xArm7).
+        dp_max: A bound on :math:`|\\Delta p(q)|` in metres.
     """
 
     real: Arm
@@ -67,6 +72,7 @@ class ModelArm:
     redundancy_names: tuple[str, ...]
     dp_joint: int
     delta: np.ndarray
+    shoulder: np.ndarray
     dp_max: float
 
     def dp(self, q: np.ndarray) -> np.ndarray:
@@ -87,22 +93,40 @@ def derive_model(arm: Arm) -> ModelArm:
     """
     if arm.dof == 6:
         model_chain, family, family_name, params = _six_dof_model(arm)
+        shoulderless = arm.chain
         sign_names, redundancy_names = ("ARM", "ELBOW", "WRIST"), ()
     elif arm.dof == 7:
-        model_chain, params = _srs_model(arm)
+        model_chain, shoulderless, params = _srs_model(arm)
         family, family_name = srs.SRS, "S-R-S: spherical shoulder, elbow, spherical wrist"
         sign_names, redundancy_names = ("SHOULDER", "ELBOW", "WRIST"), ("psi",)
     else:
         raise ModelError(f"arm '{arm.name}' has {arm.dof} joints; models exist for 6- and 7-DOF arms")
     model = arm.with_chain(model_chain, f"{arm.name}-model")
-    dp_joint = _dp_joint(arm.name, arm.chain, model_chain)
-    delta = _delta_coefficients(arm, model_chain, dp_joint)
-    w = np.linspace(-np.pi, np.pi, 3601)
-    dp_max = float(
-        np.linalg.norm(delta[0] + np.outer(np.cos(w), delta[1]) + np.outer(np.sin(w), delta[2]), axis=1).max()
+    dp_joint = _dp_joint(arm.name, shoulderless, model_chain)
+    delta = _circle_fit(
+        arm, "dp seen from the flange", dp_joint, lambda q: _delta(shoulderless, model_chain, q)
     )
+    shoulder = _circle_fit(
+        arm,
+        "the shoulder offsets' dp",
+        0,
+        lambda q: _pose(shoulderless.table, q)[1] - _pose(arm.chain.table, q)[1],
+    )
+    w = np.linspace(-np.pi, np.pi, 3601)
+    cs = np.stack([np.ones_like(w), np.cos(w), np.sin(w)], axis=1)
+    dp_max = float(np.linalg.norm(cs @ delta, axis=1).max() + np.linalg.norm(cs @ shoulder, axis=1).max())
     return ModelArm(
-        arm, model, family, family_name, params, sign_names, redundancy_names, dp_joint, delta, dp_max
+        arm,
+        model,
+        family,
+        family_name,
+        params,
+        sign_names,
+        redundancy_names,
+        dp_joint,
+        delta,
+        shoulder,
+        dp_max,
     )
 
 
@@ -140,30 +164,35 @@ def _six_dof_model(arm: Arm) -> tuple[KinematicChain, int, str, np.ndarray]:
     return model_chain, family, family_name, params
 
 
-def _srs_model(arm: Arm) -> tuple[KinematicChain, np.ndarray]:
-    r"""Zero the offsets that keep joints 5-7 (a5, a6, d6) from meeting; joints 1-3 must meet.
+def _srs_model(arm: Arm) -> tuple[KinematicChain, KinematicChain, np.ndarray]:
+    r"""Zero the offsets that keep joints 1-3 (a1, a2, d2) or joints 5-7 (a5, a6, d6) from meeting.
 
     In standard DH, joint i+1 turns about :math:`z_i` through :math:`o_i`. Axes 1 and 2 meet
     (at S = :math:`o_1`) iff :math:`a_1 = 0`; axis 3 passes through S iff :math:`d_2 = a_2 = 0`;
     likewise :math:`a_5 = 0` and :math:`d_6 = a_6 = 0` put axes 5-7 through W = :math:`o_5`.
-    The elbow's offsets (:math:`a_3, d_4, a_4`) are kept. Zeroing shoulder offsets would make
-    dp depend on q1 too, which the bounded search does not cover yet.
+    The elbow's offsets (:math:`a_3, d_4, a_4`) are kept. :math:`a_2` would make dp depend on
+    q2 as well and is refused.
+
+    Returns:
+        The model chain, the real chain with only its shoulder offsets zeroed, and the
+        closed form's parameters.
     """
     rows = list(arm.chain.rows)
     jr = arm.chain.joint_rows
     if any(rows[r].kind is not JointKind.REVOLUTE for r in jr):
         raise ModelError(f"arm '{arm.name}': the 7-DOF model needs revolute joints")
-    shoulder = {f"{f}{j + 1}": getattr(rows[jr[j]], f) for j, f in ((0, "a"), (1, "a"), (1, "d"))}
-    offsets = ", ".join(f"{k} = {v:g} m" for k, v in shoulder.items() if v != 0.0)
-    if offsets:
+    if rows[jr[1]].a != 0.0:
         raise ModelError(
-            f"arm '{arm.name}': shoulder offsets ({offsets}) make dp depend on q1 as well as q7; "
-            "the bounded search over (q1, q7) is not built yet"
+            f"arm '{arm.name}': the shoulder offset a2 = {rows[jr[1]].a:g} m makes dp depend on q2; "
+            "the bounded search handles offsets that turn with q1 or q7 only"
         )
     if jr[-1] - jr[0] != 6:
         raise ModelError(f"arm '{arm.name}': fixed rows between joints are not supported by the 7-DOF model")
     for j in (0, 1, 4, 5):
         _check_right_angle(arm.name, rows[jr[j]], j)
+    for j, fields in ((0, ("a",)), (1, ("d",))):
+        rows[jr[j]] = dataclasses.replace(rows[jr[j]], **dict.fromkeys(fields, 0.0))
+    shoulderless = arm.chain.replace_rows(rows)
     for j, fields in ((4, ("a",)), (5, ("a", "d"))):
         rows[jr[j]] = dataclasses.replace(rows[jr[j]], **dict.fromkeys(fields, 0.0))
     chain = arm.chain.replace_rows(rows)
@@ -204,7 +233,7 @@ def _srs_model(arm: Arm) -> tuple[KinematicChain, np.ndarray]:
     P[srs.BEND] = np.sign(np.cross([0.0, 0.0, 1.0], v) @ -s3)
     P[srs.UP : srs.UP + 3] = R_base.T @ np.array([0.0, 0.0, 1.0])
     P[srs.REF : srs.REF + 3] = R_base.T @ np.array([-1.0, 0.0, 0.0])
-    return chain, P
+    return chain, shoulderless, P
 
 
 def _check_right_angle(name: str, row: DHRow, j: int) -> None:
@@ -322,19 +351,22 @@ def _dp_joint(name: str, real: KinematicChain, model: KinematicChain) -> int:
     return dependent.pop() if dependent else -1
 
 
-def _delta_coefficients(arm: Arm, model: KinematicChain, dp_joint: int) -> np.ndarray:
-    """Fit delta(w) = D0 + D1 cos w + D2 sin w exactly from four angles, and check it at others."""
+def _circle_fit(arm: Arm, what: str, joint: int, f) -> np.ndarray:
+    """Fit f(q) = C0 + C1 cos q_J + C2 sin q_J exactly from four angles of joint J (f constant
+    for J = -1), and check it at random joint vectors."""
     rng = np.random.default_rng(1)
     q = rng.uniform(-np.pi, np.pi, arm.dof)
 
-    def delta(w: float) -> np.ndarray:
-        if dp_joint >= 0:
-            q[dp_joint] = w
-        return _delta(arm.chain, model, q)
+    def at(w: float) -> np.ndarray:
+        if joint >= 0:
+            q[joint] = w
+        return f(q)
 
-    d0, d1, d2, d3 = (delta(w) for w in (0.0, np.pi / 2, np.pi, -np.pi / 2))
-    D = np.array([(d0 + d2) / 2, (d0 - d2) / 2, (d1 - d3) / 2])
-    for w in rng.uniform(-np.pi, np.pi, 16):
-        if np.abs(D[0] + D[1] * np.cos(w) + D[2] * np.sin(w) - delta(w)).max() > 1e-13:
-            raise ModelError(f"arm '{arm.name}': dp seen from the flange is not affine in cos and sin of q_J")
-    return D
+    d0, d1, d2, d3 = (at(w) for w in (0.0, np.pi / 2, np.pi, -np.pi / 2))
+    C = np.array([(d0 + d2) / 2, (d0 - d2) / 2, (d1 - d3) / 2])
+    for _ in range(16):
+        q = rng.uniform(-np.pi, np.pi, arm.dof)
+        w = q[joint] if joint >= 0 else 0.0
+        if np.abs(C[0] + C[1] * np.cos(w) + C[2] * np.sin(w) - f(q)).max() > 1e-13:
+            raise ModelError(f"arm '{arm.name}': {what} is not affine in cos and sin of q{joint + 1}")
+    return C

@@ -13,6 +13,13 @@ seen from the flange and depends on one wrist joint, :math:`w = q_J` (see
 and a root gives the real arm's joints :math:`q = \mathrm{IK}_{model}(\ldots)` with
 :math:`|p_{real}(q) - p_d| = |\delta(w) - \delta(q_J)| \le \Delta p_{max}\,|g(w)|`.
 
+Arms with shoulder offsets (Gen3) add :math:`a(q_1)`, so solutions lie on a torus
+:math:`(q_1, q_7)`. The search then scans :math:`w = q_1`, where the larger offset acts,
+and solves :math:`q_7` inside each evaluation of g by a secant iteration on
+:math:`\mathrm{IK}(R_d, p_d + a(w) + R_d\,\delta(w_7), c)_7 = w_7`, which is nearly
+the identity because the wrist offset is small. Where that iteration has no root, the
+point counts as out of reach.
+
 * Local solve: Broyden's method, which in one unknown is the secant method, started with a
   finite-difference slope, from the joint of the paper's fixed-point start
   (:math:`p_m = p_d`) or of a hint.
@@ -47,6 +54,7 @@ _START_POINTS = 8  # samples of the dp circle tried when p_d is outside the mode
 _WINDOW_POINTS = 8  # samples of the window searched around a hint
 _PAIR_SEARCH = 1.0  # |g| (rad) below which a local minimum is searched for a root pair
 _REDUNDANCY_TOL = 1e-9  # a solution's redundancy values (rad) must equal the requested ones
+_INNER_TOL = 1e-12  # |h| (rad) at which the inner q7 iteration has converged
 
 
 @nb.njit(cache=True, inline="always")
@@ -78,19 +86,88 @@ def _with_signs(problem, signs):
 
 @nb.njit(cache=True, inline="always")
 def _g_margin(problem, w, q):
-    """Residual g(w) (NaN if unreachable) and the model's reach margin; writes the IK into q."""
+    """Residual g(w) (NaN if unreachable) and the model's reach margin; writes the IK into q.
+
+    With shoulder offsets (D has six rows), w is q_1 and q_7 is solved inside
+    (:func:`_wrist_ik`); otherwise w is q_J.
+    """
     family, P, mtab, _, J, D, R, p, signs, redundancy, q_prev, counter = problem
-    counter[0] += 1
-    d = _delta(D, w)
     pm = np.empty(3)
-    for k in range(3):
-        pm[k] = p[k] + R[k, 0] * d[0] + R[k, 1] * d[1] + R[k, 2] * d[2]
-    margin = model_ik(family, P, mtab, R, pm, signs, redundancy, q_prev, q)
+    if D.shape[0] == 6:
+        c, s = np.cos(w), np.sin(w)
+        for k in range(3):
+            pm[k] = p[k] + D[3, k] + D[4, k] * c + D[5, k] * s
+        margin = _wrist_ik(problem, pm, q)
+    else:
+        d = _delta(D, w)
+        for k in range(3):
+            pm[k] = p[k] + R[k, 0] * d[0] + R[k, 1] * d[1] + R[k, 2] * d[2]
+        counter[0] += 1
+        margin = model_ik(family, P, mtab, R, pm, signs, redundancy, q_prev, q)
     if margin < -REACH_SLACK:
         return np.nan, margin
     if J < 0:
         return 0.0, margin
     return wrap(q[J] - w), margin
+
+
+@nb.njit(cache=True)
+def _ik_at_q7(problem, pm, w7, q):
+    """Model IK for p_m + R delta(w7); returns (h, margin), h = wrap(q_7 - w7) (NaN out of reach)."""
+    family, P, mtab, _, _, D, R, _, signs, redundancy, q_prev, counter = problem
+    counter[0] += 1
+    d = _delta(D, w7)
+    x = np.empty(3)
+    for k in range(3):
+        x[k] = pm[k] + R[k, 0] * d[0] + R[k, 1] * d[1] + R[k, 2] * d[2]
+    margin = model_ik(family, P, mtab, R, x, signs, redundancy, q_prev, q)
+    if margin < -REACH_SLACK:
+        return np.nan, margin
+    return wrap(q[6] - w7), margin
+
+
+@nb.njit(cache=True)
+def _wrist_ik(problem, pm, q):
+    """Model IK with the wrist offsets' dp :math:`R\\,\\delta(q_7)` taken at the model's own q_7.
+
+    Solves :math:`h(w_7) = \\mathrm{wrap}(\\mathrm{IK}(p_m + R\\,\\delta(w_7))_7 - w_7) = 0` by
+    the secant method. The wrist offsets are small next to the shoulder's (the bounded search
+    scans q_1), so :math:`dh/dw_7 \\approx -1` and the root is unique except within a
+    hair of the model's reach edge. The start is the hint's q_7, or, if the model cannot
+    reach from there, the best of a few samples of the circle. Returns the reach margin at
+    the root, whose IK is in q; without a root, a negative number.
+    """
+    w0 = problem[10][6]
+    h0, margin = _ik_at_q7(problem, pm, w0, q)
+    if np.isnan(h0):
+        best, best_margin = np.inf, margin
+        for k in range(_START_POINTS):
+            w = -np.pi + 2.0 * np.pi * k / _START_POINTS
+            h, m = _ik_at_q7(problem, pm, w, q)
+            best_margin = max(best_margin, m)
+            if abs(h) < best:  # False for NaN
+                best, w0, h0 = abs(h), w, h
+        if np.isnan(h0):
+            return best_margin
+    w1 = w0 + h0  # a fixed-point step
+    h1, margin = _ik_at_q7(problem, pm, w1, q)
+    for _ in range(40):
+        while np.isnan(h1) and abs(w1 - w0) > 1e-12:  # stepped out of reach: step back
+            w1 = 0.5 * (w0 + w1)
+            h1, margin = _ik_at_q7(problem, pm, w1, q)
+        if np.isnan(h1) or abs(h1) < 1e-15 or h1 == h0:
+            break
+        step = -h1 * (w1 - w0) / (h1 - h0)
+        if abs(step) > 0.5:
+            step = 0.5 * np.sign(step)
+        w0, h0 = w1, h1
+        w1 = w1 + step
+        h1, margin = _ik_at_q7(problem, pm, w1, q)
+    if np.isnan(h1):  # q must belong to a reachable iterate
+        h1, margin = _ik_at_q7(problem, pm, w0, q)
+    # No root: the iterates ran into the reach edge. -|h| extends the margin past the edge,
+    # where both vanish, so that the search sees the region as out of reach.
+    return margin if abs(h1) < _INNER_TOL else -abs(h1)
 
 
 @nb.njit(cache=True, inline="always")

@@ -112,14 +112,17 @@ class OMSolver:
         self.scan_points = int(scan_points)
         self.om: ModelArm = derive_model(self.arm)
         chain = self.arm.chain
+        shoulder = bool(self.om.shoulder.any())
         # The data every kernel call needs, in the layout of om_system.solve_one.
         self._kernel_arm = (
             self.om.family,
             self.om.params,
             self.om.model.chain.table,
             chain.table,
-            self.om.dp_joint,
-            self.om.delta,
+            # With shoulder offsets the bounded search scans q1 (their coefficients ride below
+            # delta's) and solves q7 inside; see om_system._g_margin.
+            0 if shoulder else self.om.dp_joint,
+            np.vstack([self.om.delta, self.om.shoulder]) if shoulder else self.om.delta,
             np.linalg.inv(chain.T_root_base),
             np.linalg.inv(chain.T_flange_tool),
             self.arm.revolute,

@@ -65,7 +65,7 @@ def test_dp_depends_on_joint_6_alone_and_its_norm_is_dp_max(name, dp_max):
     np.testing.assert_allclose(om_arm.model.fk(Q)[:, :3, :3], om_arm.real.fk(Q)[:, :3, :3], atol=1e-15)
 
 
-SOLVABLE = ["spherical", "ur5e", "panda", "fr3", "iiwa14", "xarm7"]
+SOLVABLE = ["spherical", "ur5e", "panda", "fr3", "iiwa14", "gen3", "xarm7"]
 
 
 @pytest.mark.parametrize("name", SOLVABLE)
@@ -125,7 +125,26 @@ def test_seven_dof_dp_depends_on_joint_7_alone(name, dp_max):
     )
 
 
-@pytest.mark.parametrize("name", ["panda", "iiwa14", "xarm7"])
+def test_shoulder_offsets_dp_turns_with_joint_1_alone():
+    """Gen3: dp = R_flange delta(q7) + a(q1), a(q1) = A0 + A1 cos q1 + A2 sin q1 in DH frame 0."""
+    om_arm = om.derive_model(om.load_arm("gen3"))
+    real = om_arm.real
+    jr = real.chain.joint_rows
+    assert om_arm.model.chain.rows[jr[1]].d == 0.0 and real.chain.rows[jr[1]].d == -0.01175
+    Q = random_q(real, 300, np.random.default_rng(6))
+    base = real.chain.T_root_base
+    R = real.fk(Q)[:, :3, :3] @ np.linalg.inv(real.chain.T_flange_tool[:3, :3])
+    dp0 = om_arm.dp(Q) @ base[:3, :3]  # in DH frame 0
+    A, D = om_arm.shoulder, om_arm.delta
+    a = A[0] + np.outer(np.cos(Q[:, 0]), A[1]) + np.outer(np.sin(Q[:, 0]), A[2])
+    delta = D[0] + np.outer(np.cos(Q[:, 6]), D[1]) + np.outer(np.sin(Q[:, 6]), D[2])
+    R0 = base[:3, :3].T @ R
+    np.testing.assert_allclose(dp0, np.einsum("mij,mj->mi", R0, delta) + a, atol=1e-14)
+    np.testing.assert_allclose(np.linalg.norm(a, axis=1), 0.01175, atol=1e-15)
+    assert om_arm.dp_max == pytest.approx(0.01175 + 0.0003501, abs=1e-12)
+
+
+@pytest.mark.parametrize("name", ["panda", "iiwa14", "gen3", "xarm7"])
 def test_arm_angle_is_the_elbow_bend_direction_about_the_shoulder_wrist_line(name):
     """psi from the closed form's parameters equals psi computed from FK points directly."""
     om_arm = om.derive_model(om.load_arm(name))

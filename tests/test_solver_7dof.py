@@ -140,7 +140,27 @@ def test_bad_configurations_are_named(panda):
         panda.solve_batch(Ts, (1, 1, 1), np.zeros((3, 2)))
 
 
-@pytest.mark.parametrize("name", ["gen3", "sawyer"])
-def test_arms_without_a_model_yet_are_refused_with_the_reason(name):
-    with pytest.raises(om.ModelError, match=rf"arm .{name}.: shoulder offsets .* q1 as well as q7"):
-        om.OMSolver(name)
+def test_shoulder_offset_arm_solves_exactly_near_the_hint():
+    """Gen3: its shoulder offset d2 makes the bounded search two-dimensional, (q1, q7).
+
+    Every solution is exact and in the requested configuration; a hinted solve returns q or
+    a root of the same configuration nearer the hint. (Recovery over 100,000 targets is in
+    the 7-DOF benchmark: solve_all misses roots of close pairs next to the model's reach
+    edge, see the README.)
+    """
+    solver = om.OMSolver("gen3")
+    rng = np.random.default_rng(22)
+    for q in random_q(solver.arm, 100, rng):
+        T = solver.arm.fk(q)
+        c = solver.configuration_of(q)
+        hint = q + rng.uniform(-0.01, 0.01, 7)
+        hinted = solver.solve(T, c, q_hint=hint)
+        assert_exact(solver, hinted, T, c)
+        assert distance(hinted.q, hint) <= distance(q, hint) + 1e-9
+        for r in solver.solve_all(T, c):
+            assert_exact(solver, r, T, c)
+
+
+def test_arm_with_a_fixed_row_inside_the_wrist_is_refused_with_the_reason():
+    with pytest.raises(om.ModelError, match=r"arm .sawyer.: fixed rows between joints are not supported"):
+        om.OMSolver("sawyer")
