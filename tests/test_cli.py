@@ -3,6 +3,8 @@ tested (exit status, one-line errors, no traceback, pipes), else in-process thro
 
 from __future__ import annotations
 
+import csv
+import io
 import json
 import math
 import subprocess
@@ -16,7 +18,18 @@ import pytest
 import om_redundant as om
 from om_redundant.cli import build_parser, main
 from om_redundant.cli.common import UsageError
-from om_redundant.cli.sweep import build_request, parse_obstacle, psi_grid, read_path
+from om_redundant.cli.sweep import (
+    BranchSweep,
+    Choice,
+    PoseSweep,
+    Progress,
+    SweepRequest,
+    SweepResult,
+    build_request,
+    parse_obstacle,
+    psi_grid,
+    read_path,
+)
 from om_redundant.model import derive_model
 from tests.conftest import MENAGERIE, ROOT, checkout_env, run_python
 
@@ -437,3 +450,127 @@ def test_psi_grid_covers_the_circle_once():
     assert len(psi_grid(2 * math.pi)) == 1 and len(psi_grid(100.0)) == 1
     grid = psi_grid(2 * math.pi / 720)
     assert len(grid) == 720 and grid[0] == -math.pi and math.pi - grid[-1] == pytest.approx(2 * math.pi / 720)
+
+
+# ---------------------------------------------------------------------------------------
+# sweep: what the command shows of a result, from a stand-in engine (joint limits only; the
+# largest margin on the grid as the choice) until the real one is wired in
+
+
+def stand_in_sweep(request: SweepRequest) -> SweepResult:
+    solver, psi, arm = request.solver, request.psi, request.solver.arm
+    poses = []
+    for i, T in enumerate(request.poses):
+        branches, best = [], None
+        for signs in request.branches:
+            batch = solver.solve_batch(np.repeat(T[None], len(psi), axis=0), signs, psi)
+            q = np.where(batch.ok[:, None], batch.q, np.nan)
+            margin = np.minimum(q - arm.lower, arm.upper - q)
+            smallest = np.min(np.nan_to_num(margin, nan=-1.0), axis=1)
+            feasible = batch.ok & (smallest >= 0.0)
+            edges = np.flatnonzero(np.diff(np.concatenate([[0], feasible.astype(int), [0]])))
+            intervals = tuple((float(psi[a]), float(psi[b - 1])) for a, b in edges.reshape(-1, 2))
+            clearance = np.where(batch.ok, np.inf, np.nan)
+            branches.append(BranchSweep(signs, q, batch.ok, margin, clearance, feasible, intervals))
+            if feasible.any():
+                k = int(np.argmax(np.where(feasible, smallest, -np.inf)))
+                if best is None or smallest[k] > best.margin:
+                    best = Choice(om.Configuration(signs, (float(psi[k]),)), q[k], float(smallest[k]), np.inf)
+        poses.append(PoseSweep(T, tuple(branches), best))
+        request.progress(i + 1)
+    return SweepResult(psi, tuple(poses))
+
+
+def png_size(path) -> tuple[int, int]:
+    data = path.read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n" and data[12:16] == b"IHDR"
+    return int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")
+
+
+def test_sweep_outputs_agree_with_the_result(capsys, tmp_path, monkeypatch):
+    results = []
+
+    def engine(request):
+        results.append(stand_in_sweep(request))
+        return results[-1]
+
+    monkeypatch.setattr("om_redundant.cli.sweep.compute_sweep", engine)
+    files = {"csv": tmp_path / "sweep.csv", "json": tmp_path / "sweep.json", "plot": tmp_path / "sweep.png"}
+    argv = ["sweep", "--resolution", "0.05", *(a for k, f in files.items() for a in (f"--{k}", str(f)))]
+    status, out, err = in_process(capsys, *argv)
+    assert status == 0 and err == ""
+    (result,) = results
+    (pose,) = result.poses
+    signs = " ".join(f"{v:+d}" for v in pose.chosen.configuration.signs)
+    assert f"chosen: {signs}, psi = {pose.chosen.configuration.redundancy[0]:.4f} rad" in out
+    for branch in pose.branches:
+        assert all(f"[{lo:+.3f}, {hi:+.3f}]" in out for lo, hi in branch.intervals)
+    assert sum(bool(b.intervals) for b in pose.branches) == 2
+    width, height = png_size(files["plot"])
+    assert 1000 <= width <= 2000 and 700 <= height <= 1500
+
+    rows = list(csv.DictReader(files["csv"].open()))
+    assert len(rows) == 8 * len(result.psi)
+    for row in rows[:: len(result.psi) // 3]:
+        k = int(np.argmin(np.abs(result.psi - float(row["psi"]))))
+        branch = next(
+            b for b in pose.branches if b.signs == tuple(int(row[n]) for n in ("SHOULDER", "ELBOW", "WRIST"))
+        )
+        assert float(row["psi"]) == result.psi[k] and bool(int(row["feasible"])) == branch.feasible[k]
+        q = [float(row[f"q_joint{j}"]) for j in range(1, 8)]
+        np.testing.assert_array_equal(q, branch.q[k])
+
+    data = json.loads(files["json"].read_text())
+    np.testing.assert_array_equal(data["psi"], result.psi)
+    (got,) = data["poses"]
+    assert got["chosen"]["psi"] == pose.chosen.configuration.redundancy[0]
+    np.testing.assert_array_equal(got["chosen"]["q"], pose.chosen.q)
+    for b, branch in zip(got["branches"], pose.branches, strict=True):
+        assert tuple(b["signs"]) == branch.signs and [tuple(i) for i in b["intervals"]] == list(
+            branch.intervals
+        )
+        q = np.array([[np.nan if v is None else v for v in r] for r in b["q"]])
+        np.testing.assert_array_equal(q, branch.q)
+
+
+def test_sweep_path_map_and_stdout_outputs(capsys, tmp_path, monkeypatch):
+    monkeypatch.setattr("om_redundant.cli.sweep.compute_sweep", stand_in_sweep)
+    solver = om.OMSolver("panda")
+    path = tmp_path / "path.csv"
+    rows = []
+    for s in np.linspace(0.0, 0.6, 12):
+        T = solver.arm.fk(Q_PANDA + s * np.array([1.0, 0.3, 0.0, 0.4, 0.0, -0.5, 0.0]))
+        quat = np.empty(4)
+        mujoco.mju_mat2Quat(quat, np.ascontiguousarray(T[:3, :3]).ravel())
+        rows.append(",".join(repr(float(v)) for v in (*T[:3, 3], *quat)))
+    path.write_text("\n".join(rows) + "\n")
+    plot = tmp_path / "map.svg"
+    argv = ["sweep", "--path", str(path), "--signs", "1", "-1", "1", "--resolution", "0.1"]
+    status, out, _ = in_process(capsys, *argv, "--plot", str(plot))
+    assert status == 0 and len(out.splitlines()) == 4 + 12 and plot.read_text().startswith("<?xml")
+    status, out, _ = in_process(capsys, *argv, "--json")
+    data = json.loads(out)
+    assert status == 0 and len(data["poses"]) == 12 and all(p["chosen"] for p in data["poses"])
+    status, out, _ = in_process(capsys, *argv, "--csv", "--quiet")
+    assert status == 0 and out.startswith(
+        "pose,SHOULDER,ELBOW,WRIST,psi,ok,feasible,margin,clearance,q_joint1"
+    )
+    assert len(out.splitlines()) == 1 + 12 * 63
+
+
+def test_progress_bar_on_a_terminal(monkeypatch):
+    class Terminal(io.StringIO):
+        def isatty(self):
+            return True
+
+    monkeypatch.setattr(sys, "stderr", Terminal())
+    progress = Progress(4)
+    for done in range(1, 5):
+        progress(done)
+    text = sys.stderr.getvalue()
+    assert (
+        text.count("\r") == 4
+        and text.endswith("4/4 poses\n")
+        and "[###############...............] 2/4" in text
+    )
+    assert not Progress(4, enabled=False).enabled and not Progress(1).enabled

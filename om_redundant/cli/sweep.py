@@ -215,8 +215,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from .sweep_output import show  # it imports the types above
+
     request = build_request(args)
-    compute_sweep(request)
+    show(request, compute_sweep(request), args)
     return 0
 
 
