@@ -113,6 +113,7 @@ def test_bad_input_exits_2_with_one_line_and_no_traceback(argv, message):
         (["check-model", "model.xml"], "required: --arm"),
         (["check-model", "no/such/model.xml", "--arm", "panda"], "cannot read MuJoCo model"),
         (["check-model", "README.md", "--arm", "panda"], "must be an MJCF file ending in .xml"),
+        (["check-model", "arms/panda.toml", "--arm", "nope"], "unknown arm 'nope'"),
         (["sweep", "--arm", "ur5e"], "arm 'ur5e' has no arm angle to sweep"),
         (["sweep", "--arm", "sawyer"], "arm 'sawyer': shoulder offsets"),
         (["sweep", "--resolution", "0"], "--resolution must be a positive number"),
@@ -354,6 +355,17 @@ def test_check_model_prefix_root_and_site_options(capsys, tmp_path):
         "",
         "",
     )
+
+
+@pytest.mark.parametrize(
+    "option, message",
+    [(["--samples", "0"], "samples must be at least 1"), (["--tolerance", "nan"], "tolerance")],
+)
+def test_check_model_bad_settings(capsys, tmp_path, option, message):
+    path = tmp_path / "panda.xml"
+    path.write_text(panda_mjcf())
+    status, _, err = in_process(capsys, "check-model", str(path), "--arm", "panda", *option)
+    assert status == 2 and message in err and err.count("\n") == 1
 
 
 def test_check_model_against_the_menagerie_panda():

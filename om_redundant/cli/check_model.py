@@ -6,7 +6,7 @@ import argparse
 
 from ..arm import load_arm
 from ..mujoco_match import DEFAULT_TOLERANCE, compare_mujoco_model, load_mujoco_model
-from .common import Failed, UsageError, add_arm_option, add_output_options, finite, table_wanted, write_json
+from .common import Failed, add_arm_option, add_output_options, table_wanted, write_json
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -45,10 +45,6 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     arm = load_arm(args.arm)
-    if args.samples < 1:
-        raise UsageError(f"--samples must be positive, got {args.samples}")
-    if not finite(args.tolerance, "--tolerance") > 0.0:
-        raise UsageError(f"--tolerance must be positive, got {args.tolerance}")
     model = load_mujoco_model(args.model)
     result = compare_mujoco_model(
         arm,

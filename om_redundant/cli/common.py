@@ -11,10 +11,10 @@ from typing import Any
 
 import numpy as np
 
-from ..arm import Arm, arm_names, rotation_from_quat
-from ..exceptions import OMError
+from ..arm import Arm, arm_names, pose_from_xyz_quat
+from ..exceptions import InvalidInput, OMError
 from ..solver import OMSolver
-from ..validation import as_pose
+from ..validation import as_pose, as_signs
 
 #: Joint vectors whose forward kinematics is the built-in target, by number of joints;
 #: clipped into each arm's limits (the UR5e pose of the README; the Panda's for 7-DOF arms).
@@ -111,23 +111,21 @@ def target_pose(args: argparse.Namespace, arm: Arm) -> np.ndarray:
         return arm.fk(default_q(arm))
     if args.xyz is None or args.quat is None:
         raise UsageError("give both --xyz and --quat")
-    return pose_from_xyz_quat(args.xyz, args.quat, "--xyz", "--quat")
+    return pose_from_text(args.xyz, args.quat, "--xyz", "--quat")
 
 
-def pose_from_xyz_quat(xyz, quat, xyz_name: str, quat_name: str) -> np.ndarray:
-    """A 4x4 pose from a position and a (w, x, y, z) quaternion, normalised; names the bad part."""
+def pose_from_text(xyz, quat, xyz_name: str, quat_name: str) -> np.ndarray:
+    """:func:`~om_redundant.arm.pose_from_xyz_quat` of numbers read from the command line or a
+    file, an error naming them and the problem."""
     xyz, quat = np.asarray(xyz, dtype=np.float64), np.asarray(quat, dtype=np.float64)
     if not np.isfinite(xyz).all():
         raise UsageError(f"{xyz_name} {_numbers(xyz)} is not finite")
     if not np.isfinite(quat).all():
         raise UsageError(f"{quat_name} {_numbers(quat)} is not finite")
-    norm = float(np.linalg.norm(quat))
-    if norm < 1e-9:
-        raise UsageError(f"{quat_name} {_numbers(quat)} has zero norm")
-    T = np.eye(4)
-    T[:3, :3] = rotation_from_quat(quat / norm)
-    T[:3, 3] = xyz
-    return T
+    try:
+        return pose_from_xyz_quat(xyz, quat)
+    except InvalidInput:
+        raise UsageError(f"{quat_name} {_numbers(quat)} has zero norm") from None
 
 
 def read_pose_file(path: str) -> np.ndarray:
@@ -154,9 +152,7 @@ def parse_signs(signs: list[int] | None, solver: OMSolver) -> tuple[int, ...] | 
     names = solver.sign_names
     if len(signs) != len(names):
         raise UsageError(f"--signs needs {len(names)} values ({' '.join(names)}), got {len(signs)}")
-    if any(s not in (-1, 1) for s in signs):
-        raise UsageError(f"--signs must be -1 or +1, got {' '.join(map(str, signs))}")
-    return tuple(signs)
+    return tuple(as_signs(signs, len(names), "--signs").tolist())
 
 
 def finite(value: float, option: str) -> float:

@@ -31,7 +31,7 @@ from .common import (
     add_signs_option,
     check_output_path,
     parse_signs,
-    pose_from_xyz_quat,
+    pose_from_text,
     target_pose,
 )
 
@@ -335,7 +335,7 @@ def read_path(path: str) -> np.ndarray:
             values = [float(row[c]) for c in columns]
         except ValueError:
             raise UsageError(f"{where}: not a number in {','.join(row)}") from None
-        poses[i] = pose_from_xyz_quat(values[:3], values[3:], f"{where}: position", f"{where}: quaternion")
+        poses[i] = pose_from_text(values[:3], values[3:], f"{where}: position", f"{where}: quaternion")
     return poses
 
 
