@@ -4,7 +4,8 @@ The command reads and checks its input here (arm, pose or path of poses, branche
 scene, resolution, output files) into a :class:`SweepRequest`, and hands it to
 :func:`compute_sweep`, which returns a :class:`SweepResult`. The computation itself (joint
 angles, limit margins and clearance along psi, feasible intervals, the optimiser's choice)
-is not built yet: :func:`compute_sweep` says so.
+is not built yet: :func:`compute_sweep` says so. :mod:`~om_redundant.cli.sweep_output` shows
+the result (table, CSV, JSON, plots).
 """
 
 from __future__ import annotations
@@ -48,6 +49,7 @@ SHAPES = {
     "box": ("x", "y", "z", "hx", "hy", "hz"),
 }
 SIZES = {"r", "hx", "hy", "hz"}  # must be positive
+SHAPE_USAGE = ", ".join(f"{kind}:{','.join(names)}" for kind, names in SHAPES.items())
 
 
 # ---------------------------------------------------------------------------------------
@@ -189,9 +191,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         action="append",
         default=[],
         metavar="SHAPE",
-        help="an obstacle in the arm's root frame (m), repeatable: "
-        + ", ".join(f"{k}:{','.join(v)}" for k, v in SHAPES.items())
-        + " (box: centre and half-sizes, axis-aligned)",
+        help=f"an obstacle in the arm's root frame (m), repeatable: {SHAPE_USAGE} "
+        "(box: centre and half-sizes, axis-aligned)",
     )
     parser.add_argument("--scene", metavar="FILE.xml", help="MuJoCo scene whose geoms are obstacles")
     parser.add_argument(
@@ -273,9 +274,8 @@ def parse_obstacle(text: str) -> Obstacle:
     where = f"--obstacle '{text}'"
     kind, colon, numbers = text.partition(":")
     kind = kind.strip().lower()
-    usage = ", ".join(f"{k}:{','.join(v)}" for k, v in SHAPES.items())
     if kind not in SHAPES or not colon:
-        raise UsageError(f"{where}: unknown shape '{kind}'; use {usage}")
+        raise UsageError(f"{where}: unknown shape '{kind}'; use {SHAPE_USAGE}")
     names = SHAPES[kind]
     parts = [p.strip() for p in numbers.split(",")] if numbers.strip() else []
     if len(parts) != len(names):
