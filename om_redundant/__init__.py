@@ -17,6 +17,9 @@ from .mjcf import arm_model as arm_model
 from .mjcf import scene_mjcf as scene_mjcf
 from .model import ModelArm as ModelArm
 from .model import derive_model as derive_model
+from .mujoco_match import ModelComparison as ModelComparison
+from .mujoco_match import compare_mujoco_model as compare_mujoco_model
+from .mujoco_match import load_mujoco_model as load_mujoco_model
 from .solver import BatchSolution as BatchSolution
 from .solver import OMSolver as OMSolver
 from .solver import Solution as Solution

@@ -44,7 +44,7 @@ from typing import Any
 
 import numpy as np
 
-from .exceptions import ArmFileError, UnknownArm
+from .exceptions import ArmFileError, InvalidInput, UnknownArm
 from .kinematics import DHRow, JointKind, KinematicChain, standard_rows_from_modified
 from .validation import as_joint_vector
 
@@ -277,13 +277,26 @@ class _Fields:
         self.no_unknown(table, {"xyz", "quat"}, key + ".")
         xyz = self.vector(table, "xyz", key + ".", 3, [0.0, 0.0, 0.0])
         quat = self.vector(table, "quat", key + ".", 4, [1.0, 0.0, 0.0, 0.0])
-        norm = np.linalg.norm(quat)
-        if norm < 1e-9:
-            raise ArmFileError(self.path, key + ".quat", "quaternion has zero norm")
-        T = np.eye(4)
-        T[:3, :3] = rotation_from_quat(quat / norm)
-        T[:3, 3] = xyz
-        return T
+        try:
+            return pose_from_xyz_quat(xyz, quat)
+        except InvalidInput:
+            raise ArmFileError(self.path, key + ".quat", "quaternion has zero norm") from None
+
+
+def pose_from_xyz_quat(xyz: Any, quat: Any) -> np.ndarray:
+    """Pose (4, 4) from a position and a quaternion (w, x, y, z), which is normalised.
+
+    Raises:
+        InvalidInput: The quaternion has zero norm (below 1e-9) or is not finite.
+    """
+    quat = np.asarray(quat, dtype=np.float64)
+    norm = np.linalg.norm(quat)
+    if not norm >= 1e-9:
+        raise InvalidInput(f"quaternion {quat.tolist()} has zero norm")
+    T = np.eye(4)
+    T[:3, :3] = rotation_from_quat(quat / norm)
+    T[:3, 3] = xyz
+    return T
 
 
 def rotation_from_quat(wxyz: np.ndarray) -> np.ndarray:

@@ -1,28 +1,43 @@
-"""Shared fixtures: the reference Menagerie models (kinematics only) beside the project."""
+"""Shared helpers: the reference Menagerie models (kinematics only) beside the project, and
+running the checkout's code in a fresh interpreter."""
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import mujoco
 import numpy as np
 import pytest
 
-MENAGERIE = Path(__file__).resolve().parents[2] / "shared" / "reference" / "menagerie"
+from om_redundant.mujoco_match import load_mujoco_model
+
+ROOT = Path(__file__).resolve().parents[1]
+MENAGERIE = ROOT.parent / "shared" / "reference" / "menagerie"
 
 
 def load_reference_model(relative_path: str) -> mujoco.MjModel:
-    """Load a Menagerie MJCF with its meshes stripped (the files ship without them)."""
+    """Load a Menagerie MJCF, without its meshes (the files ship without them)."""
     path = MENAGERIE / relative_path
     if not path.is_file():
         pytest.skip(f"reference model {path} not available")
-    spec = mujoco.MjSpec.from_file(str(path))
-    for geom in list(spec.geoms):
-        if geom.type == mujoco.mjtGeom.mjGEOM_MESH:
-            spec.delete(geom)
-    for mesh in list(spec.meshes):
-        spec.delete(mesh)
-    return spec.compile()
+    return load_mujoco_model(path)
+
+
+def checkout_env() -> dict[str, str]:
+    """The environment in which a fresh interpreter imports this checkout's package."""
+    path = os.pathsep.join([str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])])
+    return {**os.environ, "PYTHONPATH": path}
+
+
+def run_python(*args: str, timeout: float = 300) -> subprocess.CompletedProcess:
+    """``python ARGS`` in a fresh interpreter, as a user runs it (``-m om_redundant.cli ...`` or a
+    script), importing this checkout's package; output captured as text."""
+    return subprocess.run(
+        [sys.executable, *args], cwd=ROOT, env=checkout_env(), capture_output=True, text=True, timeout=timeout
+    )
 
 
 def wrap(angle: np.ndarray) -> np.ndarray:

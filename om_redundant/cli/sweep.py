@@ -1,0 +1,364 @@
+"""``om-redundant sweep``: the arm angle psi of a 7-DOF arm swept for a pose or a path.
+
+The command reads and checks its input here (arm, pose or path of poses, branches, obstacles,
+scene, resolution, output files) into a :class:`SweepRequest`, and hands it to
+:func:`compute_sweep`, which returns a :class:`SweepResult`. The computation itself (joint
+angles, limit margins and clearance along psi, feasible intervals, the optimiser's choice)
+is not built yet: :func:`compute_sweep` says so. :mod:`~om_redundant.cli.sweep_output` shows
+the result (table, CSV, JSON, plots).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import math
+import sys
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import mujoco
+import numpy as np
+
+from ..configuration import Configuration
+from ..mujoco_match import load_mujoco_model
+from ..solver import OMSolver
+from .common import (
+    Failed,
+    UsageError,
+    add_arm_option,
+    add_output_options,
+    add_pose_options,
+    add_signs_option,
+    check_output_path,
+    parse_signs,
+    pose_from_text,
+    target_pose,
+)
+
+DEFAULT_ARM = "panda"
+DEFAULT_RESOLUTION = 2.0 * math.pi / 360.0  # rad: 360 arm angles
+MAX_SAMPLES = 100_000  # arm angles per branch and pose
+PLOT_SUFFIXES = (".png", ".svg")
+PATH_COLUMNS = ("x", "y", "z", "qw", "qx", "qy", "qz")
+
+#: Obstacle shapes: the numbers each takes, in order (metres, in the arm's root frame).
+SHAPES = {
+    "sphere": ("x", "y", "z", "r"),
+    "capsule": ("x1", "y1", "z1", "x2", "y2", "z2", "r"),
+    "box": ("x", "y", "z", "hx", "hy", "hz"),
+}
+SIZES = {"r", "hx", "hy", "hz"}  # must be positive
+SHAPE_USAGE = ", ".join(f"{kind}:{','.join(names)}" for kind, names in SHAPES.items())
+
+
+# ---------------------------------------------------------------------------------------
+# The contract between the command and the sweep engine.
+
+
+@dataclass(frozen=True)
+class Obstacle:
+    """An obstacle from the command line, in the arm's root frame (metres).
+
+    Attributes:
+        kind: ``"sphere"``, ``"capsule"`` or ``"box"`` (axis-aligned).
+        values: The numbers of :data:`SHAPES` for that kind, in order.
+    """
+
+    kind: str
+    values: tuple[float, ...]
+
+    def geom(self) -> dict[str, str]:
+        """Attributes of the MJCF ``<geom>`` of this obstacle (type, size, and pos or fromto)."""
+        v = self.values
+        text = " ".join
+        if self.kind == "sphere":
+            return {"type": "sphere", "pos": text(map(repr, v[:3])), "size": repr(v[3])}
+        if self.kind == "capsule":
+            return {"type": "capsule", "fromto": text(map(repr, v[:6])), "size": repr(v[6])}
+        return {"type": "box", "pos": text(map(repr, v[:3])), "size": text(map(repr, v[3:]))}
+
+
+@dataclass(frozen=True, eq=False)
+class SweepRequest:
+    """What to sweep, checked.
+
+    Attributes:
+        solver: The arm's solver; a 7-DOF arm (``solver.redundancy_names == ("psi",)``).
+        poses: (M, 4, 4) targets in the arm's root frame; M = 1 for a single pose.
+        path: True when the poses are a path (``--path``): psi is tracked from pose to pose.
+        branches: Branch signs to sweep: the one given with ``--signs``, or every combination.
+        psi: (N,) arm angles to evaluate, rad, increasing over [-pi, pi).
+        obstacles: Obstacles given with ``--obstacle``.
+        scene: The ``--scene`` model (compiled, meshes dropped if their files are missing),
+            whose geoms are further obstacles; None without one.
+        progress: Call with the number of poses done so far (drives the progress bar).
+    """
+
+    solver: OMSolver
+    poses: np.ndarray
+    path: bool
+    branches: tuple[tuple[int, ...], ...]
+    psi: np.ndarray
+    obstacles: tuple[Obstacle, ...] = ()
+    scene: mujoco.MjModel | None = None
+    progress: Callable[[int], None] = field(default=lambda done: None)
+
+
+@dataclass(frozen=True, eq=False)
+class BranchSweep:
+    """One branch of one pose, along the psi grid.
+
+    Attributes:
+        signs: The branch signs.
+        q: (N, dof) joint vectors at each psi (NaN rows where there is no solution).
+        ok: (N,) a solution exists at psi.
+        margin: (N, dof) distance of each joint to its nearer limit (rad, m for prismatic
+            joints), negative outside the limits; NaN where there is no solution.
+        clearance: (N,) smallest distance between the arm and the obstacles (m), negative
+            in penetration; +inf without obstacles, NaN where there is no solution.
+        feasible: (N,) a solution within the limits and clear of the obstacles.
+        intervals: Feasible psi intervals ``(low, high)``, rad, from ``feasible``.
+    """
+
+    signs: tuple[int, ...]
+    q: np.ndarray
+    ok: np.ndarray
+    margin: np.ndarray
+    clearance: np.ndarray
+    feasible: np.ndarray
+    intervals: tuple[tuple[float, float], ...]
+
+
+@dataclass(frozen=True, eq=False)
+class Choice:
+    """The optimiser's pick for one pose: a configuration, its joints, margin and clearance."""
+
+    configuration: Configuration
+    q: np.ndarray
+    margin: float  # smallest joint-limit margin (rad or m)
+    clearance: float  # m; +inf without obstacles
+
+
+@dataclass(frozen=True, eq=False)
+class PoseSweep:
+    """The sweep of one pose: every requested branch, and the choice (None if none is feasible)."""
+
+    pose: np.ndarray
+    branches: tuple[BranchSweep, ...]
+    chosen: Choice | None
+
+
+@dataclass(frozen=True, eq=False)
+class SweepResult:
+    """The sweep of every pose on the request's psi grid (for a path: the tracked choices)."""
+
+    psi: np.ndarray
+    poses: tuple[PoseSweep, ...]
+
+
+def compute_sweep(request: SweepRequest) -> SweepResult:
+    """Sweep psi for every pose and branch of the request, and pick psi with the optimiser.
+
+    Not built yet: it needs the redundancy optimiser, which is being written.
+    """
+    raise Failed("sweep: the redundancy sweep is not available yet (it needs the redundancy optimiser)")
+
+
+# ---------------------------------------------------------------------------------------
+# The command.
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    parser = sub.add_parser(
+        "sweep",
+        help="sweep the arm angle psi of a 7-DOF arm for a pose or a path",
+        description="Sweep the arm angle psi of a 7-DOF arm for a pose (or each pose of a path): which "
+        "psi intervals and branches reach it within the joint limits and clear of obstacles, how close "
+        "each joint comes to its limit, and which psi the optimiser picks. Prints a table; writes CSV, "
+        "JSON and a plot on request.",
+    )
+    add_arm_option(parser, DEFAULT_ARM)
+    add_pose_options(parser)
+    parser.add_argument(
+        "--path",
+        metavar="POSES.csv",
+        help="sweep a path: a CSV of poses, columns " + ",".join(PATH_COLUMNS) + " (header optional)",
+    )
+    add_signs_option(parser, "default: every combination")
+    parser.add_argument(
+        "--obstacle",
+        action="append",
+        default=[],
+        metavar="SHAPE",
+        help=f"an obstacle in the arm's root frame (m), repeatable: {SHAPE_USAGE} "
+        "(box: centre and half-sizes, axis-aligned)",
+    )
+    parser.add_argument("--scene", metavar="FILE.xml", help="MuJoCo scene whose geoms are obstacles")
+    parser.add_argument(
+        "--resolution",
+        type=float,
+        default=DEFAULT_RESOLUTION,
+        metavar="RAD",
+        help=f"psi step in radians (default 2 pi / 360 = {DEFAULT_RESOLUTION:.4f})",
+    )
+    parser.add_argument(
+        "--csv", nargs="?", const="-", metavar="FILE", help="write the sweep as CSV (- : stdout)"
+    )
+    parser.add_argument(
+        "--plot",
+        metavar="FILE",
+        help="write a plot (.png or .svg): joint angles and clearance against psi for a pose, "
+        "a map of pose index against psi for a path",
+    )
+    add_output_options(parser, "write the sweep as JSON to FILE, or to standard output instead of the table")
+    parser.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from .sweep_output import show  # it imports the types above
+
+    request = build_request(args)
+    show(request, compute_sweep(request), args)
+    return 0
+
+
+def build_request(args: argparse.Namespace) -> SweepRequest:
+    """Check every input and output of the command, before any computation."""
+    solver = OMSolver(args.arm)
+    if solver.redundancy_names != ("psi",):
+        raise UsageError(
+            f"arm '{solver.arm.name}' has no arm angle to sweep ({solver.arm.dof} joints); "
+            "use 'om-redundant solve'"
+        )
+    psi = psi_grid(args.resolution)
+    branches = parse_signs(args.signs, solver)
+    obstacles = tuple(parse_obstacle(text) for text in args.obstacle)
+    if args.path is not None:
+        if args.xyz is not None or args.quat is not None or args.pose_file is not None:
+            raise UsageError("give either --path or a single pose (--xyz/--quat or --pose-file), not both")
+        poses = read_path(args.path)
+    else:
+        poses = target_pose(args, solver.arm)[None]
+    scene = None if args.scene is None else load_mujoco_model(args.scene)
+    if args.csv == "-" and args.json == "-":
+        raise UsageError("--csv and --json cannot both go to standard output")
+    check_output_path(args.csv, "--csv")
+    check_output_path(args.json, "--json")
+    check_output_path(args.plot, "--plot", PLOT_SUFFIXES)
+    all_signs = tuple(c.signs for c in Configuration.all_signs(len(solver.sign_names)))
+    return SweepRequest(
+        solver=solver,
+        poses=poses,
+        path=args.path is not None,
+        branches=all_signs if branches is None else (branches,),
+        psi=psi,
+        obstacles=obstacles,
+        scene=scene,
+        progress=Progress(len(poses), enabled=args.path is not None and not getattr(args, "quiet", False)),
+    )
+
+
+def psi_grid(resolution: float) -> np.ndarray:
+    """Arm angles -pi, -pi + step, ... below pi, the step at most ``resolution``."""
+    if not math.isfinite(resolution) or resolution <= 0.0:
+        raise UsageError(f"--resolution must be a positive number of radians, got {resolution}")
+    n = max(math.ceil(2.0 * math.pi / resolution - 1e-9), 1)
+    if n > MAX_SAMPLES:
+        raise UsageError(f"--resolution {resolution:g} rad gives {n} arm angles; the most is {MAX_SAMPLES}")
+    return -math.pi + 2.0 * math.pi * np.arange(n) / n
+
+
+def parse_obstacle(text: str) -> Obstacle:
+    """An obstacle from ``shape:n1,n2,...``; the message names the option, shape and number."""
+    where = f"--obstacle '{text}'"
+    kind, colon, numbers = text.partition(":")
+    kind = kind.strip().lower()
+    if kind not in SHAPES or not colon:
+        raise UsageError(f"{where}: unknown shape '{kind}'; use {SHAPE_USAGE}")
+    names = SHAPES[kind]
+    parts = [p.strip() for p in numbers.split(",")] if numbers.strip() else []
+    if len(parts) != len(names):
+        raise UsageError(f"{where}: a {kind} takes {len(names)} numbers {','.join(names)}, got {len(parts)}")
+    values = []
+    for name, part in zip(names, parts, strict=True):
+        try:
+            value = float(part)
+        except ValueError:
+            raise UsageError(f"{where}: {name} = '{part}' is not a number") from None
+        if not math.isfinite(value):
+            raise UsageError(f"{where}: {name} = {part} is not finite")
+        if name in SIZES and value <= 0.0:
+            raise UsageError(f"{where}: {name} must be positive, got {value:g}")
+        values.append(value)
+    if kind == "capsule" and values[:3] == values[3:6]:
+        raise UsageError(f"{where}: the capsule's ends coincide; use a sphere")
+    return Obstacle(kind, tuple(values))
+
+
+def read_path(path: str) -> np.ndarray:
+    """(M, 4, 4) poses from a CSV file of x,y,z,qw,qx,qy,qz rows.
+
+    A header row, if present, names the columns (in any order; other columns are ignored);
+    without one the rows hold exactly those seven numbers. Blank lines and lines starting
+    with ``#`` are skipped.
+    """
+    name = f"path file '{path}'"
+    try:
+        with open(path, newline="") as f:
+            lines = [
+                (n, row)
+                for n, row in enumerate(csv.reader(f), start=1)
+                if row and any(c.strip() for c in row) and not row[0].lstrip().startswith("#")
+            ]
+    except (OSError, UnicodeDecodeError, csv.Error) as exc:
+        raise UsageError(f"cannot read {name}: {getattr(exc, 'strerror', None) or exc}") from None
+    header = lines and not _is_number(lines[0][1][0])
+    if header:
+        names = [c.strip().lower() for c in lines[0][1]]
+        missing = [c for c in PATH_COLUMNS if c not in names]
+        if missing:
+            raise UsageError(f"{name}: the header lacks column(s) {', '.join(missing)}")
+        columns = [names.index(c) for c in PATH_COLUMNS]
+        width = len(names)
+        lines = lines[1:]
+    else:
+        columns, width = list(range(len(PATH_COLUMNS))), len(PATH_COLUMNS)
+    if not lines:
+        raise UsageError(f"{name} holds no poses")
+    poses = np.empty((len(lines), 4, 4))
+    for i, (n, row) in enumerate(lines):
+        where = f"{name} line {n}"
+        if len(row) != width:
+            raise UsageError(f"{where}: expected {width} values, got {len(row)}")
+        try:
+            values = [float(row[c]) for c in columns]
+        except ValueError:
+            raise UsageError(f"{where}: not a number in {','.join(row)}") from None
+        poses[i] = pose_from_text(values[:3], values[3:], f"{where}: position", f"{where}: quaternion")
+    return poses
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+class Progress:
+    """A one-line progress bar on standard error, for paths on a terminal."""
+
+    def __init__(self, total: int, enabled: bool = True, width: int = 30):
+        self.total, self.width = total, width
+        self.enabled = enabled and total > 1 and sys.stderr.isatty()
+
+    def __call__(self, done: int) -> None:
+        if not self.enabled:
+            return
+        filled = self.width * done // self.total
+        sys.stderr.write(f"\rsweep [{'#' * filled}{'.' * (self.width - filled)}] {done}/{self.total} poses")
+        if done >= self.total:
+            sys.stderr.write("\n")
+        sys.stderr.flush()

@@ -1,0 +1,588 @@
+"""The ``om-redundant`` command, run as a user runs it (a subprocess) where that is what is
+tested (exit status, one-line errors, no traceback, pipes), else in-process through ``main``."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+
+import mujoco
+import numpy as np
+import pytest
+
+import om_redundant as om
+from om_redundant.cli import build_parser, main
+from om_redundant.cli.common import UsageError
+from om_redundant.cli.sweep import (
+    BranchSweep,
+    Choice,
+    PoseSweep,
+    Progress,
+    SweepRequest,
+    SweepResult,
+    build_request,
+    parse_obstacle,
+    psi_grid,
+    read_path,
+)
+from om_redundant.model import derive_model
+from tests.conftest import MENAGERIE, ROOT, checkout_env, run_python
+
+Q_PANDA = np.array([0.2, 0.4, -0.3, -1.8, 0.5, 1.9, 0.6])
+
+
+def command(*args: str) -> subprocess.CompletedProcess:
+    return run_python("-m", "om_redundant.cli", *args)
+
+
+def pose_args(T: np.ndarray) -> list[str]:
+    quat = np.empty(4)
+    mujoco.mju_mat2Quat(quat, np.ascontiguousarray(T[:3, :3]).ravel())
+    return ["--xyz", *(repr(float(v)) for v in T[:3, 3]), "--quat", *(repr(float(v)) for v in quat)]
+
+
+def in_process(capsys, *argv: str) -> tuple[int, str, str]:
+    status = main(list(argv))
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
+# ---------------------------------------------------------------------------------------
+# Conventions
+
+
+def test_default_run_solves_the_ur5e_pose_in_all_eight_configurations():
+    done = command()
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.count(" ok ") == 8 and "ur5e" in done.stdout and done.stderr == ""
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [[], ["solve"], ["sweep"], ["arms"], ["check-model"], ["bench"]],
+    ids=lambda a: a[0] if a else "top",
+)
+def test_help_everywhere(capsys, argv):
+    status, out, _ = in_process(capsys, *argv, "--help")
+    assert status == 0 and out.startswith(f"usage: om-redundant {' '.join(argv)}".rstrip())
+
+
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["solve", "--arm", "nope"], "unknown arm 'nope'"),
+        (
+            ["solve", "--xyz", "0", "0", "0", "--quat", "0", "0", "0", "0"],
+            "--quat (0, 0, 0, 0) has zero norm",
+        ),
+        (["solve", "--pose-file", "no/such/pose.txt"], "cannot read pose file 'no/such/pose.txt'"),
+        (["sweep", "--resolution", "-0.1"], "--resolution must be a positive number"),
+    ],
+    ids=["unknown arm", "zero quaternion", "unreadable file", "negative resolution"],
+)
+def test_bad_input_exits_2_with_one_line_and_no_traceback(argv, message):
+    done = command(*argv)
+    assert done.returncode == 2
+    assert done.stderr.startswith("om-redundant: error: ") and message in done.stderr
+    assert done.stderr.count("\n") == 1 and done.stdout == ""
+
+
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["solve", "--signs", "1", "2", "1"], "-1 or +1"),
+        (["solve", "--signs", "1", "1"], "--signs needs 3 values (ARM ELBOW WRIST)"),
+        (["solve", "--xyz", "0", "0", "0"], "both --xyz and --quat"),
+        (
+            ["solve", "--xyz", "nan", "0", "0", "--quat", "1", "0", "0", "0"],
+            "--xyz (nan, 0, 0) is not finite",
+        ),
+        (["solve", "--xyz", "1", "2"], "argument --xyz: expected 3 arguments"),
+        (["solve", "--arm", "panda", "--psi", "inf"], "--psi must be a finite number"),
+        (["solve", "--psi", "1"], "arm 'ur5e' has no arm angle"),
+        (["solve", "--arm", "sawyer"], "arm 'sawyer': fixed rows between joints are not supported"),
+        (["solve", "--arm", "no/such/arm.toml"], "no/such/arm.toml"),
+        (["bench", "paper", "--n", "0"], "--n must be positive"),
+        (["frobnicate"], "invalid choice: 'frobnicate'"),
+        (["arms", "nope"], "unknown arm 'nope'"),
+        (["check-model", "model.xml"], "required: --arm"),
+        (["check-model", "no/such/model.xml", "--arm", "panda"], "cannot read MuJoCo model"),
+        (["check-model", "README.md", "--arm", "panda"], "must be an MJCF file ending in .xml"),
+        (["check-model", "arms/panda.toml", "--arm", "nope"], "unknown arm 'nope'"),
+        (["sweep", "--arm", "ur5e"], "arm 'ur5e' has no arm angle to sweep"),
+        (["sweep", "--arm", "sawyer"], "arm 'sawyer': shoulder offsets"),
+        (["sweep", "--resolution", "0"], "--resolution must be a positive number"),
+        (["sweep", "--resolution", "nan"], "--resolution must be a positive number"),
+        (["sweep", "--resolution", "1e-9"], "the most is 100000"),
+        (["sweep", "--signs", "1", "-1"], "--signs needs 3 values (SHOULDER ELBOW WRIST)"),
+        (["sweep", "--obstacle", "cone:0,0,0,1"], "unknown shape 'cone'"),
+        (["sweep", "--obstacle", "sphere:0,0,0"], "a sphere takes 4 numbers x,y,z,r, got 3"),
+        (["sweep", "--obstacle", "box:0,0,0,1,-1,1"], "hy must be positive"),
+        (["sweep", "--obstacle", "capsule:0,0,0,0,0,0,0.1"], "ends coincide"),
+        (["sweep", "--obstacle", "sphere:0,0,x,1"], "z = 'x' is not a number"),
+        (["sweep", "--scene", "no/such/scene.xml"], "cannot read MuJoCo model 'no/such/scene.xml'"),
+        (["sweep", "--path", "no/such/path.csv"], "cannot read path file 'no/such/path.csv'"),
+        (["sweep", "--path", "README.md", "--xyz", "0", "0", "0"], "either --path or a single pose"),
+        (["sweep", "--plot", "sweep.jpg"], "use a file ending in .png or .svg"),
+        (["sweep", "--csv", "no/such/dir/sweep.csv"], "directory 'no/such/dir' does not exist"),
+        (["sweep", "--csv", "--json"], "cannot both go to standard output"),
+    ],
+)
+def test_more_bad_input_one_line(capsys, argv, message):
+    status, out, err = in_process(capsys, *argv)
+    assert status == 2 and out == ""
+    assert err.startswith("om-redundant: error: ") and message in err and err.count("\n") == 1
+
+
+def test_bad_pose_files_name_the_problem(capsys, tmp_path):
+    cases = {
+        "short.txt": ("1 0 0 0\n0 1 0 0\n0 0 1 0\n", "must hold a 4x4 matrix, got shape (3, 4)"),
+        "words.txt": ("a b c d\n", "cannot read pose file"),
+        "skew.txt": ("1 0 0 0\n0 1 0.5 0\n0 0 1 0\n0 0 0 1\n", "rotation is not orthonormal"),
+    }
+    for name, (text, message) in cases.items():
+        (tmp_path / name).write_text(text)
+        status, _, err = in_process(capsys, "solve", "--pose-file", str(tmp_path / name))
+        assert status == 2 and message in err and err.count("\n") == 1, err
+
+
+def test_closed_pipe_exits_quietly():
+    """``om-redundant arms | head -1`` when the reader is already gone: no traceback, status 141."""
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "om_redundant.cli", "arms"],
+        cwd=ROOT,
+        env=checkout_env(),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    proc.stdout.close()
+    err = proc.stderr.read()
+    assert proc.wait(timeout=120) == 141 and err == b""
+
+
+# ---------------------------------------------------------------------------------------
+# solve
+
+
+def test_solve_json_agrees_with_the_library():
+    solver = om.OMSolver("panda")
+    T = solver.arm.fk(Q_PANDA)
+    c = solver.configuration_of(Q_PANDA)
+    signs = [str(s) for s in c.signs]
+    done = command(
+        "solve",
+        "--arm",
+        "panda",
+        *pose_args(T),
+        "--psi",
+        repr(float(c.redundancy[0])),
+        "--signs",
+        *signs,
+        "--json",
+    )
+    assert done.returncode == 0, done.stderr
+    data = json.loads(done.stdout)
+    assert data["arm"] == "panda" and data["sign_names"] == ["SHOULDER", "ELBOW", "WRIST"]
+    (row,) = data["solutions"]
+    expected = solver.solve(np.array(data["target"]), om.Configuration(c.signs, c.redundancy))
+    assert row["ok"] and row["status"] == "ok" and row["within_limits"]
+    np.testing.assert_array_equal(row["q"], expected.q)
+    np.testing.assert_allclose(row["q"], Q_PANDA, atol=1e-9)
+    assert row["position_error"] == expected.position_error < 1e-10
+
+
+def test_solve_every_configuration_and_every_root(capsys):
+    solver = om.OMSolver("panda")
+    T = solver.arm.fk(Q_PANDA)
+    status, out, _ = in_process(capsys, "solve", "--arm", "panda", *pose_args(T), "--psi", "0.3", "--json")
+    data = json.loads(out)
+    rows, T = data["solutions"], np.array(data["target"])
+    assert status == 0 and len(rows) == 8
+    for row in rows:
+        sol = solver.solve(T, om.Configuration(tuple(row["signs"]), (0.3,)))
+        assert row["ok"] == sol.ok and row["status"] == sol.status
+        assert (row["q"] is None) == (not sol.ok)
+    status, out, _ = in_process(
+        capsys, "solve", "--arm", "panda", *pose_args(T), "--psi", "0.3", "--all-roots", "--json"
+    )
+    data = json.loads(out)
+    rows, T = data["solutions"], np.array(data["target"])
+    expected = [(c.signs, s.q) for c in solver.configurations((0.3,)) for s in solver.solve_all(T, c)]
+    found = [(tuple(r["signs"]), r["q"]) for r in rows if r["ok"]]
+    assert status == 0 and len(found) == len(expected)
+    for (signs, q), (want_signs, want_q) in zip(found, expected, strict=True):
+        assert signs == want_signs
+        np.testing.assert_array_equal(q, want_q)
+
+
+def test_solve_table_quiet_and_json_file(capsys, tmp_path):
+    argv = ["solve", "--arm", "spherical", "--xyz", "0.1", "0.2", "0.3", "--quat", "1", "0", "0", "0"]
+    status, out, _ = in_process(capsys, *argv, "--signs", "1", "1", "1")
+    assert status == 0 and "ARM ELBOW WRIST" in out and "dp_max = 0.0200 m" in out
+    status, out, err = in_process(capsys, *argv, "--quiet")
+    assert status == 0 and out == err == ""
+    status, out, _ = in_process(capsys, *argv, "--json", str(tmp_path / "solve.json"))
+    assert status == 0 and "ARM ELBOW WRIST" in out
+    assert len(json.loads((tmp_path / "solve.json").read_text())["solutions"]) == 8
+    pose = tmp_path / "pose.npy"
+    np.save(pose, om.load_arm("ur5e").fk(np.array([0.4, -1.1, 1.3, -1.2, -1.4, 0.3])))
+    status, out, _ = in_process(capsys, "solve", "--pose-file", str(pose), "--json")
+    assert status == 0 and sum(r["ok"] for r in json.loads(out)["solutions"]) == 8
+
+
+# ---------------------------------------------------------------------------------------
+# arms, bench
+
+
+def test_arms_lists_every_arm_and_why_some_cannot_be_solved_yet():
+    done = command("arms", "--json")
+    assert done.returncode == 0, done.stderr
+    rows = {row["name"]: row for row in json.loads(done.stdout)}
+    assert list(rows) == om.arm_names()
+    for name, row in rows.items():
+        arm = om.load_arm(name)
+        assert row["dof"] == arm.dof and row["joint_names"] == list(arm.joint_names)
+        if name == "sawyer":
+            assert not row["solvable"] and row["dp_max"] is None and "fixed rows" in row["reason"]
+            continue
+        model = derive_model(arm)
+        assert row["solvable"] and row["dp_max"] == model.dp_max and row["model_family"] == model.family_name
+        assert row["sign_names"] == list(model.sign_names)
+        assert row["redundancy_names"] == list(model.redundancy_names)
+    assert rows["ur5e"]["upper"][0] == pytest.approx(6.28319)
+
+
+def test_arms_table(capsys):
+    status, out, _ = in_process(capsys, "arms")
+    lines = out.splitlines()
+    assert status == 0 and len(lines) == 1 + len(om.arm_names())
+    assert "not yet solvable: shoulder offsets (d2 = -0.01175 m)" in out and "0.0880 m" in out
+
+
+def test_bench_paper_small_run(capsys):
+    status, out, _ = in_process(capsys, "bench", "paper", "--n", "40", "--json")
+    data = json.loads(out)
+    assert status == 0 and data["n"] == 40 and data["converged"] == 1.0 and data["configuration_errors"] == 0
+
+
+# ---------------------------------------------------------------------------------------
+# check-model
+
+
+def panda_mjcf(**changes) -> str:
+    """The project's Panda MJCF with one change: a joint's range or name, a body's position,
+    a joint's axis, or no end-effector site."""
+    root = ET.fromstring(om.arm_mjcf(om.load_arm("panda")))
+    joints = {j.get("name"): j for j in root.iter("joint")}
+    bodies = {b.get("name"): b for b in root.iter("body")}
+    if "range" in changes:
+        joints["joint4"].set("range", changes["range"])
+    if "rename" in changes:
+        joints["joint3"].set("name", changes["rename"])
+    if "move" in changes:
+        pos = np.array(bodies["link4"].get("pos").split(), dtype=float) + changes["move"]
+        bodies["link4"].set("pos", " ".join(repr(float(v)) for v in pos))
+    if "axis" in changes:
+        joints["joint2"].set("axis", changes["axis"])
+    if "site" in changes:
+        next(root.find("worldbody").iter("site")).set("name", changes["site"])
+    if "mount" in changes:
+        bodies["base"].set("pos", changes["mount"])
+    return ET.tostring(root, encoding="unicode")
+
+
+def test_check_model_accepts_the_projects_own_model(tmp_path):
+    path = tmp_path / "panda.xml"
+    path.write_text(panda_mjcf())
+    done = command("check-model", str(path), "--arm", "panda")
+    assert done.returncode == 0, done.stderr
+    assert "matches arm 'panda'" in done.stdout and "site 'attachment_site'" in done.stdout
+
+
+@pytest.mark.parametrize(
+    "change, message",
+    [
+        (
+            {"range": "-3 -0.0698"},
+            "joint 'joint4' range differs: model [-3, -0.0698], arm [-3.0718, -0.0698]",
+        ),
+        (
+            {"rename": "elbow"},
+            "joint 'joint3' (arm joint 3) is not in the model; model joints: joint1, joint2, elbow",
+        ),
+        ({"move": [0.0, 0.0, 0.01]}, "joint 'joint4' lies up to 0.01 m off the arm's joint axis"),
+        ({"axis": "0 0 -1"}, "joint 'joint2' axis differs from the arm's by up to 3.14 rad (reversed)"),
+        ({"site": "flange"}, "site 'attachment_site' is not in the model"),
+        ({"mount": "0.5 0 0"}, "joint 'joint1' lies up to 0.5 m off the arm's joint axis"),
+    ],
+    ids=["range", "renamed joint", "moved body", "reversed axis", "no site", "mounted elsewhere"],
+)
+def test_check_model_names_what_differs(capsys, tmp_path, change, message):
+    path = tmp_path / "panda.xml"
+    path.write_text(panda_mjcf(**change))
+    status, out, err = in_process(capsys, "check-model", str(path), "--arm", "panda")
+    assert status == 1 and out == "" and err.count("\n") == 1
+    assert err.startswith(f"om-redundant: error: {path} differs from arm 'panda': {message}"), err
+
+
+def test_check_model_moved_body_changes_the_frame_too(capsys, tmp_path):
+    path = tmp_path / "panda.xml"
+    path.write_text(panda_mjcf(move=[0.0, 0.0, 0.01]))
+    status, out, _ = in_process(capsys, "check-model", str(path), "--arm", "panda", "--json")
+    data = json.loads(out)
+    assert status == 1 and not data["ok"] and len(data["differences"]) == 2
+    assert data["differences"][1].startswith(
+        "site 'attachment_site' differs from the arm's end-effector frame"
+    )
+    assert data["max_position_error"] > 0.005
+
+
+def test_check_model_prefix_root_and_site_options(capsys, tmp_path):
+    arm = om.load_arm("panda")
+    path = tmp_path / "left.xml"
+    path.write_text(om.arm_mjcf(arm, prefix="l_"))
+    assert in_process(capsys, "check-model", str(path), "--arm", "panda", "--prefix", "l_")[0] == 0
+    path.write_text(panda_mjcf(mount="1 2 0.5"))
+    assert in_process(capsys, "check-model", str(path), "--arm", "panda", "--root", "base", "--json")[0] == 0
+    path.write_text(panda_mjcf(site="flange"))
+    assert in_process(capsys, "check-model", str(path), "--arm", "panda", "--site", "flange", "-q") == (
+        0,
+        "",
+        "",
+    )
+
+
+@pytest.mark.parametrize(
+    "option, message",
+    [(["--samples", "0"], "samples must be at least 1"), (["--tolerance", "nan"], "tolerance")],
+)
+def test_check_model_bad_settings(capsys, tmp_path, option, message):
+    path = tmp_path / "panda.xml"
+    path.write_text(panda_mjcf())
+    status, _, err = in_process(capsys, "check-model", str(path), "--arm", "panda", *option)
+    assert status == 2 and message in err and err.count("\n") == 1
+
+
+def test_check_model_against_the_menagerie_panda():
+    path = MENAGERIE / "franka_emika_panda" / "panda_nohand.xml"
+    if not path.is_file():
+        pytest.skip(f"reference model {path} not available")
+    done = command("check-model", str(path), "--arm", "panda", "--samples", "200", "--json")
+    assert done.returncode == 0, done.stderr
+    data = json.loads(done.stdout)
+    assert data["ok"] and data["samples"] == 200 and data["max_position_error"] < 1e-12
+    done = command("check-model", str(path), "--arm", "fr3")
+    assert done.returncode == 1 and "joint 'fr3_joint1' (arm joint 1) is not in the model" in done.stderr
+
+
+# ---------------------------------------------------------------------------------------
+# sweep: the input, checked into a request (the computation is not built yet)
+
+
+def sweep_request(*argv: str):
+    args = build_parser().parse_args(["sweep", *argv])
+    return build_request(args)
+
+
+def test_sweep_request_defaults():
+    request = sweep_request()
+    solver = om.OMSolver("panda")
+    assert request.solver.arm.name == "panda" and not request.path and request.obstacles == ()
+    np.testing.assert_array_equal(request.poses, solver.arm.fk(Q_PANDA)[None])
+    assert request.branches == tuple(c.signs for c in solver.configurations())
+    assert len(request.psi) == 360 and request.psi[0] == -math.pi and request.psi[-1] < math.pi
+    assert request.scene is None
+
+
+def test_sweep_request_with_everything(tmp_path):
+    scene = tmp_path / "scene.xml"
+    scene.write_text(
+        '<mujoco><worldbody><geom name="table" type="box" size="0.5 0.5 0.02"/></worldbody></mujoco>'
+    )
+    path = tmp_path / "poses.csv"
+    path.write_text("# a path\nt,qw,qx,qy,qz,x,y,z\n0,0,1,0,0,0.5,0,0.4\n\n1,0,1,0,0,0.5,0.1,0.4\n")
+    request = sweep_request(
+        "--arm", "iiwa14", "--path", str(path), "--signs", "1", "-1", "1", "--resolution", "0.1",
+        "--obstacle", "sphere:0.4,0,0.3,0.05", "--obstacle", "capsule:0,0,0,0,0,1,0.1",
+        "--obstacle", "box:0.5,0,0,0.1,0.2,0.3", "--scene", str(scene),
+        "--csv", str(tmp_path / "s.csv"), "--json", str(tmp_path / "s.json"),
+        "--plot", str(tmp_path / "map.svg"),
+    )  # fmt: skip
+    assert request.path and request.poses.shape == (2, 4, 4) and request.branches == ((1, -1, 1),)
+    np.testing.assert_allclose(request.poses[1, :3, 3], [0.5, 0.1, 0.4])
+    np.testing.assert_allclose(request.poses[1, :3, :3], np.diag([1.0, -1.0, -1.0]), atol=1e-15)
+    assert len(request.psi) == 63 and np.allclose(np.diff(request.psi), 2 * math.pi / 63)
+    assert [o.kind for o in request.obstacles] == ["sphere", "capsule", "box"]
+    assert request.scene.ngeom == 1
+
+
+def test_sweep_is_not_available_yet(capsys):
+    """The computation waits for the redundancy optimiser; the command says so in one line."""
+    status, _, err = in_process(capsys, "sweep")
+    assert status == 1 and "not available yet" in err and err.count("\n") == 1
+
+
+def test_obstacles_parse_into_mujoco_geoms():
+    specs = ["sphere:0.4,0,0.3,0.05", "capsule: 0,0,0, 0,0,1, 0.1", "BOX:0.5,0,0,0.1,0.2,0.3"]
+    obstacles = [parse_obstacle(s) for s in specs]
+    assert obstacles[1].values == (0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.1)
+    geoms = "".join(
+        "<geom {}/>".format(" ".join(f'{k}="{v}"' for k, v in o.geom().items())) for o in obstacles
+    )
+    model = mujoco.MjModel.from_xml_string(f"<mujoco><worldbody>{geoms}</worldbody></mujoco>")
+    np.testing.assert_allclose(model.geom_size[:, 0], [0.05, 0.1, 0.1])
+    np.testing.assert_allclose(model.geom_pos[2], [0.5, 0, 0])
+
+
+def test_path_files(tmp_path):
+    path = tmp_path / "p.csv"
+    path.write_text("0.5,0,0.4,1,0,0,0\n0.5,0,0.4,2,0,0,0\n")
+    poses = read_path(str(path))
+    assert poses.shape == (2, 4, 4) and np.allclose(poses[1, :3, :3], np.eye(3))
+    bad = {
+        "0.5,0,0.4,0,0,0,0\n": "line 1: quaternion (0, 0, 0, 0) has zero norm",
+        "x,y,z,qw\n": "the header lacks column(s) qx, qy, qz",
+        "x,y,z,qw,qx,qy,qz\n": "holds no poses",
+        "0.5,0,0.4,1,0,0\n": "line 1: expected 7 values, got 6",
+        "0.5,0,0.4,1,0,0,0\n0.5,a,0.4,1,0,0,0\n": "line 2: not a number",
+        "0.5,0,inf,1,0,0,0\n": "line 1: position (0.5, 0, inf) is not finite",
+    }
+    for text, message in bad.items():
+        path.write_text(text)
+        with pytest.raises(UsageError, match=message.replace("(", r"\(").replace(")", r"\)")):
+            read_path(str(path))
+
+
+def test_psi_grid_covers_the_circle_once():
+    assert len(psi_grid(2 * math.pi)) == 1 and len(psi_grid(100.0)) == 1
+    grid = psi_grid(2 * math.pi / 720)
+    assert len(grid) == 720 and grid[0] == -math.pi and math.pi - grid[-1] == pytest.approx(2 * math.pi / 720)
+
+
+# ---------------------------------------------------------------------------------------
+# sweep: what the command shows of a result, from a stand-in engine (joint limits only; the
+# largest margin on the grid as the choice) until the real one is wired in
+
+
+def stand_in_sweep(request: SweepRequest) -> SweepResult:
+    solver, psi, arm = request.solver, request.psi, request.solver.arm
+    poses = []
+    for i, T in enumerate(request.poses):
+        branches, best = [], None
+        for signs in request.branches:
+            batch = solver.solve_batch(np.repeat(T[None], len(psi), axis=0), signs, psi)
+            q = np.where(batch.ok[:, None], batch.q, np.nan)
+            margin = np.minimum(q - arm.lower, arm.upper - q)
+            smallest = np.min(np.nan_to_num(margin, nan=-1.0), axis=1)
+            feasible = batch.ok & (smallest >= 0.0)
+            edges = np.flatnonzero(np.diff(np.concatenate([[0], feasible.astype(int), [0]])))
+            intervals = tuple((float(psi[a]), float(psi[b - 1])) for a, b in edges.reshape(-1, 2))
+            clearance = np.where(batch.ok, np.inf, np.nan)
+            branches.append(BranchSweep(signs, q, batch.ok, margin, clearance, feasible, intervals))
+            if feasible.any():
+                k = int(np.argmax(np.where(feasible, smallest, -np.inf)))
+                if best is None or smallest[k] > best.margin:
+                    best = Choice(om.Configuration(signs, (float(psi[k]),)), q[k], float(smallest[k]), np.inf)
+        poses.append(PoseSweep(T, tuple(branches), best))
+        request.progress(i + 1)
+    return SweepResult(psi, tuple(poses))
+
+
+def png_size(path) -> tuple[int, int]:
+    data = path.read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n" and data[12:16] == b"IHDR"
+    return int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")
+
+
+def test_sweep_outputs_agree_with_the_result(capsys, tmp_path, monkeypatch):
+    results = []
+
+    def engine(request):
+        results.append(stand_in_sweep(request))
+        return results[-1]
+
+    monkeypatch.setattr("om_redundant.cli.sweep.compute_sweep", engine)
+    files = {"csv": tmp_path / "sweep.csv", "json": tmp_path / "sweep.json", "plot": tmp_path / "sweep.png"}
+    argv = ["sweep", "--resolution", "0.05", *(a for k, f in files.items() for a in (f"--{k}", str(f)))]
+    status, out, err = in_process(capsys, *argv)
+    assert status == 0 and err == ""
+    (result,) = results
+    (pose,) = result.poses
+    signs = " ".join(f"{v:+d}" for v in pose.chosen.configuration.signs)
+    assert f"chosen: {signs}, psi = {pose.chosen.configuration.redundancy[0]:.4f} rad" in out
+    for branch in pose.branches:
+        assert all(f"[{lo:+.3f}, {hi:+.3f}]" in out for lo, hi in branch.intervals)
+    assert sum(bool(b.intervals) for b in pose.branches) == 2
+    width, height = png_size(files["plot"])
+    assert 1000 <= width <= 2000 and 700 <= height <= 1500
+
+    rows = list(csv.DictReader(files["csv"].open()))
+    assert len(rows) == 8 * len(result.psi)
+    for row in rows[:: len(result.psi) // 3]:
+        k = int(np.argmin(np.abs(result.psi - float(row["psi"]))))
+        branch = next(
+            b for b in pose.branches if b.signs == tuple(int(row[n]) for n in ("SHOULDER", "ELBOW", "WRIST"))
+        )
+        assert float(row["psi"]) == result.psi[k] and bool(int(row["feasible"])) == branch.feasible[k]
+        q = [float(row[f"q_joint{j}"]) for j in range(1, 8)]
+        np.testing.assert_array_equal(q, branch.q[k])
+
+    data = json.loads(files["json"].read_text())
+    np.testing.assert_array_equal(data["psi"], result.psi)
+    (got,) = data["poses"]
+    assert got["chosen"]["psi"] == pose.chosen.configuration.redundancy[0]
+    np.testing.assert_array_equal(got["chosen"]["q"], pose.chosen.q)
+    for b, branch in zip(got["branches"], pose.branches, strict=True):
+        assert tuple(b["signs"]) == branch.signs and [tuple(i) for i in b["intervals"]] == list(
+            branch.intervals
+        )
+        q = np.array([[np.nan if v is None else v for v in r] for r in b["q"]])
+        np.testing.assert_array_equal(q, branch.q)
+
+
+def test_sweep_path_map_and_stdout_outputs(capsys, tmp_path, monkeypatch):
+    monkeypatch.setattr("om_redundant.cli.sweep.compute_sweep", stand_in_sweep)
+    solver = om.OMSolver("panda")
+    path = tmp_path / "path.csv"
+    rows = []
+    for s in np.linspace(0.0, 0.6, 12):
+        T = solver.arm.fk(Q_PANDA + s * np.array([1.0, 0.3, 0.0, 0.4, 0.0, -0.5, 0.0]))
+        quat = np.empty(4)
+        mujoco.mju_mat2Quat(quat, np.ascontiguousarray(T[:3, :3]).ravel())
+        rows.append(",".join(repr(float(v)) for v in (*T[:3, 3], *quat)))
+    path.write_text("\n".join(rows) + "\n")
+    plot = tmp_path / "map.svg"
+    argv = ["sweep", "--path", str(path), "--signs", "1", "-1", "1", "--resolution", "0.1"]
+    status, out, _ = in_process(capsys, *argv, "--plot", str(plot))
+    assert status == 0 and len(out.splitlines()) == 4 + 12 and plot.read_text().startswith("<?xml")
+    status, out, _ = in_process(capsys, *argv, "--json")
+    data = json.loads(out)
+    assert status == 0 and len(data["poses"]) == 12 and all(p["chosen"] for p in data["poses"])
+    status, out, _ = in_process(capsys, *argv, "--csv", "--quiet")
+    assert status == 0 and out.startswith(
+        "pose,SHOULDER,ELBOW,WRIST,psi,ok,feasible,margin,clearance,q_joint1"
+    )
+    assert len(out.splitlines()) == 1 + 12 * 63
+
+
+def test_progress_bar_on_a_terminal(monkeypatch):
+    class Terminal(io.StringIO):
+        def isatty(self):
+            return True
+
+    monkeypatch.setattr(sys, "stderr", Terminal())
+    progress = Progress(4)
+    for done in range(1, 5):
+        progress(done)
+    text = sys.stderr.getvalue()
+    assert (
+        text.count("\r") == 4
+        and text.endswith("4/4 poses\n")
+        and "[###############...............] 2/4" in text
+    )
+    assert not Progress(4, enabled=False).enabled and not Progress(1).enabled
