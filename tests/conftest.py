@@ -2,27 +2,19 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import mujoco
 import numpy as np
 import pytest
 
-MENAGERIE = Path(__file__).resolve().parents[2] / "shared" / "reference" / "menagerie"
+from benchmarks.robots import MENAGERIE, reference_model
 
 
 def load_reference_model(relative_path: str) -> mujoco.MjModel:
-    """Load a Menagerie MJCF with its meshes stripped (the files ship without them)."""
+    """Load a Menagerie MJCF with its meshes stripped; skip the test where it is missing."""
     path = MENAGERIE / relative_path
     if not path.is_file():
         pytest.skip(f"reference model {path} not available")
-    spec = mujoco.MjSpec.from_file(str(path))
-    for geom in list(spec.geoms):
-        if geom.type == mujoco.mjtGeom.mjGEOM_MESH:
-            spec.delete(geom)
-    for mesh in list(spec.meshes):
-        spec.delete(mesh)
-    return spec.compile()
+    return reference_model(relative_path)
 
 
 def wrap(angle: np.ndarray) -> np.ndarray:
