@@ -54,15 +54,17 @@ METHODS = ("om", "plain mink", "plain mink, frame only")
 class Setup:
     """One arm in one MuJoCo model."""
 
+    key: str
     label: str
     arm: str
     model: Callable[[], mujoco.MjModel]
 
 
 SETUPS = (
-    Setup("panda (project MJCF)", "panda", lambda: om.arm_model(om.load_arm("panda"))),
-    Setup("iiwa14 (project MJCF)", "iiwa14", lambda: om.arm_model(om.load_arm("iiwa14"))),
+    Setup("panda", "panda (project MJCF)", "panda", lambda: om.arm_model(om.load_arm("panda"))),
+    Setup("iiwa14", "iiwa14 (project MJCF)", "iiwa14", lambda: om.arm_model(om.load_arm("iiwa14"))),
     Setup(
+        "panda-menagerie",
         "panda (Menagerie panda_nohand.xml)",
         "panda",
         lambda: reference_model("franka_emika_panda/panda_nohand.xml"),

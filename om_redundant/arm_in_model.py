@@ -165,11 +165,15 @@ class ArmRoot:
                     "the model holds another arm, or this frame is not the one arm.fk gives "
                     f"(Menagerie's is {arm.frame_type} '{arm.frame_name}')"
                 )
-        fixed = model.body_weldid[self.body] == 0
-        self.fixed_pose = self.pose(data) if fixed else None
+        self.fixed_pose: np.ndarray | None = None
+        if model.body_weldid[self.body] == 0:
+            self.fixed_pose = self.pose(data)
 
     def pose(self, data: mujoco.MjData) -> np.ndarray:
-        """World pose (4, 4) of the arm's root frame, from data's current kinematics."""
+        """World pose (4, 4) of the arm's root frame: :attr:`fixed_pose`, or from data's
+        current kinematics where the root moves."""
+        if self.fixed_pose is not None:
+            return self.fixed_pose
         return _body_pose(data, self.body) @ self.offset
 
     def _offset(self, data: mujoco.MjData, q: np.ndarray) -> np.ndarray:

@@ -228,7 +228,7 @@ class ExactPoseTask(_ArmTask):
         q = self._arm_q(configuration)
         T = configuration.get_transform_frame_to_world(self.root.frame_name, self.root.frame_type).as_matrix()
         c = self.solver.configuration_of(q) if self.optimizer is None else None
-        self._solve(T, self._current_root(configuration), q, c)
+        self._solve(T, self.root.pose(configuration.data), q, c)
         self.arm_configuration = c
         self.transform_target_to_world = SE3.from_matrix(T)
 
@@ -250,14 +250,6 @@ class ExactPoseTask(_ArmTask):
 
     # -----------------------------------------------------------------------------------
 
-    def _target_matrix(self) -> np.ndarray:
-        assert self.transform_target_to_world is not None
-        return self.transform_target_to_world.as_matrix()
-
-    def _current_root(self, configuration: MinkConfiguration) -> np.ndarray:
-        fixed = self.root.fixed_pose
-        return fixed if fixed is not None else self.root.pose(configuration.data)
-
     def _joint_target(self, configuration: MinkConfiguration) -> np.ndarray:
         """:math:`q^*` for the configuration's root pose, solved again if the root moved."""
         self._arm_q(configuration)
@@ -266,7 +258,8 @@ class ExactPoseTask(_ArmTask):
         if self.root.fixed_pose is None:
             root = self.root.pose(configuration.data)
             if self._root_pose is None or not np.array_equal(root, self._root_pose):
-                self._solve(self._target_matrix(), root, self._q_target, self.arm_configuration)
+                T = self.transform_target_to_world.as_matrix()
+                self._solve(T, root, self._q_target, self.arm_configuration)
         assert self._q_target is not None
         return self._q_target
 

@@ -70,7 +70,7 @@ def psi_of(solver, q):
 def test_every_target_is_reached_exactly_in_its_configuration(setup, qp):
     """From home to 500 random reachable targets, FrameTask + ExactPoseTask, ConfigurationLimit:
     every one within 1e-6 m and 1e-6 rad, in the requested configuration (signs and psi)."""
-    if "Menagerie" in setup.label:
+    if setup.key == "panda-menagerie":
         load_reference_model(PANDA_NOHAND)  # skips where the reference model is missing
     solver = om.OMSolver(setup.arm)
     Q = random_joints(solver.arm, REACH_TARGETS, np.random.default_rng(5))
