@@ -387,7 +387,7 @@ def test_gripper_joints_are_left_alone(panda, panda_with_hand):
 
 
 def mobile_base_model(arm):
-    """The project's arm on a planar cart (slides x, y and a hinge about z)."""
+    """The project's arm, names prefixed "arm_", on a planar cart (slides x, y and a hinge about z)."""
     spec = mujoco.MjSpec()
     cart = spec.worldbody.add_body(name="cart", pos=[0, 0, 0.2])
     for name, kind, axis in (
@@ -398,14 +398,14 @@ def mobile_base_model(arm):
         cart.add_joint(name=name, type=kind, axis=axis)
     cart.add_geom(size=[0.2, 0.2, 0.05], type=mujoco.mjtGeom.mjGEOM_BOX)
     child = mujoco.MjSpec.from_string(om.arm_mjcf(arm))
-    cart.add_frame().attach_body(child.body("base"), "", "")
+    cart.add_frame().attach_body(child.body("base"), "arm_", "")
     return spec.compile()
 
 
 def test_mobile_base_moves_the_root_and_the_task_follows(panda):
     model = mobile_base_model(panda.arm)
     configuration = mink.Configuration(model, np.concatenate([[0.3, -0.2, 0.4], Q_PANDA]))
-    exact = om.ExactPoseTask(panda, model, arm_configuration=panda.configuration_of(Q_PANDA))
+    exact = om.ExactPoseTask(panda, model, arm_configuration=panda.configuration_of(Q_PANDA), prefix="arm_")
     assert exact.root.fixed_pose is None
     np.testing.assert_array_equal(exact.joints.dof_ids, np.arange(3, 10))
     T = exact.root.pose(configuration.data) @ panda.arm.fk(Q_PANDA)
@@ -413,11 +413,11 @@ def test_mobile_base_moves_the_root_and_the_task_follows(panda):
     c = om.Configuration(panda.configuration_of(Q_PANDA).signs, (0.2,))
     exact.set_target(T, c)
     assert exact.joint_target is None  # the root moves: solved at the next compute
-    frame = frame_task()
+    frame = frame_task("arm_attachment_site")
     frame.set_target(mink.SE3.from_matrix(T))
     for _ in range(30):
         step(configuration, [frame, exact], [mink.ConfigurationLimit(model)])
-    assert max(hand_error(configuration, "attachment_site", T)) < 1e-9
+    assert max(hand_error(configuration, "arm_attachment_site", T)) < 1e-9
     assert panda.configuration_of(configuration.q[3:]).isclose(c, 1e-6)
     # q* is the exact solution for the root where the cart now stands.
     T_root = np.linalg.inv(exact.root.pose(configuration.data)) @ T
