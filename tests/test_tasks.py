@@ -19,7 +19,7 @@ from hypothesis import strategies as st
 
 import om_redundant as om
 from benchmarks.mink_reach import SETUPS, TOLERANCE, reach
-from benchmarks.robots import pose_errors, random_joints, reference_spec
+from benchmarks.robots import home_joints, pose_errors, random_joints, reference_spec
 from om_redundant.closed_form import srs
 from tests.conftest import load_reference_model
 
@@ -64,9 +64,7 @@ def psi_of(solver, q):
 
 
 @pytest.mark.parametrize("qp", ["daqp", "osqp"])
-@pytest.mark.parametrize(
-    "setup", SETUPS, ids=lambda s: s.label.split(" (")[0] + ("-menagerie" * ("Men" in s.label))
-)
+@pytest.mark.parametrize("setup", SETUPS, ids=lambda setup: setup.key)
 def test_every_target_is_reached_exactly_in_its_configuration(setup, qp):
     """From home to 500 random reachable targets, FrameTask + ExactPoseTask, ConfigurationLimit:
     every one within 1e-6 m and 1e-6 rad, in the requested configuration (signs and psi)."""
@@ -114,7 +112,7 @@ def test_optimizer_choice_is_reached(panda, panda_model):
     frame = frame_task()
     configuration = mink.Configuration(panda_model)
     limits = [mink.ConfigurationLimit(panda_model)]
-    home = (panda.arm.lower + panda.arm.upper) / 2
+    home = home_joints(panda.arm)
     for q in random_joints(panda.arm, 50, np.random.default_rng(8)):
         T = panda.arm.fk(q)
         optimizer.q = q
@@ -144,7 +142,7 @@ def test_equal_costs_get_stuck_where_the_default_cost_does_not(panda, panda_mode
             T = panda.arm.fk(q)
             task.set_target(T, panda.configuration_of(q))
             frame.set_target(mink.SE3.from_matrix(T))
-            configuration.update((panda.arm.lower + panda.arm.upper) / 2)
+            configuration.update(home_joints(panda.arm))
             for _ in range(60):
                 step(configuration, [frame, task], limits)
             stuck[cost] += max(hand_error(configuration, "attachment_site", T)) > 1e-6
@@ -376,7 +374,7 @@ def test_gripper_joints_are_left_alone(panda, panda_with_hand):
     frame = frame_task()
     limits = [mink.ConfigurationLimit(model)]
     for q in random_joints(panda.arm, 10, np.random.default_rng(10)):
-        configuration.update(np.concatenate([(panda.arm.lower + panda.arm.upper) / 2, [0.02, 0.03]]))
+        configuration.update(np.concatenate([home_joints(panda.arm), [0.02, 0.03]]))
         T = panda.arm.fk(q)
         exact.set_target(T, panda.configuration_of(q))
         frame.set_target(mink.SE3.from_matrix(T))
