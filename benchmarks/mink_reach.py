@@ -177,7 +177,7 @@ def main() -> None:
             f"Run: `python -m benchmarks.mink_reach --n {args.n} --seed {args.seed}`, "
             f"{time.perf_counter() - start:.0f} s.",
             "",
-            __doc__.split("\n\n", 1)[1].strip(),
+            __doc__.split("\n\n", 1)[1].rsplit("\n\nRun:", 1)[0].strip(),
             "",
             "| model | QP | method | success (in c, 1e-6) | pose within 1e-6 | pose within 1e-4 "
             "| median position error | steps median / max | ms per target median / mean | targets |",
