@@ -51,6 +51,7 @@ TRAC_IK_EPSILON = 1e-7
 MINK_STEPS = 200
 MINK_DT = 0.002
 MINK_SOLVER = "daqp"
+MINK_DAMPING = 1e-3
 
 
 class Unavailable(Exception):
@@ -417,6 +418,25 @@ def ikpy_peer(arm: om.Arm, rng: np.random.Generator) -> Peer:
 # mink, differential IK on the generated MJCF
 
 
+def mink_example_tasks(
+    model: Any, frame: str, home: np.ndarray, posture: bool = True
+) -> tuple[Any, list[Any]]:
+    """mink's arm-example tasks: a FrameTask on the site ``frame`` (costs 1, lm_damping 1)
+    and, with ``posture``, a PostureTask toward ``home`` (cost 1e-2).
+
+    Returns:
+        ``(frame_task, tasks)``.
+    """
+    import mink
+
+    frame_task = mink.FrameTask(frame, "site", position_cost=1.0, orientation_cost=1.0, lm_damping=1.0)
+    if not posture:
+        return frame_task, [frame_task]
+    posture_task = mink.PostureTask(model, cost=1e-2)
+    posture_task.set_target(home)
+    return frame_task, [frame_task, posture_task]
+
+
 def _mink_peer(arm: om.Arm, posture: bool) -> Peer:
     try:
         import mink
@@ -427,10 +447,7 @@ def _mink_peer(arm: om.Arm, posture: bool) -> Peer:
     frame = arm.frame_name or om.mjcf.DEFAULT_SITE
     configuration = mink.Configuration(model)
     home = home_joints(arm)
-    frame_task = mink.FrameTask(frame, "site", position_cost=1.0, orientation_cost=1.0, lm_damping=1.0)
-    posture_task = mink.PostureTask(model, cost=1e-2)
-    posture_task.set_target(home)
-    tasks = [frame_task, posture_task] if posture else [frame_task]
+    frame_task, tasks = mink_example_tasks(model, frame, home, posture)
     limits = [mink.ConfigurationLimit(model)]
 
     def fk(q: np.ndarray) -> np.ndarray:
@@ -441,7 +458,9 @@ def _mink_peer(arm: om.Arm, posture: bool) -> Peer:
         configuration.update(home)
         frame_task.set_target(target)
         for _ in range(MINK_STEPS):
-            velocity = mink.solve_ik(configuration, tasks, MINK_DT, MINK_SOLVER, damping=1e-3, limits=limits)
+            velocity = mink.solve_ik(
+                configuration, tasks, MINK_DT, MINK_SOLVER, damping=MINK_DAMPING, limits=limits
+            )
             configuration.integrate_inplace(velocity, MINK_DT)
         return configuration.q.copy()
 
@@ -450,7 +469,7 @@ def _mink_peer(arm: om.Arm, posture: bool) -> Peer:
         f"mink ({'frame+posture' if posture else 'frame only'})",
         arm,
         fk,
-        f"{what}, lm_damping 1, damping 1e-3, ConfigurationLimit, {MINK_STEPS} steps of "
+        f"{what}, lm_damping 1, damping {MINK_DAMPING:g}, ConfigurationLimit, {MINK_STEPS} steps of "
         f'solve_ik("{MINK_SOLVER}") from home',
         any=Method(lambda T, _: mink.SE3.from_matrix(T), call, lambda _, q: _rows(q, arm.dof)),
     )

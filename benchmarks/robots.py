@@ -18,8 +18,10 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
+import mujoco
 import numpy as np
 from scipy.spatial.transform import Rotation
 
@@ -28,6 +30,8 @@ import om_redundant as om
 #: Names of the generated URDF links that the peers chain between.
 ROOT_LINK = "root"
 EE_LINK = "ee"
+#: The reference MuJoCo Menagerie models (kinematics only), beside the project.
+MENAGERIE = Path(__file__).resolve().parents[2] / "shared" / "reference" / "menagerie"
 
 
 # ---------------------------------------------------------------------------------------
@@ -60,6 +64,23 @@ def random_joints(arm: om.Arm, n: int, rng: np.random.Generator) -> np.ndarray:
     lower = np.where(np.isfinite(arm.lower), arm.lower, -np.pi)
     upper = np.where(np.isfinite(arm.upper), arm.upper, np.pi)
     return rng.uniform(lower, upper, (n, arm.dof))
+
+
+def reference_spec(relative_path: str) -> mujoco.MjSpec:
+    """A Menagerie MJCF under :data:`MENAGERIE` with its meshes stripped (the files ship
+    without them), to edit before compiling."""
+    spec = mujoco.MjSpec.from_file(str(MENAGERIE / relative_path))
+    for geom in list(spec.geoms):
+        if geom.type == mujoco.mjtGeom.mjGEOM_MESH:
+            spec.delete(geom)
+    for mesh in list(spec.meshes):
+        spec.delete(mesh)
+    return spec
+
+
+def reference_model(relative_path: str) -> mujoco.MjModel:
+    """A Menagerie model under :data:`MENAGERIE`, compiled without its missing meshes."""
+    return om.load_mujoco_model(MENAGERIE / relative_path)
 
 
 def home_joints(arm: om.Arm) -> np.ndarray:

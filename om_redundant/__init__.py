@@ -3,12 +3,19 @@
 from .arm import Arm as Arm
 from .arm import arm_names as arm_names
 from .arm import load_arm as load_arm
+from .arm_angle import arm_angle_and_gradient as arm_angle_and_gradient
+from .arm_in_model import ArmJoints as ArmJoints
+from .arm_in_model import ArmRoot as ArmRoot
 from .configuration import Configuration as Configuration
 from .exceptions import ArmFileError as ArmFileError
+from .exceptions import FrameNotFound as FrameNotFound
 from .exceptions import InvalidInput as InvalidInput
+from .exceptions import JointNotFound as JointNotFound
 from .exceptions import ModelError as ModelError
+from .exceptions import ModelMismatch as ModelMismatch
 from .exceptions import OMError as OMError
 from .exceptions import UnknownArm as UnknownArm
+from .exceptions import UnreachableTarget as UnreachableTarget
 from .kinematics import DHRow as DHRow
 from .kinematics import JointKind as JointKind
 from .kinematics import KinematicChain as KinematicChain
@@ -23,5 +30,7 @@ from .mujoco_match import load_mujoco_model as load_mujoco_model
 from .solver import BatchSolution as BatchSolution
 from .solver import OMSolver as OMSolver
 from .solver import Solution as Solution
+from .tasks import ArmAngleTask as ArmAngleTask
+from .tasks import ExactPoseTask as ExactPoseTask
 
 __version__ = "0.1.0"

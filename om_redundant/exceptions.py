@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import mujoco
+from mink.exceptions import InvalidFrame, InvalidTarget, MinkError
+
 
 class OMError(Exception):
     """Base class for om_redundant exceptions."""
@@ -40,4 +43,45 @@ class ModelError(OMError, ValueError):
 
     Raised when an arm violates a condition of the OM method's Theorem 2 (or the
     redundant-arm equivalent) or matches none of the closed-form families.
+    """
+
+
+class ModelMismatch(OMError, MinkError):
+    """A MuJoCo model does not hold the arm as a task needs it.
+
+    Raised when a joint of the arm is missing from the model or has another type, when the
+    end-effector frame does not move like the arm's, or when a task meets a
+    ``mink.Configuration`` of another model than the one it was built for. The message names
+    the joint, frame or model. Also a ``mink.MinkError``.
+    """
+
+
+class JointNotFound(ModelMismatch):
+    """A joint of the arm (with the prefix applied) is not in the MuJoCo model."""
+
+    def __init__(self, joint_name: str, arm_name: str, model: mujoco.MjModel):
+        self.joint_name = joint_name
+        available = [model.joint(i).name for i in range(model.njnt)]
+        super().__init__(
+            f"joint '{joint_name}' of arm '{arm_name}' does not exist in the model. "
+            f"Available joint names: {available}"
+        )
+
+
+class FrameNotFound(ModelMismatch, InvalidFrame):
+    """The end-effector frame named for the arm is not in the MuJoCo model.
+
+    Also a ``mink.InvalidFrame``, whose message (listing the model's frames) it keeps.
+    """
+
+    def __init__(self, frame_name: str, frame_type: str, model: mujoco.MjModel):
+        self.frame_name, self.frame_type = frame_name, frame_type
+        InvalidFrame.__init__(self, frame_name, frame_type, model)
+
+
+class UnreachableTarget(OMError, InvalidTarget):
+    """A task's target has no exact solution it may pull the arm to.
+
+    The pose is out of reach, the requested configuration has no solution for it, or every
+    solution breaks a joint limit; the message says which. Also a ``mink.InvalidTarget``.
     """

@@ -1,0 +1,219 @@
+r"""Where an arm sits inside a user's MuJoCo model: its joints, and its root frame.
+
+A model may hold more than the arm: a gripper's joints, a mobile base, a second arm whose
+names carry a prefix such as ``"l_"``. :class:`ArmJoints` finds the arm's joints by name
+(``prefix + arm.joint_names[i]``) and gives their qpos and dof addresses;
+:class:`ArmRoot` finds the arm's root frame, the frame in which ``arm.fk`` and the OM solver
+express poses, so that a target in MuJoCo's world frame can be handed to the solver.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+from mink import FRAME_TO_ENUM, FRAME_TO_POS_ATTR, FRAME_TO_XMAT_ATTR, SUPPORTED_FRAMES, UnsupportedFrame
+
+from .arm import Arm
+from .exceptions import FrameNotFound, JointNotFound, ModelMismatch
+from .mjcf import DEFAULT_SITE
+
+#: Largest disagreement (m, rad) accepted between ``arm.fk`` and the model's end-effector frame.
+MATCH_TOLERANCE = 1e-6
+#: Random joint vectors at which the end-effector frame is checked against ``arm.fk``.
+_CHECKS = 3
+
+
+class ArmJoints:
+    """The arm's joints in a MuJoCo model, found by name.
+
+    Args:
+        arm: The arm.
+        model: A MuJoCo model that holds the arm, possibly among other joints.
+        prefix: Prepended to the arm's joint names, e.g. ``"l_"``.
+
+    Attributes:
+        arm: The arm.
+        model: The model.
+        prefix: The name prefix.
+        names: The arm's joint names in the model, prefix included.
+        joint_ids: (dof,) joint ids in the model.
+        qpos_ids: (dof,) addresses of the arm's joints in ``qpos``.
+        dof_ids: (dof,) addresses of the arm's joints in the tangent space (columns of an
+            ``(k, nv)`` task Jacobian).
+        lower, upper: (dof,) joint limits, the tighter of the arm's and the model's.
+
+    Raises:
+        JointNotFound: A joint is not in the model; the message names it.
+        ModelMismatch: A joint has another type (a revolute joint must be a hinge, a
+            prismatic one a slide).
+    """
+
+    def __init__(self, arm: Arm, model: mujoco.MjModel, prefix: str = ""):
+        self.arm, self.model, self.prefix = arm, model, prefix
+        self.names = tuple(prefix + name for name in arm.joint_names)
+        ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name) for name in self.names]
+        for name, joint_id in zip(self.names, ids, strict=True):
+            if joint_id == -1:
+                raise JointNotFound(name, arm.name, model)
+        self.joint_ids = np.array(ids)
+        wanted = np.where(arm.revolute, mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE)
+        for name, joint_id, kind in zip(self.names, ids, wanted, strict=True):
+            if model.jnt_type[joint_id] != kind:
+                found = mujoco.mjtJoint(model.jnt_type[joint_id]).name
+                raise ModelMismatch(
+                    f"joint '{name}' of arm '{arm.name}' is a {found} in the model; "
+                    f"the arm needs a {mujoco.mjtJoint(kind).name}"
+                )
+        self.qpos_ids = model.jnt_qposadr[self.joint_ids]
+        self.dof_ids = model.jnt_dofadr[self.joint_ids]
+        limited = model.jnt_limited[self.joint_ids].astype(bool)
+        ranges = model.jnt_range[self.joint_ids]
+        self.lower = np.where(limited, np.maximum(arm.lower, ranges[:, 0]), arm.lower)
+        self.upper = np.where(limited, np.minimum(arm.upper, ranges[:, 1]), arm.upper)
+
+    def q(self, qpos: np.ndarray) -> np.ndarray:
+        """The arm's joint vector (dof,) out of a model's qpos."""
+        return qpos[self.qpos_ids]
+
+    def qpos_with(self, qpos: np.ndarray, q: np.ndarray) -> np.ndarray:
+        """A copy of qpos with the arm's joints set to q."""
+        out = np.array(qpos, dtype=np.float64)
+        out[self.qpos_ids] = q
+        return out
+
+    def within_limits(self, q: np.ndarray) -> bool:
+        """Whether the arm's joint vector q is within :attr:`lower` and :attr:`upper`."""
+        return bool(np.all((q >= self.lower) & (q <= self.upper)))
+
+    def nearest_turn(self, q_target: np.ndarray, q: np.ndarray) -> np.ndarray:
+        """q_target with each revolute joint shifted by a multiple of 2 pi to the value nearest
+        q, where that value is within the limits (else the joint keeps q_target's value)."""
+        turns = np.round((q - q_target) / (2.0 * np.pi))
+        shifted = q_target + 2.0 * np.pi * np.where(self.arm.revolute, turns, 0.0)
+        inside = (shifted >= self.lower) & (shifted <= self.upper)
+        return np.where(inside, shifted, q_target)
+
+    def check_model(self, model: mujoco.MjModel, who: str) -> None:
+        """Raise :class:`ModelMismatch` unless ``model`` is the model these joints were found in."""
+        if model is not self.model:
+            raise ModelMismatch(
+                f"{who} was built for another MjModel than this configuration's; build it with "
+                "configuration.model"
+            )
+
+
+class ArmRoot:
+    r"""The arm's root frame in a MuJoCo model, located through its end-effector frame.
+
+    ``arm.fk(q)`` is the pose of the end-effector frame E in the root frame. Nothing moves
+    between the root and the body B that carries the arm's first joint's body (its parent),
+    so :math:`T_{world,root} = T_{world,B}\, C` with a constant C. C is measured from the
+    model, :math:`C = T_{world,B}^{-1}\, T_{world,E}(q)\, \mathrm{fk}(q)^{-1}`, and checked at
+    random joint vectors: a frame that does not move
+    like the arm's end effector (a tool frame with an offset, another arm) is refused. This
+    holds wherever the arm is mounted: on the world (any pose), on a mobile base, on a
+    mocap body.
+
+    Args:
+        joints: The arm's joints in the model.
+        frame_name: The end-effector frame in the model, the frame ``arm.fk`` gives. Default:
+            the prefix plus the arm's frame name (``arm.frame_name``, Menagerie's), else
+            ``prefix + "end_effector"``.
+        frame_type: ``"site"``, ``"body"`` or ``"geom"``; default the arm's (``"site"`` if it
+            names none).
+
+    Attributes:
+        frame_name, frame_type: The end-effector frame.
+        body: Id of B.
+        offset: (4, 4) C, the root frame in B.
+        fixed_pose: (4, 4) world pose of the root when B is welded to the world, else None
+            (the root moves with other joints or a mocap body; see :meth:`pose`).
+
+    Raises:
+        FrameNotFound: No frame of that name and type.
+        mink.UnsupportedFrame: frame_type is none of the above.
+        ModelMismatch: The frame is not below the arm's joints, or does not move like
+            ``arm.fk``.
+    """
+
+    def __init__(self, joints: ArmJoints, frame_name: str | None = None, frame_type: str | None = None):
+        arm, model = joints.arm, joints.model
+        self.joints = joints
+        self.frame_name = frame_name or joints.prefix + (arm.frame_name or DEFAULT_SITE)
+        self.frame_type = frame_type or arm.frame_type or "site"
+        if self.frame_type not in SUPPORTED_FRAMES:
+            raise UnsupportedFrame(self.frame_type, SUPPORTED_FRAMES)
+        self._frame = mujoco.mj_name2id(model, FRAME_TO_ENUM[self.frame_type], self.frame_name)
+        if self._frame == -1:
+            raise FrameNotFound(self.frame_name, self.frame_type, model)
+        self._pos, self._xmat = FRAME_TO_POS_ATTR[self.frame_type], FRAME_TO_XMAT_ATTR[self.frame_type]
+        self.body = int(model.body_parentid[model.jnt_bodyid[joints.joint_ids[0]]])
+        self._check_path()
+        data = mujoco.MjData(model)
+        rng = np.random.default_rng(0)
+        low = np.where(np.isfinite(joints.lower), joints.lower, -np.pi)
+        high = np.where(np.isfinite(joints.upper), joints.upper, np.pi)
+        checks = rng.uniform(low, high, (_CHECKS, arm.dof))
+        offsets = [self._offset(data, q) for q in checks]
+        self.offset = offsets[0]
+        for q, offset in zip(checks[1:], offsets[1:], strict=True):
+            position, angle = _distance(offset, self.offset)
+            if max(position, angle) > MATCH_TOLERANCE:
+                raise ModelMismatch(
+                    f"{self.frame_type} '{self.frame_name}' does not move like the end effector of arm "
+                    f"'{arm.name}' ({position:.2g} m, {angle:.2g} rad off at q = {np.round(q, 3).tolist()}): "
+                    "the model holds another arm, or this frame is not the one arm.fk gives "
+                    f"(Menagerie's is {arm.frame_type} '{arm.frame_name}')"
+                )
+        self.fixed_pose: np.ndarray | None = None
+        if model.body_weldid[self.body] == 0:
+            self.fixed_pose = self.pose(data)
+
+    def pose(self, data: mujoco.MjData) -> np.ndarray:
+        """World pose (4, 4) of the arm's root frame: :attr:`fixed_pose`, or from data's
+        current kinematics where the root moves."""
+        if self.fixed_pose is not None:
+            return self.fixed_pose
+        return _body_pose(data, self.body) @ self.offset
+
+    def _offset(self, data: mujoco.MjData, q: np.ndarray) -> np.ndarray:
+        data.qpos[:] = self.joints.qpos_with(self.joints.model.qpos0, q)
+        mujoco.mj_kinematics(self.joints.model, data)
+        frame = np.eye(4)
+        frame[:3, :3] = getattr(data, self._xmat)[self._frame].reshape(3, 3)
+        frame[:3, 3] = getattr(data, self._pos)[self._frame]
+        return np.linalg.solve(_body_pose(data, self.body), frame) @ np.linalg.inv(self.joints.arm.fk(q))
+
+    def _check_path(self) -> None:
+        """The frame must hang below body B through the arm's joints only."""
+        model = self.joints.model
+        bodyid = {"site": model.site_bodyid, "geom": model.geom_bodyid}
+        body = int(bodyid[self.frame_type][self._frame]) if self.frame_type in bodyid else self._frame
+        arm_joints = set(self.joints.joint_ids.tolist())
+        while body not in (self.body, 0):
+            start, count = model.body_jntadr[body], model.body_jntnum[body]
+            others = [model.joint(j).name for j in range(start, start + count) if j not in arm_joints]
+            if others:
+                raise ModelMismatch(
+                    f"joints {others} move {self.frame_type} '{self.frame_name}' besides the joints of arm "
+                    f"'{self.joints.arm.name}'"
+                )
+            body = int(model.body_parentid[body])
+        if body != self.body:
+            raise ModelMismatch(
+                f"{self.frame_type} '{self.frame_name}' is not moved by the joints of arm "
+                f"'{self.joints.arm.name}' ({', '.join(self.joints.names)})"
+            )
+
+
+def _body_pose(data: mujoco.MjData, body: int) -> np.ndarray:
+    T = np.eye(4)
+    T[:3, :3] = data.xmat[body].reshape(3, 3)
+    T[:3, 3] = data.xpos[body]
+    return T
+
+
+def _distance(A: np.ndarray, B: np.ndarray) -> tuple[float, float]:
+    """Position (m) and rotation angle (rad) between two poses."""
+    cos = (np.trace(A[:3, :3].T @ B[:3, :3]) - 1.0) / 2.0
+    return float(np.linalg.norm(A[:3, 3] - B[:3, 3])), float(np.arccos(np.clip(cos, -1.0, 1.0)))

@@ -1,0 +1,378 @@
+r"""mink tasks fed by exact OM solutions.
+
+:class:`ExactPoseTask` turns a hand pose into the exact joint vector :math:`q^*` of the
+configuration you chose (branch signs and arm angle, or the redundancy optimiser's choice)
+and pulls the arm's joints there; :class:`ArmAngleTask` only steers a 7-DOF arm's elbow,
+leaving the hand to mink's ``FrameTask``. Both are ``mink.Task``\ s: add them to the task
+list of ``mink.solve_ik``, whose limits (joint, velocity, collision) keep every step safe.
+
+Typical use (see the README, "Using it with mink")::
+
+    solver = om.OMSolver("panda")
+    frame_task = mink.FrameTask("attachment_site", "site", position_cost=1.0, orientation_cost=1.0)
+    exact_task = om.ExactPoseTask(solver, model, arm_configuration=om.Configuration((1, -1, 1), (0.3,)))
+    frame_task.set_target(T_world_target)
+    exact_task.set_target(T_world_target)
+    velocity = mink.solve_ik(configuration, [frame_task, exact_task], dt, "daqp", limits=limits)
+
+Targets are poses of the arm's end-effector frame in MuJoCo's world frame, like a
+``FrameTask``'s; the tasks find the arm's root frame in the model (:class:`ArmRoot`).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Protocol
+
+import mujoco
+import numpy as np
+import numpy.typing as npt
+from mink import SE3, TargetNotSet, Task, TaskDefinitionError
+from mink import Configuration as MinkConfiguration
+from mink.exceptions import InvalidTarget
+
+from .arm_angle import arm_angle_and_gradient, check_arm_angle
+from .arm_in_model import ArmJoints, ArmRoot
+from .configuration import Configuration
+from .exceptions import UnreachableTarget
+from .solver import OMSolver
+from .validation import as_pose
+
+#: Default cost of :class:`ExactPoseTask`, per radian (metre for prismatic joints). With
+#: mink's usual ``FrameTask`` costs of 1 it makes the exact target dominate far from it,
+#: which removes the spurious stationary points of the sum (see :class:`ExactPoseTask`).
+EXACT_POSE_COST = 10.0
+
+
+class RedundancyOptimizer(Protocol):
+    """What :class:`ExactPoseTask` needs of a redundancy optimiser (duck-typed).
+
+    ``choose(T, previous)`` takes a pose in the arm's root frame and the previous choice (or
+    None) and returns an object with ``ok`` (bool), ``solution`` (an om
+    :class:`~om_redundant.Solution`), ``configuration`` (its
+    :class:`~om_redundant.Configuration`) and ``reason`` (str, why when not ok).
+    """
+
+    def choose(self, T: np.ndarray, previous: Any = None) -> Any: ...
+
+
+class _ArmTask(Task):
+    """A task on the arm's joints inside a larger model: cost, model check, Jacobian columns."""
+
+    def __init__(
+        self,
+        solver: OMSolver,
+        model: mujoco.MjModel,
+        k: int,
+        prefix: str,
+        cost: npt.ArrayLike,
+        gain: float,
+        lm_damping: float,
+    ):
+        super().__init__(cost=np.zeros(k), gain=gain, lm_damping=lm_damping)
+        self.k = k
+        self.solver = solver
+        self.joints = ArmJoints(solver.arm, model, prefix)
+        self.set_cost(cost)
+
+    def set_cost(self, cost: npt.ArrayLike) -> None:
+        """Set the cost: one value for every coordinate of the error, or one per coordinate."""
+        cost = np.atleast_1d(np.asarray(cost, dtype=np.float64))
+        if cost.ndim != 1 or cost.shape[0] not in (1, self.k):
+            raise TaskDefinitionError(
+                f"{self.__class__.__name__} cost must be a vector of shape (1,) or ({self.k},), "
+                f"got {cost.shape}"
+            )
+        if not np.all(cost >= 0.0):
+            raise TaskDefinitionError(f"{self.__class__.__name__} cost should be >= 0")
+        self.cost[:] = cost
+
+    def _arm_q(self, configuration: MinkConfiguration) -> np.ndarray:
+        """The arm's joints in the configuration, after checking it is of this task's model."""
+        self.joints.check_model(configuration.model, self.__class__.__name__)
+        return self.joints.q(configuration.data.qpos)
+
+    def _scatter(self, rows: np.ndarray) -> np.ndarray:
+        """(k, dof) derivatives w.r.t. the arm's joints as a (k, nv) Jacobian."""
+        jacobian = np.zeros((self.k, self.joints.model.nv))
+        jacobian[:, self.joints.dof_ids] = rows
+        return jacobian
+
+
+class ExactPoseTask(_ArmTask):
+    r"""Pull the arm's joints to the exact solution of a hand pose in a chosen configuration.
+
+    On :meth:`set_target` the OM solver gives :math:`q^*` with :math:`\mathrm{fk}(q^*) =
+    T_{root,world} T_{world,target}` exactly, in the configuration c given
+    (``arm_configuration``) or chosen by ``optimizer``, within the joint limits (the tighter
+    of the arm's and the model's). The task's error and Jacobian are
+
+    .. math::  e(q) = q_{arm} - \tilde q^*, \qquad J = [\,0 \;\cdots\; I_{dof} \;\cdots\; 0\,]
+               \in \mathbb{R}^{dof \times n_v},
+
+    the identity in the arm's dof columns, where :math:`\tilde q^*` is :math:`q^*` with each
+    revolute joint shifted by the multiple of 2 pi that brings it nearest :math:`q_{arm}`, if
+    that keeps it within the limits (so an unlimited joint takes the short way round, and a
+    limited one never leaves its range).
+
+    Since :math:`q^*` reaches the same pose as a ``FrameTask`` with the same target, the two
+    tasks agree and mink converges to the pose exactly, in configuration c, with no posture
+    bias. The QP step is a Gauss-Newton step on :math:`\tfrac12\sum_i |W_i e_i|^2`; apart
+    from :math:`q^*`, a stationary point needs :math:`W^2 (q - q^*) = -J_f^T W_f^2 e_f`, which
+    the default cost (:data:`EXACT_POSE_COST`, 10 times a unit ``FrameTask`` cost) confines
+    so close to :math:`q^*` that none remains. With equal costs about a third of random
+    targets on the Panda end at such a point, from the middle of the joint ranges.
+
+    The arm's root may move (a mobile base, a mocap body): then :math:`q^*` is solved again
+    whenever the root has moved, at the next :meth:`compute_error`; the Jacobian's columns
+    of the base stay zero (the base follows the other tasks).
+
+    Failure is never silent: if the pose is out of reach, has no solution in c, or only
+    solutions that break a joint limit, :meth:`set_target` (or, for a moving root, the
+    next ``compute_*``) raises :class:`~om_redundant.UnreachableTarget` naming the reason,
+    and the task keeps its previous target (catch it to hold the arm where it was going).
+
+    Args:
+        solver: The OM solver of the arm.
+        model: The MuJoCo model that holds the arm (possibly among other joints).
+        arm_configuration: The configuration c to solve in (branch signs and, for a 7-DOF
+            arm, the arm angle psi).
+        optimizer: Instead of c: a redundancy optimiser, asked
+            ``optimizer.choose(T_root, previous=<its last choice>)`` at each target.
+        prefix: Prefix of the arm's joint names in the model, e.g. ``"l_"``.
+        frame_name, frame_type: The arm's end-effector frame in the model (the one
+            ``arm.fk`` gives); default the prefix plus the arm's Menagerie frame.
+        cost: Cost per joint error (1/rad), one value or one per joint.
+        gain: Task gain in [0, 1].
+        lm_damping: Levenberg-Marquardt damping (see ``mink.Task``).
+
+    Raises:
+        TaskDefinitionError: Neither or both of ``arm_configuration`` and ``optimizer``; a bad cost.
+        JointNotFound, FrameNotFound, ModelMismatch: The model does not hold the arm as named.
+    """
+
+    def __init__(
+        self,
+        solver: OMSolver,
+        model: mujoco.MjModel,
+        *,
+        arm_configuration: Configuration | None = None,
+        optimizer: RedundancyOptimizer | None = None,
+        prefix: str = "",
+        frame_name: str | None = None,
+        frame_type: str | None = None,
+        cost: npt.ArrayLike = EXACT_POSE_COST,
+        gain: float = 1.0,
+        lm_damping: float = 0.0,
+    ):
+        if (arm_configuration is None) == (optimizer is None):
+            raise TaskDefinitionError(
+                "ExactPoseTask takes either arm_configuration (a fixed om.Configuration) or optimizer"
+            )
+        super().__init__(solver, model, solver.arm.dof, prefix, cost, gain, lm_damping)
+        self.root = ArmRoot(self.joints, frame_name, frame_type)
+        self.optimizer = optimizer
+        self.arm_configuration = arm_configuration
+        if arm_configuration is not None:
+            solver._configuration(arm_configuration)  # raises InvalidInput naming the problem
+        self.transform_target_to_world: SE3 | None = None
+        self.choice: Any = None
+        self._q_target: np.ndarray | None = None
+        self._root_pose: np.ndarray | None = None
+        self._jacobian = self._scatter(np.eye(self.k))
+        self._jacobian.setflags(write=False)
+
+    @property
+    def joint_target(self) -> np.ndarray | None:
+        """The exact joint vector :math:`q^*` the task pulls to (None before the first solve)."""
+        return None if self._q_target is None else self._q_target.copy()
+
+    def set_target(
+        self,
+        transform_target_to_world: SE3 | np.ndarray,
+        arm_configuration: Configuration | None = None,
+    ) -> None:
+        """Set the hand's target pose in the world frame and solve it exactly.
+
+        The solve starts from the previous :math:`q^*` (the root nearest it), so a moving
+        target keeps its branch and arm angle continuous.
+
+        Args:
+            transform_target_to_world: ``mink.SE3`` or (4, 4) pose of the end-effector frame.
+            arm_configuration: A new configuration c to solve in from now on (default: keep
+                the task's); not with an optimiser.
+
+        Raises:
+            UnreachableTarget: No exact solution to pull to; the task keeps its old target
+                and configuration.
+            InvalidInput: A malformed pose or configuration.
+            TaskDefinitionError: A configuration given to a task that uses an optimiser.
+        """
+        T = as_pose(transform_target_to_world, "transform_target_to_world")
+        if arm_configuration is None:
+            arm_configuration = self.arm_configuration
+        elif self.optimizer is not None:
+            raise TaskDefinitionError("this ExactPoseTask takes its configurations from its optimizer")
+        else:
+            self.solver._configuration(arm_configuration)  # raises InvalidInput naming the problem
+        if self.root.fixed_pose is not None:
+            self._solve(T, self.root.fixed_pose, self._q_target, arm_configuration)
+        else:
+            self._root_pose = None  # the root moves: solved at the next compute_*
+        self.transform_target_to_world = SE3.from_matrix(T)
+        self.arm_configuration = arm_configuration
+
+    def set_target_from_configuration(self, configuration: MinkConfiguration) -> None:
+        """Hold the arm where it is: the target becomes the hand's current pose and, without
+        an optimiser, c becomes the arm's current configuration (branch signs and psi)."""
+        q = self._arm_q(configuration)
+        T = configuration.get_transform_frame_to_world(self.root.frame_name, self.root.frame_type).as_matrix()
+        c = self.solver.configuration_of(q) if self.optimizer is None else None
+        self._solve(T, self.root.pose(configuration.data), q, c)
+        self.arm_configuration = c
+        self.transform_target_to_world = SE3.from_matrix(T)
+
+    def seed(self, configuration: MinkConfiguration) -> None:
+        """Put the arm's joints of ``configuration`` at :math:`q^*` (the other joints stay)."""
+        q_target = self._joint_target(configuration)
+        configuration.update(self.joints.qpos_with(configuration.data.qpos, q_target))
+
+    def compute_error(self, configuration: MinkConfiguration) -> np.ndarray:
+        r"""The joint error :math:`e(q) = q_{arm} - \tilde q^*` (dof,)."""
+        q_target = self._joint_target(configuration)
+        q = self.joints.q(configuration.data.qpos)
+        return q - self.joints.nearest_turn(q_target, q)
+
+    def compute_jacobian(self, configuration: MinkConfiguration) -> np.ndarray:
+        """The identity in the arm's dof columns, (dof, nv)."""
+        self._joint_target(configuration)
+        return self._jacobian
+
+    # -----------------------------------------------------------------------------------
+
+    def _joint_target(self, configuration: MinkConfiguration) -> np.ndarray:
+        """:math:`q^*` for the configuration's root pose, solved again if the root moved."""
+        self._arm_q(configuration)
+        if self.transform_target_to_world is None:
+            raise TargetNotSet(self.__class__.__name__)
+        if self.root.fixed_pose is None:
+            root = self.root.pose(configuration.data)
+            if self._root_pose is None or not np.array_equal(root, self._root_pose):
+                T = self.transform_target_to_world.as_matrix()
+                self._solve(T, root, self._q_target, self.arm_configuration)
+        assert self._q_target is not None
+        return self._q_target
+
+    def _solve(
+        self,
+        T_world: np.ndarray,
+        root_pose: np.ndarray,
+        hint: np.ndarray | None,
+        arm_configuration: Configuration | None,
+    ) -> None:
+        """Solve T_world for the root at root_pose and, only if that succeeds, take it."""
+        R, p = root_pose[:3, :3], root_pose[:3, 3]
+        T_root = np.eye(4)
+        T_root[:3, :3] = R.T @ T_world[:3, :3]
+        T_root[:3, 3] = R.T @ (T_world[:3, 3] - p)
+        if arm_configuration is None:
+            choice = self.optimizer.choose(T_root, previous=self.choice)
+            if not choice.ok:
+                raise UnreachableTarget(
+                    f"ExactPoseTask: the optimizer found no configuration for the target: {choice.reason}"
+                )
+            q = np.asarray(choice.solution.q, dtype=np.float64)
+            if not (choice.solution.ok and self.joints.within_limits(q)):
+                raise UnreachableTarget(
+                    f"ExactPoseTask: the optimizer's solution {np.round(q, 4).tolist()} "
+                    f"({choice.solution.status}) does not reach the target within the joint limits"
+                )
+        else:
+            choice, q = None, self._solve_in(T_root, arm_configuration, hint)
+        self._q_target, self.choice, self._root_pose = q, choice, root_pose
+
+    def _solve_in(self, T_root: np.ndarray, c: Configuration, hint: np.ndarray | None) -> np.ndarray:
+        """The exact solution in configuration c within the limits, nearest the hint."""
+        solution = self.solver.solve(T_root, c, q_hint=hint)
+        if not solution.ok:
+            raise UnreachableTarget(f"ExactPoseTask: {solution.status} for the target (configuration {c})")
+        if self.joints.within_limits(solution.q):
+            return solution.q
+        inside = [s.q for s in self.solver.solve_all(T_root, c) if self.joints.within_limits(s.q)]
+        if not inside:
+            raise UnreachableTarget(
+                f"ExactPoseTask: every solution for the target in configuration {c} breaks a joint limit"
+            )
+        return min(inside, key=lambda q: float(np.linalg.norm(q - solution.q)))
+
+
+class ArmAngleTask(_ArmTask):
+    r"""Steer a 7-DOF arm's elbow: drive its arm angle psi to a target psi*.
+
+    For users who track the hand with mink's ``FrameTask`` and only want to choose the
+    elbow's swivel about the shoulder-wrist line. psi is the model's arm angle
+    (:mod:`om_redundant.closed_form.srs`, ``solver.configuration_of(q).redundancy[0]``):
+
+    .. math::  e(q) = \mathrm{wrap}\big(\psi(q) - \psi^*\big) \in (-\pi, \pi], \qquad
+               J = \partial\psi/\partial q \in \mathbb{R}^{1 \times n_v},
+
+    the gradient derived analytically in :mod:`om_redundant.arm_angle` (nonzero on the arm's
+    joints 1-4 only). psi is undefined on its singular half-line (the wrist straight below
+    the shoulder, inside the base) and jumps by pi where the ELBOW sign flips.
+
+    Args:
+        solver: The OM solver of a 7-DOF arm.
+        model: The MuJoCo model that holds the arm.
+        prefix: Prefix of the arm's joint names in the model.
+        cost: Cost of the arm angle error (1/rad).
+        gain: Task gain in [0, 1].
+        lm_damping: Levenberg-Marquardt damping (see ``mink.Task``).
+
+    Raises:
+        InvalidInput: The arm has no arm angle.
+        JointNotFound, ModelMismatch: The model does not hold the arm as named.
+    """
+
+    def __init__(
+        self,
+        solver: OMSolver,
+        model: mujoco.MjModel,
+        *,
+        prefix: str = "",
+        cost: npt.ArrayLike = 1.0,
+        gain: float = 1.0,
+        lm_damping: float = 0.0,
+    ):
+        check_arm_angle(solver)
+        super().__init__(solver, model, 1, prefix, cost, gain, lm_damping)
+        self.target_psi: float | None = None
+
+    def set_target(self, psi: float) -> None:
+        """Set the target arm angle psi* (rad)."""
+        try:
+            value = float(psi)
+        except (TypeError, ValueError):
+            value = math.nan
+        if not math.isfinite(value):
+            raise InvalidTarget(f"ArmAngleTask target must be a finite angle in radians, got {psi!r}")
+        self.target_psi = value
+
+    def set_target_from_configuration(self, configuration: MinkConfiguration) -> None:
+        """Hold the elbow where it is: psi* becomes the arm's current arm angle."""
+        self.set_target(arm_angle_and_gradient(self.solver, self._arm_q(configuration))[0])
+
+    def compute_error(self, configuration: MinkConfiguration) -> np.ndarray:
+        r"""The arm-angle error :math:`\mathrm{wrap}(\psi(q) - \psi^*)`, shape (1,)."""
+        psi, _ = self._psi(configuration)
+        return np.array([math.remainder(psi - self.target_psi, 2.0 * math.pi)])
+
+    def compute_jacobian(self, configuration: MinkConfiguration) -> np.ndarray:
+        r""":math:`\partial\psi/\partial q` in the arm's dof columns, (1, nv)."""
+        _, gradient = self._psi(configuration)
+        return self._scatter(gradient[None, :])
+
+    def _psi(self, configuration: MinkConfiguration) -> tuple[float, np.ndarray]:
+        q = self._arm_q(configuration)
+        if self.target_psi is None:
+            raise TargetNotSet(self.__class__.__name__)
+        return arm_angle_and_gradient(self.solver, q)
