@@ -287,37 +287,80 @@ def verify(problem, q, tol_pos, tol_ori):
     return pos, ori, same and pos <= tol_pos and ori <= tol_ori
 
 
-@nb.njit(cache=True)
-def _extremum(problem, a, b, sign, of_margin, q):
-    """Golden-section search for the maximum of sign * g (or of the reach margin) on [a, b].
+@nb.njit(cache=True, inline="always")
+def _objective(problem, w, sign, of_margin, q):
+    """sign * g(w) (unreachable: -inf), or the reach margin; and g and the margin."""
+    g, m = _g_margin(problem, w, q)
+    if of_margin:
+        return m, g, m
+    return (-np.inf if np.isnan(g) else sign * g), g, m
 
-    Unreachable points count as -inf for g. Returns (argmax, g there, margin there).
+
+@nb.njit(cache=True)
+def _extremum(problem, a, b, x0, sign, of_margin, q):
+    """Brent's search, from x0, for the maximum of sign * g (or of the reach margin) on [a, b].
+
+    Unreachable points count as -inf for g. It stops early at the first point that settles
+    the caller's question: sign * g > 0 (g crosses zero) or, for the margin, a reachable
+    point. Returns (argmax, g there, margin there).
     """
-    inv_phi = 0.6180339887498949
-    c = b - inv_phi * (b - a)
-    d = a + inv_phi * (b - a)
-    gc, mc = _g_margin(problem, c, q)
-    gd, md = _g_margin(problem, d, q)
-    for _ in range(45):
-        fc = mc if of_margin else (-np.inf if np.isnan(gc) else sign * gc)
-        fd = md if of_margin else (-np.inf if np.isnan(gd) else sign * gd)
-        if fc > fd:
-            b, d, gd, md = d, c, gc, mc
-            c = b - inv_phi * (b - a)
-            gc, mc = _g_margin(problem, c, q)
+    golden = 0.3819660112501051
+    x = w = v = x0
+    fx, gx, mx = _objective(problem, x, sign, of_margin, q)
+    fw = fv = fx
+    d = e = 0.0
+    for _ in range(60):
+        if fx > 0.0 if not of_margin else not np.isnan(gx):
+            break
+        xm = 0.5 * (a + b)
+        tol = 1e-10 * abs(x) + 1e-11
+        if abs(x - xm) <= 2.0 * tol - 0.5 * (b - a):
+            break
+        parabolic = False
+        if abs(e) > tol:  # a parabola through x, w, v (NaN with an unreachable point: skipped)
+            r = (x - w) * (fx - fv)
+            p_ = (x - v) * (fx - fw)
+            den = 2.0 * (p_ - r)
+            num = (x - v) * p_ - (x - w) * r
+            if den > 0.0:
+                num = -num
+            den = abs(den)
+            if abs(num) < abs(0.5 * den * e) and num > den * (a - x) and num < den * (b - x):
+                e, d = d, num / den
+                parabolic = True
+                if (x + d) - a < 2.0 * tol or b - (x + d) < 2.0 * tol:
+                    d = tol if xm >= x else -tol
+        if not parabolic:
+            e = (a - x) if x >= xm else (b - x)
+            d = golden * e
+        u = x + (d if abs(d) >= tol else (tol if d > 0.0 else -tol))
+        fu, gu, mu = _objective(problem, u, sign, of_margin, q)
+        if fu >= fx:
+            if u >= x:
+                a = x
+            else:
+                b = x
+            v, fv, w, fw = w, fw, x, fx
+            x, fx, gx, mx = u, fu, gu, mu
         else:
-            a, c, gc, mc = c, d, gd, md
-            d = a + inv_phi * (b - a)
-            gd, md = _g_margin(problem, d, q)
-    return c, gc, mc
+            if u < x:
+                a = u
+            else:
+                b = u
+            if fu >= fw or w == x:
+                v, fv, w, fw = w, fw, u, fu
+            elif fu >= fv or v in (x, w):
+                v, fv = u, fu
+    # q must belong to the returned point.
+    gx, mx = _g_margin(problem, x, q)
+    return x, gx, mx
 
 
 @nb.njit(cache=True)
-def _brackets(problem, a, ga, b, gb, search, q, out, n):
-    """Add the roots of g on [a, b] (both ends reachable) to out[n:]; returns the new count.
+def _brackets(problem, a, ga, b, gb, q, out, n):
+    """Add the root of g on [a, b] (both ends reachable) to out[n:]; returns the new count.
 
-    A sign change is one root. With ``search``, an interval without one is searched for an
-    extremum of g that crosses zero, which gives two roots (a close pair).
+    A sign change is one root; a wrap of g from about +pi to -pi is none.
     """
     if ga == 0.0:
         out[n] = a
@@ -343,9 +386,14 @@ def _brackets(problem, a, ga, b, gb, search, q, out, n):
     if ga * gb < 0.0:
         out[n] = _refine_bracket(problem, a, ga, b, gb, q)
         return n + 1
-    if not search:
-        return n
-    w, g, _ = _extremum(problem, a, b, -np.sign(ga), False, q)
+    return n
+
+
+@nb.njit(cache=True)
+def _pair(problem, a, ga, x0, b, gb, q, out, n):
+    """Add a close pair of roots on [a, b] to out[n:]: g has one sign at a, x0 and b, and
+    its extremum between them may cross zero. Returns the new count."""
+    w, g, _ = _extremum(problem, a, b, x0, -np.sign(ga), False, q)
     if np.isnan(g) or g * ga > 0.0:
         return n
     if g == 0.0:
@@ -360,14 +408,14 @@ def _brackets(problem, a, ga, b, gb, search, q, out, n):
 def _run_roots(problem, pw, pg, L, cyclic, q, out, n):
     """Add the roots on a run of reachable points (w ascending) to out[n:]; returns the count.
 
-    Consecutive points with a sign change bracket a root. At each local minimum of |g|,
-    each adjacent cell without a sign change is searched for an extremum of g that crosses
+    Consecutive points with a sign change bracket a root. At each local minimum of |g|, the
+    adjacent cells without a sign change are searched for an extremum of g that crosses
     zero: a close pair of roots. A cyclic run covers the whole circle.
     """
     for i in range(L - 1 + cyclic):
         j = (i + 1) % L
         wj = pw[j] + (2.0 * np.pi if j == 0 else 0.0)
-        n = _brackets(problem, pw[i], pg[i], wj, pg[j], False, q, out, n)
+        n = _brackets(problem, pw[i], pg[i], wj, pg[j], q, out, n)
     for i in range(L):
         gi = pg[i]
         has_prev, has_next = i > 0 or cyclic, i < L - 1 or cyclic
@@ -375,12 +423,14 @@ def _run_roots(problem, pw, pg, L, cyclic, q, out, n):
         ghi = pg[(i + 1) % L] if has_next else np.inf
         if abs(gi) > _PAIR_SEARCH or abs(glo) < abs(gi) or abs(ghi) < abs(gi):
             continue
+        # One search over the cells on either side without a sign change.
+        a, ga, b, gb = pw[i], gi, pw[i], gi
         if has_prev and glo * gi > 0.0:
-            lo = pw[(i - 1) % L] - (2.0 * np.pi if i == 0 else 0.0)
-            n = _brackets(problem, lo, glo, pw[i], gi, True, q, out, n)
+            a, ga = pw[(i - 1) % L] - (2.0 * np.pi if i == 0 else 0.0), glo
         if has_next and ghi * gi > 0.0:
-            hi = pw[(i + 1) % L] + (2.0 * np.pi if i == L - 1 else 0.0)
-            n = _brackets(problem, pw[i], gi, hi, ghi, True, q, out, n)
+            b, gb = pw[(i + 1) % L] + (2.0 * np.pi if i == L - 1 else 0.0), ghi
+        if b > a:
+            n = _pair(problem, a, ga, pw[i], b, gb, q, out, n)
     return n
 
 
@@ -441,7 +491,7 @@ def _scan(problem, lo, hi, n_pts, full_circle, q, cands):
             if i + 2 < count:
                 change = max(change, abs(ms[i + 2] - ms[i + 1]))
             if max(ms[i], ms[i + 1]) + change > 0.0:
-                c, gc, _ = _extremum(problem, w, ws[i + 1], 1.0, True, q)
+                c, gc, _ = _extremum(problem, w, ws[i + 1], 0.5 * (w + ws[i + 1]), 1.0, True, q)
                 if not np.isnan(gc):  # an island of reach around c
                     pw[0] = _reach_edge(problem, c, w, q)
                     pw[1], pg[1] = c, gc
