@@ -115,7 +115,7 @@ def test_bad_input_exits_2_with_one_line_and_no_traceback(argv, message):
         (["check-model", "README.md", "--arm", "panda"], "must be an MJCF file ending in .xml"),
         (["check-model", "arms/panda.toml", "--arm", "nope"], "unknown arm 'nope'"),
         (["sweep", "--arm", "ur5e"], "arm 'ur5e' has no arm angle to sweep"),
-        (["sweep", "--arm", "sawyer"], "arm 'sawyer': shoulder offsets"),
+        (["sweep", "--arm", "sawyer"], "arm 'sawyer': fixed rows between joints are not supported"),
         (["sweep", "--resolution", "0"], "--resolution must be a positive number"),
         (["sweep", "--resolution", "nan"], "--resolution must be a positive number"),
         (["sweep", "--resolution", "1e-9"], "the most is 100000"),
@@ -261,7 +261,7 @@ def test_arms_table(capsys):
     status, out, _ = in_process(capsys, "arms")
     lines = out.splitlines()
     assert status == 0 and len(lines) == 1 + len(om.arm_names())
-    assert "not yet solvable: shoulder offsets (d2 = -0.01175 m)" in out and "0.0880 m" in out
+    assert "not yet solvable: fixed rows between joints" in out and "0.0121 m" in out
 
 
 def test_bench_paper_small_run(capsys):
