@@ -30,7 +30,7 @@ from scipy.spatial.transform import Rotation
 
 import om_redundant as om
 
-from .om_any import PSI_GRID, solve_any_in_limits
+from .om_any import COARSE_PSI, FINE_PSI, AnyInLimits
 from .robots import (
     EE_LINK,
     ROOT_LINK,
@@ -188,13 +188,18 @@ def om_redundant_peer(arm: om.Arm, rng: np.random.Generator) -> Peer:
         arm,
         None,
         "OMSolver defaults; any: first ok solution within limits over the configurations"
-        + (f" x {len(PSI_GRID)} arm angles psi" if solver.redundancy_names else ""),
+        + (
+            f" x {COARSE_PSI} arm angles psi, most frequent cells of random in-limit joint vectors"
+            f" first, then {FINE_PSI} arm angles"
+            if solver.redundancy_names
+            else ""
+        ),
         exact=Method(
             lambda T, q: (T, solver.configuration_of(q)),
             lambda argument: solver.solve(*argument),
             solved,
         ),
-        any=Method(lambda T, q: T, lambda T: solve_any_in_limits(solver, T), solved),
+        any=Method(lambda T, q: T, AnyInLimits(solver), solved),
         every=Method(
             every_prepare,
             every_call,
