@@ -1,0 +1,226 @@
+r"""The climb: a trust-region SQP that maximises the objective over the redundancy variables.
+
+From a feasible exact solution q(psi) on a branch, every piece v_j of every group g of the
+objective (:mod:`om_redundant.objective`) is linearised through the self-motion tangent
+dq/dpsi (:func:`self_motion_tangent`), :math:`v_j(\psi + \delta) \approx v_j + a_j^T\delta`,
+and the QP
+
+.. math::  \max_{\delta, t}\ \sum_g w_g t_g - \tfrac12 \delta^T B \delta
+           \quad\text{s.t.}\quad t_g \le v_j + a_j^T\delta\ (j \in g),\quad
+           \mathrm{floor}_g \le t_g \le \mathrm{cap}_g,\quad
+           |\delta|_\infty \le \Delta,\quad lo \le \psi + \delta \le hi
+
+(the epigraph form of the max-min objective; the floors keep the linearised margins >= 0
+and clearances >= d_min) is solved by OSQP through qpsolvers. B is a damped BFGS estimate of
+the curvature of the Lagrangian, from the QP's multipliers z_j:
+:math:`s = \delta`, :math:`y = -\sum_j z_j (a_j^{new} - a_j^{old})`. The step is solved
+exactly (the current q as hint); it is accepted when the exact point is feasible and gains
+at least a tenth of the model's gain :math:`\sum_g w_g \min(cap_g, \min_j (v_j + a_j^T\delta))
+- \tfrac12\delta^T B\delta - f`; the trust radius Delta then doubles (a good full step) or
+otherwise shrinks to a quarter of the step. The climb stops when the step or the model's
+gain vanishes. Everything here is written for r redundancy variables (r = 1 for 7-DOF arms).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import qpsolvers
+import scipy.sparse as sp
+
+from .exceptions import InvalidInput
+from .intervals import Point, Probe
+from .objective import Group
+from .solver import OMSolver
+from .validation import as_joint_vector
+
+STEP_TOLERANCE = 1e-9  # rad: the climb stops when the step is this small
+GAIN_TOLERANCE = 1e-12  # the climb stops when the model promises no more
+_MAX_CLIMB = 60  # QPs per climb
+_ACCEPT = 0.1  # accepted steps gain this fraction of the model's gain
+_INITIAL_CURVATURE = 0.1  # B at the first QP of a climb
+_ANGLE_STEP = 1e-6  # rad: central differences of the arm angle along the null space
+_JOINT_STEP = 0.25  # rad: the trust radius keeps the linearised joint motion within this
+_OSQP = {"eps_abs": 1e-6, "eps_rel": 1e-6, "polish": True, "verbose": False}
+
+
+def self_motion_tangent(solver: OMSolver, q: np.ndarray) -> np.ndarray:
+    r"""dq/dpsi: how the joints move per unit of the redundancy variables, hand fixed.
+
+    The self-motion keeps the hand still, :math:`J(q)\,\dot q = 0`, so
+    :math:`\dot q = N a` with N (dof x r) an orthonormal basis of the null space of the
+    real arm's Jacobian J (6 x dof; its last r right singular vectors). The redundancy
+    variables (the model's arm angle psi(q)) change by :math:`\dot\psi = D\psi(q)\,N a`, so
+
+    .. math::  \frac{dq}{d\psi} = N\,\big(D\psi(q)\,N\big)^{-1},
+
+    with :math:`D\psi\,N` (r x r) by central differences of psi(q) along the columns of N
+    (step 1e-6 rad; error about 1e-10). It is singular where psi stops changing along the
+    self-motion (a fold of the solution path).
+
+    Args:
+        solver: The solver of a redundant arm (r = dof - 6 redundancy variables).
+        q: (dof,) joint vector.
+
+    Returns:
+        (dof, r) matrix.
+    """
+    r = len(solver.redundancy_names)
+    if r == 0 or solver.arm.dof - 6 != r:
+        raise InvalidInput(
+            f"arm '{solver.arm.name}' has {solver.arm.dof - 6} self-motion directions and "
+            f"{r} redundancy variables; the tangent needs as many of each, at least one"
+        )
+    q = as_joint_vector(q, solver.arm.dof)
+    null = np.linalg.svd(solver.arm.jacobian(q))[2][6:].T
+    change = np.empty((r, r))
+    for c in range(r):
+        ahead = solver.configuration_of(q + _ANGLE_STEP * null[:, c]).redundancy
+        behind = solver.configuration_of(q - _ANGLE_STEP * null[:, c]).redundancy
+        change[:, c] = [
+            math.remainder(a - b, 2.0 * math.pi) / (2.0 * _ANGLE_STEP)
+            for a, b in zip(ahead, behind, strict=True)
+        ]
+    return np.linalg.solve(change.T, null.T).T
+
+
+@dataclass(frozen=True)
+class _Step:
+    """A QP step: delta, the model's gain over the current value, multipliers per group."""
+
+    delta: np.ndarray
+    gain: float
+    multipliers: list[np.ndarray]
+
+
+def qp_step(groups: list[Group], curvature: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> _Step | None:
+    """Solve the climb's QP (module docstring) for the step delta.
+
+    Pieces that cannot be their group's minimum anywhere in the box [lower, upper] are left
+    out (their constraints are implied by the minimum's); their multipliers are zero.
+
+    Args:
+        groups: Groups with jacobians (p_g, r) by the redundancy variables.
+        curvature: B (r, r), positive definite.
+        lower, upper: (r,) bounds of delta (trust region and interval).
+
+    Returns:
+        The step, or None when OSQP finds no solution.
+    """
+    r, n_groups = len(lower), len(groups)
+    reach = np.maximum(-lower, upper)
+    keep = []
+    for g in groups:
+        change = np.abs(g.jacobian) @ reach
+        keep.append(g.values - change <= (g.values + change).min())
+    # OSQP solves for u = delta / scale with every column of the rows scaled to a largest
+    # entry of 1: with slopes far from 1 (small near a flat optimum, large near a fold) the
+    # ADMM iteration otherwise stalls.
+    slopes = np.vstack([g.jacobian[k] for g, k in zip(groups, keep, strict=True)])
+    largest = np.abs(slopes).max(axis=0)
+    scale = 1.0 / np.where(largest > 0.0, largest, 1.0)
+    rows = [
+        np.hstack([-g.jacobian[k] * scale, np.tile(np.eye(n_groups)[i], (k.sum(), 1))])
+        for i, (g, k) in enumerate(zip(groups, keep, strict=True))
+    ]
+    P = sp.block_diag(
+        [sp.csc_matrix(curvature * np.outer(scale, scale)), sp.csc_matrix((n_groups, n_groups))]
+    )
+    problem = qpsolvers.Problem(
+        P.tocsc(),
+        np.concatenate([np.zeros(r), [-g.weight for g in groups]]),
+        sp.csc_matrix(np.vstack(rows)),
+        np.concatenate([g.values[k] for g, k in zip(groups, keep, strict=True)]),
+        lb=np.concatenate([lower / scale, [g.floor for g in groups]]),
+        ub=np.concatenate([upper / scale, [g.cap for g in groups]]),
+    )
+    solution = qpsolvers.solve_problem(problem, solver="osqp", **_OSQP)
+    if not solution.found:
+        return None
+    delta = solution.x[:r] * scale
+    gain = _model(groups, delta) - 0.5 * delta @ curvature @ delta - _model(groups, np.zeros(r))
+    duals = np.split(np.maximum(solution.z, 0.0), np.cumsum([k.sum() for k in keep])[:-1])
+    multipliers = []
+    for g, k, z in zip(groups, keep, duals, strict=True):
+        full = np.zeros(len(g.values))
+        full[k] = z
+        multipliers.append(full)
+    return _Step(delta, gain, multipliers)
+
+
+def _model(groups: list[Group], delta: np.ndarray) -> float:
+    """The linearised objective sum_g w_g min(cap_g, min_j (v_j + a_j delta))."""
+    return sum(g.weight * min(g.cap, float((g.values + g.jacobian @ delta).min())) for g in groups)
+
+
+def _bfgs(B: np.ndarray, s: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Damped (Powell) BFGS update of B, kept positive definite."""
+    Bs = B @ s
+    sBs = s @ Bs
+    if sBs <= 1e-300:
+        return B
+    sy = s @ y
+    if sy < 0.2 * sBs:
+        theta = 0.8 * sBs / (sBs - sy)
+        y, sy = theta * y + (1.0 - theta) * Bs, 0.2 * sBs
+    return B - np.outer(Bs, Bs) / sBs + np.outer(y, y) / sy
+
+
+def maximise(probe: Probe, start: Point, lower: float, upper: float, radius: float) -> Point:
+    """Climb from a feasible point to a local maximum of f within [lower, upper].
+
+    The trust radius Delta is also kept below ``_JOINT_STEP / max_i sum_c |dq_i/dpsi_c|``,
+    so that no step moves a joint by more than 0.25 rad to first order (near a fold of the
+    solution path dq/dpsi is large and the linearisation holds only briefly).
+
+    Args:
+        probe: Exact solutions on the branch at the pose.
+        start: A feasible point; every step continues from the current one.
+        lower, upper: Bounds of psi (the feasible interval).
+        radius: First trust radius (rad).
+
+    Returns:
+        The best feasible point found.
+    """
+    point, x = start, np.atleast_1d(start.psi).astype(float)
+    groups, reach = _linearised(probe, point.q)
+    if not groups:  # nothing to maximise: f is constant
+        return start
+    B = _INITIAL_CURVATURE * np.eye(len(x))
+    for _ in range(_MAX_CLIMB):
+        radius = min(radius, reach)
+        if radius <= STEP_TOLERANCE:
+            break
+        lo = np.minimum(np.maximum(lower - x, -radius), 0.0)
+        step = qp_step(groups, B, lo, np.maximum(np.minimum(upper - x, radius), 0.0))
+        if step is None or np.abs(step.delta).max() <= STEP_TOLERANCE or step.gain <= GAIN_TOLERANCE:
+            break
+        size = np.abs(step.delta).max()
+        trial = probe.at(_angle(x + step.delta), point.q)
+        gain = trial.evaluation.value - point.evaluation.value if trial is not None else -math.inf
+        if trial is None or not trial.evaluation.feasible or gain < _ACCEPT * step.gain:
+            radius = size / 4.0
+            continue
+        new, new_reach = _linearised(probe, trial.q)
+        y = -sum(
+            z @ (gn.jacobian - g.jacobian) for z, g, gn in zip(step.multipliers, groups, new, strict=True)
+        )
+        B = _bfgs(B, step.delta, y)
+        if gain > 0.75 * step.gain and size >= 0.9 * radius:
+            radius *= 2.0
+        point, groups, reach, x = trial, new, new_reach, x + step.delta
+    return Point(_angle(x), point.q, point.evaluation)
+
+
+def _angle(x: np.ndarray) -> float | np.ndarray:
+    return float(x[0]) if len(x) == 1 else x
+
+
+def _linearised(probe: Probe, q: np.ndarray) -> tuple[list[Group], float]:
+    """The groups at q with jacobians by psi, and the trust radius that keeps joints
+    within ``_JOINT_STEP``."""
+    tangent = self_motion_tangent(probe.solver, q)
+    reach = _JOINT_STEP / max(float(np.abs(tangent).sum(axis=1).max()), 1e-12)
+    return [g.along(tangent) for g in probe.objective.groups(q, jacobian=True)], reach
