@@ -24,6 +24,7 @@ gain vanishes. Everything here is written for r redundancy variables (r = 1 for 
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -43,7 +44,15 @@ _ACCEPT = 0.1  # accepted steps gain this fraction of the model's gain
 _INITIAL_CURVATURE = 0.1  # B at the first QP of a climb
 _ANGLE_STEP = 1e-6  # rad: central differences of the arm angle along the null space
 _JOINT_STEP = 0.25  # rad: the trust radius keeps the linearised joint motion within this
-_OSQP = {"eps_abs": 1e-6, "eps_rel": 1e-6, "polish": True, "verbose": False}
+_FLAT = 1e-9  # slopes of the linearised pieces below this are rounding errors
+_OSQP = {
+    "eps_abs": 1e-6,
+    "eps_rel": 1e-6,
+    "polishing": True,
+    "rho": 1.0,
+    "verbose": False,
+    "raise_error": False,
+}
 
 
 def self_motion_tangent(solver: OMSolver, q: np.ndarray) -> np.ndarray:
@@ -107,7 +116,9 @@ def qp_step(groups: list[Group], curvature: np.ndarray, lower: np.ndarray, upper
         lower, upper: (r,) bounds of delta (trust region and interval).
 
     Returns:
-        The step, or None when OSQP finds no solution.
+        The step, or None when OSQP returns no iterate. OSQP's iterate is taken even when it
+        did not meet its tolerances (on nearly degenerate problems, at a kink the climb has
+        already reached): the climb checks every step exactly.
     """
     r, n_groups = len(lower), len(groups)
     reach = np.maximum(-lower, upper)
@@ -115,12 +126,15 @@ def qp_step(groups: list[Group], curvature: np.ndarray, lower: np.ndarray, upper
     for g in groups:
         change = np.abs(g.jacobian) @ reach
         keep.append(g.values - change <= (g.values + change).min())
-    # OSQP solves for u = delta / scale with every column of the rows scaled to a largest
-    # entry of 1: with slopes far from 1 (small near a flat optimum, large near a fold) the
-    # ADMM iteration otherwise stalls.
+    # OSQP solves for u = delta / scale with scale = sqrt(reach / largest slope) per
+    # variable: the box of u and the rows' entries then have the same size,
+    # sqrt(reach * slope). Slopes and trust radii far from 1 (a flat optimum, a fold, a tiny
+    # late step) otherwise stall its ADMM iteration. Slopes below _FLAT are rounding (a
+    # joint that the self-motion does not move, like the elbow of an S-R-S arm): scale = reach.
     slopes = np.vstack([g.jacobian[k] for g, k in zip(groups, keep, strict=True)])
     largest = np.abs(slopes).max(axis=0)
-    scale = 1.0 / np.where(largest > 0.0, largest, 1.0)
+    scale = np.where(largest > _FLAT, np.sqrt(reach / np.maximum(largest, _FLAT)), reach)
+    scale = np.where(scale > 0.0, scale, 1.0)
     rows = [
         np.hstack([-g.jacobian[k] * scale, np.tile(np.eye(n_groups)[i], (k.sum(), 1))])
         for i, (g, k) in enumerate(zip(groups, keep, strict=True))
@@ -136,8 +150,11 @@ def qp_step(groups: list[Group], curvature: np.ndarray, lower: np.ndarray, upper
         lb=np.concatenate([lower / scale, [g.floor for g in groups]]),
         ub=np.concatenate([upper / scale, [g.cap for g in groups]]),
     )
-    solution = qpsolvers.solve_problem(problem, solver="osqp", **_OSQP)
-    if not solution.found:
+    start = np.concatenate([np.zeros(r), [min(g.cap, g.values.min()) for g in groups]])  # delta = 0
+    with warnings.catch_warnings():  # an iterate that OSQP did not certify is still a proposal
+        warnings.filterwarnings("ignore", "OSQP exited with status", UserWarning)
+        solution = qpsolvers.solve_problem(problem, solver="osqp", initvals=start, **_OSQP)
+    if solution.x is None or not np.isfinite(solution.x).all():
         return None
     delta = solution.x[:r] * scale
     gain = _model(groups, delta) - 0.5 * delta @ curvature @ delta - _model(groups, np.zeros(r))

@@ -6,13 +6,15 @@ solutions (2-4 near a singular wrist or a straight elbow), so "the solution at p
 defined by continuation:
 
 * **Samples.** psi runs over a grid; each sample is the exact solution nearest the
-  previous sample's (``q_hint``). Two neighbouring samples lie on one *solution path* when
-  the joints move by at most :data:`JUMP` (max-norm) between them; a larger step means the
-  path ended (it folded back in psi, or left the branch or the reach) and the solver
-  returned another root, so the path breaks there. On the full circle the grid is first
-  solved in one parallel batch without hints (the solver then prefers a root within the
-  limits) and re-solved with the previous sample as hint wherever neighbours are further
-  apart than :data:`JUMP`.
+  previous sample's (``q_hint``). Neighbouring samples lie on one *solution path* when the
+  path can be followed from one to the other in steps that each move the joints by at most
+  :data:`JUMP` (max-norm); a step that moves them more is halved (near a singular shoulder
+  or wrist two joints turn fast), down to :data:`END_TOLERANCE`. Below that, the path has
+  ended (it folded back in psi, or left the branch or the reach) and the solver returned
+  another root: the path breaks there. On the full circle the grid is first solved in one
+  parallel batch without hints (the solver then prefers a root within the limits) and
+  followed from the previous sample wherever neighbours are further apart than
+  :data:`JUMP`.
 * **Feasible interval.** A maximal psi interval over which one solution path is exact,
   within the limits and clear: a run of feasible, linked samples, extended at each end to
   the boundary. Where the neighbouring sample is on the same path, the boundary is the
@@ -98,6 +100,23 @@ class Probe:
             return None
         return Point(psi, sol.q, self.objective.evaluate(sol.q))
 
+    def follow(self, start: Point, psi: float) -> Point | None:
+        """Continue start's solution path to psi, in steps that each move the joints by at
+        most :data:`JUMP`: a step that moves them more is halved (near a singular shoulder or
+        wrist the path turns two joints fast), and doubled again after a success. None if
+        the path ends on the way (the step falls below :data:`END_TOLERANCE`)."""
+        point, step = start, psi - start.psi
+        while point.psi != psi:
+            if abs(step) < END_TOLERANCE:
+                return None
+            x = psi if abs(psi - point.psi) <= abs(step) else point.psi + step
+            nxt = self.at(x, point.q)
+            if nxt is None:
+                step /= 2.0
+            else:
+                point, step = nxt, 2.0 * step
+        return point
+
 
 @dataclass(eq=False)
 class Samples:
@@ -136,33 +155,35 @@ def sweep_circle(
     sweeps = []
     for b, signs in enumerate(branches):
         rows = slice(b * n, (b + 1) * n)
-        q, ok = batch.q[rows].copy(), batch.ok[rows].copy()
+        q, ok = batch.q[rows], batch.ok[rows]
         probe = Probe(solver, objective, T, signs)
-        for k in range(1, n):  # continuation where neighbours are far apart
-            if ok[k - 1] and ok[k] and np.abs(q[k] - q[k - 1]).max() > JUMP:
-                sol = solver.solve(T, Configuration(signs, (psi[k],)), q_hint=q[k - 1])
-                if sol.ok:
-                    q[k] = sol.q
-        step = np.abs(q - np.roll(q, 1, axis=0)).max(axis=1)
-        linked = ok & np.roll(ok, 1) & (step <= JUMP)
-        points = [Point(psi[k], q[k], probe.objective.evaluate(q[k])) if ok[k] else None for k in range(n)]
+        points = [Point(psi[k], q[k], objective.evaluate(q[k])) if ok[k] else None for k in range(n)]
+        linked = np.zeros(n, dtype=bool)
+        for k in range(n):  # continuation where neighbours are far apart
+            before, here = points[k - 1], points[k]
+            if before is None or here is None:
+                continue
+            if np.abs(here.q - before.q).max() <= JUMP:
+                linked[k] = True
+            elif k > 0:  # (sample 0 is not replaced: the circle's seam stays unlinked)
+                followed = probe.follow(before, here.psi)
+                linked[k] = followed is not None
+                points[k] = followed or here
         sweeps.append(Samples(signs, psi, points, linked, cyclic=True))
     return sweeps
 
 
-def sweep_window(
-    probe: Probe, start: Point | None, center: float, hint: np.ndarray, half_width: float, n: int
-):
-    """Samples at center + half_width * j / n, j = -n..n, continued outwards from the
-    solution nearest ``hint`` at the centre (``start`` if already known). Each side stops
-    where the path breaks, so every sample found is on the hint's solution path."""
+def sweep_window(probe: Probe, center: float, hint: np.ndarray, half_width: float, n: int) -> Samples:
+    """Samples at center + half_width * j / n, j = -n..n, followed outwards from the
+    solution nearest ``hint`` at the centre. Each side stops where the path ends, so every
+    sample found is on the hint's solution path."""
     psi = center + half_width * np.arange(-n, n + 1) / n
     points: list[Point | None] = [None] * len(psi)
-    points[n] = start or probe.at(center, hint)
+    points[n] = probe.at(center, hint)
     for side in (1, -1):
         k = n
         while points[k] is not None and 0 <= k + side < len(psi):
-            points[k + side] = probe.at(psi[k + side], points[k].q)
+            points[k + side] = probe.follow(points[k], psi[k + side])
             k += side
     linked = np.array(
         [k > 0 and points[k] is not None and points[k - 1] is not None for k in range(len(psi))]
@@ -232,9 +253,9 @@ def refine_end(probe: Probe, inside: Point, psi_out: float, outside: Point | Non
     ``outside`` is the solution at psi_out on inside's path, if there is one. While the
     slack is known at both ends of the bracket the Illinois method (regula falsi that halves
     the slack kept at a stale end) moves the inner end; where the outer end has no solution
-    on the path, bisection. Every trial is continued from the inner end. It stops when the
-    bracket is narrower than :data:`END_TOLERANCE` or the inner slack below
-    :data:`SLACK_TOLERANCE`.
+    on the path, bisection. Every trial is followed from the inner end
+    (:meth:`Probe.follow`). It stops when the bracket is narrower than
+    :data:`END_TOLERANCE` or the inner slack below :data:`SLACK_TOLERANCE`.
     """
     a, fa = inside, inside.evaluation.slack
     b = psi_out
@@ -247,7 +268,7 @@ def refine_end(probe: Probe, inside: Point, psi_out: float, outside: Point | Non
             x = b - fb * (b - a.psi) / (fb - fa)
         else:
             x = 0.5 * (a.psi + b)
-        p = probe.at(x, a.q)
+        p = probe.follow(a, x)
         if p is not None and p.evaluation.feasible:
             a, fa = p, p.evaluation.slack
             fb, stale = (fb / 2.0 if stale == 1 else fb), 1

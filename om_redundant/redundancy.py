@@ -187,7 +187,7 @@ class RedundancyOptimizer:
     def _track(self, T: np.ndarray, previous: RedundancyChoice) -> RedundancyChoice:
         signs, (psi,) = previous.configuration.signs, previous.configuration.redundancy
         probe = self._probe(T, signs)
-        window = sweep_window(probe, None, psi, previous.solution.q, self.max_step, _WINDOW_POINTS)
+        window = sweep_window(probe, psi, previous.solution.q, self.max_step, _WINDOW_POINTS)
         runs = feasible_runs(probe, window)
         if runs:
             return self._result(T, self._climb_all(T, runs), runs)
