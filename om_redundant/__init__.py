@@ -7,7 +7,6 @@ from .clearance import Box as Box
 from .clearance import Capsule as Capsule
 from .clearance import Clearance as Clearance
 from .clearance import Sphere as Sphere
-from .climb import self_motion_tangent as self_motion_tangent
 from .configuration import Configuration as Configuration
 from .exceptions import ArmFileError as ArmFileError
 from .exceptions import InvalidInput as InvalidInput
@@ -28,6 +27,7 @@ from .objective import Objective as Objective
 from .objective import joint_margins as joint_margins
 from .redundancy import RedundancyChoice as RedundancyChoice
 from .redundancy import RedundancyOptimizer as RedundancyOptimizer
+from .self_motion import self_motion_tangent as self_motion_tangent
 from .solver import BatchSolution as BatchSolution
 from .solver import OMSolver as OMSolver
 from .solver import Solution as Solution

@@ -25,24 +25,20 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import qpsolvers
 import scipy.sparse as sp
 
-from .exceptions import InvalidInput
 from .intervals import Point, Probe
 from .objective import Group
-from .solver import OMSolver
-from .validation import as_joint_vector
 
 STEP_TOLERANCE = 1e-9  # rad: the climb stops when the step is this small
 GAIN_TOLERANCE = 1e-12  # the climb stops when the model promises no more
 _MAX_CLIMB = 60  # QPs per climb
 _ACCEPT = 0.1  # accepted steps gain this fraction of the model's gain
 _INITIAL_CURVATURE = 0.1  # B at the first QP of a climb
-_ANGLE_STEP = 1e-6  # rad: central differences of the arm angle along the null space
 _JOINT_STEP = 0.25  # rad: the trust radius keeps the linearised joint motion within this
 _FLAT = 1e-9  # slopes of the linearised pieces below this are rounding errors
 _OSQP = {
@@ -53,46 +49,6 @@ _OSQP = {
     "verbose": False,
     "raise_error": False,
 }
-
-
-def self_motion_tangent(solver: OMSolver, q: np.ndarray) -> np.ndarray:
-    r"""dq/dpsi: how the joints move per unit of the redundancy variables, hand fixed.
-
-    The self-motion keeps the hand still, :math:`J(q)\,\dot q = 0`, so
-    :math:`\dot q = N a` with N (dof x r) an orthonormal basis of the null space of the
-    real arm's Jacobian J (6 x dof; its last r right singular vectors). The redundancy
-    variables (the model's arm angle psi(q)) change by :math:`\dot\psi = D\psi(q)\,N a`, so
-
-    .. math::  \frac{dq}{d\psi} = N\,\big(D\psi(q)\,N\big)^{-1},
-
-    with :math:`D\psi\,N` (r x r) by central differences of psi(q) along the columns of N
-    (step 1e-6 rad; error about 1e-10). It is singular where psi stops changing along the
-    self-motion (a fold of the solution path).
-
-    Args:
-        solver: The solver of a redundant arm (r = dof - 6 redundancy variables).
-        q: (dof,) joint vector.
-
-    Returns:
-        (dof, r) matrix.
-    """
-    r = len(solver.redundancy_names)
-    if r == 0 or solver.arm.dof - 6 != r:
-        raise InvalidInput(
-            f"arm '{solver.arm.name}' has {solver.arm.dof - 6} self-motion directions and "
-            f"{r} redundancy variables; the tangent needs as many of each, at least one"
-        )
-    q = as_joint_vector(q, solver.arm.dof)
-    null = np.linalg.svd(solver.arm.jacobian(q))[2][6:].T
-    change = np.empty((r, r))
-    for c in range(r):
-        ahead = solver.configuration_of(q + _ANGLE_STEP * null[:, c]).redundancy
-        behind = solver.configuration_of(q - _ANGLE_STEP * null[:, c]).redundancy
-        change[:, c] = [
-            math.remainder(a - b, 2.0 * math.pi) / (2.0 * _ANGLE_STEP)
-            for a, b in zip(ahead, behind, strict=True)
-        ]
-    return np.linalg.solve(change.T, null.T).T
 
 
 @dataclass(frozen=True)
@@ -113,43 +69,18 @@ def qp_step(groups: list[Group], curvature: np.ndarray, lower: np.ndarray, upper
     Args:
         groups: Groups with jacobians (p_g, r) by the redundancy variables.
         curvature: B (r, r), positive definite.
-        lower, upper: (r,) bounds of delta (trust region and interval).
+        lower, upper: (r,) bounds of delta (trust region and interval), lower <= 0 <= upper.
 
     Returns:
         The step, or None when OSQP returns no iterate. OSQP's iterate is taken even when it
         did not meet its tolerances (on nearly degenerate problems, at a kink the climb has
         already reached): the climb checks every step exactly.
     """
-    r, n_groups = len(lower), len(groups)
+    r = len(lower)
     reach = np.maximum(-lower, upper)
-    keep = []
-    for g in groups:
-        change = np.abs(g.jacobian) @ reach
-        keep.append(g.values - change <= (g.values + change).min())
-    # OSQP solves for u = delta / scale with scale = sqrt(reach / largest slope) per
-    # variable: the box of u and the rows' entries then have the same size,
-    # sqrt(reach * slope). Slopes and trust radii far from 1 (a flat optimum, a fold, a tiny
-    # late step) otherwise stall its ADMM iteration. Slopes below _FLAT are rounding (a
-    # joint that the self-motion does not move, like the elbow of an S-R-S arm): scale = reach.
-    slopes = np.vstack([g.jacobian[k] for g, k in zip(groups, keep, strict=True)])
-    largest = np.abs(slopes).max(axis=0)
-    scale = np.where(largest > _FLAT, np.sqrt(reach / np.maximum(largest, _FLAT)), reach)
-    scale = np.where(scale > 0.0, scale, 1.0)
-    rows = [
-        np.hstack([-g.jacobian[k] * scale, np.tile(np.eye(n_groups)[i], (k.sum(), 1))])
-        for i, (g, k) in enumerate(zip(groups, keep, strict=True))
-    ]
-    P = sp.block_diag(
-        [sp.csc_matrix(curvature * np.outer(scale, scale)), sp.csc_matrix((n_groups, n_groups))]
-    )
-    problem = qpsolvers.Problem(
-        P.tocsc(),
-        np.concatenate([np.zeros(r), [-g.weight for g in groups]]),
-        sp.csc_matrix(np.vstack(rows)),
-        np.concatenate([g.values[k] for g, k in zip(groups, keep, strict=True)]),
-        lb=np.concatenate([lower / scale, [g.floor for g in groups]]),
-        ub=np.concatenate([upper / scale, [g.cap for g in groups]]),
-    )
+    keep = [_may_be_least(g, reach) for g in groups]
+    scale = _scale(np.vstack([g.jacobian[k] for g, k in zip(groups, keep, strict=True)]), reach)
+    problem = _problem(groups, keep, curvature, scale, lower, upper)
     start = np.concatenate([np.zeros(r), [min(g.cap, g.values.min()) for g in groups]])  # delta = 0
     with warnings.catch_warnings():  # an iterate that OSQP did not certify is still a proposal
         warnings.filterwarnings("ignore", "OSQP exited with status", UserWarning)
@@ -159,12 +90,53 @@ def qp_step(groups: list[Group], curvature: np.ndarray, lower: np.ndarray, upper
     delta = solution.x[:r] * scale
     gain = _model(groups, delta) - 0.5 * delta @ curvature @ delta - _model(groups, np.zeros(r))
     duals = np.split(np.maximum(solution.z, 0.0), np.cumsum([k.sum() for k in keep])[:-1])
-    multipliers = []
-    for g, k, z in zip(groups, keep, duals, strict=True):
-        full = np.zeros(len(g.values))
+    multipliers = [np.zeros(len(g.values)) for g in groups]
+    for full, k, z in zip(multipliers, keep, duals, strict=True):
         full[k] = z
-        multipliers.append(full)
     return _Step(delta, gain, multipliers)
+
+
+def _may_be_least(group: Group, reach: np.ndarray) -> np.ndarray:
+    """Which pieces can be the group's minimum somewhere in the box |delta_i| <= reach_i."""
+    change = np.abs(group.jacobian) @ reach
+    return group.values - change <= (group.values + change).min()
+
+
+def _scale(slopes: np.ndarray, reach: np.ndarray) -> np.ndarray:
+    """Per variable, OSQP solves for u = delta / scale, scale = sqrt(reach / largest slope):
+    the box of u and the rows' entries then have the same size, sqrt(reach * slope).
+    Slopes and trust radii far from 1 (a flat optimum, a fold, a tiny late step) otherwise
+    stall its ADMM iteration. Slopes below _FLAT are rounding (a joint that the self-motion
+    does not move, like the elbow of an S-R-S arm): then scale = reach."""
+    largest = np.abs(slopes).max(axis=0)
+    scale = np.where(largest > _FLAT, np.sqrt(reach / np.maximum(largest, _FLAT)), reach)
+    return np.where(scale > 0.0, scale, 1.0)
+
+
+def _problem(
+    groups: list[Group],
+    keep: list[np.ndarray],
+    curvature: np.ndarray,
+    scale: np.ndarray,
+    lower: np.ndarray,
+    upper: np.ndarray,
+) -> qpsolvers.Problem:
+    """The QP in x = (u, t): minimise 1/2 u^T S B S u - sum_g w_g t_g subject to
+    t_g - a_j^T S u <= v_j for the kept pieces, the box of u, floor_g <= t_g <= cap_g."""
+    n_groups = len(groups)
+    rows = [
+        np.hstack([-g.jacobian[k] * scale, np.tile(np.eye(n_groups)[i], (k.sum(), 1))])
+        for i, (g, k) in enumerate(zip(groups, keep, strict=True))
+    ]
+    P = sp.block_diag([curvature * np.outer(scale, scale), np.zeros((n_groups, n_groups))], format="csc")
+    return qpsolvers.Problem(
+        P,
+        np.concatenate([np.zeros(len(scale)), [-g.weight for g in groups]]),
+        sp.csc_matrix(np.vstack(rows)),
+        np.concatenate([g.values[k] for g, k in zip(groups, keep, strict=True)]),
+        lb=np.concatenate([lower / scale, [g.floor for g in groups]]),
+        ub=np.concatenate([upper / scale, [g.cap for g in groups]]),
+    )
 
 
 def _model(groups: list[Group], delta: np.ndarray) -> float:
@@ -202,16 +174,15 @@ def maximise(probe: Probe, start: Point, lower: float, upper: float, radius: flo
         The best feasible point found.
     """
     point, x = start, np.atleast_1d(start.psi).astype(float)
-    groups, reach = _linearised(probe, point.q)
-    if not groups:  # nothing to maximise: f is constant
+    if not point.groups:  # nothing to maximise: f is constant
         return start
     B = _INITIAL_CURVATURE * np.eye(len(x))
     for _ in range(_MAX_CLIMB):
-        radius = min(radius, reach)
+        radius = min(radius, _JOINT_STEP / max(float(np.abs(point.tangent).sum(axis=1).max()), 1e-12))
         if radius <= STEP_TOLERANCE:
             break
         lo = np.minimum(np.maximum(lower - x, -radius), 0.0)
-        step = qp_step(groups, B, lo, np.maximum(np.minimum(upper - x, radius), 0.0))
+        step = qp_step(point.groups, B, lo, np.maximum(np.minimum(upper - x, radius), 0.0))
         if step is None or np.abs(step.delta).max() <= STEP_TOLERANCE or step.gain <= GAIN_TOLERANCE:
             break
         size = np.abs(step.delta).max()
@@ -220,24 +191,16 @@ def maximise(probe: Probe, start: Point, lower: float, upper: float, radius: flo
         if trial is None or not trial.evaluation.feasible or gain < _ACCEPT * step.gain:
             radius = size / 4.0
             continue
-        new, new_reach = _linearised(probe, trial.q)
         y = -sum(
-            z @ (gn.jacobian - g.jacobian) for z, g, gn in zip(step.multipliers, groups, new, strict=True)
+            z @ (new.jacobian - old.jacobian)
+            for z, old, new in zip(step.multipliers, point.groups, trial.groups, strict=True)
         )
         B = _bfgs(B, step.delta, y)
         if gain > 0.75 * step.gain and size >= 0.9 * radius:
             radius *= 2.0
-        point, groups, reach, x = trial, new, new_reach, x + step.delta
-    return Point(_angle(x), point.q, point.evaluation)
+        point, x = trial, x + step.delta
+    return replace(point, psi=_angle(x))
 
 
 def _angle(x: np.ndarray) -> float | np.ndarray:
     return float(x[0]) if len(x) == 1 else x
-
-
-def _linearised(probe: Probe, q: np.ndarray) -> tuple[list[Group], float]:
-    """The groups at q with jacobians by psi, and the trust radius that keeps joints
-    within ``_JOINT_STEP``."""
-    tangent = self_motion_tangent(probe.solver, q)
-    reach = _JOINT_STEP / max(float(np.abs(tangent).sum(axis=1).max()), 1e-12)
-    return [g.along(tangent) for g in probe.objective.groups(q, jacobian=True)], reach

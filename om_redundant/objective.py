@@ -25,7 +25,7 @@ arm away from mid-range.
 Each term is a *group*: a weight w, a floor (the feasibility bound: 0 for M,
 :math:`d_{min}/d_{cap}` for the clearance), a cap (none for M, 1 for the clearance), and
 pieces :math:`v_j(q)` whose minimum it takes. The QP linearises every piece
-(:func:`~om_redundant.redundancy.maximise`).
+(:func:`~om_redundant.climb.maximise`).
 """
 
 from __future__ import annotations
@@ -57,7 +57,9 @@ def joint_margins(arm: Arm, q: np.ndarray) -> np.ndarray:
     return np.where(limited, np.minimum(*_limit_distances(q, arm.lower, arm.upper, half)), np.inf)
 
 
-def _limit_distances(q, lower, upper, half) -> tuple[np.ndarray, np.ndarray]:
+def _limit_distances(
+    q: np.ndarray, lower: np.ndarray, upper: np.ndarray, half: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """The two affine pieces of the margins, (q - l)/h and (u - q)/h."""
     return (q - lower) / half, (upper - q) / half
 
@@ -68,6 +70,7 @@ class Group:
     ``min_j values_j >= floor``.
 
     Attributes:
+        kind: ``"margin"`` or ``"clearance"``.
         weight: w >= 0.
         floor: Feasibility bound on the minimum.
         cap: Upper cap of the term (inf for none).
@@ -76,6 +79,7 @@ class Group:
             or None when not asked for.
     """
 
+    kind: str
     weight: float
     floor: float
     cap: float
@@ -88,9 +92,22 @@ class Group:
     def slack(self) -> float:
         return float(self.values.min()) - self.floor
 
+    def constraints(self) -> tuple[np.ndarray, np.ndarray]:
+        """The group's feasibility functions, >= 0 where feasible, and their derivatives
+        (by the first variable of the jacobian). A joint's two margin pieces count as one
+        function, the smaller: 1 - |q_i - c_i| / h_i about mid-range c_i, continuous also
+        where a revolute joint's angle is taken modulo 2 pi at the representative nearest c_i.
+        """
+        v, d = self.values - self.floor, self.jacobian[:, 0]
+        if self.kind != "margin":
+            return v, d
+        half = len(v) // 2
+        lower = v[:half] <= v[half:]
+        return np.where(lower, v[:half], v[half:]), np.where(lower, d[:half], d[half:])
+
     def along(self, tangent: np.ndarray) -> Group:
         """The same group with the jacobian chained through dq/dpsi = tangent (dof, r)."""
-        return Group(self.weight, self.floor, self.cap, self.values, self.jacobian @ tangent)
+        return Group(self.kind, self.weight, self.floor, self.cap, self.values, self.jacobian @ tangent)
 
 
 @dataclass(frozen=True)
@@ -166,25 +183,28 @@ class Objective:
 
     def evaluate(self, q: np.ndarray) -> Evaluation:
         """f(q), M(q), D(q) and the feasibility slack."""
-        q = as_joint_vector(q, self._dof)
-        margin = self._margin(q, False) if len(self._limited) else None
-        clearance = self._clearance(q, False) if self.clearance is not None else None
-        groups = [g for g in (margin, clearance) if g is not None]
+        return self.evaluation(self.groups(as_joint_vector(q, self._dof)))
+
+    def evaluation(self, groups: list[Group]) -> Evaluation:
+        """f, M, D and the slack from the groups at one joint vector."""
+        kinds = {g.kind: float(g.values.min()) for g in groups}
         return Evaluation(
             sum(g.term() for g in groups),
-            float(margin.values.min()) if margin else math.inf,
-            float(clearance.values.min()) * self.clearance_cap if clearance else math.inf,
+            kinds.get("margin", math.inf),
+            kinds.get("clearance", math.inf) * self.clearance_cap,
             min((g.slack() for g in groups), default=math.inf),
         )
 
     def _margin(self, q: np.ndarray, jacobian: bool) -> Group:
         lim = self._limited
         pieces = np.concatenate(_limit_distances(q[lim], self._lower, self._upper, self._half))
-        return Group(self.margin_weight, 0.0, math.inf, pieces, self._margin_jacobian if jacobian else None)
+        return Group(
+            "margin", self.margin_weight, 0.0, math.inf, pieces, self._margin_jacobian if jacobian else None
+        )
 
     def _clearance(self, q: np.ndarray, jacobian: bool) -> Group:
         cap, floor = self.clearance_cap, self.min_clearance / self.clearance_cap
         if jacobian:
             d, grad = self.clearance.distances_and_gradients(q)
-            return Group(self.clearance_weight, floor, 1.0, d / cap, grad / cap)
-        return Group(self.clearance_weight, floor, 1.0, self.clearance.distances(q) / cap)
+            return Group("clearance", self.clearance_weight, floor, 1.0, d / cap, grad / cap)
+        return Group("clearance", self.clearance_weight, floor, 1.0, self.clearance.distances(q) / cap)

@@ -33,7 +33,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from .clearance import Clearance, Shape
+from .clearance import DEFAULT_DISTMAX, Clearance, Shape
 from .climb import maximise
 from .configuration import Configuration
 from .exceptions import InvalidInput
@@ -116,7 +116,9 @@ class RedundancyOptimizer:
                 "the optimiser needs one (a 7-DOF arm's arm angle)"
             )
         if obstacles is not None and not isinstance(obstacles, Clearance):
-            obstacles = Clearance.for_arm(solver.arm, obstacles, distmax=max(1.0, 2.0 * clearance_cap))
+            obstacles = Clearance.for_arm(
+                solver.arm, obstacles, distmax=max(DEFAULT_DISTMAX, 2.0 * clearance_cap)
+            )
         self.solver = solver
         self.objective = Objective(
             solver.arm,
@@ -174,8 +176,8 @@ class RedundancyOptimizer:
         samples = sweep_circle(self.solver, self.objective, T, branches, self.grid_points)
         return [(s, feasible_runs(self._probe(T, b), s)) for s, b in zip(samples, branches, strict=True)]
 
-    def _probe(self, T: np.ndarray, signs: tuple[int, ...]) -> Probe:
-        return Probe(self.solver, self.objective, T, signs)
+    def _probe(self, T: np.ndarray, signs: tuple[int, ...], wrapped: bool = True) -> Probe:
+        return Probe(self.solver, self.objective, T, signs, wrapped)
 
     def _best_anywhere(self, T: np.ndarray, branches: list[tuple[int, ...]]) -> RedundancyChoice:
         swept = self._sweep(T, branches)
@@ -186,11 +188,11 @@ class RedundancyOptimizer:
 
     def _track(self, T: np.ndarray, previous: RedundancyChoice) -> RedundancyChoice:
         signs, (psi,) = previous.configuration.signs, previous.configuration.redundancy
-        probe = self._probe(T, signs)
+        probe = self._probe(T, signs, wrapped=False)  # the joints move continuously
         window = sweep_window(probe, psi, previous.solution.q, self.max_step, _WINDOW_POINTS)
         runs = feasible_runs(probe, window)
         if runs:
-            return self._result(T, self._climb_all(T, runs), runs)
+            return self._result(T, self._climb_all(T, runs, wrapped=False), runs)
         ((samples, branch_runs),) = self._sweep(T, [signs])
         if branch_runs:
             where = ", ".join(f"[{r.interval.lo:+.3f}, {r.interval.hi:+.3f}]" for r in branch_runs)
@@ -206,7 +208,7 @@ class RedundancyOptimizer:
             return replace(choice, reason=f"{why}; {choice.reason}")
         return replace(choice, branch_flipped=True, reason=f"{why}; switched to {choice.configuration.signs}")
 
-    def _climb_all(self, T: np.ndarray, runs: list[Run]) -> tuple[Run, Point]:
+    def _climb_all(self, T: np.ndarray, runs: list[Run], wrapped: bool = True) -> tuple[Run, Point]:
         """The global maximum over the runs: climbs from the best starts (module docstring)."""
         slope = 0.0
         starts = []
@@ -225,7 +227,7 @@ class RedundancyOptimizer:
             if value + 2.0 * slope * gap < best.evaluation.value:
                 continue
             lo, hi = (-math.inf, math.inf) if run.interval.closed else (run.interval.lo, run.interval.hi)
-            point = maximise(self._probe(T, run.interval.signs), start, lo, hi, max(gap, 1e-6))
+            point = maximise(self._probe(T, run.interval.signs, wrapped), start, lo, hi, max(gap, 1e-6))
             if point.evaluation.value > best.evaluation.value:
                 best_run, best = run, point
         return best_run, best
