@@ -31,8 +31,8 @@ import numpy as np
 import qpsolvers
 import scipy.sparse as sp
 
-from .intervals import Point, Probe
 from .objective import Group
+from .paths import Point, Probe
 
 STEP_TOLERANCE = 1e-9  # rad: the climb stops when the step is this small
 GAIN_TOLERANCE = 1e-12  # the climb stops when the model promises no more

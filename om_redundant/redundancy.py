@@ -37,8 +37,9 @@ from .clearance import DEFAULT_DISTMAX, Clearance, Shape
 from .climb import maximise
 from .configuration import Configuration
 from .exceptions import InvalidInput
-from .intervals import Point, Probe, PsiInterval, Run, Samples, feasible_runs, sweep_circle, sweep_window
+from .intervals import PsiInterval, Run, feasible_runs
 from .objective import Objective
+from .paths import Path, Point, Probe, sweep_circle, sweep_window
 from .solver import OMSolver, Solution
 from .validation import as_pose, as_signs
 
@@ -145,7 +146,7 @@ class RedundancyOptimizer:
     def intervals(self, T: Any) -> list[PsiInterval]:
         """The feasible psi intervals of every allowed branch at pose T."""
         T = as_pose(T)
-        return [run.interval for _, runs in self._sweep(T, self.branches) for run in runs]
+        return [run.interval for _, _, runs in self._sweep(T, self.branches) for run in runs]
 
     def choose(self, T: Any, previous: RedundancyChoice | None = None) -> RedundancyChoice:
         """The best configuration for pose T, or with ``previous`` the best near it.
@@ -172,28 +173,35 @@ class RedundancyOptimizer:
 
     # -----------------------------------------------------------------------------------
 
-    def _sweep(self, T: np.ndarray, branches: list[tuple[int, ...]]) -> list[tuple[Samples, list[Run]]]:
-        samples = sweep_circle(self.solver, self.objective, T, branches, self.grid_points)
-        return [(s, feasible_runs(self._probe(T, b), s)) for s, b in zip(samples, branches, strict=True)]
+    def _sweep(
+        self, T: np.ndarray, branches: list[tuple[int, ...]]
+    ) -> list[tuple[tuple[int, ...], list[Path], list[Run]]]:
+        """Every branch's solution paths and feasible runs."""
+        swept = sweep_circle(self.solver, self.objective, T, branches, self.grid_points)
+        return [
+            (signs, paths, [run for path in paths for run in feasible_runs(self._probe(T, signs), path)])
+            for signs, paths in zip(branches, swept, strict=True)
+        ]
 
     def _probe(self, T: np.ndarray, signs: tuple[int, ...], wrapped: bool = True) -> Probe:
         return Probe(self.solver, self.objective, T, signs, wrapped)
 
     def _best_anywhere(self, T: np.ndarray, branches: list[tuple[int, ...]]) -> RedundancyChoice:
         swept = self._sweep(T, branches)
-        runs = [run for _, branch_runs in swept for run in branch_runs]
+        runs = [run for _, _, branch_runs in swept for run in branch_runs]
         if not runs:
-            return _failure((), "no feasible arm angle: " + "; ".join(self._why(s) for s, _ in swept))
+            why = "; ".join(self._why(signs, paths) for signs, paths, _ in swept)
+            return _failure((), f"no feasible arm angle: {why}")
         return self._result(T, self._climb_all(T, runs), runs)
 
     def _track(self, T: np.ndarray, previous: RedundancyChoice) -> RedundancyChoice:
         signs, (psi,) = previous.configuration.signs, previous.configuration.redundancy
         probe = self._probe(T, signs, wrapped=False)  # the joints move continuously
         window = sweep_window(probe, psi, previous.solution.q, self.max_step, _WINDOW_POINTS)
-        runs = feasible_runs(probe, window)
+        runs = [run for path in window for run in feasible_runs(probe, path)]
         if runs:
             return self._result(T, self._climb_all(T, runs, wrapped=False), runs)
-        ((samples, branch_runs),) = self._sweep(T, [signs])
+        ((_, paths, branch_runs),) = self._sweep(T, [signs])
         if branch_runs:
             where = ", ".join(f"[{r.interval.lo:+.3f}, {r.interval.hi:+.3f}]" for r in branch_runs)
             return _failure(
@@ -203,7 +211,7 @@ class RedundancyOptimizer:
             )
         others = [b for b in self.branches if b != signs]
         choice = self._best_anywhere(T, others) if others else _failure((), "no other branch is allowed")
-        why = f"branch {signs} has no feasible psi at this pose ({self._why(samples)})"
+        why = f"branch {signs} has no feasible psi at this pose ({self._why(signs, paths)})"
         if not choice.ok:
             return replace(choice, reason=f"{why}; {choice.reason}")
         return replace(choice, branch_flipped=True, reason=f"{why}; switched to {choice.configuration.signs}")
@@ -242,19 +250,18 @@ class RedundancyOptimizer:
             True, configuration, solution, ev.margin, ev.clearance, ev.value, tuple(r.interval for r in runs)
         )
 
-    def _why(self, samples: Samples) -> str:
-        """Why a branch's samples hold nothing feasible."""
-        points = [p for p in samples.points if p is not None]
-        name = f"branch {samples.signs}"
+    def _why(self, signs: tuple[int, ...], paths: list[Path]) -> str:
+        """Why a branch's solution paths hold nothing feasible."""
+        points = [p for path in paths for p in path.points]
         if not points:
-            return f"{name}: no solution at any of {len(samples.psi)} arm angles"
+            return f"branch {signs}: no solution at any of {self.grid_points} arm angles"
         within = [p for p in points if p.evaluation.margin >= 0.0]
         if not within:
             best = max(p.evaluation.margin for p in points)
-            return f"{name}: outside the joint limits wherever solved (best margin {best:.3f})"
+            return f"branch {signs}: outside the joint limits wherever solved (best margin {best:.3f})"
         best = max(p.evaluation.clearance for p in within)
         return (
-            f"{name}: clearance below {self.objective.min_clearance} m wherever within the limits "
+            f"branch {signs}: clearance below {self.objective.min_clearance} m wherever within the limits "
             f"(best {best:.4f} m)"
         )
 
