@@ -40,7 +40,7 @@ import numpy as np
 from .configuration import Configuration
 from .objective import Evaluation, Group, Objective
 from .self_motion import self_motion_tangent
-from .solver import OMSolver
+from .solver import OMSolver, Solution
 
 JUMP = 1.0  # rad, max-norm joint step between neighbouring solutions of one path
 END_TOLERANCE = 1e-9  # rad: a path whose following step falls below this has ended
@@ -65,6 +65,8 @@ class Point:
         evaluation: The objective at q.
         groups: The objective's groups at q, their jacobians by psi (p_g, r).
         tangent: dq/dpsi (dof, r).
+        solution: The solver's Solution of it, when solved singly (its q may differ from
+            ``q`` by turns of revolute joints); None for a batch sample.
     """
 
     psi: float | np.ndarray
@@ -72,6 +74,7 @@ class Point:
     evaluation: Evaluation
     groups: list[Group]
     tangent: np.ndarray
+    solution: Solution | None = None
 
     def pieces(self) -> tuple[np.ndarray, np.ndarray]:
         """The feasibility functions g_j (all >= 0 iff feasible; see
@@ -127,12 +130,12 @@ class Probe:
         d = b - a
         return float(np.abs(np.where(self._cyclic, _wrap(d), d)).max())
 
-    def point(self, psi: float | np.ndarray, q: np.ndarray) -> Point:
+    def point(self, psi: float | np.ndarray, q: np.ndarray, solution: Solution | None = None) -> Point:
         """The point of solution q at psi, q at its representative (see the class)."""
         q = np.where(self._centred, self._centre + _wrap(q - self._centre), q)
         tangent = self_motion_tangent(self.solver, q)
         groups = [g.along(tangent) for g in self.objective.groups(q, jacobian=True)]
-        return Point(psi, q, self.objective.evaluation(groups), groups, tangent)
+        return Point(psi, q, self.objective.evaluation(groups), groups, tangent, solution)
 
     def at(self, psi: float | np.ndarray, hint: np.ndarray) -> Point | None:
         """The solution at psi nearest ``hint``; None if none exists or it is more than
@@ -140,12 +143,12 @@ class Probe:
         sol = self.solver.solve(self.T, Configuration(self.signs, tuple(np.atleast_1d(psi))), q_hint=hint)
         if not sol.ok or self.step(hint, sol.q) > JUMP:
             return None
-        return self.point(psi, sol.q)
+        return self.point(psi, sol.q, sol)
 
     def all_at(self, psi: float) -> list[Point]:
         """Every solution at psi (the solver's bounded search)."""
         configuration = Configuration(self.signs, (psi,))
-        return [self.point(psi, s.q) for s in self.solver.solve_all(self.T, configuration)]
+        return [self.point(psi, s.q, s) for s in self.solver.solve_all(self.T, configuration)]
 
     def follow(self, start: Point, psi: float) -> tuple[Point, bool]:
         """Continue start's path towards psi (module docstring).

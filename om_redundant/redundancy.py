@@ -244,10 +244,29 @@ class RedundancyOptimizer:
         run, point = best
         psi = math.remainder(point.psi, 2.0 * math.pi)
         configuration = Configuration(run.interval.signs, (-math.pi if psi >= math.pi else psi,))
-        solution = self.solver.solve(T, configuration, q_hint=point.q)
-        ev = self.objective.evaluate(solution.q)
+        # The point's own solve (a batch sample is solved again, nearest itself), at the
+        # point's representative of the joints: where psi has several roots near a singular
+        # wrist, a fresh solve might return another one.
+        solution = point.solution or self.solver.solve(T, configuration, q_hint=point.q)
+        if not solution.ok:
+            return _failure(
+                tuple(r.interval for r in runs), f"the exact solve at the chosen psi: {solution.status}"
+            )
+        solution = replace(
+            solution,
+            q=point.q,
+            configuration=configuration,
+            within_limits=self.solver.arm.within_limits(point.q),
+        )
+        ev = point.evaluation
         return RedundancyChoice(
-            True, configuration, solution, ev.margin, ev.clearance, ev.value, tuple(r.interval for r in runs)
+            solution.ok,
+            configuration,
+            solution,
+            ev.margin,
+            ev.clearance,
+            ev.value,
+            tuple(r.interval for r in runs),
         )
 
     def _why(self, signs: tuple[int, ...], paths: list[Path]) -> str:

@@ -151,9 +151,14 @@ def assert_intervals_match(intervals, sweep):
         near_end = np.array([len(ends) > 0 and np.abs(wrap(p - ends)).min() <= DENSE_STEP for p in psi])
         disagree = (inside != feasible) & ~near_end
         assert not disagree.any(), (signs, psi[disagree][:5], mine)
-        for end in ends:  # each end sits on a change of the dense sweep's feasibility
+        # Each end sits on a change of the dense sweep's feasibility, unless another interval
+        # covers it (two solution paths) or another end is within a dense step (a dip or an
+        # island narrower than the dense step).
+        for end in ends:
             k = int(np.floor((wrap(end) + math.pi) / DENSE_STEP)) % DENSE
-            assert feasible[k] != feasible[(k + 1) % DENSE], (signs, end)
+            covered = sum(i.contains(end) for i in mine) > 1
+            narrow = np.sort(np.abs(wrap(ends - end)))[1] <= DENSE_STEP if len(ends) > 1 else False
+            assert covered or narrow or feasible[k] != feasible[(k + 1) % DENSE], (signs, end)
 
 
 def test_a_sphere_at_the_elbow_of_psi_zero_is_avoided_exactly(panda):
