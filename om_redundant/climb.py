@@ -186,7 +186,7 @@ def maximise(probe: Probe, start: Point, lower: float, upper: float, radius: flo
         if step is None or np.abs(step.delta).max() <= STEP_TOLERANCE or step.gain <= GAIN_TOLERANCE:
             break
         size = np.abs(step.delta).max()
-        trial = probe.at(_angle(x + step.delta), point.q)
+        trial = probe.next(point, _angle(x + step.delta))
         gain = trial.evaluation.value - point.evaluation.value if trial is not None else -math.inf
         if trial is None or not trial.evaluation.feasible or gain < _ACCEPT * step.gain:
             radius = size / 4.0

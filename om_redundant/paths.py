@@ -5,9 +5,10 @@ One (signs, psi) can have several exact solutions (2-4 near a singular wrist or 
 elbow), so the solutions of a branch are organised as *paths*:
 
 * **Following.** From a solution, the next one is the solution nearest it (``q_hint``),
-  accepted when no joint moves more than :data:`JUMP` (max-norm); a step that moves them
-  more is halved (near a singular shoulder or wrist two joints turn fast), and doubled again
-  after a success (:meth:`Probe.follow`). Below :data:`END_TOLERANCE` the path has *ended*:
+  accepted when it continues the path (:meth:`Probe.continues`: no joint moves more than
+  :data:`JUMP`, and the joints move as the path's tangent predicts); a step that fails is
+  halved (near a singular shoulder or wrist two joints turn fast), and doubled again after
+  a success (:meth:`Probe.follow`). Below :data:`END_TOLERANCE` the path has *ended*:
   it folded back in psi (meeting a second path there), or left the branch or the reach.
   For the feasible intervals, revolute joints are compared modulo 2 pi and each solution is
   taken at the representative nearest mid-range (the solver's within-limits one, if any):
@@ -127,8 +128,11 @@ class Probe:
 
     def step(self, a: np.ndarray, b: np.ndarray) -> float:
         """The largest joint step between joint vectors a and b."""
+        return float(np.abs(self._delta(a, b)).max())
+
+    def _delta(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         d = b - a
-        return float(np.abs(np.where(self._cyclic, _wrap(d), d)).max())
+        return np.where(self._cyclic, _wrap(d), d)
 
     def point(self, psi: float | np.ndarray, q: np.ndarray, solution: Solution | None = None) -> Point:
         """The point of solution q at psi, q at its representative (see the class)."""
@@ -138,12 +142,24 @@ class Probe:
         return Point(psi, q, self.objective.evaluation(groups), groups, tangent, solution)
 
     def at(self, psi: float | np.ndarray, hint: np.ndarray) -> Point | None:
-        """The solution at psi nearest ``hint``; None if none exists or it is more than
-        :data:`JUMP` away from the hint (another solution path)."""
+        """The solution at psi nearest ``hint``, if there is one."""
         sol = self.solver.solve(self.T, Configuration(self.signs, tuple(np.atleast_1d(psi))), q_hint=hint)
-        if not sol.ok or self.step(hint, sol.q) > JUMP:
-            return None
-        return self.point(psi, sol.q, sol)
+        return self.point(psi, sol.q, sol) if sol.ok else None
+
+    def continues(self, point: Point, other: Point) -> bool:
+        r"""Whether ``other`` continues point's path: its joints moved at most :data:`JUMP` and
+        as the path's tangent predicts to first order,
+        :math:`|\Delta q - (dq/d\psi)\,\Delta\psi|_\infty \le \frac12 |\Delta q|_\infty`. (A
+        solution on another path, however near, is off by the paths' separation, which no
+        shorter step of psi shrinks.)"""
+        moved = self._delta(point.q, other.q)
+        error = moved - point.tangent @ np.atleast_1d(other.psi - point.psi)
+        return np.abs(moved).max() <= JUMP and np.abs(error).max() <= 0.5 * np.abs(moved).max() + _SAME
+
+    def next(self, point: Point, psi: float | np.ndarray) -> Point | None:
+        """The solution at psi nearest point, if it continues point's path."""
+        nxt = self.at(psi, point.q)
+        return nxt if nxt is not None and self.continues(point, nxt) else None
 
     def all_at(self, psi: float) -> list[Point]:
         """Every solution at psi (the solver's bounded search)."""
@@ -162,7 +178,7 @@ class Probe:
             if abs(step) < END_TOLERANCE:
                 return point, False
             x = psi if abs(psi - point.psi) <= abs(step) else point.psi + step
-            nxt = self.at(x, point.q)
+            nxt = self.next(point, x)
             if nxt is None:
                 step /= 2.0
             else:
@@ -200,7 +216,7 @@ def sweep_window(probe: Probe, center: float, hint: np.ndarray, half_width: floa
     """The path through the solution nearest ``hint`` at the centre, followed outwards
     through center + half_width * j / n, j = -n..n, to the window's edges or its ends."""
     start = probe.at(center, hint)
-    if start is None:
+    if start is None or probe.step(hint, start.q) > JUMP:
         return []
     halves, edges = [], []
     for side in (-1, 1):
@@ -227,8 +243,8 @@ def _link(probe: Probe, psi: np.ndarray, roots: list[list[Point]]) -> list[Path]
         taken = [False] * len(roots[k])
         reaching = []
         for i in ongoing:
-            if len(roots[k]) == 1 and probe.step(paths[i][-1].q, roots[k][0].q) <= JUMP:
-                reached, arrived = roots[k][0], True  # the only solution, and near: no search
+            if len(roots[k]) == 1 and probe.continues(paths[i][-1], roots[k][0]):
+                reached, arrived = roots[k][0], True  # the only solution, and it continues the path
             else:
                 reached, arrived = probe.follow(paths[i][-1], psi[k])
             if not arrived:
