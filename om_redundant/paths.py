@@ -161,11 +161,6 @@ class Probe:
         nxt = self.at(psi, point.q)
         return nxt if nxt is not None and self.continues(point, nxt) else None
 
-    def all_at(self, psi: float) -> list[Point]:
-        """Every solution at psi (the solver's bounded search)."""
-        configuration = Configuration(self.signs, (psi,))
-        return [self.point(psi, s.q, s) for s in self.solver.solve_all(self.T, configuration)]
-
     def follow(self, start: Point, psi: float) -> tuple[Point, bool]:
         """Continue start's path towards psi (module docstring).
 
@@ -204,9 +199,10 @@ def sweep_circle(
         roots = []
         for k, row in enumerate(range(b * n, (b + 1) * n)):
             found = [probe.point(psi[k], batch.q[row])] if batch.ok[row] else []
-            for p in probe.all_at(psi[k]) if found and several else []:
-                if all(probe.step(p.q, f.q) > _SAME for f in found):
-                    found.append(p)
+            others = solver.solve_all(T, Configuration(signs, (psi[k],))) if found and several else []
+            for sol in others:
+                if all(probe.step(sol.q, f.q) > _SAME for f in found):
+                    found.append(probe.point(psi[k], sol.q, sol))
             roots.append(found)
         swept.append([_with_hidden(probe, path) for path in _link(probe, psi, roots)])
     return swept
