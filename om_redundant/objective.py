@@ -5,7 +5,9 @@ Joint-limit margin of joint i (limited joints only), normalised by half its rang
 
 .. math::  m_i(q) = \min(q_i - l_i,\ u_i - q_i) / h_i,
 
-1 at mid-range, 0 on a limit, negative beyond it; :math:`M(q) = \min_i m_i(q)`. Each
+1 at mid-range, 0 on a limit, negative beyond it; :math:`M(q) = \min_i m_i(q)`. (The
+optimiser takes each revolute joint at its turn nearest mid-range, which has the most
+margin; :mod:`om_redundant.paths`.) Each
 :math:`m_i` is the minimum of two functions affine in q, :math:`(q_i - l_i)/h_i` and
 :math:`(u_i - q_i)/h_i`, so M is the minimum of ``2 * limited`` affine pieces.
 
@@ -32,6 +34,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -62,6 +65,29 @@ def _limit_distances(
 ) -> tuple[np.ndarray, np.ndarray]:
     """The two affine pieces of the margins, (q - l)/h and (u - q)/h."""
     return (q - lower) / half, (upper - q) / half
+
+
+def check_weights(margin_weight: Any, clearance_weight: Any, clearance_cap: Any, min_clearance: Any) -> None:
+    """Raise InvalidInput naming the first of the objective's numbers that is out of range."""
+    for name, value in (("margin_weight", margin_weight), ("clearance_weight", clearance_weight)):
+        if not _number(value, name) >= 0.0:
+            raise InvalidInput(f"{name} must be a finite number >= 0, got {value}")
+    if not _number(clearance_cap, "clearance_cap") > 0.0:
+        raise InvalidInput(f"clearance_cap must be a positive number of metres, got {clearance_cap}")
+    if not 0.0 <= _number(min_clearance, "min_clearance") < clearance_cap:
+        raise InvalidInput(
+            f"min_clearance must be >= 0 and below clearance_cap ({clearance_cap} m), got {min_clearance}"
+        )
+
+
+def _number(value: Any, name: str) -> float:
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise InvalidInput(f"{name} must be a number, got {value!r}") from None
+    if not math.isfinite(number):
+        raise InvalidInput(f"{name} must be finite, got {value!r}")
+    return number
 
 
 @dataclass(frozen=True)
@@ -153,15 +179,7 @@ class Objective:
         clearance_cap: float = 0.1,
         min_clearance: float = 0.0,
     ):
-        for name, value in (("margin_weight", margin_weight), ("clearance_weight", clearance_weight)):
-            if not (math.isfinite(value) and value >= 0.0):
-                raise InvalidInput(f"{name} must be a finite number >= 0, got {value}")
-        if not (math.isfinite(clearance_cap) and clearance_cap > 0.0):
-            raise InvalidInput(f"clearance_cap must be a positive number of metres, got {clearance_cap}")
-        if not (math.isfinite(min_clearance) and 0.0 <= min_clearance < clearance_cap):
-            raise InvalidInput(
-                f"min_clearance must be >= 0 and below clearance_cap ({clearance_cap} m), got {min_clearance}"
-            )
+        check_weights(margin_weight, clearance_weight, clearance_cap, min_clearance)
         if clearance is not None and clearance.distmax < clearance_cap:
             raise InvalidInput(
                 f"the clearance's distmax ({clearance.distmax} m) is below clearance_cap ({clearance_cap} m)"

@@ -5,8 +5,9 @@ c = (signs, psi) that maximises the objective f of :mod:`om_redundant.objective`
 normalised joint-limit margin and capped obstacle clearance) over the feasible set (within
 the limits, clearance >= d_min), and the exact OM solution in it:
 
-1. **Sweep.** Every allowed branch is sampled on a psi grid and cut into feasible
-   intervals with refined ends (:mod:`om_redundant.intervals`).
+1. **Sweep.** Every allowed branch's exact solutions are sampled on a psi grid and linked
+   into solution paths (:mod:`om_redundant.paths`), which are cut into feasible intervals
+   with refined ends (:mod:`om_redundant.intervals`).
 2. **Starts.** In each interval, the samples that are local maxima of f. With L the largest
    slope of f between neighbouring samples (times 2) and h a start's distance to its
    neighbours, a start can only lead above ``f_start + L h``; starts are climbed best
@@ -14,7 +15,7 @@ the limits, clearance >= d_min), and the exact OM solution in it:
    finds the global optimum rather than the nearest local one.
 3. **Climb** from each start (:func:`~om_redundant.climb.maximise`): a trust-region SQP
    whose QP, solved by OSQP, linearises margins and clearances around the current exact
-   solution, within the interval; then one exact solve in the chosen configuration.
+   solution, within the interval. The result is the best point's own exact solve.
 
 **Tracking** (``choose(T, previous)``): the previous branch only, psi within ``max_step``
 of the previous psi, every solution continued from the previous joints. The branch is left
@@ -38,7 +39,7 @@ from .climb import maximise
 from .configuration import Configuration
 from .exceptions import InvalidInput
 from .intervals import PsiInterval, Run, feasible_runs
-from .objective import Objective
+from .objective import Objective, check_weights
 from .paths import Path, Point, Probe, sweep_circle, sweep_window
 from .solver import OMSolver, Solution
 from .validation import as_pose, as_signs
@@ -116,10 +117,10 @@ class RedundancyOptimizer:
                 f"arm '{solver.arm.name}' has {len(solver.redundancy_names)} redundancy variables; "
                 "the optimiser needs one (a 7-DOF arm's arm angle)"
             )
+        check_weights(margin_weight, clearance_weight, clearance_cap, min_clearance)
         if obstacles is not None and not isinstance(obstacles, Clearance):
-            obstacles = Clearance.for_arm(
-                solver.arm, obstacles, distmax=max(DEFAULT_DISTMAX, 2.0 * clearance_cap)
-            )
+            distmax = max(DEFAULT_DISTMAX, 2.0 * clearance_cap)
+            obstacles = Clearance.for_arm(solver.arm, obstacles, distmax=distmax)
         self.solver = solver
         self.objective = Objective(
             solver.arm,
@@ -135,8 +136,6 @@ class RedundancyOptimizer:
         else:
             signs = as_signs(branches, len(solver.sign_names), "branches").reshape(-1, len(solver.sign_names))
             self.branches = list(dict.fromkeys(tuple(int(s) for s in row) for row in signs))
-            if not self.branches:
-                raise InvalidInput("branches is empty")
         if int(grid_points) < 16:
             raise InvalidInput(f"grid_points must be at least 16, got {grid_points}")
         if not (math.isfinite(max_step) and 0.0 < max_step <= math.pi):
