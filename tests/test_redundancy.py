@@ -89,8 +89,9 @@ def brute_force_optimum(optimizer, T, sweep, candidates=4):
 
 
 def agreement_cases():
-    """(arm, seed): random poses of the Panda and the iiwa14."""
-    return [("panda", 1), ("panda", 2), ("iiwa14", 1), ("iiwa14", 2)]
+    """(arm, seed, obstacle): random poses of the Panda and the iiwa14; with ``obstacle``, a
+    sphere of radius 6 cm at the elbow of the pose's own joints and 2 cm required clearance."""
+    return [(arm, seed, seed == 3) for arm in ("panda", "iiwa14") for seed in (1, 2, 3)]
 
 
 @pytest.fixture(scope="module")
@@ -98,7 +99,7 @@ def swept(panda, iiwa14):
     """Optimiser, pose, choice and dense sweep per case, computed once for two tests."""
     solvers, cache = {"panda": panda, "iiwa14": iiwa14}, {}
 
-    def get(arm, seed):
+    def get(arm, seed, obstacle):
         if (arm, seed) not in cache:
             solver = solvers[arm]
             q = random_q(solver.arm, 1, np.random.default_rng(seed))[0]
@@ -108,19 +109,31 @@ def swept(panda, iiwa14):
             # so its sweep keeps the pose's own WRIST sign. The iiwa14 sweeps all 8 branches.
             wrist = solver.configuration_of(q).signs[2]
             branches = [c.signs for c in solver.configurations() if arm != "panda" or c.signs[2] == wrist]
-            optimizer = om.RedundancyOptimizer(solver, branches=branches)
+            spheres = [om.Sphere(elbow(solver, q), 0.06)] if obstacle else None
+            optimizer = om.RedundancyOptimizer(
+                solver, spheres, branches=branches, min_clearance=0.02 * obstacle
+            )
             cache[arm, seed] = optimizer, T, optimizer.choose(T), dense_sweep(optimizer, T)
         return cache[arm, seed]
 
     return get
 
 
+def elbow(solver, q):
+    """The origin of link4 (the elbow joint) at joints q, by the project's MuJoCo model."""
+    model = om.arm_model(solver.arm)
+    data = mujoco.MjData(model)
+    data.qpos[:] = q
+    mujoco.mj_kinematics(model, data)
+    return data.body("link4").xpos.copy()
+
+
 # -- the must-show items ---------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("arm, seed", agreement_cases())
-def test_qp_optimum_matches_a_dense_brute_force_sweep(swept, arm, seed):
-    optimizer, T, choice, sweep = swept(arm, seed)
+@pytest.mark.parametrize("arm, seed, obstacle", agreement_cases())
+def test_qp_optimum_matches_a_dense_brute_force_sweep(swept, arm, seed, obstacle):
+    optimizer, T, choice, sweep = swept(arm, seed, obstacle)
     assert choice.ok, choice.reason
     assert exact(optimizer.solver, choice.solution.q, T)
     assert optimizer.solver.configuration_of(choice.solution.q).isclose(choice.configuration)
@@ -133,12 +146,12 @@ def test_qp_optimum_matches_a_dense_brute_force_sweep(swept, arm, seed):
     assert same_point or abs(choice.value - value) < 1e-6, (choice, value, signs, psi)
 
 
-@pytest.mark.parametrize("arm, seed", agreement_cases())
-def test_feasible_intervals_agree_with_the_dense_sweep(swept, arm, seed):
+@pytest.mark.parametrize("arm, seed, obstacle", agreement_cases())
+def test_feasible_intervals_agree_with_the_dense_sweep(swept, arm, seed, obstacle):
     """Each dense psi is feasible exactly when it lies in an interval of its branch, except
     within one dense step of an interval's end; so the ends are refined far below the
     optimiser's own grid (2 pi / 64)."""
-    _, _, choice, sweep = swept(arm, seed)
+    _, _, choice, sweep = swept(arm, seed, obstacle)
     assert choice.intervals
     assert_intervals_match(choice.intervals, sweep)
 
@@ -170,11 +183,7 @@ def test_a_sphere_at_the_elbow_of_psi_zero_is_avoided_exactly(panda):
         blocked = panda.solve(T, om.Configuration(panda.configuration_of(q).signs, (0.0,)))
         if blocked.ok and blocked.within_limits:
             break
-    model = om.arm_model(panda.arm)
-    data = mujoco.MjData(model)
-    data.qpos[:] = blocked.q
-    mujoco.mj_kinematics(model, data)
-    sphere = om.Sphere(data.body("link4").xpos.copy(), 0.06, name="ball")
+    sphere = om.Sphere(elbow(panda, blocked.q), 0.06, name="ball")
     required = 0.03
     optimizer = om.RedundancyOptimizer(panda, [sphere], min_clearance=required)
     assert optimizer.objective.clearance.minimum(blocked.q) < 0.0  # psi = 0 collides
