@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -93,14 +93,12 @@ class Path:
     Attributes:
         points: The samples.
         turns: For a loop, the number of turns of psi after which it closes; 0 if it does
-            not close.
-        edges: Whether the first and the last sample are at the edge of the swept range (a
-            bound); otherwise the path ends there (to :data:`END_TOLERANCE`).
+            not close: then its first and last samples are where it ends (to
+            :data:`END_TOLERANCE`) or the edges of the swept window.
     """
 
     points: list[Point]
     turns: int = 0
-    edges: tuple[bool, bool] = field(default=(False, False))
 
 
 class Probe:
@@ -214,9 +212,9 @@ def sweep_window(probe: Probe, center: float, hint: np.ndarray, half_width: floa
     start = probe.at(center, hint)
     if start is None or probe.step(hint, start.q) > JUMP:
         return []
-    halves, edges = [], []
+    halves = []
     for side in (-1, 1):
-        points, arrived = [start], True
+        points = [start]
         for j in range(1, n + 1):
             reached, arrived = probe.follow(points[-1], center + side * half_width * j / n)
             if reached is not points[-1]:
@@ -224,8 +222,7 @@ def sweep_window(probe: Probe, center: float, hint: np.ndarray, half_width: floa
             if not arrived:
                 break
         halves.append(points[1:])
-        edges.append(arrived)
-    path = Path(halves[0][::-1] + [start] + halves[1], edges=(edges[0], edges[1]))
+    path = Path(halves[0][::-1] + [start] + halves[1])
     return [_with_hidden(probe, path)]
 
 
@@ -316,7 +313,7 @@ def _with_hidden(probe: Probe, path: Path) -> Path:
     filled = [ends[0]]
     for a, b in itertools.pairwise(ends):
         filled += [*_hidden(probe, a, b), b]
-    return Path(filled[:-1] if path.turns else filled, path.turns, path.edges)
+    return Path(filled[:-1] if path.turns else filled, path.turns)
 
 
 def _hidden(probe: Probe, a: Point, b: Point) -> list[Point]:
