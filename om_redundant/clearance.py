@@ -1,0 +1,327 @@
+r"""Obstacle clearance of an arm, computed by MuJoCo.
+
+The clearance of joint vector q is the smallest signed distance between the arm's collision
+geoms and the obstacle geoms,
+
+.. math::  D(q) = \min_k d_k(q), \qquad d_k(q) = \mathrm{dist}\big(A_k(q), O_k\big),
+
+over the pairs k of (arm geom :math:`A_k`, obstacle geom :math:`O_k`), each computed by
+``mujoco.mj_geomDistance`` (negative when the geoms overlap, capped at ``distmax``). With
+:math:`p_A, p_O` the nearest points and :math:`n_k = (p_O - p_A)/d_k` the unit direction
+from the arm geom to the obstacle (the division by the signed distance keeps it pointing
+that way when the geoms overlap), moving the arm point by :math:`dp` changes the distance
+by :math:`-n_k \cdot dp`, so
+
+.. math::  \frac{\partial d_k}{\partial q} = -n_k^T J_p(p_A),
+
+with :math:`J_p` the translational Jacobian of the arm geom's body at :math:`p_A`
+(``mujoco.mj_jac``). A pair farther apart than ``distmax`` reports ``distmax`` with a zero
+gradient.
+
+Obstacles come three ways: simple shapes (:class:`Sphere`, :class:`Capsule`, :class:`Box`)
+or the primitive geoms of a MuJoCo model, placed in the arm's root frame and combined with
+the project's MJCF of the arm (:meth:`Clearance.for_arm`); or geoms named in the user's own
+MuJoCo model that contains the arm, its joints found by name with an optional prefix
+(:class:`Clearance`). The arm's collision geoms are the geoms with a non-zero ``contype`` or
+``conaffinity`` on the bodies that the arm's joints move.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import mujoco
+import numpy as np
+
+from .arm import Arm
+from .exceptions import InvalidInput
+from .mjcf import arm_mjcf
+from .validation import as_joint_vector, as_pose
+
+DEFAULT_DISTMAX = 1.0  # m: pairs farther apart report this distance
+
+_PRIMITIVES = {
+    mujoco.mjtGeom.mjGEOM_PLANE,
+    mujoco.mjtGeom.mjGEOM_SPHERE,
+    mujoco.mjtGeom.mjGEOM_CAPSULE,
+    mujoco.mjtGeom.mjGEOM_ELLIPSOID,
+    mujoco.mjtGeom.mjGEOM_CYLINDER,
+    mujoco.mjtGeom.mjGEOM_BOX,
+}
+
+
+@dataclass(frozen=True)
+class _Geom:
+    """A world geom to add to a MuJoCo spec: type, size, position, quaternion (w, x, y, z)."""
+
+    name: str
+    type: mujoco.mjtGeom
+    size: np.ndarray
+    pos: np.ndarray
+    quat: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class Sphere:
+    """A sphere obstacle, in the arm's root frame (metres).
+
+    Attributes:
+        center: (3,) centre.
+        radius: Radius, > 0.
+        name: Geom name; default ``"obstacle<k>"`` for the k-th obstacle.
+    """
+
+    center: Any
+    radius: float
+    name: str = ""
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "center", _point(self.center, "Sphere center"))
+        object.__setattr__(self, "radius", _positive(self.radius, "Sphere radius"))
+
+    def _geom(self, name: str) -> _Geom:
+        size = np.array([self.radius, 0.0, 0.0])
+        return _Geom(name, mujoco.mjtGeom.mjGEOM_SPHERE, size, self.center, np.array([1.0, 0, 0, 0]))
+
+
+@dataclass(frozen=True, eq=False)
+class Capsule:
+    """A capsule obstacle: the points within ``radius`` of the segment ``start``-``end``.
+
+    Attributes:
+        start, end: (3,) ends of the axis in the arm's root frame, distinct.
+        radius: Radius, > 0.
+        name: Geom name; default ``"obstacle<k>"``.
+    """
+
+    start: Any
+    end: Any
+    radius: float
+    name: str = ""
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "start", _point(self.start, "Capsule start"))
+        object.__setattr__(self, "end", _point(self.end, "Capsule end"))
+        object.__setattr__(self, "radius", _positive(self.radius, "Capsule radius"))
+        if np.linalg.norm(self.end - self.start) == 0.0:
+            raise InvalidInput("Capsule start and end coincide; use a Sphere")
+
+    def _geom(self, name: str) -> _Geom:
+        axis = self.end - self.start
+        quat = np.empty(4)
+        mujoco.mju_quatZ2Vec(quat, axis)
+        size = np.array([self.radius, np.linalg.norm(axis) / 2.0, 0.0])
+        return _Geom(name, mujoco.mjtGeom.mjGEOM_CAPSULE, size, (self.start + self.end) / 2.0, quat)
+
+
+@dataclass(frozen=True, eq=False)
+class Box:
+    """A box obstacle.
+
+    Attributes:
+        half_sizes: (3,) half edge lengths along the box's own axes, each > 0.
+        pose: Pose of the box centre in the arm's root frame: 4x4 or ``mink.SE3``.
+        name: Geom name; default ``"obstacle<k>"``.
+    """
+
+    half_sizes: Any
+    pose: Any = field(default_factory=lambda: np.eye(4))
+    name: str = ""
+
+    def __post_init__(self) -> None:
+        half = _point(self.half_sizes, "Box half_sizes")
+        if not (half > 0.0).all():
+            raise InvalidInput(f"Box half_sizes must be positive, got {half.tolist()}")
+        object.__setattr__(self, "half_sizes", half)
+        object.__setattr__(self, "pose", as_pose(self.pose, "Box pose"))
+
+    def _geom(self, name: str) -> _Geom:
+        quat = np.empty(4)
+        mujoco.mju_mat2Quat(quat, np.ascontiguousarray(self.pose[:3, :3]).ravel())
+        return _Geom(name, mujoco.mjtGeom.mjGEOM_BOX, self.half_sizes, self.pose[:3, 3], quat)
+
+
+Shape = Sphere | Capsule | Box
+
+
+class Clearance:
+    """Signed distances between an arm's collision geoms and obstacle geoms (module docstring).
+
+    Args:
+        model: A MuJoCo model holding the arm and the obstacles, e.g. the user's scene.
+        arm: The arm; its joints are found in the model as ``prefix + joint name``.
+        obstacle_geoms: Names of the obstacle geoms in the model.
+        prefix: Prepended to the arm's joint names.
+        distmax: Pairs farther apart than this (m) report ``distmax``.
+
+    Raises:
+        InvalidInput: a joint or geom is missing, a joint's type differs from the arm's, an
+            obstacle geom moves with the arm, no obstacle is given, or distmax is not positive.
+
+    Example::
+
+        clearance = om.Clearance.for_arm(arm, [om.Sphere([0.5, 0.0, 0.4], 0.05)])
+        clearance.minimum(q)  # metres
+    """
+
+    def __init__(
+        self,
+        model: mujoco.MjModel,
+        arm: Arm,
+        obstacle_geoms: Sequence[str],
+        *,
+        prefix: str = "",
+        distmax: float = DEFAULT_DISTMAX,
+    ):
+        self.model, self.arm, self._dof = model, arm, arm.dof
+        self.distmax = _positive(distmax, "distmax")
+        self._data = mujoco.MjData(model)
+        joints = [_find(model, mujoco.mjtObj.mjOBJ_JOINT, prefix + name, "joint") for name in arm.joint_names]
+        for j, revolute in zip(joints, arm.revolute, strict=True):
+            expected = mujoco.mjtJoint.mjJNT_HINGE if revolute else mujoco.mjtJoint.mjJNT_SLIDE
+            if model.jnt_type[j] != expected:
+                raise InvalidInput(f"joint '{model.joint(j).name}' is not a {expected.name} joint")
+        self._qpos = model.jnt_qposadr[joints]
+        self._dofs = model.jnt_dofadr[joints]
+        moving = _subtree(model, model.jnt_bodyid[joints[0]])
+        arm_geoms = [
+            g
+            for g in range(model.ngeom)
+            if moving[model.geom_bodyid[g]] and (model.geom_contype[g] or model.geom_conaffinity[g])
+        ]
+        if not obstacle_geoms:
+            raise InvalidInput("no obstacle geoms given")
+        obstacles = [_find(model, mujoco.mjtObj.mjOBJ_GEOM, name, "geom") for name in obstacle_geoms]
+        for o in obstacles:
+            if moving[model.geom_bodyid[o]]:
+                raise InvalidInput(f"obstacle geom '{model.geom(o).name}' moves with the arm")
+        self._pairs = np.array([(a, o) for a in arm_geoms for o in obstacles], dtype=np.int64).reshape(-1, 2)
+        self.pairs: tuple[tuple[str, str], ...] = tuple(
+            (model.geom(a).name, model.geom(o).name) for a, o in self._pairs
+        )
+
+    @classmethod
+    def for_arm(
+        cls,
+        arm: Arm,
+        obstacles: Sequence[Shape] | mujoco.MjModel,
+        *,
+        radius: float | None = None,
+        distmax: float = DEFAULT_DISTMAX,
+    ) -> Clearance:
+        """The project's MJCF of the arm (:func:`~om_redundant.arm_mjcf`) with obstacles added.
+
+        Args:
+            arm: The arm; its root frame is the model's world frame.
+            obstacles: Shapes, or a MuJoCo model whose primitive geoms (plane, sphere,
+                capsule, ellipsoid, cylinder, box), as placed at its ``qpos0``, are the obstacles.
+            radius: Capsule radius of the arm's MJCF (default: :func:`~om_redundant.arm_mjcf`'s).
+            distmax: As in :class:`Clearance`.
+        """
+        geoms = _model_geoms(obstacles) if isinstance(obstacles, mujoco.MjModel) else _shape_geoms(obstacles)
+        spec = mujoco.MjSpec.from_string(arm_mjcf(arm, radius=radius))
+        taken = {g.name for g in spec.geoms}
+        for g in geoms:
+            if g.name in taken:
+                raise InvalidInput(f"obstacle name '{g.name}' is already taken")
+            taken.add(g.name)
+            spec.worldbody.add_geom(name=g.name, type=g.type, size=g.size, pos=g.pos, quat=g.quat)
+        return cls(spec.compile(), arm, [g.name for g in geoms], distmax=distmax)
+
+    def distances(self, q: np.ndarray) -> np.ndarray:
+        """Signed distance d_k(q) of every pair (m), in the order of :attr:`pairs`."""
+        return self._evaluate(q, gradient=False)[0]
+
+    def minimum(self, q: np.ndarray) -> float:
+        """The clearance D(q) = min_k d_k(q) in metres."""
+        return float(self.distances(q).min())
+
+    def distances_and_gradients(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """d_k(q) (P,) and their gradients dd_k/dq (P, dof) (module docstring)."""
+        return self._evaluate(q, gradient=True)
+
+    def _evaluate(self, q: np.ndarray, gradient: bool) -> tuple[np.ndarray, np.ndarray]:
+        q = as_joint_vector(q, self._dof)
+        if q.ndim != 1:
+            raise InvalidInput("Clearance takes one joint vector")
+        m, d = self.model, self._data
+        d.qpos[self._qpos] = q
+        mujoco.mj_kinematics(m, d)
+        if gradient:
+            mujoco.mj_comPos(m, d)
+        dist = np.empty(len(self._pairs))
+        grad = np.zeros((len(self._pairs), self._dof))
+        fromto, jacp = np.zeros(6), np.zeros((3, m.nv))
+        for k, (a, o) in enumerate(self._pairs):
+            dist[k] = mujoco.mj_geomDistance(m, d, a, o, self.distmax, fromto)
+            if gradient and dist[k] < self.distmax and dist[k] != 0.0:
+                normal = (fromto[3:] - fromto[:3]) / dist[k]
+                mujoco.mj_jac(m, d, jacp, None, fromto[:3], m.geom_bodyid[a])
+                grad[k] = -normal @ jacp[:, self._dofs]
+        return dist, grad
+
+
+def _shape_geoms(obstacles: Sequence[Shape]) -> list[_Geom]:
+    if isinstance(obstacles, Sphere | Capsule | Box):
+        obstacles = [obstacles]
+    geoms = []
+    for k, shape in enumerate(obstacles):
+        if not isinstance(shape, Sphere | Capsule | Box):
+            raise InvalidInput(
+                f"obstacle {k} must be a Sphere, Capsule or Box (or pass a MuJoCo model), "
+                f"got {type(shape).__name__}"
+            )
+        geoms.append(shape._geom(shape.name or f"obstacle{k}"))
+    return geoms
+
+
+def _model_geoms(model: mujoco.MjModel) -> list[_Geom]:
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    geoms = []
+    for g in range(model.ngeom):
+        kind = mujoco.mjtGeom(model.geom_type[g])
+        name = model.geom(g).name or f"obstacle{g}"
+        if kind not in _PRIMITIVES:
+            raise InvalidInput(
+                f"obstacle geom '{name}' is a {kind.name[7:].lower()}; only primitive geoms are copied "
+                "(for others, put the arm in your model and use Clearance(model, arm, names))"
+            )
+        quat = np.empty(4)
+        mujoco.mju_mat2Quat(quat, data.geom_xmat[g])
+        geoms.append(_Geom(name, kind, model.geom_size[g].copy(), data.geom_xpos[g].copy(), quat))
+    return geoms
+
+
+def _find(model: mujoco.MjModel, kind: mujoco.mjtObj, name: str, what: str) -> int:
+    index = mujoco.mj_name2id(model, kind, name)
+    if index < 0:
+        raise InvalidInput(f"the MuJoCo model has no {what} named '{name}'")
+    return index
+
+
+def _subtree(model: mujoco.MjModel, root: int) -> np.ndarray:
+    """Whether each body is ``root`` or one of its descendants."""
+    inside = np.zeros(model.nbody, dtype=bool)
+    for b in range(model.nbody):  # parents come before their children
+        inside[b] = b == root or (b > 0 and inside[model.body_parentid[b]])
+    return inside
+
+
+def _point(value: Any, name: str) -> np.ndarray:
+    point = np.asarray(value, dtype=np.float64)
+    if point.shape != (3,) or not np.isfinite(point).all():
+        raise InvalidInput(f"{name} must be 3 finite numbers, got {value!r}")
+    return point
+
+
+def _positive(value: Any, name: str) -> float:
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise InvalidInput(f"{name} must be a positive number, got {value!r}") from None
+    if not (np.isfinite(number) and number > 0.0):
+        raise InvalidInput(f"{name} must be a positive finite number, got {value!r}")
+    return number

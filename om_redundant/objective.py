@@ -1,0 +1,228 @@
+r"""What the redundancy optimiser maximises: joint-limit margin and obstacle clearance.
+
+Joint-limit margin of joint i (limited joints only), normalised by half its range
+:math:`h_i = (u_i - l_i)/2`:
+
+.. math::  m_i(q) = \min(q_i - l_i,\ u_i - q_i) / h_i,
+
+1 at mid-range, 0 on a limit, negative beyond it; :math:`M(q) = \min_i m_i(q)`. (The
+optimiser takes each revolute joint at its turn nearest mid-range, which has the most
+margin; :mod:`om_redundant.paths`.) Each
+:math:`m_i` is the minimum of two functions affine in q, :math:`(q_i - l_i)/h_i` and
+:math:`(u_i - q_i)/h_i`, so M is the minimum of ``2 * limited`` affine pieces.
+
+Clearance :math:`D(q) = \min_k d_k(q)` (:mod:`om_redundant.clearance`), capped at
+:math:`d_{cap}` and normalised by it.
+
+The objective, maximised over the redundancy variables, with weights :math:`w_m, w_c \ge 0`:
+
+.. math::  f(q) = w_m\, M(q) + w_c \min\big(1,\ D(q)/d_{cap}\big),
+
+and q is feasible when it is within the limits and clear: :math:`M(q) \ge 0` and
+:math:`D(q) \ge d_{min}`. Both terms are dimensionless in [0, 1] on the feasible set, so the
+weights trade them directly: with the defaults, 1 cm of clearance below the cap of 0.1 m is
+worth 0.1 of normalised margin. Capping the clearance stops far obstacles from pulling the
+arm away from mid-range.
+
+Each term is a *group*: a weight w, a floor (the feasibility bound: 0 for M,
+:math:`d_{min}/d_{cap}` for the clearance), a cap (none for M, 1 for the clearance), and
+pieces :math:`v_j(q)` whose minimum it takes. The QP linearises every piece
+(:func:`~om_redundant.climb.maximise`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .arm import Arm
+from .clearance import Clearance
+from .exceptions import InvalidInput
+from .validation import as_joint_vector
+
+
+def joint_margins(arm: Arm, q: np.ndarray) -> np.ndarray:
+    """Normalised joint-limit margins m_i(q) (module docstring); +inf for unlimited joints.
+
+    Args:
+        arm: The arm.
+        q: (dof,) or (M, dof) joint vectors.
+
+    Returns:
+        Margins of the same shape as q: 1 at mid-range, 0 on a limit, negative beyond.
+    """
+    q = as_joint_vector(q, arm.dof)
+    limited = np.isfinite(arm.lower) & np.isfinite(arm.upper)
+    half = np.where(limited, (arm.upper - arm.lower) / 2.0, 1.0)
+    return np.where(limited, np.minimum(*_limit_distances(q, arm.lower, arm.upper, half)), np.inf)
+
+
+def _limit_distances(
+    q: np.ndarray, lower: np.ndarray, upper: np.ndarray, half: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """The two affine pieces of the margins, (q - l)/h and (u - q)/h."""
+    return (q - lower) / half, (upper - q) / half
+
+
+def check_weights(margin_weight: Any, clearance_weight: Any, clearance_cap: Any, min_clearance: Any) -> None:
+    """Raise InvalidInput naming the first of the objective's numbers that is out of range."""
+    for name, value in (("margin_weight", margin_weight), ("clearance_weight", clearance_weight)):
+        if not _number(value, name) >= 0.0:
+            raise InvalidInput(f"{name} must be a finite number >= 0, got {value}")
+    if not _number(clearance_cap, "clearance_cap") > 0.0:
+        raise InvalidInput(f"clearance_cap must be a positive number of metres, got {clearance_cap}")
+    if not 0.0 <= _number(min_clearance, "min_clearance") < clearance_cap:
+        raise InvalidInput(
+            f"min_clearance must be >= 0 and below clearance_cap ({clearance_cap} m), got {min_clearance}"
+        )
+
+
+def _number(value: Any, name: str) -> float:
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise InvalidInput(f"{name} must be a number, got {value!r}") from None
+    if not math.isfinite(number):
+        raise InvalidInput(f"{name} must be finite, got {value!r}")
+    return number
+
+
+@dataclass(frozen=True)
+class Group:
+    """One term of the objective: ``weight * min(cap, min_j values_j)``, feasible if
+    ``min_j values_j >= floor``.
+
+    Attributes:
+        kind: ``"margin"`` or ``"clearance"``.
+        weight: w >= 0.
+        floor: Feasibility bound on the minimum.
+        cap: Upper cap of the term (inf for none).
+        values: (p,) the pieces v_j.
+        jacobian: (p, n) their derivatives by n variables (q, or the redundancy variables),
+            or None when not asked for.
+    """
+
+    kind: str
+    weight: float
+    floor: float
+    cap: float
+    values: np.ndarray
+    jacobian: np.ndarray | None = None
+
+    def term(self) -> float:
+        return self.weight * min(self.cap, float(self.values.min()))
+
+    def slack(self) -> float:
+        return float(self.values.min()) - self.floor
+
+    def constraints(self) -> tuple[np.ndarray, np.ndarray]:
+        """The group's feasibility functions, >= 0 where feasible, and their derivatives
+        (by the first variable of the jacobian). A joint's two margin pieces count as one
+        function, the smaller: 1 - |q_i - c_i| / h_i about mid-range c_i, continuous also
+        where a revolute joint's angle is taken modulo 2 pi at the representative nearest c_i.
+        """
+        v, d = self.values - self.floor, self.jacobian[:, 0]
+        if self.kind != "margin":
+            return v, d
+        half = len(v) // 2
+        lower = v[:half] <= v[half:]
+        return np.where(lower, v[:half], v[half:]), np.where(lower, d[:half], d[half:])
+
+    def along(self, tangent: np.ndarray) -> Group:
+        """The same group with the jacobian chained through dq/dpsi = tangent (dof, r)."""
+        return Group(self.kind, self.weight, self.floor, self.cap, self.values, self.jacobian @ tangent)
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """The objective at one joint vector.
+
+    Attributes:
+        value: f(q).
+        margin: M(q), the smallest normalised joint-limit margin (inf if no joint is limited).
+        clearance: D(q) in metres (inf without obstacles).
+        slack: The smallest of M(q) and (D(q) - d_min) / d_cap; q is feasible iff >= 0.
+    """
+
+    value: float
+    margin: float
+    clearance: float
+    slack: float
+
+    @property
+    def feasible(self) -> bool:
+        return self.slack >= 0.0
+
+
+class Objective:
+    """The objective f and the feasibility test of the module docstring.
+
+    Args:
+        arm: The arm.
+        clearance: Obstacle distances, or None for no obstacles.
+        margin_weight: w_m >= 0.
+        clearance_weight: w_c >= 0 (ignored without obstacles).
+        clearance_cap: d_cap > 0 (m): clearance beyond it earns nothing more.
+        min_clearance: d_min (m), 0 <= d_min < d_cap: the clearance every choice must keep.
+    """
+
+    def __init__(
+        self,
+        arm: Arm,
+        clearance: Clearance | None = None,
+        *,
+        margin_weight: float = 1.0,
+        clearance_weight: float = 1.0,
+        clearance_cap: float = 0.1,
+        min_clearance: float = 0.0,
+    ):
+        check_weights(margin_weight, clearance_weight, clearance_cap, min_clearance)
+        if clearance is not None and clearance.distmax < clearance_cap:
+            raise InvalidInput(
+                f"the clearance's distmax ({clearance.distmax} m) is below clearance_cap ({clearance_cap} m)"
+            )
+        self.arm, self.clearance, self._dof = arm, clearance, arm.dof
+        self.margin_weight, self.clearance_weight = float(margin_weight), float(clearance_weight)
+        self.clearance_cap, self.min_clearance = float(clearance_cap), float(min_clearance)
+        self._limited = np.flatnonzero(np.isfinite(arm.lower) & np.isfinite(arm.upper))
+        self._lower, self._upper = arm.lower[self._limited], arm.upper[self._limited]
+        self._half = (self._upper - self._lower) / 2.0
+        eye = np.eye(self._dof)[self._limited] / self._half[:, None]
+        self._margin_jacobian = np.vstack([eye, -eye])  # pieces (q - l)/h, then (u - q)/h
+
+    def groups(self, q: np.ndarray, jacobian: bool = False) -> list[Group]:
+        """The groups at q (module docstring): margin (if any joint is limited), then
+        clearance (if there are obstacles); their jacobians by q if asked."""
+        groups = [self._margin(q, jacobian)] if len(self._limited) else []
+        return groups + ([self._clearance(q, jacobian)] if self.clearance is not None else [])
+
+    def evaluate(self, q: np.ndarray) -> Evaluation:
+        """f(q), M(q), D(q) and the feasibility slack."""
+        return self.evaluation(self.groups(as_joint_vector(q, self._dof)))
+
+    def evaluation(self, groups: list[Group]) -> Evaluation:
+        """f, M, D and the slack from the groups at one joint vector."""
+        kinds = {g.kind: float(g.values.min()) for g in groups}
+        return Evaluation(
+            sum(g.term() for g in groups),
+            kinds.get("margin", math.inf),
+            kinds.get("clearance", math.inf) * self.clearance_cap,
+            min((g.slack() for g in groups), default=math.inf),
+        )
+
+    def _margin(self, q: np.ndarray, jacobian: bool) -> Group:
+        lim = self._limited
+        pieces = np.concatenate(_limit_distances(q[lim], self._lower, self._upper, self._half))
+        return Group(
+            "margin", self.margin_weight, 0.0, math.inf, pieces, self._margin_jacobian if jacobian else None
+        )
+
+    def _clearance(self, q: np.ndarray, jacobian: bool) -> Group:
+        cap, floor = self.clearance_cap, self.min_clearance / self.clearance_cap
+        if jacobian:
+            d, grad = self.clearance.distances_and_gradients(q)
+            return Group("clearance", self.clearance_weight, floor, 1.0, d / cap, grad / cap)
+        return Group("clearance", self.clearance_weight, floor, 1.0, self.clearance.distances(q) / cap)

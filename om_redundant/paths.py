@@ -1,0 +1,353 @@
+r"""Solution paths of a branch: the exact solutions of one pose and one set of branch signs,
+followed continuously in the arm angle psi.
+
+One (signs, psi) can have several exact solutions (2-4 near a singular wrist or a straight
+elbow), so the solutions of a branch are organised as *paths*:
+
+* **Following.** From a solution, the next one is the solution nearest it (``q_hint``),
+  accepted when it continues the path (:meth:`Probe.continues`: no joint moves more than
+  :data:`JUMP`, and the joints move as the path's tangent predicts); a step that fails is
+  halved (near a singular shoulder or wrist two joints turn fast), and doubled again after
+  a success (:meth:`Probe.follow`). Below :data:`END_TOLERANCE` the path has *ended*:
+  it folded back in psi (meeting a second path there), or left the branch or the reach.
+  For the feasible intervals, revolute joints are compared modulo 2 pi and each solution is
+  taken at the representative nearest mid-range (the solver's within-limits one, if any):
+  feasibility is that of the arm's pose, not of one unwrapped joint vector. Tracking
+  compares the joints as they are (the path the joints can move along).
+* **Sweep** (:func:`sweep_circle`). The branch is solved on a psi grid in one parallel
+  batch without hints; where the model can have several solutions per psi (an offset
+  model, ``dp_max > 0``) :meth:`~om_redundant.OMSolver.solve_all` adds the others at every
+  grid psi that has one. Each solution is followed to the next grid psi and linked to the
+  solution it arrives at; solutions not arrived at start new paths, followed backwards to
+  where they end; paths are joined across +-pi, and close into loops.
+* **Cells.** Between neighbouring samples of a path where a joint moves more than
+  :data:`FINE_STEP`, samples are inserted. Every sample carries its feasibility functions
+  :math:`g_j` (each joint's margin, each clearance minus d_min, normalised; feasible iff all
+  :math:`g_j \ge 0`) and their rates :math:`dg_j/d\psi` (through dq/dpsi); between
+  neighbours each :math:`g_j` is modelled by the cubic Hermite interpolant of those values
+  and rates, and where the models predict a feasible island or an infeasible dip that the
+  two samples do not show (two limits pinching, a joint turning through a limit), an exact
+  sample is inserted there, and the cell is checked again.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from .configuration import Configuration
+from .objective import Evaluation, Group, Objective
+from .self_motion import self_motion_tangent
+from .solver import OMSolver, Solution
+
+JUMP = 1.0  # rad, max-norm joint step between neighbouring solutions of one path
+END_TOLERANCE = 1e-9  # rad: a path whose following step falls below this has ended
+FINE_STEP = 0.25  # rad: cells in which a joint moves further get samples in between
+_SAME = 1e-6  # rad, max-norm: two solutions at one psi this close are one
+_MODEL_POINTS = 256  # points of a cell where the Hermite models are checked
+_MAX_INSERTED = 64  # exact samples inserted per cell
+_T = np.arange(1, _MODEL_POINTS + 1) / (_MODEL_POINTS + 1)
+_HERMITE = np.array(
+    [2 * _T**3 - 3 * _T**2 + 1, _T**3 - 2 * _T**2 + _T, -2 * _T**3 + 3 * _T**2, _T**3 - _T**2]
+)
+_TURN = 2.0 * math.pi
+
+
+@dataclass(frozen=True, eq=False)
+class Point:
+    """An exact solution on a branch, its objective, and their rates along psi.
+
+    Attributes:
+        psi: The redundancy value (rad); an (r,) array for r > 1 redundancy variables.
+        q: The joints.
+        evaluation: The objective at q.
+        groups: The objective's groups at q, their jacobians by psi (p_g, r).
+        tangent: dq/dpsi (dof, r).
+        solution: The solver's Solution of it, when solved singly (its q may differ from
+            ``q`` by turns of revolute joints); None for a batch sample.
+    """
+
+    psi: float | np.ndarray
+    q: np.ndarray
+    evaluation: Evaluation
+    groups: list[Group]
+    tangent: np.ndarray
+    solution: Solution | None = None
+
+    def pieces(self) -> tuple[np.ndarray, np.ndarray]:
+        """The feasibility functions g_j (all >= 0 iff feasible; see
+        :meth:`~om_redundant.objective.Group.constraints`) and dg_j/dpsi."""
+        if not self.groups:
+            return np.zeros(0), np.zeros(0)
+        g, dg = zip(*(group.constraints() for group in self.groups), strict=True)
+        return np.concatenate(g), np.concatenate(dg)
+
+
+@dataclass(eq=False)
+class Path:
+    """One solution path of a branch, its samples in increasing psi (unwrapped).
+
+    Attributes:
+        points: The samples.
+        turns: For a loop, the number of turns of psi after which it closes; 0 if it does
+            not close: then its first and last samples are where it ends (to
+            :data:`END_TOLERANCE`) or the edges of the swept window.
+    """
+
+    points: list[Point]
+    turns: int = 0
+
+
+class Probe:
+    """Exact solutions along one branch at one pose, and their objective.
+
+    Args:
+        solver, objective, T, signs: The solver, the objective, the pose and the branch.
+        wrapped: Revolute joints modulo 2 pi, at the representative nearest mid-range (for
+            the feasible intervals); False keeps them as solved (for tracking).
+    """
+
+    def __init__(
+        self,
+        solver: OMSolver,
+        objective: Objective,
+        T: np.ndarray,
+        signs: tuple[int, ...],
+        wrapped: bool = True,
+    ):
+        self.solver, self.objective, self.T, self.signs = solver, objective, T, signs
+        arm = solver.arm
+        self._cyclic = arm.revolute & wrapped
+        self._centred = self._cyclic & np.isfinite(arm.lower) & np.isfinite(arm.upper)
+        self._centre = np.where(self._centred, (arm.lower + arm.upper) / 2.0, 0.0)
+
+    def step(self, a: np.ndarray, b: np.ndarray) -> float:
+        """The largest joint step between joint vectors a and b."""
+        return float(np.abs(self._delta(a, b)).max())
+
+    def _delta(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        d = b - a
+        return np.where(self._cyclic, _wrap(d), d)
+
+    def point(self, psi: float | np.ndarray, q: np.ndarray, solution: Solution | None = None) -> Point:
+        """The point of solution q at psi, q at its representative (see the class)."""
+        q = np.where(self._centred, self._centre + _wrap(q - self._centre), q)
+        tangent = self_motion_tangent(self.solver, q)
+        groups = [g.along(tangent) for g in self.objective.groups(q, jacobian=True)]
+        return Point(psi, q, self.objective.evaluation(groups), groups, tangent, solution)
+
+    def at(self, psi: float | np.ndarray, hint: np.ndarray) -> Point | None:
+        """The solution at psi nearest ``hint``, if there is one."""
+        sol = self.solver.solve(self.T, Configuration(self.signs, tuple(np.atleast_1d(psi))), q_hint=hint)
+        return self.point(psi, sol.q, sol) if sol.ok else None
+
+    def continues(self, point: Point, other: Point) -> bool:
+        r"""Whether ``other`` continues point's path: its joints moved at most :data:`JUMP` and
+        as the path's tangent predicts to first order,
+        :math:`|\Delta q - (dq/d\psi)\,\Delta\psi|_\infty \le \frac12 |\Delta q|_\infty`. (A
+        solution on another path, however near, is off by the paths' separation, which no
+        shorter step of psi shrinks.)"""
+        moved = self._delta(point.q, other.q)
+        error = moved - point.tangent @ np.atleast_1d(other.psi - point.psi)
+        return np.abs(moved).max() <= JUMP and np.abs(error).max() <= 0.5 * np.abs(moved).max() + _SAME
+
+    def next(self, point: Point, psi: float | np.ndarray) -> Point | None:
+        """The solution at psi nearest point, if it continues point's path."""
+        nxt = self.at(psi, point.q)
+        return nxt if nxt is not None and self.continues(point, nxt) else None
+
+    def follow(self, start: Point, psi: float) -> tuple[Point, bool]:
+        """Continue start's path towards psi (module docstring).
+
+        Returns:
+            The point reached and whether it is at psi. When the path ends on the way the
+            point is its end, to :data:`END_TOLERANCE`.
+        """
+        point, step = start, psi - start.psi
+        while point.psi != psi:
+            if abs(step) < END_TOLERANCE:
+                return point, False
+            x = psi if abs(psi - point.psi) <= abs(step) else point.psi + step
+            nxt = self.next(point, x)
+            if nxt is None:
+                step /= 2.0
+            else:
+                point, step = nxt, 2.0 * step
+        return point, True
+
+
+def sweep_circle(
+    solver: OMSolver, objective: Objective, T: np.ndarray, branches: list[tuple[int, ...]], n: int
+) -> list[list[Path]]:
+    """The solution paths of every branch over the whole circle, from the grid
+    psi_k = -pi + 2 pi k / n (module docstring)."""
+    psi = -math.pi + _TURN * np.arange(n) / n
+    batch = solver.solve_batch(
+        np.repeat(T[None], n * len(branches), axis=0),
+        np.repeat(branches, n, axis=0),
+        np.tile(psi, len(branches)),
+    )
+    several = solver.dp_max > 0.0  # an exact S-R-S model has one solution per psi
+    swept = []
+    for b, signs in enumerate(branches):
+        probe = Probe(solver, objective, T, signs)
+        roots = []
+        for k, row in enumerate(range(b * n, (b + 1) * n)):
+            found = [probe.point(psi[k], batch.q[row])] if batch.ok[row] else []
+            others = solver.solve_all(T, Configuration(signs, (psi[k],))) if found and several else []
+            for sol in others:
+                if all(probe.step(sol.q, f.q) > _SAME for f in found):
+                    found.append(probe.point(psi[k], sol.q, sol))
+            roots.append(found)
+        swept.append([_with_hidden(probe, path) for path in _link(probe, psi, roots)])
+    return swept
+
+
+def sweep_window(probe: Probe, center: float, hint: np.ndarray, half_width: float, n: int) -> list[Path]:
+    """The path through the solution nearest ``hint`` at the centre, followed outwards
+    through center + half_width * j / n, j = -n..n, to the window's edges or its ends."""
+    start = probe.at(center, hint)
+    if start is None or probe.step(hint, start.q) > JUMP:
+        return []
+    halves = []
+    for side in (-1, 1):
+        points = [start]
+        for j in range(1, n + 1):
+            reached, arrived = probe.follow(points[-1], center + side * half_width * j / n)
+            if reached is not points[-1]:
+                points.append(reached)
+            if not arrived:
+                break
+        halves.append(points[1:])
+    path = Path(halves[0][::-1] + [start] + halves[1])
+    return [_with_hidden(probe, path)]
+
+
+def _link(probe: Probe, psi: np.ndarray, roots: list[list[Point]]) -> list[Path]:
+    """Paths through the solutions at each grid psi (module docstring)."""
+    n = len(psi)
+    paths: list[list[Point]] = []
+    first: list[int] = []  # grid index of each path's first sample
+    ongoing: list[int] = []  # paths that reached the previous grid psi
+    for k in range(n):
+        taken = [False] * len(roots[k])
+        reaching = []
+        for i in ongoing:
+            if len(roots[k]) == 1 and probe.continues(paths[i][-1], roots[k][0]):
+                reached, arrived = roots[k][0], True  # the only solution, and it continues the path
+            else:
+                reached, arrived = probe.follow(paths[i][-1], psi[k])
+            if not arrived:
+                paths[i] += [reached] if reached is not paths[i][-1] else []
+                continue
+            j = _same(probe, reached, roots[k])
+            if j is None:  # a solution the bounded search did not list
+                roots[k].append(reached)
+                taken.append(False)
+                j = len(roots[k]) - 1
+            if not taken[j]:  # (else two paths met: this one stops here)
+                taken[j] = True
+                paths[i].append(roots[k][j])
+                reaching.append(i)
+        for j, root in enumerate(roots[k]):
+            if not taken[j]:
+                paths.append([root])
+                first.append(k)
+                reaching.append(len(paths) - 1)
+        ongoing = reaching
+    return _joined(probe, psi, paths, first, ongoing)
+
+
+def _joined(
+    probe: Probe, psi: np.ndarray, paths: list[list[Point]], first: list[int], last: list[int]
+) -> list[Path]:
+    """The paths joined across +-pi (those reaching the last grid psi continue into those
+    starting at the first), loops closed, and the other starts followed back to their end."""
+    following: dict[int, int] = {}  # path i continues across +-pi into path following[i]
+    for i in last:
+        reached, arrived = probe.follow(paths[i][-1], psi[0] + _TURN)
+        starts = [j for j in range(len(paths)) if first[j] == 0 and j not in following.values()]
+        j = _same(probe, reached, [paths[j][0] for j in starts]) if arrived else None
+        if j is not None:
+            following[i] = starts[j]
+        elif not arrived and reached is not paths[i][-1]:
+            paths[i].append(reached)
+    heads = [i for i in range(len(paths)) if i not in following.values()]
+    result, seen = [], set()
+    for head in heads + list(following):  # chains from their heads, then the loops
+        if head in seen:
+            continue
+        chain = [head]
+        while chain[-1] in following and following[chain[-1]] not in chain:
+            chain.append(following[chain[-1]])
+        seen.update(chain)
+        points = [replace(p, psi=p.psi + _TURN * turn) for turn, i in enumerate(chain) for p in paths[i]]
+        if following.get(chain[-1]) == chain[0]:
+            result.append(Path(points, turns=len(chain)))
+        else:
+            result.append(Path(_back_to_end(probe, psi, points, first[chain[0]])))
+    return result
+
+
+def _back_to_end(probe: Probe, psi: np.ndarray, points: list[Point], k: int) -> list[Point]:
+    """The path's samples with, in front, where it ends before its first grid sample."""
+    previous = psi[k - 1] if k > 0 else psi[-1] - _TURN
+    reached, _ = probe.follow(points[0], previous)
+    return ([reached] if reached is not points[0] else []) + points
+
+
+def _same(probe: Probe, point: Point, candidates: list[Point]) -> int | None:
+    """The index of the candidate that is the same solution as point, if any."""
+    steps = [probe.step(point.q, c.q) for c in candidates]
+    return int(np.argmin(steps)) if steps and min(steps) <= _SAME else None
+
+
+def _with_hidden(probe: Probe, path: Path) -> Path:
+    """The path with exact samples inserted where a cell hides a feature (module docstring)."""
+    ends = list(path.points)
+    if path.turns:  # the closing cell, to the first sample a loop later
+        ends.append(replace(ends[0], psi=ends[0].psi + _TURN * path.turns))
+    filled = [ends[0]]
+    for a, b in itertools.pairwise(ends):
+        filled += [*_hidden(probe, a, b), b]
+    return Path(filled[:-1] if path.turns else filled, path.turns)
+
+
+def _hidden(probe: Probe, a: Point, b: Point) -> list[Point]:
+    """Exact samples inserted between neighbours a and b of a path, in order: halving until
+    no joint moves more than :data:`FINE_STEP` in a sub-cell, then until the Hermite models
+    of every sub-cell agree with its ends (module docstring)."""
+    inserted, cells = [], [(a, b)]
+    while cells and len(inserted) < _MAX_INSERTED:
+        left, right = cells.pop()
+        t = 0.5 if probe.step(left.q, right.q) > FINE_STEP else _surprise(left, right)
+        if t is None or right.psi - left.psi <= END_TOLERANCE:
+            continue
+        middle, arrived = probe.follow(left, left.psi + t * (right.psi - left.psi))
+        if arrived:
+            inserted.append(middle)
+            cells += [(left, middle), (middle, right)]
+    return sorted(inserted, key=lambda p: p.psi)
+
+
+def _surprise(a: Point, b: Point) -> float | None:
+    """Where, as a fraction of the cell, the pieces' cubic models predict a feasibility that
+    the ends do not explain: more changes between feasible and infeasible than the ends'
+    (none if alike, one if not). Returns the middle of the first unexplained stretch."""
+    (ga, da), (gb, db) = a.pieces(), b.pieces()
+    if len(ga) == 0:
+        return None
+    span = b.psi - a.psi
+    models = np.column_stack([ga, da * span, gb, db * span]) @ _HERMITE  # (pieces, points)
+    pattern = np.concatenate([[a.evaluation.feasible], (models >= 0.0).all(axis=0), [b.evaluation.feasible]])
+    changes = np.flatnonzero(pattern[1:] != pattern[:-1])
+    if len(changes) <= int(pattern[0] != pattern[-1]):
+        return None
+    return (changes[0] + 1 + changes[1]) / 2.0 / (len(pattern) - 1)
+
+
+def _wrap(x: np.ndarray) -> np.ndarray:
+    return np.remainder(x + math.pi, _TURN) - math.pi

@@ -1,0 +1,288 @@
+r"""The redundancy optimiser: a QP picks the arm angle for joint-limit margin and clearance.
+
+For a pose T, :meth:`RedundancyOptimizer.choose` returns the configuration
+c = (signs, psi) that maximises the objective f of :mod:`om_redundant.objective` (weighted
+normalised joint-limit margin and capped obstacle clearance) over the feasible set (within
+the limits, clearance >= d_min), and the exact OM solution in it:
+
+1. **Sweep.** Every allowed branch's exact solutions are sampled on a psi grid and linked
+   into solution paths (:mod:`om_redundant.paths`), which are cut into feasible intervals
+   with refined ends (:mod:`om_redundant.intervals`).
+2. **Starts.** In each interval, the samples that are local maxima of f. With L the largest
+   slope of f between neighbouring samples (times 2) and h a start's distance to its
+   neighbours, a start can only lead above ``f_start + L h``; starts are climbed best
+   first, and those whose bound is below the best value found are skipped. This is what
+   finds the global optimum rather than the nearest local one.
+3. **Climb** from each start (:func:`~om_redundant.climb.maximise`): a trust-region SQP
+   whose QP, solved by OSQP, linearises margins and clearances around the current exact
+   solution, within the interval. The result is the best point's own exact solve.
+
+**Tracking** (``choose(T, previous)``): the previous branch only, psi within ``max_step``
+of the previous psi, every solution continued from the previous joints. The branch is left
+only when it has no feasible psi at all at this pose, and the result says so
+(``branch_flipped``, ``reason``); if it is feasible only farther than ``max_step`` away, the
+result is not ok and names where.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from typing import Any
+
+import mujoco
+import numpy as np
+
+from .clearance import DEFAULT_DISTMAX, Clearance, Shape
+from .climb import maximise
+from .configuration import Configuration
+from .exceptions import InvalidInput
+from .intervals import PsiInterval, Run, feasible_runs
+from .objective import Objective, check_weights
+from .paths import Path, Point, Probe, sweep_circle, sweep_window
+from .solver import OMSolver, Solution
+from .validation import as_pose, as_signs
+
+_WINDOW_POINTS = 4  # tracking samples on each side of the previous psi
+
+
+@dataclass(frozen=True, eq=False)
+class RedundancyChoice:
+    """What :meth:`RedundancyOptimizer.choose` picked.
+
+    Attributes:
+        ok: A feasible configuration was found.
+        configuration: The chosen configuration (signs, (psi,)), psi in [-pi, pi); None if not ok.
+        solution: The exact OM solution in it; None if not ok.
+        margin: Smallest normalised joint-limit margin M(q) (nan if not ok).
+        clearance: Clearance D(q) in metres (inf without obstacles, nan if not ok).
+        value: The objective f(q) (nan if not ok).
+        intervals: The feasible intervals searched: every allowed branch's, or in tracking
+            mode those within ``max_step`` of the previous psi.
+        reason: Why nothing is feasible, or why the branch flipped; "" otherwise.
+        branch_flipped: Tracking mode left the previous branch (it had no feasible psi).
+    """
+
+    ok: bool
+    configuration: Configuration | None
+    solution: Solution | None
+    margin: float
+    clearance: float
+    value: float
+    intervals: tuple[PsiInterval, ...]
+    reason: str = ""
+    branch_flipped: bool = False
+
+
+class RedundancyOptimizer:
+    """Picks the arm angle psi (and branch) of a 7-DOF arm for margin and clearance.
+
+    Args:
+        solver: The OM solver of an arm with one redundancy variable.
+        obstacles: None; shapes (:class:`~om_redundant.Sphere`, ``Capsule``, ``Box``) or a
+            MuJoCo model of obstacles, in the arm's root frame (combined with the project's
+            MJCF of the arm); or a :class:`~om_redundant.Clearance` (e.g. of your own model).
+        margin_weight, clearance_weight, clearance_cap, min_clearance: The objective
+            (:class:`~om_redundant.objective.Objective`).
+        branches: Allowed branch signs, e.g. ``[(1, -1, 1)]``; default all.
+        grid_points: psi samples per branch of the sweep, >= 16.
+        max_step: Largest psi change (rad) per tracking call.
+
+    Example::
+
+        optimizer = om.RedundancyOptimizer(om.OMSolver("panda"), [om.Sphere([0.4, 0, 0.6], 0.05)])
+        choice = optimizer.choose(T)
+        if choice.ok:
+            q = choice.solution.q
+    """
+
+    def __init__(
+        self,
+        solver: OMSolver,
+        obstacles: Sequence[Shape] | mujoco.MjModel | Clearance | None = None,
+        *,
+        margin_weight: float = 1.0,
+        clearance_weight: float = 1.0,
+        clearance_cap: float = 0.1,
+        min_clearance: float = 0.0,
+        branches: Sequence[Sequence[int]] | None = None,
+        grid_points: int = 64,
+        max_step: float = 0.05,
+    ):
+        if not isinstance(solver, OMSolver):
+            raise InvalidInput(f"solver must be an OMSolver, got {type(solver).__name__}")
+        if len(solver.redundancy_names) != 1:
+            raise InvalidInput(
+                f"arm '{solver.arm.name}' has {len(solver.redundancy_names)} redundancy variables; "
+                "the optimiser needs one (a 7-DOF arm's arm angle)"
+            )
+        check_weights(margin_weight, clearance_weight, clearance_cap, min_clearance)
+        if obstacles is not None and not isinstance(obstacles, Clearance):
+            distmax = max(DEFAULT_DISTMAX, 2.0 * clearance_cap)
+            obstacles = Clearance.for_arm(solver.arm, obstacles, distmax=distmax)
+        self.solver = solver
+        self.objective = Objective(
+            solver.arm,
+            obstacles,
+            margin_weight=margin_weight,
+            clearance_weight=clearance_weight,
+            clearance_cap=clearance_cap,
+            min_clearance=min_clearance,
+        )
+        every = [c.signs for c in solver.configurations()]
+        if branches is None:
+            self.branches = every
+        else:
+            signs = as_signs(branches, len(solver.sign_names), "branches").reshape(-1, len(solver.sign_names))
+            self.branches = list(dict.fromkeys(tuple(int(s) for s in row) for row in signs))
+        if int(grid_points) < 16:
+            raise InvalidInput(f"grid_points must be at least 16, got {grid_points}")
+        if not (math.isfinite(max_step) and 0.0 < max_step <= math.pi):
+            raise InvalidInput(f"max_step must be in (0, pi] rad, got {max_step}")
+        self.grid_points, self.max_step = int(grid_points), float(max_step)
+
+    def intervals(self, T: Any) -> list[PsiInterval]:
+        """The feasible psi intervals of every allowed branch at pose T."""
+        T = as_pose(T)
+        return [run.interval for _, _, runs in self._sweep(T, self.branches) for run in runs]
+
+    def choose(self, T: Any, previous: RedundancyChoice | None = None) -> RedundancyChoice:
+        """The best configuration for pose T, or with ``previous`` the best near it.
+
+        Args:
+            T: Target pose of the end effector in the root frame: 4x4 or ``mink.SE3``.
+            previous: The choice for the previous pose of a path: tracking mode (module
+                docstring). A previous choice that is not ok starts afresh.
+
+        Returns:
+            A :class:`RedundancyChoice`; ``ok`` is False, with the reason, when nothing is
+            feasible.
+        """
+        T = as_pose(T)
+        if previous is None or (isinstance(previous, RedundancyChoice) and not previous.ok):
+            return self._best_anywhere(T, self.branches)
+        if not isinstance(previous, RedundancyChoice):
+            raise InvalidInput(f"previous must be a RedundancyChoice, got {type(previous).__name__}")
+        if previous.configuration.signs not in self.branches:
+            raise InvalidInput(
+                f"previous branch {previous.configuration.signs} is not among the allowed branches"
+            )
+        return self._track(T, previous)
+
+    # -----------------------------------------------------------------------------------
+
+    def _sweep(
+        self, T: np.ndarray, branches: list[tuple[int, ...]]
+    ) -> list[tuple[tuple[int, ...], list[Path], list[Run]]]:
+        """Every branch's solution paths and feasible runs."""
+        swept = sweep_circle(self.solver, self.objective, T, branches, self.grid_points)
+        return [
+            (signs, paths, [run for path in paths for run in feasible_runs(self._probe(T, signs), path)])
+            for signs, paths in zip(branches, swept, strict=True)
+        ]
+
+    def _probe(self, T: np.ndarray, signs: tuple[int, ...], wrapped: bool = True) -> Probe:
+        return Probe(self.solver, self.objective, T, signs, wrapped)
+
+    def _best_anywhere(self, T: np.ndarray, branches: list[tuple[int, ...]]) -> RedundancyChoice:
+        swept = self._sweep(T, branches)
+        runs = [run for _, _, branch_runs in swept for run in branch_runs]
+        if not runs:
+            why = "; ".join(self._why(signs, paths) for signs, paths, _ in swept)
+            return _failure((), f"no feasible arm angle: {why}")
+        return self._result(T, self._climb_all(T, runs), runs)
+
+    def _track(self, T: np.ndarray, previous: RedundancyChoice) -> RedundancyChoice:
+        signs, (psi,) = previous.configuration.signs, previous.configuration.redundancy
+        probe = self._probe(T, signs, wrapped=False)  # the joints move continuously
+        window = sweep_window(probe, psi, previous.solution.q, self.max_step, _WINDOW_POINTS)
+        runs = [run for path in window for run in feasible_runs(probe, path)]
+        if runs:
+            return self._result(T, self._climb_all(T, runs, wrapped=False), runs)
+        ((_, paths, branch_runs),) = self._sweep(T, [signs])
+        if branch_runs:
+            where = ", ".join(f"[{r.interval.lo:+.3f}, {r.interval.hi:+.3f}]" for r in branch_runs)
+            return _failure(
+                tuple(r.interval for r in branch_runs),
+                f"branch {signs}: no feasible psi within max_step = {self.max_step} rad of psi = "
+                f"{psi:+.4f}; the branch is feasible at psi in {where}",
+            )
+        others = [b for b in self.branches if b != signs]
+        choice = self._best_anywhere(T, others) if others else _failure((), "no other branch is allowed")
+        why = f"branch {signs} has no feasible psi at this pose ({self._why(signs, paths)})"
+        if not choice.ok:
+            return replace(choice, reason=f"{why}; {choice.reason}")
+        return replace(choice, branch_flipped=True, reason=f"{why}; switched to {choice.configuration.signs}")
+
+    def _climb_all(self, T: np.ndarray, runs: list[Run], wrapped: bool = True) -> tuple[Run, Point]:
+        """The global maximum over the runs: climbs from the best starts (module docstring)."""
+        slope = 0.0
+        starts = []
+        for run in runs:
+            psi = np.array([p.psi for p in run.points])
+            f = np.array([p.evaluation.value for p in run.points])
+            if len(f) > 1:
+                slope = max(slope, float(np.max(np.abs(np.diff(f)) / np.maximum(np.diff(psi), 1e-12))))
+            for k in range(len(f)):
+                if (k == 0 or f[k] >= f[k - 1]) and (k == len(f) - 1 or f[k] >= f[k + 1]):
+                    gap = max(psi[min(k + 1, len(f) - 1)] - psi[k], psi[k] - psi[max(k - 1, 0)])
+                    starts.append((f[k], gap, run, run.points[k]))
+        starts.sort(key=lambda s: -s[0])
+        best_run, best = starts[0][2], starts[0][3]
+        for value, gap, run, start in starts:
+            if value + 2.0 * slope * gap < best.evaluation.value:
+                continue
+            lo, hi = (-math.inf, math.inf) if run.interval.closed else (run.interval.lo, run.interval.hi)
+            point = maximise(self._probe(T, run.interval.signs, wrapped), start, lo, hi, max(gap, 1e-6))
+            if point.evaluation.value > best.evaluation.value:
+                best_run, best = run, point
+        return best_run, best
+
+    def _result(self, T: np.ndarray, best: tuple[Run, Point], runs: list[Run]) -> RedundancyChoice:
+        run, point = best
+        psi = math.remainder(point.psi, 2.0 * math.pi)
+        configuration = Configuration(run.interval.signs, (-math.pi if psi >= math.pi else psi,))
+        # The point's own solve (a batch sample is solved again, nearest itself), at the
+        # point's representative of the joints: where psi has several roots near a singular
+        # wrist, a fresh solve might return another one.
+        solution = point.solution or self.solver.solve(T, configuration, q_hint=point.q)
+        if not solution.ok:
+            return _failure(
+                tuple(r.interval for r in runs), f"the exact solve at the chosen psi: {solution.status}"
+            )
+        solution = replace(
+            solution,
+            q=point.q,
+            configuration=configuration,
+            within_limits=self.solver.arm.within_limits(point.q),
+        )
+        ev = point.evaluation
+        return RedundancyChoice(
+            solution.ok,
+            configuration,
+            solution,
+            ev.margin,
+            ev.clearance,
+            ev.value,
+            tuple(r.interval for r in runs),
+        )
+
+    def _why(self, signs: tuple[int, ...], paths: list[Path]) -> str:
+        """Why a branch's solution paths hold nothing feasible."""
+        points = [p for path in paths for p in path.points]
+        if not points:
+            return f"branch {signs}: no solution at any of {self.grid_points} arm angles"
+        within = [p for p in points if p.evaluation.margin >= 0.0]
+        if not within:
+            best = max(p.evaluation.margin for p in points)
+            return f"branch {signs}: outside the joint limits wherever solved (best margin {best:.3f})"
+        best = max(p.evaluation.clearance for p in within)
+        return (
+            f"branch {signs}: clearance below {self.objective.min_clearance} m wherever within the limits "
+            f"(best {best:.4f} m)"
+        )
+
+
+def _failure(intervals: tuple[PsiInterval, ...], reason: str) -> RedundancyChoice:
+    return RedundancyChoice(False, None, None, math.nan, math.nan, math.nan, intervals, reason)
