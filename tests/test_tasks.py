@@ -127,6 +127,34 @@ def test_optimizer_choice_is_reached(panda, panda_model):
     assert optimizer.previous[0] is None and optimizer.previous[1] is not None
 
 
+def test_the_redundancy_optimizers_choice_is_reached_clear_of_an_obstacle(panda, panda_model):
+    """The real optimiser behind the task: a sphere at the elbow of the psi = 0 solution; mink
+    ends on the pose exactly, in the chosen configuration, with the chosen clearance."""
+    T = panda.arm.fk(Q_PANDA)
+    c0 = panda.configuration_of(Q_PANDA)
+    at_zero = panda.solve(T, om.Configuration(c0.signs, (0.0,)), q_hint=Q_PANDA)
+    assert at_zero.ok
+    data = mujoco.MjData(panda_model)
+    data.qpos[:] = at_zero.q
+    mujoco.mj_forward(panda_model, data)
+    centre = data.xpos[panda_model.body("link4").id].copy()  # the elbow
+    optimizer = om.RedundancyOptimizer(panda, obstacles=[om.Sphere(centre, 0.05)], min_clearance=0.02)
+    task = om.ExactPoseTask(panda, panda_model, optimizer=optimizer)
+    frame = frame_task()
+    task.set_target(T)
+    frame.set_target(mink.SE3.from_matrix(T))
+    choice = task.choice
+    assert choice.ok and choice.clearance >= 0.02
+    configuration = mink.Configuration(panda_model)
+    configuration.update(home_joints(panda.arm))
+    limits = [mink.ConfigurationLimit(panda_model)]
+    for _ in range(10):
+        step(configuration, [frame, task], limits)
+    assert max(hand_error(configuration, "attachment_site", T)) < 1e-9
+    assert panda.configuration_of(configuration.q).isclose(choice.configuration, 1e-6)
+    assert optimizer.objective.evaluate(configuration.q).clearance >= 0.02 - 1e-9
+
+
 def test_equal_costs_get_stuck_where_the_default_cost_does_not(panda, panda_model):
     """Why the default cost is 10: with the FrameTask's weight equal to the joint task's, the
     sum has stationary points away from q* (the docstring's claim, on a few targets)."""
