@@ -69,13 +69,7 @@ def random_joints(arm: om.Arm, n: int, rng: np.random.Generator) -> np.ndarray:
 def reference_spec(relative_path: str) -> mujoco.MjSpec:
     """A Menagerie MJCF under :data:`MENAGERIE` with its meshes stripped (the files ship
     without them), to edit before compiling."""
-    spec = mujoco.MjSpec.from_file(str(MENAGERIE / relative_path))
-    for geom in list(spec.geoms):
-        if geom.type == mujoco.mjtGeom.mjGEOM_MESH:
-            spec.delete(geom)
-    for mesh in list(spec.meshes):
-        spec.delete(mesh)
-    return spec
+    return om.without_meshes(mujoco.MjSpec.from_file(str(MENAGERIE / relative_path)))
 
 
 def reference_model(relative_path: str) -> mujoco.MjModel:

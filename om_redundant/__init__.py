@@ -32,6 +32,7 @@ from .model import derive_model as derive_model
 from .mujoco_match import ModelComparison as ModelComparison
 from .mujoco_match import compare_mujoco_model as compare_mujoco_model
 from .mujoco_match import load_mujoco_model as load_mujoco_model
+from .mujoco_match import without_meshes as without_meshes
 from .objective import Evaluation as Evaluation
 from .objective import Objective as Objective
 from .objective import joint_margins as joint_margins

@@ -84,14 +84,15 @@ def load_mujoco_model(path: str | Path) -> mujoco.MjModel:
             if not spec.meshes:
                 raise
             try:
-                return _without_meshes(spec).compile()
+                return without_meshes(spec).compile()
             except ValueError:
                 raise first from None
     except ValueError as exc:
         raise InvalidInput(f"cannot load MuJoCo model '{path}': {' '.join(str(exc).split())}") from None
 
 
-def _without_meshes(spec: mujoco.MjSpec) -> mujoco.MjSpec:
+def without_meshes(spec: mujoco.MjSpec) -> mujoco.MjSpec:
+    """Delete the spec's mesh geoms and meshes (in place; returns the spec)."""
     for geom in list(spec.geoms):
         if geom.type == mujoco.mjtGeom.mjGEOM_MESH:
             spec.delete(geom)
