@@ -43,7 +43,7 @@ import numpy as np
 from .closed_form import srs
 from .closed_form.common import add, cross, dot, scale, sub, vec
 from .exceptions import InvalidInput
-from .kinematics import _apply_row
+from .kinematics import joint_axes_kernel
 from .solver import OMSolver
 from .validation import as_joint_vector
 
@@ -66,21 +66,9 @@ def arm_angle_gradient_kernel(P, table, q, grad):
     """
     # Axis and origin of joints 1-6 in DH frame 0: joint j turns about z of the frame its
     # row starts from. S is the origin after joint 1's row, W the one after joint 5's row.
-    R = np.eye(3)
-    p = np.zeros(3)
     axes = np.empty((6, 3))
     origins = np.empty((6, 3))
-    j = 0
-    for k in range(table.shape[0]):
-        if table[k, 5] == 2.0:
-            _apply_row(R, p, table[k], 0.0)
-            continue
-        axes[j] = R[:, 2]
-        origins[j] = p
-        j += 1
-        if j == 6:
-            break
-        _apply_row(R, p, table[k], q[j - 1])
+    joint_axes_kernel(table, q, axes, origins, np.empty((3, 3)), np.empty(3))
     S = (origins[1, 0], origins[1, 1], origins[1, 2])
     W = (origins[5, 0], origins[5, 1], origins[5, 2])
     z4 = (axes[3, 0], axes[3, 1], axes[3, 2])

@@ -243,24 +243,41 @@ def fk_batch_kernel(table, base, tool, Q):
 
 
 @nb.njit(cache=True)
-def jacobian_kernel(table, base, tool, q):
-    dof = q.shape[0]
-    axes = np.empty((dof, 3))
-    origins = np.empty((dof, 3))
-    kinds = np.empty(dof)
-    R = np.eye(3)
-    p = np.zeros(3)
+def joint_axes_kernel(table, q, axes, origins, R, p):
+    """Write the axis and origin, in DH frame 0, of joints 1..n (n = ``len(axes)``); R and p
+    end as the frame after every row before joint n+1's (the flange for n = dof).
+
+    A standard row's joint acts about the z-axis of the frame it starts from.
+    """
+    R[:] = np.eye(3)
+    p[:] = 0.0
     j = 0
     for k in range(table.shape[0]):
         if table[k, 5] == 2.0:
             _apply_row(R, p, table[k], 0.0)
             continue
-        # A standard row's joint acts about the z-axis of the frame it starts from.
+        if j == axes.shape[0]:
+            break
         axes[j] = R[:, 2]
         origins[j] = p
-        kinds[j] = table[k, 5]
         _apply_row(R, p, table[k], q[j])
         j += 1
+
+
+@nb.njit(cache=True)
+def jacobian_kernel(table, base, tool, q):
+    dof = q.shape[0]
+    axes = np.empty((dof, 3))
+    origins = np.empty((dof, 3))
+    R = np.empty((3, 3))
+    p = np.empty(3)
+    joint_axes_kernel(table, q, axes, origins, R, p)
+    kinds = np.empty(dof)
+    j = 0
+    for k in range(table.shape[0]):
+        if table[k, 5] != 2.0:
+            kinds[j] = table[k, 5]
+            j += 1
     Rb = np.ascontiguousarray(base[:3, :3])
     p_ee = Rb @ (p + R @ np.ascontiguousarray(tool[:3, 3])) + base[:3, 3]
     J = np.zeros((6, dof))
