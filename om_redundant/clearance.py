@@ -38,7 +38,7 @@ import numpy as np
 from .arm import Arm
 from .exceptions import InvalidInput
 from .mjcf import arm_mjcf
-from .validation import as_joint_vector, as_pose
+from .validation import as_joint_vector, as_pose, as_positive
 
 DEFAULT_DISTMAX = 1.0  # m: pairs farther apart report this distance
 
@@ -79,7 +79,7 @@ class Sphere:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "center", _point(self.center, "Sphere center"))
-        object.__setattr__(self, "radius", _positive(self.radius, "Sphere radius"))
+        object.__setattr__(self, "radius", as_positive(self.radius, "Sphere radius"))
 
     def _geom(self, name: str) -> _Geom:
         size = np.array([self.radius, 0.0, 0.0])
@@ -104,7 +104,7 @@ class Capsule:
     def __post_init__(self) -> None:
         object.__setattr__(self, "start", _point(self.start, "Capsule start"))
         object.__setattr__(self, "end", _point(self.end, "Capsule end"))
-        object.__setattr__(self, "radius", _positive(self.radius, "Capsule radius"))
+        object.__setattr__(self, "radius", as_positive(self.radius, "Capsule radius"))
         if np.linalg.norm(self.end - self.start) == 0.0:
             raise InvalidInput("Capsule start and end coincide; use a Sphere")
 
@@ -176,7 +176,7 @@ class Clearance:
         distmax: float = DEFAULT_DISTMAX,
     ):
         self.model, self.arm, self._dof = model, arm, arm.dof
-        self.distmax = _positive(distmax, "distmax")
+        self.distmax = as_positive(distmax, "distmax")
         self._data = mujoco.MjData(model)
         joints = [_find(model, mujoco.mjtObj.mjOBJ_JOINT, prefix + name, "joint") for name in arm.joint_names]
         for j, revolute in zip(joints, arm.revolute, strict=True):
@@ -315,13 +315,3 @@ def _point(value: Any, name: str) -> np.ndarray:
     if point.shape != (3,) or not np.isfinite(point).all():
         raise InvalidInput(f"{name} must be 3 finite numbers, got {value!r}")
     return point
-
-
-def _positive(value: Any, name: str) -> float:
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise InvalidInput(f"{name} must be a positive number, got {value!r}") from None
-    if not (np.isfinite(number) and number > 0.0):
-        raise InvalidInput(f"{name} must be a positive finite number, got {value!r}")
-    return number

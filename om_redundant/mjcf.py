@@ -38,7 +38,7 @@ import mujoco
 import numpy as np
 
 from .arm import Arm
-from .exceptions import InvalidInput
+from .validation import as_positive
 
 DEFAULT_SITE = "end_effector"
 RADIUS_PER_REACH = 0.03  # default capsule radius over the stretched length of the chain
@@ -82,7 +82,9 @@ def _arm_tree(arm: Arm, prefix: str, radius: float | None, scene: bool) -> ET.El
     n = arm.dof
     ends = np.vstack([P[:, :3, 3], P_tail[:3, 3]])  # segment of body k: origin -> ends[k]
     lengths = np.linalg.norm(ends, axis=1)
-    r = _radius(max(round(RADIUS_PER_REACH * lengths.sum(), 4), 1e-4) if radius is None else radius)
+    r = as_positive(
+        max(round(RADIUS_PER_REACH * lengths.sum(), 4), 1e-4) if radius is None else radius, "radius (m)"
+    )
     cls = f"{prefix}collision"
     names = {-1: "world", 0: f"{prefix}base"} | {k: f"{prefix}link{k}" for k in range(1, n + 1)}
 
@@ -127,16 +129,6 @@ def _arm_tree(arm: Arm, prefix: str, radius: float | None, scene: bool) -> ET.El
             if b == a + 1 or chain <= 2 * r:
                 ET.SubElement(contact, "exclude", body1=names[a], body2=names[b])
     return root
-
-
-def _radius(radius: float) -> float:
-    try:
-        value = float(radius)
-    except (TypeError, ValueError):
-        raise InvalidInput(f"radius must be a positive number of metres, got {radius!r}") from None
-    if not (math.isfinite(value) and value > 0):
-        raise InvalidInput(f"radius must be a positive finite number of metres, got {radius!r}")
-    return value
 
 
 def _pose(T: np.ndarray) -> dict[str, str]:

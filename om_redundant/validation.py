@@ -102,3 +102,14 @@ def as_signs(signs: Any, count: int, name: str = "signs") -> np.ndarray:
     if raw.dtype.kind not in "iuf" or not np.isin(raw, (-1, 1)).all():
         raise InvalidInput(f"{name} must be -1 or +1, got {np.unique(raw)[:5].tolist()}")
     return raw.astype(np.int64)
+
+
+def as_positive(value: Any, name: str) -> float:
+    """A positive finite number, or InvalidInput naming ``name``."""
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise InvalidInput(f"{name} must be a positive number, got {value!r}") from None
+    if not (np.isfinite(number) and number > 0.0):
+        raise InvalidInput(f"{name} must be a positive finite number, got {value!r}")
+    return number
