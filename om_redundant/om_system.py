@@ -691,6 +691,25 @@ def solve_one(arm, settings, T, signs, redundancy, hint, has_hint, q_out):
     return OK, pos, ori, counter[0], inside
 
 
+@nb.njit(cache=True)
+def solve_all_kernel(arm, settings, T, signs, redundancy, roots, pos, ori, within):
+    """Every solution in one configuration: the bounded search, in one call from Python.
+
+    Writes the roots (revolute joints shifted into the limits where possible) and their
+    errors and limit checks. Returns (count, residual evaluations).
+    """
+    family, P, mtab, rtab, J, D, base_inv, tool_inv, revolute, lower, upper = arm
+    n_scan, tol_pos, tol_ori = settings
+    R, p = flange_target(T, base_inv, tool_inv)
+    zeros = np.zeros(roots.shape[1])
+    problem = make_problem(family, P, mtab, rtab, J, D, R, p, signs, redundancy, zeros)
+    n = all_roots(problem, n_scan, tol_pos, tol_ori, roots)
+    for r in range(n):
+        within[r] = representative(roots[r], revolute, lower, upper, zeros, False)
+        pos[r], ori[r], _ = verify(problem, roots[r], tol_pos, tol_ori)
+    return n, problem[11][0]
+
+
 @nb.njit(cache=True, parallel=True)
 def solve_batch_kernel(
     arm, settings, Ts, signs, redundancy, hints, has_hint, q_out, status, pos, ori, evals, within

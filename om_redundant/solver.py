@@ -198,20 +198,19 @@ class OMSolver:
 
     def solve_all(self, T: Any, configuration: Configuration) -> list[Solution]:
         """Every real solution with this configuration (the bounded search), possibly none."""
-        family, P, mtab, rtab, J, D, base_inv, tool_inv, revolute, lower, upper = self._kernel_arm
-        R, p = om_system.flange_target(as_pose(T), base_inv, tool_inv)
-        zeros = np.zeros(self.arm.dof)
         signs, redundancy = self._configuration(configuration)
-        problem = om_system.make_problem(family, P, mtab, rtab, J, D, R, p, signs, redundancy, zeros)
         roots = np.empty((om_system.MAX_ROOTS, self.arm.dof))
-        n = om_system.all_roots(problem, self.scan_points, *self.tolerances, roots)
-        evals = int(problem[11][0])
-        solutions = []
-        for q in roots[:n]:
-            within = om_system.representative(q, revolute, lower, upper, zeros, False)
-            pos, ori, _ = om_system.verify(problem, q, *self.tolerances)
-            solutions.append(Solution(q, True, "ok", configuration, pos, ori, evals, within))
-        return solutions
+        pos, ori = np.empty(om_system.MAX_ROOTS), np.empty(om_system.MAX_ROOTS)
+        within = np.empty(om_system.MAX_ROOTS, dtype=np.bool_)
+        n, evals = om_system.solve_all_kernel(
+            self._kernel_arm, self._kernel_settings, as_pose(T), signs, redundancy, roots, pos, ori, within
+        )
+        return [
+            Solution(
+                roots[r], True, "ok", configuration, float(pos[r]), float(ori[r]), int(evals), bool(within[r])
+            )
+            for r in range(n)
+        ]
 
     def solve_batch(
         self,
