@@ -44,6 +44,8 @@ DEFAULT_RESOLUTION = 2.0 * math.pi / 360.0  # rad: 360 arm angles
 MAX_SAMPLES = 100_000  # arm angles per branch and pose
 PLOT_SUFFIXES = (".png", ".svg")
 PATH_COLUMNS = ("x", "y", "z", "qw", "qx", "qy", "qz")
+#: The run without a command: the Panda's built-in pose with a ball beside its elbow.
+DEFAULT_RUN = ("sweep", "--obstacle", "sphere:0.2,0.12,0.6,0.05")
 
 #: Obstacle shapes: the numbers each takes, in order (metres, in the arm's root frame).
 SHAPES = {
