@@ -79,8 +79,22 @@ def test_help_everywhere(capsys, argv):
         ),
         (["solve", "--pose-file", "no/such/pose.txt"], "cannot read pose file 'no/such/pose.txt'"),
         (["sweep", "--resolution", "-0.1"], "--resolution must be a positive number"),
+        (["sweep", "--arm", "nope"], "unknown arm 'nope'"),
+        (
+            ["sweep", "--xyz", "0.5", "0", "0.4", "--quat", "0", "0", "0", "0"],
+            "--quat (0, 0, 0, 0) has zero norm",
+        ),
+        (["sweep", "--path", "no/such/path.csv"], "cannot read path file 'no/such/path.csv'"),
     ],
-    ids=["unknown arm", "zero quaternion", "unreadable file", "negative resolution"],
+    ids=[
+        "unknown arm",
+        "zero quaternion",
+        "unreadable file",
+        "negative resolution",
+        "sweep unknown arm",
+        "sweep zero quaternion",
+        "sweep unreadable path",
+    ],
 )
 def test_bad_input_exits_2_with_one_line_and_no_traceback(argv, message):
     done = command(*argv)
