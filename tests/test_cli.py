@@ -631,3 +631,35 @@ def test_progress_bar_on_a_terminal(monkeypatch):
         and "[###############...............] 2/4" in text
     )
     assert not Progress(4, enabled=False).enabled and not Progress(1).enabled
+
+
+def test_sweep_path_tracks_like_the_optimiser_and_says_why_not(capsys, tmp_path):
+    """Every branch (some unsolved at some psi: no hints there), an obstacle: the tracked
+    choices are choose(T, previous)'s, and a pose left without one says why."""
+    solver = om.OMSolver("panda")
+    rows = []
+    for t in np.linspace(0.0, 0.5, 3):
+        T = solver.arm.fk(Q_PANDA + t * np.array([1.0, 0.3, 0.0, 0.4, 0.0, -0.5, 0.0]))
+        quat = np.empty(4)
+        mujoco.mju_mat2Quat(quat, np.ascontiguousarray(T[:3, :3]).ravel())
+        rows.append(",".join(repr(float(v)) for v in (*T[:3, 3], *quat)))
+    path = tmp_path / "path.csv"
+    path.write_text("\n".join(rows) + "\n")
+    poses = read_path(str(path))
+    ball = "sphere:0.2,0.12,0.6,0.05"
+    status, out, err = in_process(
+        capsys, "sweep", "--path", str(path), "--obstacle", ball, "--json", "--resolution", "0.1"
+    )
+    assert status == 0, err
+    data = json.loads(out)
+    optimizer = om.RedundancyOptimizer(solver, [om.Sphere([0.2, 0.12, 0.6], 0.05)])
+    previous = None
+    for got, T in zip(data["poses"], poses, strict=True):
+        choice = optimizer.choose(T, previous)
+        previous = choice
+        assert got["note"] == choice.reason
+        if choice.ok:
+            assert got["chosen"]["psi"] == pytest.approx(choice.configuration.redundancy[0], abs=1e-9)
+        else:
+            assert got["chosen"] is None and "no feasible psi within max_step" in got["note"]
+    assert any(p["chosen"] is None for p in data["poses"])

@@ -235,6 +235,8 @@ def _branch_sweep(request, objective, T, signs, hint) -> BranchSweep:
     solver, psi = request.solver, request.psi
     arm = solver.arm
     n = len(psi)
+    if hint is not None and not np.isfinite(hint).all():
+        hint = None  # the kernel takes hints for every row or none
     batch = solver.solve_batch(np.repeat(T[None], n, axis=0), signs, psi, q_hint=hint)
     ok = np.asarray(batch.ok, dtype=bool)
     q = np.full((n, arm.dof), np.nan)
