@@ -206,7 +206,7 @@ class Clearance:
     def for_arm(
         cls,
         arm: Arm,
-        obstacles: Sequence[Shape] | mujoco.MjModel,
+        obstacles: Sequence[Shape | mujoco.MjModel] | mujoco.MjModel,
         *,
         radius: float | None = None,
         distmax: float = DEFAULT_DISTMAX,
@@ -216,7 +216,8 @@ class Clearance:
         Args:
             arm: The arm; its root frame is the model's world frame.
             obstacles: Shapes, or a MuJoCo model whose primitive geoms (plane, sphere,
-                capsule, ellipsoid, cylinder, box), as placed at its ``qpos0``, are the obstacles.
+                capsule, ellipsoid, cylinder, box), as placed at its ``qpos0``, are the obstacles;
+                or a sequence mixing both (e.g. a scene and a few shapes).
             radius: Capsule radius of the arm's MJCF (default: :func:`~om_redundant.arm_mjcf`'s).
             distmax: As in :class:`Clearance`.
         """
@@ -268,6 +269,9 @@ def _shape_geoms(obstacles: Sequence[Shape]) -> list[_Geom]:
         obstacles = [obstacles]
     geoms = []
     for k, shape in enumerate(obstacles):
+        if isinstance(shape, mujoco.MjModel):
+            geoms += _model_geoms(shape)
+            continue
         if not isinstance(shape, Sphere | Capsule | Box):
             raise InvalidInput(
                 f"obstacle {k} must be a Sphere, Capsule or Box (or pass a MuJoCo model), "

@@ -19,13 +19,10 @@ import om_redundant as om
 from om_redundant.cli import build_parser, main
 from om_redundant.cli.common import UsageError
 from om_redundant.cli.sweep import (
-    BranchSweep,
-    Choice,
-    PoseSweep,
     Progress,
-    SweepRequest,
     SweepResult,
     build_request,
+    compute_sweep,
     parse_obstacle,
     psi_grid,
     read_path,
@@ -56,10 +53,10 @@ def in_process(capsys, *argv: str) -> tuple[int, str, str]:
 # Conventions
 
 
-def test_default_run_solves_the_ur5e_pose_in_all_eight_configurations():
+def test_default_run_sweeps_the_panda_arm_angle():
     done = command()
-    assert done.returncode == 0, done.stderr
-    assert done.stdout.count(" ok ") == 8 and "ur5e" in done.stdout and done.stderr == ""
+    assert done.returncode == 0 and done.stderr == "", done.stderr
+    assert "arm: panda" in done.stdout and "obstacles: 1" in done.stdout and "chosen: +1 -1 +1" in done.stdout
 
 
 @pytest.mark.parametrize(
@@ -82,8 +79,22 @@ def test_help_everywhere(capsys, argv):
         ),
         (["solve", "--pose-file", "no/such/pose.txt"], "cannot read pose file 'no/such/pose.txt'"),
         (["sweep", "--resolution", "-0.1"], "--resolution must be a positive number"),
+        (["sweep", "--arm", "nope"], "unknown arm 'nope'"),
+        (
+            ["sweep", "--xyz", "0.5", "0", "0.4", "--quat", "0", "0", "0", "0"],
+            "--quat (0, 0, 0, 0) has zero norm",
+        ),
+        (["sweep", "--path", "no/such/path.csv"], "cannot read path file 'no/such/path.csv'"),
     ],
-    ids=["unknown arm", "zero quaternion", "unreadable file", "negative resolution"],
+    ids=[
+        "unknown arm",
+        "zero quaternion",
+        "unreadable file",
+        "negative resolution",
+        "sweep unknown arm",
+        "sweep zero quaternion",
+        "sweep unreadable path",
+    ],
 )
 def test_bad_input_exits_2_with_one_line_and_no_traceback(argv, message):
     done = command(*argv)
@@ -381,7 +392,7 @@ def test_check_model_against_the_menagerie_panda():
 
 
 # ---------------------------------------------------------------------------------------
-# sweep: the input, checked into a request (the computation is not built yet)
+# sweep: the input, checked into a request
 
 
 def sweep_request(*argv: str):
@@ -421,22 +432,73 @@ def test_sweep_request_with_everything(tmp_path):
     assert request.scene.ngeom == 1
 
 
-def test_sweep_is_not_available_yet(capsys):
-    """The computation waits for the redundancy optimiser; the command says so in one line."""
-    status, _, err = in_process(capsys, "sweep")
-    assert status == 1 and "not available yet" in err and err.count("\n") == 1
+def test_sweep_json_agrees_with_the_optimiser(tmp_path):
+    """A subprocess run with an obstacle and a scene: the chosen configuration and q are
+    RedundancyOptimizer.choose's, the intervals its intervals(T) (exact ends)."""
+    scene = tmp_path / "scene.xml"
+    scene.write_text(
+        '<mujoco><worldbody><geom name="table" type="box" pos="0.6 0 -0.05" size="0.3 0.3 0.02"/>'
+        "</worldbody></mujoco>"
+    )
+    out = tmp_path / "sweep.json"
+    ball = "sphere:0.2,0.12,0.6,0.05"
+    done = command(
+        "sweep", "--obstacle", ball, "--scene", str(scene), "--resolution", "0.05", "--json", str(out)
+    )
+    assert done.returncode == 0, done.stderr
+    data = json.loads(out.read_text())
+    solver = om.OMSolver("panda")
+    T = solver.arm.fk(Q_PANDA)
+    shapes = [om.Sphere([0.2, 0.12, 0.6], 0.05, "cli_sphere0"), om.load_mujoco_model(scene)]
+    optimizer = om.RedundancyOptimizer(solver, om.Clearance.for_arm(solver.arm, shapes))
+    choice = optimizer.choose(T)
+    (pose,) = data["poses"]
+    chosen = pose["chosen"]
+    assert tuple(chosen["signs"]) == choice.configuration.signs
+    assert chosen["psi"] == pytest.approx(choice.configuration.redundancy[0], abs=1e-9)
+    np.testing.assert_allclose(chosen["q"], choice.solution.q, atol=1e-9)
+    assert chosen["margin"] == pytest.approx(choice.margin) and chosen["clearance"] == pytest.approx(
+        choice.clearance
+    )
+    expected = {}
+    for iv in optimizer.intervals(T):
+        expected.setdefault(iv.signs, []).append([iv.lo, iv.hi])
+    for branch in pose["branches"]:
+        np.testing.assert_allclose(
+            np.reshape(branch["intervals"], (-1, 2)),
+            np.reshape(expected.get(tuple(branch["signs"]), []), (-1, 2)),
+        )
+    assert sum(bool(b["intervals"]) for b in pose["branches"]) == 2
+    # the grid columns: margins are the library's, clearance the optimiser's own
+    branch = next(b for b in pose["branches"] if tuple(b["signs"]) == choice.configuration.signs)
+    k = int(np.flatnonzero(branch["ok"])[0])
+    q = np.array(branch["q"][k])
+    np.testing.assert_allclose(branch["margin"][k], om.joint_margins(solver.arm, q))
+    assert branch["clearance"][k] == pytest.approx(optimizer.objective.clearance.minimum(q))
+
+
+def test_sweep_plot_is_a_png_of_sensible_size(tmp_path):
+    plot = tmp_path / "sweep.png"
+    done = command(
+        "sweep", "--obstacle", "sphere:0.2,0.12,0.6,0.05", "--resolution", "0.05", "--plot", str(plot), "-q"
+    )
+    assert done.returncode == 0 and done.stdout == "", done.stderr
+    width, height = png_size(plot)
+    assert plot.stat().st_size > 20_000 and 1000 <= width <= 2000 and 700 <= height <= 1500
 
 
 def test_obstacles_parse_into_mujoco_geoms():
     specs = ["sphere:0.4,0,0.3,0.05", "capsule: 0,0,0, 0,0,1, 0.1", "BOX:0.5,0,0,0.1,0.2,0.3"]
     obstacles = [parse_obstacle(s) for s in specs]
     assert obstacles[1].values == (0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.1)
-    geoms = "".join(
-        "<geom {}/>".format(" ".join(f'{k}="{v}"' for k, v in o.geom().items())) for o in obstacles
-    )
-    model = mujoco.MjModel.from_xml_string(f"<mujoco><worldbody>{geoms}</worldbody></mujoco>")
-    np.testing.assert_allclose(model.geom_size[:, 0], [0.05, 0.1, 0.1])
-    np.testing.assert_allclose(model.geom_pos[2], [0.5, 0, 0])
+    shapes = [o.shape(f"o{k}") for k, o in enumerate(obstacles)]
+    assert [type(s) for s in shapes] == [om.Sphere, om.Capsule, om.Box]
+    model = om.Clearance.for_arm(om.load_arm("panda"), shapes).model
+    sizes = [model.geom(f"o{k}").size for k in range(3)]
+    np.testing.assert_allclose([s[0] for s in sizes], [0.05, 0.1, 0.1])
+    np.testing.assert_allclose(sizes[2], [0.1, 0.2, 0.3])
+    np.testing.assert_allclose(model.geom("o1").size[1], 0.5)
+    np.testing.assert_allclose(model.geom("o2").pos, [0.5, 0, 0])
 
 
 def test_path_files(tmp_path):
@@ -465,32 +527,20 @@ def test_psi_grid_covers_the_circle_once():
 
 
 # ---------------------------------------------------------------------------------------
-# sweep: what the command shows of a result, from a stand-in engine (joint limits only; the
-# largest margin on the grid as the choice) until the real one is wired in
+# sweep: what the command shows of a result, in-process with the real engine
 
 
-def stand_in_sweep(request: SweepRequest) -> SweepResult:
-    solver, psi, arm = request.solver, request.psi, request.solver.arm
-    poses = []
-    for i, T in enumerate(request.poses):
-        branches, best = [], None
-        for signs in request.branches:
-            batch = solver.solve_batch(np.repeat(T[None], len(psi), axis=0), signs, psi)
-            q = np.where(batch.ok[:, None], batch.q, np.nan)
-            margin = np.minimum(q - arm.lower, arm.upper - q)
-            smallest = np.min(np.nan_to_num(margin, nan=-1.0), axis=1)
-            feasible = batch.ok & (smallest >= 0.0)
-            edges = np.flatnonzero(np.diff(np.concatenate([[0], feasible.astype(int), [0]])))
-            intervals = tuple((float(psi[a]), float(psi[b - 1])) for a, b in edges.reshape(-1, 2))
-            clearance = np.where(batch.ok, np.inf, np.nan)
-            branches.append(BranchSweep(signs, q, batch.ok, margin, clearance, feasible, intervals))
-            if feasible.any():
-                k = int(np.argmax(np.where(feasible, smallest, -np.inf)))
-                if best is None or smallest[k] > best.margin:
-                    best = Choice(om.Configuration(signs, (float(psi[k]),)), q[k], float(smallest[k]), np.inf)
-        poses.append(PoseSweep(T, tuple(branches), best))
-        request.progress(i + 1)
-    return SweepResult(psi, tuple(poses))
+def recording(monkeypatch) -> list[SweepResult]:
+    """Record every result of compute_sweep during the test."""
+    results = []
+    real = compute_sweep
+
+    def engine(request):
+        results.append(real(request))
+        return results[-1]
+
+    monkeypatch.setattr("om_redundant.cli.sweep.compute_sweep", engine)
+    return results
 
 
 def png_size(path) -> tuple[int, int]:
@@ -500,13 +550,7 @@ def png_size(path) -> tuple[int, int]:
 
 
 def test_sweep_outputs_agree_with_the_result(capsys, tmp_path, monkeypatch):
-    results = []
-
-    def engine(request):
-        results.append(stand_in_sweep(request))
-        return results[-1]
-
-    monkeypatch.setattr("om_redundant.cli.sweep.compute_sweep", engine)
+    results = recording(monkeypatch)
     files = {"csv": tmp_path / "sweep.csv", "json": tmp_path / "sweep.json", "plot": tmp_path / "sweep.png"}
     argv = ["sweep", "--resolution", "0.05", *(a for k, f in files.items() for a in (f"--{k}", str(f)))]
     status, out, err = in_process(capsys, *argv)
@@ -546,11 +590,10 @@ def test_sweep_outputs_agree_with_the_result(capsys, tmp_path, monkeypatch):
 
 
 def test_sweep_path_map_and_stdout_outputs(capsys, tmp_path, monkeypatch):
-    monkeypatch.setattr("om_redundant.cli.sweep.compute_sweep", stand_in_sweep)
     solver = om.OMSolver("panda")
     path = tmp_path / "path.csv"
     rows = []
-    for s in np.linspace(0.0, 0.6, 12):
+    for s in np.linspace(0.0, 0.6, 4):
         T = solver.arm.fk(Q_PANDA + s * np.array([1.0, 0.3, 0.0, 0.4, 0.0, -0.5, 0.0]))
         quat = np.empty(4)
         mujoco.mju_mat2Quat(quat, np.ascontiguousarray(T[:3, :3]).ravel())
@@ -559,15 +602,17 @@ def test_sweep_path_map_and_stdout_outputs(capsys, tmp_path, monkeypatch):
     plot = tmp_path / "map.svg"
     argv = ["sweep", "--path", str(path), "--signs", "1", "-1", "1", "--resolution", "0.1"]
     status, out, _ = in_process(capsys, *argv, "--plot", str(plot))
-    assert status == 0 and len(out.splitlines()) == 4 + 12 and plot.read_text().startswith("<?xml")
+    assert status == 0 and len(out.splitlines()) == 4 + 4 and plot.read_text().startswith("<?xml")
+    png = tmp_path / "map.png"
+    assert in_process(capsys, *argv, "--plot", str(png), "-q")[0] == 0 and png_size(png)[0] >= 800
     status, out, _ = in_process(capsys, *argv, "--json")
     data = json.loads(out)
-    assert status == 0 and len(data["poses"]) == 12 and all(p["chosen"] for p in data["poses"])
+    assert status == 0 and len(data["poses"]) == 4 and all(p["chosen"] for p in data["poses"])
     status, out, _ = in_process(capsys, *argv, "--csv", "--quiet")
     assert status == 0 and out.startswith(
         "pose,SHOULDER,ELBOW,WRIST,psi,ok,feasible,margin,clearance,q_joint1"
     )
-    assert len(out.splitlines()) == 1 + 12 * 63
+    assert len(out.splitlines()) == 1 + 4 * 63
 
 
 def test_progress_bar_on_a_terminal(monkeypatch):
@@ -586,3 +631,35 @@ def test_progress_bar_on_a_terminal(monkeypatch):
         and "[###############...............] 2/4" in text
     )
     assert not Progress(4, enabled=False).enabled and not Progress(1).enabled
+
+
+def test_sweep_path_tracks_like_the_optimiser_and_says_why_not(capsys, tmp_path):
+    """Every branch (some unsolved at some psi: no hints there), an obstacle: the tracked
+    choices are choose(T, previous)'s, and a pose left without one says why."""
+    solver = om.OMSolver("panda")
+    rows = []
+    for t in np.linspace(0.0, 0.5, 3):
+        T = solver.arm.fk(Q_PANDA + t * np.array([1.0, 0.3, 0.0, 0.4, 0.0, -0.5, 0.0]))
+        quat = np.empty(4)
+        mujoco.mju_mat2Quat(quat, np.ascontiguousarray(T[:3, :3]).ravel())
+        rows.append(",".join(repr(float(v)) for v in (*T[:3, 3], *quat)))
+    path = tmp_path / "path.csv"
+    path.write_text("\n".join(rows) + "\n")
+    poses = read_path(str(path))
+    ball = "sphere:0.2,0.12,0.6,0.05"
+    status, out, err = in_process(
+        capsys, "sweep", "--path", str(path), "--obstacle", ball, "--json", "--resolution", "0.1"
+    )
+    assert status == 0, err
+    data = json.loads(out)
+    optimizer = om.RedundancyOptimizer(solver, [om.Sphere([0.2, 0.12, 0.6], 0.05)])
+    previous = None
+    for got, T in zip(data["poses"], poses, strict=True):
+        choice = optimizer.choose(T, previous)
+        previous = choice
+        assert got["note"] == choice.reason
+        if choice.ok:
+            assert got["chosen"]["psi"] == pytest.approx(choice.configuration.redundancy[0], abs=1e-9)
+        else:
+            assert got["chosen"] is None and "no feasible psi within max_step" in got["note"]
+    assert any(p["chosen"] is None for p in data["poses"])

@@ -1,7 +1,7 @@
 """The ``om-redundant`` command.
 
-Subcommands, one module each: ``solve`` (one pose, one configuration or all; also the run
-without arguments), ``sweep`` (the arm angle of a 7-DOF arm for a pose or a path), ``arms``
+Subcommands, one module each: ``solve`` (one pose, one configuration or all), ``sweep`` (the
+arm angle of a 7-DOF arm for a pose or a path; also the run without arguments), ``arms``
 (the arms and their models), ``check-model`` (a MuJoCo model against an arm) and ``bench
 paper`` (the OM paper's experiment).
 
@@ -28,7 +28,7 @@ def build_parser() -> Parser:
     parser = Parser(
         prog=PROG,
         description="Exact inverse kinematics with configuration control (offset modification method). "
-        "Without a command: solve the UR5e's built-in pose in all eight configurations.",
+        "Without a command: sweep the Panda's arm angle for its built-in pose, a ball beside its elbow.",
     )
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     parser.add_argument("-q", "--quiet", action="store_true", help="print no table, only errors")
@@ -47,7 +47,7 @@ def main(argv: list[str] | None = None) -> int:
         except SystemExit as done:  # --help and --version print and stop here
             return done.code if isinstance(done.code, int) else 0
         if args.command is None:
-            args = parser.parse_args(["solve", *(["--quiet"] if args.quiet else [])])
+            args = parser.parse_args([*sweep.DEFAULT_RUN, *(["--quiet"] if args.quiet else [])])
         status = args.run(args)
         sys.stdout.flush()  # a closed pipe shows here, not at interpreter exit
         return status

@@ -32,7 +32,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help="solve one pose in one configuration or all, print q",
         description="Solve one pose exactly, in one configuration or in all branch-sign combinations, and "
         "print the joint vectors, statuses, errors and whether they are within the limits. "
-        "Without arguments: the UR5e's built-in pose in all eight configurations (the default run).",
+        "Without arguments: the UR5e's built-in pose in all eight configurations.",
     )
     add_arm_option(parser, DEFAULT_ARM)
     add_pose_options(parser)

@@ -2,10 +2,11 @@
 
 The command reads and checks its input here (arm, pose or path of poses, branches, obstacles,
 scene, resolution, output files) into a :class:`SweepRequest`, and hands it to
-:func:`compute_sweep`, which returns a :class:`SweepResult`. The computation itself (joint
-angles, limit margins and clearance along psi, feasible intervals, the optimiser's choice)
-is not built yet: :func:`compute_sweep` says so. :mod:`~om_redundant.cli.sweep_output` shows
-the result (table, CSV, JSON, plots).
+:func:`compute_sweep`, which returns a :class:`SweepResult`: joint angles, normalised
+joint-limit margins (:func:`~om_redundant.joint_margins`) and clearance along the psi grid,
+and from the redundancy optimiser (:class:`~om_redundant.RedundancyOptimizer`) the feasible
+intervals (exact ends) and its choice. :mod:`~om_redundant.cli.sweep_output` shows the result
+(table, CSV, JSON, plots).
 """
 
 from __future__ import annotations
@@ -15,16 +16,18 @@ import csv
 import math
 import sys
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import mujoco
 import numpy as np
 
+from ..clearance import Box, Capsule, Clearance, Shape, Sphere
 from ..configuration import Configuration
 from ..mujoco_match import load_mujoco_model
+from ..objective import joint_margins
+from ..redundancy import RedundancyChoice, RedundancyOptimizer
 from ..solver import OMSolver
 from .common import (
-    Failed,
     UsageError,
     add_arm_option,
     add_output_options,
@@ -41,6 +44,8 @@ DEFAULT_RESOLUTION = 2.0 * math.pi / 360.0  # rad: 360 arm angles
 MAX_SAMPLES = 100_000  # arm angles per branch and pose
 PLOT_SUFFIXES = (".png", ".svg")
 PATH_COLUMNS = ("x", "y", "z", "qw", "qx", "qy", "qz")
+#: The run without a command: the Panda's built-in pose with a ball beside its elbow.
+DEFAULT_RUN = ("sweep", "--obstacle", "sphere:0.2,0.12,0.6,0.05")
 
 #: Obstacle shapes: the numbers each takes, in order (metres, in the arm's root frame).
 SHAPES = {
@@ -68,15 +73,16 @@ class Obstacle:
     kind: str
     values: tuple[float, ...]
 
-    def geom(self) -> dict[str, str]:
-        """Attributes of the MJCF ``<geom>`` of this obstacle (type, size, and pos or fromto)."""
+    def shape(self, name: str = "") -> Shape:
+        """The library's obstacle (:class:`~om_redundant.Sphere`, ``Capsule`` or ``Box``)."""
         v = self.values
-        text = " ".join
         if self.kind == "sphere":
-            return {"type": "sphere", "pos": text(map(repr, v[:3])), "size": repr(v[3])}
+            return Sphere(v[:3], v[3], name)
         if self.kind == "capsule":
-            return {"type": "capsule", "fromto": text(map(repr, v[:6])), "size": repr(v[6])}
-        return {"type": "box", "pos": text(map(repr, v[:3])), "size": text(map(repr, v[3:]))}
+            return Capsule(v[:3], v[3:6], v[6], name)
+        pose = np.eye(4)
+        pose[:3, 3] = v[:3]
+        return Box(v[3:], pose, name)
 
 
 @dataclass(frozen=True, eq=False)
@@ -113,12 +119,15 @@ class BranchSweep:
         signs: The branch signs.
         q: (N, dof) joint vectors at each psi (NaN rows where there is no solution).
         ok: (N,) a solution exists at psi.
-        margin: (N, dof) distance of each joint to its nearer limit (rad, m for prismatic
-            joints), negative outside the limits; NaN where there is no solution.
+        margin: (N, dof) normalised joint-limit margin of each joint
+            (:func:`~om_redundant.joint_margins`: 1 at mid-range, 0 on a limit, negative
+            beyond); NaN where there is no solution.
         clearance: (N,) smallest distance between the arm and the obstacles (m), negative
             in penetration; +inf without obstacles, NaN where there is no solution.
         feasible: (N,) a solution within the limits and clear of the obstacles.
-        intervals: Feasible psi intervals ``(low, high)``, rad, from ``feasible``.
+        intervals: Feasible psi intervals ``(low, high)``, rad, with the optimiser's exact ends
+            (:meth:`~om_redundant.RedundancyOptimizer.intervals`): low in [-pi, pi), high
+            above pi when the arc crosses +-pi; ``(-pi, pi)`` for the whole circle.
     """
 
     signs: tuple[int, ...]
@@ -136,17 +145,21 @@ class Choice:
 
     configuration: Configuration
     q: np.ndarray
-    margin: float  # smallest joint-limit margin (rad or m)
+    margin: float  # smallest normalised joint-limit margin
     clearance: float  # m; +inf without obstacles
+    value: float = math.nan  # the optimiser's objective
+    branch_flipped: bool = False  # path mode: left the previous branch
 
 
 @dataclass(frozen=True, eq=False)
 class PoseSweep:
-    """The sweep of one pose: every requested branch, and the choice (None if none is feasible)."""
+    """The sweep of one pose: every requested branch, and the choice (None if none is feasible);
+    ``note``: why nothing was chosen, or (path mode) why the branch flipped."""
 
     pose: np.ndarray
     branches: tuple[BranchSweep, ...]
     chosen: Choice | None
+    note: str = ""
 
 
 @dataclass(frozen=True, eq=False)
@@ -157,12 +170,97 @@ class SweepResult:
     poses: tuple[PoseSweep, ...]
 
 
+def optimizer_for(request: SweepRequest) -> RedundancyOptimizer:
+    """The redundancy optimiser of the request: its arm, branches and obstacles (shapes and
+    scene in one :class:`~om_redundant.Clearance`), default objective."""
+    shapes: list[Shape | mujoco.MjModel] = [
+        o.shape(f"cli_{o.kind}{k}") for k, o in enumerate(request.obstacles)
+    ]
+    if request.scene is not None:
+        shapes.append(request.scene)
+    obstacles = Clearance.for_arm(request.solver.arm, shapes) if shapes else None
+    return RedundancyOptimizer(request.solver, obstacles, branches=request.branches)
+
+
 def compute_sweep(request: SweepRequest) -> SweepResult:
     """Sweep psi for every pose and branch of the request, and pick psi with the optimiser.
 
-    Not built yet: it needs the redundancy optimiser, which is being written.
+    For each pose and branch the psi grid is solved in one batch (on a path, hinted by the
+    previous pose's joints at the same psi); margins and clearance are the optimiser's own
+    (:func:`~om_redundant.joint_margins`, its :class:`~om_redundant.Clearance`). The intervals
+    are :meth:`RedundancyOptimizer.intervals`, the choice :meth:`RedundancyOptimizer.choose`
+    (on a path, tracked from the previous pose's choice).
     """
-    raise Failed("sweep: the redundancy sweep is not available yet (it needs the redundancy optimiser)")
+    psi = request.psi
+    optimizer = optimizer_for(request)
+    objective = optimizer.objective
+    poses: list[PoseSweep] = []
+    previous: RedundancyChoice | None = None
+    hints: dict[tuple[int, ...], np.ndarray] = {}
+    for i, T in enumerate(request.poses):
+        choice = optimizer.choose(T, previous if request.path else None)
+        if request.path:
+            found = optimizer.intervals(T)
+            previous = choice
+        else:
+            found = list(choice.intervals)  # untracked: every allowed branch's, as intervals(T)
+        branches = []
+        for signs in request.branches:
+            sweep = _branch_sweep(request, objective, T, signs, hints.get(signs))
+            if request.path:
+                hints[signs] = np.where(sweep.ok[:, None], sweep.q, hints.get(signs, sweep.q))
+            spans = tuple(
+                (-math.pi, math.pi) if iv.closed else (float(iv.lo), float(iv.hi))
+                for iv in found
+                if tuple(iv.signs) == tuple(signs)
+            )
+            branches.append(replace(sweep, intervals=spans))
+        chosen = None
+        if choice.ok:
+            chosen = Choice(
+                choice.configuration,
+                np.array(choice.solution.q),
+                float(choice.margin),
+                float(choice.clearance),
+                float(choice.value),
+                choice.branch_flipped,
+            )
+        poses.append(PoseSweep(T, tuple(branches), chosen, choice.reason))
+        request.progress(i + 1)
+    return SweepResult(psi, tuple(poses))
+
+
+def _branch_sweep(request, objective, T, signs, hint) -> BranchSweep:
+    """One branch along the grid: one batch solve, margins, clearance, feasibility."""
+    solver, psi = request.solver, request.psi
+    arm = solver.arm
+    n = len(psi)
+    if hint is not None and not np.isfinite(hint).all():
+        hint = None  # the kernel takes hints for every row or none
+    batch = solver.solve_batch(np.repeat(T[None], n, axis=0), signs, psi, q_hint=hint)
+    ok = np.asarray(batch.ok, dtype=bool)
+    q = np.full((n, arm.dof), np.nan)
+    margin = np.full((n, arm.dof), np.nan)
+    clearance = np.full(n, np.nan)
+    if ok.any():
+        q[ok] = _nearest_mid_range(arm, batch.q[ok])
+        margin[ok] = joint_margins(arm, q[ok])
+        if objective.clearance is None:
+            clearance[ok] = math.inf
+        else:
+            clearance[ok] = [objective.clearance.minimum(row) for row in q[ok]]
+    with np.errstate(invalid="ignore"):
+        feasible = ok & (np.min(np.nan_to_num(margin, nan=-1.0), axis=1) >= 0.0)
+        feasible &= ~(clearance < objective.min_clearance)
+    return BranchSweep(tuple(signs), q, ok, margin, clearance, feasible, ())
+
+
+def _nearest_mid_range(arm, q: np.ndarray) -> np.ndarray:
+    """Revolute joints with limits at their turn nearest mid-range, as the optimiser takes them."""
+    centred = arm.revolute & np.isfinite(arm.lower) & np.isfinite(arm.upper)
+    centre = np.where(centred, (arm.lower + arm.upper) / 2.0, 0.0)
+    wrapped = centre + np.remainder(q - centre + math.pi, 2.0 * math.pi) - math.pi
+    return np.where(centred, wrapped, q)
 
 
 # ---------------------------------------------------------------------------------------

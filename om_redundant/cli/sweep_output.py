@@ -47,12 +47,17 @@ def table(request: SweepRequest, result: SweepResult) -> str:
             c = pose.chosen
             if c is None:
                 lines.append(f"{i:>5}  {x:7.3f} {y:7.3f} {z:7.3f}  no feasible arm angle")
+                if pose.note:
+                    lines.append(f"{'':>7}{pose.note}")
                 continue
             signs, psi = signs_text(c.configuration.signs), c.configuration.redundancy[0]
             lines.append(
                 f"{i:>5}  {x:7.3f} {y:7.3f} {z:7.3f}  {signs:<9} {psi:7.3f}  "
                 f"{margin_text(c.margin):>7}  {clearance_text(c.clearance)}"
+                + ("  (branch flipped)" if c.branch_flipped else "")
             )
+            if pose.note:
+                lines.append(f"{'':>7}{pose.note}")
         return "\n".join(lines)
     (pose,) = result.poses
     names = " ".join(solver.sign_names)
@@ -82,7 +87,7 @@ def _best(margin: np.ndarray, clearance: np.ndarray, feasible: np.ndarray) -> tu
 def _choice_lines(request: SweepRequest, pose: PoseSweep) -> list[str]:
     c = pose.chosen
     if c is None:
-        return ["chosen: none (no feasible arm angle in any branch)"]
+        return ["chosen: none (no feasible arm angle in any branch)"] + ([pose.note] if pose.note else [])
     joints = request.solver.arm.joint_names
     return [
         f"chosen: {signs_text(c.configuration.signs)}, psi = {c.configuration.redundancy[0]:.4f} rad, "
@@ -153,7 +158,9 @@ def json_data(request: SweepRequest, result: SweepResult) -> dict:
             }
             for b in pose.branches
         ]
-        poses.append({"target": pose.pose, "chosen": chosen, "branches": branches})
+        if c is not None:
+            chosen.update(value=c.value, branch_flipped=c.branch_flipped)
+        poses.append({"target": pose.pose, "chosen": chosen, "note": pose.note, "branches": branches})
     return {
         "arm": solver.arm.name,
         "sign_names": solver.sign_names,
@@ -234,7 +241,11 @@ def _pose_plot(request: SweepRequest, result: SweepResult):
     ax = axes[arm.dof + 1]
     step = psi[1] - psi[0] if len(psi) > 1 else 2 * math.pi
     for b, branch in enumerate(pose.branches):
-        spans = [(lo, max(hi - lo, step)) for lo, hi in branch.intervals]
+        spans = []
+        for lo, hi in branch.intervals:  # an arc crossing +-pi is drawn at both ends
+            spans.append((lo, max(min(hi, math.pi) - lo, step)))
+            if hi > math.pi:
+                spans.append((-math.pi, max(hi - 2.0 * math.pi + math.pi, step)))
         ax.broken_barh(spans, (b - 0.35, 0.7), color=colour(b % 10))
         if chosen is not None and chosen.configuration.signs == branch.signs:
             ax.plot([chosen_psi], [b], "k*", ms=10)
@@ -292,7 +303,7 @@ def _path_map(request: SweepRequest, result: SweepResult):
     image = ax.imshow(
         np.ma.masked_invalid(best), aspect="auto", extent=extent, cmap=cmap, interpolation="nearest"
     )
-    figure.colorbar(image, ax=ax, label="best joint-limit margin of a feasible branch (rad)")
+    figure.colorbar(image, ax=ax, label="best normalised joint-limit margin of a feasible branch")
     tracked = [(i, p.chosen.configuration.redundancy[0]) for i, p in enumerate(result.poses) if p.chosen]
     if tracked:
         index, angle = np.array(tracked).T
