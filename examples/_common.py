@@ -88,7 +88,7 @@ def follow(solver, model, obstacles, path, seconds, *, exact, q_start, margin) -
         mink.CollisionAvoidanceLimit(model, [(arm_geoms, list(obstacles))], collision_detection_distance=0.1),
     ]
     run = Run("OM + mink" if exact else "plain mink")
-    for k in range(int(round(seconds / DT)) + 1):
+    for k in range(round(seconds / DT) + 1):
         T = path(min(1.0, k * DT / (0.75 * seconds)))
         frame.set_target(mink.SE3.from_matrix(T))
         if exact and not run.failure:
@@ -113,7 +113,8 @@ def report(example: str, margin: float, om_run: Run, mink_run: Run) -> dict:
     for run in (om_run, mink_run):
         s = run.summary()
         print(
-            f"{run.name:>11}: min clearance {s['min_clearance'] * 1000:7.1f} mm (margin {margin * 1000:.0f} mm), "
+            f"{run.name:>11}: min clearance {s['min_clearance'] * 1000:7.1f} mm "
+            f"(margin {margin * 1000:.0f} mm), "
             f"min joint margin {s['min_joint_margin']:.2f}, final hand error {s['final_error']:.1e} m"
         )
     return {"example": example, "margin": margin, "om": om_run.summary(), "mink": mink_run.summary()}
@@ -161,7 +162,8 @@ def plot(runs, margin: float, title: str, file: Path) -> Path:
         axes[1].plot(run.t, run.joint_margin, label=run.name)
         axes[2].semilogy(run.t, np.maximum(run.error, 1e-12), label=run.name)
     axes[0].axhline(margin * 1000, color="k", ls="--", lw=0.8, label="margin")
-    for ax, label in zip(axes, ["clearance to obstacle (mm)", "min joint-limit margin", "hand error (m)"]):
+    labels = ["clearance to obstacle (mm)", "min joint-limit margin", "hand error (m)"]
+    for ax, label in zip(axes, labels, strict=True):
         ax.set_xlabel("t (s)")
         ax.set_ylabel(label)
     axes[0].legend()
@@ -180,7 +182,7 @@ def show(model, runs, path_of_run) -> None:
         while viewer.is_running():
             for run in runs:
                 print("showing", run.name)
-                for t, q in zip(run.t, run.q):
+                for t, q in zip(run.t, run.q, strict=True):
                     data.qpos[: len(q)] = q
                     data.mocap_pos[0] = path_of_run(t)[:3, 3]
                     mujoco.mj_forward(model, data)
