@@ -18,15 +18,15 @@ MARGIN = 0.03  # m of clearance the optimiser keeps
 HOME = np.array([0.0, 0.6, 0.0, -1.3, 0.0, 1.2, 0.0])  # hand down in front, elbow up
 
 solver = om.OMSolver("iiwa14")
-obstacles = {"shelf": dict(type=mujoco.mjtGeom.mjGEOM_BOX, size=[0.3, 0.5, 0.01], pos=[0.6, 0.0, 0.68])}
+obstacles = {"shelf": dict(type=mujoco.mjtGeom.mjGEOM_BOX, size=[0.3, 0.5, 0.01], pos=[0.6, 0.0, 0.74])}
 model = scene(solver.arm, obstacles)
 T_home = solver.arm.fk(HOME)
 
 
 def path(s: float) -> np.ndarray:
-    """Hand pointing down at 0.45 m height, reaching in from x = 0.45 to 0.7 m under the shelf."""
+    """Hand pointing down at 0.4 m height, reaching in from x = 0.45 to 0.7 m under the shelf."""
     T = T_home.copy()
-    T[:3, 3] = [0.45 + 0.25 * s, 0.1 - 0.2 * s, 0.45]
+    T[:3, 3] = [0.45 + 0.25 * s, 0.1 - 0.2 * s, 0.4]
     return T
 
 
