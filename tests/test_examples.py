@@ -29,7 +29,9 @@ def test_readme_snippets_run():
 SCRIPTS = sorted(p for p in (ROOT / "examples").glob("*.py") if not p.name.startswith("_"))
 
 
-@pytest.mark.parametrize("script", [p for p in SCRIPTS if not p.name.startswith("avoid_")], ids=lambda p: p.name)
+@pytest.mark.parametrize(
+    "script", [p for p in SCRIPTS if not p.name.startswith("avoid_")], ids=lambda p: p.name
+)
 def test_example_runs(script):
     done = run_python(str(script))
     assert done.returncode == 0, done.stderr
