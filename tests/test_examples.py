@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import re
 
 import pytest
@@ -25,7 +26,28 @@ def test_readme_snippets_run():
         exec(compile(block, "README.md", "exec"), {})
 
 
-@pytest.mark.parametrize("script", sorted((ROOT / "examples").glob("*.py")), ids=lambda p: p.name)
+SCRIPTS = sorted(p for p in (ROOT / "examples").glob("*.py") if not p.name.startswith("_"))
+
+
+@pytest.mark.parametrize(
+    "script", [p for p in SCRIPTS if not p.name.startswith("avoid_")], ids=lambda p: p.name
+)
 def test_example_runs(script):
     done = run_python(str(script))
     assert done.returncode == 0, done.stderr
+
+
+@pytest.mark.parametrize("script", [p for p in SCRIPTS if p.name.startswith("avoid_")], ids=lambda p: p.name)
+def test_obstacle_example(script, tmp_path, monkeypatch):
+    """Headless, 2 s of simulated time: OM keeps the margin and ends on the pose; plain mink's
+    numbers are only reported."""
+    monkeypatch.setenv("MUJOCO_GL", "egl")
+    done = run_python(str(script), "--headless", "--seconds", "2", "--out", str(tmp_path))
+    assert done.returncode == 0, done.stderr
+    summary = json.loads(done.stdout.strip().splitlines()[-1])
+    print(summary)
+    assert "failure" not in summary["om"], summary["om"]
+    assert summary["om"]["min_clearance"] >= summary["margin"]
+    assert summary["om"]["final_error"] < 1e-4
+    assert {"min_clearance", "final_error"} <= summary["mink"].keys()
+    assert any(tmp_path.glob("*_strip.png")) and any(tmp_path.glob("*_clearance.png"))
