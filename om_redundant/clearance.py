@@ -36,6 +36,7 @@ import mujoco
 import numpy as np
 
 from .arm import Arm
+from .arm_in_model import ArmJoints
 from .exceptions import InvalidInput
 from .mjcf import arm_mjcf
 from .validation import as_joint_vector, as_pose, as_positive
@@ -157,8 +158,10 @@ class Clearance:
         distmax: Pairs farther apart than this (m) report ``distmax``.
 
     Raises:
-        InvalidInput: a joint or geom is missing, a joint's type differs from the arm's, an
-            obstacle geom moves with the arm, no obstacle is given, or distmax is not positive.
+        JointNotFound: A joint is not in the model (as in :class:`~om_redundant.ArmJoints`).
+        ModelMismatch: A joint's type differs from the arm's.
+        InvalidInput: A geom is missing, an obstacle geom moves with the arm, no obstacle is
+            given, or distmax is not positive.
 
     Example::
 
@@ -178,14 +181,10 @@ class Clearance:
         self.model, self.arm, self._dof = model, arm, arm.dof
         self.distmax = as_positive(distmax, "distmax")
         self._data = mujoco.MjData(model)
-        joints = [_find(model, mujoco.mjtObj.mjOBJ_JOINT, prefix + name, "joint") for name in arm.joint_names]
-        for j, revolute in zip(joints, arm.revolute, strict=True):
-            expected = mujoco.mjtJoint.mjJNT_HINGE if revolute else mujoco.mjtJoint.mjJNT_SLIDE
-            if model.jnt_type[j] != expected:
-                raise InvalidInput(f"joint '{model.joint(j).name}' is not a {expected.name} joint")
-        self._qpos = model.jnt_qposadr[joints]
-        self._dofs = model.jnt_dofadr[joints]
-        moving = _subtree(model, model.jnt_bodyid[joints[0]])
+        joints = ArmJoints(arm, model, prefix)
+        self._qpos = joints.qpos_ids
+        self._dofs = joints.dof_ids
+        moving = _subtree(model, model.jnt_bodyid[joints.joint_ids[0]])
         arm_geoms = [
             g
             for g in range(model.ngeom)

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from enum import StrEnum
+from functools import cached_property
 
 import numba as nb
 import numpy as np
@@ -104,14 +105,15 @@ class KinematicChain:
         for name in ("T_root_base", "T_flange_tool"):
             object.__setattr__(self, name, np.ascontiguousarray(getattr(self, name), dtype=np.float64))
 
-    @property
+    @cached_property
     def dof(self) -> int:
-        return sum(r.is_joint for r in self.rows)
+        """Number of joints (rows that are not fixed); computed once, the rows are frozen."""
+        return len(self.joint_rows)
 
-    @property
-    def joint_rows(self) -> list[int]:
-        """Index in :attr:`rows` of each joint's row, in joint order."""
-        return [i for i, r in enumerate(self.rows) if r.is_joint]
+    @cached_property
+    def joint_rows(self) -> tuple[int, ...]:
+        """Index in :attr:`rows` of each joint's row, in joint order; computed once."""
+        return tuple(i for i, r in enumerate(self.rows) if r.is_joint)
 
     def replace_rows(self, rows: list[DHRow]) -> KinematicChain:
         """The same chain with other rows (same base and tool)."""

@@ -2,15 +2,11 @@
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from .exceptions import InvalidInput
+from .arm_angle import arm_angle_and_gradient, check_arm_angle
 from .solver import OMSolver
 from .validation import as_joint_vector
-
-_ANGLE_STEP = 1e-6  # rad: central differences of the arm angle along the null space
 
 
 def self_motion_tangent(solver: OMSolver, q: np.ndarray) -> np.ndarray:
@@ -23,9 +19,9 @@ def self_motion_tangent(solver: OMSolver, q: np.ndarray) -> np.ndarray:
 
     .. math::  \frac{dq}{d\psi} = N\,\big(D\psi(q)\,N\big)^{-1},
 
-    with :math:`D\psi\,N` (r x r) by central differences of psi(q) along the columns of N
-    (step 1e-6 rad; error about 1e-10). It is singular where psi stops changing along the
-    self-motion (a fold of the solution path).
+    with :math:`D\psi` the analytic gradient of
+    :func:`~om_redundant.arm_angle.arm_angle_and_gradient`. It is singular where psi stops
+    changing along the self-motion (a fold of the solution path).
 
     Args:
         solver: The solver of a redundant arm (r = dof - 6 redundancy variables).
@@ -33,21 +29,13 @@ def self_motion_tangent(solver: OMSolver, q: np.ndarray) -> np.ndarray:
 
     Returns:
         (dof, r) matrix.
+
+    Raises:
+        InvalidInput: The arm has no arm angle, or q is malformed.
     """
-    r = len(solver.redundancy_names)
-    if r == 0 or solver.arm.dof - 6 != r:
-        raise InvalidInput(
-            f"arm '{solver.arm.name}' has {solver.arm.dof - 6} self-motion directions and "
-            f"{r} redundancy variables; the tangent needs as many of each, at least one"
-        )
+    check_arm_angle(solver)
     q = as_joint_vector(q, solver.arm.dof)
     null = np.linalg.svd(solver.arm.jacobian(q))[2][6:].T
-    change = np.empty((r, r))
-    for c in range(r):
-        ahead = solver.configuration_of(q + _ANGLE_STEP * null[:, c]).redundancy
-        behind = solver.configuration_of(q - _ANGLE_STEP * null[:, c]).redundancy
-        change[:, c] = [
-            math.remainder(a - b, 2.0 * math.pi) / (2.0 * _ANGLE_STEP)
-            for a, b in zip(ahead, behind, strict=True)
-        ]
+    gradient = arm_angle_and_gradient(solver, q)[1]
+    change = np.atleast_2d(gradient @ null)
     return np.linalg.solve(change.T, null.T).T

@@ -322,7 +322,7 @@ def test_bad_input_is_named_and_nothing_feasible_says_why(panda):
         om.Box([0.1, 0.0, 0.1])
     with pytest.raises(om.InvalidInput, match="Box pose: rotation is not orthonormal"):
         om.Box([0.1, 0.1, 0.1], np.diag([1.0, 2.0, 1.0, 1.0]))
-    with pytest.raises(om.InvalidInput, match="no joint named 'r_joint1'"):
+    with pytest.raises(om.JointNotFound, match="joint 'r_joint1' of arm 'panda' does not exist"):
         om.Clearance(om.arm_model(panda.arm, prefix="l_"), panda.arm, ["l_link1_capsule0"], prefix="r_")
     with pytest.raises(om.InvalidInput, match="no geom named 'wall'"):
         om.Clearance(om.arm_model(panda.arm), panda.arm, ["wall"])
