@@ -10,7 +10,7 @@ import sys
 
 import numpy as np
 
-from .common import Failed, table_wanted, write_json
+from .common import table_wanted, write_json
 from .sweep import PoseSweep, SweepRequest, SweepResult
 
 MAX_INTERVALS_SHOWN = 4  # per branch in the table
@@ -179,10 +179,8 @@ def json_data(request: SweepRequest, result: SweepResult) -> dict:
 
 
 def _pyplot():
-    try:
-        import matplotlib
-    except ImportError:
-        raise Failed("--plot needs matplotlib: pip install 'om_redundant[plot]'") from None
+    import matplotlib  # imported here: it is slow to import and only plots need it
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
