@@ -91,19 +91,15 @@ def _g_margin(problem, w, q):
     With shoulder offsets (D has six rows), w is q_1 and q_7 is solved inside
     (:func:`_wrist_ik`); otherwise w is q_J.
     """
-    family, P, mtab, _, J, D, R, p, signs, redundancy, q_prev, counter = problem
-    pm = np.empty(3)
+    J, D, p = problem[4], problem[5], problem[7]
     if D.shape[0] == 6:
         c, s = np.cos(w), np.sin(w)
+        pm = np.empty(3)
         for k in range(3):
             pm[k] = p[k] + D[3, k] + D[4, k] * c + D[5, k] * s
         margin = _wrist_ik(problem, pm, q)
     else:
-        d = _delta(D, w)
-        for k in range(3):
-            pm[k] = p[k] + R[k, 0] * d[0] + R[k, 1] * d[1] + R[k, 2] * d[2]
-        counter[0] += 1
-        margin = model_ik(family, P, mtab, R, pm, signs, redundancy, q_prev, q)
+        margin = _ik_plus_delta(problem, p, w, q)
     if margin < -REACH_SLACK:
         return np.nan, margin
     if J < 0:
@@ -111,16 +107,22 @@ def _g_margin(problem, w, q):
     return wrap(q[J] - w), margin
 
 
+@nb.njit(cache=True, inline="always")
+def _ik_plus_delta(problem, base, w, q):
+    """Model IK for p_m = base + R delta(w) (one residual evaluation); returns the reach margin."""
+    family, P, mtab, _, _, D, R, _, signs, redundancy, q_prev, counter = problem
+    counter[0] += 1
+    d = _delta(D, w)
+    pm = np.empty(3)
+    for k in range(3):
+        pm[k] = base[k] + R[k, 0] * d[0] + R[k, 1] * d[1] + R[k, 2] * d[2]
+    return model_ik(family, P, mtab, R, pm, signs, redundancy, q_prev, q)
+
+
 @nb.njit(cache=True)
 def _ik_at_q7(problem, pm, w7, q):
     """Model IK for p_m + R delta(w7); returns (h, margin), h = wrap(q_7 - w7) (NaN out of reach)."""
-    family, P, mtab, _, _, D, R, _, signs, redundancy, q_prev, counter = problem
-    counter[0] += 1
-    d = _delta(D, w7)
-    x = np.empty(3)
-    for k in range(3):
-        x[k] = pm[k] + R[k, 0] * d[0] + R[k, 1] * d[1] + R[k, 2] * d[2]
-    margin = model_ik(family, P, mtab, R, x, signs, redundancy, q_prev, q)
+    margin = _ik_plus_delta(problem, pm, w7, q)
     if margin < -REACH_SLACK:
         return np.nan, margin
     return wrap(q[6] - w7), margin
