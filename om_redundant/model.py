@@ -186,8 +186,12 @@ def _srs_model(arm: Arm) -> tuple[KinematicChain, KinematicChain, np.ndarray]:
             f"arm '{arm.name}': the shoulder offset a2 = {rows[jr[1]].a:g} m makes dp depend on q2; "
             "the bounded search handles offsets that turn with q1 or q7 only"
         )
-    if jr[-1] - jr[0] != 6:
-        raise ModelError(f"arm '{arm.name}': fixed rows between joints are not supported by the 7-DOF model")
+    if jr[5] - jr[0] != 5:
+        raise ModelError(
+            f"arm '{arm.name}': fixed rows between joints 1 and 6 are not supported by the 7-DOF model"
+        )
+    if any(rows[r].a != 0.0 for r in range(jr[5] + 1, jr[6])):
+        raise ModelError(f"arm '{arm.name}': fixed rows between joints 6 and 7 need a = 0")
     for j in (0, 1, 4, 5):
         _check_right_angle(arm.name, rows[jr[j]], j)
     for j, fields in ((0, ("a",)), (1, ("d",))):
@@ -195,6 +199,12 @@ def _srs_model(arm: Arm) -> tuple[KinematicChain, KinematicChain, np.ndarray]:
     shoulderless = arm.chain.replace_rows(rows)
     for j, fields in ((4, ("a",)), (5, ("a", "d"))):
         rows[jr[j]] = dataclasses.replace(rows[jr[j]], **dict.fromkeys(fields, 0.0))
+    # Lengths along joint 7's axis between joints 6 and 7 move past joint 7 (its row's d):
+    # joint 7's axis then meets W, and the hand moves by no more than their tilt.
+    moved = sum(rows[r].d for r in range(jr[5] + 1, jr[6]))
+    for r in range(jr[5] + 1, jr[6]):
+        rows[r] = dataclasses.replace(rows[r], d=0.0)
+    rows[jr[6]] = dataclasses.replace(rows[jr[6]], d=rows[jr[6]].d + moved)
     chain = arm.chain.replace_rows(rows)
     table = chain.table
 
@@ -214,10 +224,14 @@ def _srs_model(arm: Arm) -> tuple[KinematicChain, KinematicChain, np.ndarray]:
     if np.hypot(k1, k2) < 1e-9:
         raise ModelError(f"arm '{arm.name}': joint 4 does not change the shoulder-wrist distance")
     P = np.zeros(srs.N_PARAMS)
-    P[srs.SIGMA1], P[srs.SIGMA2], P[srs.SIGMA5], P[srs.SIGMA6] = (
-        np.sign(np.sin(rows[jr[j]].alpha)) for j in (0, 1, 4, 5)
-    )
+    P[srs.SIGMA1], P[srs.SIGMA2], P[srs.SIGMA5] = (np.sign(np.sin(rows[jr[j]].alpha)) for j in (0, 1, 4))
     P[srs.THETA : srs.THETA + 7] = [rows[r].theta for r in jr]
+    # The wrist's middle rotation Rx(alpha_6) F = Rz(a) Rx(beta) Rz(b), F the fixed rows'.
+    middle = _rotx(rows[jr[5]].alpha) @ _pose(table[jr[5] + 1 : jr[6]], q0[:0])[0]
+    sin_beta = np.sign(np.sin(rows[jr[5]].alpha)) * np.sqrt(max(1.0 - middle[2, 2] ** 2, 0.0))
+    P[srs.SIN_BETA], P[srs.COS_BETA] = sin_beta, middle[2, 2]
+    P[srs.THETA + 5] += np.arctan2(middle[0, 2] / sin_beta, -middle[1, 2] / sin_beta)
+    P[srs.THETA + 6] += np.arctan2(middle[2, 0] / sin_beta, middle[2, 1] / sin_beta)
     P[srs.SHOULDER : srs.SHOULDER + 3] = S
     P[srs.WRIST : srs.WRIST + 3] = R_fl.T @ (W - p_fl)
     P[srs.S3 : srs.S3 + 3] = s3

@@ -13,21 +13,26 @@ seen from the flange and depends on one wrist joint, :math:`w = q_J` (see
 and a root gives the real arm's joints :math:`q = \mathrm{IK}_{model}(\ldots)` with
 :math:`|p_{real}(q) - p_d| = |\delta(w) - \delta(q_J)| \le \Delta p_{max}\,|g(w)|`.
 
-Arms with shoulder offsets (Gen3) add :math:`a(q_1)`, so solutions lie on a torus
-:math:`(q_1, q_7)`. The search then scans :math:`w = q_1`, where the larger offset acts,
-and solves :math:`q_7` inside each evaluation of g by a secant iteration on
-:math:`\mathrm{IK}(R_d, p_d + a(w) + R_d\,\delta(w_7), c)_7 = w_7`, which is nearly
-the identity because the wrist offset is small. Where that iteration has no root, the
-point counts as out of reach.
+Arms with shoulder offsets (Gen3, Sawyer) add :math:`a(q_1)`, so solutions lie on a torus
+:math:`(w_1, w_7) = (q_1, q_7)`: :math:`p_m = p_d + a(w_1) + R_d\,\delta(w_7)`. There the
+system is lifted to three unknowns :math:`(w_1, w_7, \varphi_4)` and three residuals that
+are smooth everywhere (:func:`~om_redundant.closed_form.srs.model_ik_lifted`): the model IK
+with q1, q7 and the elbow angle given is consistent with the shoulder, the wrist and the
+elbow equation. In (w1, w7) alone the residual has a square-root branch point at the edge of
+reach (the straight or folded elbow) and steep Euler angles at the shoulder and wrist
+singularities, which is where roots crowd; lifted, Newton's method converges there.
 
 * Local solve: Broyden's method, which in one unknown is the secant method, started with a
   finite-difference slope, from the joint of the paper's fixed-point start
-  (:math:`p_m = p_d`) or of a hint.
+  (:math:`p_m = p_d`) or of a hint; on the torus, damped Newton on the lifted system.
 * Bounded search, the paper's guarantee: g is sampled on a grid over the whole circle (the
   image of the ball :math:`|p_m - p_d| \le \Delta p_{max}` that can hold solutions); each sign
   change is refined; near the edges of the model's reach, at local minima of |g| and on
   small islands of reach, where roots come in close pairs, 1-D extremum searches find
-  them. Every candidate is verified with the REAL arm's forward kinematics.
+  them. On the torus, a grid of the lifted residual seeds Newton's method, with deflation
+  and a search along each root's fold direction for close pairs (:func:`_torus_roots`);
+  this is a thorough search rather than a proof. Every candidate is verified with the REAL
+  arm's forward kinematics.
 
 All kernels work in DH frame 0 with the flange pose. One target's problem travels as one
 tuple, see :func:`make_problem`; its last entry counts the residual evaluations.
@@ -38,8 +43,8 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from .closed_form import REACH_SLACK, branch_values, model_ik, redundancy_values, wrap
-from .closed_form.common import dot, mtm
+from .closed_form import REACH_SLACK, branch_values, model_ik, redundancy_values, srs, wrap
+from .closed_form.common import add, cross, dot, mtm, scale, unit
 from .kinematics import flange_kernel
 
 OK = 0
@@ -54,7 +59,13 @@ _START_POINTS = 8  # samples of the dp circle tried when p_d is outside the mode
 _WINDOW_POINTS = 8  # samples of the window searched around a hint
 _PAIR_SEARCH = 1.0  # |g| (rad) below which a local minimum is searched for a root pair
 _REDUNDANCY_TOL = 1e-9  # a solution's redundancy values (rad) must equal the requested ones
-_INNER_TOL = 1e-12  # |h| (rad) at which the inner q7 iteration has converged
+_TORUS_SIDE = 0.75  # the torus grid has _TORUS_SIDE * scan points nodes per side
+_MAX_KNOWN = 64  # roots of the lifted torus system kept for deflation
+_MIN_STEP = 1.0 / 256.0  # the shortest damped Newton step on the torus, as a fraction of the full one
+_STALL = 3  # slow damped Newton steps in a row after which a run on the torus gives up
+_NEAR_ROOT = 0.1  # on the whole torus, every node with a lifted residual below this starts Newton
+_PARTNER_CELLS = 2.0  # a root's fold partner is sought this many grid cells away at most
+_PARTNER_SAMPLES = 8  # samples each way along the fold direction
 
 
 @nb.njit(cache=True, inline="always")
@@ -86,20 +97,9 @@ def _with_signs(problem, signs):
 
 @nb.njit(cache=True, inline="always")
 def _g_margin(problem, w, q):
-    """Residual g(w) (NaN if unreachable) and the model's reach margin; writes the IK into q.
-
-    With shoulder offsets (D has six rows), w is q_1 and q_7 is solved inside
-    (:func:`_wrist_ik`); otherwise w is q_J.
-    """
-    J, D, p = problem[4], problem[5], problem[7]
-    if D.shape[0] == 6:
-        c, s = np.cos(w), np.sin(w)
-        pm = np.empty(3)
-        for k in range(3):
-            pm[k] = p[k] + D[3, k] + D[4, k] * c + D[5, k] * s
-        margin = _wrist_ik(problem, pm, q)
-    else:
-        margin = _ik_plus_delta(problem, p, w, q)
+    """Residual g(w) (NaN if unreachable) and the model's reach margin; writes the IK into q."""
+    J, p = problem[4], problem[7]
+    margin = _ik_plus_delta(problem, p, w, q)
     if margin < -REACH_SLACK:
         return np.nan, margin
     if J < 0:
@@ -119,57 +119,93 @@ def _ik_plus_delta(problem, base, w, q):
     return model_ik(family, P, mtab, R, pm, signs, redundancy, q_prev, q)
 
 
-@nb.njit(cache=True)
-def _ik_at_q7(problem, pm, w7, q):
-    """Model IK for p_m + R delta(w7); returns (h, margin), h = wrap(q_7 - w7) (NaN out of reach)."""
-    margin = _ik_plus_delta(problem, pm, w7, q)
-    if margin < -REACH_SLACK:
-        return np.nan, margin
-    return wrap(q[6] - w7), margin
+@nb.njit(cache=True, inline="always")
+def _torus_target(problem, w1, w7):
+    """p_m = p_d + a(w1) + R delta(w7); counts one residual evaluation."""
+    D, R, p, counter = problem[5], problem[6], problem[7], problem[11]
+    counter[0] += 1
+    c1, s1 = np.cos(w1), np.sin(w1)
+    d = _delta(D, w7)
+    pm = np.empty(3)
+    for k in range(3):
+        pm[k] = (
+            p[k] + D[3, k] + D[4, k] * c1 + D[5, k] * s1 + R[k, 0] * d[0] + R[k, 1] * d[1] + R[k, 2] * d[2]
+        )
+    return pm
+
+
+@nb.njit(cache=True, inline="always")
+def _lifted_residual(problem, x, q):
+    """The lifted residual (shoulder, wrist, elbow) at x = (w1, w7, phi4) for
+    p_m = p_d + a(w1) + R delta(w7) (see srs.model_ik_lifted); writes the model IK into q."""
+    _, P, _, _, _, _, R, _, signs, redundancy, _, _ = problem
+    pm = _torus_target(problem, x[0], x[1])
+    return srs.model_ik_lifted(P, R, pm, signs, redundancy[0], x[0], x[1], x[2], q)
+
+
+@nb.njit(cache=True, inline="always")
+def _deflated_residual(problem, x, q, known, n_known):
+    """The lifted residual times prod_k (1 + 1 / |x - x_k|^2) over the roots x_k already
+    known (deflation: Newton's method is then repelled from them, to find another)."""
+    F = _lifted_residual(problem, x, q)
+    factor = 1.0
+    for k in range(n_known):
+        d2 = 0.0
+        for i in range(3):
+            d2 += wrap(x[i] - known[k, i]) ** 2
+        factor *= 1.0 + 1.0 / max(d2, 1e-300)
+    return scale(factor, F)
 
 
 @nb.njit(cache=True)
-def _wrist_ik(problem, pm, q):
-    """Model IK with the wrist offsets' dp :math:`R\\,\\delta(q_7)` taken at the model's own q_7.
+def _newton_torus(problem, x, q, known, n_known):
+    """Damped Newton's method on the lifted system from x = (w1, w7, phi4), with a
+    forward-difference Jacobian, deflated by the first n_known rows of known.
 
-    Solves :math:`h(w_7) = \\mathrm{wrap}(\\mathrm{IK}(p_m + R\\,\\delta(w_7))_7 - w_7) = 0` by
-    the secant method. The wrist offsets are small next to the shoulder's (the bounded search
-    scans q_1), so :math:`dh/dw_7 \\approx -1` and the root is unique except within a
-    hair of the model's reach edge. The start is the hint's q_7, or, if the model cannot
-    reach from there, the best of a few samples of the circle. Returns the reach margin at
-    the root, whose IK is in q; without a root, a negative number.
+    Each step is halved until the residual's max norm decreases, so that it stops, rather
+    than jumps, where the Jacobian is singular; it also stops after ``_STALL`` steps in a row
+    that shrink the norm by less than a tenth (a local minimum of the norm that is no root).
+    Returns the max norm of the (undeflated) residual at the end, inf if not finite, and the
+    end point; q holds the model IK there.
     """
-    w0 = problem[10][6]
-    h0, margin = _ik_at_q7(problem, pm, w0, q)
-    if np.isnan(h0):
-        best, best_margin = np.inf, margin
-        for k in range(_START_POINTS):
-            w = -np.pi + 2.0 * np.pi * k / _START_POINTS
-            h, m = _ik_at_q7(problem, pm, w, q)
-            best_margin = max(best_margin, m)
-            if abs(h) < best:  # False for NaN
-                best, w0, h0 = abs(h), w, h
-        if np.isnan(h0):
-            return best_margin
-    w1 = w0 + h0  # a fixed-point step
-    h1, margin = _ik_at_q7(problem, pm, w1, q)
-    for _ in range(40):
-        while np.isnan(h1) and abs(w1 - w0) > 1e-12:  # stepped out of reach: step back
-            w1 = 0.5 * (w0 + w1)
-            h1, margin = _ik_at_q7(problem, pm, w1, q)
-        if np.isnan(h1) or abs(h1) < 1e-15 or h1 == h0:
+    F = _deflated_residual(problem, x, q, known, n_known)
+    r = _norm(F)
+    eps = 1e-7
+    slow = 0
+    for _ in range(30):
+        if not r < np.inf or r < 1e-15 or slow == _STALL:
             break
-        step = -h1 * (w1 - w0) / (h1 - h0)
-        if abs(step) > 0.5:
-            step = 0.5 * np.sign(step)
-        w0, h0 = w1, h1
-        w1 = w1 + step
-        h1, margin = _ik_at_q7(problem, pm, w1, q)
-    if np.isnan(h1):  # q must belong to a reachable iterate
-        h1, margin = _ik_at_q7(problem, pm, w0, q)
-    # No root: the iterates ran into the reach edge. -|h| extends the margin past the edge,
-    # where both vanish, so that the search sees the region as out of reach.
-    return margin if abs(h1) < _INNER_TOL else -abs(h1)
+        # Rows of the Jacobian, then the step -J^-1 F by cofactors.
+        F0 = _deflated_residual(problem, (x[0] + eps, x[1], x[2]), q, known, n_known)
+        F1 = _deflated_residual(problem, (x[0], x[1] + eps, x[2]), q, known, n_known)
+        F2 = _deflated_residual(problem, (x[0], x[1], x[2] + eps), q, known, n_known)
+        rows = [((F0[i] - F[i]) / eps, (F1[i] - F[i]) / eps, (F2[i] - F[i]) / eps) for i in range(3)]
+        c0, c1, c2 = cross(rows[1], rows[2]), cross(rows[2], rows[0]), cross(rows[0], rows[1])
+        det = dot(rows[0], c0)
+        if not abs(det) > 0.0:  # also NaN
+            break
+        step = scale(-1.0 / det, add(add(scale(F[0], c0), scale(F[1], c1)), scale(F[2], c2)))
+        size = max(abs(step[0]), abs(step[1]), abs(step[2]))
+        t = 1.0 if size < 0.5 else 0.5 / size
+        while t > _MIN_STEP:
+            Fn = _deflated_residual(problem, add(x, scale(t, step)), q, known, n_known)
+            if _norm(Fn) < r:  # False for NaN
+                break
+            t *= 0.5
+        if t <= _MIN_STEP:
+            break
+        x = add(x, scale(t, step))
+        F = Fn
+        slow = slow + 1 if _norm(F) > 0.9 * r else 0
+        r = _norm(F)
+    # q must belong to the final iterate.
+    r = _norm(_lifted_residual(problem, x, q))
+    return (r if r < np.inf else np.inf), x
+
+
+@nb.njit(cache=True, inline="always")
+def _norm(F):
+    return max(abs(F[0]), abs(F[1]), abs(F[2]))
 
 
 @nb.njit(cache=True, inline="always")
@@ -507,40 +543,241 @@ def _scan(problem, lo, hi, n_pts, full_circle, q, cands):
 
 
 @nb.njit(cache=True)
-def all_roots(problem, n_scan, tol_pos, tol_ori, roots, lo=-np.pi, hi=np.pi):
+def _add_root(problem, q, tol_pos, tol_ori, roots, count):
+    """Append q to roots if the real arm verifies it and it is new; returns the count."""
+    if not verify(problem, q, tol_pos, tol_ori)[2]:
+        return count
+    for r in range(count):
+        diff = 0.0
+        for j in range(q.shape[0]):
+            diff = max(diff, abs(wrap(q[j] - roots[r, j])))
+        if diff < _SAME_ROOT:
+            return count
+    if count < roots.shape[0]:
+        roots[count] = q
+        count += 1
+    return count
+
+
+@nb.njit(cache=True)
+def _crosses(A, i, j):
+    """Whether A changes sign over the grid cell (i, j) (four reachable corners, no wrap)."""
+    lo, hi = np.inf, -np.inf
+    for a in (A[i, j], A[i + 1, j], A[i, j + 1], A[i + 1, j + 1]):
+        if np.isnan(a):
+            return False
+        lo, hi = min(lo, a), max(hi, a)
+    return lo <= 0.0 <= hi and hi - lo < np.pi
+
+
+@nb.njit(cache=True)
+def _torus_roots(problem, n, tol_pos, tol_ori, roots, centre, radius):
+    """Bounded search on the torus (w1, w7) of an arm with shoulder offsets; returns the count.
+
+    The lifted residual, with phi4 from the elbow equation (so its third entry is zero in
+    reach and the reach deficit beyond), is sampled on an n x n grid (over the square of
+    half-width ``radius`` around the centre's (q_1, q_7) when radius < pi). Its max norm is
+    continuous. Newton's method starts from every node where the norm is a local minimum
+    below ``_PAIR_SEARCH`` or (on the whole torus) below ``_NEAR_ROOT``, and from every cell
+    where both the shoulder and the wrist residual change sign. Each new root is followed by
+    more runs from the same start, deflated by the roots found so far, until they find no new
+    one, and by runs from its fold partners (:func:`_fold_partners`): close pairs of roots
+    are not missed.
+    """
+    q = np.empty(roots.shape[1])
+    whole = radius >= np.pi
+    if whole:
+        lo1, lo7, span = -np.pi, -np.pi, 2.0 * np.pi
+    else:
+        lo1, lo7, span = centre[0] - radius, centre[6] - radius, 2.0 * radius
+    step = span / n
+    m = n + 1  # on the whole torus the last row and column repeat the first
+    S, W, F, E = np.empty((m, m)), np.empty((m, m)), np.empty((m, m)), np.empty((m, m))
+    for i in range(m):
+        for j in range(m):
+            r = _lifted_residual(problem, (lo1 + i * step, lo7 + j * step, np.nan), q)
+            S[i, j], W[i, j], E[i, j] = r[0], r[1], q[3] + problem[1][srs.THETA + 3]
+            F[i, j] = _norm(r) if _norm(r) < np.inf else np.inf
+    count = 0
+    known = np.empty((_MAX_KNOWN, 3))
+    n_known = 0
+    partners = [(0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)]
+    phi_star = problem[1][srs.PHI_STAR]
+    for i in range(m):
+        for j in range(m):
+            for centre_of_cell in (False, True):
+                if centre_of_cell:
+                    start = i < n and j < n and _crosses(S, i, j) and _crosses(W, i, j)
+                    x = (lo1 + (i + 0.5) * step, lo7 + (j + 0.5) * step, E[i, j])
+                else:
+                    start = F[i, j] < _PAIR_SEARCH
+                    for ii in range(max(i - 1, 0), min(i + 2, m)):
+                        for jj in range(max(j - 1, 0), min(j + 2, m)):
+                            start = start and F[ii, jj] >= F[i, j]
+                    start = start or (whole and F[i, j] < _NEAR_ROOT)
+                    x = (lo1 + i * step, lo7 + j * step, E[i, j])
+                if not start or n_known == _MAX_KNOWN:
+                    continue
+                first = n_known
+                n_known = _new_root(problem, x, False, known, n_known, q)
+                if n_known == first:
+                    # Near the edge of reach the elbow angle changes fastest: try once more
+                    # from the nearer edge's (the straight or the folded elbow).
+                    edge = phi_star if np.cos(x[2] - phi_star) > 0.0 else phi_star + np.pi
+                    n_known = _new_root(problem, (x[0], x[1], edge), False, known, n_known, q)
+                if n_known == first:
+                    continue
+                count = _add_root(problem, q, tol_pos, tol_ori, roots, count)
+                while n_known < _MAX_KNOWN:  # deflated, from the same start
+                    found = n_known
+                    n_known = _new_root(problem, x, True, known, n_known, q)
+                    if n_known == found:
+                        break
+                    count = _add_root(problem, q, tol_pos, tol_ori, roots, count)
+                k = first
+                while k < n_known < _MAX_KNOWN:
+                    root = (known[k, 0], known[k, 1], known[k, 2])
+                    k += 1
+                    for a in range(_fold_partners(problem, root, _PARTNER_CELLS * step, q, partners)):
+                        found = n_known
+                        n_known = _new_root(problem, partners[a], True, known, n_known, q)
+                        if n_known == found:  # the line bends away from the partner: halfway
+                            halfway = scale(0.5, add(partners[a], root))
+                            n_known = _new_root(problem, halfway, True, known, n_known, q)
+                        if n_known > found:
+                            count = _add_root(problem, q, tol_pos, tol_ori, roots, count)
+    return count
+
+
+@nb.njit(cache=True)
+def _new_root(problem, x, deflate, known, n_known, q):
+    """Newton's method from x, deflated by the known roots if ``deflate``; a new root is
+    appended to known, with its model IK in q. Returns the number of known roots."""
+    r, x_root = _newton_torus(problem, x, q, known, n_known if deflate else 0)
+    if r > _ROOT_TOL:
+        return n_known
+    for k in range(n_known):
+        if (
+            max(
+                abs(wrap(x_root[0] - known[k, 0])),
+                abs(wrap(x_root[1] - known[k, 1])),
+                abs(wrap(x_root[2] - known[k, 2])),
+            )
+            < _SAME_ROOT
+        ):
+            return n_known
+    known[n_known] = x_root
+    return n_known + 1
+
+
+@nb.njit(cache=True)
+def _fold_partners(problem, x, reach, q, starts):
+    r"""Starts for the partners of the root x, if x is one of a close pair; returns the count.
+
+    Two roots close together straddle a fold, where the Jacobian J is singular. With u, v
+    J's near-null left and right vectors, the residual along the line x + t v is nearly
+    :math:`u \cdot F`, which vanishes at t = 0 with slope :math:`u \cdot J v` and, at a
+    partner, again. A partner nearer than the samples (a near-double root) is the second
+    zero of the quadratic fit :math:`u \cdot F \approx (u \cdot J v)\, t + c\, t^2`; further
+    out, :math:`u \cdot F` is sampled at ``_PARTNER_SAMPLES`` points each way up to
+    ``reach``, and the first sign change each way is a start.
+    """
+    eps = 1e-7
+    F = _lifted_residual(problem, x, q)
+    F0 = _lifted_residual(problem, (x[0] + eps, x[1], x[2]), q)
+    F1 = _lifted_residual(problem, (x[0], x[1] + eps, x[2]), q)
+    F2 = _lifted_residual(problem, (x[0], x[1], x[2] + eps), q)
+    cols = (
+        scale(1.0 / eps, (F0[0] - F[0], F0[1] - F[1], F0[2] - F[2])),
+        scale(1.0 / eps, (F1[0] - F[0], F1[1] - F[1], F1[2] - F[2])),
+        scale(1.0 / eps, (F2[0] - F[0], F2[1] - F[1], F2[2] - F[2])),
+    )
+    rows = (
+        (cols[0][0], cols[1][0], cols[2][0]),
+        (cols[0][1], cols[1][1], cols[2][1]),
+        (cols[0][2], cols[1][2], cols[2][2]),
+    )
+    v, u = _null_vector(rows), _null_vector(cols)
+    slope = dot(u, add(add(scale(v[0], cols[0]), scale(v[1], cols[1])), scale(v[2], cols[2])))
+    n = 0
+    h = reach / _PARTNER_SAMPLES
+    # A partner closer than the samples (a near-double root): the second zero of the
+    # quadratic u.F = slope t + c t^2, c from one more point.
+    d = 1e-4
+    c = (dot(u, _lifted_residual(problem, add(x, scale(d, v)), q)) - dot(u, F) - slope * d) / (d * d)
+    t = -slope / c
+    if abs(t) < h:  # also not NaN
+        starts[n] = add(x, scale(t, v))
+        n += 1
+    for direction in (-1.0, 1.0):
+        t_prev, f_prev = 0.0, 0.0
+        for k in range(1, _PARTNER_SAMPLES + 1):
+            t = direction * k * h
+            f = dot(u, _lifted_residual(problem, add(x, scale(t, v)), q))
+            if np.isnan(f):
+                break
+            if f * slope * direction < 0.0:  # u.F has come back through zero
+                if k > 1:
+                    t = t_prev + (t - t_prev) * f_prev / (f_prev - f)
+                starts[n] = add(x, scale(t, v))
+                n += 1
+                break
+            t_prev, f_prev = t, f
+    return n
+
+
+@nb.njit(cache=True, inline="always")
+def _null_vector(rows):
+    """Unit vector nearest the null space of a nearly singular 3x3 matrix (given by rows):
+    the longest cross product of two rows."""
+    best = cross(rows[0], rows[1])
+    for c in (cross(rows[1], rows[2]), cross(rows[2], rows[0])):
+        if dot(c, c) > dot(best, best):
+            best = c
+    return unit(best)
+
+
+@nb.njit(cache=True)
+def all_roots(problem, n_scan, tol_pos, tol_ori, roots, centre, radius):
     """Bounded search: every verified solution in this configuration. Returns the count.
 
-    With ``lo, hi`` narrower than the circle, only roots with q_J in [lo, hi] are sought.
+    With ``radius < pi``, only roots whose scanned joints (q_J, or q_1 and q_7 on the torus)
+    lie within ``radius`` of the centre's are sought.
     """
     dof = roots.shape[1]
     q = np.empty(dof)
-    if problem[4] < 0:
+    J = problem[4]
+    if J < 0:
         g = _g(problem, 0.0, q)
-        if not np.isnan(g) and verify(problem, q, tol_pos, tol_ori)[2]:
-            roots[0] = q
-            return 1
-        return 0
+        return 0 if np.isnan(g) else _add_root(problem, q, tol_pos, tol_ori, roots, 0)
+    if problem[5].shape[0] == 6:
+        return _torus_roots(
+            problem, max(int(_TORUS_SIDE * n_scan), 4), tol_pos, tol_ori, roots, centre, radius
+        )
     cands = np.empty(8 * n_scan + 8)
-    full_circle = hi - lo >= 2.0 * np.pi
-    n = _scan(problem, lo, lo + 2.0 * np.pi if full_circle else hi, n_scan, full_circle, q, cands)
+    full_circle = radius >= np.pi
+    lo, hi = (-np.pi, np.pi) if full_circle else (centre[J] - radius, centre[J] + radius)
+    n = _scan(problem, lo, hi, n_scan, full_circle, q, cands)
     count = 0
     for i in range(n):
         g = _g(problem, cands[i], q)
         if not np.isnan(g) and abs(g) > _ROOT_TOL:  # polish the bracket's estimate
             _broyden(problem, cands[i], q)
-        if not verify(problem, q, tol_pos, tol_ori)[2]:
-            continue
-        duplicate = False
-        for r in range(count):
-            diff = 0.0
-            for j in range(dof):
-                diff = max(diff, abs(wrap(q[j] - roots[r, j])))
-            if diff < _SAME_ROOT:
-                duplicate = True
-        if not duplicate and count < roots.shape[0]:
-            roots[count] = q
-            count += 1
+        count = _add_root(problem, q, tol_pos, tol_ori, roots, count)
     return count
+
+
+@nb.njit(cache=True)
+def _local_solve(problem, start, q):
+    """Local solve from the joint vector start (its q_J, or q_1 and q_7 on the torus).
+
+    Returns the final residual; q holds the model IK there.
+    """
+    if problem[5].shape[0] == 6:
+        x = (start[0], start[6], start[3] + problem[1][srs.THETA + 3])
+        return _newton_torus(problem, x, q, np.empty((0, 3)), 0)[0]
+    J = problem[4]
+    return _broyden(problem, start[J] if J >= 0 else 0.0, q)
 
 
 @nb.njit(cache=True)
@@ -583,7 +820,7 @@ def _exists_other(problem, n_scan, tol_pos, tol_ori):
             same = same and other[i] == signs[i]
         if same:
             continue
-        if all_roots(_with_signs(problem, other), n_scan, tol_pos, tol_ori, roots):
+        if all_roots(_with_signs(problem, other), n_scan, tol_pos, tol_ori, roots, signs, np.inf):
             return True
     return False
 
@@ -593,7 +830,7 @@ def _nearest_in_window(problem, hint, tol_pos, tol_ori, q):
     """Replace root q by any root nearer the hint.
 
     A root nearer the hint than q in joint space has |q_J - hint_J| below that distance, so
-    scanning that window of the circle is enough.
+    scanning that window of the circle (or square of the torus) is enough.
     """
     d2 = 0.0
     for j in range(q.shape[0]):
@@ -602,8 +839,7 @@ def _nearest_in_window(problem, hint, tol_pos, tol_ori, q):
     if radius < 1e-12:
         return
     roots = np.empty((MAX_ROOTS, q.shape[0]))
-    J = problem[4]
-    n = all_roots(problem, _WINDOW_POINTS, tol_pos, tol_ori, roots, hint[J] - radius, hint[J] + radius)
+    n = all_roots(problem, _WINDOW_POINTS, tol_pos, tol_ori, roots, hint, radius)
     for r in range(n):
         e2 = 0.0
         for j in range(q.shape[0]):
@@ -639,22 +875,21 @@ def solve_one(arm, settings, T, signs, redundancy, hint, has_hint, q_out):
     problem = make_problem(family, P, mtab, rtab, J, D, R, p, signs, redundancy, q_prev)
     counter = problem[11]
     q = np.empty(dof)
-    if has_hint:
-        w0 = hint[J] if J >= 0 else 0.0
-    else:  # the paper's fixed-point start, p_m = p_d
-        reach = model_ik(family, P, mtab, R, p, signs, redundancy, q_prev, q) >= -REACH_SLACK
-        w0 = q[J] if (reach and J >= 0) else np.nan
-        if not reach and J >= 0:
+    start = hint.copy()
+    found = has_hint
+    if not has_hint:  # the paper's fixed-point start, p_m = p_d
+        found = model_ik(family, P, mtab, R, p, signs, redundancy, q_prev, start) >= -REACH_SLACK
+        if not found and J >= 0 and D.shape[0] == 3:
             # p_d is outside the model's reach: start from the point of the dp circle
             # that the model reaches with the smallest residual.
             best = np.inf
             for k in range(_START_POINTS):
-                w = -np.pi + 2.0 * np.pi * k / _START_POINTS
-                g = _g(problem, w, q)
+                g = _g(problem, -np.pi + 2.0 * np.pi * k / _START_POINTS, q)
                 if abs(g) < best:  # False for NaN
-                    best, w0 = abs(g), w
-    if not np.isnan(w0):
-        _broyden(problem, w0, q)
+                    best, found = abs(g), True
+                    start[:] = q
+    if found:
+        _local_solve(problem, start, q)
         if verify(problem, q, tol_pos, tol_ori)[2]:
             if has_hint and J >= 0:
                 _nearest_in_window(problem, hint, tol_pos, tol_ori, q)
@@ -665,26 +900,24 @@ def solve_one(arm, settings, T, signs, redundancy, hint, has_hint, q_out):
                 return OK, pos, ori, counter[0], inside
             # Without a hint, a root within the limits is preferred: search for one.
     roots = np.empty((MAX_ROOTS, dof))
-    n = all_roots(problem, n_scan, tol_pos, tol_ori, roots)
+    n = all_roots(problem, n_scan, tol_pos, tol_ori, roots, hint, np.inf)
     if n == 0:
         q_out[:] = np.nan
         if _exists_other(problem, n_scan, tol_pos, tol_ori):
             return NO_SOLUTION_IN_CONFIGURATION, np.nan, np.nan, counter[0], False
         return UNREACHABLE, np.nan, np.nan, counter[0], False
     # The root nearest the hint; without one, a root within the limits first, then the one
-    # nearest the fixed-point start's joint J.
+    # nearest the fixed-point start.
     best, best_dist = 0, np.inf
     for r in range(n):
         dist = 0.0
-        if has_hint:
+        if found:
             for j in range(dof):
-                dist += wrap(roots[r, j] - hint[j]) ** 2
-        else:
-            if J >= 0 and not np.isnan(w0):
-                dist = abs(wrap(roots[r, J] - w0))
+                dist += wrap(roots[r, j] - start[j]) ** 2
+        if not has_hint:
             shifted = roots[r].copy()
             if not representative(shifted, revolute, lower, upper, hint, False):
-                dist += 4.0 * np.pi
+                dist += dof * (2.0 * np.pi) ** 2  # after every root within the limits
         if dist < best_dist:
             best, best_dist = r, dist
     q_out[:] = roots[best]
@@ -705,7 +938,7 @@ def solve_all_kernel(arm, settings, T, signs, redundancy, roots, pos, ori, withi
     R, p = flange_target(T, base_inv, tool_inv)
     zeros = np.zeros(roots.shape[1])
     problem = make_problem(family, P, mtab, rtab, J, D, R, p, signs, redundancy, zeros)
-    n = all_roots(problem, n_scan, tol_pos, tol_ori, roots)
+    n = all_roots(problem, n_scan, tol_pos, tol_ori, roots, zeros, np.inf)
     for r in range(n):
         within[r] = representative(roots[r], revolute, lower, upper, zeros, False)
         pos[r], ori[r], _ = verify(problem, roots[r], tol_pos, tol_ori)

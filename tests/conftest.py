@@ -50,3 +50,14 @@ def random_q(arm, n: int, rng: np.random.Generator) -> np.ndarray:
     lower = np.where(np.isfinite(arm.lower), arm.lower, -np.pi)
     upper = np.where(np.isfinite(arm.upper), arm.upper, np.pi)
     return rng.uniform(lower, upper, (n, arm.dof))
+
+
+@pytest.fixture
+def arm_without_a_model(tmp_path) -> Path:
+    """An arm file the OM method refuses: the Sawyer with a sideways offset (a = 0.01 m) in its
+    fixed row between joints 6 and 7, which would make dp depend on q6 as well."""
+    text = (ROOT / "arms" / "sawyer.toml").read_text()
+    text = text.replace('name = "sawyer"', 'name = "bent"').replace("d = 0.11\n", "d = 0.11\na = 0.01\n")
+    path = tmp_path / "bent.toml"
+    path.write_text(text)
+    return path

@@ -116,7 +116,6 @@ def test_bad_input_exits_2_with_one_line_and_no_traceback(argv, message):
         (["solve", "--xyz", "1", "2"], "argument --xyz: expected 3 arguments"),
         (["solve", "--arm", "panda", "--psi", "inf"], "--psi must be a finite number"),
         (["solve", "--psi", "1"], "arm 'ur5e' has no arm angle"),
-        (["solve", "--arm", "sawyer"], "arm 'sawyer': fixed rows between joints are not supported"),
         (["solve", "--arm", "no/such/arm.toml"], "no/such/arm.toml"),
         (["bench", "paper", "--n", "0"], "--n must be positive"),
         (["frobnicate"], "invalid choice: 'frobnicate'"),
@@ -126,7 +125,6 @@ def test_bad_input_exits_2_with_one_line_and_no_traceback(argv, message):
         (["check-model", "README.md", "--arm", "panda"], "must be an MJCF file ending in .xml"),
         (["check-model", "arms/panda.toml", "--arm", "nope"], "unknown arm 'nope'"),
         (["sweep", "--arm", "ur5e"], "arm 'ur5e' has no arm angle to sweep"),
-        (["sweep", "--arm", "sawyer"], "arm 'sawyer': fixed rows between joints are not supported"),
         (["sweep", "--resolution", "0"], "--resolution must be a positive number"),
         (["sweep", "--resolution", "nan"], "--resolution must be a positive number"),
         (["sweep", "--resolution", "1e-9"], "the most is 100000"),
@@ -250,7 +248,7 @@ def test_solve_table_quiet_and_json_file(capsys, tmp_path):
 # arms, bench
 
 
-def test_arms_lists_every_arm_and_why_some_cannot_be_solved_yet():
+def test_arms_lists_every_arm_with_its_model(arm_without_a_model):
     done = command("arms", "--json")
     assert done.returncode == 0, done.stderr
     rows = {row["name"]: row for row in json.loads(done.stdout)}
@@ -258,21 +256,31 @@ def test_arms_lists_every_arm_and_why_some_cannot_be_solved_yet():
     for name, row in rows.items():
         arm = om.load_arm(name)
         assert row["dof"] == arm.dof and row["joint_names"] == list(arm.joint_names)
-        if name == "sawyer":
-            assert not row["solvable"] and row["dp_max"] is None and "fixed rows" in row["reason"]
-            continue
         model = derive_model(arm)
         assert row["solvable"] and row["dp_max"] == model.dp_max and row["model_family"] == model.family_name
         assert row["sign_names"] == list(model.sign_names)
         assert row["redundancy_names"] == list(model.redundancy_names)
     assert rows["ur5e"]["upper"][0] == pytest.approx(6.28319)
+    done = command("arms", str(arm_without_a_model), "--json")
+    (row,) = json.loads(done.stdout)
+    assert not row["solvable"] and row["dp_max"] is None
+    assert row["reason"] == "fixed rows between joints 6 and 7 need a = 0"
 
 
-def test_arms_table(capsys):
+def test_arms_table(capsys, arm_without_a_model):
     status, out, _ = in_process(capsys, "arms")
     lines = out.splitlines()
     assert status == 0 and len(lines) == 1 + len(om.arm_names())
-    assert "not yet solvable: fixed rows between joints" in out and "0.0121 m" in out
+    assert "0.0121 m" in out and "not yet solvable" not in out
+    status, out, _ = in_process(capsys, "arms", str(arm_without_a_model))
+    assert status == 0 and "not yet solvable: fixed rows between joints 6 and 7 need a = 0" in out
+
+
+@pytest.mark.parametrize("subcommand", ["solve", "sweep"])
+def test_an_arm_without_a_model_is_refused_in_one_line(capsys, arm_without_a_model, subcommand):
+    status, _, err = in_process(capsys, subcommand, "--arm", str(arm_without_a_model))
+    assert status == 2
+    assert err.strip().endswith("arm 'bent': fixed rows between joints 6 and 7 need a = 0")
 
 
 def test_bench_paper_small_run(capsys):

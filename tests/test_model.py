@@ -65,7 +65,7 @@ def test_dp_depends_on_joint_6_alone_and_its_norm_is_dp_max(name, dp_max):
     np.testing.assert_allclose(om_arm.model.fk(Q)[:, :3, :3], om_arm.real.fk(Q)[:, :3, :3], atol=1e-15)
 
 
-SOLVABLE = ["spherical", "ur5e", "panda", "fr3", "iiwa14", "gen3", "xarm7"]
+SOLVABLE = om.arm_names()
 
 
 @pytest.mark.parametrize("name", SOLVABLE)
@@ -125,12 +125,18 @@ def test_seven_dof_dp_depends_on_joint_7_alone(name, dp_max):
     )
 
 
-def test_shoulder_offsets_dp_turns_with_joint_1_alone():
-    """Gen3: dp = R_flange delta(q7) + a(q1), a(q1) = A0 + A1 cos q1 + A2 sin q1 in DH frame 0."""
-    om_arm = om.derive_model(om.load_arm("gen3"))
+@pytest.mark.parametrize(
+    "name, shoulder, wrist_min, wrist_max",
+    [
+        ("gen3", 0.01175, 0.0003501, 0.0003501),
+        # The Sawyer's wrist: d6 and 0.11 m times joint 7's tilt of 7.35e-6 rad.
+        ("sawyer", np.hypot(0.081, 0.1925), 0.1363, 0.1363 + 0.11 * 7.35e-6),
+    ],
+)
+def test_shoulder_offsets_dp_turns_with_joint_1_alone(name, shoulder, wrist_min, wrist_max):
+    """dp = R_flange delta(q7) + a(q1), a(q1) = A0 + A1 cos q1 + A2 sin q1 in DH frame 0."""
+    om_arm = om.derive_model(om.load_arm(name))
     real = om_arm.real
-    jr = real.chain.joint_rows
-    assert om_arm.model.chain.rows[jr[1]].d == 0.0 and real.chain.rows[jr[1]].d == -0.01175
     Q = random_q(real, 300, np.random.default_rng(6))
     base = real.chain.T_root_base
     R = real.fk(Q)[:, :3, :3] @ np.linalg.inv(real.chain.T_flange_tool[:3, :3])
@@ -140,11 +146,83 @@ def test_shoulder_offsets_dp_turns_with_joint_1_alone():
     delta = D[0] + np.outer(np.cos(Q[:, 6]), D[1]) + np.outer(np.sin(Q[:, 6]), D[2])
     R0 = base[:3, :3].T @ R
     np.testing.assert_allclose(dp0, np.einsum("mij,mj->mi", R0, delta) + a, atol=1e-14)
-    np.testing.assert_allclose(np.linalg.norm(a, axis=1), 0.01175, atol=1e-15)
-    assert om_arm.dp_max == pytest.approx(0.01175 + 0.0003501, abs=1e-12)
+    np.testing.assert_allclose(np.linalg.norm(a, axis=1), shoulder, atol=1e-15)
+    assert shoulder + wrist_min - 1e-12 <= om_arm.dp_max <= shoulder + wrist_max + 1e-12
 
 
-@pytest.mark.parametrize("name", ["panda", "iiwa14", "gen3", "xarm7"])
+def test_sawyer_model_moves_the_length_before_joint_7_past_it():
+    """The Sawyer's fixed row between joints 6 and 7 (0.11 m along joint 7's axis, which
+    Menagerie tilts by 7.35e-6 rad) moves into joint 7's row: joint 7's axis then meets the
+    wrist centre and the hand moves by 0.11 m times the tilt, not 0.11 m."""
+    arm = om.load_arm("sawyer")
+    om_arm = om.derive_model(arm)
+    real_rows, model_rows = arm.chain.rows, om_arm.model.chain.rows
+    jr = arm.chain.joint_rows
+    fixed = jr[5] + 1
+    assert real_rows[fixed].d == 0.11 and model_rows[fixed].d == 0.0
+    assert model_rows[jr[6]].d == pytest.approx(0.0245 + 0.11, abs=1e-15)
+    for i, (real, model) in enumerate(zip(real_rows, model_rows, strict=True)):
+        assert (model.alpha, model.theta) == (real.alpha, real.theta)
+        if i not in (jr[0], jr[1], jr[5], fixed, jr[6]):
+            assert (model.a, model.d) == (real.a, real.d)
+    np.testing.assert_allclose(np.linalg.norm(om_arm.delta[1:], axis=1), 0.1363, atol=1e-6)
+    Q = random_q(arm, 100, np.random.default_rng(7))
+    np.testing.assert_allclose(om_arm.model.fk(Q)[:, :3, :3], arm.fk(Q)[:, :3, :3], atol=1e-15)
+
+
+def _lifted_at(om_arm, q):
+    """The model's flange pose at q, its configuration, and model_ik_lifted at q's own q1, q7, phi4."""
+    P = om_arm.params
+    R, p = np.empty((3, 3)), np.empty(3)
+    flange_kernel(om_arm.model.chain.table, q, R, p)
+    values = np.empty(3)
+    branch_values(om_arm.family, P, q, values)
+    signs = np.where(values < 0, -1, 1)
+    psi = np.empty(1)
+    redundancy_values(om_arm.family, P, q, psi)
+    out = np.empty(7)
+    phi4 = q[3] + P[srs.THETA + 3]
+    residual = srs.model_ik_lifted(P, R, p, signs, psi[0], q[0], q[6], phi4, out)
+    return (R, p, signs, psi[0]), np.array(residual), out
+
+
+@pytest.mark.parametrize("name", ["gen3", "sawyer"])
+@settings(max_examples=200, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), singular=st.sampled_from(["none", "shoulder", "elbow", "wrist"]))
+def test_lifted_model_ik_vanishes_exactly_at_the_model_joints(name, seed, singular):
+    """With q1, q7 and phi4 given, the three residuals vanish at the model's own joints and q
+    comes back, also exactly at the shoulder, elbow and wrist singularities, where the
+    closed form's Euler angles and square root are ill-conditioned."""
+    om_arm = om.derive_model(om.load_arm(name))
+    P = om_arm.params
+    q = random_q(om_arm.real, 1, np.random.default_rng(seed))[0]
+    if singular == "shoulder":
+        q[1] = -P[srs.THETA + 1]
+    elif singular == "elbow":
+        q[3] = P[srs.PHI_STAR] - P[srs.THETA + 3]
+    elif singular == "wrist":
+        q[5] = -P[srs.THETA + 5]
+    _, residual, out = _lifted_at(om_arm, q)
+    assert np.abs(residual).max() < 1e-12
+    assert np.abs(wrap(out - q)).max() < 1e-10
+
+
+@pytest.mark.parametrize("name", ["gen3", "sawyer"])
+def test_lifted_residuals_detect_a_wrong_q1_q7_or_elbow(name):
+    om_arm = om.derive_model(om.load_arm(name))
+    P = om_arm.params
+    rng = np.random.default_rng(8)
+    for q in random_q(om_arm.real, 50, rng):
+        (R, p, signs, psi), _, _ = _lifted_at(om_arm, q)
+        x = np.array([q[0], q[6], q[3] + P[srs.THETA + 3]])
+        for k in range(3):
+            moved = x.copy()
+            moved[k] += 0.1
+            residual = srs.model_ik_lifted(P, R, p, signs, psi, *moved, np.empty(7))
+            assert np.abs(residual).max() > 1e-6
+
+
+@pytest.mark.parametrize("name", ["panda", "iiwa14", "gen3", "xarm7", "sawyer"])
 def test_arm_angle_is_the_elbow_bend_direction_about_the_shoulder_wrist_line(name):
     """psi from the closed form's parameters equals psi computed from FK points directly."""
     om_arm = om.derive_model(om.load_arm(name))
@@ -152,8 +230,9 @@ def test_arm_angle_is_the_elbow_bend_direction_about_the_shoulder_wrist_line(nam
     Q = random_q(om_arm.real, 200, np.random.default_rng(5))
     for q in Q:
         frames = [np.eye(4)]
-        for row, qi in zip(chain.rows, q, strict=True):
-            frames.append(frames[-1] @ _row(row, qi))
+        joints = iter(q)
+        for row in chain.rows:  # the Sawyer's fixed row comes after joint 6
+            frames.append(frames[-1] @ _row(row, 0.0 if row.kind is om.JointKind.FIXED else next(joints)))
         T = chain.T_root_base
         S, W = (T @ frames[1])[:3, 3], (T @ frames[5])[:3, 3]
         z4 = (T @ frames[3])[:3, 2]  # joint 4 turns about z of frame 3

@@ -3,16 +3,21 @@ revolute joints with intersecting axes (a spherical shoulder or wrist).
 
 The rotation of such a triple is
 
-.. math::  M = R_z(\varphi_a)\, R_x(\alpha_a)\, R_z(\varphi_b)\, R_x(\alpha_b)\, R_z(\varphi_c),
-           \qquad \sigma_{a,b} = \sin\alpha_{a,b} = \pm 1,
+.. math::  M = R_z(\varphi_a)\, R_x(\alpha_a)\, R_z(\varphi_b)\, R_x(\beta)\, R_z(\varphi_c),
+           \qquad \sigma_a = \sin\alpha_a = \pm 1,
 
-so :math:`M e_z = (\sigma_b S_b C_a,\ \sigma_b S_b S_a,\ -\sigma_a \sigma_b C_b)` with
-:math:`S = \sin, C = \cos`. With the branch sign :math:`s = \mathrm{sign}(\sin\varphi_b)`,
-:math:`\varphi_a` and :math:`\varphi_b` are atan2s of M's last column, and :math:`\varphi_c` is
-the angle of the residual :math:`(R_z(\varphi_a) R_x(\alpha_a) R_z(\varphi_b) R_x(\alpha_b))^T M`.
-Taking :math:`\varphi_c` from this residual rather than from M's last row makes the three angles
-consistent, so that their rounding errors cancel in the product even near the singularity
-:math:`\sin\varphi_b = 0`, where axes a and c align and :math:`\varphi_a` keeps a given value.
+so with :math:`S = \sin, C = \cos`, :math:`M e_z = R_z(\varphi_a)\,(S_\beta S_b,\
+-\sigma_a C_\beta)` in x and y and :math:`-\sigma_a S_\beta C_b` in z. Axes a and b are
+perpendicular; :math:`\beta` is :math:`\pm 90°` on most arms but may differ (the Sawyer's
+joint 7 leans by :math:`7 \cdot 10^{-6}` rad), which leaves a cone of half-angle
+:math:`|C_\beta|` around axis a that axis c cannot reach. With the branch sign
+:math:`s = \mathrm{sign}(\sin\varphi_b)`, :math:`\varphi_b` and :math:`\varphi_a` follow from M's
+last column, and :math:`\varphi_c` is the angle of the residual
+:math:`(R_z(\varphi_a) R_x(\alpha_a) R_z(\varphi_b) R_x(\beta))^T M`. Taking :math:`\varphi_c`
+from this residual rather than from M's last row makes the three angles consistent, so that
+their rounding errors cancel in the product even near the singularity
+:math:`\sin\varphi_b = 0`, where axes a and c align (up to :math:`C_\beta`) and
+:math:`\varphi_a` keeps a given value.
 """
 
 from __future__ import annotations
@@ -120,27 +125,66 @@ def rz_times(phi, X):
 
 
 @nb.njit(cache=True)
-def euler_zxzxz(M, sigma_a, sigma_b, sign, phi_a_singular):
-    """(phi_a, phi_b, phi_c) with M = Rz(phi_a) Rx(alpha_a) Rz(phi_b) Rx(alpha_b) Rz(phi_c).
+def euler_zxzxz(M, sigma_a, sin_b, cos_b, sign, phi_a_singular):
+    """(phi_a, phi_b, phi_c) with M = Rz(phi_a) Rx(alpha_a) Rz(phi_b) Rx(beta) Rz(phi_c).
 
     Args:
         M: Rotation, 3x3 as three rows.
-        sigma_a, sigma_b: sin(alpha_a), sin(alpha_b), each +-1.
+        sigma_a: sin(alpha_a) = +-1.
+        sin_b, cos_b: sin(beta) and cos(beta), with |cos(beta)| small (0 on most arms).
         sign: Branch sign of sin(phi_b).
-        phi_a_singular: phi_a used when sin(phi_b) = 0 (axes a and c aligned).
+        phi_a_singular: phi_a used when sin(phi_b) = 0 (axes a and c aligned). Inside the
+            cone that axis c cannot reach, sin(phi_b) is taken as 0 too.
     """
     ax, ay, az = M[0][2], M[1][2], M[2][2]
-    sin_b = np.sqrt(ax * ax + ay * ay)
-    if sin_b > SINGULAR:
-        phi_a = np.arctan2(sigma_b * sign * ay, sigma_b * sign * ax)
-        phi_b = np.arctan2(sign * sin_b, -sigma_a * sigma_b * az)
+    # |S_beta S_b| from the length of M e_z's xy part, (S_beta S_b, -sigma_a C_beta) turned.
+    radial = np.sqrt(max(ax * ax + ay * ay - cos_b * cos_b, 0.0))
+    sb_sign = 1.0 if sin_b > 0.0 else -1.0
+    phi_b = np.arctan2(sign * radial, -sigma_a * sb_sign * az)
+    if radial > SINGULAR:
+        px, py = sin_b * np.sin(phi_b), -sigma_a * cos_b
+        phi_a = np.arctan2(px * ay - py * ax, px * ax + py * ay)
     else:
         phi_a = phi_a_singular
-        phi_b = np.arctan2(0.0, -sigma_a * sigma_b * az)
     ca, sa, cb, sb = np.cos(phi_a), np.sin(phi_a), np.cos(phi_b), np.sin(phi_b)
-    # Columns 0 and 1 of A = Rz(phi_a) Rx(alpha_a) Rz(phi_b) Rx(alpha_b), dotted with M's
+    # Columns 0 and 1 of A = Rz(phi_a) Rx(alpha_a) Rz(phi_b) Rx(beta), dotted with M's
     # first column, give cos and sin of phi_c (X = A^T M = Rz(phi_c)).
     m0 = col(M, 0)
     x00 = dot((cb * ca, cb * sa, sb * sigma_a), m0)
-    x10 = sigma_a * sigma_b * (sa * m0[0] - ca * m0[1])
+    x10 = dot(
+        (
+            sa * sigma_a * sin_b - ca * sb * cos_b,
+            -ca * sigma_a * sin_b - sa * sb * cos_b,
+            sigma_a * cb * cos_b,
+        ),
+        m0,
+    )
     return phi_a, phi_b, np.arctan2(x10, x00)
+
+
+@nb.njit(cache=True)
+def euler_zxzxz_given_first(M, sin_a, cos_a, sigma_b, phi_a):
+    """(phi_b, phi_c, residual) for M = Rz(phi_a) Rx(alpha_a) Rz(phi_b) Rx(alpha_b) Rz(phi_c)
+    with phi_a given.
+
+    :math:`N = R_x(\\alpha_a)^T R_z(-\\varphi_a) M` must equal
+    :math:`R_z(\\varphi_b) R_x(\\alpha_b) R_z(\\varphi_c)`, whose last column is
+    :math:`\\sigma_b (S_b, -C_b, 0)` and last row :math:`\\sigma_b (S_c, C_c, 0)`; the angles are
+    their atan2s and the residual is :math:`N_{22}`, zero iff phi_a is consistent with M. Unlike
+    :func:`euler_zxzxz`, all three are smooth in M and phi_a, also where axes a and c align.
+
+    Args:
+        M: Rotation, 3x3 as three rows.
+        sin_a, cos_a: sin and cos of alpha_a.
+        sigma_b: sin(alpha_b) = +-1.
+        phi_a: The first angle.
+    """
+    ca, sa = np.cos(phi_a), np.sin(phi_a)
+    # Rz(-phi_a) M, rows 0-2; then Rx(alpha_a)^T mixes rows 1 and 2.
+    r0 = add(scale(ca, M[0]), scale(sa, M[1]))
+    r1 = sub(scale(ca, M[1]), scale(sa, M[0]))
+    n1 = add(scale(cos_a, r1), scale(sin_a, M[2]))
+    n2 = sub(scale(cos_a, M[2]), scale(sin_a, r1))
+    phi_b = np.arctan2(sigma_b * r0[2], -sigma_b * n1[2])
+    phi_c = np.arctan2(sigma_b * n2[0], sigma_b * n2[1])
+    return phi_b, phi_c, n2[2]

@@ -124,7 +124,7 @@ def model_ik(family, P, table, R, p, signs, q_prev, q):
     E = P[E_ROT : E_ROT + 9].reshape(3, 3)
     M = Rin.T @ R @ E.T
     rows = ((M[0, 0], M[0, 1], M[0, 2]), (M[1, 0], M[1, 1], M[1, 2]), (M[2, 0], M[2, 1], M[2, 2]))
-    phi = euler_zxzxz(rows, P[SIGMA4], P[SIGMA5], signs[2], q_prev[3] + P[THETA4])
+    phi = euler_zxzxz(rows, P[SIGMA4], P[SIGMA5], 0.0, signs[2], q_prev[3] + P[THETA4])
     for k in range(3):
         q[3 + k] = wrap(phi[k] - P[THETA4 + k])
     return margin

@@ -44,7 +44,11 @@ Joints 1-3 and 5-7 then follow from :func:`~om_redundant.closed_form.common.eule
 with the SHOULDER and WRIST signs
 (:math:`\mathrm{sign}\sin\varphi_2`, :math:`\mathrm{sign}\sin\varphi_6`).
 
-Angles :math:`\varphi_i = q_i + \theta_i` are DH joint angles with their offsets.
+Angles :math:`\varphi_i = q_i + \theta_i` are DH joint angles with their offsets. Fixed
+rows between joints 6 and 7 (the Sawyer's) fold into the wrist's middle rotation,
+:math:`R_x(\alpha_6) F = R_z(a) R_x(\beta) R_z(b)`: a joins :math:`\theta_6`, b joins
+:math:`\theta_7`, and :math:`\beta` is the twist between joints 6 and 7 (see
+:func:`~om_redundant.closed_form.common.euler_zxzxz`).
 """
 
 from __future__ import annotations
@@ -59,6 +63,7 @@ from .common import (
     cross,
     dot,
     euler_zxzxz,
+    euler_zxzxz_given_first,
     mat,
     mm,
     mmt,
@@ -67,6 +72,7 @@ from .common import (
     rz_times,
     scale,
     sub,
+    transpose,
     unit,
     vec,
     wrap,
@@ -75,8 +81,9 @@ from .common import (
 SRS = 2
 
 # Parameter vector layout.
-SIGMA1, SIGMA2, SIGMA5, SIGMA6 = 0, 1, 2, 3
-THETA = 4  # 7 entries: theta_1..theta_7
+SIGMA1, SIGMA2, SIGMA5 = 0, 1, 2
+SIN_BETA = 3  # sin(beta), the wrist's middle twist (joints 6 to 7); +-1 on most arms
+THETA = 4  # 7 entries: theta_1..theta_7 (theta_6, theta_7 with a, b of the wrist twist)
 SHOULDER = 11  # 3: S in DH frame 0
 WRIST = 14  # 3: W in the flange frame
 S3 = 17  # 3: S in DH frame 3
@@ -89,7 +96,8 @@ E_ROT = 53  # 9: from the frame after Rz(phi7) to the flange
 UP = 62  # 3: the root frame's up axis, in DH frame 0
 REF = 65  # 3: the reference direction r, in DH frame 0
 BEND = 68  # sigma: the bend direction's sign
-N_PARAMS = 69
+COS_BETA = 69  # cos(beta); 0 on most arms
+N_PARAMS = 70
 
 _DEGENERATE = 1e-12
 
@@ -118,6 +126,13 @@ def _elbow_vector(P, phi4):
     return (c4 * u[0] - s4 * u[1] - s3[0], s4 * u[0] + c4 * u[1] - s3[1], u[2] - s3[2])
 
 
+@nb.njit(cache=True, inline="always")
+def _wrist_centre(P, R, p):
+    """R as three rows, and W - S in DH frame 0 for the flange pose (R, p)."""
+    Rt = ((R[0, 0], R[0, 1], R[0, 2]), (R[1, 0], R[1, 1], R[1, 2]), (R[2, 0], R[2, 1], R[2, 2]))
+    return Rt, sub(add((p[0], p[1], p[2]), mv(Rt, vec(P, WRIST))), vec(P, SHOULDER))
+
+
 @nb.njit(cache=True)
 def model_ik(P, R, p, signs, psi, q_prev, q):
     """Solve the model for the flange pose (R, p) in DH frame 0, branch signs and arm angle.
@@ -126,9 +141,7 @@ def model_ik(P, R, p, signs, psi, q_prev, q):
         The reach margin, ``1 - x^2`` of the elbow equation; negative (beyond a tiny slack)
         means the wrist centre is out of the model's reach and q is not written.
     """
-    th = P[THETA : THETA + 7]
-    Rt = ((R[0, 0], R[0, 1], R[0, 2]), (R[1, 0], R[1, 1], R[1, 2]), (R[2, 0], R[2, 1], R[2, 2]))
-    w = sub(add((p[0], p[1], p[2]), mv(Rt, vec(P, WRIST))), vec(P, SHOULDER))
+    Rt, w = _wrist_centre(P, R, p)
     L2 = dot(w, w)
     if L2 < _DEGENERATE:  # wrist centre at the shoulder centre
         return -1.0
@@ -137,23 +150,78 @@ def model_ik(P, R, p, signs, psi, q_prev, q):
     if margin < -REACH_SLACK:
         return margin
     phi4 = P[PHI_STAR] + np.arctan2(signs[1] * np.sqrt(max(margin, 0.0)), x)
+    _ik_with_elbow(P, Rt, w, L2, phi4, signs, psi, q_prev, q)
+    return margin
+
+
+@nb.njit(cache=True)
+def model_ik_lifted(P, R, p, signs, psi, q1, q7, phi4, q):
+    r"""The model IK with q1, q7 and the elbow angle phi4 given rather than solved for
+    (phi4 NaN: the elbow equation's root in the ELBOW branch, the edge of reach beyond it).
+
+    Writes q (q1 and q7 as given) and returns the residuals of the three equations they
+    must satisfy: the shoulder's and the wrist's consistency (see
+    :func:`~om_redundant.closed_form.common.euler_zxzxz_given_first`) and the elbow's,
+    :math:`x - \cos(\varphi_4 - \varphi^*)`. Unlike :func:`model_ik`, this is smooth
+    everywhere but at W = S (NaN): across the straight elbow, where the two ELBOW branches
+    meet in a square root, and at the shoulder and wrist singularities, where the Euler
+    angles are ill-conditioned. Its roots are the model's IK in every SHOULDER and WRIST
+    branch at once (each angle pair's branch follows from q1 or q7).
+    """
+    Rt, w = _wrist_centre(P, R, p)
+    L2 = dot(w, w)
+    if L2 < _DEGENERATE:
+        return np.nan, np.nan, np.nan
+    x = (L2 - P[K0]) / P[K]
+    if np.isnan(phi4):  # the ELBOW branch's root of the elbow equation, x clamped into reach
+        xc = min(max(x, -1.0), 1.0)
+        phi4 = P[PHI_STAR] + np.arctan2(signs[1] * np.sqrt(1.0 - xc * xc), xc)
+    th = P[THETA : THETA + 7]
+    R03 = _rotation_03_at(P, w, L2, phi4, signs[1], psi)
+    phi2, phi3, shoulder = euler_zxzxz_given_first(
+        mmt(mtm(mat(P, R_PRE), R03), mat(P, X3)), P[SIGMA1], 0.0, P[SIGMA2], q1 + th[0]
+    )
+    R04 = mm(R03, rz_times(phi4, mat(P, X4)))
+    M = mmt(mtm(R04, Rt), mat(P, E_ROT))
+    # The wrist's M^T = Rz(-phi7) Rx(-beta) Rz(-phi6) Rx(-alpha5) Rz(-phi5): phi7 comes first.
+    neg6, neg5, wrist = euler_zxzxz_given_first(
+        transpose(M), -P[SIN_BETA], P[COS_BETA], -P[SIGMA5], -(q7 + th[6])
+    )
+    q[0], q[1], q[2], q[3] = q1, wrap(phi2 - th[1]), wrap(phi3 - th[2]), wrap(phi4 - th[3])
+    q[4], q[5], q[6] = wrap(-neg5 - th[4]), wrap(-neg6 - th[5]), q7
+    return shoulder, wrist, x - np.cos(phi4 - P[PHI_STAR])
+
+
+@nb.njit(cache=True, inline="always")
+def _rotation_03_at(P, w, L2, phi4, elbow, psi):
+    """R03 for W - S = w, the elbow angle phi4 and the arm angle psi.
+
+    It maps the frame-3 triad (v_hat, b3_hat, v_hat x b3_hat) onto (w_hat, m, w_hat x m):
+    the shoulder-wrist direction and the bend direction, in frame 3 and in frame 0.
+    """
     w_hat = scale(1.0 / np.sqrt(L2), w)
     n, nw = _reference(P, w_hat)
     m = add(scale(np.cos(psi), n), scale(np.sin(psi), nw))
-    # R03 maps the frame-3 triad (v_hat, b3_hat, v_hat x b3_hat) onto (w_hat, m, w_hat x m).
     v = _elbow_vector(P, phi4)
     v_hat = unit(v)
-    b3 = unit(scale(signs[1] * P[BEND], (-v[1], v[0], 0.0)))
-    R03 = mtm((w_hat, m, cross(w_hat, m)), (v_hat, b3, cross(v_hat, b3)))
+    b3 = unit(scale(elbow * P[BEND], (-v[1], v[0], 0.0)))
+    return mtm((w_hat, m, cross(w_hat, m)), (v_hat, b3, cross(v_hat, b3)))
+
+
+@nb.njit(cache=True, inline="always")
+def _ik_with_elbow(P, Rt, w, L2, phi4, signs, psi, q_prev, q):
+    """Joints 1-3 and 5-7 for the elbow angle phi4, W - S = w and the arm angle psi."""
+    th = P[THETA : THETA + 7]
+    R03 = _rotation_03_at(P, w, L2, phi4, signs[1], psi)
     phi = euler_zxzxz(
-        mmt(mtm(mat(P, R_PRE), R03), mat(P, X3)), P[SIGMA1], P[SIGMA2], signs[0], q_prev[0] + th[0]
+        mmt(mtm(mat(P, R_PRE), R03), mat(P, X3)), P[SIGMA1], P[SIGMA2], 0.0, signs[0], q_prev[0] + th[0]
     )
     q[0], q[1], q[2] = wrap(phi[0] - th[0]), wrap(phi[1] - th[1]), wrap(phi[2] - th[2])
     q[3] = wrap(phi4 - th[3])
     R04 = mm(R03, rz_times(phi4, mat(P, X4)))
-    phi = euler_zxzxz(mmt(mtm(R04, Rt), mat(P, E_ROT)), P[SIGMA5], P[SIGMA6], signs[2], q_prev[4] + th[4])
+    M = mmt(mtm(R04, Rt), mat(P, E_ROT))
+    phi = euler_zxzxz(M, P[SIGMA5], P[SIN_BETA], P[COS_BETA], signs[2], q_prev[4] + th[4])
     q[4], q[5], q[6] = wrap(phi[0] - th[4]), wrap(phi[1] - th[5]), wrap(phi[2] - th[6])
-    return margin
 
 
 @nb.njit(cache=True)
