@@ -9,7 +9,7 @@ c = configuration_of(q) (SHOULDER, ELBOW, WRIST, psi):
 
 Speed (medians of single calls from Python, and batch throughput) on the first arm.
 
-Run: ``python -m benchmarks.seven_dof [--n 100000] [--arms panda fr3 iiwa14 xarm7]``.
+Run: ``python -m benchmarks.seven_dof [--n 100000] [--arms panda fr3 iiwa14 gen3 xarm7 sawyer]``.
 """
 
 from __future__ import annotations
@@ -136,7 +136,7 @@ def main() -> None:
     )
     parser.add_argument("--n", type=int, default=100_000)
     parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--arms", nargs="+", default=["panda", "fr3", "iiwa14", "xarm7"])
+    parser.add_argument("--arms", nargs="+", default=["panda", "fr3", "iiwa14", "gen3", "xarm7", "sawyer"])
     args = parser.parse_args()
     rows = []
     for name in args.arms:

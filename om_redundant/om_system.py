@@ -113,9 +113,11 @@ def _ik_plus_delta(problem, base, w, q):
     family, P, mtab, _, _, D, R, _, signs, redundancy, q_prev, counter = problem
     counter[0] += 1
     d = _delta(D, w)
-    pm = np.empty(3)
-    for k in range(3):
-        pm[k] = base[k] + R[k, 0] * d[0] + R[k, 1] * d[1] + R[k, 2] * d[2]
+    pm = (  # a tuple: no heap allocation in the innermost loop
+        base[0] + R[0, 0] * d[0] + R[0, 1] * d[1] + R[0, 2] * d[2],
+        base[1] + R[1, 0] * d[0] + R[1, 1] * d[1] + R[1, 2] * d[2],
+        base[2] + R[2, 0] * d[0] + R[2, 1] * d[1] + R[2, 2] * d[2],
+    )
     return model_ik(family, P, mtab, R, pm, signs, redundancy, q_prev, q)
 
 
@@ -310,14 +312,13 @@ def verify(problem, q, tol_pos, tol_ori):
     E = mtm(R, Rr)
     s = 0.5 * np.sqrt((E[2][1] - E[1][2]) ** 2 + (E[0][2] - E[2][0]) ** 2 + (E[1][0] - E[0][1]) ** 2)
     ori = np.arctan2(s, 0.5 * (E[0][0] + E[1][1] + E[2][2] - 1.0))
-    values = np.empty(signs.shape[0])
+    values = np.empty(max(signs.shape[0], redundancy.shape[0]))
     branch_values(family, P, q, values)
     same = True
     for i in range(signs.shape[0]):
         # A branch quantity at zero (a singular joint) belongs to both branches.
         if values[i] * signs[i] < -1e-12:
             same = False
-    values = np.empty(redundancy.shape[0])
     redundancy_values(family, P, q, values)
     for i in range(redundancy.shape[0]):
         if abs(wrap(values[i] - redundancy[i])) > _REDUNDANCY_TOL:
@@ -851,9 +852,22 @@ def _nearest_in_window(problem, hint, tol_pos, tol_ori, q):
 
 @nb.njit(cache=True)
 def flange_target(T, base_inv, tool_inv):
-    """The flange pose in DH frame 0 for an end-effector pose T in the root frame."""
-    F = base_inv @ T @ tool_inv
-    return np.ascontiguousarray(F[:3, :3]), np.ascontiguousarray(F[:3, 3])
+    """The flange pose in DH frame 0 for an end-effector pose T in the root frame.
+
+    Written out: for 4x4 matrices a loop beats the BLAS call that ``@`` makes.
+    """
+    F = np.empty((3, 4))  # rows 0-2 of base_inv @ T (row 3 is [0, 0, 0, 1])
+    for i in range(3):
+        for j in range(4):
+            F[i, j] = (
+                base_inv[i, 0] * T[0, j] + base_inv[i, 1] * T[1, j] + base_inv[i, 2] * T[2, j]
+            ) + base_inv[i, 3] * T[3, j]
+    R, p = np.empty((3, 3)), np.empty(3)
+    for i in range(3):
+        for j in range(3):
+            R[i, j] = F[i, 0] * tool_inv[0, j] + F[i, 1] * tool_inv[1, j] + F[i, 2] * tool_inv[2, j]
+        p[i] = F[i, 0] * tool_inv[0, 3] + F[i, 1] * tool_inv[1, 3] + F[i, 2] * tool_inv[2, 3] + F[i, 3]
+    return R, p
 
 
 @nb.njit(cache=True)
@@ -899,6 +913,16 @@ def solve_one(arm, settings, T, signs, redundancy, hint, has_hint, q_out):
                 pos, ori, _ = verify(problem, q_out, tol_pos, tol_ori)
                 return OK, pos, ori, counter[0], inside
             # Without a hint, a root within the limits is preferred: search for one.
+    if not has_hint and J >= 0 and D.shape[0] == 3:
+        # Other starts on the circle first: cheaper than the bounded search, and a root
+        # within the limits is usually among their roots.
+        for k in range(_START_POINTS):
+            _broyden(problem, -np.pi + 2.0 * np.pi * (k + 0.5) / _START_POINTS, q)
+            if verify(problem, q, tol_pos, tol_ori)[2]:
+                q_out[:] = q
+                if representative(q_out, revolute, lower, upper, hint, False):
+                    pos, ori, _ = verify(problem, q_out, tol_pos, tol_ori)
+                    return OK, pos, ori, counter[0], True
     roots = np.empty((MAX_ROOTS, dof))
     n = all_roots(problem, n_scan, tol_pos, tol_ori, roots, hint, np.inf)
     if n == 0:

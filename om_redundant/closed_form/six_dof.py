@@ -68,7 +68,9 @@ def model_ik(family, P, table, R, p, signs, q_prev, q):
         is not written; it measures how far, which lets a search find small islands of reach.
     """
     c = P[WRIST_CENTRE : WRIST_CENTRE + 3]
-    pw = p + R @ c
+    pw = R @ c
+    for k in range(3):  # p may be an array or a tuple
+        pw[k] += p[k]
     # Shoulder.
     h = P[LATERAL]
     r2 = pw[0] * pw[0] + pw[1] * pw[1]
