@@ -55,7 +55,7 @@ STATUS_NAMES = ("ok", "unreachable", "no solution in this configuration")
 MAX_ROOTS = 16
 _ROOT_TOL = 1e-13  # |g| accepted as a root before verification
 _SAME_ROOT = 1e-9  # joint-space distance under which two roots are one
-_START_POINTS = 8  # samples of the dp circle tried when p_d is outside the model's reach
+_START_POINTS = 8  # starts on the dp circle when p_d is out of reach or a first root out of limits
 _WINDOW_POINTS = 8  # samples of the window searched around a hint
 _PAIR_SEARCH = 1.0  # |g| (rad) below which a local minimum is searched for a root pair
 _REDUNDANCY_TOL = 1e-9  # a solution's redundancy values (rad) must equal the requested ones
@@ -248,12 +248,30 @@ def _broyden(problem, w0, q):
 
 @nb.njit(cache=True)
 def _refine_bracket(problem, a, ga, b, gb, q):
-    """Illinois regula falsi on a sign-changing bracket; returns the root estimate."""
+    """Illinois regula falsi on a sign-changing bracket; returns the root estimate.
+
+    Both ends are reachable, but a gap of reach can hide between them (the model's elbow
+    straightens and bends back within a sample spacing). If the iterate falls into one, the
+    bracket shrinks to the side of the gap whose edge keeps the sign change.
+    """
     side = 0
     for _ in range(100):
         c = (a * gb - b * ga) / (gb - ga)
         gc = _g(problem, c, q)
-        if np.isnan(gc) or gc == 0.0 or abs(b - a) < 1e-15:
+        if np.isnan(gc):
+            e = _reach_edge(problem, a, c, q)
+            ge = _g(problem, e, q)
+            if ge * ga <= 0.0:
+                b, gb = e, ge
+            else:
+                e = _reach_edge(problem, b, c, q)
+                ge = _g(problem, e, q)
+                if ge * gb > 0.0:  # no sign change on either side: none to refine
+                    return c
+                a, ga = e, ge
+            side = 0
+            continue
+        if gc == 0.0 or abs(b - a) < 1e-15:
             return c
         if np.sign(gc) == np.sign(gb):
             b, gb = c, gc

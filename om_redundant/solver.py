@@ -119,8 +119,8 @@ class OMSolver:
             self.om.params,
             self.om.model.chain.table,
             chain.table,
-            # With shoulder offsets the bounded search scans q1 (their coefficients ride below
-            # delta's) and solves q7 inside; see om_system._g_margin.
+            # With shoulder offsets the search runs on the torus (q1, q7): the shoulder's
+            # coefficients ride below delta's; see om_system._torus_roots.
             0 if shoulder else self.om.dp_joint,
             np.vstack([self.om.delta, self.om.shoulder]) if shoulder else self.om.delta,
             np.linalg.inv(chain.T_root_base),

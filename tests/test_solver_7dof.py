@@ -140,6 +140,29 @@ def test_bad_configurations_are_named(panda):
         panda.solve_batch(Ts, (1, 1, 1), np.zeros((3, 2)))
 
 
+def test_a_root_beside_a_gap_of_reach_between_two_samples_is_found():
+    """xArm7, 1 in 100,000 (benchmark seed 0): both neighbouring samples of q7 are in reach,
+    but the model's elbow straightens and bends back between them; the root sits 0.0013 rad
+    from that hidden gap, and the bracket's refinement must step around it."""
+    solver = om.OMSolver("xarm7")
+    q = np.array(
+        [
+            2.0858335553764524,
+            -1.2087949878456372,
+            0.5026803745558182,
+            2.7474387374400795,
+            3.01375038722163,
+            -1.261211858524415,
+            -2.8638560035539866,
+        ]
+    )
+    T, c = solver.arm.fk(q), solver.configuration_of(q)
+    roots = solver.solve_all(T, c)
+    assert min(distance(r.q, q) for r in roots) < 1e-9
+    hinted = solver.solve(T, c, q_hint=q + 0.005)
+    assert_exact(solver, hinted, T, c)
+
+
 def test_arm_without_a_model_is_refused_with_the_reason(arm_without_a_model):
     with pytest.raises(om.ModelError, match=r"arm 'bent': fixed rows between joints 6 and 7 need a = 0"):
         om.OMSolver(om.load_arm(str(arm_without_a_model)))
