@@ -24,7 +24,10 @@ singularities, which is where roots crowd; lifted, Newton's method converges the
 
 * Local solve: Broyden's method, which in one unknown is the secant method, started with a
   finite-difference slope, from the joint of the paper's fixed-point start
-  (:math:`p_m = p_d`) or of a hint; on the torus, damped Newton on the lifted system.
+  (:math:`p_m = p_d`) or of a hint; on the torus, damped Newton on the lifted system. On a
+  7-DOF circle arm, where the secant fails (g's square root at the edge of reach sends it
+  out of reach) or p_d is beyond the model's reach (the start then holds the elbow at the
+  edge), the same lifted Newton, with zero shoulder offsets, takes over.
 * Bounded search, the paper's guarantee: g is sampled on a grid over the whole circle (the
   image of the ball :math:`|p_m - p_d| \le \Delta p_{max}` that can hold solutions); each sign
   change is refined; near the edges of the model's reach, at local minima of |g| and on
@@ -57,6 +60,7 @@ _ROOT_TOL = 1e-13  # |g| accepted as a root before verification
 _SAME_ROOT = 1e-9  # joint-space distance under which two roots are one
 _START_POINTS = 8  # starts on the dp circle when p_d is out of reach or a first root out of limits
 _WINDOW_POINTS = 8  # samples of the window searched around a hint
+_LAST_STEP = 1e-5  # a secant step (rad) below which the next iterate is evaluated with every joint
 _PAIR_SEARCH = 1.0  # |g| (rad) below which a local minimum is searched for a root pair
 _REDUNDANCY_TOL = 1e-9  # a solution's redundancy values (rad) must equal the requested ones
 _TORUS_SIDE = 0.75  # the torus grid has _TORUS_SIDE * scan points nodes per side
@@ -96,10 +100,14 @@ def _with_signs(problem, signs):
 
 
 @nb.njit(cache=True, inline="always")
-def _g_margin(problem, w, q):
-    """Residual g(w) (NaN if unreachable) and the model's reach margin; writes the IK into q."""
+def _g_margin(problem, w, q, all_joints=False):
+    """Residual g(w) (NaN if unreachable) and the model's reach margin; writes the IK into q.
+
+    The searches need only q_J; where q itself is wanted, ``all_joints`` makes the model
+    write every joint (a 7-DOF model skips its shoulder otherwise).
+    """
     J, p = problem[4], problem[7]
-    margin = _ik_plus_delta(problem, p, w, q)
+    margin = _ik_plus_delta(problem, p, w, q, all_joints or J < 0)
     if margin < -REACH_SLACK:
         return np.nan, margin
     if J < 0:
@@ -108,7 +116,7 @@ def _g_margin(problem, w, q):
 
 
 @nb.njit(cache=True, inline="always")
-def _ik_plus_delta(problem, base, w, q):
+def _ik_plus_delta(problem, base, w, q, all_joints):
     """Model IK for p_m = base + R delta(w) (one residual evaluation); returns the reach margin."""
     family, P, mtab, _, _, D, R, _, signs, redundancy, q_prev, counter = problem
     counter[0] += 1
@@ -118,7 +126,7 @@ def _ik_plus_delta(problem, base, w, q):
         base[1] + R[1, 0] * d[0] + R[1, 1] * d[1] + R[1, 2] * d[2],
         base[2] + R[2, 0] * d[0] + R[2, 1] * d[1] + R[2, 2] * d[2],
     )
-    return model_ik(family, P, mtab, R, pm, signs, redundancy, q_prev, q)
+    return model_ik(family, P, mtab, R, pm, signs, redundancy, q_prev, q, all_joints)
 
 
 @nb.njit(cache=True, inline="always")
@@ -211,16 +219,20 @@ def _norm(F):
 
 
 @nb.njit(cache=True, inline="always")
-def _g(problem, w, q):
-    """Residual g(w) of the reduced system; writes the model IK into q. NaN if unreachable."""
-    return _g_margin(problem, w, q)[0]
+def _g(problem, w, q, all_joints=False):
+    """Residual g(w) of the reduced system; writes the model IK into q (see :func:`_g_margin`).
+    NaN if unreachable."""
+    return _g_margin(problem, w, q, all_joints)[0]
 
 
 @nb.njit(cache=True)
 def _broyden(problem, w0, q):
     """Secant (1-D Broyden) iteration from w0 with a finite-difference slope.
 
-    Returns |g| at the end; q holds the model IK at the last iterate.
+    Returns |g| at the end; q holds the model IK (every joint) at the last iterate. The
+    iterates need only q_J; once a step is below ``_LAST_STEP``, the next iterate is
+    usually the last (the secant converges superlinearly), so it is evaluated with every
+    joint, which spares a final evaluation.
     """
     g0 = _g(problem, w0, q)
     if problem[4] < 0 or np.isnan(g0):
@@ -229,21 +241,25 @@ def _broyden(problem, w0, q):
     g1 = _g(problem, w0 + h, q)
     slope = (g1 - g0) / h if not np.isnan(g1) else -1.0
     w, g = w0, g0
+    complete = False  # whether q holds every joint at w
     for _ in range(40):
         if g == 0.0 or slope == 0.0 or np.isnan(slope):
             break
         step = -g / slope
         if abs(step) > 0.5:
             step = 0.5 * np.sign(step)
-        g_new = _g(problem, w + step, q)
+        last = abs(step) < _LAST_STEP
+        g_new = _g(problem, w + step, q, last)
         if np.isnan(g_new):
+            complete = False
             break
         slope = (g_new - g) / step
-        w, g = w + step, g_new
+        w, g, complete = w + step, g_new, last
         if abs(step) < 1e-15 * max(1.0, abs(w)) or abs(g) < 1e-16:
             break
-    # q must belong to the final iterate.
-    return abs(_g(problem, w, q))
+    if not complete:
+        g = _g(problem, w, q, True)
+    return abs(g)
 
 
 @nb.njit(cache=True)
@@ -767,7 +783,7 @@ def all_roots(problem, n_scan, tol_pos, tol_ori, roots, centre, radius):
     q = np.empty(dof)
     J = problem[4]
     if J < 0:
-        g = _g(problem, 0.0, q)
+        g = _g(problem, 0.0, q, True)
         return 0 if np.isnan(g) else _add_root(problem, q, tol_pos, tol_ori, roots, 0)
     if problem[5].shape[0] == 6:
         return _torus_roots(
@@ -779,7 +795,7 @@ def all_roots(problem, n_scan, tol_pos, tol_ori, roots, centre, radius):
     n = _scan(problem, lo, hi, n_scan, full_circle, q, cands)
     count = 0
     for i in range(n):
-        g = _g(problem, cands[i], q)
+        g = _g(problem, cands[i], q, True)
         if not np.isnan(g) and abs(g) > _ROOT_TOL:  # polish the bracket's estimate
             _broyden(problem, cands[i], q)
         count = _add_root(problem, q, tol_pos, tol_ori, roots, count)
@@ -788,15 +804,30 @@ def all_roots(problem, n_scan, tol_pos, tol_ori, roots, centre, radius):
 
 @nb.njit(cache=True)
 def _local_solve(problem, start, q):
-    """Local solve from the joint vector start (its q_J, or q_1 and q_7 on the torus).
-
-    Returns the final residual; q holds the model IK there.
-    """
+    """Local solve from the joint vector start: the secant on g from its q_J, or on the
+    torus :func:`_lifted_solve`. Returns the final residual; q holds the model IK there."""
     if problem[5].shape[0] == 6:
-        x = (start[0], start[6], start[3] + problem[1][srs.THETA + 3])
-        return _newton_torus(problem, x, q, np.empty((0, 3)), 0)[0]
+        return _lifted_solve(problem, start, q)
     J = problem[4]
     return _broyden(problem, start[J] if J >= 0 else 0.0, q)
+
+
+@nb.njit(cache=True)
+def _lifted_solve(problem, start, q):
+    """Damped Newton on the lifted system in (q1, q7, phi4) from the joint vector start.
+
+    A 7-DOF arm whose dp turns with q7 alone is lifted with zero shoulder offsets: g has a
+    square root at the edge of the model's reach, which sends the secant out of reach near
+    it, while the lifted system is smooth there. Returns the final residual; q holds the
+    model IK there.
+    """
+    if problem[5].shape[0] == 3:
+        family, P, mtab, rtab, J, D, R, p, signs, redundancy, q_prev, counter = problem
+        D_torus = np.zeros((6, 3))
+        D_torus[:3] = D
+        problem = (family, P, mtab, rtab, J, D_torus, R, p, signs, redundancy, q_prev, counter)
+    x = (start[0], start[6], start[3] + problem[1][srs.THETA + 3])
+    return _newton_torus(problem, x, q, np.empty((0, 3)), 0)[0]
 
 
 @nb.njit(cache=True)
@@ -844,9 +875,18 @@ def _exists_other(problem, n_scan, tol_pos, tol_ori):
     return False
 
 
+@nb.njit(cache=True, inline="always")
+def _shifted(a, b):
+    """Whether joint vectors a and b differ (by the 2 pi shifts of :func:`representative`)."""
+    for j in range(a.shape[0]):  # noqa: SIM110 (numba compiles no generator into any())
+        if a[j] != b[j]:
+            return True
+    return False
+
+
 @nb.njit(cache=True)
 def _nearest_in_window(problem, hint, tol_pos, tol_ori, q):
-    """Replace root q by any root nearer the hint.
+    """Replace root q by any root nearer the hint; returns whether one was.
 
     A root nearer the hint than q in joint space has |q_J - hint_J| below that distance, so
     scanning that window of the circle (or square of the torus) is enough.
@@ -856,16 +896,18 @@ def _nearest_in_window(problem, hint, tol_pos, tol_ori, q):
         d2 += wrap(q[j] - hint[j]) ** 2
     radius = np.sqrt(d2)
     if radius < 1e-12:
-        return
+        return False
     roots = np.empty((MAX_ROOTS, q.shape[0]))
     n = all_roots(problem, _WINDOW_POINTS, tol_pos, tol_ori, roots, hint, radius)
+    replaced = False
     for r in range(n):
         e2 = 0.0
         for j in range(q.shape[0]):
             e2 += wrap(roots[r, j] - hint[j]) ** 2
         if e2 < d2:
-            d2 = e2
+            d2, replaced = e2, True
             q[:] = roots[r]
+    return replaced
 
 
 @nb.njit(cache=True)
@@ -890,7 +932,7 @@ def flange_target(T, base_inv, tool_inv):
 
 @nb.njit(cache=True)
 def solve_one(arm, settings, T, signs, redundancy, hint, has_hint, q_out):
-    """One OM solve: local Broyden, then the bounded search.
+    """One OM solve: the local solve (secant, or lifted Newton), then the bounded search.
 
     Args:
         arm: (family, P, model table, real table, J, D, base^-1, tool^-1, revolute, lower,
@@ -909,26 +951,35 @@ def solve_one(arm, settings, T, signs, redundancy, hint, has_hint, q_out):
     q = np.empty(dof)
     start = hint.copy()
     found = has_hint
+    lifted = family == srs.SRS and J >= 0  # a 7-DOF arm with a search (see _lifted_solve)
     if not has_hint:  # the paper's fixed-point start, p_m = p_d
         found = model_ik(family, P, mtab, R, p, signs, redundancy, q_prev, start) >= -REACH_SLACK
-        if not found and J >= 0 and D.shape[0] == 3:
+        if not found and lifted:
+            # p_d is outside the model's reach: the elbow held at the edge of reach instead.
+            found = srs.model_ik_at_reach(P, R, p, signs, redundancy[0], q_prev, start)
+        elif not found and J >= 0 and D.shape[0] == 3:
             # p_d is outside the model's reach: start from the point of the dp circle
             # that the model reaches with the smallest residual.
             best = np.inf
             for k in range(_START_POINTS):
-                g = _g(problem, -np.pi + 2.0 * np.pi * k / _START_POINTS, q)
+                g = _g(problem, -np.pi + 2.0 * np.pi * k / _START_POINTS, q, True)
                 if abs(g) < best:  # False for NaN
                     best, found = abs(g), True
                     start[:] = q
     if found:
         _local_solve(problem, start, q)
-        if verify(problem, q, tol_pos, tol_ori)[2]:
-            if has_hint and J >= 0:
-                _nearest_in_window(problem, hint, tol_pos, tol_ori, q)
+        pos, ori, verified = verify(problem, q, tol_pos, tol_ori)
+        if not verified and lifted and D.shape[0] == 3:
+            _lifted_solve(problem, start, q)
+            pos, ori, verified = verify(problem, q, tol_pos, tol_ori)
+        if verified:
+            if has_hint and J >= 0 and _nearest_in_window(problem, hint, tol_pos, tol_ori, q):
+                pos, ori, _ = verify(problem, q, tol_pos, tol_ori)
             q_out[:] = q
             inside = representative(q_out, revolute, lower, upper, hint, has_hint)
             if inside or has_hint or J < 0:
-                pos, ori, _ = verify(problem, q_out, tol_pos, tol_ori)
+                if _shifted(q_out, q):  # the errors of the vector returned, to its rounding
+                    pos, ori, _ = verify(problem, q_out, tol_pos, tol_ori)
                 return OK, pos, ori, counter[0], inside
             # Without a hint, a root within the limits is preferred: search for one.
     if not has_hint and J >= 0 and D.shape[0] == 3:
@@ -936,10 +987,12 @@ def solve_one(arm, settings, T, signs, redundancy, hint, has_hint, q_out):
         # within the limits is usually among their roots.
         for k in range(_START_POINTS):
             _broyden(problem, -np.pi + 2.0 * np.pi * (k + 0.5) / _START_POINTS, q)
-            if verify(problem, q, tol_pos, tol_ori)[2]:
+            pos, ori, verified = verify(problem, q, tol_pos, tol_ori)
+            if verified:
                 q_out[:] = q
                 if representative(q_out, revolute, lower, upper, hint, False):
-                    pos, ori, _ = verify(problem, q_out, tol_pos, tol_ori)
+                    if _shifted(q_out, q):
+                        pos, ori, _ = verify(problem, q_out, tol_pos, tol_ori)
                     return OK, pos, ori, counter[0], True
     roots = np.empty((MAX_ROOTS, dof))
     n = all_roots(problem, n_scan, tol_pos, tol_ori, roots, hint, np.inf)

@@ -124,6 +124,15 @@ def rz_times(phi, X):
     return (sub(scale(c, X[0]), scale(s, X[1])), add(scale(s, X[0]), scale(c, X[1])), X[2])
 
 
+@nb.njit(cache=True, inline="always")
+def _angle(y, x, fallback):
+    """atan2(y, x) with its cos and sin; the fallback angle where x = y = 0."""
+    r = np.sqrt(x * x + y * y)
+    if r > 0.0:
+        return np.arctan2(y, x), x / r, y / r
+    return fallback, np.cos(fallback), np.sin(fallback)
+
+
 @nb.njit(cache=True)
 def euler_zxzxz(M, sigma_a, sin_b, cos_b, sign, phi_a_singular):
     """(phi_a, phi_b, phi_c) with M = Rz(phi_a) Rx(alpha_a) Rz(phi_b) Rx(beta) Rz(phi_c).
@@ -140,13 +149,14 @@ def euler_zxzxz(M, sigma_a, sin_b, cos_b, sign, phi_a_singular):
     # |S_beta S_b| from the length of M e_z's xy part, (S_beta S_b, -sigma_a C_beta) turned.
     radial = np.sqrt(max(ax * ax + ay * ay - cos_b * cos_b, 0.0))
     sb_sign = 1.0 if sin_b > 0.0 else -1.0
-    phi_b = np.arctan2(sign * radial, -sigma_a * sb_sign * az)
+    # Each angle's cos and sin come from its atan2's arguments, normalised: no more trig.
+    yb, xb = sign * radial, -sigma_a * sb_sign * az
+    phi_b, cb, sb = _angle(yb, xb, 0.0)
+    px, py = sin_b * sb, -sigma_a * cos_b
     if radial > SINGULAR:
-        px, py = sin_b * np.sin(phi_b), -sigma_a * cos_b
-        phi_a = np.arctan2(px * ay - py * ax, px * ax + py * ay)
+        phi_a, ca, sa = _angle(px * ay - py * ax, px * ax + py * ay, phi_a_singular)
     else:
-        phi_a = phi_a_singular
-    ca, sa, cb, sb = np.cos(phi_a), np.sin(phi_a), np.cos(phi_b), np.sin(phi_b)
+        phi_a, ca, sa = phi_a_singular, np.cos(phi_a_singular), np.sin(phi_a_singular)
     # Columns 0 and 1 of A = Rz(phi_a) Rx(alpha_a) Rz(phi_b) Rx(beta), dotted with M's
     # first column, give cos and sin of phi_c (X = A^T M = Rz(phi_c)).
     m0 = col(M, 0)

@@ -8,7 +8,7 @@ from . import six_dof, srs
 
 
 @nb.njit(cache=True, inline="always")
-def model_ik(family, P, table, R, p, signs, redundancy, q_prev, q):
+def model_ik(family, P, table, R, p, signs, redundancy, q_prev, q, all_joints=True):
     """Solve the model arm for the flange pose (R, p) in DH frame 0; write q.
 
     Args:
@@ -20,13 +20,15 @@ def model_ik(family, P, table, R, p, signs, redundancy, q_prev, q):
         redundancy: Redundancy values (the arm angle of a 7-DOF arm; empty for 6-DOF).
         q_prev: Joints kept at singularities.
         q: Output joint vector.
+        all_joints: False lets a family skip the joints that the OM residual does not need
+            (a 7-DOF model's shoulder); the rest of q is then stale.
 
     Returns:
         The reach margin: negative (beyond ``REACH_SLACK``) when the pose is out of the
         model's reach, in which case q is not written; it measures how far.
     """
     if family == srs.SRS:
-        return srs.model_ik(P, R, p, signs, redundancy[0], q_prev, q)
+        return srs.model_ik(P, R, p, signs, redundancy[0], q_prev, q, all_joints)
     return six_dof.model_ik(family, P, table, R, p, signs, q_prev, q)
 
 

@@ -134,8 +134,11 @@ def _wrist_centre(P, R, p):
 
 
 @nb.njit(cache=True)
-def model_ik(P, R, p, signs, psi, q_prev, q):
+def model_ik(P, R, p, signs, psi, q_prev, q, shoulder):
     """Solve the model for the flange pose (R, p) in DH frame 0, branch signs and arm angle.
+
+    With ``shoulder`` False, joints 1-3 are not written: the wrist's angles follow from the
+    elbow and the arm angle alone, and the OM residual needs only q7 (a third of the cost).
 
     Returns:
         The reach margin, ``1 - x^2`` of the elbow equation; negative (beyond a tiny slack)
@@ -149,9 +152,28 @@ def model_ik(P, R, p, signs, psi, q_prev, q):
     margin = 1.0 - x * x
     if margin < -REACH_SLACK:
         return margin
-    phi4 = P[PHI_STAR] + np.arctan2(signs[1] * np.sqrt(max(margin, 0.0)), x)
-    _ik_with_elbow(P, Rt, w, L2, phi4, signs, psi, q_prev, q)
+    _ik_with_elbow(P, Rt, w, L2, _elbow_root(P, x, signs[1]), signs, psi, q_prev, q, shoulder)
     return margin
+
+
+@nb.njit(cache=True)
+def model_ik_at_reach(P, R, p, signs, psi, q_prev, q):
+    """:func:`model_ik`, but where the wrist centre lies beyond the model's reach the elbow is
+    held at the edge (straight or folded): a start for :func:`model_ik_lifted`, which is
+    smooth across that edge. Returns False, and leaves q, only where W = S."""
+    Rt, w = _wrist_centre(P, R, p)
+    L2 = dot(w, w)
+    if L2 < _DEGENERATE:
+        return False
+    _ik_with_elbow(P, Rt, w, L2, _elbow_root(P, (L2 - P[K0]) / P[K], signs[1]), signs, psi, q_prev, q, True)
+    return True
+
+
+@nb.njit(cache=True, inline="always")
+def _elbow_root(P, x, elbow):
+    """The root phi4 of x = cos(phi4 - phi*) in the ELBOW branch, x clamped into [-1, 1]."""
+    xc = min(max(x, -1.0), 1.0)
+    return P[PHI_STAR] + np.arctan2(elbow * np.sqrt(1.0 - xc * xc), xc)
 
 
 @nb.njit(cache=True)
@@ -173,9 +195,8 @@ def model_ik_lifted(P, R, p, signs, psi, q1, q7, phi4, q):
     if L2 < _DEGENERATE:
         return np.nan, np.nan, np.nan
     x = (L2 - P[K0]) / P[K]
-    if np.isnan(phi4):  # the ELBOW branch's root of the elbow equation, x clamped into reach
-        xc = min(max(x, -1.0), 1.0)
-        phi4 = P[PHI_STAR] + np.arctan2(signs[1] * np.sqrt(1.0 - xc * xc), xc)
+    if np.isnan(phi4):
+        phi4 = _elbow_root(P, x, signs[1])
     th = P[THETA : THETA + 7]
     R03 = _rotation_03_at(P, w, L2, phi4, signs[1], psi)
     phi2, phi3, shoulder = euler_zxzxz_given_first(
@@ -209,14 +230,16 @@ def _rotation_03_at(P, w, L2, phi4, elbow, psi):
 
 
 @nb.njit(cache=True, inline="always")
-def _ik_with_elbow(P, Rt, w, L2, phi4, signs, psi, q_prev, q):
-    """Joints 1-3 and 5-7 for the elbow angle phi4, W - S = w and the arm angle psi."""
+def _ik_with_elbow(P, Rt, w, L2, phi4, signs, psi, q_prev, q, shoulder):
+    """Joints 1-3 (if ``shoulder``) and 5-7 for the elbow angle phi4, W - S = w and the arm
+    angle psi."""
     th = P[THETA : THETA + 7]
     R03 = _rotation_03_at(P, w, L2, phi4, signs[1], psi)
-    phi = euler_zxzxz(
-        mmt(mtm(mat(P, R_PRE), R03), mat(P, X3)), P[SIGMA1], P[SIGMA2], 0.0, signs[0], q_prev[0] + th[0]
-    )
-    q[0], q[1], q[2] = wrap(phi[0] - th[0]), wrap(phi[1] - th[1]), wrap(phi[2] - th[2])
+    if shoulder:
+        phi = euler_zxzxz(
+            mmt(mtm(mat(P, R_PRE), R03), mat(P, X3)), P[SIGMA1], P[SIGMA2], 0.0, signs[0], q_prev[0] + th[0]
+        )
+        q[0], q[1], q[2] = wrap(phi[0] - th[0]), wrap(phi[1] - th[1]), wrap(phi[2] - th[2])
     q[3] = wrap(phi4 - th[3])
     R04 = mm(R03, rz_times(phi4, mat(P, X4)))
     M = mmt(mtm(R04, Rt), mat(P, E_ROT))
