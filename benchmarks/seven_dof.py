@@ -4,7 +4,8 @@ For each arm, N joint vectors q uniform within limits (unlimited joints in [-pi,
 c = configuration_of(q) (SHOULDER, ELBOW, WRIST, psi):
 
 * q among ``solve_all(fk(q), c)``;
-* ``solve(fk(q), c, q_hint=q + U(+-0.01))`` returns q, or else another root nearer the hint;
+* ``solve(fk(q), c, q_hint=q + U(+-0.01))`` returns q, or else another root nearer the hint
+  (and how far that root lies from q: a close twin of q in the same configuration);
 * every returned solution: position and orientation error, configuration equal to c.
 
 Speed (medians of single calls from Python, and batch throughput) on the first arm.
@@ -43,7 +44,7 @@ def recovery(name: str, n: int, seed: int) -> dict[str, float]:
     psi = np.array([c.redundancy[0] for c in configurations])
     batch = solver.solve_batch(T, signs, psi, q_hint=hints)
     among = hinted_q = nearest = wrong_c = roots_total = 0
-    worst_pos = worst_ori = 0.0
+    worst_pos = worst_ori = twin = 0.0
     for i, (q, c) in enumerate(zip(Q, configurations, strict=True)):
         roots = solver.solve_all(T[i], c)
         roots_total += len(roots)
@@ -54,7 +55,10 @@ def recovery(name: str, n: int, seed: int) -> dict[str, float]:
         for ok, q_returned, pos, ori in returned:
             worst_pos, worst_ori = max(worst_pos, pos), max(worst_ori, ori)
             wrong_c += not (ok and solver.configuration_of(q_returned).isclose(c))
-        hinted_q += np.abs(_wrap(batch.q[i] - q)).max() < 1e-9
+        returned_q = np.abs(_wrap(batch.q[i] - q)).max() < 1e-9
+        hinted_q += returned_q
+        if not returned_q:  # how far the root returned instead lies from q
+            twin = max(twin, np.linalg.norm(_wrap(batch.q[i] - q)))
         to_hint = [np.linalg.norm(_wrap(r.q - hints[i])) for r in roots]
         nearest += np.linalg.norm(_wrap(batch.q[i] - hints[i])) <= min(to_hint, default=np.inf) + 1e-9
     return {
@@ -64,6 +68,7 @@ def recovery(name: str, n: int, seed: int) -> dict[str, float]:
         "among": among / n,
         "hinted_q": hinted_q / n,
         "nearest": nearest / n,
+        "twin": twin,
         "roots": roots_total / n,
         "wrong_c": wrong_c,
         "pos": worst_pos,
@@ -106,15 +111,15 @@ def report(rows: list[dict[str, float]], timing: dict[str, float], speed_arm: st
         f"# 7-DOF arms: {rows[0]['n']:,} random joint vectors per arm (seed {seed})",
         "",
         "| arm | dp_max (m) | q among solve_all | hinted solve returns q | ... or a root nearer the hint "
-        "| roots per (pose, c) | wrong configuration | max position error (m) "
-        "| max orientation error (rad) |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "| its largest distance from q (rad) | roots per (pose, c) | wrong configuration "
+        "| max position error (m) | max orientation error (rad) |",
+        "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         lines.append(
             f"| {r['arm']} | {r['dp_max']:.3f} | {100 * r['among']:.3f} % | {100 * r['hinted_q']:.3f} % "
-            f"| {100 * r['nearest']:.3f} % | {r['roots']:.3f} | {r['wrong_c']} | {r['pos']:.1e} "
-            f"| {r['ori']:.1e} |"
+            f"| {100 * r['nearest']:.3f} % | {r['twin']:.3f} | {r['roots']:.3f} | {r['wrong_c']} "
+            f"| {r['pos']:.1e} | {r['ori']:.1e} |"
         )
     lines += [
         "",
