@@ -91,6 +91,11 @@ def test_model_closed_form_inverts_model_fk(name, seed):
     diff[om_arm.real.revolute] = wrap(diff[om_arm.real.revolute])
     # Joint-space agreement is ill-conditioned only within ~1e-5 rad of a singular joint.
     assert np.abs(diff).max() < 1e-8
+    if om_arm.family == srs.SRS:  # the searches' IK without the shoulder: the same q4..q7, bit for bit
+        wrist = np.full(dof, np.nan)
+        model_ik(om_arm.family, om_arm.params, table, R, p, signs, redundancy, np.zeros(dof), wrist, False)
+        np.testing.assert_array_equal(wrist[3:], out[3:])
+        assert np.isnan(wrist[:3]).all()
 
 
 @pytest.mark.parametrize("name, zeroed", [("panda", {5: ("a",)}), ("xarm7", {5: ("a",)}), ("iiwa14", {})])
@@ -205,6 +210,34 @@ def test_lifted_model_ik_vanishes_exactly_at_the_model_joints(name, seed, singul
     _, residual, out = _lifted_at(om_arm, q)
     assert np.abs(residual).max() < 1e-12
     assert np.abs(wrap(out - q)).max() < 1e-10
+
+
+@pytest.mark.parametrize("name", ["panda", "xarm7", "sawyer"])
+@settings(max_examples=100, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), stretch=st.floats(0.05, 0.9))
+def test_model_ik_at_reach_holds_the_elbow_at_the_edge_beyond_reach(name, seed, stretch):
+    """Within reach it is the closed form; with the wrist centre moved beyond the reach, or
+    inside the folded elbow's, the elbow is held straight or folded at the edge:
+    sin(phi4 - phi*) = 0, a start for the lifted Newton."""
+    om_arm = om.derive_model(om.load_arm(name))
+    P = om_arm.params
+    q = random_q(om_arm.real, 1, np.random.default_rng(seed))[0]
+    (R, p, signs, psi), _, _ = _lifted_at(om_arm, q)
+    table, zeros = om_arm.model.chain.table, np.zeros(7)
+    closed_form, at_reach = np.empty(7), np.empty(7)
+    assert model_ik(om_arm.family, P, table, R, p, signs, np.array([psi]), zeros, closed_form) >= -REACH_SLACK
+    assert srs.model_ik_at_reach(P, R, p, signs, psi, zeros, at_reach)
+    np.testing.assert_array_equal(at_reach, closed_form)
+    S_W = p + R @ P[srs.WRIST : srs.WRIST + 3] - P[srs.SHOULDER : srs.SHOULDER + 3]
+    longest, shortest = np.sqrt(P[srs.K0] + P[srs.K]), np.sqrt(P[srs.K0] - P[srs.K])
+    for distance in (longest * (1.0 + stretch), shortest * (1.0 - stretch)):
+        moved = p + (distance / np.linalg.norm(S_W) - 1.0) * S_W
+        margin = model_ik(om_arm.family, P, table, R, moved, signs, np.array([psi]), zeros, np.empty(7))
+        assert margin < -REACH_SLACK
+        assert srs.model_ik_at_reach(P, R, moved, signs, psi, zeros, at_reach)
+        values = np.empty(3)
+        branch_values(om_arm.family, P, at_reach, values)
+        assert abs(values[1]) < 1e-12
 
 
 @pytest.mark.parametrize("name", ["gen3", "sawyer"])

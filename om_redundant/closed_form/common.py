@@ -150,8 +150,7 @@ def euler_zxzxz(M, sigma_a, sin_b, cos_b, sign, phi_a_singular):
     radial = np.sqrt(max(ax * ax + ay * ay - cos_b * cos_b, 0.0))
     sb_sign = 1.0 if sin_b > 0.0 else -1.0
     # Each angle's cos and sin come from its atan2's arguments, normalised: no more trig.
-    yb, xb = sign * radial, -sigma_a * sb_sign * az
-    phi_b, cb, sb = _angle(yb, xb, 0.0)
+    phi_b, cb, sb = _angle(sign * radial, -sigma_a * sb_sign * az, 0.0)
     px, py = sin_b * sb, -sigma_a * cos_b
     if radial > SINGULAR:
         phi_a, ca, sa = _angle(px * ay - py * ax, px * ax + py * ay, phi_a_singular)
