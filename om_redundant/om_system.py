@@ -803,13 +803,21 @@ def all_roots(problem, n_scan, tol_pos, tol_ori, roots, centre, radius):
 
 
 @nb.njit(cache=True)
-def _local_solve(problem, start, q):
-    """Local solve from the joint vector start: the secant on g from its q_J, or on the
-    torus :func:`_lifted_solve`. Returns the final residual; q holds the model IK there."""
-    if problem[5].shape[0] == 6:
-        return _lifted_solve(problem, start, q)
-    J = problem[4]
-    return _broyden(problem, start[J] if J >= 0 else 0.0, q)
+def _local_solve(problem, start, tol_pos, tol_ori, q):
+    """Local solve from the joint vector start, verified with the real arm: the secant on g
+    from its q_J; on the torus, and on a 7-DOF circle arm where the secant fails,
+    :func:`_lifted_solve`. Returns :func:`verify`'s (position error, orientation error,
+    accepted); q holds the model IK at the end."""
+    family, J, D = problem[0], problem[4], problem[5]
+    if D.shape[0] == 6:
+        _lifted_solve(problem, start, q)
+        return verify(problem, q, tol_pos, tol_ori)
+    _broyden(problem, start[J] if J >= 0 else 0.0, q)
+    result = verify(problem, q, tol_pos, tol_ori)
+    if not result[2] and family == srs.SRS and J >= 0:
+        _lifted_solve(problem, start, q)
+        result = verify(problem, q, tol_pos, tol_ori)
+    return result
 
 
 @nb.njit(cache=True)
@@ -951,11 +959,11 @@ def solve_one(arm, settings, T, signs, redundancy, hint, has_hint, q_out):
     q = np.empty(dof)
     start = hint.copy()
     found = has_hint
-    lifted = family == srs.SRS and J >= 0  # a 7-DOF arm with a search (see _lifted_solve)
     if not has_hint:  # the paper's fixed-point start, p_m = p_d
         found = model_ik(family, P, mtab, R, p, signs, redundancy, q_prev, start) >= -REACH_SLACK
-        if not found and lifted:
-            # p_d is outside the model's reach: the elbow held at the edge of reach instead.
+        if not found and family == srs.SRS and J >= 0:
+            # p_d is outside the model's reach: the elbow held at the edge of reach instead,
+            # a start for the lifted Newton (see _local_solve).
             found = srs.model_ik_at_reach(P, R, p, signs, redundancy[0], q_prev, start)
         elif not found and J >= 0 and D.shape[0] == 3:
             # p_d is outside the model's reach: start from the point of the dp circle
@@ -967,11 +975,7 @@ def solve_one(arm, settings, T, signs, redundancy, hint, has_hint, q_out):
                     best, found = abs(g), True
                     start[:] = q
     if found:
-        _local_solve(problem, start, q)
-        pos, ori, verified = verify(problem, q, tol_pos, tol_ori)
-        if not verified and lifted and D.shape[0] == 3:
-            _lifted_solve(problem, start, q)
-            pos, ori, verified = verify(problem, q, tol_pos, tol_ori)
+        pos, ori, verified = _local_solve(problem, start, tol_pos, tol_ori, q)
         if verified:
             if has_hint and J >= 0 and _nearest_in_window(problem, hint, tol_pos, tol_ori, q):
                 pos, ori, _ = verify(problem, q, tol_pos, tol_ori)

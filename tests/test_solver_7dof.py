@@ -175,12 +175,12 @@ def test_targets_beyond_the_models_reach_are_solved_by_the_lifted_newton(name):
     solver = om.OMSolver(name)
     chain, model = solver.arm.chain, solver.om
     base_inv, tool_inv = np.linalg.inv(chain.T_root_base), np.linalg.inv(chain.T_flange_tool)
+    table = model.model.chain.table
     evaluations = []
     for q in random_q(solver.arm, 4000, np.random.default_rng(5)):
         T, c = solver.arm.fk(q), solver.configuration_of(q)
         R, p = flange_target(T, base_inv, tool_inv)
         signs, psi = np.array(c.signs), np.array(c.redundancy)
-        table = model.model.chain.table
         if model_ik(model.family, model.params, table, R, p, signs, psi, q, np.empty(7)) >= -REACH_SLACK:
             continue
         sol = solver.solve(T, c)

@@ -151,8 +151,8 @@ def euler_zxzxz(M, sigma_a, sin_b, cos_b, sign, phi_a_singular):
     sb_sign = 1.0 if sin_b > 0.0 else -1.0
     # Each angle's cos and sin come from its atan2's arguments, normalised: no more trig.
     phi_b, cb, sb = _angle(sign * radial, -sigma_a * sb_sign * az, 0.0)
-    px, py = sin_b * sb, -sigma_a * cos_b
     if radial > SINGULAR:
+        px, py = sin_b * sb, -sigma_a * cos_b
         phi_a, ca, sa = _angle(px * ay - py * ax, px * ax + py * ay, phi_a_singular)
     else:
         phi_a, ca, sa = phi_a_singular, np.cos(phi_a_singular), np.sin(phi_a_singular)
