@@ -449,7 +449,7 @@ def _mink_peer(arm: om.Arm, posture: bool) -> Peer:
         raise Unavailable(f"not installed ({exc})") from exc
     _revolute_only(arm)
     model = om.arm_model(arm)
-    frame = arm.frame_name or om.mjcf.DEFAULT_SITE
+    frame = arm.frame_name or om.mujoco_io.DEFAULT_SITE
     configuration = mink.Configuration(model)
     home = home_joints(arm)
     frame_task, tasks = mink_example_tasks(model, frame, home, posture)

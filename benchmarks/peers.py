@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 import om_redundant as om
-from om_redundant.paper_experiment import run as run_paper_experiment
+from om_redundant.om.experiment import run as run_paper_experiment
 
 from .adapters import PEERS, Peer, Unavailable
 from .protocols import PROTOCOLS, Targets, measure, measure_batch

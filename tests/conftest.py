@@ -12,7 +12,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from om_redundant.mujoco_match import load_mujoco_model
+from om_redundant.mujoco_io.model_match import load_mujoco_model
 
 ROOT = Path(__file__).resolve().parents[1]
 MENAGERIE = ROOT.parent / "shared" / "reference" / "menagerie"

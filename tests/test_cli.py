@@ -27,7 +27,7 @@ from om_redundant.cli.sweep import (
     psi_grid,
     read_path,
 )
-from om_redundant.model import derive_model
+from om_redundant.om.model import derive_model
 from tests.conftest import MENAGERIE, ROOT, checkout_env, run_python
 
 Q_PANDA = np.array([0.2, 0.4, -0.3, -1.8, 0.5, 1.9, 0.6])

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import om_redundant as om
-from om_redundant.mjcf import DEFAULT_SITE, arm_mjcf, arm_model, scene_mjcf
+from om_redundant.mujoco_io.mjcf import DEFAULT_SITE, arm_mjcf, arm_model, scene_mjcf
 from tests.conftest import load_reference_model, random_q
 
 ARMS = om.arm_names()

@@ -10,8 +10,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
-from om_redundant.closed_form import REACH_SLACK, branch_values, model_ik, redundancy_values, srs
-from om_redundant.kinematics import flange_kernel
+from om_redundant.kinematics.chain import flange_kernel
+from om_redundant.om.families import REACH_SLACK, branch_values, model_ik, redundancy_values, srs
 from tests.conftest import random_q, wrap
 
 

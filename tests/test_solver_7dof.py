@@ -8,8 +8,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
-from om_redundant.closed_form import REACH_SLACK, model_ik
-from om_redundant.om_system import flange_target
+from om_redundant.om.families import REACH_SLACK, model_ik
+from om_redundant.om.system import flange_target
 from tests.conftest import random_q, wrap
 
 ARMS = ["panda", "fr3", "iiwa14", "gen3", "xarm7", "sawyer"]

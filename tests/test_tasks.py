@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 import om_redundant as om
 from benchmarks.mink_reach import SETUPS, TOLERANCE, reach
 from benchmarks.robots import home_joints, pose_errors, random_joints, reference_spec
-from om_redundant.closed_form import srs
+from om_redundant.om.families import srs
 from tests.conftest import load_reference_model
 
 REACH_TARGETS = 500

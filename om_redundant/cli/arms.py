@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import argparse
 
-from ..arm import arm_names, load_arm
 from ..exceptions import ModelError
-from ..model import derive_model
+from ..kinematics.arm import arm_names, load_arm
+from ..om.model import derive_model
 from .common import add_output_options, table_wanted, write_json
 
 

@@ -11,9 +11,9 @@ from typing import Any
 
 import numpy as np
 
-from ..arm import Arm, arm_names, pose_from_xyz_quat
 from ..exceptions import InvalidInput, OMError
-from ..solver import OMSolver
+from ..kinematics.arm import Arm, arm_names, pose_from_xyz_quat
+from ..om.solver import OMSolver
 from ..validation import as_pose, as_signs
 
 #: Joint vectors whose forward kinematics is the built-in target, by number of joints;
@@ -115,7 +115,7 @@ def target_pose(args: argparse.Namespace, arm: Arm) -> np.ndarray:
 
 
 def pose_from_text(xyz, quat, xyz_name: str, quat_name: str) -> np.ndarray:
-    """:func:`~om_redundant.arm.pose_from_xyz_quat` of numbers read from the command line or a
+    """:func:`~om_redundant.kinematics.arm.pose_from_xyz_quat` of numbers read from the command line or a
     file, an error naming them and the problem."""
     xyz, quat = np.asarray(xyz, dtype=np.float64), np.asarray(quat, dtype=np.float64)
     if not np.isfinite(xyz).all():

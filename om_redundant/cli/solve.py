@@ -7,8 +7,8 @@ import argparse
 import mujoco
 import numpy as np
 
-from ..configuration import Configuration
-from ..solver import OMSolver, Solution
+from ..om.configuration import Configuration
+from ..om.solver import OMSolver, Solution
 from .common import (
     UsageError,
     add_arm_option,

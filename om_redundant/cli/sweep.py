@@ -21,12 +21,12 @@ from dataclasses import dataclass, field, replace
 import mujoco
 import numpy as np
 
-from ..clearance import Box, Capsule, Clearance, Shape, Sphere
-from ..configuration import Configuration
-from ..mujoco_match import load_mujoco_model
-from ..objective import joint_margins
-from ..redundancy import RedundancyChoice, RedundancyOptimizer
-from ..solver import OMSolver
+from ..mujoco_io.model_match import load_mujoco_model
+from ..om.configuration import Configuration
+from ..om.solver import OMSolver
+from ..redundancy.clearance import Box, Capsule, Clearance, Shape, Sphere
+from ..redundancy.objective import joint_margins
+from ..redundancy.optimizer import RedundancyChoice, RedundancyOptimizer
 from .common import (
     UsageError,
     add_arm_option,

@@ -6,7 +6,7 @@ import math
 from dataclasses import dataclass
 from itertools import product
 
-from .exceptions import InvalidInput
+from ..exceptions import InvalidInput
 
 
 @dataclass(frozen=True)

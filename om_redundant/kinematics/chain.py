@@ -27,7 +27,7 @@ from functools import cached_property
 import numba as nb
 import numpy as np
 
-from .validation import as_joint_vector
+from ..validation import as_joint_vector
 
 
 class JointKind(StrEnum):

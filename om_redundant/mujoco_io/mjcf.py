@@ -37,8 +37,8 @@ import xml.etree.ElementTree as ET
 import mujoco
 import numpy as np
 
-from .arm import Arm
-from .validation import as_positive
+from ..kinematics.arm import Arm
+from ..validation import as_positive
 
 DEFAULT_SITE = "end_effector"
 RADIUS_PER_REACH = 0.03  # default capsule radius over the stretched length of the chain

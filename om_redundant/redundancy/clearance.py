@@ -35,11 +35,11 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from .arm import Arm
-from .arm_in_model import ArmJoints
-from .exceptions import InvalidInput
-from .mjcf import arm_mjcf
-from .validation import as_joint_vector, as_pose, as_positive
+from ..exceptions import InvalidInput
+from ..kinematics.arm import Arm
+from ..mujoco_io.arm_in_model import ArmJoints
+from ..mujoco_io.mjcf import arm_mjcf
+from ..validation import as_joint_vector, as_pose, as_positive
 
 DEFAULT_DISTMAX = 1.0  # m: pairs farther apart report this distance
 

@@ -38,10 +38,10 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .configuration import Configuration
+from ..om.configuration import Configuration
+from ..om.solver import OMSolver, Solution
 from .objective import Evaluation, Group, Objective
 from .self_motion import self_motion_tangent
-from .solver import OMSolver, Solution
 
 JUMP = 1.0  # rad, max-norm joint step between neighbouring solutions of one path
 END_TOLERANCE = 1e-9  # rad: a path whose following step falls below this has ended
@@ -79,7 +79,7 @@ class Point:
 
     def pieces(self) -> tuple[np.ndarray, np.ndarray]:
         """The feasibility functions g_j (all >= 0 iff feasible; see
-        :meth:`~om_redundant.objective.Group.constraints`) and dg_j/dpsi."""
+        :meth:`~om_redundant.redundancy.objective.Group.constraints`) and dg_j/dpsi."""
         if not self.groups:
             return np.zeros(0), np.zeros(0)
         g, dg = zip(*(group.constraints() for group in self.groups), strict=True)

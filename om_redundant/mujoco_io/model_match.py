@@ -25,8 +25,8 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from .arm import Arm
-from .exceptions import InvalidInput
+from ..exceptions import InvalidInput
+from ..kinematics.arm import Arm
 from .mjcf import DEFAULT_SITE
 
 #: Default largest accepted difference: metres for positions and limits, radians for angles.

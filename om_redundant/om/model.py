@@ -8,7 +8,7 @@ the few lengths that stand in the way of a closed form:
   joint-indexed rows), which makes the wrist spherical.
 * 7-DOF arms: :math:`a_1, d_2` (shoulder offsets, Gen3 and Sawyer) and
   :math:`a_5, a_6, d_6` (wrist offsets), which make the shoulder and the wrist spherical
-  while the elbow keeps its offsets (a Hollerbach arm, see :mod:`om_redundant.closed_form.srs`).
+  while the elbow keeps its offsets (a Hollerbach arm, see :mod:`om_redundant.om.families.srs`).
 
 For equal joints the hand orientations agree and the positions differ by
 
@@ -32,10 +32,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .arm import Arm
-from .closed_form import six_dof, srs
-from .exceptions import ModelError
-from .kinematics import DHRow, JointKind, KinematicChain, flange_kernel
+from ..exceptions import ModelError
+from ..kinematics.arm import Arm
+from ..kinematics.chain import DHRow, JointKind, KinematicChain, flange_kernel
+from .families import six_dof, srs
 
 _ANGLE_EPS = 1e-9
 
@@ -47,7 +47,7 @@ class ModelArm:
     Attributes:
         real: The real arm.
         model: The offset-modified arm (same joints, names, limits, base and tool).
-        family: Closed-form family code (see :mod:`om_redundant.closed_form`).
+        family: Closed-form family code (see :mod:`om_redundant.om.families`).
         family_name: Human-readable family name.
         params: Parameter vector of the family kernel.
         sign_names: Names of the configuration's branch signs.
@@ -84,7 +84,7 @@ def derive_model(arm: Arm) -> ModelArm:
     """Derive the closed-form model arm of a real arm.
 
     6-DOF arms get a spherical-wrist model (Theorem 2); 7-DOF arms a Hollerbach model with a
-    spherical shoulder and wrist (:mod:`om_redundant.closed_form.srs`), keeping the elbow's
+    spherical shoulder and wrist (:mod:`om_redundant.om.families.srs`), keeping the elbow's
     offsets.
 
     Raises:

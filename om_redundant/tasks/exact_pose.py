@@ -31,12 +31,12 @@ from mink import SE3, TargetNotSet, Task, TaskDefinitionError
 from mink import Configuration as MinkConfiguration
 from mink.exceptions import InvalidTarget
 
-from .arm_angle import arm_angle_and_gradient, check_arm_angle
-from .arm_in_model import ArmJoints, ArmRoot
-from .configuration import Configuration
-from .exceptions import UnreachableTarget
-from .solver import OMSolver
-from .validation import as_pose
+from ..exceptions import UnreachableTarget
+from ..mujoco_io.arm_in_model import ArmJoints, ArmRoot
+from ..om.configuration import Configuration
+from ..om.solver import OMSolver
+from ..redundancy.arm_angle import arm_angle_and_gradient, check_arm_angle
+from ..validation import as_pose
 
 #: Default cost of :class:`ExactPoseTask`, per radian (metre for prismatic joints). With
 #: mink's usual ``FrameTask`` costs of 1 it makes the exact target dominate far from it,
@@ -311,12 +311,12 @@ class ArmAngleTask(_ArmTask):
 
     For users who track the hand with mink's ``FrameTask`` and only want to choose the
     elbow's swivel about the shoulder-wrist line. psi is the model's arm angle
-    (:mod:`om_redundant.closed_form.srs`, ``solver.configuration_of(q).redundancy[0]``):
+    (:mod:`om_redundant.om.families.srs`, ``solver.configuration_of(q).redundancy[0]``):
 
     .. math::  e(q) = \mathrm{wrap}\big(\psi(q) - \psi^*\big) \in (-\pi, \pi], \qquad
                J = \partial\psi/\partial q \in \mathbb{R}^{1 \times n_v},
 
-    the gradient derived analytically in :mod:`om_redundant.arm_angle` (nonzero on the arm's
+    the gradient derived analytically in :mod:`om_redundant.redundancy.arm_angle` (nonzero on the arm's
     joints 1-4 only). psi is undefined on its singular half-line (the wrist straight below
     the shoulder, inside the base) and jumps by pi where the ELBOW sign flips.
 

@@ -7,11 +7,11 @@ Joint-limit margin of joint i (limited joints only), normalised by half its rang
 
 1 at mid-range, 0 on a limit, negative beyond it; :math:`M(q) = \min_i m_i(q)`. (The
 optimiser takes each revolute joint at its turn nearest mid-range, which has the most
-margin; :mod:`om_redundant.paths`.) Each
+margin; :mod:`om_redundant.redundancy.paths`.) Each
 :math:`m_i` is the minimum of two functions affine in q, :math:`(q_i - l_i)/h_i` and
 :math:`(u_i - q_i)/h_i`, so M is the minimum of ``2 * limited`` affine pieces.
 
-Clearance :math:`D(q) = \min_k d_k(q)` (:mod:`om_redundant.clearance`), capped at
+Clearance :math:`D(q) = \min_k d_k(q)` (:mod:`om_redundant.redundancy.clearance`), capped at
 :math:`d_{cap}` and normalised by it.
 
 The objective, maximised over the redundancy variables, with weights :math:`w_m, w_c \ge 0`:
@@ -27,7 +27,7 @@ arm away from mid-range.
 Each term is a *group*: a weight w, a floor (the feasibility bound: 0 for M,
 :math:`d_{min}/d_{cap}` for the clearance), a cap (none for M, 1 for the clearance), and
 pieces :math:`v_j(q)` whose minimum it takes. The QP linearises every piece
-(:func:`~om_redundant.climb.maximise`).
+(:func:`~om_redundant.redundancy.climb.maximise`).
 """
 
 from __future__ import annotations
@@ -38,10 +38,10 @@ from typing import Any
 
 import numpy as np
 
-from .arm import Arm
+from ..exceptions import InvalidInput
+from ..kinematics.arm import Arm
+from ..validation import as_joint_vector
 from .clearance import Clearance
-from .exceptions import InvalidInput
-from .validation import as_joint_vector
 
 
 def joint_margins(arm: Arm, q: np.ndarray) -> np.ndarray:

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..om.solver import OMSolver
+from ..validation import as_joint_vector
 from .arm_angle import arm_angle_and_gradient, check_arm_angle
-from .solver import OMSolver
-from .validation import as_joint_vector
 
 
 def self_motion_tangent(solver: OMSolver, q: np.ndarray) -> np.ndarray:
@@ -20,7 +20,7 @@ def self_motion_tangent(solver: OMSolver, q: np.ndarray) -> np.ndarray:
     .. math::  \frac{dq}{d\psi} = N\,\big(D\psi(q)\,N\big)^{-1},
 
     with :math:`D\psi` the analytic gradient of
-    :func:`~om_redundant.arm_angle.arm_angle_and_gradient`. It is singular where psi stops
+    :func:`~om_redundant.redundancy.arm_angle.arm_angle_and_gradient`. It is singular where psi stops
     changing along the self-motion (a fold of the solution path).
 
     Args:

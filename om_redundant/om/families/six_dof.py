@@ -41,7 +41,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from ..kinematics import _apply_row
+from ...kinematics.chain import _apply_row
 from .common import REACH_SLACK, euler_zxzxz, wrap
 
 RRR_SPHERICAL_WRIST = 0

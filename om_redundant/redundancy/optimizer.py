@@ -1,19 +1,19 @@
 r"""The redundancy optimiser: a QP picks the arm angle for joint-limit margin and clearance.
 
 For a pose T, :meth:`RedundancyOptimizer.choose` returns the configuration
-c = (signs, psi) that maximises the objective f of :mod:`om_redundant.objective` (weighted
+c = (signs, psi) that maximises the objective f of :mod:`om_redundant.redundancy.objective` (weighted
 normalised joint-limit margin and capped obstacle clearance) over the feasible set (within
 the limits, clearance >= d_min), and the exact OM solution in it:
 
 1. **Sweep.** Every allowed branch's exact solutions are sampled on a psi grid and linked
-   into solution paths (:mod:`om_redundant.paths`), which are cut into feasible intervals
-   with refined ends (:mod:`om_redundant.intervals`).
+   into solution paths (:mod:`om_redundant.redundancy.paths`), which are cut into feasible intervals
+   with refined ends (:mod:`om_redundant.redundancy.intervals`).
 2. **Starts.** In each interval, the samples that are local maxima of f. With L the largest
    slope of f between neighbouring samples (times 2) and h a start's distance to its
    neighbours, a start can only lead above ``f_start + L h``; starts are climbed best
    first, and those whose bound is below the best value found are skipped. This is what
    finds the global optimum rather than the nearest local one.
-3. **Climb** from each start (:func:`~om_redundant.climb.maximise`): a trust-region SQP
+3. **Climb** from each start (:func:`~om_redundant.redundancy.climb.maximise`): a trust-region SQP
    whose QP, solved by OSQP, linearises margins and clearances around the current exact
    solution, within the interval. The result is the best point's own exact solve.
 
@@ -34,15 +34,15 @@ from typing import Any
 import mujoco
 import numpy as np
 
+from ..exceptions import InvalidInput
+from ..om.configuration import Configuration
+from ..om.solver import OMSolver, Solution
+from ..validation import as_pose, as_signs
 from .clearance import DEFAULT_DISTMAX, Clearance, Shape
 from .climb import maximise
-from .configuration import Configuration
-from .exceptions import InvalidInput
 from .intervals import PsiInterval, Run, feasible_runs
 from .objective import Objective, check_weights
 from .paths import Path, Point, Probe, sweep_circle, sweep_window
-from .solver import OMSolver, Solution
-from .validation import as_pose, as_signs
 
 _WINDOW_POINTS = 4  # tracking samples on each side of the previous psi
 
@@ -84,7 +84,7 @@ class RedundancyOptimizer:
             MuJoCo model of obstacles, in the arm's root frame (combined with the project's
             MJCF of the arm); or a :class:`~om_redundant.Clearance` (e.g. of your own model).
         margin_weight, clearance_weight, clearance_cap, min_clearance: The objective
-            (:class:`~om_redundant.objective.Objective`).
+            (:class:`~om_redundant.redundancy.objective.Objective`).
         branches: Allowed branch signs, e.g. ``[(1, -1, 1)]``; default all.
         grid_points: psi samples per branch of the sweep, >= 16.
         max_step: Largest psi change (rad) per tracking call.

@@ -44,9 +44,9 @@ from typing import Any
 
 import numpy as np
 
-from .exceptions import ArmFileError, InvalidInput, UnknownArm
-from .kinematics import DHRow, JointKind, KinematicChain, standard_rows_from_modified
-from .validation import as_joint_vector
+from ..exceptions import ArmFileError, InvalidInput, UnknownArm
+from ..validation import as_joint_vector
+from .chain import DHRow, JointKind, KinematicChain, standard_rows_from_modified
 
 
 @dataclass(frozen=True, eq=False)

@@ -1,6 +1,6 @@
 r"""The arm angle psi of a 7-DOF arm and its gradient d psi / dq, from the model's kinematics.
 
-psi is defined in :mod:`om_redundant.closed_form.srs` on the MODEL arm at joints q: with the
+psi is defined in :mod:`om_redundant.om.families.srs` on the MODEL arm at joints q: with the
 shoulder centre S, the wrist centre W, :math:`w = W - S`, :math:`\hat w = w/|w|`, joint 4's
 axis :math:`z_4` and the bend direction :math:`b = e\,\sigma\,(z_4 \times \hat w)`
 (e the ELBOW sign, :math:`\sigma` the model's constant bend sign),
@@ -40,12 +40,12 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from .closed_form import srs
-from .closed_form.common import add, cross, dot, scale, sub, vec
-from .exceptions import InvalidInput
-from .kinematics import joint_axes_kernel
-from .solver import OMSolver
-from .validation import as_joint_vector
+from ..exceptions import InvalidInput
+from ..kinematics.chain import joint_axes_kernel
+from ..om.families import srs
+from ..om.families.common import add, cross, dot, scale, sub, vec
+from ..om.solver import OMSolver
+from ..validation import as_joint_vector
 
 #: Number of joints psi depends on: the shoulder's three and the elbow.
 ARM_ANGLE_JOINTS = 4
@@ -56,13 +56,13 @@ def arm_angle_gradient_kernel(P, table, q, grad):
     """psi at q of the S-R-S model with parameters P and DH table ``table``; writes d psi/dq.
 
     Args:
-        P: The model's parameter vector (:mod:`om_redundant.closed_form.srs` layout).
+        P: The model's parameter vector (:mod:`om_redundant.om.families.srs` layout).
         table: The model chain's DH table.
         q: (7,) joint vector.
         grad: (7,) output, d psi / dq.
 
     Returns:
-        psi (rad), equal to :func:`om_redundant.closed_form.srs.arm_angle`.
+        psi (rad), equal to :func:`om_redundant.om.families.srs.arm_angle`.
     """
     # Axis and origin of joints 1-6 in DH frame 0: joint j turns about z of the frame its
     # row starts from. S is the origin after joint 1's row, W the one after joint 5's row.

@@ -2,12 +2,12 @@ r"""Feasible intervals of the arm angle psi: where a branch's exact solution exi
 within the joint limits and keeps the required clearance.
 
 A **feasible interval** is a maximal psi interval over which one solution path
-(:mod:`om_redundant.paths`) is exact, within the limits and clear: a run of feasible
+(:mod:`om_redundant.redundancy.paths`) is exact, within the limits and clear: a run of feasible
 neighbouring samples of the path, extended at each end to the boundary. Where the path's
 next sample is infeasible, the boundary is the root of the continuous feasibility slack
-(:class:`~om_redundant.objective.Evaluation`) along the path between the two, by the
+(:class:`~om_redundant.redundancy.objective.Evaluation`) along the path between the two, by the
 Illinois method (:func:`refine_end`); where the path itself ends, its end; both to
-:data:`~om_redundant.paths.END_TOLERANCE`.
+:data:`~om_redundant.redundancy.paths.END_TOLERANCE`.
 
 So a psi can lie in two intervals of one branch (two solution paths), and a solution that
 no path reaches (a path shorter than the sweep's grid step that meets no other) is not
@@ -113,8 +113,8 @@ def refine_end(probe: Probe, inside: Point, outside: Point) -> Point:
 
     The feasibility slack changes sign between them; the Illinois method (regula falsi that
     halves the slack kept at a stale end) finds the root, each trial followed from the inner
-    end (:meth:`~om_redundant.paths.Probe.follow`). It stops when the bracket is narrower
-    than :data:`~om_redundant.paths.END_TOLERANCE` or the inner slack below
+    end (:meth:`~om_redundant.redundancy.paths.Probe.follow`). It stops when the bracket is narrower
+    than :data:`~om_redundant.redundancy.paths.END_TOLERANCE` or the inner slack below
     :data:`SLACK_TOLERANCE`.
     """
     a, fa, b, fb = inside, inside.evaluation.slack, outside.psi, outside.evaluation.slack

@@ -40,7 +40,7 @@ Shoulder and wrist. Given :math:`\psi`, :math:`R_{03}` maps the frame-3 triad
 :math:`(\hat v, \hat b_3, \hat v \times \hat b_3)`, :math:`b_3 = \mathrm{ELBOW}\,\sigma\,
 (e_z \times v)` (the shoulder-wrist direction and the bend direction in frame 3) onto
 :math:`(\hat w, m, \hat w \times m)`, :math:`m = \cos\psi\, n + \sin\psi\, (\hat w \times n)`.
-Joints 1-3 and 5-7 then follow from :func:`~om_redundant.closed_form.common.euler_zxzxz`
+Joints 1-3 and 5-7 then follow from :func:`~om_redundant.om.families.common.euler_zxzxz`
 with the SHOULDER and WRIST signs
 (:math:`\mathrm{sign}\sin\varphi_2`, :math:`\mathrm{sign}\sin\varphi_6`).
 
@@ -48,7 +48,7 @@ Angles :math:`\varphi_i = q_i + \theta_i` are DH joint angles with their offsets
 rows between joints 6 and 7 (the Sawyer's) fold into the wrist's middle rotation,
 :math:`R_x(\alpha_6) F = R_z(a) R_x(\beta) R_z(b)`: a joins :math:`\theta_6`, b joins
 :math:`\theta_7`, and :math:`\beta` is the twist between joints 6 and 7 (see
-:func:`~om_redundant.closed_form.common.euler_zxzxz`).
+:func:`~om_redundant.om.families.common.euler_zxzxz`).
 """
 
 from __future__ import annotations
@@ -183,7 +183,7 @@ def model_ik_lifted(P, R, p, signs, psi, q1, q7, phi4, q):
 
     Writes q (q1 and q7 as given) and returns the residuals of the three equations they
     must satisfy: the shoulder's and the wrist's consistency (see
-    :func:`~om_redundant.closed_form.common.euler_zxzxz_given_first`) and the elbow's,
+    :func:`~om_redundant.om.families.common.euler_zxzxz_given_first`) and the elbow's,
     :math:`x - \cos(\varphi_4 - \varphi^*)`. Unlike :func:`model_ik`, this is smooth
     everywhere but at W = S (NaN): across the straight elbow, where the two ELBOW branches
     meet in a square root, and at the shoulder and wrist singularities, where the Euler

@@ -1,7 +1,7 @@
 r"""The climb: a trust-region SQP that maximises the objective over the redundancy variables.
 
 From a feasible exact solution q(psi) on a branch, every piece v_j of every group g of the
-objective (:mod:`om_redundant.objective`) is linearised through the self-motion tangent
+objective (:mod:`om_redundant.redundancy.objective`) is linearised through the self-motion tangent
 dq/dpsi (:func:`self_motion_tangent`), :math:`v_j(\psi + \delta) \approx v_j + a_j^T\delta`,
 and the QP
 

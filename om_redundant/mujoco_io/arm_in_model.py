@@ -13,8 +13,8 @@ import mujoco
 import numpy as np
 from mink import FRAME_TO_ENUM, FRAME_TO_POS_ATTR, FRAME_TO_XMAT_ATTR, SUPPORTED_FRAMES, UnsupportedFrame
 
-from .arm import Arm
-from .exceptions import FrameNotFound, JointNotFound, ModelMismatch
+from ..exceptions import FrameNotFound, JointNotFound, ModelMismatch
+from ..kinematics.arm import Arm
 from .mjcf import DEFAULT_SITE
 
 #: Largest disagreement (m, rad) accepted between ``arm.fk`` and the model's end-effector frame.

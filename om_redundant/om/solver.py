@@ -7,12 +7,12 @@ from typing import Any
 
 import numpy as np
 
-from . import om_system
-from .arm import Arm, load_arm
+from ..exceptions import InvalidInput
+from ..kinematics.arm import Arm, load_arm
+from ..validation import as_joint_vector, as_pose, as_poses, as_signs
+from . import system
 from .configuration import Configuration
-from .exceptions import InvalidInput
 from .model import ModelArm, derive_model
-from .validation import as_joint_vector, as_pose, as_poses, as_signs
 
 DEFAULT_POSITION_TOLERANCE = 1e-10
 DEFAULT_ORIENTATION_TOLERANCE = 1e-9
@@ -71,7 +71,7 @@ class BatchSolution:
 
     @property
     def status(self) -> list[str]:
-        return [om_system.STATUS_NAMES[c] for c in self.status_code]
+        return [system.STATUS_NAMES[c] for c in self.status_code]
 
 
 class OMSolver:
@@ -113,14 +113,14 @@ class OMSolver:
         self.om: ModelArm = derive_model(self.arm)
         chain = self.arm.chain
         shoulder = bool(self.om.shoulder.any())
-        # The data every kernel call needs, in the layout of om_system.solve_one.
+        # The data every kernel call needs, in the layout of system.solve_one.
         self._kernel_arm = (
             self.om.family,
             self.om.params,
             self.om.model.chain.table,
             chain.table,
             # With shoulder offsets the search runs on the torus (q1, q7): the shoulder's
-            # coefficients ride below delta's; see om_system._torus_roots.
+            # coefficients ride below delta's; see system._torus_roots.
             0 if shoulder else self.om.dp_joint,
             np.vstack([self.om.delta, self.om.shoulder]) if shoulder else self.om.delta,
             np.linalg.inv(chain.T_root_base),
@@ -166,9 +166,9 @@ class OMSolver:
         if q.ndim != 1:
             raise InvalidInput("configuration_of takes one joint vector")
         values = np.empty(len(self.sign_names))
-        om_system.branch_values(self.om.family, self.om.params, q, values)
+        system.branch_values(self.om.family, self.om.params, q, values)
         redundancy = np.empty(len(self.redundancy_names))
-        om_system.redundancy_values(self.om.family, self.om.params, q, redundancy)
+        system.redundancy_values(self.om.family, self.om.params, q, redundancy)
         return Configuration(tuple(np.where(values < 0.0, -1, 1)), tuple(redundancy))
 
     def solve(self, T: Any, configuration: Configuration, q_hint: np.ndarray | None = None) -> Solution:
@@ -189,20 +189,20 @@ class OMSolver:
         signs, redundancy = self._configuration(configuration)
         hint, has_hint = self._hint(q_hint)
         q = np.empty(self.arm.dof)
-        status, pos, ori, evals, within = om_system.solve_one(
+        status, pos, ori, evals, within = system.solve_one(
             self._kernel_arm, self._kernel_settings, T, signs, redundancy, hint, has_hint, q
         )
         return Solution(
-            q, status == om_system.OK, om_system.STATUS_NAMES[status], configuration, pos, ori, evals, within
+            q, status == system.OK, system.STATUS_NAMES[status], configuration, pos, ori, evals, within
         )
 
     def solve_all(self, T: Any, configuration: Configuration) -> list[Solution]:
         """Every real solution with this configuration (the bounded search), possibly none."""
         signs, redundancy = self._configuration(configuration)
-        roots = np.empty((om_system.MAX_ROOTS, self.arm.dof))
-        pos, ori = np.empty(om_system.MAX_ROOTS), np.empty(om_system.MAX_ROOTS)
-        within = np.empty(om_system.MAX_ROOTS, dtype=np.bool_)
-        n, evals = om_system.solve_all_kernel(
+        roots = np.empty((system.MAX_ROOTS, self.arm.dof))
+        pos, ori = np.empty(system.MAX_ROOTS), np.empty(system.MAX_ROOTS)
+        within = np.empty(system.MAX_ROOTS, dtype=np.bool_)
+        n, evals = system.solve_all_kernel(
             self._kernel_arm, self._kernel_settings, as_pose(T), signs, redundancy, roots, pos, ori, within
         )
         return [
@@ -244,7 +244,7 @@ class OMSolver:
         status = np.empty(m, dtype=np.int64)
         pos, ori, evals = np.empty(m), np.empty(m), np.empty(m, dtype=np.int64)
         within = np.empty(m, dtype=np.bool_)
-        om_system.solve_batch_kernel(
+        system.solve_batch_kernel(
             self._kernel_arm,
             self._kernel_settings,
             T,
@@ -259,7 +259,7 @@ class OMSolver:
             evals,
             within,
         )
-        return BatchSolution(q, status == om_system.OK, status, pos, ori, evals, within)
+        return BatchSolution(q, status == system.OK, status, pos, ori, evals, within)
 
     # -----------------------------------------------------------------------------------
 

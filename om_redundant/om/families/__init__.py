@@ -3,12 +3,12 @@
 A family kernel solves the MODEL arm exactly for a flange pose in DH frame 0, a set of
 branch signs and (for redundant arms) redundancy values, and evaluates the branch
 quantities and redundancy values that define the configuration of a joint vector.
-:mod:`om_redundant.model` recognises the family of a model arm and packs its parameters;
-the solver calls the dispatchers in :mod:`.families`.
+:mod:`om_redundant.om.model` recognises the family of a model arm and packs its parameters;
+the solver calls the dispatchers in :mod:`.dispatch`.
 """
 
 from .common import REACH_SLACK, wrap
-from .families import branch_values, model_ik, redundancy_values
+from .dispatch import branch_values, model_ik, redundancy_values
 from .six_dof import RRP_SPHERICAL_WRIST, RRR_SPHERICAL_WRIST
 from .srs import SRS
 

@@ -6,7 +6,7 @@ System (9) asks for the model's hand position :math:`p_m` with
 
 Every solution has the form :math:`p_m = p_d + R_d\,\delta(w)`, where :math:`\delta` is dp
 seen from the flange and depends on one wrist joint, :math:`w = q_J` (see
-:mod:`om_redundant.model`). So the three equations reduce exactly to one on the circle,
+:mod:`om_redundant.om.model`). So the three equations reduce exactly to one on the circle,
 
 .. math::  g(w) = \mathrm{wrap}\big(\mathrm{IK}_{model}(R_d, p_d + R_d\,\delta(w), c)_J - w\big) = 0,
 
@@ -16,7 +16,7 @@ and a root gives the real arm's joints :math:`q = \mathrm{IK}_{model}(\ldots)` w
 Arms with shoulder offsets (Gen3, Sawyer) add :math:`a(q_1)`, so solutions lie on a torus
 :math:`(w_1, w_7) = (q_1, q_7)`: :math:`p_m = p_d + a(w_1) + R_d\,\delta(w_7)`. There the
 system is lifted to three unknowns :math:`(w_1, w_7, \varphi_4)` and three residuals that
-are smooth everywhere (:func:`~om_redundant.closed_form.srs.model_ik_lifted`): the model IK
+are smooth everywhere (:func:`~om_redundant.om.families.srs.model_ik_lifted`): the model IK
 with q1, q7 and the elbow angle given is consistent with the shoulder, the wrist and the
 elbow equation. In (w1, w7) alone the residual has a square-root branch point at the edge of
 reach (the straight or folded elbow) and steep Euler angles at the shoulder and wrist
@@ -46,9 +46,9 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from .closed_form import REACH_SLACK, branch_values, model_ik, redundancy_values, srs, wrap
-from .closed_form.common import add, cross, dot, mtm, scale, unit
-from .kinematics import flange_kernel
+from ..kinematics.chain import flange_kernel
+from .families import REACH_SLACK, branch_values, model_ik, redundancy_values, srs, wrap
+from .families.common import add, cross, dot, mtm, scale, unit
 
 OK = 0
 UNREACHABLE = 1

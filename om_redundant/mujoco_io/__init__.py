@@ -1,0 +1,20 @@
+"""MuJoCo: the project's MJCF of an arm (:mod:`.mjcf`), the arm's joints and root inside a
+larger model (:mod:`.arm_in_model`), and the check of a model against an arm file
+(:mod:`.model_match`)."""
+
+from .arm_in_model import ArmJoints, ArmRoot
+from .mjcf import DEFAULT_SITE, arm_mjcf, arm_model, scene_mjcf
+from .model_match import ModelComparison, compare_mujoco_model, load_mujoco_model, without_meshes
+
+__all__ = [
+    "DEFAULT_SITE",
+    "ArmJoints",
+    "ArmRoot",
+    "ModelComparison",
+    "arm_mjcf",
+    "arm_model",
+    "compare_mujoco_model",
+    "load_mujoco_model",
+    "scene_mjcf",
+    "without_meshes",
+]
