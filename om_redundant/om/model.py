@@ -34,7 +34,8 @@ import numpy as np
 
 from ..exceptions import ModelError
 from ..kinematics.arm import Arm
-from ..kinematics.chain import DHRow, JointKind, KinematicChain, flange_kernel
+from ..kinematics.chain import DHRow, JointKind, KinematicChain
+from ..kinematics.kernels import flange_kernel
 from .families import six_dof, srs
 
 _ANGLE_EPS = 1e-9

@@ -46,7 +46,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from ..kinematics.chain import flange_kernel
+from ..kinematics.kernels import flange_kernel
 from .families import REACH_SLACK, branch_values, model_ik, redundancy_values, srs, wrap
 from .families.common import add, cross, dot, mtm, scale, unit
 

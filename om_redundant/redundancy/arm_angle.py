@@ -41,7 +41,7 @@ import numba as nb
 import numpy as np
 
 from ..exceptions import InvalidInput
-from ..kinematics.chain import joint_axes_kernel
+from ..kinematics.kernels import joint_axes_kernel
 from ..om.families import srs
 from ..om.families.common import add, cross, dot, scale, sub, vec
 from ..om.solver import OMSolver

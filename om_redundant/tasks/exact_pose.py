@@ -1,42 +1,28 @@
-r"""mink tasks fed by exact OM solutions.
+"""The mink task that pulls the arm's joints to the exact OM solution of a hand pose.
 
 :class:`ExactPoseTask` turns a hand pose into the exact joint vector :math:`q^*` of the
 configuration you chose (branch signs and arm angle, or the redundancy optimiser's choice)
-and pulls the arm's joints there; :class:`ArmAngleTask` only steers a 7-DOF arm's elbow,
-leaving the hand to mink's ``FrameTask``. Both are ``mink.Task``\ s: add them to the task
-list of ``mink.solve_ik``, whose limits (joint, velocity, collision) keep every step safe.
-
-Typical use (see the README, "Using it with mink")::
-
-    solver = om.OMSolver("panda")
-    frame_task = mink.FrameTask("attachment_site", "site", position_cost=1.0, orientation_cost=1.0)
-    exact_task = om.ExactPoseTask(solver, model, arm_configuration=om.Configuration((1, -1, 1), (0.3,)))
-    frame_task.set_target(T_world_target)
-    exact_task.set_target(T_world_target)
-    velocity = mink.solve_ik(configuration, [frame_task, exact_task], dt, "daqp", limits=limits)
-
-Targets are poses of the arm's end-effector frame in MuJoCo's world frame, like a
-``FrameTask``'s; the tasks find the arm's root frame in the model (:class:`ArmRoot`).
+and pulls the arm's joints there. Targets are poses of the arm's end-effector frame in
+MuJoCo's world frame, like a ``FrameTask``'s; the task finds the arm's root frame in the
+model (:class:`~om_redundant.ArmRoot`).
 """
 
 from __future__ import annotations
 
-import math
 from typing import Any, Protocol
 
 import mujoco
 import numpy as np
 import numpy.typing as npt
-from mink import SE3, TargetNotSet, Task, TaskDefinitionError
+from mink import SE3, TargetNotSet, TaskDefinitionError
 from mink import Configuration as MinkConfiguration
-from mink.exceptions import InvalidTarget
 
 from ..exceptions import UnreachableTarget
-from ..mujoco_io.arm_in_model import ArmJoints, ArmRoot
+from ..mujoco_io.arm_in_model import ArmRoot
 from ..om.configuration import Configuration
 from ..om.solver import OMSolver
-from ..redundancy.arm_angle import arm_angle_and_gradient, check_arm_angle
 from ..validation import as_pose
+from .arm_task import ArmTask
 
 #: Default cost of :class:`ExactPoseTask`, per radian (metre for prismatic joints). With
 #: mink's usual ``FrameTask`` costs of 1 it makes the exact target dominate far from it,
@@ -56,50 +42,7 @@ class RedundancyOptimizer(Protocol):
     def choose(self, T: np.ndarray, previous: Any = None) -> Any: ...
 
 
-class _ArmTask(Task):
-    """A task on the arm's joints inside a larger model: cost, model check, Jacobian columns."""
-
-    def __init__(
-        self,
-        solver: OMSolver,
-        model: mujoco.MjModel,
-        k: int,
-        prefix: str,
-        cost: npt.ArrayLike,
-        gain: float,
-        lm_damping: float,
-    ):
-        super().__init__(cost=np.zeros(k), gain=gain, lm_damping=lm_damping)
-        self.k = k
-        self.solver = solver
-        self.joints = ArmJoints(solver.arm, model, prefix)
-        self.set_cost(cost)
-
-    def set_cost(self, cost: npt.ArrayLike) -> None:
-        """Set the cost: one value for every coordinate of the error, or one per coordinate."""
-        cost = np.atleast_1d(np.asarray(cost, dtype=np.float64))
-        if cost.ndim != 1 or cost.shape[0] not in (1, self.k):
-            raise TaskDefinitionError(
-                f"{self.__class__.__name__} cost must be a vector of shape (1,) or ({self.k},), "
-                f"got {cost.shape}"
-            )
-        if not np.all(cost >= 0.0):
-            raise TaskDefinitionError(f"{self.__class__.__name__} cost should be >= 0")
-        self.cost[:] = cost
-
-    def _arm_q(self, configuration: MinkConfiguration) -> np.ndarray:
-        """The arm's joints in the configuration, after checking it is of this task's model."""
-        self.joints.check_model(configuration.model, self.__class__.__name__)
-        return self.joints.q(configuration.data.qpos)
-
-    def _scatter(self, rows: np.ndarray) -> np.ndarray:
-        """(k, dof) derivatives w.r.t. the arm's joints as a (k, nv) Jacobian."""
-        jacobian = np.zeros((self.k, self.joints.model.nv))
-        jacobian[:, self.joints.dof_ids] = rows
-        return jacobian
-
-
-class ExactPoseTask(_ArmTask):
+class ExactPoseTask(ArmTask):
     r"""Pull the arm's joints to the exact solution of a hand pose in a chosen configuration.
 
     On :meth:`set_target` the OM solver gives :math:`q^*` with :math:`\mathrm{fk}(q^*) =
@@ -179,7 +122,7 @@ class ExactPoseTask(_ArmTask):
         self.choice: Any = None
         self._q_target: np.ndarray | None = None
         self._root_pose: np.ndarray | None = None
-        self._jacobian = self._scatter(np.eye(self.k))
+        self._jacobian = self.scatter(np.eye(self.k))
         self._jacobian.setflags(write=False)
 
     @property
@@ -225,7 +168,7 @@ class ExactPoseTask(_ArmTask):
     def set_target_from_configuration(self, configuration: MinkConfiguration) -> None:
         """Hold the arm where it is: the target becomes the hand's current pose and, without
         an optimiser, c becomes the arm's current configuration (branch signs and psi)."""
-        q = self._arm_q(configuration)
+        q = self.arm_q(configuration)
         T = configuration.get_transform_frame_to_world(self.root.frame_name, self.root.frame_type).as_matrix()
         c = self.solver.configuration_of(q) if self.optimizer is None else None
         self._solve(T, self.root.pose(configuration.data), q, c)
@@ -252,7 +195,7 @@ class ExactPoseTask(_ArmTask):
 
     def _joint_target(self, configuration: MinkConfiguration) -> np.ndarray:
         """:math:`q^*` for the configuration's root pose, solved again if the root moved."""
-        self._arm_q(configuration)
+        self.arm_q(configuration)
         if self.transform_target_to_world is None:
             raise TargetNotSet(self.__class__.__name__)
         if self.root.fixed_pose is None:
@@ -304,75 +247,3 @@ class ExactPoseTask(_ArmTask):
                 f"ExactPoseTask: every solution for the target in configuration {c} breaks a joint limit"
             )
         return min(inside, key=lambda q: float(np.linalg.norm(q - solution.q)))
-
-
-class ArmAngleTask(_ArmTask):
-    r"""Steer a 7-DOF arm's elbow: drive its arm angle psi to a target psi*.
-
-    For users who track the hand with mink's ``FrameTask`` and only want to choose the
-    elbow's swivel about the shoulder-wrist line. psi is the model's arm angle
-    (:mod:`om_redundant.om.families.srs`, ``solver.configuration_of(q).redundancy[0]``):
-
-    .. math::  e(q) = \mathrm{wrap}\big(\psi(q) - \psi^*\big) \in (-\pi, \pi], \qquad
-               J = \partial\psi/\partial q \in \mathbb{R}^{1 \times n_v},
-
-    the gradient derived analytically in :mod:`om_redundant.redundancy.arm_angle` (nonzero on the arm's
-    joints 1-4 only). psi is undefined on its singular half-line (the wrist straight below
-    the shoulder, inside the base) and jumps by pi where the ELBOW sign flips.
-
-    Args:
-        solver: The OM solver of a 7-DOF arm.
-        model: The MuJoCo model that holds the arm.
-        prefix: Prefix of the arm's joint names in the model.
-        cost: Cost of the arm angle error (1/rad).
-        gain: Task gain in [0, 1].
-        lm_damping: Levenberg-Marquardt damping (see ``mink.Task``).
-
-    Raises:
-        InvalidInput: The arm has no arm angle.
-        JointNotFound, ModelMismatch: The model does not hold the arm as named.
-    """
-
-    def __init__(
-        self,
-        solver: OMSolver,
-        model: mujoco.MjModel,
-        *,
-        prefix: str = "",
-        cost: npt.ArrayLike = 1.0,
-        gain: float = 1.0,
-        lm_damping: float = 0.0,
-    ):
-        check_arm_angle(solver)
-        super().__init__(solver, model, 1, prefix, cost, gain, lm_damping)
-        self.target_psi: float | None = None
-
-    def set_target(self, psi: float) -> None:
-        """Set the target arm angle psi* (rad)."""
-        try:
-            value = float(psi)
-        except (TypeError, ValueError):
-            value = math.nan
-        if not math.isfinite(value):
-            raise InvalidTarget(f"ArmAngleTask target must be a finite angle in radians, got {psi!r}")
-        self.target_psi = value
-
-    def set_target_from_configuration(self, configuration: MinkConfiguration) -> None:
-        """Hold the elbow where it is: psi* becomes the arm's current arm angle."""
-        self.set_target(arm_angle_and_gradient(self.solver, self._arm_q(configuration))[0])
-
-    def compute_error(self, configuration: MinkConfiguration) -> np.ndarray:
-        r"""The arm-angle error :math:`\mathrm{wrap}(\psi(q) - \psi^*)`, shape (1,)."""
-        psi, _ = self._psi(configuration)
-        return np.array([math.remainder(psi - self.target_psi, 2.0 * math.pi)])
-
-    def compute_jacobian(self, configuration: MinkConfiguration) -> np.ndarray:
-        r""":math:`\partial\psi/\partial q` in the arm's dof columns, (1, nv)."""
-        _, gradient = self._psi(configuration)
-        return self._scatter(gradient[None, :])
-
-    def _psi(self, configuration: MinkConfiguration) -> tuple[float, np.ndarray]:
-        q = self._arm_q(configuration)
-        if self.target_psi is None:
-            raise TargetNotSet(self.__class__.__name__)
-        return arm_angle_and_gradient(self.solver, q)

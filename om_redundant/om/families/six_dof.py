@@ -41,7 +41,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from ...kinematics.chain import _apply_row
+from ...kinematics.kernels import apply_row
 from .common import REACH_SLACK, euler_zxzxz, wrap
 
 RRR_SPHERICAL_WRIST = 0
@@ -119,9 +119,9 @@ def model_ik(family, P, table, R, p, signs, q_prev, q):
     j = 0
     for row in range(int(P[WRIST_ROW])):
         if table[row, 5] == 2.0:
-            _apply_row(Rin, pin, table[row], 0.0)
+            apply_row(Rin, pin, table[row], 0.0)
         else:
-            _apply_row(Rin, pin, table[row], q[j])
+            apply_row(Rin, pin, table[row], q[j])
             j += 1
     E = P[E_ROT : E_ROT + 9].reshape(3, 3)
     M = Rin.T @ R @ E.T

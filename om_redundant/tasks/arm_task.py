@@ -1,0 +1,67 @@
+"""The base of the mink tasks on an arm's joints inside a larger MuJoCo model."""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import numpy.typing as npt
+from mink import Configuration as MinkConfiguration
+from mink import Task, TaskDefinitionError
+
+from ..mujoco_io.arm_in_model import ArmJoints
+from ..om.solver import OMSolver
+
+
+class ArmTask(Task):
+    """A task on the arm's joints inside a larger model: cost, model check, Jacobian columns.
+
+    The base of :class:`~om_redundant.ExactPoseTask` and :class:`~om_redundant.ArmAngleTask`.
+
+    Args:
+        solver: The OM solver of the arm.
+        model: The MuJoCo model that holds the arm (possibly among other joints).
+        k: Number of coordinates of the task's error.
+        prefix: Prefix of the arm's joint names in the model.
+        cost: Cost, one value for every coordinate of the error or one per coordinate.
+        gain: Task gain in [0, 1].
+        lm_damping: Levenberg-Marquardt damping (see ``mink.Task``).
+    """
+
+    def __init__(
+        self,
+        solver: OMSolver,
+        model: mujoco.MjModel,
+        k: int,
+        prefix: str,
+        cost: npt.ArrayLike,
+        gain: float,
+        lm_damping: float,
+    ):
+        super().__init__(cost=np.zeros(k), gain=gain, lm_damping=lm_damping)
+        self.k = k
+        self.solver = solver
+        self.joints = ArmJoints(solver.arm, model, prefix)
+        self.set_cost(cost)
+
+    def set_cost(self, cost: npt.ArrayLike) -> None:
+        """Set the cost: one value for every coordinate of the error, or one per coordinate."""
+        cost = np.atleast_1d(np.asarray(cost, dtype=np.float64))
+        if cost.ndim != 1 or cost.shape[0] not in (1, self.k):
+            raise TaskDefinitionError(
+                f"{self.__class__.__name__} cost must be a vector of shape (1,) or ({self.k},), "
+                f"got {cost.shape}"
+            )
+        if not np.all(cost >= 0.0):
+            raise TaskDefinitionError(f"{self.__class__.__name__} cost should be >= 0")
+        self.cost[:] = cost
+
+    def arm_q(self, configuration: MinkConfiguration) -> np.ndarray:
+        """The arm's joints in the configuration, after checking it is of this task's model."""
+        self.joints.check_model(configuration.model, self.__class__.__name__)
+        return self.joints.q(configuration.data.qpos)
+
+    def scatter(self, rows: np.ndarray) -> np.ndarray:
+        """(k, dof) derivatives w.r.t. the arm's joints as a (k, nv) Jacobian."""
+        jacobian = np.zeros((self.k, self.joints.model.nv))
+        jacobian[:, self.joints.dof_ids] = rows
+        return jacobian
