@@ -18,16 +18,9 @@ import pytest
 import om_redundant as om
 from om_redundant.cli import build_parser, main
 from om_redundant.cli.common import UsageError
-from om_redundant.cli.sweep import (
-    Progress,
-    SweepResult,
-    build_request,
-    compute_sweep,
-    parse_obstacle,
-    psi_grid,
-    read_path,
-)
+from om_redundant.cli.sweep import Progress, build_request, parse_obstacle, psi_grid, read_path
 from om_redundant.om.model import derive_model
+from om_redundant.redundancy.sweep import SweepResult, compute_sweep
 from tests.conftest import MENAGERIE, ROOT, checkout_env, run_python
 
 Q_PANDA = np.array([0.2, 0.4, -0.3, -1.8, 0.5, 1.9, 0.6])

@@ -1,5 +1,5 @@
-"""What ``om-redundant sweep`` shows of a :class:`~om_redundant.cli.sweep.SweepResult`: a table,
-CSV, JSON, and plots (matplotlib, imported only for ``--plot``)."""
+"""What ``om-redundant sweep`` shows of a :class:`~om_redundant.redundancy.sweep.SweepResult`: a
+table, CSV, JSON, and plots (matplotlib, imported only for ``--plot``)."""
 
 from __future__ import annotations
 
@@ -10,8 +10,8 @@ import sys
 
 import numpy as np
 
+from ..redundancy.sweep import PoseSweep, SweepRequest, SweepResult
 from .common import table_wanted, write_json
-from .sweep import PoseSweep, SweepRequest, SweepResult
 
 MAX_INTERVALS_SHOWN = 4  # per branch in the table
 

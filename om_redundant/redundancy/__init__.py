@@ -1,7 +1,8 @@
 """The redundancy of 7-DOF arms: the arm angle (:mod:`.arm_angle`) and the self-motion
 (:mod:`.self_motion`), the objective (:mod:`.objective`, :mod:`.clearance`), solution paths
-along psi (:mod:`.paths`), feasible intervals (:mod:`.intervals`), the climb (:mod:`.climb`)
-and the optimiser that combines them (:mod:`.optimizer`)."""
+along psi (:mod:`.paths`), feasible intervals (:mod:`.intervals`), the climb (:mod:`.climb`),
+the optimiser that combines them (:mod:`.optimizer`), and the sweep of psi for a pose or a
+path that ``om-redundant sweep`` shows (:mod:`.sweep`)."""
 
 from .arm_angle import arm_angle_and_gradient
 from .clearance import Box, Capsule, Clearance, Sphere
@@ -9,18 +10,36 @@ from .intervals import PsiInterval
 from .objective import Evaluation, Objective, joint_margins
 from .optimizer import RedundancyChoice, RedundancyOptimizer
 from .self_motion import self_motion_tangent
+from .sweep import (
+    BranchSweep,
+    Choice,
+    Obstacle,
+    PoseSweep,
+    SweepRequest,
+    SweepResult,
+    compute_sweep,
+    optimizer_for,
+)
 
 __all__ = [
     "Box",
+    "BranchSweep",
     "Capsule",
+    "Choice",
     "Clearance",
     "Evaluation",
     "Objective",
+    "Obstacle",
+    "PoseSweep",
     "PsiInterval",
     "RedundancyChoice",
     "RedundancyOptimizer",
     "Sphere",
+    "SweepRequest",
+    "SweepResult",
     "arm_angle_and_gradient",
+    "compute_sweep",
     "joint_margins",
+    "optimizer_for",
     "self_motion_tangent",
 ]
