@@ -186,7 +186,7 @@ class OMSolver:
             exists in this configuration.
         """
         T = as_pose(T)
-        signs, redundancy = self._configuration(configuration)
+        signs, redundancy = self.check_configuration(configuration)
         hint, has_hint = self._hint(q_hint)
         q = np.empty(self.arm.dof)
         status, pos, ori, evals, within = system.solve_one(
@@ -198,7 +198,7 @@ class OMSolver:
 
     def solve_all(self, T: Any, configuration: Configuration) -> list[Solution]:
         """Every real solution with this configuration (the bounded search), possibly none."""
-        signs, redundancy = self._configuration(configuration)
+        signs, redundancy = self.check_configuration(configuration)
         roots = np.empty((system.MAX_ROOTS, self.arm.dof))
         pos, ori = np.empty(system.MAX_ROOTS), np.empty(system.MAX_ROOTS)
         within = np.empty(system.MAX_ROOTS, dtype=np.bool_)
@@ -261,10 +261,23 @@ class OMSolver:
         )
         return BatchSolution(q, status == system.OK, status, pos, ori, evals, within)
 
-    # -----------------------------------------------------------------------------------
+    def check_configuration(self, configuration: Configuration) -> tuple[np.ndarray, np.ndarray]:
+        """Check that a configuration fits this arm; return it as the kernels take it.
 
-    def _configuration(self, configuration: Configuration) -> tuple[np.ndarray, np.ndarray]:
-        """Branch signs and redundancy values as kernel arrays, checked against the arm."""
+        The solves call this on their configuration; call it to reject a bad configuration
+        before any solve (``ExactPoseTask`` does, when it is given one).
+
+        Args:
+            configuration: A :class:`Configuration` with as many branch signs as
+                :attr:`sign_names` and as many redundancy values as :attr:`redundancy_names`.
+
+        Returns:
+            The branch signs (int64 array) and the redundancy values (float64 array).
+
+        Raises:
+            InvalidInput: Not a Configuration, or the wrong number of signs or redundancy
+                values (the message names the arm and what it needs).
+        """
         if not isinstance(configuration, Configuration):
             raise InvalidInput(f"configuration must be a Configuration, got {type(configuration).__name__}")
         k, names = len(self.sign_names), self.redundancy_names
@@ -279,6 +292,8 @@ class OMSolver:
                 f"got {len(configuration.redundancy)}"
             )
         return np.array(configuration.signs, dtype=np.int64), np.array(configuration.redundancy)
+
+    # -----------------------------------------------------------------------------------
 
     def _redundancy_rows(self, redundancy: Any, m: int) -> np.ndarray:
         """(M, r) redundancy values for a batch, checked: shape and finiteness, named."""

@@ -78,7 +78,7 @@ def arm_angle_gradient_kernel(P, table, q, grad):
     elbow = -1.0 if np.sin(q[3] + P[srs.THETA + 3] - P[srs.PHI_STAR]) < 0.0 else 1.0
     bend = elbow * P[srs.BEND]
     b = scale(bend, cross(z4, w_hat))
-    n, nw = srs._reference(P, w_hat)
+    n, nw = srs.reference_direction(P, w_hat)
     up = vec(P, srs.UP)
     wb = cross(w_hat, b)
     bb = dot(b, b)

@@ -117,7 +117,7 @@ class ExactPoseTask(ArmTask):
         self.optimizer = optimizer
         self.arm_configuration = arm_configuration
         if arm_configuration is not None:
-            solver._configuration(arm_configuration)  # raises InvalidInput naming the problem
+            solver.check_configuration(arm_configuration)  # raises InvalidInput naming the problem
         self.transform_target_to_world: SE3 | None = None
         self.choice: Any = None
         self._q_target: np.ndarray | None = None
@@ -157,7 +157,7 @@ class ExactPoseTask(ArmTask):
         elif self.optimizer is not None:
             raise TaskDefinitionError("this ExactPoseTask takes its configurations from its optimizer")
         else:
-            self.solver._configuration(arm_configuration)  # raises InvalidInput naming the problem
+            self.solver.check_configuration(arm_configuration)  # raises InvalidInput naming the problem
         if self.root.fixed_pose is not None:
             self._solve(T, self.root.fixed_pose, self._q_target, arm_configuration)
         else:

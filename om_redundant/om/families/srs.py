@@ -109,7 +109,7 @@ def _rx(sigma):
 
 
 @nb.njit(cache=True)
-def _reference(P, w_hat):
+def reference_direction(P, w_hat):
     """The arm angle's reference direction n(w_hat), and w_hat x n."""
     up, r = vec(P, UP), vec(P, REF)
     v = cross(up, w_hat)
@@ -221,7 +221,7 @@ def _rotation_03_at(P, w, L2, phi4, elbow, psi):
     the shoulder-wrist direction and the bend direction, in frame 3 and in frame 0.
     """
     w_hat = scale(1.0 / np.sqrt(L2), w)
-    n, nw = _reference(P, w_hat)
+    n, nw = reference_direction(P, w_hat)
     m = add(scale(np.cos(psi), n), scale(np.sin(psi), nw))
     v = _elbow_vector(P, phi4)
     v_hat = unit(v)
@@ -261,7 +261,7 @@ def arm_angle(P, q):
     R03 = _rotation_03(P, q)
     phi4 = q[3] + P[THETA + 3]
     w_hat = unit(mv(R03, _elbow_vector(P, phi4)))
-    n, nw = _reference(P, w_hat)
+    n, nw = reference_direction(P, w_hat)
     elbow = -1.0 if np.sin(phi4 - P[PHI_STAR]) < 0.0 else 1.0
     b = scale(elbow * P[BEND], cross(col(R03, 2), w_hat))
     return np.arctan2(dot(nw, b), dot(n, b))
