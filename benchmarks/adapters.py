@@ -206,7 +206,7 @@ def om_redundant_peer(arm: om.Arm, rng: np.random.Generator) -> Peer:
             lambda _, found: _rows([s.q for s in found], arm.dof),
         ),
         batch=BatchMethod(
-            "om_redundant solve_batch (numba, parallel)",
+            "om_redundant solve_batch (C, threads)",
             batch_prepare,
             lambda argument: solver.solve_batch(*argument),
             batch_solutions,

@@ -22,7 +22,6 @@ from .robots import FKCheck
 PACKAGES = (
     "om_redundant",
     "numpy",
-    "numba",
     "scipy",
     "eaik",
     "ik-geo",

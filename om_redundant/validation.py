@@ -9,9 +9,9 @@ from __future__ import annotations
 
 from typing import Any
 
-import numba as nb
 import numpy as np
 
+from . import ckernels
 from .exceptions import InvalidInput
 
 #: Largest accepted deviation max|R^T R - I| of a pose's rotation block.
@@ -22,39 +22,18 @@ def as_pose(T: Any, name: str = "T") -> np.ndarray:
     """Return a validated (4, 4) homogeneous transform from an array or a ``mink.SE3``."""
     if hasattr(T, "as_matrix") and not isinstance(T, np.ndarray):
         T = T.as_matrix()
-    T = np.asarray(T, dtype=np.float64)
+    T = np.ascontiguousarray(T, dtype=np.float64)
     if T.shape != (4, 4):
         raise InvalidInput(f"{name} must be a (4, 4) homogeneous transform, got shape {T.shape}")
-    if _pose_is_valid(T):  # fast path; the full check below names the problem
+    if ckernels.pose_is_valid(T, ORTHONORMALITY_TOLERANCE):  # fast path; the full check names the problem
         return T
     _check_poses(T[None], name)
-    raise AssertionError("unreachable: _pose_is_valid and _check_poses disagree")
-
-
-@nb.njit(cache=True)
-def _pose_is_valid(T):
-    for i in range(4):
-        for j in range(4):
-            if not np.isfinite(T[i, j]):
-                return False
-    if T[3, 0] != 0.0 or T[3, 1] != 0.0 or T[3, 2] != 0.0 or T[3, 3] != 1.0:
-        return False
-    for i in range(3):
-        for j in range(3):
-            dot = T[0, i] * T[0, j] + T[1, i] * T[1, j] + T[2, i] * T[2, j]
-            if abs(dot - (1.0 if i == j else 0.0)) > ORTHONORMALITY_TOLERANCE:
-                return False
-    det = (
-        T[0, 0] * (T[1, 1] * T[2, 2] - T[1, 2] * T[2, 1])
-        - T[0, 1] * (T[1, 0] * T[2, 2] - T[1, 2] * T[2, 0])
-        + T[0, 2] * (T[1, 0] * T[2, 1] - T[1, 1] * T[2, 0])
-    )
-    return det > 0.0
+    raise AssertionError("unreachable: pose_is_valid and _check_poses disagree")
 
 
 def as_poses(T: Any, name: str = "T") -> np.ndarray:
     """Return a validated (M, 4, 4) stack of homogeneous transforms."""
-    T = np.asarray(T, dtype=np.float64)
+    T = np.ascontiguousarray(T, dtype=np.float64)
     if T.ndim != 3 or T.shape[1:] != (4, 4):
         raise InvalidInput(f"{name} must have shape (M, 4, 4), got {T.shape}")
     _check_poses(T, name)

@@ -120,7 +120,7 @@ def test_ur5e_configurations_agree_with_an_independent_closed_form(ur5e):
         for e in expected:
             assert min(np.abs(wrap(f - e)).max() for f in found) < 1e-9
         values = np.empty(3)
-        om.om.system.branch_values(ur5e.om.family, ur5e.om.params, q, values)
+        om.om.families.branch_values(ur5e.om.family, ur5e.om.params, q, values)
         if len(expected) == 8 and abs(values[0]) > 2 * ur5e.dp_max:
             checked += 1
             for c in ur5e.configurations():

@@ -1,4 +1,4 @@
-"""Kinematics of real arms: DH chains (:mod:`.chain`), their numba kernels (:mod:`.kernels`),
+"""Kinematics of real arms: DH chains (:mod:`.chain`, with C kernels in ``csrc/kinematics.c``),
 and arms read from arm files (:mod:`.arm`)."""
 
 from .arm import Arm, arm_names, load_arm, pose_from_xyz_quat, rotation_from_quat

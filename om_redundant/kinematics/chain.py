@@ -15,8 +15,8 @@ A table in the modified (Craig) convention,
 regroups into a fixed row :math:`T_x(a_0) R_x(\alpha_0)` followed by standard rows. One
 internal convention keeps one code path for FK, Jacobians and the OM model.
 
-The numeric kernels (:mod:`.kernels`) are compiled with numba; :class:`KinematicChain` is
-the typed front.
+The numeric kernels are C (``csrc/kinematics.c``, in :mod:`om_redundant.ckernels`);
+:class:`KinematicChain` is the typed front.
 """
 
 from __future__ import annotations
@@ -27,8 +27,8 @@ from functools import cached_property
 
 import numpy as np
 
+from .. import ckernels
 from ..validation import as_joint_vector
-from .kernels import fk_batch_kernel, fk_kernel, jacobian_kernel
 
 
 class JointKind(StrEnum):
@@ -155,10 +155,10 @@ class KinematicChain:
         Returns:
             (4, 4) transform, or (M, 4, 4) for a stack.
         """
-        q = as_joint_vector(q, self.dof)
-        if q.ndim == 1:
-            return fk_kernel(self.table, self.T_root_base, self.T_flange_tool, q)
-        return fk_batch_kernel(self.table, self.T_root_base, self.T_flange_tool, q)
+        q = np.ascontiguousarray(as_joint_vector(q, self.dof))
+        out = np.empty((*q.shape[:-1], 4, 4))
+        ckernels.fk(self.table, self.T_root_base, self.T_flange_tool, q, out)
+        return out
 
     def jacobian(self, q: np.ndarray) -> np.ndarray:
         r"""Geometric Jacobian of the end-effector frame, in the root frame.
@@ -176,7 +176,9 @@ class KinematicChain:
         q = as_joint_vector(q, self.dof)
         if q.ndim != 1:
             raise ValueError("jacobian takes one joint vector")
-        return jacobian_kernel(self.table, self.T_root_base, self.T_flange_tool, q)
+        J = np.empty((6, self.dof))
+        ckernels.jacobian(self.table, self.T_root_base, self.T_flange_tool, np.ascontiguousarray(q), J)
+        return J
 
 
 def _row_transform(row: DHRow) -> np.ndarray:

@@ -32,10 +32,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import ckernels
 from ..exceptions import ModelError
 from ..kinematics.arm import Arm
 from ..kinematics.chain import DHRow, JointKind, KinematicChain
-from ..kinematics.kernels import flange_kernel
 from .families import six_dof, srs
 
 _ANGLE_EPS = 1e-9
@@ -336,7 +336,7 @@ def _position_family(name: str, rows: list[DHRow], jr: list[int]) -> tuple[int, 
 
 def _pose(table: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     R, p = np.empty((3, 3)), np.empty(3)
-    flange_kernel(np.ascontiguousarray(table), q, R, p)
+    ckernels.flange(np.ascontiguousarray(table), np.ascontiguousarray(q, dtype=np.float64), R, p)
     return R, p
 
 

@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import ckernels
 from ..exceptions import InvalidInput
 from ..kinematics.arm import Arm, load_arm
 from ..validation import as_joint_vector, as_pose, as_poses, as_signs
@@ -111,25 +112,35 @@ class OMSolver:
         self.tolerances = (float(position_tolerance), float(orientation_tolerance))
         self.scan_points = int(scan_points)
         self.om: ModelArm = derive_model(self.arm)
-        chain = self.arm.chain
-        shoulder = bool(self.om.shoulder.any())
-        # The data every kernel call needs, in the layout of system.solve_one.
-        self._kernel_arm = (
-            self.om.family,
-            self.om.params,
-            self.om.model.chain.table,
-            chain.table,
-            # With shoulder offsets the search runs on the torus (q1, q7): the shoulder's
-            # coefficients ride below delta's; see system._torus_roots.
-            0 if shoulder else self.om.dp_joint,
-            np.vstack([self.om.delta, self.om.shoulder]) if shoulder else self.om.delta,
-            np.linalg.inv(chain.T_root_base),
-            np.linalg.inv(chain.T_flange_tool),
-            self.arm.revolute,
-            self.arm.lower,
-            self.arm.upper,
+        self._kernel = ckernels.Solver(self._solver_data())
+
+    def _solver_data(self) -> system.SolverData:
+        """The fixed data of the compiled kernel (see :class:`~om_redundant.om.system.SolverData`)."""
+        om, chain = self.om, self.arm.chain
+        if om.shoulder.any():  # dp turns with q1 and q7: the torus (q1, q7)
+            mode, dp_joint = system.TORUS, 0
+        elif om.dp_joint >= 0:
+            mode, dp_joint = system.CIRCLE, om.dp_joint
+        else:
+            mode, dp_joint = system.FIXED, 0
+        c = system.as_kernel_array
+        return system.SolverData(
+            family=int(om.family),
+            mode=mode,
+            params=c(om.params),
+            model_table=c(om.model.chain.table),
+            real_table=c(chain.table),
+            dp_joint=int(dp_joint),
+            dp_coefficients=c(np.vstack([om.delta, om.shoulder])),
+            T_base_root=c(np.linalg.inv(chain.T_root_base)),
+            T_tool_flange=c(np.linalg.inv(chain.T_flange_tool)),
+            revolute=np.ascontiguousarray(self.arm.revolute, dtype=np.bool_),
+            lower=c(self.arm.lower),
+            upper=c(self.arm.upper),
+            scan_points=self.scan_points,
+            position_tolerance=self.tolerances[0],
+            orientation_tolerance=self.tolerances[1],
         )
-        self._kernel_settings = (self.scan_points, *self.tolerances)
 
     @property
     def model(self) -> Arm:
@@ -166,9 +177,8 @@ class OMSolver:
         if q.ndim != 1:
             raise InvalidInput("configuration_of takes one joint vector")
         values = np.empty(len(self.sign_names))
-        system.branch_values(self.om.family, self.om.params, q, values)
         redundancy = np.empty(len(self.redundancy_names))
-        system.redundancy_values(self.om.family, self.om.params, q, redundancy)
+        self._kernel.configuration_values(system.as_kernel_array(q), values, redundancy)
         return Configuration(tuple(np.where(values < 0.0, -1, 1)), tuple(redundancy))
 
     def solve(self, T: Any, configuration: Configuration, q_hint: np.ndarray | None = None) -> Solution:
@@ -186,11 +196,10 @@ class OMSolver:
             exists in this configuration.
         """
         T = as_pose(T)
-        signs, redundancy = self.check_configuration(configuration)
-        hint, has_hint = self._hint(q_hint)
+        self.check_configuration(configuration)
         q = np.empty(self.arm.dof)
-        status, pos, ori, evals, within = system.solve_one(
-            self._kernel_arm, self._kernel_settings, T, signs, redundancy, hint, has_hint, q
+        status, pos, ori, evals, within = self._kernel.solve(
+            T, configuration.signs, configuration.redundancy, self._hint(q_hint), q
         )
         return Solution(
             q, status == system.OK, system.STATUS_NAMES[status], configuration, pos, ori, evals, within
@@ -198,17 +207,13 @@ class OMSolver:
 
     def solve_all(self, T: Any, configuration: Configuration) -> list[Solution]:
         """Every real solution with this configuration (the bounded search), possibly none."""
-        signs, redundancy = self.check_configuration(configuration)
+        T = as_pose(T)
+        self.check_configuration(configuration)
         roots = np.empty((system.MAX_ROOTS, self.arm.dof))
-        pos, ori = np.empty(system.MAX_ROOTS), np.empty(system.MAX_ROOTS)
-        within = np.empty(system.MAX_ROOTS, dtype=np.bool_)
-        n, evals = system.solve_all_kernel(
-            self._kernel_arm, self._kernel_settings, as_pose(T), signs, redundancy, roots, pos, ori, within
-        )
+        info = np.empty((system.MAX_ROOTS, 3))
+        n, evals = self._kernel.solve_all(T, configuration.signs, configuration.redundancy, roots, info)
         return [
-            Solution(
-                roots[r], True, "ok", configuration, float(pos[r]), float(ori[r]), int(evals), bool(within[r])
-            )
+            Solution(roots[r], True, "ok", configuration, info[r, 0], info[r, 1], evals, bool(info[r, 2]))
             for r in range(n)
         ]
 
@@ -233,36 +238,33 @@ class OMSolver:
         k = len(self.sign_names)
         signs = np.ascontiguousarray(np.broadcast_to(as_signs(signs, k), (m, k)))
         redundancy = self._redundancy_rows(redundancy, m)
-        if q_hint is None:
-            hints, has_hint = np.zeros((m, self.arm.dof)), False
-        else:
+        hints = None
+        if q_hint is not None:
             hints = as_joint_vector(q_hint, self.arm.dof, "q_hint").reshape(-1, self.arm.dof)
             if len(hints) != m:
                 raise InvalidInput(f"q_hint must have {m} rows, got {len(hints)}")
-            hints, has_hint = np.ascontiguousarray(hints), True
+            hints = system.as_kernel_array(hints)
         q = np.empty((m, self.arm.dof))
-        status = np.empty(m, dtype=np.int64)
-        pos, ori, evals = np.empty(m), np.empty(m), np.empty(m, dtype=np.int64)
-        within = np.empty(m, dtype=np.bool_)
-        system.solve_batch_kernel(
-            self._kernel_arm,
-            self._kernel_settings,
-            T,
-            signs,
-            redundancy,
-            hints,
-            has_hint,
-            q,
-            status,
-            pos,
-            ori,
-            evals,
-            within,
-        )
-        return BatchSolution(q, status == system.OK, status, pos, ori, evals, within)
+        info = np.empty((m, 5))  # status, position error, orientation error, evaluations, within limits
+        kernel = self._kernel
 
-    def check_configuration(self, configuration: Configuration) -> tuple[np.ndarray, np.ndarray]:
-        """Check that a configuration fits this arm; return it as the kernels take it.
+        def solve_range(start: int, stop: int) -> None:
+            kernel.solve_rows(T, signs, redundancy, hints, start, stop, q, info)
+
+        system.run_rows(solve_range, m)
+        status = info[:, 0].astype(np.int64)
+        return BatchSolution(
+            q,
+            status == system.OK,
+            status,
+            info[:, 1],
+            info[:, 2],
+            info[:, 3].astype(np.int64),
+            info[:, 4] > 0.0,
+        )
+
+    def check_configuration(self, configuration: Configuration) -> None:
+        """Check that a configuration fits this arm.
 
         The solves call this on their configuration; call it to reject a bad configuration
         before any solve (``ExactPoseTask`` does, when it is given one).
@@ -270,9 +272,6 @@ class OMSolver:
         Args:
             configuration: A :class:`Configuration` with as many branch signs as
                 :attr:`sign_names` and as many redundancy values as :attr:`redundancy_names`.
-
-        Returns:
-            The branch signs (int64 array) and the redundancy values (float64 array).
 
         Raises:
             InvalidInput: Not a Configuration, or the wrong number of signs or redundancy
@@ -291,7 +290,6 @@ class OMSolver:
                 f"arm '{self.arm.name}' needs {len(names)} redundancy values {names}, "
                 f"got {len(configuration.redundancy)}"
             )
-        return np.array(configuration.signs, dtype=np.int64), np.array(configuration.redundancy)
 
     # -----------------------------------------------------------------------------------
 
@@ -317,10 +315,11 @@ class OMSolver:
             raise InvalidInput(f"redundancy value {names[col]} is {values[row, col]} in row {row}")
         return values
 
-    def _hint(self, q_hint: np.ndarray | None) -> tuple[np.ndarray, bool]:
+    def _hint(self, q_hint: np.ndarray | None) -> np.ndarray | None:
+        """The hint as the kernel takes it (None: no hint)."""
         if q_hint is None:
-            return np.zeros(self.arm.dof), False
+            return None
         hint = as_joint_vector(q_hint, self.arm.dof, "q_hint")
         if hint.ndim != 1:
             raise InvalidInput("q_hint must be one joint vector")
-        return hint, True
+        return system.as_kernel_array(hint)

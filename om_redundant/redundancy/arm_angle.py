@@ -32,67 +32,18 @@ W), :math:`\partial_j \hat w = (I - \hat w \hat w^T)\,\partial_j W / |w|`,
 :math:`\partial_j z_4 = z_j \times z_4` for the joints before joint 4 (zero from joint 4 on),
 :math:`\partial_j b = e\sigma(\partial_j z_4 \times \hat w + z_4 \times \partial_j \hat w)`.
 So psi depends on q1..q4 only. It jumps by pi where the ELBOW sign flips (the straight
-elbow), where this gradient is the one-sided derivative of either branch.
+elbow), where this gradient is the one-sided derivative of either branch. The kernel is C
+(``om_arm_angle_gradient`` in ``csrc/srs.c``).
 """
 
 from __future__ import annotations
 
-import numba as nb
 import numpy as np
 
+from .. import ckernels
 from ..exceptions import InvalidInput
-from ..kinematics.kernels import joint_axes_kernel
-from ..om.families import srs
-from ..om.families.common import add, cross, dot, scale, sub, vec
 from ..om.solver import OMSolver
 from ..validation import as_joint_vector
-
-#: Number of joints psi depends on: the shoulder's three and the elbow.
-ARM_ANGLE_JOINTS = 4
-
-
-@nb.njit(cache=True)
-def arm_angle_gradient_kernel(P, table, q, grad):
-    """psi at q of the S-R-S model with parameters P and DH table ``table``; writes d psi/dq.
-
-    Args:
-        P: The model's parameter vector (:mod:`om_redundant.om.families.srs` layout).
-        table: The model chain's DH table.
-        q: (7,) joint vector.
-        grad: (7,) output, d psi / dq.
-
-    Returns:
-        psi (rad), equal to :func:`om_redundant.om.families.srs.arm_angle`.
-    """
-    # Axis and origin of joints 1-6 in DH frame 0: joint j turns about z of the frame its
-    # row starts from. S is the origin after joint 1's row, W the one after joint 5's row.
-    axes = np.empty((6, 3))
-    origins = np.empty((6, 3))
-    joint_axes_kernel(table, q, axes, origins, np.empty((3, 3)), np.empty(3))
-    S = (origins[1, 0], origins[1, 1], origins[1, 2])
-    W = (origins[5, 0], origins[5, 1], origins[5, 2])
-    z4 = (axes[3, 0], axes[3, 1], axes[3, 2])
-    w = sub(W, S)
-    length = np.sqrt(dot(w, w))
-    w_hat = scale(1.0 / length, w)
-    elbow = -1.0 if np.sin(q[3] + P[srs.THETA + 3] - P[srs.PHI_STAR]) < 0.0 else 1.0
-    bend = elbow * P[srs.BEND]
-    b = scale(bend, cross(z4, w_hat))
-    n, nw = srs.reference_direction(P, w_hat)
-    up = vec(P, srs.UP)
-    wb = cross(w_hat, b)
-    bb = dot(b, b)
-    twist = 1.0 / (1.0 + dot(up, w_hat))
-    grad[:] = 0.0
-    for j in range(ARM_ANGLE_JOINTS):
-        zj = (axes[j, 0], axes[j, 1], axes[j, 2])
-        oj = (origins[j, 0], origins[j, 1], origins[j, 2])
-        dW = cross(zj, sub(W, oj))
-        dw_hat = scale(1.0 / length, sub(dW, scale(dot(w_hat, dW), w_hat)))
-        dz4 = cross(zj, z4) if j < 3 else (0.0, 0.0, 0.0)
-        db = scale(bend, add(cross(dz4, w_hat), cross(z4, dw_hat)))
-        grad[j] = dot(wb, db) / bb + dot(up, cross(w_hat, dw_hat)) * twist
-    return np.arctan2(dot(nw, b), dot(n, b))
 
 
 def check_arm_angle(solver: OMSolver) -> None:
@@ -122,5 +73,7 @@ def arm_angle_and_gradient(solver: OMSolver, q: np.ndarray) -> tuple[float, np.n
     if q.ndim != 1:
         raise InvalidInput("arm_angle_and_gradient takes one joint vector")
     grad = np.empty(solver.arm.dof)
-    psi = arm_angle_gradient_kernel(solver.om.params, solver.model.chain.table, q, grad)
+    psi = ckernels.arm_angle_gradient(
+        solver.om.params, solver.model.chain.table, np.ascontiguousarray(q), grad
+    )
     return float(psi), grad

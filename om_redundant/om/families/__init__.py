@@ -1,13 +1,14 @@
-"""Closed-form inverse kinematics of the model arms' families (numba kernels).
+"""Closed-form inverse kinematics of the model arms' families.
 
-A family kernel solves the MODEL arm exactly for a flange pose in DH frame 0, a set of
-branch signs and (for redundant arms) redundancy values, and evaluates the branch
-quantities and redundancy values that define the configuration of a joint vector.
-:mod:`om_redundant.om.model` recognises the family of a model arm and packs its parameters;
-the solver calls the dispatchers in :mod:`.dispatch`.
+A family solves the MODEL arm exactly for a flange pose in DH frame 0, a set of branch
+signs and (for redundant arms) redundancy values, and evaluates the branch quantities and
+redundancy values that define the configuration of a joint vector. The closed forms are C
+(``csrc/``); these modules hold their parameter layouts and their math, and call them from
+Python (:mod:`.dispatch`). :mod:`om_redundant.om.model` recognises the family of a model
+arm and packs its parameters.
 """
 
-from .common import REACH_SLACK, wrap
+from .common import REACH_SLACK
 from .dispatch import branch_values, model_ik, redundancy_values
 from .six_dof import RRP_SPHERICAL_WRIST, RRR_SPHERICAL_WRIST
 from .srs import SRS
@@ -20,5 +21,4 @@ __all__ = [
     "branch_values",
     "model_ik",
     "redundancy_values",
-    "wrap",
 ]

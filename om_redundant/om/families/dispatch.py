@@ -1,14 +1,29 @@
-"""Dispatch on the family code: one entry point per question the solver asks a family."""
+"""Dispatch on the family code: one entry point per question the solver asks a family.
+
+The closed forms are C (``csrc/six_dof.c``, ``csrc/srs.c``, ``csrc/families.c``); these
+functions call them from Python on arrays, as the tests and the model's derivation do. The
+solver itself calls them inside its compiled kernels.
+"""
 
 from __future__ import annotations
 
-import numba as nb
+import numpy as np
 
-from . import six_dof, srs
+from ... import ckernels
 
 
-@nb.njit(cache=True, inline="always")
-def model_ik(family, P, table, R, p, signs, redundancy, q_prev, q, all_joints=True):
+def model_ik(
+    family: int,
+    P: np.ndarray,
+    table: np.ndarray,
+    R: np.ndarray,
+    p: np.ndarray,
+    signs: np.ndarray,
+    redundancy: np.ndarray,
+    q_prev: np.ndarray,
+    q: np.ndarray,
+    all_joints: bool = True,
+) -> float:
     """Solve the model arm for the flange pose (R, p) in DH frame 0; write q.
 
     Args:
@@ -19,7 +34,7 @@ def model_ik(family, P, table, R, p, signs, redundancy, q_prev, q, all_joints=Tr
         signs: Branch signs.
         redundancy: Redundancy values (the arm angle of a 7-DOF arm; empty for 6-DOF).
         q_prev: Joints kept at singularities.
-        q: Output joint vector.
+        q: Output joint vector (C-contiguous float64).
         all_joints: False lets a family skip the joints that the OM residual does not need
             (a 7-DOF model's shoulder); the rest of q is then stale.
 
@@ -27,22 +42,35 @@ def model_ik(family, P, table, R, p, signs, redundancy, q_prev, q, all_joints=Tr
         The reach margin: negative (beyond ``REACH_SLACK``) when the pose is out of the
         model's reach, in which case q is not written; it measures how far.
     """
-    if family == srs.SRS:
-        return srs.model_ik(P, R, p, signs, redundancy[0], q_prev, q, all_joints)
-    return six_dof.model_ik(family, P, table, R, p, signs, q_prev, q)
+    return ckernels.model_ik(
+        int(family),
+        f64(P),
+        f64(table),
+        f64(R),
+        f64(p),
+        i64(signs),
+        f64(redundancy),
+        f64(q_prev),
+        q,
+        all_joints,
+    )
 
 
-@nb.njit(cache=True)
-def branch_values(family, P, q, out):
+def branch_values(family: int, P: np.ndarray, q: np.ndarray, out: np.ndarray) -> None:
     """Write the quantities whose signs are the configuration's branch signs at q."""
-    if family == srs.SRS:
-        srs.branch_values(P, q, out)
-    else:
-        six_dof.branch_values(family, P, q, out)
+    ckernels.branch_values(int(family), f64(P), f64(q), out)
 
 
-@nb.njit(cache=True)
-def redundancy_values(family, P, q, out):
+def redundancy_values(family: int, P: np.ndarray, q: np.ndarray, out: np.ndarray) -> None:
     """Write the redundancy values of the configuration at q (the arm angle for 7-DOF)."""
-    if family == srs.SRS:
-        out[0] = srs.arm_angle(P, q)
+    ckernels.redundancy_values(int(family), f64(P), f64(q), out)
+
+
+def f64(values: np.ndarray) -> np.ndarray:
+    """C-contiguous float64, as the kernels read their inputs."""
+    return np.ascontiguousarray(values, dtype=np.float64)
+
+
+def i64(values: np.ndarray) -> np.ndarray:
+    """C-contiguous int64 (branch signs)."""
+    return np.ascontiguousarray(values, dtype=np.int64)

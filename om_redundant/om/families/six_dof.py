@@ -33,16 +33,11 @@ At :math:`\sin\varphi_5 = 0` (rule 3 of the paper) :math:`q_4` keeps its previou
 likewise :math:`q_1` (rule 1) when the wrist centre is on the axis of joint 1. Every angle
 comes from atan2, never acos, so that precision holds near singular joints.
 
-The parameter vector layout is given by the index constants below.
+The closed form is C (``csrc/six_dof.c``); the parameter vector layout is given by the index
+constants below.
 """
 
 from __future__ import annotations
-
-import numba as nb
-import numpy as np
-
-from ...kinematics.kernels import apply_row
-from .common import REACH_SLACK, euler_zxzxz, wrap
 
 RRR_SPHERICAL_WRIST = 0
 RRP_SPHERICAL_WRIST = 1
@@ -56,93 +51,3 @@ WRIST_CENTRE = 15  # 3 entries: wrist centre in the flange frame
 E_ROT = 18  # 9 entries, row-major: rotation from the frame after Rz(phi6) to the flange
 WRIST_ROW = 27  # index in the table of joint 4's row
 N_PARAMS = 28
-
-
-@nb.njit(cache=True)
-def model_ik(family, P, table, R, p, signs, q_prev, q):
-    """Solve the model arm for the flange pose (R, p) in DH frame 0; write q.
-
-    Returns:
-        The reach margin: the smallest normalised argument of the square roots taken.
-        Negative (beyond a tiny slack) means the pose is outside the model's reach and q
-        is not written; it measures how far, which lets a search find small islands of reach.
-    """
-    c = P[WRIST_CENTRE : WRIST_CENTRE + 3]
-    pw = R @ c
-    for k in range(3):  # p may be an array or a tuple
-        pw[k] += p[k]
-    # Shoulder.
-    h = P[LATERAL]
-    r2 = pw[0] * pw[0] + pw[1] * pw[1]
-    k = r2 - h * h
-    margin = k / max(r2, 1.0)
-    if margin < -REACH_SLACK:
-        return margin
-    rho = signs[0] * np.sqrt(max(k, 0.0))
-    if r2 < 1e-24:  # rule 1: wrist centre on joint 1's axis
-        phi1 = q_prev[0] + P[THETA1]
-    else:
-        phi1 = np.arctan2(pw[1], pw[0]) - np.arctan2(-P[SIGMA1] * h, rho)
-    q[0] = wrap(phi1 - P[THETA1])
-    u = np.cos(phi1) * pw[0] + np.sin(phi1) * pw[1] - P[A1]
-    v = P[SIGMA1] * (pw[2] - P[D1])
-    D = u * u + v * v
-    a2 = P[A2]
-    if family == RRR_SPHERICAL_WRIST:
-        l3 = P[ELL3]
-        k = ((abs(a2) + l3) ** 2 - D) * (D - (abs(a2) - l3) ** 2)
-        margin = min(margin, k / max(D * D, 1.0))
-        if margin < -REACH_SLACK:
-            return margin
-        gamma = np.arctan2(signs[1] * np.sqrt(max(k, 0.0)), np.sign(a2) * (D - a2 * a2 - l3 * l3))
-        if D < 1e-24:  # rule 2: wrist centre on joint 2's axis
-            phi2 = q_prev[1] + P[THETA2]
-        else:
-            phi2 = np.arctan2(v, u) - np.arctan2(l3 * np.sin(gamma), a2 + l3 * np.cos(gamma))
-        q[1] = wrap(phi2 - P[THETA2])
-        q[2] = wrap(gamma - P[BETA] - P[THETA3])
-    else:
-        k = D - a2 * a2
-        margin = min(margin, k / max(D, 1.0))
-        if margin < -REACH_SLACK:
-            return margin
-        t = -signs[1] * np.sqrt(max(k, 0.0))
-        if D < 1e-24:
-            phi2 = q_prev[1] + P[THETA2]
-        else:
-            phi2 = np.arctan2(v, u) - np.arctan2(t, a2)
-        q[1] = wrap(phi2 - P[THETA2])
-        q[2] = -P[SIGMA2] * t - P[D3]
-    # Wrist: M = R_in^T R E^T.
-    Rin = np.eye(3)
-    pin = np.zeros(3)
-    j = 0
-    for row in range(int(P[WRIST_ROW])):
-        if table[row, 5] == 2.0:
-            apply_row(Rin, pin, table[row], 0.0)
-        else:
-            apply_row(Rin, pin, table[row], q[j])
-            j += 1
-    E = P[E_ROT : E_ROT + 9].reshape(3, 3)
-    M = Rin.T @ R @ E.T
-    rows = ((M[0, 0], M[0, 1], M[0, 2]), (M[1, 0], M[1, 1], M[1, 2]), (M[2, 0], M[2, 1], M[2, 2]))
-    phi = euler_zxzxz(rows, P[SIGMA4], P[SIGMA5], 0.0, signs[2], q_prev[3] + P[THETA4])
-    for k in range(3):
-        q[3 + k] = wrap(phi[k] - P[THETA4 + k])
-    return margin
-
-
-@nb.njit(cache=True)
-def branch_values(family, P, q, out):
-    """Write the quantities whose signs are (ARM, ELBOW, WRIST) at joint vector q."""
-    phi2 = q[1] + P[THETA2]
-    if family == RRR_SPHERICAL_WRIST:
-        gamma = q[2] + P[THETA3] + P[BETA]
-        u = P[A2] * np.cos(phi2) + P[ELL3] * np.cos(phi2 + gamma)
-        out[1] = np.sin(gamma)
-    else:
-        t = -P[SIGMA2] * (q[2] + P[D3])
-        u = P[A2] * np.cos(phi2) - t * np.sin(phi2)
-        out[1] = -t
-    out[0] = P[A1] + u
-    out[2] = np.sin(q[4] + P[THETA5])

@@ -1,0 +1,194 @@
+/* The bounded search on the circle: every root of g(w), the paper's guarantee
+ * (port of om_redundant/_system/circle.py). */
+#include "om_system.h"
+
+/* out[n] = v if there is room; returns the new count (numba assumed the room). */
+static int _put(double *out, int n, int cap, double v)
+{
+    if (n >= cap)
+        return n;
+    out[n] = v;
+    return n + 1;
+}
+
+/* Add the root of g on [a, b] (both ends reachable) to out[n:]; returns the new count.
+ * A sign change is one root; a wrap of g from about +pi to -pi is none. */
+static int _bracket(om_problem *pb, double a, double ga, double b, double gb, double *q, double *out, int n,
+                    int cap)
+{
+    if (ga == 0.0)
+        return _put(out, n, cap, a);
+    /* A jump of more than pi is a wrap of g or a steep crossing of zero near a singular
+     * wrist: bisect until it is clearly one or the other. */
+    for (int it = 0; it < 60; it++) {
+        if (fabs(ga - gb) <= OM_PI || fabs(ga - gb) > 1.9 * OM_PI)
+            break;
+        double c = 0.5 * (a + b);
+        double gc = om_g(pb, c, q, false);
+        if (isnan(gc))
+            return n;
+        if (gc * ga > 0.0) {
+            a = c;
+            ga = gc;
+        } else {
+            b = c;
+            gb = gc;
+        }
+    }
+    if (gb == 0.0)
+        return _put(out, n, cap, b);
+    if (fabs(ga - gb) > OM_PI)
+        return n;
+    if (ga * gb < 0.0)
+        return _put(out, n, cap, om_refine_bracket(pb, a, ga, b, gb, q));
+    return n;
+}
+
+/* Add a close pair of roots on [a, b] to out[n:]: g has one sign at a, x0 and b, and its
+ * extremum between them may cross zero. Returns the new count. */
+static int _pair(om_problem *pb, double a, double ga, double x0, double b, double gb, double *q, double *out, int n,
+                 int cap)
+{
+    double gw;
+    double w = om_extremum(pb, a, b, x0, -om_sign(ga), false, q, &gw, NULL);
+    if (isnan(gw) || gw * ga > 0.0)
+        return n;
+    if (gw == 0.0)
+        return _put(out, n, cap, w);
+    double r0 = om_refine_bracket(pb, a, ga, w, gw, q);
+    double r1 = om_refine_bracket(pb, w, gw, b, gb, q);
+    n = _put(out, n, cap, r0);
+    return _put(out, n, cap, r1);
+}
+
+/* Add the roots on a run of reachable points (w ascending) to out[n:]; returns the count.
+ * Sign changes bracket roots; local minima of |g| are searched for close pairs. A cyclic
+ * run covers the whole circle. */
+static int _run_roots(om_problem *pb, const double *pw, const double *pg, int L, bool cyclic, double *q,
+                      double *out, int n, int cap)
+{
+    for (int i = 0; i < L - 1 + (int)cyclic; i++) {
+        int j = (i + 1) % L;
+        double wj = pw[j] + (j == 0 ? 2.0 * OM_PI : 0.0);
+        n = _bracket(pb, pw[i], pg[i], wj, pg[j], q, out, n, cap);
+    }
+    for (int i = 0; i < L; i++) {
+        double gi = pg[i];
+        bool has_prev = i > 0 || cyclic, has_next = i < L - 1 || cyclic;
+        double glo = has_prev ? pg[py_mod(i - 1, L)] : INFINITY;
+        double ghi = has_next ? pg[py_mod(i + 1, L)] : INFINITY;
+        if (fabs(gi) > OM_PAIR_SEARCH || fabs(glo) < fabs(gi) || fabs(ghi) < fabs(gi))
+            continue;
+        /* One search over the cells on either side without a sign change. */
+        double a = pw[i], ga = gi, b = pw[i], gb = gi;
+        if (has_prev && glo * gi > 0.0) {
+            a = pw[py_mod(i - 1, L)] - (i == 0 ? 2.0 * OM_PI : 0.0);
+            ga = glo;
+        }
+        if (has_next && ghi * gi > 0.0) {
+            b = pw[py_mod(i + 1, L)] + (i == L - 1 ? 2.0 * OM_PI : 0.0);
+            gb = ghi;
+        }
+        if (b > a)
+            n = _pair(pb, a, ga, pw[i], b, gb, q, out, n, cap);
+    }
+    return n;
+}
+
+/* Candidate roots of g on [lo, hi] (the whole circle if full_circle) into cands (capacity
+ * cap); returns the count. g and the reach margin are sampled at n_pts points; runs of
+ * reach (extended to its edges) and islands of reach between samples are searched. */
+int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool full_circle, double *q,
+                         double *cands, int cap)
+{
+    double h = (hi - lo) / (double)(full_circle ? n_pts : n_pts - 1);
+    int count = full_circle ? n_pts + 1 : n_pts;
+    /* ws, gs, ms (n_pts + 1 each), their rotations (count each), pw, pg (count + 2 each) */
+    size_t size = (size_t)(3 * (n_pts + 1) + 3 * count + 2 * (count + 2));
+    double *buffer = malloc(size * sizeof(double));
+    int *order = malloc((size_t)count * sizeof(int));
+    if (!buffer || !order) {
+        free(buffer);
+        free(order);
+        return 0;
+    }
+    double *ws = buffer, *gs = ws + (n_pts + 1), *ms = gs + (n_pts + 1);
+    double *rws = ms + (n_pts + 1), *rgs = rws + count, *rms = rgs + count;
+    double *pw = rms + count, *pg = pw + (count + 2);
+    int start = -1;
+    for (int k = 0; k < n_pts; k++) {
+        ws[k] = lo + h * (double)k;
+        gs[k] = om_g_margin(pb, ws[k], q, false, &ms[k]);
+        if (start < 0 && isnan(gs[k]))
+            start = k;
+    }
+    int n = 0;
+    if (full_circle && start < 0) { /* reachable everywhere: one cyclic run */
+        n = _run_roots(pb, ws, gs, n_pts, true, q, cands, n, cap);
+        free(buffer);
+        free(order);
+        return n;
+    }
+    if (full_circle) { /* rotate to start and end at the same unreachable sample */
+        for (int i = 0; i < count; i++)
+            order[i] = (start + i) % n_pts;
+        for (int i = 0; i < count; i++) {
+            rws[i] = ws[order[i]] + h * (double)(i - order[i] + start);
+            rgs[i] = gs[order[i]];
+            rms[i] = ms[order[i]];
+        }
+        ws = rws;
+        gs = rgs;
+        ms = rms;
+        ws[0] = lo + h * (double)start;
+    }
+    int L = 0;
+    for (int i = 0; i < count; i++) {
+        double w = ws[i];
+        if (!isnan(gs[i])) {
+            if (L == 0 && i > 0) { /* entering reach */
+                pw[0] = om_reach_edge(pb, w, ws[i - 1], q);
+                pg[0] = om_g(pb, pw[0], q, false);
+                L = 1;
+            }
+            pw[L] = w;
+            pg[L] = gs[i];
+            L += 1;
+            continue;
+        }
+        if (L > 0) { /* leaving reach */
+            pw[L] = om_reach_edge(pb, pw[L - 1], w, q);
+            pg[L] = om_g(pb, pw[L], q, false);
+            n = _run_roots(pb, pw, pg, L + 1, false, q, cands, n, cap);
+            L = 0;
+        }
+        if (i + 1 < count && isnan(gs[i + 1])) {
+            /* Both ends of this cell are out of reach. The margin can peak between them by
+             * about half its change across a cell; if that could reach zero, look for an
+             * island of reach. */
+            double change = fabs(ms[i + 1] - ms[i]);
+            if (i > 0)
+                change = py_max(change, fabs(ms[i] - ms[i - 1]));
+            if (i + 2 < count)
+                change = py_max(change, fabs(ms[i + 2] - ms[i + 1]));
+            if (py_max(ms[i], ms[i + 1]) + change > 0.0) {
+                double gc;
+                double c = om_extremum(pb, w, ws[i + 1], 0.5 * (w + ws[i + 1]), 1.0, true, q, &gc, NULL);
+                if (!isnan(gc)) { /* an island of reach around c */
+                    pw[0] = om_reach_edge(pb, c, w, q);
+                    pw[1] = c;
+                    pg[1] = gc;
+                    pw[2] = om_reach_edge(pb, c, ws[i + 1], q);
+                    pg[0] = om_g(pb, pw[0], q, false);
+                    pg[2] = om_g(pb, pw[2], q, false);
+                    n = _run_roots(pb, pw, pg, 3, false, q, cands, n, cap);
+                }
+            }
+        }
+    }
+    if (L > 0) /* a run that reaches the end of the window */
+        n = _run_roots(pb, pw, pg, L, false, q, cands, n, cap);
+    free(buffer);
+    free(order);
+    return n;
+}

@@ -1,0 +1,140 @@
+/* DH chains: a port of the numba kernels of om_redundant/kinematics.py (fk and the Jacobian
+ * in their BLAS-free form: explicit 4x4 products and rigid transforms, sums left to right).
+ * A table row is (a, d, theta, cos(alpha), sin(alpha), kind). */
+#include "om_kernels.h"
+
+/* Right-multiply the frame (R, p) in place by the standard DH row Rz(theta) Tz(d) Tx(a) Rx(alpha),
+ * the variable qi added to theta (revolute, kind 0) or d (prismatic, kind 1). */
+void om_apply_row(double *R, double *p, const double *row, double qi)
+{
+    double kind = row[5];
+    double theta = kind == 0.0 ? row[2] + qi : row[2];
+    double d = kind == 1.0 ? row[1] + qi : row[1];
+    double ct = cos(theta), st = sin(theta), ca = row[3], sa = row[4], a = row[0];
+    for (int i = 0; i < 3; i++) {
+        double r0 = R[3 * i], r1 = R[3 * i + 1], r2 = R[3 * i + 2];
+        p[i] += r0 * a * ct + r1 * a * st + r2 * d;
+        R[3 * i] = r0 * ct + r1 * st;
+        R[3 * i + 1] = -r0 * st * ca + r1 * ct * ca + r2 * sa;
+        R[3 * i + 2] = r0 * st * sa - r1 * ct * sa + r2 * ca;
+    }
+}
+
+static void set_identity(double *R, double *p)
+{
+    for (int i = 0; i < 9; i++)
+        R[i] = 0.0;
+    R[0] = R[4] = R[8] = 1.0;
+    p[0] = p[1] = p[2] = 0.0;
+}
+
+/* The pose (R, p) of the last DH frame in DH frame 0 (flange_kernel). */
+void om_flange(const double *table, int n_rows, const double *q, double *R, double *p)
+{
+    set_identity(R, p);
+    int j = 0;
+    for (int k = 0; k < n_rows; k++) {
+        const double *row = table + 6 * k;
+        if (row[5] == 2.0) {
+            om_apply_row(R, p, row, 0.0);
+        } else {
+            om_apply_row(R, p, row, q[j]);
+            j++;
+        }
+    }
+}
+
+/* Axis and origin in DH frame 0 of joints 1..n (joint_axes_kernel): a standard row's joint acts
+ * about the z-axis of the frame it starts from. (R, p) end as the frame before joint n+1's row. */
+void om_joint_axes(const double *table, int n_rows, const double *q, int n, double *axes, double *origins,
+                   double *R, double *p)
+{
+    set_identity(R, p);
+    int j = 0;
+    for (int k = 0; k < n_rows; k++) {
+        const double *row = table + 6 * k;
+        if (row[5] == 2.0) {
+            om_apply_row(R, p, row, 0.0);
+            continue;
+        }
+        if (j == n)
+            break;
+        for (int i = 0; i < 3; i++) {
+            axes[3 * j + i] = R[3 * i + 2];
+            origins[3 * j + i] = p[i];
+        }
+        om_apply_row(R, p, row, q[j]);
+        j++;
+    }
+}
+
+/* out = A @ B for 4x4 row-major matrices (_matmul4). */
+static void matmul4(const double *A, const double *B, double *out)
+{
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++)
+            out[4 * i + j] = A[4 * i] * B[j] + A[4 * i + 1] * B[4 + j] + A[4 * i + 2] * B[8 + j] +
+                             A[4 * i + 3] * B[12 + j];
+}
+
+/* base @ A(q) @ tool (fk_kernel): two explicit 4x4 products. */
+void om_fk(const double *table, int n_rows, const double *base, const double *tool, const double *q, double *out)
+{
+    double R[9], p[3], T[16] = {0.0}, BT[16];
+    om_flange(table, n_rows, q, R, p);
+    for (int i = 0; i < 3; i++) {
+        for (int j = 0; j < 3; j++)
+            T[4 * i + j] = R[3 * i + j];
+        T[4 * i + 3] = p[i];
+    }
+    T[15] = 1.0;
+    matmul4(base, T, BT);
+    matmul4(BT, tool, out);
+}
+
+/* T applied to x in homogeneous coordinates (x, w): a point (w = 1) or a direction (w = 0) (_rigid). */
+static void rigid(const double *T, const double *x, double w, double *out)
+{
+    for (int i = 0; i < 3; i++)
+        out[i] = T[4 * i] * x[0] + T[4 * i + 1] * x[1] + T[4 * i + 2] * x[2] + T[4 * i + 3] * w;
+}
+
+/* Geometric Jacobian [v; omega] (6 x dof, row-major) of the end-effector frame in the root frame
+ * (jacobian_kernel): z_j x (p_ee - o_j) and z_j for a revolute joint, z_j and 0 for a prismatic one. */
+void om_jacobian(const double *table, int n_rows, const double *base, const double *tool, const double *q, int dof,
+                 double *J)
+{
+    double axes[OM_MAX_DOF * 3], origins[OM_MAX_DOF * 3], kinds[OM_MAX_DOF], R[9], p[3];
+    om_joint_axes(table, n_rows, q, dof, axes, origins, R, p);
+    int j = 0;
+    for (int k = 0; k < n_rows; k++) {
+        if (table[6 * k + 5] != 2.0 && j < dof) {
+            kinds[j] = table[6 * k + 5];
+            j++;
+        }
+    }
+    /* p_ee = Rb (p + R t) + b for the base (Rb, b) and the tool offset t. */
+    double flange_ee[3], p_ee[3];
+    for (int i = 0; i < 3; i++)
+        flange_ee[i] = p[i] + R[3 * i] * tool[3] + R[3 * i + 1] * tool[7] + R[3 * i + 2] * tool[11];
+    rigid(base, flange_ee, 1.0, p_ee);
+    for (int i = 0; i < 6 * dof; i++)
+        J[i] = 0.0;
+    for (j = 0; j < dof; j++) {
+        double z[3], o[3], r[3];
+        rigid(base, axes + 3 * j, 0.0, z);
+        if (kinds[j] == 1.0) {
+            for (int i = 0; i < 3; i++)
+                J[i * dof + j] = z[i];
+        } else {
+            rigid(base, origins + 3 * j, 1.0, o);
+            for (int i = 0; i < 3; i++)
+                r[i] = p_ee[i] - o[i];
+            J[0 * dof + j] = z[1] * r[2] - z[2] * r[1];
+            J[1 * dof + j] = z[2] * r[0] - z[0] * r[2];
+            J[2 * dof + j] = z[0] * r[1] - z[1] * r[0];
+            for (int i = 0; i < 3; i++)
+                J[(3 + i) * dof + j] = z[i];
+        }
+    }
+}

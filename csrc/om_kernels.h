@@ -1,0 +1,199 @@
+/* om_redundant's compiled core: DH kinematics, the model arms' closed forms, and the OM
+ * system (9) with its solvers.
+ *
+ * A 1:1 port of the former numba kernels: same algorithms, same order of floating-point
+ * operations, so that results agree with them to the last bit wherever libm agrees.
+ * Built with -ffp-contract=off (no fused multiply-add), never -ffast-math.
+ *
+ * Conventions
+ * - Small vectors and matrices travel by value: vec3, and mat3 as three rows.
+ * - Arrays are C-contiguous float64 (int64 for branch signs, uint8 for flags), row-major.
+ * - A DH table has n_rows rows of 6 doubles: a, d, theta, cos(alpha), sin(alpha), kind
+ *   (kind 0 revolute, 1 prismatic, 2 fixed).
+ * - Nothing here allocates on the hot path except the bounded searches' scratch arrays.
+ */
+#ifndef OM_KERNELS_H
+#define OM_KERNELS_H
+
+#include <math.h>
+#include <stdbool.h>
+#include <stdint.h>
+
+#define OM_MAX_DOF 16  /* joints of an arm the kernels take (the binding checks) */
+#define OM_MAX_ROOTS 16 /* roots kept per configuration */
+
+/* ------------------------------------------------------------------------------------ */
+/* om_math.h: tuple math, angle wrapping; common.c: the Euler decomposition of a revolute triple. */
+
+#define OM_SINGULAR 1e-12
+#define OM_REACH_SLACK 1e-12 /* relative slack under a square root before out of reach */
+
+#include "om_math.h"
+
+/* (phi_a, phi_b, phi_c) with M = Rz(phi_a) Rx(alpha_a) Rz(phi_b) Rx(beta) Rz(phi_c),
+ * sigma_a = sin(alpha_a) = +-1; see common.py's euler_zxzxz. */
+vec3 om_euler_zxzxz(mat3 M, double sigma_a, double sin_b, double cos_b, double sign, double phi_a_singular);
+/* (phi_b, phi_c, residual N22) for phi_a given; see euler_zxzxz_given_first. */
+vec3 om_euler_zxzxz_given_first(mat3 M, double sin_a, double cos_a, double sigma_b, double phi_a);
+
+/* ------------------------------------------------------------------------------------ */
+/* kinematics.c: DH chains.                                                               */
+
+/* Right-multiply the frame (R row-major 3x3, p) in place by a standard DH row with variable qi. */
+void om_apply_row(double *R, double *p, const double *row, double qi);
+/* The pose of the last DH frame in DH frame 0. */
+void om_flange(const double *table, int n_rows, const double *q, double *R, double *p);
+/* Axis and origin (in DH frame 0) of joints 1..n into axes[n*3], origins[n*3]; R, p end
+ * as the frame after every row before joint n+1's (the flange for n = dof). */
+void om_joint_axes(const double *table, int n_rows, const double *q, int n, double *axes, double *origins,
+                   double *R, double *p);
+/* base @ A(q) @ tool into out (4x4 row-major). */
+void om_fk(const double *table, int n_rows, const double *base, const double *tool, const double *q, double *out);
+/* Geometric Jacobian (6 x dof, row-major, rows [v; omega]) of the end-effector frame in the root frame. */
+void om_jacobian(const double *table, int n_rows, const double *base, const double *tool, const double *q, int dof,
+                 double *J);
+
+/* ------------------------------------------------------------------------------------ */
+/* six_dof.c, srs.c, families.c: the model arms' closed forms (see the Python modules     */
+/* om_redundant/om/families/six_dof.py and srs.py for the parameter layouts and the math). */
+
+enum { OM_RRR_SPHERICAL_WRIST = 0, OM_RRP_SPHERICAL_WRIST = 1, OM_SRS = 2 };
+
+/* six_dof.py parameter layout */
+enum {
+    SD_A1 = 0, SD_D1 = 1, SD_SIGMA1 = 2, SD_THETA1 = 3, SD_LATERAL = 4, SD_A2 = 5, SD_THETA2 = 6,
+    SD_ELL3 = 7, SD_BETA = 8, SD_THETA3 = 9, /* RRR */
+    SD_SIGMA2 = 7, SD_D3 = 8,                /* RRP */
+    SD_SIGMA4 = 10, SD_SIGMA5 = 11, SD_THETA4 = 12, SD_THETA5 = 13, SD_THETA6 = 14,
+    SD_WRIST_CENTRE = 15, SD_E_ROT = 18, SD_WRIST_ROW = 27, SD_N_PARAMS = 28
+};
+
+/* srs.py parameter layout */
+enum {
+    SRS_SIGMA1 = 0, SRS_SIGMA2 = 1, SRS_SIGMA5 = 2, SRS_SIN_BETA = 3, SRS_THETA = 4, SRS_SHOULDER = 11,
+    SRS_WRIST = 14, SRS_S3 = 17, SRS_U = 20, SRS_K0 = 23, SRS_K = 24, SRS_PHI_STAR = 25, SRS_R_PRE = 26,
+    SRS_X3 = 35, SRS_X4 = 44, SRS_E_ROT = 53, SRS_UP = 62, SRS_REF = 65, SRS_BEND = 68, SRS_COS_BETA = 69,
+    SRS_N_PARAMS = 70
+};
+
+/* Returns the reach margin (negative beyond OM_REACH_SLACK: out of reach, q not written). */
+double om_six_dof_model_ik(int family, const double *P, const double *table, const mat3 *R, vec3 p,
+                           const int64_t *signs, const double *q_prev, double *q);
+void om_six_dof_branch_values(int family, const double *P, const double *q, double *out);
+
+/* With shoulder false, joints 1-3 are not written. Returns the reach margin 1 - x^2. */
+double om_srs_model_ik(const double *P, const mat3 *R, vec3 p, const int64_t *signs, double psi,
+                       const double *q_prev, double *q, bool shoulder);
+bool om_srs_model_ik_at_reach(const double *P, const mat3 *R, vec3 p, const int64_t *signs, double psi,
+                              const double *q_prev, double *q);
+/* phi4 NaN: the elbow equation's root in the ELBOW branch. Returns (shoulder, wrist, elbow) residuals. */
+vec3 om_srs_model_ik_lifted(const double *P, const mat3 *R, vec3 p, const int64_t *signs, double psi, double q1,
+                            double q7, double phi4, double *q);
+/* The arm angle's reference direction n(w_hat) into *n, and w_hat x n into *nw. */
+void om_srs_reference(const double *P, vec3 w_hat, vec3 *n, vec3 *nw);
+double om_srs_arm_angle(const double *P, const double *q);
+void om_srs_branch_values(const double *P, const double *q, double *out);
+/* psi at q of the S-R-S model with parameters P and DH table; writes d psi / dq (7). */
+double om_arm_angle_gradient(const double *P, const double *table, int n_rows, const double *q, double *grad);
+
+/* Dispatch on the family (families.c). */
+double om_model_ik(int family, const double *P, const double *table, const mat3 *R, vec3 p, const int64_t *signs,
+                   const double *redundancy, const double *q_prev, double *q, bool all_joints);
+void om_branch_values(int family, const double *P, const double *q, double *out);
+void om_redundancy_values(int family, const double *P, const double *q, double *out);
+
+/* ------------------------------------------------------------------------------------ */
+/* The OM system (9) and its solvers.                                                     */
+
+enum { OM_FIXED = 0, OM_CIRCLE = 1, OM_TORUS = 2 }; /* om_solver_data.mode */
+enum { OM_OK = 0, OM_UNREACHABLE = 1, OM_NO_SOLUTION_IN_CONFIGURATION = 2 };
+
+#define OM_ROOT_TOL 1e-13   /* a residual (rad) accepted as a root before verification */
+#define OM_SAME_ROOT 1e-9   /* joint-space distance under which two roots are one */
+#define OM_PAIR_SEARCH 1.0  /* |g| (rad) below which a local minimum is searched for a root pair */
+
+/* The solver's fixed data (the binding owns the arrays). */
+typedef struct {
+    int family, mode, dof, n_signs, n_redundancy;
+    int dp_joint; /* J: the joint delta depends on (CIRCLE); 0 on the TORUS and for FIXED */
+    const double *params;
+    const double *model_table; /* n_model_rows x 6 */
+    int n_model_rows;
+    const double *real_table; /* n_real_rows x 6 */
+    int n_real_rows;
+    double D[6][3];         /* rows 0-2: delta(w) = D0 + D1 cos w + D2 sin w; 3-5: a(q1) */
+    double T_base_root[16]; /* inverse of the pose of DH frame 0 in the root frame */
+    double T_tool_flange[16]; /* inverse of the end-effector frame in the flange frame */
+    const uint8_t *revolute;
+    const double *lower, *upper;
+    int scan_points;
+    double tol_pos, tol_ori;
+} om_solver_data;
+
+/* One target. */
+typedef struct {
+    const om_solver_data *s;
+    mat3 R; /* flange pose in DH frame 0 */
+    vec3 p;
+    const int64_t *signs;
+    const double *redundancy;
+    const double *q_prev; /* joints kept at singularities */
+    int64_t counter;      /* residual evaluations */
+} om_problem;
+
+/* residual.c */
+vec3 om_delta(const double D[6][3], double w);
+double om_model_ik_at(om_problem *pb, double w, double *q, bool all_joints); /* returns the reach margin */
+double om_g_margin(om_problem *pb, double w, double *q, bool all_joints, double *margin); /* g (NaN out of reach) */
+double om_g(om_problem *pb, double w, double *q, bool all_joints);
+vec3 om_lifted_residual(om_problem *pb, vec3 x, double *q);
+vec3 om_deflated_residual(om_problem *pb, vec3 x, double *q, const double *known, int n_known); /* known: n x 3 */
+double om_max_norm(vec3 F);
+
+/* scalar.c */
+double om_secant(om_problem *pb, double w0, double *q);
+double om_refine_bracket(om_problem *pb, double a, double ga, double b, double gb, double *q);
+double om_reach_edge(om_problem *pb, double inside, double outside, double *q);
+/* Brent's search for the max of sign * g (or of the margin); returns argmax, g and margin there. */
+double om_extremum(om_problem *pb, double a, double b, double x0, double sign, bool of_margin, double *q,
+                   double *g_out, double *margin_out);
+
+/* circle.c: candidates into cands (capacity cap); returns the count. */
+int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool full_circle, double *q,
+                         double *cands, int cap);
+
+/* torus.c */
+double om_newton(om_problem *pb, vec3 x, double *q, const double *known, int n_known, vec3 *x_end);
+double om_lifted_solve(om_problem *pb, const double *start, double *q);
+int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, double radius);
+
+/* verify.c */
+bool om_verify(om_problem *pb, const double *q, double *pos, double *ori); /* returns accepted */
+int om_add_root(om_problem *pb, const double *q, double *roots, int count); /* roots: OM_MAX_ROOTS x dof */
+bool om_representative(double *q, int dof, const uint8_t *revolute, const double *lower, const double *upper,
+                       const double *hint, bool has_hint);
+
+/* search.c */
+int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre, double radius);
+bool om_local_solve(om_problem *pb, const double *start, double *q, double *pos, double *ori);
+bool om_exists_other(om_problem *pb);
+bool om_nearest_in_window(om_problem *pb, const double *hint, double *q);
+
+/* solve.c */
+typedef struct {
+    int status;
+    double position_error, orientation_error;
+    int64_t evaluations;
+    bool within_limits;
+} om_result;
+
+void om_flange_target(const double *T, const double *T_base_root, const double *T_tool_flange, mat3 *R, vec3 *p);
+/* hint NULL: no hint. */
+om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
+                       const double *hint, double *q_out);
+/* Every root (OM_MAX_ROOTS x dof) with per root (position error, orientation error, within limits)
+ * in info (OM_MAX_ROOTS x 3). Returns the count; *evaluations the residual evaluations. */
+int om_solve_all(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
+                 double *roots, double *info, int64_t *evaluations);
+
+#endif

@@ -1,0 +1,24 @@
+/* Private helpers of the OM system's kernels (residual.c ... solve.c): Python's float
+ * semantics where the numba sources rely on them. Not part of the binding's contract. */
+#ifndef OM_SYSTEM_H
+#define OM_SYSTEM_H
+
+#include <stddef.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "om_kernels.h"
+
+
+/* Python's max(a, b) on floats: b if b > a else a (so max(NaN, x) is NaN, max(x, NaN) is x). */
+static inline double py_max(double a, double b) { return b > a ? b : a; }
+/* Python's min(a, b) on floats: b if b < a else a. */
+static inline double py_min(double a, double b) { return b < a ? b : a; }
+/* Python's a % n for n > 0 (never negative). */
+static inline int py_mod(int a, int n) { int r = a % n; return r < 0 ? r + n : r; }
+
+/* numba's q = np.empty(dof) holds heap garbage that verify may read (see solve.c); a C
+ * scratch joint vector starts as NaN instead, which verify always rejects. */
+static inline void nan_fill(double *q, int n) { for (int j = 0; j < n; j++) q[j] = NAN; }
+
+#endif

@@ -1,0 +1,87 @@
+/* The residual of the OM system (9), reduced to the circle or lifted on the torus
+ * (port of om_redundant/_system/residual.py). Each evaluation counts in pb->counter. */
+#include "om_system.h"
+
+/* dp seen from the flange, delta(w) = D0 + D1 cos w + D2 sin w (rows 0-2 of D). */
+vec3 om_delta(const double D[6][3], double w)
+{
+    double c = cos(w), s = sin(w);
+    return v3(D[0][0] + D[1][0] * c + D[2][0] * s, D[0][1] + D[1][1] * c + D[2][1] * s,
+              D[0][2] + D[1][2] * c + D[2][2] * s);
+}
+
+/* Model IK for p_m = p_d + R delta(w), one residual evaluation; returns the reach margin
+ * (negative beyond OM_REACH_SLACK: out of the model's reach, q not written). */
+double om_model_ik_at(om_problem *pb, double w, double *q, bool all_joints)
+{
+    const om_solver_data *data = pb->s;
+    pb->counter++;
+    vec3 d = om_delta(data->D, w);
+    const mat3 *R = &pb->R;
+    vec3 p = pb->p;
+    vec3 pm = v3(p.x + R->r0.x * d.x + R->r0.y * d.y + R->r0.z * d.z,
+                 p.y + R->r1.x * d.x + R->r1.y * d.y + R->r1.z * d.z,
+                 p.z + R->r2.x * d.x + R->r2.y * d.y + R->r2.z * d.z);
+    return om_model_ik(data->family, data->params, data->model_table, R, pm, pb->signs, pb->redundancy, pb->q_prev,
+                       q, all_joints);
+}
+
+/* Residual g(w) (NaN if unreachable) and the model's reach margin; writes the IK into q. */
+double om_g_margin(om_problem *pb, double w, double *q, bool all_joints, double *margin)
+{
+    bool fixed = pb->s->mode == OM_FIXED;
+    double m = om_model_ik_at(pb, w, q, all_joints || fixed);
+    if (margin)
+        *margin = m;
+    if (m < -OM_REACH_SLACK)
+        return NAN;
+    if (fixed)
+        return 0.0;
+    return om_wrap(q[pb->s->dp_joint] - w);
+}
+
+/* Residual g(w) of the reduced system, NaN if unreachable (see om_g_margin). */
+double om_g(om_problem *pb, double w, double *q, bool all_joints)
+{
+    return om_g_margin(pb, w, q, all_joints, NULL);
+}
+
+/* The lifted residual (shoulder, wrist, elbow) at x = (w1, w7, phi4) for
+ * p_m = p_d + a(w1) + R delta(w7) (see srs.model_ik_lifted); writes the model IK into q. */
+vec3 om_lifted_residual(om_problem *pb, vec3 x, double *q)
+{
+    const om_solver_data *data = pb->s;
+    const double(*D)[3] = data->D;
+    const mat3 *R = &pb->R;
+    vec3 p = pb->p;
+    pb->counter++;
+    double c1 = cos(x.x), s1 = sin(x.x);
+    vec3 d = om_delta(data->D, x.y);
+    vec3 pm = v3(p.x + D[3][0] + D[4][0] * c1 + D[5][0] * s1 + R->r0.x * d.x + R->r0.y * d.y + R->r0.z * d.z,
+                 p.y + D[3][1] + D[4][1] * c1 + D[5][1] * s1 + R->r1.x * d.x + R->r1.y * d.y + R->r1.z * d.z,
+                 p.z + D[3][2] + D[4][2] * c1 + D[5][2] * s1 + R->r2.x * d.x + R->r2.y * d.y + R->r2.z * d.z);
+    return om_srs_model_ik_lifted(data->params, R, pm, pb->signs, pb->redundancy[0], x.x, x.y, x.z, q);
+}
+
+/* The lifted residual times prod_k (1 + 1 / |x - x_k|^2) over the known roots x_k
+ * (deflation: Newton's method is repelled from them). known: n_known x 3. */
+vec3 om_deflated_residual(om_problem *pb, vec3 x, double *q, const double *known, int n_known)
+{
+    vec3 F = om_lifted_residual(pb, x, q);
+    double factor = 1.0;
+    for (int k = 0; k < n_known; k++) {
+        double d2 = 0.0;
+        for (int i = 0; i < 3; i++) {
+            double e = om_wrap(v_get(x, i) - known[3 * k + i]);
+            d2 += e * e;
+        }
+        factor *= 1.0 + 1.0 / py_max(d2, 1e-300);
+    }
+    return v_scale(factor, F);
+}
+
+/* max |F_i| of a 3-vector (Python's max: a NaN after the first entry is skipped). */
+double om_max_norm(vec3 F)
+{
+    return py_max(py_max(fabs(F.x), fabs(F.y)), fabs(F.z));
+}

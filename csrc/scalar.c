@@ -1,0 +1,214 @@
+/* Root and extremum finders in one unknown w, on the residual g of the circle
+ * (port of om_redundant/_system/scalar.py). */
+#include "om_system.h"
+
+#define LAST_STEP 1e-5 /* a secant step (rad) below which the next iterate is evaluated with every joint */
+
+/* Secant (1-D Broyden) iteration from w0 with a finite-difference slope; returns |g| at the
+ * end, q holding the model IK (every joint) at the last iterate. */
+double om_secant(om_problem *pb, double w0, double *q)
+{
+    double g0 = om_g(pb, w0, q, false);
+    if (pb->s->mode == OM_FIXED || isnan(g0))
+        return fabs(g0);
+    double h = 1e-7;
+    double g1 = om_g(pb, w0 + h, q, false);
+    double slope = !isnan(g1) ? (g1 - g0) / h : -1.0;
+    double w = w0, gw = g0;
+    bool complete = false; /* whether q holds every joint at w */
+    for (int it = 0; it < 40; it++) {
+        if (gw == 0.0 || slope == 0.0 || isnan(slope))
+            break;
+        double step = -gw / slope;
+        if (fabs(step) > 0.5)
+            step = 0.5 * om_sign(step);
+        bool last = fabs(step) < LAST_STEP;
+        double g_new = om_g(pb, w + step, q, last);
+        if (isnan(g_new)) {
+            complete = false;
+            break;
+        }
+        slope = (g_new - gw) / step;
+        w = w + step;
+        gw = g_new;
+        complete = last;
+        if (fabs(step) < 1e-15 * py_max(1.0, fabs(w)) || fabs(gw) < 1e-16)
+            break;
+    }
+    if (!complete)
+        gw = om_g(pb, w, q, true);
+    return fabs(gw);
+}
+
+/* Illinois regula falsi on a sign-changing bracket; returns the root estimate. A gap of
+ * reach inside the bracket shrinks it to the side whose edge keeps the sign change. */
+double om_refine_bracket(om_problem *pb, double a, double ga, double b, double gb, double *q)
+{
+    int side = 0;
+    for (int it = 0; it < 100; it++) {
+        double c = (a * gb - b * ga) / (gb - ga);
+        double gc = om_g(pb, c, q, false);
+        if (isnan(gc)) {
+            double e = om_reach_edge(pb, a, c, q);
+            double ge = om_g(pb, e, q, false);
+            if (ge * ga <= 0.0) {
+                b = e;
+                gb = ge;
+            } else {
+                e = om_reach_edge(pb, b, c, q);
+                ge = om_g(pb, e, q, false);
+                if (ge * gb > 0.0) /* no sign change on either side: none to refine */
+                    return c;
+                a = e;
+                ga = ge;
+            }
+            side = 0;
+            continue;
+        }
+        if (gc == 0.0 || fabs(b - a) < 1e-15)
+            return c;
+        if (om_sign(gc) == om_sign(gb)) {
+            b = c;
+            gb = gc;
+            if (side == -1)
+                ga *= 0.5;
+            side = -1;
+        } else {
+            a = c;
+            ga = gc;
+            if (side == 1)
+                gb *= 0.5;
+            side = 1;
+        }
+    }
+    return 0.5 * (a + b);
+}
+
+/* A reachable point next to the edge of the model's reach, between inside and outside:
+ * Illinois regula falsi on the reach margin. */
+double om_reach_edge(om_problem *pb, double inside, double outside, double *q)
+{
+    double fi, fo, fc;
+    om_g_margin(pb, inside, q, false, &fi);
+    fi = fi + OM_REACH_SLACK;
+    om_g_margin(pb, outside, q, false, &fo);
+    fo = fo + OM_REACH_SLACK;
+    int side = 0;
+    for (int it = 0; it < 80; it++) {
+        if (fabs(outside - inside) <= 4e-16 * py_max(1.0, fabs(inside)))
+            break;
+        double c = (inside * fo - outside * fi) / (fo - fi);
+        if (!(py_min(inside, outside) < c && c < py_max(inside, outside)))
+            c = 0.5 * (inside + outside);
+        om_g_margin(pb, c, q, false, &fc);
+        fc = fc + OM_REACH_SLACK;
+        if (fc >= 0.0) {
+            inside = c;
+            fi = fc;
+            if (side == 1)
+                fo *= 0.5;
+            side = 1;
+        } else {
+            outside = c;
+            fo = fc;
+            if (side == -1)
+                fi *= 0.5;
+            side = -1;
+        }
+    }
+    return inside;
+}
+
+/* sign * g(w) (unreachable: -inf), or the reach margin; and g and the margin. */
+static double _objective(om_problem *pb, double w, double sign, bool of_margin, double *q, double *g_out,
+                         double *m_out)
+{
+    double m;
+    double gw = om_g_margin(pb, w, q, false, &m);
+    *g_out = gw;
+    *m_out = m;
+    if (of_margin)
+        return m;
+    return isnan(gw) ? -INFINITY : sign * gw;
+}
+
+/* Brent's search, from x0, for the maximum of sign * g (or of the reach margin) on [a, b];
+ * stops at the first point that settles the caller's question. Returns the argmax, with g
+ * and the margin there in *g_out and *margin_out (either may be NULL). */
+double om_extremum(om_problem *pb, double a, double b, double x0, double sign, bool of_margin, double *q,
+                   double *g_out, double *margin_out)
+{
+    const double golden = 0.3819660112501051;
+    double x = x0, w = x0, v = x0;
+    double gx, mx;
+    double fx = _objective(pb, x, sign, of_margin, q, &gx, &mx);
+    double fw = fx, fv = fx;
+    double d = 0.0, e = 0.0;
+    for (int it = 0; it < 60; it++) {
+        if (!of_margin ? fx > 0.0 : !isnan(gx))
+            break;
+        double xm = 0.5 * (a + b);
+        double tol = 1e-10 * fabs(x) + 1e-11;
+        if (fabs(x - xm) <= 2.0 * tol - 0.5 * (b - a))
+            break;
+        bool parabolic = false;
+        if (fabs(e) > tol) { /* a parabola through x, w, v (NaN with an unreachable point: skipped) */
+            double r = (x - w) * (fx - fv);
+            double p_ = (x - v) * (fx - fw);
+            double den = 2.0 * (p_ - r);
+            double num = (x - v) * p_ - (x - w) * r;
+            if (den > 0.0)
+                num = -num;
+            den = fabs(den);
+            if (fabs(num) < fabs(0.5 * den * e) && num > den * (a - x) && num < den * (b - x)) {
+                e = d;
+                d = num / den;
+                parabolic = true;
+                if ((x + d) - a < 2.0 * tol || b - (x + d) < 2.0 * tol)
+                    d = xm >= x ? tol : -tol;
+            }
+        }
+        if (!parabolic) {
+            e = x >= xm ? (a - x) : (b - x);
+            d = golden * e;
+        }
+        double u = x + (fabs(d) >= tol ? d : (d > 0.0 ? tol : -tol));
+        double gu, mu;
+        double fu = _objective(pb, u, sign, of_margin, q, &gu, &mu);
+        if (fu >= fx) {
+            if (u >= x)
+                a = x;
+            else
+                b = x;
+            v = w;
+            fv = fw;
+            w = x;
+            fw = fx;
+            x = u;
+            fx = fu;
+            gx = gu;
+            mx = mu;
+        } else {
+            if (u < x)
+                a = u;
+            else
+                b = u;
+            if (fu >= fw || w == x) {
+                v = w;
+                fv = fw;
+                w = u;
+                fw = fu;
+            } else if (fu >= fv || v == x || v == w) {
+                v = u;
+                fv = fu;
+            }
+        }
+    }
+    /* q must belong to the returned point. */
+    gx = om_g_margin(pb, x, q, false, &mx);
+    if (g_out)
+        *g_out = gx;
+    if (margin_out)
+        *margin_out = mx;
+    return x;
+}

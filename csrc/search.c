@@ -1,0 +1,119 @@
+/* The solve strategies on one problem: local solve, bounded search, and what they answer
+ * (port of om_redundant/_system/search.py). */
+#include "om_system.h"
+
+#define TORUS_SIDE 0.75  /* the torus grid has TORUS_SIDE * scan points nodes per side */
+#define WINDOW_POINTS 8  /* samples of the window searched around a hint */
+
+/* Bounded search: every verified solution in this configuration into roots (OM_MAX_ROOTS x
+ * dof); returns the count. With radius < pi, only roots whose scanned joints lie within
+ * radius of the centre's are sought. */
+int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre, double radius)
+{
+    const om_solver_data *data = pb->s;
+    double q[OM_MAX_DOF];
+    nan_fill(q, OM_MAX_DOF); /* numba: np.empty */
+    if (data->mode == OM_FIXED) {
+        double gw = om_g(pb, 0.0, q, true);
+        return isnan(gw) ? 0 : om_add_root(pb, q, roots, 0);
+    }
+    if (data->mode == OM_TORUS) {
+        int side = (int)(TORUS_SIDE * (double)n_scan);
+        return om_torus_roots(pb, side > 4 ? side : 4, roots, centre, radius);
+    }
+    int J = data->dp_joint;
+    int cap = 8 * n_scan + 8;
+    double *cands = malloc((size_t)cap * sizeof(double));
+    if (!cands)
+        return 0;
+    bool full_circle = radius >= OM_PI;
+    double lo = full_circle ? -OM_PI : centre[J] - radius;
+    double hi = full_circle ? OM_PI : centre[J] + radius;
+    int n = om_circle_candidates(pb, lo, hi, n_scan, full_circle, q, cands, cap);
+    int count = 0;
+    for (int i = 0; i < n; i++) {
+        double gw = om_g(pb, cands[i], q, true);
+        if (!isnan(gw) && fabs(gw) > OM_ROOT_TOL) /* polish the bracket's estimate */
+            om_secant(pb, cands[i], q);
+        count = om_add_root(pb, q, roots, count);
+    }
+    free(cands);
+    return count;
+}
+
+/* Local solve from the joint vector start, verified with the real arm: the secant on g from
+ * its q_J; on the torus, and on a 7-DOF circle arm where the secant fails, the lifted Newton.
+ * Returns accepted (errors into *pos, *ori); q holds the model IK at the end. */
+bool om_local_solve(om_problem *pb, const double *start, double *q, double *pos, double *ori)
+{
+    const om_solver_data *data = pb->s;
+    if (data->mode == OM_TORUS) {
+        om_lifted_solve(pb, start, q);
+        return om_verify(pb, q, pos, ori);
+    }
+    om_secant(pb, data->mode == OM_CIRCLE ? start[data->dp_joint] : 0.0, q);
+    bool accepted = om_verify(pb, q, pos, ori);
+    if (!accepted && data->family == OM_SRS && data->mode == OM_CIRCLE) {
+        om_lifted_solve(pb, start, q);
+        accepted = om_verify(pb, q, pos, ori);
+    }
+    return accepted;
+}
+
+/* Whether any configuration other than the problem's has a solution. The other
+ * configurations' evaluations count in pb->counter (numba shares the counter array). */
+bool om_exists_other(om_problem *pb)
+{
+    const int64_t *signs = pb->signs;
+    int k = pb->s->n_signs;
+    int64_t other[64];
+    double roots[OM_MAX_ROOTS * OM_MAX_DOF];
+    for (int64_t code = 0; code < ((int64_t)1 << k); code++) {
+        bool same = true;
+        for (int i = 0; i < k; i++) {
+            other[i] = ((code >> i) & 1) ? 1 : -1;
+            same = same && other[i] == signs[i];
+        }
+        if (same)
+            continue;
+        om_problem with_signs = *pb;
+        with_signs.signs = other;
+        with_signs.counter = 0;
+        int n = om_all_roots(&with_signs, pb->s->scan_points, roots, pb->q_prev, INFINITY);
+        pb->counter += with_signs.counter;
+        if (n)
+            return true;
+    }
+    return false;
+}
+
+/* Replace root q by any root nearer the hint; returns whether one was. A nearer root has
+ * |q_J - hint_J| below that distance: scanning that window is enough. */
+bool om_nearest_in_window(om_problem *pb, const double *hint, double *q)
+{
+    int dof = pb->s->dof;
+    double d2 = 0.0;
+    for (int j = 0; j < dof; j++) {
+        double e = om_wrap(q[j] - hint[j]);
+        d2 += e * e;
+    }
+    double radius = sqrt(d2);
+    if (radius < 1e-12)
+        return false;
+    double roots[OM_MAX_ROOTS * OM_MAX_DOF];
+    int n = om_all_roots(pb, WINDOW_POINTS, roots, hint, radius);
+    bool replaced = false;
+    for (int r = 0; r < n; r++) {
+        double e2 = 0.0;
+        for (int j = 0; j < dof; j++) {
+            double e = om_wrap(roots[r * dof + j] - hint[j]);
+            e2 += e * e;
+        }
+        if (e2 < d2) {
+            d2 = e2;
+            replaced = true;
+            memcpy(q, roots + r * dof, (size_t)dof * sizeof(double));
+        }
+    }
+    return replaced;
+}

@@ -1,0 +1,101 @@
+/* 6-DOF model arms with a spherical wrist (RRR and RRP position families): a port of
+ * om_redundant/closed_form/six_dof.py, BLAS-free form (see its docstrings for the math). */
+#include "om_kernels.h"
+
+/* Python's max(a, b) and min(a, b) on floats: the first unless the second compares greater (less). */
+static double py_max(double a, double b) { return b > a ? b : a; }
+static double py_min(double a, double b) { return b < a ? b : a; }
+
+/* Solve the model arm for the flange pose (R, p) in DH frame 0 and the branch signs
+ * (ARM, ELBOW, WRIST); write q. Returns the reach margin (model_ik): below -OM_REACH_SLACK the
+ * pose is out of reach and q is not written. */
+double om_six_dof_model_ik(int family, const double *P, const double *table, const mat3 *R, vec3 p,
+                           const int64_t *signs, const double *q_prev, double *q)
+{
+    mat3 Rt = *R;
+    vec3 pw = v_add(m_mv(Rt, v_load(P, SD_WRIST_CENTRE)), p);
+    /* Shoulder. */
+    double h = P[SD_LATERAL];
+    double r2 = pw.x * pw.x + pw.y * pw.y;
+    double k = r2 - h * h;
+    double margin = k / py_max(r2, 1.0);
+    if (margin < -OM_REACH_SLACK)
+        return margin;
+    double rho = (double)signs[0] * sqrt(py_max(k, 0.0));
+    double phi1;
+    if (r2 < 1e-24) /* rule 1: wrist centre on joint 1's axis */
+        phi1 = q_prev[0] + P[SD_THETA1];
+    else
+        phi1 = atan2(pw.y, pw.x) - atan2(-P[SD_SIGMA1] * h, rho);
+    q[0] = om_wrap(phi1 - P[SD_THETA1]);
+    double u = cos(phi1) * pw.x + sin(phi1) * pw.y - P[SD_A1];
+    double v = P[SD_SIGMA1] * (pw.z - P[SD_D1]);
+    double D = u * u + v * v;
+    double a2 = P[SD_A2];
+    double phi2;
+    if (family == OM_RRR_SPHERICAL_WRIST) {
+        double l3 = P[SD_ELL3];
+        double outer = fabs(a2) + l3, inner = fabs(a2) - l3; /* (.)**2 is x * x in numba */
+        k = (outer * outer - D) * (D - inner * inner);
+        margin = py_min(margin, k / py_max(D * D, 1.0));
+        if (margin < -OM_REACH_SLACK)
+            return margin;
+        double gamma = atan2((double)signs[1] * sqrt(py_max(k, 0.0)), om_sign(a2) * (D - a2 * a2 - l3 * l3));
+        if (D < 1e-24) /* rule 2: wrist centre on joint 2's axis */
+            phi2 = q_prev[1] + P[SD_THETA2];
+        else
+            phi2 = atan2(v, u) - atan2(l3 * sin(gamma), a2 + l3 * cos(gamma));
+        q[1] = om_wrap(phi2 - P[SD_THETA2]);
+        q[2] = om_wrap(gamma - P[SD_BETA] - P[SD_THETA3]);
+    } else {
+        k = D - a2 * a2;
+        margin = py_min(margin, k / py_max(D, 1.0));
+        if (margin < -OM_REACH_SLACK)
+            return margin;
+        double t = (double)(-signs[1]) * sqrt(py_max(k, 0.0));
+        if (D < 1e-24)
+            phi2 = q_prev[1] + P[SD_THETA2];
+        else
+            phi2 = atan2(v, u) - atan2(t, a2);
+        q[1] = om_wrap(phi2 - P[SD_THETA2]);
+        q[2] = -P[SD_SIGMA2] * t - P[SD_D3];
+    }
+    /* Wrist: M = R_in^T R E^T, R_in the frame before joint 4's row. */
+    double Rin[9], pin[3];
+    for (int i = 0; i < 9; i++)
+        Rin[i] = (i % 4 == 0) ? 1.0 : 0.0;
+    pin[0] = pin[1] = pin[2] = 0.0;
+    int j = 0;
+    for (int row = 0; row < (int)P[SD_WRIST_ROW]; row++) {
+        if (table[6 * row + 5] == 2.0) {
+            om_apply_row(Rin, pin, table + 6 * row, 0.0);
+        } else {
+            om_apply_row(Rin, pin, table + 6 * row, q[j]);
+            j++;
+        }
+    }
+    mat3 M = m_mmt(m_mtm(m_load(Rin, 0), Rt), m_load(P, SD_E_ROT));
+    vec3 phi = om_euler_zxzxz(M, P[SD_SIGMA4], P[SD_SIGMA5], 0.0, (double)signs[2], q_prev[3] + P[SD_THETA4]);
+    q[3] = om_wrap(phi.x - P[SD_THETA4]);
+    q[4] = om_wrap(phi.y - P[SD_THETA5]);
+    q[5] = om_wrap(phi.z - P[SD_THETA6]);
+    return margin;
+}
+
+/* The quantities whose signs are (ARM, ELBOW, WRIST) at joint vector q, into out[0..2]. */
+void om_six_dof_branch_values(int family, const double *P, const double *q, double *out)
+{
+    double phi2 = q[1] + P[SD_THETA2];
+    double u;
+    if (family == OM_RRR_SPHERICAL_WRIST) {
+        double gamma = q[2] + P[SD_THETA3] + P[SD_BETA];
+        u = P[SD_A2] * cos(phi2) + P[SD_ELL3] * cos(phi2 + gamma);
+        out[1] = sin(gamma);
+    } else {
+        double t = -P[SD_SIGMA2] * (q[2] + P[SD_D3]);
+        u = P[SD_A2] * cos(phi2) - t * sin(phi2);
+        out[1] = -t;
+    }
+    out[0] = P[SD_A1] + u;
+    out[2] = sin(q[4] + P[SD_THETA5]);
+}

@@ -1,0 +1,185 @@
+/* The entry points: one solve, and every root of one configuration
+ * (port of om_redundant/_system/entry.py's solve_one and solve_all). */
+#include "om_system.h"
+
+#define START_POINTS 8 /* starts on the dp circle when p_d is out of reach or a first root out of limits */
+
+/* The flange pose in DH frame 0 for an end-effector pose T (4x4 row-major) in the root frame. */
+void om_flange_target(const double *T, const double *T_base_root, const double *T_tool_flange, mat3 *R, vec3 *p)
+{
+    double F[3][4]; /* rows 0-2 of T_base_root @ T (row 3 is [0, 0, 0, 1]) */
+    const double *B = T_base_root, *X = T_tool_flange;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 4; j++)
+            F[i][j] = (B[4 * i + 0] * T[0 + j] + B[4 * i + 1] * T[4 + j] + B[4 * i + 2] * T[8 + j]) +
+                      B[4 * i + 3] * T[12 + j];
+    double Rm[3][3], pv[3];
+    for (int i = 0; i < 3; i++) {
+        for (int j = 0; j < 3; j++)
+            Rm[i][j] = F[i][0] * X[0 + j] + F[i][1] * X[4 + j] + F[i][2] * X[8 + j];
+        pv[i] = F[i][0] * X[3] + F[i][1] * X[7] + F[i][2] * X[11] + F[i][3];
+    }
+    R->r0 = v3(Rm[0][0], Rm[0][1], Rm[0][2]);
+    R->r1 = v3(Rm[1][0], Rm[1][1], Rm[1][2]);
+    R->r2 = v3(Rm[2][0], Rm[2][1], Rm[2][2]);
+    *p = v3(pv[0], pv[1], pv[2]);
+}
+
+/* Whether joint vectors a and b differ (by the 2 pi shifts of representative). */
+static bool _shifted(const double *a, const double *b, int dof)
+{
+    for (int j = 0; j < dof; j++)
+        if (a[j] != b[j])
+            return true;
+    return false;
+}
+
+static om_result _result(int status, double pos, double ori, int64_t evaluations, bool inside)
+{
+    om_result result = {status, pos, ori, evaluations, inside};
+    return result;
+}
+
+/* One OM solve: the local solve (secant, or lifted Newton), then the bounded search.
+ * hint NULL: no hint. Writes q_out (dof; NaN when no solution). */
+om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
+                       const double *hint, double *q_out)
+{
+    int family = s->family, mode = s->mode, dof = s->dof;
+    const double *P = s->params, *mtab = s->model_table;
+    const uint8_t *revolute = s->revolute;
+    const double *lower = s->lower, *upper = s->upper;
+    bool has_hint = hint != NULL;
+    double zeros[OM_MAX_DOF] = {0.0};
+    if (!has_hint)
+        hint = zeros; /* what the Python side passes without a hint */
+    om_problem problem;
+    problem.s = s;
+    om_flange_target(T, s->T_base_root, s->T_tool_flange, &problem.R, &problem.p);
+    problem.signs = signs;
+    problem.redundancy = redundancy;
+    problem.q_prev = hint; /* the hint, or zeros */
+    problem.counter = 0;
+    om_problem *pb = &problem;
+    double q[OM_MAX_DOF], start[OM_MAX_DOF];
+    /* numba: np.empty. local_solve verifies q even where the secant's first point is out of
+     * reach and q was never written; NaN makes that verification fail deterministically. */
+    nan_fill(q, OM_MAX_DOF);
+    memcpy(start, hint, (size_t)dof * sizeof(double));
+    bool found = has_hint;
+    vec3 pd = problem.p;
+    double pos = NAN, ori = NAN;
+    if (!has_hint) { /* the paper's fixed-point start, p_m = p_d */
+        found = om_model_ik(family, P, mtab, &problem.R, pd, signs, redundancy, problem.q_prev, start, true) >=
+                -OM_REACH_SLACK;
+        if (!found && family == OM_SRS && mode != OM_FIXED) {
+            /* p_d is outside the model's reach: the elbow held at the edge of reach instead,
+             * a start for the lifted Newton (see local_solve). */
+            found = om_srs_model_ik_at_reach(P, &problem.R, pd, signs, redundancy[0], problem.q_prev, start);
+        } else if (!found && mode == OM_CIRCLE) {
+            /* p_d is outside the model's reach: start from the point of the dp circle that
+             * the model reaches with the smallest residual. */
+            double best = INFINITY;
+            for (int k = 0; k < START_POINTS; k++) {
+                double gk = om_g(pb, -OM_PI + 2.0 * OM_PI * (double)k / START_POINTS, q, true);
+                if (fabs(gk) < best) { /* false for NaN */
+                    best = fabs(gk);
+                    found = true;
+                    memcpy(start, q, (size_t)dof * sizeof(double));
+                }
+            }
+        }
+    }
+    if (found) {
+        bool verified = om_local_solve(pb, start, q, &pos, &ori);
+        if (verified) {
+            if (has_hint && mode != OM_FIXED && om_nearest_in_window(pb, hint, q))
+                om_verify(pb, q, &pos, &ori);
+            memcpy(q_out, q, (size_t)dof * sizeof(double));
+            bool inside = om_representative(q_out, dof, revolute, lower, upper, hint, has_hint);
+            if (inside || has_hint || mode == OM_FIXED) {
+                if (_shifted(q_out, q, dof)) /* the errors of the vector returned, to its rounding */
+                    om_verify(pb, q_out, &pos, &ori);
+                return _result(OM_OK, pos, ori, problem.counter, inside);
+            }
+            /* Without a hint, a root within the limits is preferred: search for one. */
+        }
+    }
+    if (!has_hint && mode == OM_CIRCLE) {
+        /* Other starts on the circle first: cheaper than the bounded search, and a root
+         * within the limits is usually among their roots. */
+        for (int k = 0; k < START_POINTS; k++) {
+            om_secant(pb, -OM_PI + 2.0 * OM_PI * ((double)k + 0.5) / START_POINTS, q);
+            bool verified = om_verify(pb, q, &pos, &ori);
+            if (verified) {
+                memcpy(q_out, q, (size_t)dof * sizeof(double));
+                if (om_representative(q_out, dof, revolute, lower, upper, hint, false)) {
+                    if (_shifted(q_out, q, dof))
+                        om_verify(pb, q_out, &pos, &ori);
+                    return _result(OM_OK, pos, ori, problem.counter, true);
+                }
+            }
+        }
+    }
+    double roots[OM_MAX_ROOTS * OM_MAX_DOF];
+    int n = om_all_roots(pb, s->scan_points, roots, hint, INFINITY);
+    if (n == 0) {
+        for (int j = 0; j < dof; j++)
+            q_out[j] = NAN;
+        int status = om_exists_other(pb) ? OM_NO_SOLUTION_IN_CONFIGURATION : OM_UNREACHABLE;
+        return _result(status, NAN, NAN, problem.counter, false);
+    }
+    /* The root nearest the hint; without one, a root within the limits first, then the one
+     * nearest the fixed-point start. */
+    int best = 0;
+    double best_dist = INFINITY;
+    for (int r = 0; r < n; r++) {
+        double dist = 0.0;
+        if (found) {
+            for (int j = 0; j < dof; j++) {
+                double e = om_wrap(roots[r * dof + j] - start[j]);
+                dist += e * e;
+            }
+        }
+        if (!has_hint) {
+            double shifted[OM_MAX_DOF];
+            memcpy(shifted, roots + r * dof, (size_t)dof * sizeof(double));
+            if (!om_representative(shifted, dof, revolute, lower, upper, hint, false))
+                dist += (double)dof * ((2.0 * OM_PI) * (2.0 * OM_PI)); /* after every root within the limits */
+        }
+        if (dist < best_dist) {
+            best = r;
+            best_dist = dist;
+        }
+    }
+    memcpy(q_out, roots + best * dof, (size_t)dof * sizeof(double));
+    bool inside = om_representative(q_out, dof, revolute, lower, upper, hint, has_hint);
+    om_verify(pb, q_out, &pos, &ori);
+    return _result(OM_OK, pos, ori, problem.counter, inside);
+}
+
+/* Every solution in one configuration (the bounded search): roots (OM_MAX_ROOTS x dof,
+ * revolute joints shifted into the limits where possible) and per root (position error,
+ * orientation error, within limits) in info (OM_MAX_ROOTS x 3). Returns the count. */
+int om_solve_all(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
+                 double *roots, double *info, int64_t *evaluations)
+{
+    double zeros[OM_MAX_DOF] = {0.0};
+    int dof = s->dof;
+    om_problem problem;
+    problem.s = s;
+    om_flange_target(T, s->T_base_root, s->T_tool_flange, &problem.R, &problem.p);
+    problem.signs = signs;
+    problem.redundancy = redundancy;
+    problem.q_prev = zeros;
+    problem.counter = 0;
+    int n = om_all_roots(&problem, s->scan_points, roots, zeros, INFINITY);
+    for (int r = 0; r < n; r++) {
+        bool inside = om_representative(roots + r * dof, dof, s->revolute, s->lower, s->upper, zeros, false);
+        om_verify(&problem, roots + r * dof, &info[3 * r], &info[3 * r + 1]);
+        info[3 * r + 2] = inside ? 1.0 : 0.0;
+    }
+    if (evaluations)
+        *evaluations = problem.counter;
+    return n;
+}

@@ -1,0 +1,218 @@
+/* 7-DOF S-R-S model arms (spherical shoulder, elbow, spherical wrist): a port of
+ * om_redundant/closed_form/srs.py and of arm_angle_gradient_kernel in om_redundant/arm_angle.py
+ * (see their docstrings for the math and the parameter layout). */
+#include "om_kernels.h"
+
+#define DEGENERATE 1e-12 /* |W - S|^2 below which the wrist centre is at the shoulder centre */
+
+/* Python's max(a, b) and min(a, b) on floats: the first unless the second compares greater (less). */
+static double py_max(double a, double b) { return b > a ? b : a; }
+static double py_min(double a, double b) { return b < a ? b : a; }
+
+/* Rx(alpha) with sin(alpha) = sigma = +-1. */
+static mat3 rx(double sigma)
+{
+    mat3 A = {v3(1.0, 0.0, 0.0), v3(0.0, 0.0, -sigma), v3(0.0, sigma, 0.0)};
+    return A;
+}
+
+/* The arm angle's reference direction n(w_hat) = R(up -> w_hat) r, and w_hat x n (_reference). */
+void om_srs_reference(const double *P, vec3 w_hat, vec3 *n, vec3 *nw)
+{
+    vec3 up = v_load(P, SRS_UP), r = v_load(P, SRS_REF);
+    vec3 v = v_cross(up, w_hat);
+    vec3 vr = v_cross(v, r);
+    *n = v_unit(v_add(v_add(r, vr), v_scale(1.0 / py_max(1.0 + v_dot(up, w_hat), 1e-300), v_cross(v, vr))));
+    *nw = v_cross(w_hat, *n);
+}
+
+/* v(phi4) = Rz(phi4) u - s3: W - S in frame 3. */
+static vec3 elbow_vector(const double *P, double phi4)
+{
+    double c4 = cos(phi4), s4 = sin(phi4);
+    vec3 u = v_load(P, SRS_U), s3 = v_load(P, SRS_S3);
+    return v3(c4 * u.x - s4 * u.y - s3.x, s4 * u.x + c4 * u.y - s3.y, u.z - s3.z);
+}
+
+/* W - S in DH frame 0 for the flange pose (R, p). */
+static vec3 wrist_centre(const double *P, mat3 Rt, vec3 p)
+{
+    return v_sub(v_add(p, m_mv(Rt, v_load(P, SRS_WRIST))), v_load(P, SRS_SHOULDER));
+}
+
+/* The root phi4 of x = cos(phi4 - phi*) in the ELBOW branch, x clamped into [-1, 1]. */
+static double elbow_root(const double *P, double x, double elbow)
+{
+    double xc = py_min(py_max(x, -1.0), 1.0);
+    return P[SRS_PHI_STAR] + atan2(elbow * sqrt(1.0 - xc * xc), xc);
+}
+
+/* R03 for W - S = w, the elbow angle phi4 and the arm angle psi: it maps the frame-3 triad
+ * (v_hat, b3_hat, v_hat x b3_hat) onto (w_hat, m, w_hat x m). */
+static mat3 rotation_03_at(const double *P, vec3 w, double L2, double phi4, double elbow, double psi)
+{
+    vec3 w_hat = v_scale(1.0 / sqrt(L2), w);
+    vec3 n, nw;
+    om_srs_reference(P, w_hat, &n, &nw);
+    vec3 m = v_add(v_scale(cos(psi), n), v_scale(sin(psi), nw));
+    vec3 v = elbow_vector(P, phi4);
+    vec3 v_hat = v_unit(v);
+    vec3 b3 = v_unit(v_scale(elbow * P[SRS_BEND], v3(-v.y, v.x, 0.0)));
+    mat3 A = {w_hat, m, v_cross(w_hat, m)};
+    mat3 B = {v_hat, b3, v_cross(v_hat, b3)};
+    return m_mtm(A, B);
+}
+
+/* Joints 1-3 (if shoulder) and 4-7 for the elbow angle phi4, W - S = w and the arm angle psi. */
+static void ik_with_elbow(const double *P, mat3 Rt, vec3 w, double L2, double phi4, const int64_t *signs,
+                          double psi, const double *q_prev, double *q, bool shoulder)
+{
+    const double *th = P + SRS_THETA;
+    mat3 R03 = rotation_03_at(P, w, L2, phi4, (double)signs[1], psi);
+    if (shoulder) {
+        vec3 phi = om_euler_zxzxz(m_mmt(m_mtm(m_load(P, SRS_R_PRE), R03), m_load(P, SRS_X3)), P[SRS_SIGMA1],
+                                  P[SRS_SIGMA2], 0.0, (double)signs[0], q_prev[0] + th[0]);
+        q[0] = om_wrap(phi.x - th[0]);
+        q[1] = om_wrap(phi.y - th[1]);
+        q[2] = om_wrap(phi.z - th[2]);
+    }
+    q[3] = om_wrap(phi4 - th[3]);
+    mat3 R04 = m_mm(R03, m_rz_times(phi4, m_load(P, SRS_X4)));
+    mat3 M = m_mmt(m_mtm(R04, Rt), m_load(P, SRS_E_ROT));
+    vec3 phi = om_euler_zxzxz(M, P[SRS_SIGMA5], P[SRS_SIN_BETA], P[SRS_COS_BETA], (double)signs[2],
+                              q_prev[4] + th[4]);
+    q[4] = om_wrap(phi.x - th[4]);
+    q[5] = om_wrap(phi.y - th[5]);
+    q[6] = om_wrap(phi.z - th[6]);
+}
+
+/* Solve the model for the flange pose (R, p) in DH frame 0, the branch signs
+ * (SHOULDER, ELBOW, WRIST) and the arm angle psi (model_ik). Returns the reach margin 1 - x^2;
+ * below -OM_REACH_SLACK (or -1 where W = S) q is not written. */
+double om_srs_model_ik(const double *P, const mat3 *R, vec3 p, const int64_t *signs, double psi,
+                       const double *q_prev, double *q, bool shoulder)
+{
+    mat3 Rt = *R;
+    vec3 w = wrist_centre(P, Rt, p);
+    double L2 = v_dot(w, w);
+    if (L2 < DEGENERATE) /* wrist centre at the shoulder centre */
+        return -1.0;
+    double x = (L2 - P[SRS_K0]) / P[SRS_K];
+    double margin = 1.0 - x * x;
+    if (margin < -OM_REACH_SLACK)
+        return margin;
+    ik_with_elbow(P, Rt, w, L2, elbow_root(P, x, (double)signs[1]), signs, psi, q_prev, q, shoulder);
+    return margin;
+}
+
+/* om_srs_model_ik with the elbow held at the edge of reach beyond it (model_ik_at_reach);
+ * false, q untouched, only where W = S. */
+bool om_srs_model_ik_at_reach(const double *P, const mat3 *R, vec3 p, const int64_t *signs, double psi,
+                              const double *q_prev, double *q)
+{
+    mat3 Rt = *R;
+    vec3 w = wrist_centre(P, Rt, p);
+    double L2 = v_dot(w, w);
+    if (L2 < DEGENERATE)
+        return false;
+    ik_with_elbow(P, Rt, w, L2, elbow_root(P, (L2 - P[SRS_K0]) / P[SRS_K], (double)signs[1]), signs, psi, q_prev,
+                  q, true);
+    return true;
+}
+
+/* The model IK with q1, q7 and the elbow angle phi4 given (phi4 NaN: the elbow root in the ELBOW
+ * branch); writes q and returns the (shoulder, wrist, elbow) residuals (model_ik_lifted). */
+vec3 om_srs_model_ik_lifted(const double *P, const mat3 *R, vec3 p, const int64_t *signs, double psi, double q1,
+                            double q7, double phi4, double *q)
+{
+    mat3 Rt = *R;
+    vec3 w = wrist_centre(P, Rt, p);
+    double L2 = v_dot(w, w);
+    if (L2 < DEGENERATE)
+        return v3(NAN, NAN, NAN);
+    double x = (L2 - P[SRS_K0]) / P[SRS_K];
+    if (isnan(phi4))
+        phi4 = elbow_root(P, x, (double)signs[1]);
+    const double *th = P + SRS_THETA;
+    mat3 R03 = rotation_03_at(P, w, L2, phi4, (double)signs[1], psi);
+    vec3 sh = om_euler_zxzxz_given_first(m_mmt(m_mtm(m_load(P, SRS_R_PRE), R03), m_load(P, SRS_X3)), P[SRS_SIGMA1],
+                                         0.0, P[SRS_SIGMA2], q1 + th[0]);
+    mat3 R04 = m_mm(R03, m_rz_times(phi4, m_load(P, SRS_X4)));
+    mat3 M = m_mmt(m_mtm(R04, Rt), m_load(P, SRS_E_ROT));
+    /* The wrist's M^T = Rz(-phi7) Rx(-beta) Rz(-phi6) Rx(-alpha5) Rz(-phi5): phi7 comes first. */
+    vec3 wr = om_euler_zxzxz_given_first(m_transpose(M), -P[SRS_SIN_BETA], P[SRS_COS_BETA], -P[SRS_SIGMA5],
+                                         -(q7 + th[6]));
+    q[0] = q1;
+    q[1] = om_wrap(sh.x - th[1]);
+    q[2] = om_wrap(sh.y - th[2]);
+    q[3] = om_wrap(phi4 - th[3]);
+    q[4] = om_wrap(-wr.y - th[4]);
+    q[5] = om_wrap(-wr.x - th[5]);
+    q[6] = q7;
+    return v3(sh.z, wr.z, x - cos(phi4 - P[SRS_PHI_STAR]));
+}
+
+/* R03 at joint vector q (_rotation_03). */
+static mat3 rotation_03(const double *P, const double *q)
+{
+    const double *th = P + SRS_THETA;
+    mat3 R = m_mm(m_load(P, SRS_R_PRE), m_rz_times(q[0] + th[0], rx(P[SRS_SIGMA1])));
+    R = m_mm(R, m_rz_times(q[1] + th[1], rx(P[SRS_SIGMA2])));
+    return m_mm(R, m_rz_times(q[2] + th[2], m_load(P, SRS_X3)));
+}
+
+/* The model's arm angle psi at joint vector q (arm_angle). */
+double om_srs_arm_angle(const double *P, const double *q)
+{
+    mat3 R03 = rotation_03(P, q);
+    double phi4 = q[3] + P[SRS_THETA + 3];
+    vec3 w_hat = v_unit(m_mv(R03, elbow_vector(P, phi4)));
+    vec3 n, nw;
+    om_srs_reference(P, w_hat, &n, &nw);
+    double elbow = sin(phi4 - P[SRS_PHI_STAR]) < 0.0 ? -1.0 : 1.0;
+    vec3 b = v_scale(elbow * P[SRS_BEND], v_cross(m_col(R03, 2), w_hat));
+    return atan2(v_dot(nw, b), v_dot(n, b));
+}
+
+/* The quantities whose signs are (SHOULDER, ELBOW, WRIST) at joint vector q, into out[0..2]. */
+void om_srs_branch_values(const double *P, const double *q, double *out)
+{
+    const double *th = P + SRS_THETA;
+    out[0] = sin(q[1] + th[1]);
+    out[1] = sin(q[3] + th[3] - P[SRS_PHI_STAR]);
+    out[2] = sin(q[5] + th[5]);
+}
+
+/* psi at q of the S-R-S model with parameters P and DH table, and d psi / dq into grad[0..6]
+ * (arm_angle_gradient_kernel; psi depends on joints 1-4 only). */
+double om_arm_angle_gradient(const double *P, const double *table, int n_rows, const double *q, double *grad)
+{
+    /* Axis and origin of joints 1-6 in DH frame 0; S is the origin after joint 1's row, W the one
+     * after joint 5's row. */
+    double axes[6 * 3], origins[6 * 3], R[9], p[3];
+    om_joint_axes(table, n_rows, q, 6, axes, origins, R, p);
+    vec3 S = v_load(origins, 3), W = v_load(origins, 15), z4 = v_load(axes, 9);
+    vec3 w = v_sub(W, S);
+    double length = sqrt(v_dot(w, w));
+    vec3 w_hat = v_scale(1.0 / length, w);
+    double elbow = sin(q[3] + P[SRS_THETA + 3] - P[SRS_PHI_STAR]) < 0.0 ? -1.0 : 1.0;
+    double bend = elbow * P[SRS_BEND];
+    vec3 b = v_scale(bend, v_cross(z4, w_hat));
+    vec3 n, nw;
+    om_srs_reference(P, w_hat, &n, &nw);
+    vec3 up = v_load(P, SRS_UP);
+    vec3 wb = v_cross(w_hat, b);
+    double bb = v_dot(b, b);
+    double twist = 1.0 / (1.0 + v_dot(up, w_hat));
+    for (int j = 0; j < 7; j++)
+        grad[j] = 0.0;
+    for (int j = 0; j < 4; j++) {
+        vec3 zj = v_load(axes, 3 * j), oj = v_load(origins, 3 * j);
+        vec3 dW = v_cross(zj, v_sub(W, oj));
+        vec3 dw_hat = v_scale(1.0 / length, v_sub(dW, v_scale(v_dot(w_hat, dW), w_hat)));
+        vec3 dz4 = j < 3 ? v_cross(zj, z4) : v3(0.0, 0.0, 0.0);
+        vec3 db = v_scale(bend, v_add(v_cross(dz4, w_hat), v_cross(z4, dw_hat)));
+        grad[j] = v_dot(wb, db) / bb + v_dot(up, v_cross(w_hat, dw_hat)) * twist;
+    }
+    return atan2(v_dot(nw, b), v_dot(n, b));
+}

@@ -1,0 +1,92 @@
+/* Every candidate checked with the REAL arm: pose errors, configuration, joint limits
+ * (port of om_redundant/_system/verify.py). */
+#include "om_system.h"
+
+#define REDUNDANCY_TOL 1e-9 /* a solution's redundancy values (rad) must equal the requested ones */
+#define MAX_VALUES 16       /* branch and redundancy values of a family (3 and 1 today) */
+
+/* Position and orientation error of the REAL arm at q (into *pos, *ori), and the
+ * configuration check; returns whether q is accepted. */
+bool om_verify(om_problem *pb, const double *q, double *pos, double *ori)
+{
+    const om_solver_data *data = pb->s;
+    double Rr[9], pr[3];
+    om_flange(data->real_table, data->n_real_rows, q, Rr, pr);
+    vec3 d = v3(pr[0] - pb->p.x, pr[1] - pb->p.y, pr[2] - pb->p.z);
+    double position = sqrt(v_dot(d, d));
+    mat3 E = m_mtm(pb->R, m_load(Rr, 0));
+    double e0 = E.r2.y - E.r1.z, e1 = E.r0.z - E.r2.x, e2 = E.r1.x - E.r0.y;
+    double s = 0.5 * sqrt(e0 * e0 + e1 * e1 + e2 * e2);
+    double orientation = atan2(s, 0.5 * (E.r0.x + E.r1.y + E.r2.z - 1.0));
+    double values[MAX_VALUES];
+    om_branch_values(data->family, data->params, q, values);
+    bool same = true;
+    for (int i = 0; i < data->n_signs; i++) {
+        /* A branch quantity at zero (a singular joint) belongs to both branches. */
+        if (values[i] * (double)pb->signs[i] < -1e-12)
+            same = false;
+    }
+    om_redundancy_values(data->family, data->params, q, values);
+    for (int i = 0; i < data->n_redundancy; i++) {
+        if (fabs(om_wrap(values[i] - pb->redundancy[i])) > REDUNDANCY_TOL)
+            same = false;
+    }
+    if (pos)
+        *pos = position;
+    if (ori)
+        *ori = orientation;
+    return same && position <= data->tol_pos && orientation <= data->tol_ori;
+}
+
+/* Append q to roots (OM_MAX_ROOTS x dof) if the real arm verifies it and it is new;
+ * returns the count. */
+int om_add_root(om_problem *pb, const double *q, double *roots, int count)
+{
+    if (!om_verify(pb, q, NULL, NULL))
+        return count;
+    int dof = pb->s->dof;
+    for (int r = 0; r < count; r++) {
+        double diff = 0.0;
+        for (int j = 0; j < dof; j++)
+            diff = py_max(diff, fabs(om_wrap(q[j] - roots[r * dof + j])));
+        if (diff < OM_SAME_ROOT)
+            return count;
+    }
+    if (count < OM_MAX_ROOTS) {
+        memcpy(roots + count * dof, q, (size_t)dof * sizeof(double));
+        count += 1;
+    }
+    return count;
+}
+
+/* Shift revolute joints by multiples of 2 pi into the limits, nearest to the hint (to zero
+ * without one); returns whether q is within limits. hint is read only if has_hint. */
+bool om_representative(double *q, int dof, const uint8_t *revolute, const double *lower, const double *upper,
+                       const double *hint, bool has_hint)
+{
+    bool inside = true;
+    for (int j = 0; j < dof; j++) {
+        if (!revolute[j]) {
+            inside = inside && lower[j] <= q[j] && q[j] <= upper[j];
+            continue;
+        }
+        double target = has_hint ? hint[j] : 0.0;
+        double best = om_wrap(q[j] - target) + target;
+        bool found = lower[j] <= best && best <= upper[j];
+        if (!found) {
+            double base = om_wrap(q[j]);
+            double best_dist = INFINITY;
+            for (int k = -3; k < 4; k++) {
+                double cand = base + 2.0 * OM_PI * (double)k;
+                if (lower[j] <= cand && cand <= upper[j] && fabs(cand - target) < best_dist) {
+                    best = cand;
+                    best_dist = fabs(cand - target);
+                    found = true;
+                }
+            }
+        }
+        q[j] = best;
+        inside = inside && found;
+    }
+    return inside;
+}
