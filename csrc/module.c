@@ -663,19 +663,38 @@ PyMODINIT_FUNC PyInit_ckernels(void) {
     if (PyType_Ready(&SolverType) < 0) return NULL;
     PyObject *m = PyModule_Create(&module);
     if (!m) return NULL;
-    if (PyModule_AddObjectRef(m, "Solver", (PyObject *)&SolverType) < 0 ||
-        PyModule_AddIntConstant(m, "MAX_ROOTS", OM_MAX_ROOTS) < 0 ||
-        PyModule_AddIntConstant(m, "MAX_DOF", OM_MAX_DOF) < 0 ||
-        PyModule_AddIntConstant(m, "SD_N_PARAMS", SD_N_PARAMS) < 0 ||
-        PyModule_AddIntConstant(m, "SRS_N_PARAMS", SRS_N_PARAMS) < 0 ||
-        PyModule_AddIntConstant(m, "SRS_THETA", SRS_THETA) < 0 ||
-        PyModule_AddIntConstant(m, "SRS_PHI_STAR", SRS_PHI_STAR) < 0 ||
-        PyModule_AddIntConstant(m, "SRS_BEND", SRS_BEND) < 0 ||
-        PyModule_AddIntConstant(m, "SRS_COS_BETA", SRS_COS_BETA) < 0 ||
-        PyModule_AddIntConstant(m, "SD_WRIST_ROW", SD_WRIST_ROW) < 0 ||
-        PyModule_AddObjectRef(m, "REACH_SLACK", PyFloat_FromDouble(OM_REACH_SLACK)) < 0) {
-        Py_DECREF(m);
-        return NULL;
+    /* The parameter layouts, for the Python side to check its own against (tests). */
+    static const struct {
+        const char *name;
+        int value;
+    } constants[] = {
+        {"MAX_ROOTS", OM_MAX_ROOTS}, {"MAX_DOF", OM_MAX_DOF},
+        {"SD_A1", SD_A1}, {"SD_D1", SD_D1}, {"SD_SIGMA1", SD_SIGMA1}, {"SD_THETA1", SD_THETA1},
+        {"SD_LATERAL", SD_LATERAL}, {"SD_A2", SD_A2}, {"SD_THETA2", SD_THETA2}, {"SD_ELL3", SD_ELL3},
+        {"SD_BETA", SD_BETA}, {"SD_THETA3", SD_THETA3}, {"SD_SIGMA2", SD_SIGMA2}, {"SD_D3", SD_D3},
+        {"SD_SIGMA4", SD_SIGMA4}, {"SD_SIGMA5", SD_SIGMA5}, {"SD_THETA4", SD_THETA4}, {"SD_THETA5", SD_THETA5},
+        {"SD_THETA6", SD_THETA6}, {"SD_WRIST_CENTRE", SD_WRIST_CENTRE}, {"SD_E_ROT", SD_E_ROT},
+        {"SD_WRIST_ROW", SD_WRIST_ROW}, {"SD_N_PARAMS", SD_N_PARAMS},
+        {"SRS_SIGMA1", SRS_SIGMA1}, {"SRS_SIGMA2", SRS_SIGMA2}, {"SRS_SIGMA5", SRS_SIGMA5},
+        {"SRS_SIN_BETA", SRS_SIN_BETA}, {"SRS_THETA", SRS_THETA}, {"SRS_SHOULDER", SRS_SHOULDER},
+        {"SRS_WRIST", SRS_WRIST}, {"SRS_S3", SRS_S3}, {"SRS_U", SRS_U}, {"SRS_K0", SRS_K0}, {"SRS_K", SRS_K},
+        {"SRS_PHI_STAR", SRS_PHI_STAR}, {"SRS_R_PRE", SRS_R_PRE}, {"SRS_X3", SRS_X3}, {"SRS_X4", SRS_X4},
+        {"SRS_E_ROT", SRS_E_ROT}, {"SRS_UP", SRS_UP}, {"SRS_REF", SRS_REF}, {"SRS_BEND", SRS_BEND},
+        {"SRS_COS_BETA", SRS_COS_BETA}, {"SRS_N_PARAMS", SRS_N_PARAMS},
+        {"RRR_SPHERICAL_WRIST", OM_RRR_SPHERICAL_WRIST}, {"RRP_SPHERICAL_WRIST", OM_RRP_SPHERICAL_WRIST},
+        {"SRS", OM_SRS}, {"FIXED", OM_FIXED}, {"CIRCLE", OM_CIRCLE}, {"TORUS", OM_TORUS}, {"OK", OM_OK},
+        {"UNREACHABLE", OM_UNREACHABLE}, {"NO_SOLUTION_IN_CONFIGURATION", OM_NO_SOLUTION_IN_CONFIGURATION},
+    };
+    if (PyModule_AddObjectRef(m, "Solver", (PyObject *)&SolverType) < 0) goto fail;
+    for (size_t i = 0; i < sizeof constants / sizeof constants[0]; i++)
+        if (PyModule_AddIntConstant(m, constants[i].name, constants[i].value) < 0) goto fail;
+    PyObject *slack = PyFloat_FromDouble(OM_REACH_SLACK);
+    if (!slack || PyModule_AddObject(m, "REACH_SLACK", slack) < 0) {
+        Py_XDECREF(slack);
+        goto fail;
     }
     return m;
+fail:
+    Py_DECREF(m);
+    return NULL;
 }

@@ -1,0 +1,162 @@
+"""The compiled core at its edge: memory layouts, malformed buffers, threads, constants."""
+
+from __future__ import annotations
+
+import threading
+
+import numpy as np
+import pytest
+
+import om_redundant as om
+from om_redundant import ckernels
+from om_redundant.om.families import six_dof, srs
+from om_redundant.om.system import MAX_ROOTS, SolverData
+from tests.conftest import random_q
+
+
+@pytest.fixture(scope="module")
+def panda() -> om.OMSolver:
+    return om.OMSolver("panda")
+
+
+def _target(solver: om.OMSolver, seed: int) -> tuple[np.ndarray, np.ndarray, om.Configuration]:
+    q = random_q(solver.arm, 1, np.random.default_rng(seed))[0]
+    return q, solver.arm.fk(q), solver.configuration_of(q)
+
+
+def _layouts(array: np.ndarray) -> dict[str, np.ndarray]:
+    """The same values as a Fortran-order, a read-only, a strided and a list copy."""
+    read_only = array.copy()
+    read_only.flags.writeable = False
+    return {
+        "fortran": np.asfortranarray(array),
+        "read-only": read_only,
+        "strided": np.repeat(array, 2, axis=-1)[..., ::2],
+        "list": array.tolist(),
+    }
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_every_layout_of_pose_and_hint_gives_the_same_solution(panda, seed):
+    q, T, c = _target(panda, seed)
+    hint = q + 0.01
+    reference = panda.solve(T, c, q_hint=hint)
+    assert reference.ok
+    for name, pose in _layouts(T).items():
+        for hint_name, h in _layouts(hint).items():
+            sol = panda.solve(pose, c, q_hint=h)
+            np.testing.assert_array_equal(sol.q, reference.q, err_msg=f"{name} pose, {hint_name} hint")
+            assert sol.iterations == reference.iterations
+    for name, pose in _layouts(T).items():
+        roots = panda.solve_all(pose, c)
+        assert [r.q.tolist() for r in roots] == [r.q.tolist() for r in panda.solve_all(T, c)], name
+
+
+def test_every_layout_of_a_batch_gives_the_same_solutions(panda):
+    rng = np.random.default_rng(7)
+    Q = random_q(panda.arm, 100, rng)
+    T = panda.arm.fk(Q)
+    cs = [panda.configuration_of(q) for q in Q]
+    signs = np.array([c.signs for c in cs])
+    psi = np.array([c.redundancy for c in cs])
+    reference = panda.solve_batch(T, signs, psi, q_hint=Q)
+    assert reference.ok.all()
+    for name, poses in _layouts(T).items():
+        for signs_layout in (np.asfortranarray(signs), signs.astype(np.float64), signs[:, ::-1][:, ::-1]):
+            batch = panda.solve_batch(
+                poses, signs_layout, np.asfortranarray(psi), q_hint=np.asfortranarray(Q)
+            )
+            np.testing.assert_array_equal(batch.q, reference.q, err_msg=name)
+            np.testing.assert_array_equal(batch.iterations, reference.iterations)
+
+
+def test_batch_equals_one_solve_per_row_across_threads(panda):
+    """The thread pool's chunks cover every row once; the answers are the serial ones."""
+    rng = np.random.default_rng(3)
+    Q = random_q(panda.arm, 300, rng)
+    T = panda.arm.fk(Q)
+    cs = [panda.configuration_of(q) for q in Q]
+    batch = panda.solve_batch(T, np.array([c.signs for c in cs]), np.array([c.redundancy for c in cs]))
+    for m in range(len(Q)):
+        sol = panda.solve(T[m], cs[m])
+        np.testing.assert_array_equal(batch.q[m], sol.q)
+        assert batch.status[m] == sol.status and batch.iterations[m] == sol.iterations
+
+
+def test_threads_sharing_one_solver_agree_with_serial_calls(panda):
+    targets = [_target(panda, seed) for seed in range(40)]
+    serial = [panda.solve(T, c).q for _, T, c in targets]
+    results: dict[int, list[np.ndarray]] = {}
+
+    def work(k: int) -> None:
+        results[k] = [panda.solve(T, c).q for _, T, c in targets]
+
+    threads = [threading.Thread(target=work, args=(k,)) for k in range(4)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    for k in range(4):
+        for a, b in zip(results[k], serial, strict=True):
+            np.testing.assert_array_equal(a, b)
+
+
+def test_the_binding_rejects_malformed_buffers_with_a_named_error(panda):
+    q, T, c = _target(panda, 0)
+    kernel = ckernels.Solver(panda._solver_data())
+    out = np.empty(7)
+    with pytest.raises(TypeError, match="T must be float64"):
+        kernel.solve(T.astype(np.float32), c.signs, c.redundancy, None, out)
+    with pytest.raises(TypeError, match="T must be a C-contiguous"):
+        kernel.solve(np.asfortranarray(T), c.signs, c.redundancy, None, out)
+    with pytest.raises(ValueError, match="T must have 16 entries"):
+        kernel.solve(T[:3], c.signs, c.redundancy, None, out)
+    with pytest.raises(ValueError, match="q_hint must have 7 entries"):
+        kernel.solve(T, c.signs, c.redundancy, np.zeros(6), out)
+    with pytest.raises(TypeError, match="q_out must be a C-contiguous writable"):
+        read_only = np.empty(7)
+        read_only.flags.writeable = False
+        kernel.solve(T, c.signs, c.redundancy, None, read_only)
+    with pytest.raises(ValueError, match="signs must be -1 or"):
+        kernel.solve(T, (1, 0, 1), c.redundancy, None, out)
+    with pytest.raises(ValueError, match="redundancy must have 1 entries"):
+        kernel.solve(T, c.signs, (), None, out)
+    with pytest.raises(ValueError, match="Ts must be"):
+        kernel.solve_rows(
+            T[None],
+            np.ones((1, 3), np.int64),
+            np.zeros((1, 1)),
+            None,
+            0,
+            2,
+            np.empty((1, 7)),
+            np.empty((1, 5)),
+        )
+    with pytest.raises(ValueError, match="info must have 15 entries"):
+        kernel.solve_rows(
+            np.stack([T] * 3),
+            np.ones((3, 3), np.int64),
+            np.zeros((3, 1)),
+            None,
+            0,
+            3,
+            np.empty((3, 7)),
+            np.empty((3, 5))[:, :0].copy(),
+        )
+    with pytest.raises(ValueError, match="malformed solver data"):
+        ckernels.Solver(panda._solver_data()._replace(scan_points=2))
+    with pytest.raises(AttributeError):
+        ckernels.Solver(object())
+
+
+def test_the_c_layouts_equal_the_python_ones():
+    """The families' parameter layouts and the codes are written twice, in C and in Python."""
+    for module, prefix in ((six_dof, "SD_"), (srs, "SRS_")):
+        names = [n for n in dir(module) if n.isupper() and isinstance(getattr(module, n), int)]
+        for name in names:
+            c_name = name if name in ("RRR_SPHERICAL_WRIST", "RRP_SPHERICAL_WRIST", "SRS") else prefix + name
+            assert getattr(ckernels, c_name) == getattr(module, name), name
+    assert MAX_ROOTS == ckernels.MAX_ROOTS
+    for name in ("FIXED", "CIRCLE", "TORUS", "OK", "UNREACHABLE", "NO_SOLUTION_IN_CONFIGURATION"):
+        assert getattr(om.om.system, name) == getattr(ckernels, name), name
+    assert set(SolverData._fields) >= {"family", "mode", "params", "dp_coefficients"}
