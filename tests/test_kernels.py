@@ -102,8 +102,8 @@ def test_threads_sharing_one_solver_agree_with_serial_calls(panda):
 
 
 def test_the_binding_rejects_malformed_buffers_with_a_named_error(panda):
-    q, T, c = _target(panda, 0)
-    kernel = ckernels.Solver(panda._solver_data())
+    _, T, c = _target(panda, 0)
+    kernel = ckernels.Solver(panda.solver_data())
     out = np.empty(7)
     with pytest.raises(TypeError, match="T must be float64"):
         kernel.solve(T.astype(np.float32), c.signs, c.redundancy, None, out)
@@ -144,7 +144,7 @@ def test_the_binding_rejects_malformed_buffers_with_a_named_error(panda):
             np.empty((3, 5))[:, :0].copy(),
         )
     with pytest.raises(ValueError, match="malformed solver data"):
-        ckernels.Solver(panda._solver_data()._replace(scan_points=2))
+        ckernels.Solver(panda.solver_data()._replace(scan_points=2))
     with pytest.raises(AttributeError):
         ckernels.Solver(object())
 

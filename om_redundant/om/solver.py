@@ -20,7 +20,7 @@ DEFAULT_ORIENTATION_TOLERANCE = 1e-9
 DEFAULT_SCAN_POINTS = 64
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, slots=True)
 class Solution:
     """The outcome of one solve.
 
@@ -48,7 +48,7 @@ class Solution:
     within_limits: bool
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, slots=True)
 class BatchSolution:
     """Outcomes of :meth:`OMSolver.solve_batch`, one row per target.
 
@@ -112,9 +112,9 @@ class OMSolver:
         self.tolerances = (float(position_tolerance), float(orientation_tolerance))
         self.scan_points = int(scan_points)
         self.om: ModelArm = derive_model(self.arm)
-        self._kernel = ckernels.Solver(self._solver_data())
+        self._kernel = ckernels.Solver(self.solver_data())
 
-    def _solver_data(self) -> system.SolverData:
+    def solver_data(self) -> system.SolverData:
         """The fixed data of the compiled kernel (see :class:`~om_redundant.om.system.SolverData`)."""
         om, chain = self.om, self.arm.chain
         if om.shoulder.any():  # dp turns with q1 and q7: the torus (q1, q7)
