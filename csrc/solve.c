@@ -34,6 +34,47 @@ static bool _shifted(const double *a, const double *b, int dof)
     return false;
 }
 
+/* Write the verified root q into q_out, revolute joints shifted by whole turns into the
+ * limits, nearest the hint (has_hint) or zero; *pos and *ori hold q's errors on entry and the
+ * returned vector's on exit. Shifting toward a huge hint is inexact in floating point (a turn
+ * is not representable at 1e8 rad to 1e-10): where the shifted vector no longer verifies,
+ * the shift nearest zero is taken, and where that fails too, q itself. So the vector
+ * returned always verifies. Returns whether it is within the limits. */
+static bool _finish(om_problem *pb, const double *q, const double *hint, bool has_hint, double *q_out, double *pos,
+                    double *ori)
+{
+    const om_solver_data *s = pb->s;
+    int dof = s->dof;
+    double q_pos = *pos, q_ori = *ori;
+    for (int toward_hint = has_hint; toward_hint >= 0; toward_hint--) {
+        memcpy(q_out, q, (size_t)dof * sizeof(double));
+        bool inside = om_representative(q_out, dof, s->revolute, s->lower, s->upper, hint, toward_hint);
+        if (!_shifted(q_out, q, dof)) {
+            *pos = q_pos;
+            *ori = q_ori;
+            return inside;
+        }
+        if (om_verify(pb, q_out, pos, ori)) /* the errors of the vector returned, to its rounding */
+            return inside;
+    }
+    memcpy(q_out, q, (size_t)dof * sizeof(double));
+    *pos = q_pos;
+    *ori = q_ori;
+    bool inside = true;
+    for (int j = 0; j < dof; j++)
+        inside = inside && s->lower[j] <= q[j] && q[j] <= s->upper[j];
+    return inside;
+}
+
+/* The requested redundancy values as the kernels use them: angles reduced into [-pi, pi] by
+ * the exact IEEE remainder, so that a huge psi (1e16) is one well-defined angle rather than
+ * one whose rounding in every later subtraction exceeds the check's tolerance. */
+static void _reduce(const om_solver_data *s, const double *redundancy, double *reduced)
+{
+    for (int i = 0; i < s->n_redundancy; i++)
+        reduced[i] = remainder(redundancy[i], 2.0 * OM_PI);
+}
+
 static om_result _result(int status, double pos, double ori, int64_t evaluations, bool inside)
 {
     om_result result = {status, pos, ori, evaluations, inside};
@@ -56,6 +97,9 @@ om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *
     om_problem problem;
     problem.s = s;
     om_flange_target(T, s->T_base_root, s->T_tool_flange, &problem.R, &problem.p);
+    double psi[1];
+    _reduce(s, redundancy, psi);
+    redundancy = psi;
     problem.signs = signs;
     problem.redundancy = redundancy;
     problem.q_prev = hint; /* the hint, or zeros */
@@ -95,13 +139,9 @@ om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *
         if (verified) {
             if (has_hint && mode != OM_FIXED && om_nearest_in_window(pb, hint, q))
                 om_verify(pb, q, &pos, &ori);
-            memcpy(q_out, q, (size_t)dof * sizeof(double));
-            bool inside = om_representative(q_out, dof, revolute, lower, upper, hint, has_hint);
-            if (inside || has_hint || mode == OM_FIXED) {
-                if (_shifted(q_out, q, dof)) /* the errors of the vector returned, to its rounding */
-                    om_verify(pb, q_out, &pos, &ori);
+            bool inside = _finish(pb, q, hint, has_hint, q_out, &pos, &ori);
+            if (inside || has_hint || mode == OM_FIXED)
                 return _result(OM_OK, pos, ori, problem.counter, inside);
-            }
             /* Without a hint, a root within the limits is preferred: search for one. */
         }
     }
@@ -110,15 +150,8 @@ om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *
          * within the limits is usually among their roots. */
         for (int k = 0; k < START_POINTS; k++) {
             om_secant(pb, -OM_PI + 2.0 * OM_PI * ((double)k + 0.5) / START_POINTS, q);
-            bool verified = om_verify(pb, q, &pos, &ori);
-            if (verified) {
-                memcpy(q_out, q, (size_t)dof * sizeof(double));
-                if (om_representative(q_out, dof, revolute, lower, upper, hint, false)) {
-                    if (_shifted(q_out, q, dof))
-                        om_verify(pb, q_out, &pos, &ori);
-                    return _result(OM_OK, pos, ori, problem.counter, true);
-                }
-            }
+            if (om_verify(pb, q, &pos, &ori) && _finish(pb, q, hint, false, q_out, &pos, &ori))
+                return _result(OM_OK, pos, ori, problem.counter, true);
         }
     }
     double roots[OM_MAX_ROOTS * OM_MAX_DOF];
@@ -152,9 +185,8 @@ om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *
             best_dist = dist;
         }
     }
-    memcpy(q_out, roots + best * dof, (size_t)dof * sizeof(double));
-    bool inside = om_representative(q_out, dof, revolute, lower, upper, hint, has_hint);
-    om_verify(pb, q_out, &pos, &ori);
+    om_verify(pb, roots + best * dof, &pos, &ori);
+    bool inside = _finish(pb, roots + best * dof, hint, has_hint, q_out, &pos, &ori);
     return _result(OM_OK, pos, ori, problem.counter, inside);
 }
 
@@ -166,17 +198,21 @@ int om_solve_all(const om_solver_data *s, const double *T, const int64_t *signs,
 {
     double zeros[OM_MAX_DOF] = {0.0};
     int dof = s->dof;
+    double psi[1];
+    _reduce(s, redundancy, psi);
     om_problem problem;
     problem.s = s;
     om_flange_target(T, s->T_base_root, s->T_tool_flange, &problem.R, &problem.p);
     problem.signs = signs;
-    problem.redundancy = redundancy;
+    problem.redundancy = psi;
     problem.q_prev = zeros;
     problem.counter = 0;
     int n = om_all_roots(&problem, s->scan_points, roots, zeros, INFINITY);
     for (int r = 0; r < n; r++) {
-        bool inside = om_representative(roots + r * dof, dof, s->revolute, s->lower, s->upper, zeros, false);
-        om_verify(&problem, roots + r * dof, &info[3 * r], &info[3 * r + 1]);
+        double root[OM_MAX_DOF];
+        memcpy(root, roots + r * dof, (size_t)dof * sizeof(double));
+        om_verify(&problem, root, &info[3 * r], &info[3 * r + 1]);
+        bool inside = _finish(&problem, root, zeros, false, roots + r * dof, &info[3 * r], &info[3 * r + 1]);
         info[3 * r + 2] = inside ? 1.0 : 0.0;
     }
     if (evaluations)

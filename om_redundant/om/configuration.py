@@ -8,6 +8,8 @@ from itertools import product
 
 from ..exceptions import InvalidInput
 
+_TURN = 2.0 * math.pi
+
 
 @dataclass(frozen=True)
 class Configuration:
@@ -38,8 +40,10 @@ class Configuration:
         """Same signs, and redundancy values (angles) equal within ``atol`` modulo 2 pi."""
         if self.signs != other.signs or len(self.redundancy) != len(other.redundancy):
             return False
+        # Each angle reduced first (exactly, as the solver does): a - b of a huge angle and a
+        # small one would lose the small one's digits.
         return all(
-            abs(math.remainder(a - b, 2.0 * math.pi)) <= atol
+            abs(math.remainder(math.remainder(a, _TURN) - math.remainder(b, _TURN), _TURN)) <= atol
             for a, b in zip(self.redundancy, other.redundancy, strict=True)
         )
 
