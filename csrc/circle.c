@@ -20,7 +20,8 @@ static int _bracket(om_problem *pb, double a, double ga, double b, double gb, do
         return _put(out, n, cap, a);
     /* A jump of more than pi is a wrap of g or a steep crossing of zero near a singular
      * wrist: bisect until it is clearly one or the other. */
-    for (int it = 0; it < 60; it++) {
+    int it = 0;
+    for (; it < 60; it++) {
         if (fabs(ga - gb) <= OM_PI || fabs(ga - gb) > 1.9 * OM_PI)
             break;
         double c = 0.5 * (a + b);
@@ -37,6 +38,12 @@ static int _bracket(om_problem *pb, double a, double ga, double b, double gb, do
     }
     if (gb == 0.0)
         return _put(out, n, cap, b);
+    /* Bisected to the last bit and still a jump short of a wrap's 2 pi: g crosses zero
+     * there, too steeply for floating point (the wrist within about 1e-9 of its
+     * singularity, where q_J swings by pi). The candidate goes to the lifted Newton, which
+     * is smooth there (see om_all_roots). */
+    if (it == 60 && ga * gb < 0.0)
+        return _put(out, n, cap, 0.5 * (a + b));
     if (fabs(ga - gb) > OM_PI)
         return n;
     if (ga * gb < 0.0)

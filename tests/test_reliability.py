@@ -68,20 +68,24 @@ def test_a_moderate_hint_still_picks_the_turn_nearest_it():
     turns=st.floats(1e3, 1e15),
 )
 def test_a_huge_arm_angle_is_one_angle(name, seed, turns):
-    """psi and psi + 2 pi k are the same configuration, however large k (issue: |psi| 1e7 ...
-    1e16 answered 'unreachable' for a quarter of reachable requests)."""
+    """psi and its exact reduction remainder(psi, 2 pi) are the same configuration, however
+    large psi (issue: |psi| 1e7 ... 1e16 answered 'unreachable' for a quarter of reachable
+    requests). Where psi + 2 pi k is exact (k below 2**20 or so), that is psi itself."""
     solver = _solver(name)
     q = random_q(solver.arm, 1, np.random.default_rng(seed))[0]
     T, c = solver.arm.fk(q), solver.configuration_of(q)
     psi = c.redundancy[0] + 2.0 * math.pi * math.floor(turns)
     huge = om.Configuration(c.signs, (psi,))
-    sol = solver.solve(T, huge)
-    assert sol.ok, sol.status
-    reached = solver.arm.fk(sol.q)
-    assert np.abs(reached - T).max() < 1e-10
-    # The angle the solver reached is psi reduced exactly (IEEE remainder by the double 2 pi).
-    assert solver.configuration_of(sol.q).isclose(huge)
-    assert any(r.ok for r in solver.solve_all(T, huge))
+    reduced = om.Configuration(c.signs, (math.remainder(psi, 2.0 * math.pi),))
+    sol, same = solver.solve(T, huge), solver.solve(T, reduced)
+    assert sol.status == same.status
+    np.testing.assert_array_equal(sol.q, same.q)
+    if turns < 2**20:
+        assert sol.ok, sol.status
+    if sol.ok:
+        assert np.abs(solver.arm.fk(sol.q) - T).max() < 1e-10
+        assert solver.configuration_of(sol.q).isclose(huge)
+        assert any(r.ok for r in solver.solve_all(T, huge))
 
 
 def test_the_same_question_gets_the_same_answer_in_any_order():
@@ -129,3 +133,29 @@ def test_repeated_random_calls_in_shuffled_order_agree(name):
         again = solver.solve(T, c, q_hint=h)
         assert again.status == first[k].status
         np.testing.assert_array_equal(again.q, first[k].q)
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    name=st.sampled_from(["panda", "fr3", "xarm7"]),
+    seed=st.integers(0, 2**32 - 1),
+    exponent=st.floats(-12.0, -4.0),
+    side=st.sampled_from([-1.0, 1.0]),
+)
+def test_a_pose_next_to_the_wrist_singularity_is_solved(name, seed, exponent, side):
+    """T = FK(q) with sin(q6 + theta6) = +-10**exponent: the steep crossing of g there goes to
+    the lifted Newton (issue: such reachable poses answered 'no solution in this configuration')."""
+    solver = _solver(name)
+    rng = np.random.default_rng(seed)
+    q = random_q(solver.arm, 1, rng)[0]
+    theta6 = solver.om.params[om.om.families.srs.THETA + 5]
+    candidates = [k * math.pi - theta6 + side * 10.0**exponent for k in range(-2, 3)]
+    inside = [v for v in candidates if solver.arm.lower[5] <= v <= solver.arm.upper[5]]
+    if not inside:
+        return
+    q[5] = inside[int(rng.integers(len(inside)))]
+    T, c = solver.arm.fk(q), solver.configuration_of(q)
+    sol = solver.solve(T, c)
+    assert sol.ok, sol.status
+    _assert_exact(solver, sol.q, T, c)
+    assert solver.solve_all(T, c)
