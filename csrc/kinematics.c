@@ -28,22 +28,6 @@ static void set_identity(double *R, double *p)
     p[0] = p[1] = p[2] = 0.0;
 }
 
-/* The pose (R, p) of the last DH frame in DH frame 0 (flange_kernel). */
-void om_flange(const double *table, int n_rows, const double *q, double *R, double *p)
-{
-    set_identity(R, p);
-    int j = 0;
-    for (int k = 0; k < n_rows; k++) {
-        const double *row = table + 6 * k;
-        if (row[5] == 2.0) {
-            om_apply_row(R, p, row, 0.0);
-        } else {
-            om_apply_row(R, p, row, q[j]);
-            j++;
-        }
-    }
-}
-
 /* Axis and origin in DH frame 0 of joints 1..n (joint_axes_kernel): a standard row's joint acts
  * about the z-axis of the frame it starts from. (R, p) end as the frame before joint n+1's row. */
 void om_joint_axes(const double *table, int n_rows, const double *q, int n, double *axes, double *origins,
@@ -59,13 +43,21 @@ void om_joint_axes(const double *table, int n_rows, const double *q, int n, doub
         }
         if (j == n)
             break;
-        for (int i = 0; i < 3; i++) {
-            axes[3 * j + i] = R[3 * i + 2];
-            origins[3 * j + i] = p[i];
-        }
+        if (axes)
+            for (int i = 0; i < 3; i++) {
+                axes[3 * j + i] = R[3 * i + 2];
+                origins[3 * j + i] = p[i];
+            }
         om_apply_row(R, p, row, q[j]);
         j++;
     }
+}
+
+/* The pose (R, p) of the last DH frame in DH frame 0: every row applied (no row has more
+ * than n_rows joints before it). */
+void om_flange(const double *table, int n_rows, const double *q, double *R, double *p)
+{
+    om_joint_axes(table, n_rows, q, n_rows, NULL, NULL, R, p);
 }
 
 /* out = A @ B for 4x4 row-major matrices (_matmul4). */

@@ -207,6 +207,15 @@ static PyObject *result_tuple(om_result r) {
                          r.within_limits ? Py_True : Py_False);
 }
 
+/* The target of a solve: signs and redundancy values (the configuration's tuples) and the
+ * pose T (16 float64). Returns -1 with an exception set. */
+static int get_target(const om_solver_data *s, PyObject *const *args, int64_t *signs, double *redundancy,
+                      Py_buffer *T) {
+    if (get_signs(args[1], signs, s->n_signs) < 0 || get_doubles(args[2], redundancy, s->n_redundancy, "redundancy") < 0)
+        return -1;
+    return get_buffer(args[0], T, F64, 16, 0, "T");
+}
+
 /* solve(T, signs, redundancy, hint, q_out) -> (status, position error, orientation error,
  * evaluations, within limits). hint None: no hint. */
 static PyObject *Solver_solve(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
@@ -217,10 +226,8 @@ static PyObject *Solver_solve(Solver *self, PyObject *const *args, Py_ssize_t na
     const om_solver_data *s = &self->data;
     int64_t signs[3];
     double redundancy[1];
-    if (get_signs(args[1], signs, s->n_signs) < 0 || get_doubles(args[2], redundancy, s->n_redundancy, "redundancy") < 0)
-        return NULL;
     Py_buffer T, hint, q;
-    if (get_buffer(args[0], &T, F64, 16, 0, "T") < 0) return NULL;
+    if (get_target(s, args, signs, redundancy, &T) < 0) return NULL;
     int has_hint = args[3] != Py_None;
     if (has_hint && get_buffer(args[3], &hint, F64, s->dof, 0, "q_hint") < 0) {
         PyBuffer_Release(&T);
@@ -312,10 +319,8 @@ static PyObject *Solver_solve_all(Solver *self, PyObject *const *args, Py_ssize_
     const om_solver_data *s = &self->data;
     int64_t signs[3];
     double redundancy[1];
-    if (get_signs(args[1], signs, s->n_signs) < 0 || get_doubles(args[2], redundancy, s->n_redundancy, "redundancy") < 0)
-        return NULL;
     Py_buffer T, roots, info;
-    if (get_buffer(args[0], &T, F64, 16, 0, "T") < 0) return NULL;
+    if (get_target(s, args, signs, redundancy, &T) < 0) return NULL;
     if (get_buffer(args[3], &roots, F64, OM_MAX_ROOTS * s->dof, 1, "roots") < 0) {
         PyBuffer_Release(&T);
         return NULL;

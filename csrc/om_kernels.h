@@ -17,6 +17,7 @@
 
 #include <math.h>
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #define OM_MAX_DOF 16  /* joints of an arm the kernels take (the binding checks) */
@@ -43,8 +44,9 @@ vec3 om_euler_zxzxz_given_first(mat3 M, double sin_a, double cos_a, double sigma
 void om_apply_row(double *R, double *p, const double *row, double qi);
 /* The pose of the last DH frame in DH frame 0. */
 void om_flange(const double *table, int n_rows, const double *q, double *R, double *p);
-/* Axis and origin (in DH frame 0) of joints 1..n into axes[n*3], origins[n*3]; R, p end
- * as the frame after every row before joint n+1's (the flange for n = dof). */
+/* Axis and origin (in DH frame 0) of joints 1..n into axes[n*3], origins[n*3] (both NULL:
+ * not written); R, p end as the frame after every row before joint n+1's (the flange for
+ * n >= dof). */
 void om_joint_axes(const double *table, int n_rows, const double *q, int n, double *axes, double *origins,
                    double *R, double *p);
 /* base @ A(q) @ tool into out (4x4 row-major). */
