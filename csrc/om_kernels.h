@@ -82,6 +82,9 @@ enum {
 double om_six_dof_model_ik(int family, const double *P, const double *table, const mat3 *R, vec3 p,
                            const int64_t *signs, const double *q_prev, double *q);
 void om_six_dof_branch_values(int family, const double *P, const double *q, double *out);
+/* q6 given: smooth at the wrist singularity; *residual the wrist's consistency. Returns the margin. */
+double om_six_dof_model_ik_q6(int family, const double *P, const double *table, const mat3 *R, vec3 p,
+                              const int64_t *signs, const double *q_prev, double q6, double *q, double *residual);
 
 /* With shoulder false, joints 1-3 are not written. Returns the reach margin 1 - x^2. */
 double om_srs_model_ik(const double *P, const mat3 *R, vec3 p, const int64_t *signs, double psi,
@@ -151,11 +154,15 @@ double om_g(om_problem *pb, double w, double *q, bool all_joints);
 vec3 om_lifted_residual(om_problem *pb, vec3 x, double *q);
 vec3 om_deflated_residual(om_problem *pb, vec3 x, double *q, const double *known, int n_known); /* known: n x 3 */
 double om_max_norm(vec3 F);
+/* 6-DOF circle arms: the wrist's consistency with q_J = w given (NaN out of reach). */
+double om_wrist_residual(om_problem *pb, double w, double *q);
 
 /* scalar.c */
 double om_secant(om_problem *pb, double w0, double *q);
 double om_refine_bracket(om_problem *pb, double a, double ga, double b, double gb, double *q);
 double om_reach_edge(om_problem *pb, double inside, double outside, double *q);
+/* The secant on om_wrist_residual from w0; returns |residual| at the end. */
+double om_wrist_secant(om_problem *pb, double w0, double *q);
 /* Brent's search for the max of sign * g (or of the margin); returns argmax, g and margin there. */
 double om_extremum(om_problem *pb, double a, double b, double x0, double sign, bool of_margin, double *q,
                    double *g_out, double *margin_out);

@@ -10,20 +10,38 @@ vec3 om_delta(const double D[6][3], double w)
               D[0][2] + D[1][2] * c + D[2][2] * s);
 }
 
+/* The model's hand position on the circle, p_m = p_d + R delta(w); counts one evaluation. */
+static vec3 circle_point(om_problem *pb, double w)
+{
+    pb->counter++;
+    vec3 d = om_delta(pb->s->D, w);
+    const mat3 *R = &pb->R;
+    vec3 p = pb->p;
+    return v3(p.x + R->r0.x * d.x + R->r0.y * d.y + R->r0.z * d.z, p.y + R->r1.x * d.x + R->r1.y * d.y + R->r1.z * d.z,
+              p.z + R->r2.x * d.x + R->r2.y * d.y + R->r2.z * d.z);
+}
+
 /* Model IK for p_m = p_d + R delta(w), one residual evaluation; returns the reach margin
  * (negative beyond OM_REACH_SLACK: out of the model's reach, q not written). */
 double om_model_ik_at(om_problem *pb, double w, double *q, bool all_joints)
 {
     const om_solver_data *data = pb->s;
-    pb->counter++;
-    vec3 d = om_delta(data->D, w);
-    const mat3 *R = &pb->R;
-    vec3 p = pb->p;
-    vec3 pm = v3(p.x + R->r0.x * d.x + R->r0.y * d.y + R->r0.z * d.z,
-                 p.y + R->r1.x * d.x + R->r1.y * d.y + R->r1.z * d.z,
-                 p.z + R->r2.x * d.x + R->r2.y * d.y + R->r2.z * d.z);
-    return om_model_ik(data->family, data->params, data->model_table, R, pm, pb->signs, pb->redundancy, pb->q_prev,
-                       q, all_joints);
+    vec3 pm = circle_point(pb, w);
+    return om_model_ik(data->family, data->params, data->model_table, &pb->R, pm, pb->signs, pb->redundancy,
+                       pb->q_prev, q, all_joints);
+}
+
+/* The wrist's consistency at p_m = p_d + R delta(w) with the wrist joint J = w given, for a
+ * 6-DOF circle arm (om_six_dof_model_ik_q6): smooth where g is steep at a singular wrist.
+ * Writes q (q_J = w); NaN out of the model's reach. */
+double om_wrist_residual(om_problem *pb, double w, double *q)
+{
+    const om_solver_data *data = pb->s;
+    vec3 pm = circle_point(pb, w);
+    double residual;
+    double margin = om_six_dof_model_ik_q6(data->family, data->params, data->model_table, &pb->R, pm, pb->signs,
+                                           pb->q_prev, w, q, &residual);
+    return margin < -OM_REACH_SLACK ? NAN : residual;
 }
 
 /* Residual g(w) (NaN if unreachable) and the model's reach margin; writes the IK into q. */

@@ -212,3 +212,31 @@ double om_extremum(om_problem *pb, double a, double b, double x0, double sign, b
         *margin_out = mx;
     return x;
 }
+
+/* The secant on the wrist's consistency residual (om_wrist_residual) from w0, a steep crossing
+ * of g at a singular wrist of a 6-DOF circle arm. Returns |residual| at the end (NaN out of
+ * reach); q holds the model IK there. */
+double om_wrist_secant(om_problem *pb, double w0, double *q)
+{
+    double h = 1e-7, w = w0;
+    double f = om_wrist_residual(pb, w, q);
+    if (isnan(f))
+        return f;
+    double slope = (om_wrist_residual(pb, w + h, q) - f) / h;
+    for (int it = 0; it < 40; it++) {
+        if (f == 0.0 || slope == 0.0 || isnan(slope))
+            break;
+        double step = -f / slope;
+        if (fabs(step) > 0.5)
+            step = 0.5 * om_sign(step);
+        double f_new = om_wrist_residual(pb, w + step, q);
+        if (isnan(f_new))
+            break;
+        slope = (f_new - f) / step;
+        w += step;
+        f = f_new;
+        if (fabs(step) < 1e-15 * (fabs(w) > 1.0 ? fabs(w) : 1.0) || fabs(f) < 1e-16)
+            break;
+    }
+    return fabs(om_wrist_residual(pb, w, q)); /* q must belong to the final iterate */
+}

@@ -31,17 +31,22 @@ int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre
     double hi = full_circle ? OM_PI : centre[J] + radius;
     int n = om_circle_candidates(pb, lo, hi, n_scan, full_circle, q, cands, cap);
     int count = 0;
-    bool lifted = data->family == OM_SRS; /* the lifted system, smooth at a singular wrist */
+    bool lifted = data->family == OM_SRS; /* 7-DOF: the lifted system; 6-DOF: the wrist with q6 given */
     for (int i = 0; i < n; i++) {
         double gw = om_g(pb, cands[i], q, true);
         if (!isnan(gw) && fabs(gw) > OM_ROOT_TOL) /* polish the bracket's estimate */
             om_secant(pb, cands[i], q);
         int before = count;
         count = om_add_root(pb, q, roots, count);
-        if (count == before && lifted && !isnan(om_g(pb, cands[i], q, true))) {
-            double start[OM_MAX_DOF];
-            memcpy(start, q, (size_t)data->dof * sizeof(double));
-            om_lifted_solve(pb, start, q);
+        if (count == before && !isnan(om_g(pb, cands[i], q, true))) {
+            /* A steep crossing at a singular wrist: solved where it is smooth. */
+            if (lifted) {
+                double start[OM_MAX_DOF];
+                memcpy(start, q, (size_t)data->dof * sizeof(double));
+                om_lifted_solve(pb, start, q);
+            } else {
+                om_wrist_secant(pb, cands[i], q);
+            }
             count = om_add_root(pb, q, roots, count);
         }
     }

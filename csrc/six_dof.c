@@ -6,11 +6,12 @@
 static double py_max(double a, double b) { return b > a ? b : a; }
 static double py_min(double a, double b) { return b < a ? b : a; }
 
-/* Solve the model arm for the flange pose (R, p) in DH frame 0 and the branch signs
- * (ARM, ELBOW, WRIST); write q. Returns the reach margin (model_ik): below -OM_REACH_SLACK the
- * pose is out of reach and q is not written. */
-double om_six_dof_model_ik(int family, const double *P, const double *table, const mat3 *R, vec3 p,
-                           const int64_t *signs, const double *q_prev, double *q)
+/* Joints 1-3 for the flange pose (R, p) in DH frame 0 and the ARM and ELBOW signs, into q,
+ * and the wrist's rotation M = Rz(phi4) Rx(alpha4) Rz(phi5) Rx(alpha5) Rz(phi6) into *M.
+ * Returns the reach margin: below -OM_REACH_SLACK the pose is out of reach and neither is
+ * written. */
+static double position_and_wrist(int family, const double *P, const double *table, const mat3 *R, vec3 p,
+                                 const int64_t *signs, const double *q_prev, double *q, mat3 *M)
 {
     mat3 Rt = *R;
     vec3 pw = v_add(m_mv(Rt, v_load(P, SD_WRIST_CENTRE)), p);
@@ -74,11 +75,44 @@ double om_six_dof_model_ik(int family, const double *P, const double *table, con
             j++;
         }
     }
-    mat3 M = m_mmt(m_mtm(m_load(Rin, 0), Rt), m_load(P, SD_E_ROT));
+    *M = m_mmt(m_mtm(m_load(Rin, 0), Rt), m_load(P, SD_E_ROT));
+    return margin;
+}
+
+/* Solve the model arm for the flange pose (R, p) in DH frame 0 and the branch signs
+ * (ARM, ELBOW, WRIST); write q. Returns the reach margin (model_ik): below -OM_REACH_SLACK the
+ * pose is out of reach and q is not written. */
+double om_six_dof_model_ik(int family, const double *P, const double *table, const mat3 *R, vec3 p,
+                           const int64_t *signs, const double *q_prev, double *q)
+{
+    mat3 M;
+    double margin = position_and_wrist(family, P, table, R, p, signs, q_prev, q, &M);
+    if (margin < -OM_REACH_SLACK)
+        return margin;
     vec3 phi = om_euler_zxzxz(M, P[SD_SIGMA4], P[SD_SIGMA5], 0.0, (double)signs[2], q_prev[3] + P[SD_THETA4]);
     q[3] = om_wrap(phi.x - P[SD_THETA4]);
     q[4] = om_wrap(phi.y - P[SD_THETA5]);
     q[5] = om_wrap(phi.z - P[SD_THETA6]);
+    return margin;
+}
+
+/* The closed form with q6 given (as the S-R-S lifted system takes q7): joints 1-3 as in
+ * om_six_dof_model_ik, joints 4 and 5 from M^T = Rz(-phi6) Rx(-alpha5) Rz(-phi5) Rx(-alpha4)
+ * Rz(-phi4) with phi6 first (om_euler_zxzxz_given_first), which is smooth also at the wrist
+ * singularity sin(phi5) = 0, where the closed form's q4 and q6 swing by pi. Writes q (q6 as
+ * given) and *residual, the wrist's consistency (zero iff q6 fits M); returns the margin. */
+double om_six_dof_model_ik_q6(int family, const double *P, const double *table, const mat3 *R, vec3 p,
+                              const int64_t *signs, const double *q_prev, double q6, double *q, double *residual)
+{
+    mat3 M;
+    double margin = position_and_wrist(family, P, table, R, p, signs, q_prev, q, &M);
+    if (margin < -OM_REACH_SLACK)
+        return margin;
+    vec3 neg = om_euler_zxzxz_given_first(m_transpose(M), -P[SD_SIGMA5], 0.0, -P[SD_SIGMA4], -(q6 + P[SD_THETA6]));
+    q[3] = om_wrap(-neg.y - P[SD_THETA4]);
+    q[4] = om_wrap(-neg.x - P[SD_THETA5]);
+    q[5] = q6;
+    *residual = neg.z;
     return margin;
 }
 

