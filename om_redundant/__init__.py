@@ -18,7 +18,7 @@ from .exceptions import (
     UnknownArm,
     UnreachableTarget,
 )
-from .kinematics import Arm, DHRow, JointKind, KinematicChain, arm_names, load_arm
+from .kinematics import Arm, DHRow, JointKind, KinematicChain, arm_names, load_arm, write_arm_file
 from .mujoco_io import (
     ArmJoints,
     ArmRoot,
@@ -94,4 +94,5 @@ __all__ = [
     "scene_mjcf",
     "self_motion_tangent",
     "without_meshes",
+    "write_arm_file",
 ]
