@@ -55,7 +55,7 @@ def test_default_run_sweeps_the_panda_arm_angle():
 
 @pytest.mark.parametrize(
     "argv",
-    [[], ["solve"], ["sweep"], ["arms"], ["check-model"], ["bench"]],
+    [[], ["solve"], ["sweep"], ["arms"], ["check-model"], ["import-arm"], ["bench"]],
     ids=lambda a: a[0] if a else "top",
 )
 def test_help_everywhere(capsys, argv):
