@@ -18,11 +18,12 @@ from .exceptions import (
     UnknownArm,
     UnreachableTarget,
 )
-from .kinematics import Arm, DHRow, JointKind, KinematicChain, arm_names, load_arm
+from .kinematics import Arm, DHRow, JointKind, KinematicChain, arm_names, load_arm, write_arm_file
 from .mujoco_io import (
     ArmJoints,
     ArmRoot,
     ModelComparison,
+    arm_from_mujoco,
     arm_mjcf,
     arm_model,
     compare_mujoco_model,
@@ -83,6 +84,7 @@ __all__ = [
     "UnknownArm",
     "UnreachableTarget",
     "arm_angle_and_gradient",
+    "arm_from_mujoco",
     "arm_mjcf",
     "arm_model",
     "arm_names",
@@ -94,4 +96,5 @@ __all__ = [
     "scene_mjcf",
     "self_motion_tangent",
     "without_meshes",
+    "write_arm_file",
 ]

@@ -7,6 +7,7 @@ import csv
 import io
 import json
 import math
+import re
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
@@ -54,7 +55,7 @@ def test_default_run_sweeps_the_panda_arm_angle():
 
 @pytest.mark.parametrize(
     "argv",
-    [[], ["solve"], ["sweep"], ["arms"], ["check-model"], ["bench"]],
+    [[], ["solve"], ["sweep"], ["arms"], ["check-model"], ["import-arm"], ["bench"]],
     ids=lambda a: a[0] if a else "top",
 )
 def test_help_everywhere(capsys, argv):
@@ -390,6 +391,27 @@ def test_check_model_against_the_menagerie_panda():
     assert data["ok"] and data["samples"] == 200 and data["max_position_error"] < 1e-12
     done = command("check-model", str(path), "--arm", "fr3")
     assert done.returncode == 1 and "joint 'fr3_joint1' (arm joint 1) is not in the model" in done.stderr
+
+
+def test_check_model_skips_missing_textures_and_mesh_fitted_geoms(capsys, tmp_path):
+    """A material's texture file and a capsule fitted to a mesh (both missing) do not stop the
+    kinematics; an error that remains names its own cause, not the mesh."""
+    text = om.arm_mjcf(om.load_arm("ur5e")).replace(
+        "<worldbody>",
+        '<asset><texture name="skin" type="2d" file="gone.png"/><material name="m" texture="skin"/>'
+        '<mesh name="shell" file="gone.stl"/></asset><worldbody>',
+    )
+    shell = '<body name="shell"><geom type="capsule" mesh="shell" material="m"/></body>'
+    text = text.replace('<body name="link2"', shell + '<body name="link2"', 1)
+    path = tmp_path / "ur5e.xml"
+    path.write_text(text)
+    assert in_process(capsys, "check-model", str(path), "--arm", "ur5e", "-q") == (0, "", "")
+    path.write_text(text.replace("</mujoco>", '<actuator><motor joint="no_such_joint"/></actuator></mujoco>'))
+    status, _, err = in_process(capsys, "check-model", str(path), "--arm", "ur5e")
+    assert status == 2 and err.count("\n") == 1
+    assert re.search(
+        r"no_such_joint.*\(with its meshes and textures skipped, which failed first: .*gone", err
+    )
 
 
 # ---------------------------------------------------------------------------------------

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import mujoco
@@ -146,3 +147,13 @@ def test_simulates_under_gravity(name, build):
     assert np.isfinite(data.qpos).all() and np.isfinite(data.qvel).all()
     assert not np.array_equal(data.qpos, start)  # gravity moved the arm
     assert [w.number for w in data.warning] == [0] * len(data.warning)
+
+
+def test_a_frame_body_named_like_a_link_keeps_its_name():
+    """An arm whose end-effector frame is a body named 'link7' (Flexiv Rizon 4's): the writer's
+    seventh link becomes 'link7_body', the frame keeps its name, the kinematics stay."""
+    arm = dataclasses.replace(om.load_arm("panda"), frame_name="link7", frame_type="body")
+    model = om.arm_model(arm)
+    assert model.body("link7").parentid[0] == model.body("link7_body").id
+    result = om.compare_mujoco_model(arm, model)
+    assert result.ok and result.frame == "body 'link7'", result.differences

@@ -8,6 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
+from om_redundant.om import model as model_module
 from tests.conftest import random_q, wrap
 from tests.ur_closed_form import ur_ik
 
@@ -153,3 +154,41 @@ def test_solve_all_returns_nothing_when_the_configuration_has_no_solution(spheri
             if not sol.ok:
                 assert sol.status == "no solution in this configuration"
     del rng
+
+
+def test_an_arm_that_cannot_solve_is_refused_at_construction(monkeypatch):
+    """The issue's case: a twist 4e-6 rad off 90 deg, let through by a loose acceptance check,
+    solved nothing. The solver's own check refuses it, naming q and the status."""
+    ur5e = om.load_arm("ur5e")
+    rows = list(ur5e.chain.rows)
+    rows[3] = om.DHRow(a=rows[3].a, alpha=rows[3].alpha + 4e-6, d=rows[3].d, theta=rows[3].theta)
+    bent = ur5e.with_chain(ur5e.chain.replace_rows(rows), "bent")
+    with pytest.raises(
+        om.ModelError, match=r"joints 4 and 5 perpendicular .*got 90.00022918 deg \(4e-06 rad off\)"
+    ):
+        om.OMSolver(bent)
+    monkeypatch.setattr(model_module, "_RIGHT_ANGLE_EPS", 1e-5)
+    om.derive_model(bent)  # accepted by the loosened check ...
+    with pytest.raises(
+        om.ModelError,
+        match=r"arm 'bent' does not solve its own pose at q = \[[-0-9., ]+\] \(configuration ARM [+-]1, "
+        r"ELBOW [+-]1, WRIST [+-]1\): (unreachable|no solution in this configuration)",
+    ):
+        om.OMSolver(bent)  # ... but not by the solver
+
+
+def test_the_self_check_runs_once_per_arm(monkeypatch):
+    arm = om.load_arm("panda")
+    om.OMSolver(arm)
+    calls = []
+    solve = om.OMSolver.solve
+
+    def counted(self, *args, **kwargs):
+        calls.append(args)
+        return solve(self, *args, **kwargs)
+
+    monkeypatch.setattr(om.OMSolver, "solve", counted)
+    om.OMSolver(arm)
+    assert calls == []
+    om.OMSolver(om.load_arm("panda"))  # another instance is checked again
+    assert len(calls) > 0

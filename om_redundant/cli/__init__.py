@@ -2,8 +2,8 @@
 
 Subcommands, one module each: ``solve`` (one pose, one configuration or all), ``sweep`` (the
 arm angle of a 7-DOF arm for a pose or a path; also the run without arguments), ``arms``
-(the arms and their models), ``check-model`` (a MuJoCo model against an arm) and ``bench
-paper`` (the OM paper's experiment).
+(the arms and their models), ``check-model`` (a MuJoCo model against an arm), ``import-arm``
+(an arm file from a MuJoCo model) and ``bench paper`` (the OM paper's experiment).
 
 Exit status: 0 on success; 1 when the answer is no (a model that differs, a feature not
 built yet); 2 on bad input, with one line ``om-redundant: error: ...`` and no traceback;
@@ -17,11 +17,11 @@ import sys
 
 from .. import __version__
 from ..exceptions import OMError
-from . import arms, bench, check_model, solve, sweep
+from . import arms, bench, check_model, import_arm, solve, sweep
 from .common import Failed, Parser
 
 PROG = "om-redundant"
-SUBCOMMANDS = (solve, sweep, arms, check_model, bench)
+SUBCOMMANDS = (solve, sweep, arms, check_model, import_arm, bench)
 
 
 def build_parser() -> Parser:

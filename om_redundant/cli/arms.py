@@ -6,7 +6,7 @@ import argparse
 
 from ..exceptions import ModelError
 from ..kinematics.arm import arm_names, load_arm
-from ..om.model import derive_model
+from ..om.solver import OMSolver
 from .common import add_output_options, table_wanted, write_json
 
 
@@ -49,7 +49,7 @@ def _describe(name: str) -> dict:
         "reason": None,
     }
     try:
-        model = derive_model(arm)
+        model = OMSolver(arm).om  # the solver's acceptance: a closed-form model that solves the arm
     except ModelError as exc:
         reason = str(exc).removeprefix(f"arm '{arm.name}': ")
         return (

@@ -16,9 +16,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         description="Compare a MuJoCo model (MJCF) with an arm: joint names, types, order and limits, "
         "then each joint's axis and the end-effector frame against the arm's forward kinematics over "
         "random joint vectors. Exits 0 if they match within the tolerance, 1 with a one-line reason "
-        "if not. Missing mesh files are skipped (kinematics do not need them).",
+        "if not. Missing mesh and texture files are skipped (kinematics do not need them).",
     )
-    parser.add_argument("model", metavar="MODEL.xml", help="the MuJoCo model file")
+    parser.add_argument("model", metavar="MODEL.xml|MODEL.urdf", help="the MuJoCo model file")
     add_arm_option(parser, None, required=True)
     parser.add_argument(
         "--site",

@@ -31,10 +31,17 @@ by name or path and :func:`arm_names` lists the built-in ones. The file format::
 
 Units: metres for lengths and limits of prismatic joints, radians for revolute limits,
 degrees for the DH angles (their key says so).
+
+:func:`write_arm_file` writes an arm in this format (standard convention, numbers in full
+precision), and :func:`load_arm` reads back the same arm bit for bit: rows, limits, names,
+base and tool. That holds for every arm read from a file, and for arms whose angles and
+transforms :func:`exact_angle` and :func:`exact_pose` made (an imported arm's).
 """
 
 from __future__ import annotations
 
+import itertools
+import json
 import math
 import tomllib
 from dataclasses import dataclass, field
@@ -42,6 +49,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
+import mujoco
 import numpy as np
 
 from ..exceptions import ArmFileError, InvalidInput, UnknownArm
@@ -309,3 +317,123 @@ def rotation_from_quat(wxyz: np.ndarray) -> np.ndarray:
             [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
         ]
     )
+
+
+# ---------------------------------------------------------------------------------------
+# Writing: the same format, standard convention, numbers as shortest round-trip text.
+
+
+def write_arm_file(arm: Arm, path: str | Path, comment: str = "") -> None:
+    """Write the arm as an arm file that :func:`load_arm` reads back (see the module docstring).
+
+    Args:
+        arm: The arm.
+        path: The file to write (overwritten).
+        comment: Lines written first, each as a TOML comment.
+    """
+    Path(path).write_text(arm_file_text(arm, comment))
+
+
+def arm_file_text(arm: Arm, comment: str = "") -> str:
+    """The text :func:`write_arm_file` writes."""
+    lines = [f"# {line}".rstrip() for line in comment.splitlines()]
+    lines += [f"name = {_string(arm.name)}"]
+    if arm.description:
+        lines.append(f"description = {_string(arm.description)}")
+    lines.append('convention = "standard"')
+    fields = {"model": arm.mujoco_model, "frame": arm.frame_name, "frame_type": arm.frame_type}
+    if any(fields.values()):
+        lines += ["", "[mujoco]"]
+        lines += [f"{key} = {_string(value)}" for key, value in fields.items() if value]
+    for key, T in (("base", arm.chain.T_root_base), ("tool", arm.chain.T_flange_tool)):
+        xyz, quat = file_xyz_quat(T)
+        lines += ["", f"[{key}]", f"xyz = {_numbers(xyz)}", f"quat = {_numbers(quat)}"]
+    joint = 0
+    for row in arm.chain.rows:
+        lines += ["", "[[rows]]"]
+        if row.is_joint:
+            lines.append(f"joint = {_string(arm.joint_names[joint])}")
+        lines.append(f"type = {_string(row.kind.value)}")
+        for key, value in (("a", row.a), ("d", row.d)):
+            if value != 0.0:
+                lines.append(f"{key} = {value!r}")
+        for key, value in (("alpha_deg", row.alpha), ("theta_deg", row.theta)):
+            if value != 0.0:
+                lines.append(f"{key} = {math.degrees(value)!r}")
+        if row.is_joint:
+            if np.isfinite(arm.lower[joint]) and np.isfinite(arm.upper[joint]):
+                lines.append(f"range = {_numbers([arm.lower[joint], arm.upper[joint]])}")
+            joint += 1
+    return "\n".join(lines) + "\n"
+
+
+def xyz_quat(T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Position and unit quaternion (w, x, y, z; w >= 0) of a pose (4, 4), entries below
+    1e-15 written as 0."""
+    quat = np.empty(4)
+    mujoco.mju_mat2Quat(quat, np.ascontiguousarray(T[:3, :3], dtype=np.float64).ravel())
+    quat = np.where(np.abs(quat) < 1e-15, 0.0, quat)
+    if quat[0] < 0.0 or (quat[0] == 0.0 and quat[np.flatnonzero(quat)[0]] < 0.0):
+        quat = -quat
+    xyz = np.where(np.abs(T[:3, 3]) < 1e-15, 0.0, T[:3, 3])
+    return xyz + 0.0, quat + 0.0  # + 0.0: no negative zeros
+
+
+def file_xyz_quat(T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The ``xyz`` and ``quat`` :func:`write_arm_file` writes for T: T's (:func:`xyz_quat`), or
+    a quaternion a few 1e-16 from it that :func:`pose_from_xyz_quat` turns back into T
+    exactly, where one exists (it does for every pose read from a file)."""
+    xyz, quat = xyz_quat(T)
+    for candidate in _nearby(quat):
+        if np.array_equal(pose_from_xyz_quat(xyz, candidate), T):
+            return xyz, candidate
+    return xyz, quat
+
+
+def exact_pose(T: np.ndarray) -> np.ndarray:
+    """A pose within a few 1e-16 of T that :func:`write_arm_file` writes and :func:`load_arm`
+    reads back bit for bit.
+
+    The file holds a quaternion, which :func:`pose_from_xyz_quat` turns into a matrix with
+    rounding: the poses of the quaternions around T's are tried until one gives its own
+    quaternion back (else the first, for which :func:`file_xyz_quat` searches further).
+    """
+    xyz, quat = xyz_quat(T)
+    for candidate in _nearby(quat):
+        pose = pose_from_xyz_quat(xyz, candidate)
+        if np.array_equal(pose_from_xyz_quat(*xyz_quat(pose)), pose):
+            return pose
+    return pose_from_xyz_quat(xyz, quat)
+
+
+def _nearby(quat: np.ndarray):
+    """quat, then quaternions that differ by -2 ... 2 steps of 2^-53 (then 2^-51) in each
+    component, fewest steps first."""
+    for step in (2.0**-53, 2.0**-51):
+        for delta in _QUATERNION_STEPS:
+            yield quat + step * delta
+
+
+_QUATERNION_STEPS = np.array(
+    sorted(itertools.product(range(-2, 3), repeat=4), key=lambda d: (sum(map(abs, d)), d)), dtype=np.float64
+)
+
+
+def exact_angle(angle: float) -> float:
+    """The angle (rad) an arm file's degrees give for ``angle``: the same up to rounding, and
+    one that :func:`write_arm_file` writes and :func:`load_arm` reads back bit for bit."""
+    for _ in range(8):
+        exact = math.radians(math.degrees(angle))
+        if exact == angle:
+            break
+        angle = exact
+    return angle
+
+
+def _string(text: str) -> str:
+    """A TOML basic string (JSON's escapes are TOML's)."""
+    return json.dumps(text, ensure_ascii=False)
+
+
+def _numbers(values: Any) -> str:
+    return "[" + ", ".join(repr(float(v)) for v in values) + "]"

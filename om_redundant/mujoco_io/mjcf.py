@@ -87,6 +87,10 @@ def _arm_tree(arm: Arm, prefix: str, radius: float | None, scene: bool) -> ET.El
     )
     cls = f"{prefix}collision"
     names = {-1: "world", 0: f"{prefix}base"} | {k: f"{prefix}link{k}" for k in range(1, n + 1)}
+    frame = prefix + (arm.frame_name or DEFAULT_SITE)
+    for k, name in names.items():
+        if arm.frame_type == "body" and name == frame:  # the frame body keeps its model's name
+            names[k] = f"{name}_body"
 
     root = ET.Element("mujoco", model=f"{prefix}{arm.name}")
     ET.SubElement(root, "compiler", angle="radian", autolimits="true")
@@ -110,7 +114,7 @@ def _arm_tree(arm: Arm, prefix: str, radius: float | None, scene: bool) -> ET.El
         segments += ([[0, 0, 0], ends[k]],) if lengths[k] > 1e-6 else ()
         for j, (a, b) in enumerate(segments):
             ET.SubElement(body, "geom", name=f"{names[k]}_capsule{j}", fromto=_f([*a, *b]))
-    site = {"name": prefix + (arm.frame_name or DEFAULT_SITE), **_pose(P_tail)}
+    site = {"name": frame, **_pose(P_tail)}
     if arm.frame_type == "body":
         body = ET.SubElement(body, "body", name=site["name"], **_pose(P_tail))
         site = {"name": site["name"]}

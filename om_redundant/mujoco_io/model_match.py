@@ -63,42 +63,66 @@ class ModelComparison:
 
 
 def load_mujoco_model(path: str | Path) -> mujoco.MjModel:
-    """Compile an MJCF file; if its mesh files are missing, compile it without its meshes.
+    """Compile an MJCF (.xml) or URDF (.urdf) file; if its mesh or texture files are missing,
+    compile it without its meshes and textures.
 
-    Kinematics do not depend on meshes, and copies of models (like the reference Menagerie
-    ones) often come without them.
+    Kinematics depend on neither, and copies of models (like the reference Menagerie ones)
+    often come without them. A URDF is read by MuJoCo's own URDF loader, with its bodies
+    kept apart (``fusestatic`` off: a link on a fixed joint, such as ``tool0``, stays a body).
 
     Raises:
-        InvalidInput: The file cannot be read or does not compile; the message is one line.
+        InvalidInput: The file cannot be read or does not compile; the message is one line
+            and names the error that remains once meshes and textures are skipped.
     """
     path = Path(path)
     if not path.is_file():
         raise InvalidInput(f"cannot read MuJoCo model '{path}': no such file")
-    if path.suffix.lower() != ".xml":  # MuJoCo picks its reader by the suffix, and warns without one
-        raise InvalidInput(f"MuJoCo model '{path}' must be an MJCF file ending in .xml")
+    suffix = path.suffix.lower()
+    if suffix not in (".xml", ".urdf"):  # MuJoCo picks its reader by the suffix, and warns without one
+        raise InvalidInput(
+            f"MuJoCo model '{path}' must be an MJCF file ending in .xml or a URDF ending in .urdf"
+        )
     try:
         spec = mujoco.MjSpec.from_file(str(path))
-        try:
-            return spec.compile()
-        except ValueError as first:
-            if not spec.meshes:
-                raise
-            try:
-                return without_meshes(spec).compile()
-            except ValueError:
-                raise first from None
     except ValueError as exc:
-        raise InvalidInput(f"cannot load MuJoCo model '{path}': {' '.join(str(exc).split())}") from None
+        raise InvalidInput(f"cannot load MuJoCo model '{path}': {_one_line(exc)}") from None
+    if suffix == ".urdf":
+        spec.compiler.fusestatic = False
+    try:
+        return spec.compile()
+    except ValueError as first:
+        if not (spec.meshes or spec.textures):
+            raise InvalidInput(f"cannot load MuJoCo model '{path}': {_one_line(first)}") from None
+        try:
+            return without_meshes(spec).compile()
+        except ValueError as exc:
+            raise InvalidInput(
+                f"cannot load MuJoCo model '{path}': {_one_line(exc)} (with its meshes and textures "
+                f"skipped, which failed first: {_one_line(first)})"
+            ) from None
 
 
 def without_meshes(spec: mujoco.MjSpec) -> mujoco.MjSpec:
-    """Delete the spec's mesh geoms and meshes (in place; returns the spec)."""
+    """Delete the spec's meshes and textures and what needs them (in place; returns the spec).
+
+    Deleted: geoms of type mesh, and geoms of other types fitted to a mesh (a ``mesh``
+    attribute, e.g. a collision capsule sized by its mesh); meshes; textures, and the
+    references of materials to them.
+    """
     for geom in list(spec.geoms):
-        if geom.type == mujoco.mjtGeom.mjGEOM_MESH:
+        if geom.type == mujoco.mjtGeom.mjGEOM_MESH or geom.meshname:
             spec.delete(geom)
     for mesh in list(spec.meshes):
         spec.delete(mesh)
+    for material in spec.materials:
+        material.textures = [""] * len(material.textures)
+    for texture in list(spec.textures):
+        spec.delete(texture)
     return spec
+
+
+def _one_line(exc: BaseException) -> str:
+    return " ".join(str(exc).split())
 
 
 def compare_mujoco_model(

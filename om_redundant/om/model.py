@@ -39,6 +39,9 @@ from ..kinematics.chain import DHRow, JointKind, KinematicChain
 from .families import six_dof, srs
 
 _ANGLE_EPS = 1e-9
+#: Largest deviation (rad) of a twist from +-90 deg that the closed forms, which take it to be
+#: exact, absorb: the hand then moves by well under the solver's 1e-10 m per metre of reach.
+_RIGHT_ANGLE_EPS = 1e-11
 
 
 @dataclass(frozen=True, eq=False)
@@ -138,8 +141,7 @@ def _six_dof_model(arm: Arm) -> tuple[KinematicChain, int, str, np.ndarray]:
     for j in (3, 4, 5):
         if rows[jr[j]].kind is not JointKind.REVOLUTE:
             raise ModelError(f"arm '{arm.name}': Theorem 2 C3 needs joint {j + 1} revolute")
-    if jr[5] - jr[3] != 2:
-        raise ModelError(f"arm '{arm.name}': fixed rows between the wrist joints are not supported")
+    _refuse_fixed_rows(arm.name, rows, jr, (3, 4, 5))
     for j in (3, 4):
         _check_right_angle(arm.name, rows[jr[j]], j)
     if abs(rows[jr[3]].a) > 0.0:
@@ -187,10 +189,7 @@ def _srs_model(arm: Arm) -> tuple[KinematicChain, KinematicChain, np.ndarray]:
             f"arm '{arm.name}': the shoulder offset a2 = {rows[jr[1]].a:g} m makes dp depend on q2; "
             "the bounded search handles offsets that turn with q1 or q7 only"
         )
-    if jr[5] - jr[0] != 5:
-        raise ModelError(
-            f"arm '{arm.name}': fixed rows between joints 1 and 6 are not supported by the 7-DOF model"
-        )
+    _refuse_fixed_rows(arm.name, rows, jr, (0, 1, 2, 3, 4, 5))
     if any(rows[r].a != 0.0 for r in range(jr[5] + 1, jr[6])):
         raise ModelError(f"arm '{arm.name}': fixed rows between joints 6 and 7 need a = 0")
     for j in (0, 1, 4, 5):
@@ -257,11 +256,53 @@ def _check_right_angle(name: str, row: DHRow, j: int) -> None:
             f"arm '{name}': joints {j + 1} and {j + 2} are parallel; the spherical joint triple "
             "needs them non-parallel (Theorem 2 C3)"
         )
-    if abs(abs(np.sin(row.alpha)) - 1.0) > _ANGLE_EPS:
+    if _off_right_angle(row.alpha) > _RIGHT_ANGLE_EPS:
         raise ModelError(
             f"arm '{name}': the closed form needs joints {j + 1} and {j + 2} perpendicular "
-            f"(alpha_{j + 1} = +-90 deg), got {np.degrees(row.alpha):g} deg"
+            f"(alpha_{j + 1} = +-90 deg), got {np.degrees(row.alpha):.10g} deg "
+            f"({_off_right_angle(row.alpha):.2g} rad off)"
         )
+
+
+def _refuse_fixed_rows(name: str, rows: list[DHRow], jr: tuple[int, ...], joints: tuple[int, ...]) -> None:
+    """Raise :class:`ModelError` if fixed rows lie between these consecutive joints (0-based),
+    naming each row and, between joints whose axes it turns nearly parallel or perpendicular,
+    by how much."""
+    found = []
+    for k in joints[:-1]:
+        between = rows[jr[k] + 1 : jr[k + 1]]
+        if not between:
+            continue
+        values = [
+            f"{key} {value:.10g}{unit}"
+            for row in between
+            for key, value, unit in (
+                ("a", row.a, " m"),
+                ("d", row.d, " m"),
+                ("alpha", np.degrees(row.alpha), " deg"),
+                ("theta", np.degrees(row.theta), " deg"),
+            )
+            if value != 0.0
+        ]
+        twist = _pose(KinematicChain((rows[jr[k]], *between)).table, np.zeros(1))[0][2, 2]
+        angle = float(np.arccos(np.clip(twist, -1.0, 1.0)))
+        nominal = np.pi / 2 * round(angle / (np.pi / 2))
+        off = f", {abs(angle - nominal):.2g} rad from {np.degrees(nominal):g} deg" if angle != nominal else ""
+        found.append(
+            f"after joint {k + 1} ({', '.join(values) or 'identity'}; axes {k + 1} and {k + 2} "
+            f"{np.degrees(angle):.10g} deg apart{off})"
+        )
+    if found:
+        shown = ", ".join(str(j + 1) for j in joints)
+        raise ModelError(
+            f"arm '{name}': the closed form needs the rows of joints {shown} to follow one another; "
+            f"fixed rows {'; '.join(found)}"
+        )
+
+
+def _off_right_angle(alpha: float) -> float:
+    """How far (rad) the twist alpha is from +-90 deg."""
+    return float(np.arctan2(abs(np.cos(alpha)), abs(np.sin(alpha))))
 
 
 def _check_concurrent(name: str, chain: KinematicChain, what: str, joints: tuple[int, ...]) -> None:
@@ -302,8 +343,14 @@ def _position_family(name: str, rows: list[DHRow], jr: list[int]) -> tuple[int, 
     P = np.zeros(six_dof.N_PARAMS)
     if r1.kind is not JointKind.REVOLUTE or r2.kind is not JointKind.REVOLUTE:
         raise ModelError(f"arm '{name}': joints 1 and 2 must be revolute for a closed-form model")
-    if abs(abs(np.sin(r1.alpha)) - 1.0) > _ANGLE_EPS or jr[1] != jr[0] + 1 or jr[0] != 0:
-        raise ModelError(f"arm '{name}': joint 1 must be perpendicular to joint 2 (alpha_1 = +-90 deg)")
+    if jr[0] != 0:
+        raise ModelError(f"arm '{name}': the closed forms need joint 1's row first (no fixed row before it)")
+    _refuse_fixed_rows(name, rows, jr, (0, 1, 2))
+    if _off_right_angle(r1.alpha) > _RIGHT_ANGLE_EPS:
+        raise ModelError(
+            f"arm '{name}': joint 1 must be perpendicular to joint 2 (alpha_1 = +-90 deg), got "
+            f"{np.degrees(r1.alpha):.10g} deg"
+        )
     P[six_dof.A1], P[six_dof.D1], P[six_dof.THETA1] = r1.a, r1.d, r1.theta
     P[six_dof.SIGMA1] = np.sign(np.sin(r1.alpha))
     P[six_dof.A2], P[six_dof.THETA2] = r2.a, r2.theta
@@ -321,7 +368,7 @@ def _position_family(name: str, rows: list[DHRow], jr: list[int]) -> tuple[int, 
         if np.cos(r2.alpha) < 0.0:
             raise ModelError(f"arm '{name}': alpha_2 = 180 deg is not supported")
         return six_dof.RRR_SPHERICAL_WRIST, "RRR + spherical wrist (parallel joints 2, 3)", P
-    if r3.kind is JointKind.PRISMATIC and abs(abs(np.sin(r2.alpha)) - 1.0) < _ANGLE_EPS:
+    if r3.kind is JointKind.PRISMATIC and _off_right_angle(r2.alpha) <= _RIGHT_ANGLE_EPS:
         if r3.a != 0.0 or r4.d != 0.0:
             raise ModelError(f"arm '{name}': RRP family needs a3 = 0 and d4 = 0")
         P[six_dof.LATERAL] = r2.d

@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from .. import ckernels
-from ..exceptions import InvalidInput
+from ..exceptions import InvalidInput, ModelError
 from ..kinematics.arm import Arm, load_arm
 from ..validation import as_joint_vector, as_pose, as_poses, as_signs
 from . import system
@@ -18,6 +19,11 @@ from .model import ModelArm, derive_model
 DEFAULT_POSITION_TOLERANCE = 1e-10
 DEFAULT_ORIENTATION_TOLERANCE = 1e-9
 DEFAULT_SCAN_POINTS = 64
+#: Seeded random joint vectors within the limits whose poses a new solver must solve.
+SELF_CHECK_SAMPLES = 12
+
+# Arms (by instance) that passed the self-check, with the (tolerances, scan points) it used.
+_SELF_CHECKED: weakref.WeakKeyDictionary[Arm, set[tuple]] = weakref.WeakKeyDictionary()
 
 
 @dataclass(frozen=True, eq=False, slots=True)
@@ -84,6 +90,15 @@ class OMSolver:
         orientation_tolerance: Largest accepted orientation error (rad).
         scan_points: Grid points of the bounded search over the dp circle.
 
+    Raises:
+        ModelError: The arm has no closed-form model (:func:`~.model.derive_model` names the
+            condition), or it fails to solve its own pose ``arm.fk(q)`` in the configuration
+            of q at one of ``SELF_CHECK_SAMPLES`` seeded random joint vectors within the limits
+            (the message names q and the status). An accepted arm's "unreachable" means
+            unreachable. The check takes about a millisecond and is done once per
+            :class:`Arm` instance and tolerances.
+        InvalidInput: A tolerance or scan_points out of range.
+
     Example::
 
         solver = om.OMSolver("ur5e")
@@ -113,6 +128,7 @@ class OMSolver:
         self.scan_points = int(scan_points)
         self.om: ModelArm = derive_model(self.arm)
         self._kernel = ckernels.Solver(self.solver_data())
+        self._check_solves_itself()
 
     def solver_data(self) -> system.SolverData:
         """The fixed data of the compiled kernel (see :class:`~om_redundant.om.system.SolverData`)."""
@@ -292,6 +308,32 @@ class OMSolver:
             )
 
     # -----------------------------------------------------------------------------------
+
+    def _check_solves_itself(self) -> None:
+        """Raise :class:`ModelError` unless the arm solves its own poses (see the class)."""
+        key = (self.tolerances, self.scan_points)
+        if key in _SELF_CHECKED.get(self.arm, ()):
+            return
+        arm = self.arm
+        span = np.where(arm.revolute, np.pi, 1.0)
+        lower = np.where(np.isfinite(arm.lower), arm.lower, -span)
+        upper = np.where(np.isfinite(arm.upper), arm.upper, span)
+        for q in np.random.default_rng(0).uniform(lower, upper, (SELF_CHECK_SAMPLES, arm.dof)):
+            configuration = self.configuration_of(q)
+            solution = self.solve(arm.fk(q), configuration)
+            if not solution.ok:
+                shown = ", ".join(f"{v:.4f}" for v in q)
+                named = [f"{n} {s:+d}" for n, s in zip(self.sign_names, configuration.signs, strict=True)]
+                named += [
+                    f"{n} {v:.4f}"
+                    for n, v in zip(self.redundancy_names, configuration.redundancy, strict=True)
+                ]
+                raise ModelError(
+                    f"arm '{arm.name}' does not solve its own pose at q = [{shown}] "
+                    f"(configuration {', '.join(named)}): {solution.status}; the offset-modified "
+                    f"model ({self.om.family_name}) does not fit this arm"
+                )
+        _SELF_CHECKED.setdefault(arm, set()).add(key)
 
     def _redundancy_rows(self, redundancy: Any, m: int) -> np.ndarray:
         """(M, r) redundancy values for a batch, checked: shape and finiteness, named."""
