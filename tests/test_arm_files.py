@@ -123,3 +123,48 @@ def test_spherical_arm_reproduces_the_papers_delta_p():
     )
     np.testing.assert_allclose(solver.om.dp(Q), expected, atol=1e-15)
     assert solver.dp_max == pytest.approx(d5, abs=1e-15)
+
+
+# ---------------------------------------------------------------------------------------
+# Issue 18: hostile files raise ArmFileError naming the problem, never another exception.
+
+
+@pytest.mark.parametrize(
+    "text, field, problem",
+    [
+        (
+            'name = "x"\nconvention = "standard"\nrows = ' + "[" * 5000 + "]" * 5000,
+            "<file>",
+            "nested too deeply",
+        ),
+        (
+            'name = "x"\nconvention = "standard"\n' + UR5E_ROWS.replace("d = 0.1", "d = 1" + "0" * 400),
+            "rows[0].d",
+            "too large for a float",
+        ),
+        ('name = "x"\nconvention = "standard"\ndescription = 5\n' + UR5E_ROWS, "description", "string"),
+        ('name = "x"\nconvention = "standard"\n[mujoco]\nmodel = 5\n' + UR5E_ROWS, "mujoco.model", "string"),
+        (
+            'name = "x"\nconvention = "standard"\n[tool]\nxyz = [0, 0, true]\n' + UR5E_ROWS,
+            "tool.xyz",
+            "3 finite",
+        ),
+    ],
+    ids=["deeply nested", "huge integer", "description", "model", "boolean"],
+)
+def test_hostile_file_names_file_field_and_problem(tmp_path, text, field, problem):
+    path = write(tmp_path, text)
+    with pytest.raises(om.ArmFileError) as info:
+        om.load_arm(path)
+    assert info.value.field == field and problem in info.value.problem, info.value
+
+
+def test_a_file_that_is_not_text_is_named(tmp_path):
+    path = tmp_path / "binary.toml"
+    path.write_bytes(b"\xff\xfe\x00name")
+    with pytest.raises(om.ArmFileError, match=r"binary\.toml: field '<file>': cannot read"):
+        om.load_arm(path)
+
+
+def test_an_optional_description_may_be_empty(tmp_path):
+    assert om.load_arm(write(tmp_path, 'name = "x"\nconvention = "standard"\ndescription = ""\n' + UR5E_ROWS))

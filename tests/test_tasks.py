@@ -576,3 +576,27 @@ def test_bad_task_definitions(panda, panda_model):
     task = om.ExactPoseTask(panda, panda_model, optimizer=PickConfigurationOf(panda))
     with pytest.raises(mink.TaskDefinitionError, match="optimizer"):
         task.set_target(panda.arm.fk(Q_PANDA), c)
+
+
+def test_task_arguments_of_the_wrong_type_are_named(panda, panda_model):
+    """Issue 18, item 7: the library's errors, never an AttributeError or a MuJoCo TypeError."""
+    c = panda.configuration_of(Q_PANDA)
+    with pytest.raises(om.InvalidInput, match=r"model must be a mujoco\.MjModel, got str 'model'"):
+        om.ExactPoseTask(panda, "model", arm_configuration=c)
+    with pytest.raises(om.InvalidInput, match="solver must be an OMSolver, got None"):
+        om.ExactPoseTask(None, panda_model, arm_configuration=c)
+    with pytest.raises(om.InvalidInput, match=r"model must be a mujoco\.MjModel"):
+        om.ArmAngleTask(panda, None)
+    with pytest.raises(om.InvalidInput, match="frame_name must be a str, got int 5"):
+        om.ExactPoseTask(panda, panda_model, arm_configuration=c, frame_name=5)
+    with pytest.raises(om.InvalidInput, match="configuration must be a Configuration, got a tuple"):
+        om.ExactPoseTask(panda, panda_model, arm_configuration=(1, 1, 1))
+    with pytest.raises(mink.TaskDefinitionError, match="gain must be a finite number, got str"):
+        om.ExactPoseTask(panda, panda_model, arm_configuration=c, gain="1")
+    with pytest.raises(mink.TaskDefinitionError, match="cost must be numbers, got str"):
+        om.ArmAngleTask(panda, panda_model, cost="1")
+    task = om.ExactPoseTask(panda, panda_model, arm_configuration=c)
+    with pytest.raises(om.InvalidInput, match="transform_target_to_world must be a \\(4, 4\\)"):
+        task.set_target("pose")
+    with pytest.raises(mink.InvalidTarget, match="finite angle"):
+        om.ArmAngleTask(panda, panda_model).set_target("0.5")

@@ -21,7 +21,7 @@ from ..exceptions import UnreachableTarget
 from ..mujoco_io.arm_in_model import ArmRoot
 from ..om.configuration import Configuration
 from ..om.solver import OMSolver
-from ..validation import as_pose
+from ..validation import as_instance, as_pose
 from .arm_task import ArmTask
 
 #: Default cost of :class:`ExactPoseTask`, per radian (metre for prismatic joints). With
@@ -108,6 +108,7 @@ class ExactPoseTask(ArmTask):
         gain: float = 1.0,
         lm_damping: float = 0.0,
     ):
+        as_instance(solver, OMSolver, "solver")
         if (arm_configuration is None) == (optimizer is None):
             raise TaskDefinitionError(
                 "ExactPoseTask takes either arm_configuration (a fixed om.Configuration) or optimizer"
