@@ -14,7 +14,7 @@ The rules, the same everywhere:
 * Arrays have the shape asked for; structured, object, text, boolean and complex arrays
   are refused (:func:`as_array` and the functions built on it: :func:`as_pose`,
   :func:`as_poses`, :func:`as_joint_vector`, :func:`as_signs`, :func:`as_redundancy`,
-  :func:`as_vector`).
+  :func:`as_vector`, :func:`as_quaternion`).
 * Objects of a library type are checked by :func:`as_instance`.
 """
 
@@ -31,6 +31,8 @@ from .exceptions import InvalidInput
 
 #: Largest accepted deviation max|R^T R - I| of a pose's rotation block.
 ORTHONORMALITY_TOLERANCE = 1e-9
+#: A quaternion whose norm is below this is refused as zero (it has no direction to keep).
+MIN_QUATERNION_NORM = 1e-9
 
 _REAL_KINDS = "iuf"  # numpy dtype kinds of real numbers: signed, unsigned, floating
 _KIND_NAMES = {
@@ -307,6 +309,29 @@ def as_vector(value: Any, size: int, name: str) -> np.ndarray:
     if vector.shape != (size,) or not np.isfinite(vector).all():
         raise InvalidInput(f"{name} must be {expected}, got {_describe(value)}")
     return vector
+
+
+def as_quaternion(quat: Any, name: str = "quaternion") -> np.ndarray:
+    """A unit quaternion (w, x, y, z) from four finite real numbers, normalised.
+
+    The norm is taken after scaling by the largest entry, so that 1e300 in every entry
+    normalises correctly (the plain norm overflows to inf).
+
+    Raises:
+        InvalidInput: Not 4 finite numbers, or a norm below :data:`MIN_QUATERNION_NORM` (1e-300
+            in every entry included: no direction to keep).
+    """
+    quat = as_array(quat, name, "a quaternion (w, x, y, z)")
+    if quat.shape != (4,):
+        raise InvalidInput(f"{name} must be 4 numbers (w, x, y, z), got shape {quat.shape}")
+    if not np.isfinite(quat).all():
+        raise InvalidInput(f"{name} {numbers_text(quat)} is not finite")
+    scale = float(np.abs(quat).max())
+    unit = quat / scale if scale > 0.0 else quat
+    length = float(np.linalg.norm(unit))
+    if not scale * length >= MIN_QUATERNION_NORM:
+        raise InvalidInput(f"{name} {numbers_text(quat)} has zero norm (below {MIN_QUATERNION_NORM:g})")
+    return unit / length
 
 
 # ---------------------------------------------------------------------------------------

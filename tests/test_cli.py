@@ -167,6 +167,30 @@ def test_closed_pipe_exits_quietly():
     assert proc.wait(timeout=120) == 141 and err == b""
 
 
+# Issue 18, item 6: a quaternion whose norm overflows keeps its direction.
+
+
+def test_a_quaternion_whose_norm_overflows_keeps_its_direction(capsys):
+    argv = ["solve", "--xyz", "0.3", "0.1", "0.4", "--quat", "1e300", "1e300", "1e300", "1e300", "--json"]
+    status, out, _ = in_process(capsys, *argv)
+    T = np.array(json.loads(out)["target"])
+    assert status == 0
+    np.testing.assert_allclose(T[:3, :3], [[0, 0, 1], [1, 0, 0], [0, 1, 0]], atol=1e-15)  # not the identity
+
+
+@pytest.mark.parametrize(
+    "quat, message",
+    [
+        (["1e-300"] * 4, "--quat (1e-300, 1e-300, 1e-300, 1e-300) has zero norm"),
+        (["nan", "1", "1", "1"], "--quat (nan, 1, 1, 1) is not finite"),
+        (["inf", "1", "1", "1"], "--quat (inf, 1, 1, 1) is not finite"),
+    ],
+)
+def test_a_quaternion_without_a_direction_exits_2(capsys, quat, message):
+    status, out, err = in_process(capsys, "solve", "--xyz", "0.3", "0.1", "0.4", "--quat", *quat)
+    assert status == 2 and out == "" and message in err and err.count("\n") == 1, err
+
+
 # ---------------------------------------------------------------------------------------
 # solve
 

@@ -46,7 +46,7 @@ from typing import Any
 import numpy as np
 
 from ..exceptions import ArmFileError, InvalidInput, UnknownArm
-from ..validation import as_instance, as_joint_vector, as_number
+from ..validation import as_instance, as_joint_vector, as_number, as_quaternion, as_vector
 from .chain import DHRow, JointKind, KinematicChain, standard_rows_from_modified
 
 
@@ -293,23 +293,22 @@ class _Fields:
         quat = self.vector(table, "quat", key + ".", 4, [1.0, 0.0, 0.0, 0.0])
         try:
             return pose_from_xyz_quat(xyz, quat)
-        except InvalidInput:
-            raise ArmFileError(self.path, key + ".quat", "quaternion has zero norm") from None
+        except InvalidInput as exc:
+            raise ArmFileError(self.path, key + ".quat", str(exc)) from None
 
 
-def pose_from_xyz_quat(xyz: Any, quat: Any) -> np.ndarray:
-    """Pose (4, 4) from a position and a quaternion (w, x, y, z), which is normalised.
+def pose_from_xyz_quat(xyz: Any, quat: Any, quat_name: str = "quaternion") -> np.ndarray:
+    """Pose (4, 4) from a position and a quaternion (w, x, y, z), which is normalised
+    (:func:`~om_redundant.validation.as_quaternion`: scaled first, so huge entries normalise
+    correctly).
 
     Raises:
-        InvalidInput: The quaternion has zero norm (below 1e-9) or is not finite.
+        InvalidInput: xyz is not 3 finite numbers; the quaternion (named ``quat_name`` in the
+            message) is not 4 finite numbers, or has zero norm (below 1e-9).
     """
-    quat = np.asarray(quat, dtype=np.float64)
-    norm = np.linalg.norm(quat)
-    if not norm >= 1e-9:
-        raise InvalidInput(f"quaternion {quat.tolist()} has zero norm")
     T = np.eye(4)
-    T[:3, :3] = rotation_from_quat(quat / norm)
-    T[:3, 3] = xyz
+    T[:3, :3] = rotation_from_quat(as_quaternion(quat, quat_name))
+    T[:3, 3] = as_vector(xyz, 3, "xyz")
     return T
 
 
