@@ -137,7 +137,7 @@ def read_pose_file(path: str) -> np.ndarray:
             T = np.load(path, allow_pickle=False)
         else:
             T = np.loadtxt(path, ndmin=2)
-    except (OSError, ValueError) as exc:
+    except (OSError, ValueError, EOFError) as exc:  # EOFError: an empty or cut-off .npy file
         raise UsageError(f"cannot read {name}: {' '.join(str(exc).split())}") from None
     if T.shape != (4, 4):
         raise UsageError(f"{name} must hold a 4x4 matrix, got shape {T.shape}")
