@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 import om_redundant as om
+from om_redundant.kinematics.arm import pose_from_xyz_quat
 from tests.conftest import random_q
 
 UR5E_ROWS = """
@@ -152,3 +155,99 @@ def test_spherical_arm_reproduces_the_papers_delta_p():
     )
     np.testing.assert_allclose(solver.om.dp(Q), expected, atol=1e-15)
     assert solver.dp_max == pytest.approx(d5, abs=1e-15)
+
+
+# ---------------------------------------------------------------------------------------
+# Issue 18: hostile files raise ArmFileError naming the problem, never another exception.
+
+
+@pytest.mark.parametrize(
+    "text, field, problem",
+    [
+        (
+            'name = "x"\nconvention = "standard"\nrows = ' + "[" * 5000 + "]" * 5000,
+            "<file>",
+            "nested too deeply",
+        ),
+        (
+            'name = "x"\nconvention = "standard"\n' + UR5E_ROWS.replace("d = 0.1", "d = 1" + "0" * 400),
+            "rows[0].d",
+            "too large for a float",
+        ),
+        ('name = "x"\nconvention = "standard"\ndescription = 5\n' + UR5E_ROWS, "description", "string"),
+        ('name = "x"\nconvention = "standard"\n[mujoco]\nmodel = 5\n' + UR5E_ROWS, "mujoco.model", "string"),
+        (
+            'name = "x"\nconvention = "standard"\n[tool]\nxyz = [0, 0, true]\n' + UR5E_ROWS,
+            "tool.xyz",
+            "3 finite",
+        ),
+    ],
+    ids=["deeply nested", "huge integer", "description", "model", "boolean"],
+)
+def test_hostile_file_names_file_field_and_problem(tmp_path, text, field, problem):
+    path = write(tmp_path, text)
+    with pytest.raises(om.ArmFileError) as info:
+        om.load_arm(path)
+    assert info.value.field == field and problem in info.value.problem, info.value
+
+
+def test_a_file_that_is_not_text_is_named(tmp_path):
+    path = tmp_path / "binary.toml"
+    path.write_bytes(b"\xff\xfe\x00name")
+    with pytest.raises(om.ArmFileError, match=r"binary\.toml: field '<file>': cannot read"):
+        om.load_arm(path)
+
+
+def test_an_optional_description_may_be_empty(tmp_path):
+    assert om.load_arm(write(tmp_path, 'name = "x"\nconvention = "standard"\ndescription = ""\n' + UR5E_ROWS))
+
+
+# ---------------------------------------------------------------------------------------
+# Issue 18, item 6: a quaternion is normalised after scaling by its largest entry, so one whose
+# norm overflows (1e300 in every entry) keeps its direction instead of becoming the identity;
+# a tiny one (1e-300: no direction left) or a NaN one is refused.
+
+
+@pytest.mark.parametrize("scale", [1e300, 1e100, 1e-5])
+def test_a_scaled_quaternion_is_the_same_rotation(tmp_path, scale):
+    panda = om.load_arm("panda")
+    text = Path(panda.source).read_text()
+    tool = "quat = [0.3826834, 0.0, 0.0, 0.9238795]"
+    assert tool in text
+    scaled = write(
+        tmp_path, text.replace(tool, f"quat = [{0.3826834 * scale!r}, 0.0, 0.0, {0.9238795 * scale!r}]")
+    )
+    q = np.linspace(-1.0, 1.0, 7)
+    np.testing.assert_allclose(om.load_arm(scaled).fk(q), panda.fk(q), atol=1e-15)
+
+
+@pytest.mark.parametrize(
+    "quat, problem",
+    [
+        ("[1e-300, 1e-300, 1e-300, 1e-300]", "has zero norm"),
+        ("[nan, 0, 0, 1]", "4 finite numbers"),
+        ("[inf, 0, 0, 1]", "4 finite numbers"),
+    ],
+)
+def test_a_quaternion_without_a_direction_is_refused(tmp_path, quat, problem):
+    path = write(tmp_path, f'name = "x"\nconvention = "standard"\n[tool]\nquat = {quat}\n' + UR5E_ROWS)
+    with pytest.raises(om.ArmFileError) as info:
+        om.load_arm(path)
+    assert info.value.field == "tool.quat" and problem in info.value.problem
+
+
+def test_pose_from_quaternion_scales_before_normalising():
+    T = pose_from_xyz_quat([0.1, 0.2, 0.3], [1e300, 1e300, 1e300, 1e300])
+    np.testing.assert_allclose(
+        T[:3, :3], [[0, 0, 1], [1, 0, 0], [0, 1, 0]], atol=1e-15
+    )  # 120 deg about (1,1,1)
+    for quat, message in [
+        ([1e-300] * 4, "has zero norm"),
+        ([np.nan, 1, 1, 1], "is not finite"),
+        ([np.inf, 1, 1, 1], "is not finite"),
+        ([1, 1, 1], "must be 4 numbers"),
+        ([1j, 0, 0, 0], "complex"),
+        ("1 0 0 0", "got str"),
+    ]:
+        with pytest.raises(om.InvalidInput, match=message):
+            pose_from_xyz_quat([0.0, 0.0, 0.0], quat)

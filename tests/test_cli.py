@@ -7,6 +7,7 @@ import csv
 import io
 import json
 import math
+import os
 import re
 import subprocess
 import sys
@@ -166,6 +167,77 @@ def test_closed_pipe_exits_quietly():
     proc.stdout.close()
     err = proc.stderr.read()
     assert proc.wait(timeout=120) == 141 and err == b""
+
+
+# Issue 18, item 6: a quaternion whose norm overflows keeps its direction.
+
+
+def test_a_quaternion_whose_norm_overflows_keeps_its_direction(capsys):
+    argv = ["solve", "--xyz", "0.3", "0.1", "0.4", "--quat", "1e300", "1e300", "1e300", "1e300", "--json"]
+    status, out, _ = in_process(capsys, *argv)
+    T = np.array(json.loads(out)["target"])
+    assert status == 0
+    np.testing.assert_allclose(T[:3, :3], [[0, 0, 1], [1, 0, 0], [0, 1, 0]], atol=1e-15)  # not the identity
+
+
+@pytest.mark.parametrize(
+    "quat, message",
+    [
+        (["1e-300"] * 4, "--quat (1e-300, 1e-300, 1e-300, 1e-300) has zero norm"),
+        (["nan", "1", "1", "1"], "--quat (nan, 1, 1, 1) is not finite"),
+        (["inf", "1", "1", "1"], "--quat (inf, 1, 1, 1) is not finite"),
+    ],
+)
+def test_a_quaternion_without_a_direction_exits_2(capsys, quat, message):
+    status, out, err = in_process(capsys, "solve", "--xyz", "0.3", "0.1", "0.4", "--quat", *quat)
+    assert status == 2 and out == "" and message in err and err.count("\n") == 1, err
+
+
+# Issue 18, item 8: pose files of the wrong kind, and a closed standard output.
+
+
+def test_pose_files_of_the_wrong_kind_exit_2_with_one_line(capsys, tmp_path):
+    arrays = {
+        "structured.npy": (np.zeros((4, 4), dtype=[("a", "f8"), ("b", "i4")]), "got a structured array"),
+        "zero_size.npy": (np.zeros((0,)), "must hold a 4x4 matrix, got shape (0,)"),
+        "complex.npy": (np.eye(4, dtype=complex), "got complex numbers"),
+        "bool.npy": (np.eye(4, dtype=bool), "got booleans"),
+        "objects.npy": (np.array([None, 1], dtype=object), "cannot read pose file"),  # a pickle
+    }
+    for name, (array, _) in arrays.items():
+        np.save(tmp_path / name, array, allow_pickle=True)
+    (tmp_path / "empty.npy").write_bytes(b"")
+    (tmp_path / "cut.npy").write_bytes((tmp_path / "bool.npy").read_bytes()[:70])
+    cases = {name: message for name, (_, message) in arrays.items()}
+    cases |= {"empty.npy": "cannot read pose file", "cut.npy": "cannot read pose file"}
+    for name, message in cases.items():
+        status, out, err = in_process(capsys, "solve", "--pose-file", str(tmp_path / name))
+        assert status == 2 and out == "" and err.startswith("om-redundant: error: "), (name, err)
+        assert message in err and err.count("\n") == 1, (name, err)
+
+
+def closed_stdout(*args: str) -> subprocess.CompletedProcess:
+    """The command started with standard output closed, as ``om-redundant ARGS >&-``."""
+    return subprocess.run(
+        [sys.executable, "-m", "om_redundant.cli", *args],
+        cwd=ROOT,
+        env=checkout_env(),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=lambda: os.close(1),
+        timeout=300,
+    )
+
+
+def test_closed_stdout_is_an_error_only_when_there_is_something_to_print(tmp_path):
+    done = closed_stdout("solve")
+    assert done.returncode == 2 and done.stderr.count("\n") == 1, done.stderr
+    assert done.stderr.startswith("om-redundant: error: standard output is closed")
+    assert closed_stdout("solve", "-q").returncode == 0
+    done = closed_stdout("solve", "-q", "--json", str(tmp_path / "out.json"))
+    assert done.returncode == 0 and done.stderr == ""
+    assert json.loads((tmp_path / "out.json").read_text())["arm"] == "ur5e"
 
 
 # ---------------------------------------------------------------------------------------

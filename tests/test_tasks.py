@@ -450,6 +450,44 @@ def test_mobile_base_moves_the_root_and_the_task_follows(panda):
     assert max(pose_errors(panda.arm.fk(exact.joint_target), T_root)) < 1e-9
 
 
+def test_a_target_out_of_reach_of_a_moving_root_is_refused_and_the_old_one_kept(panda):
+    """Issue 18, item 5: on the cart's slide joints, set_target of a pose 5 m away raises and
+    keeps the previous target (it used to take it, and every later compute_error raised)."""
+    model = mobile_base_model(panda.arm)
+    configuration = mink.Configuration(model, np.concatenate([[0.3, -0.2, 0.4], Q_PANDA]))
+    c = panda.configuration_of(Q_PANDA)
+    exact = om.ExactPoseTask(panda, model, arm_configuration=c, prefix="arm_")
+    T = exact.root.pose(configuration.data) @ panda.arm.fk(Q_PANDA)
+    exact.set_target(T)
+    error = exact.compute_error(configuration)  # the task has seen where the root is
+    far = T.copy()
+    far[:3, 3] += [5.0, 0.0, 0.0]
+    with pytest.raises(om.UnreachableTarget, match="unreachable"):
+        exact.set_target(far)
+    np.testing.assert_allclose(exact.transform_target_to_world.as_matrix(), T, atol=1e-15)
+    np.testing.assert_array_equal(exact.compute_error(configuration), error)  # the old target holds
+    configuration.update(np.concatenate([[5.3, -0.2, 0.4], Q_PANDA]))  # the cart drove 5 m along x
+    exact.set_target(far)  # solved for the root where it now stands
+    assert np.abs(exact.compute_error(configuration)).max() < 1e-9
+
+
+def test_a_target_set_before_the_root_was_seen_is_dropped_when_out_of_reach(panda):
+    """A target set before any compute_* is solved at the first: if it fails there, the task
+    raises and goes back to its previous target (here none), instead of raising ever after."""
+    model = mobile_base_model(panda.arm)
+    configuration = mink.Configuration(model, np.concatenate([[0.3, -0.2, 0.4], Q_PANDA]))
+    c = panda.configuration_of(Q_PANDA)
+    exact = om.ExactPoseTask(panda, model, arm_configuration=c, prefix="arm_")
+    far = exact.root.pose(configuration.data) @ panda.arm.fk(Q_PANDA)
+    far[:3, 3] += [5.0, 0.0, 0.0]
+    exact.set_target(far, om.Configuration(c.signs, (0.1,)))
+    with pytest.raises(om.UnreachableTarget, match="the target is dropped"):
+        exact.compute_error(configuration)
+    assert exact.transform_target_to_world is None and exact.arm_configuration == c
+    with pytest.raises(mink.TargetNotSet):
+        exact.compute_error(configuration)
+
+
 # ---------------------------------------------------------------------------------------
 # Helpers
 
@@ -576,3 +614,27 @@ def test_bad_task_definitions(panda, panda_model):
     task = om.ExactPoseTask(panda, panda_model, optimizer=PickConfigurationOf(panda))
     with pytest.raises(mink.TaskDefinitionError, match="optimizer"):
         task.set_target(panda.arm.fk(Q_PANDA), c)
+
+
+def test_task_arguments_of_the_wrong_type_are_named(panda, panda_model):
+    """Issue 18, item 7: the library's errors, never an AttributeError or a MuJoCo TypeError."""
+    c = panda.configuration_of(Q_PANDA)
+    with pytest.raises(om.InvalidInput, match=r"model must be a mujoco\.MjModel, got str 'model'"):
+        om.ExactPoseTask(panda, "model", arm_configuration=c)
+    with pytest.raises(om.InvalidInput, match="solver must be an OMSolver, got None"):
+        om.ExactPoseTask(None, panda_model, arm_configuration=c)
+    with pytest.raises(om.InvalidInput, match=r"model must be a mujoco\.MjModel"):
+        om.ArmAngleTask(panda, None)
+    with pytest.raises(om.InvalidInput, match="frame_name must be a str, got int 5"):
+        om.ExactPoseTask(panda, panda_model, arm_configuration=c, frame_name=5)
+    with pytest.raises(om.InvalidInput, match="configuration must be a Configuration, got a tuple"):
+        om.ExactPoseTask(panda, panda_model, arm_configuration=(1, 1, 1))
+    with pytest.raises(mink.TaskDefinitionError, match="gain must be a finite number, got str"):
+        om.ExactPoseTask(panda, panda_model, arm_configuration=c, gain="1")
+    with pytest.raises(mink.TaskDefinitionError, match="cost must be numbers, got str"):
+        om.ArmAngleTask(panda, panda_model, cost="1")
+    task = om.ExactPoseTask(panda, panda_model, arm_configuration=c)
+    with pytest.raises(om.InvalidInput, match="transform_target_to_world must be a \\(4, 4\\)"):
+        task.set_target("pose")
+    with pytest.raises(mink.InvalidTarget, match="finite angle"):
+        om.ArmAngleTask(panda, panda_model).set_target("0.5")

@@ -6,19 +6,22 @@ arm angle of a 7-DOF arm for a pose or a path; also the run without arguments), 
 (an arm file from a MuJoCo model) and ``bench paper`` (the OM paper's experiment).
 
 Exit status: 0 on success; 1 when the answer is no (a model that differs, a feature not
-built yet); 2 on bad input, with one line ``om-redundant: error: ...`` and no traceback;
-130 on Ctrl-C; 141 when the reader of standard output goes away (``| head``).
+built yet); 2 on bad input, with one line ``om-redundant: error: ...`` and no traceback, and
+when standard output is closed (``>&-``) and the command has something to print there (with
+``-q``, or ``--json FILE``, it runs normally); 130 on Ctrl-C; 141 when the reader of standard
+output goes away (``| head``).
 """
 
 from __future__ import annotations
 
+import io
 import os
 import sys
 
 from .. import __version__
 from ..exceptions import OMError
 from . import arms, bench, check_model, import_arm, solve, sweep
-from .common import Failed, Parser
+from .common import Failed, Parser, UsageError
 
 PROG = "om-redundant"
 SUBCOMMANDS = (solve, sweep, arms, check_model, import_arm, bench)
@@ -40,6 +43,8 @@ def build_parser() -> Parser:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command; returns the exit status (see the module docstring)."""
+    if sys.stdout is None:  # started with standard output closed (>&-)
+        _hold_stdout()
     parser = build_parser()
     try:
         try:
@@ -67,6 +72,36 @@ def main(argv: list[str] | None = None) -> int:
 
 def _error(exc: BaseException) -> None:
     print(f"{PROG}: error: {' '.join(str(exc).split())}", file=sys.stderr)
+
+
+CLOSED_STDOUT = "standard output is closed (>&-); nothing can be printed (use -q or --json FILE)"
+
+
+class _ClosedOutput(io.TextIOBase):
+    """Standard output of a command started with it closed: writing anything is an error."""
+
+    def writable(self) -> bool:
+        return True
+
+    def write(self, text: str) -> int:
+        if text:
+            raise UsageError(
+                "standard output is closed (>&-); nothing can be printed (use -q or --json FILE)"
+            )
+        return 0
+
+
+def _hold_stdout() -> None:
+    """Keep file descriptor 1 taken (by /dev/null, so that no file the command opens lands on it
+    and receives what a library prints) and make Python's standard output refuse writes."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        if devnull != 1:
+            os.dup2(devnull, 1)
+            os.close(devnull)
+    except OSError:
+        pass
+    sys.stdout = _ClosedOutput()
 
 
 def _discard_stdout() -> None:

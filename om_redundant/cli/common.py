@@ -14,7 +14,7 @@ import numpy as np
 from ..exceptions import InvalidInput, OMError
 from ..kinematics.arm import Arm, arm_names, pose_from_xyz_quat
 from ..om.solver import OMSolver
-from ..validation import as_pose, as_signs
+from ..validation import as_pose, as_signs, numbers_text
 
 #: Joint vectors whose forward kinematics is the built-in target, by number of joints;
 #: clipped into each arm's limits (the UR5e pose of the README; the Panda's for 7-DOF arms).
@@ -116,16 +116,15 @@ def target_pose(args: argparse.Namespace, arm: Arm) -> np.ndarray:
 
 def pose_from_text(xyz, quat, xyz_name: str, quat_name: str) -> np.ndarray:
     """:func:`~om_redundant.kinematics.arm.pose_from_xyz_quat` of numbers read from the command line or a
-    file, an error naming them and the problem."""
-    xyz, quat = np.asarray(xyz, dtype=np.float64), np.asarray(quat, dtype=np.float64)
+    file, an error naming them and the problem (a quaternion that is not finite, has zero norm,
+    ...: :func:`~om_redundant.validation.as_quaternion`)."""
+    xyz = np.asarray(xyz, dtype=np.float64)
     if not np.isfinite(xyz).all():
-        raise UsageError(f"{xyz_name} {_numbers(xyz)} is not finite")
-    if not np.isfinite(quat).all():
-        raise UsageError(f"{quat_name} {_numbers(quat)} is not finite")
+        raise UsageError(f"{xyz_name} {numbers_text(xyz)} is not finite")
     try:
-        return pose_from_xyz_quat(xyz, quat)
-    except InvalidInput:
-        raise UsageError(f"{quat_name} {_numbers(quat)} has zero norm") from None
+        return pose_from_xyz_quat(xyz, quat, quat_name)
+    except InvalidInput as exc:
+        raise UsageError(str(exc)) from None
 
 
 def read_pose_file(path: str) -> np.ndarray:
@@ -138,7 +137,7 @@ def read_pose_file(path: str) -> np.ndarray:
             T = np.load(path, allow_pickle=False)
         else:
             T = np.loadtxt(path, ndmin=2)
-    except (OSError, ValueError) as exc:
+    except (OSError, ValueError, EOFError) as exc:  # EOFError: an empty or cut-off .npy file
         raise UsageError(f"cannot read {name}: {' '.join(str(exc).split())}") from None
     if T.shape != (4, 4):
         raise UsageError(f"{name} must hold a 4x4 matrix, got shape {T.shape}")
@@ -203,7 +202,3 @@ def write_json(data: Any, destination: str) -> None:
 def table_wanted(args: argparse.Namespace) -> bool:
     """Print the human-readable table: not --quiet, and standard output not taken by JSON."""
     return not getattr(args, "quiet", False) and getattr(args, "json", None) != "-"
-
-
-def _numbers(values: np.ndarray) -> str:
-    return "(" + ", ".join(f"{v:g}" for v in values) + ")"

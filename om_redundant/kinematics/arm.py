@@ -43,6 +43,7 @@ from __future__ import annotations
 import itertools
 import json
 import math
+import os
 import tomllib
 from dataclasses import dataclass, field
 from importlib import resources
@@ -53,7 +54,7 @@ import mujoco
 import numpy as np
 
 from ..exceptions import ArmFileError, InvalidInput, UnknownArm
-from ..validation import as_joint_vector
+from ..validation import as_instance, as_joint_vector, as_number, as_quaternion, as_vector
 from .chain import DHRow, JointKind, KinematicChain, standard_rows_from_modified
 
 
@@ -105,6 +106,7 @@ class Arm:
     def within_limits(self, q: np.ndarray, tolerance: float = 0.0) -> bool | np.ndarray:
         """Whether q (dof,) or each row of q (M, dof) lies within the joint limits."""
         q = as_joint_vector(q, self.dof)
+        tolerance = as_number(tolerance, "tolerance")
         inside = ((q >= self.lower - tolerance) & (q <= self.upper + tolerance)).all(axis=-1)
         return bool(inside) if q.ndim == 1 else inside
 
@@ -136,8 +138,11 @@ def load_arm(name_or_path: str | Path) -> Arm:
 
     Raises:
         UnknownArm: The name is neither a built-in arm nor an existing file.
-        ArmFileError: The file is malformed; the message names file, field and problem.
+        ArmFileError: The file is unreadable or malformed; the message names file, field and
+            problem.
+        InvalidInput: ``name_or_path`` is neither a string nor a path.
     """
+    as_instance(name_or_path, str | os.PathLike, "arm", "an arm name or the path of an arm file")
     text_name = str(name_or_path)
     builtin = _arm_dir() / f"{text_name}.toml"
     if isinstance(name_or_path, str) and "/" not in text_name and not text_name.endswith(".toml"):
@@ -147,7 +152,11 @@ def load_arm(name_or_path: str | Path) -> Arm:
     path = Path(name_or_path)
     if not path.is_file():
         raise ArmFileError(str(path), "<file>", "no such file")
-    return _parse(path.read_text(), str(path))
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ArmFileError(str(path), "<file>", f"cannot read: {exc}") from None
+    return _parse(text, str(path))
 
 
 def _arm_dir() -> Any:
@@ -157,6 +166,7 @@ def _arm_dir() -> Any:
 # ---------------------------------------------------------------------------------------
 # Parsing, strict: unknown keys are errors, so that a typo never silently means zero.
 
+_REQUIRED = object()  # a field without a default
 _TOP_KEYS = {"name", "description", "convention", "mujoco", "base", "tool", "rows"}
 _ROW_KEYS = {"joint", "type", "a", "d", "alpha_deg", "theta_deg", "range"}
 
@@ -166,6 +176,8 @@ def _parse(text: str, path: str) -> Arm:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ArmFileError(path, "<file>", f"not valid TOML: {exc}") from None
+    except RecursionError:  # arrays or tables nested thousands deep
+        raise ArmFileError(path, "<file>", "not valid as an arm file: nested too deeply") from None
     f = _Fields(path)
     f.no_unknown(data, _TOP_KEYS, "")
     name = f.string(data, "name")
@@ -225,9 +237,9 @@ def _parse(text: str, path: str) -> Arm:
         joint_names=tuple(joint_names),
         lower=np.array(lower),
         upper=np.array(upper),
-        description=data.get("description", ""),
-        mujoco_model=mujoco.get("model"),
-        frame_name=mujoco.get("frame"),
+        description=f.string(data, "description", "", ""),
+        mujoco_model=f.string(mujoco, "model", "mujoco.", None),
+        frame_name=f.string(mujoco, "frame", "mujoco.", None),
         frame_type=frame_type,
         source=path,
     )
@@ -242,33 +254,35 @@ class _Fields:
             if key not in allowed:
                 raise ArmFileError(self.path, prefix + key, f"unknown field; allowed: {sorted(allowed)}")
 
-    def string(self, table: dict, key: str, prefix: str = "") -> str:
+    def string(self, table: dict, key: str, prefix: str = "", default: Any = _REQUIRED) -> Any:
         if key not in table:
+            if default is not _REQUIRED:
+                return default
             raise ArmFileError(self.path, prefix + key, "missing")
-        if not isinstance(table[key], str) or not table[key]:
-            raise ArmFileError(self.path, prefix + key, f"must be a non-empty string, got {table[key]!r}")
-        return table[key]
+        value = table[key]
+        if not isinstance(value, str) or (not value and default is _REQUIRED):  # optional ones may be ""
+            raise ArmFileError(self.path, prefix + key, f"must be a non-empty string, got {value!r}")
+        return value
 
     def number(self, table: dict, key: str, prefix: str = "", default: float | None = None) -> float:
         if key not in table:
             if default is None:
                 raise ArmFileError(self.path, prefix + key, "missing")
             return default
-        value = table[key]
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-            raise ArmFileError(self.path, prefix + key, f"must be a finite number, got {value!r}")
-        return float(value)
+        try:
+            return as_number(table[key], prefix + key)
+        except InvalidInput as exc:
+            raise ArmFileError(self.path, prefix + key, str(exc).removeprefix(prefix + key + " ")) from None
 
     def vector(self, table: dict, key: str, prefix: str, size: int, default: list[float]) -> np.ndarray:
         value = table.get(key, default)
-        if (
-            not isinstance(value, list)
-            or len(value) != size
-            or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
-            or not all(math.isfinite(v) for v in value)
-        ):
-            raise ArmFileError(self.path, prefix + key, f"must be {size} finite numbers, got {value!r}")
-        return np.array(value, dtype=np.float64)
+        problem = f"must be {size} finite numbers, got {value!r}"
+        if not isinstance(value, list) or len(value) != size:
+            raise ArmFileError(self.path, prefix + key, problem)
+        try:
+            return np.array([as_number(v, prefix + key) for v in value])
+        except InvalidInput:
+            raise ArmFileError(self.path, prefix + key, problem) from None
 
     def limits(self, raw: dict, where: str) -> tuple[float, float]:
         if "range" not in raw:
@@ -287,23 +301,22 @@ class _Fields:
         quat = self.vector(table, "quat", key + ".", 4, [1.0, 0.0, 0.0, 0.0])
         try:
             return pose_from_xyz_quat(xyz, quat)
-        except InvalidInput:
-            raise ArmFileError(self.path, key + ".quat", "quaternion has zero norm") from None
+        except InvalidInput as exc:
+            raise ArmFileError(self.path, key + ".quat", str(exc)) from None
 
 
-def pose_from_xyz_quat(xyz: Any, quat: Any) -> np.ndarray:
-    """Pose (4, 4) from a position and a quaternion (w, x, y, z), which is normalised.
+def pose_from_xyz_quat(xyz: Any, quat: Any, quat_name: str = "quaternion") -> np.ndarray:
+    """Pose (4, 4) from a position and a quaternion (w, x, y, z), which is normalised
+    (:func:`~om_redundant.validation.as_quaternion`: scaled first, so huge entries normalise
+    correctly).
 
     Raises:
-        InvalidInput: The quaternion has zero norm (below 1e-9) or is not finite.
+        InvalidInput: xyz is not 3 finite numbers; the quaternion (named ``quat_name`` in the
+            message) is not 4 finite numbers, or has zero norm (below 1e-9).
     """
-    quat = np.asarray(quat, dtype=np.float64)
-    norm = np.linalg.norm(quat)
-    if not norm >= 1e-9:
-        raise InvalidInput(f"quaternion {quat.tolist()} has zero norm")
     T = np.eye(4)
-    T[:3, :3] = rotation_from_quat(quat / norm)
-    T[:3, 3] = xyz
+    T[:3, :3] = rotation_from_quat(as_quaternion(quat, quat_name))
+    T[:3, 3] = as_vector(xyz, 3, "xyz")
     return T
 
 

@@ -173,9 +173,7 @@ class KinematicChain:
         Returns:
             (6, dof) array.
         """
-        q = as_joint_vector(q, self.dof)
-        if q.ndim != 1:
-            raise ValueError("jacobian takes one joint vector")
+        q = as_joint_vector(q, self.dof, stack=False)
         J = np.empty((6, self.dof))
         ckernels.jacobian(self.table, self.T_root_base, self.T_flange_tool, np.ascontiguousarray(q), J)
         return J

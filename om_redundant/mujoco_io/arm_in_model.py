@@ -15,6 +15,7 @@ from mink import FRAME_TO_ENUM, FRAME_TO_POS_ATTR, FRAME_TO_XMAT_ATTR, SUPPORTED
 
 from ..exceptions import FrameNotFound, JointNotFound, ModelMismatch
 from ..kinematics.arm import Arm
+from ..validation import as_instance
 from .mjcf import DEFAULT_SITE
 
 #: Largest disagreement (m, rad) accepted between ``arm.fk`` and the model's end-effector frame.
@@ -46,9 +47,14 @@ class ArmJoints:
         JointNotFound: A joint is not in the model; the message names it.
         ModelMismatch: A joint has another type (a revolute joint must be a hinge, a
             prismatic one a slide).
+        InvalidInput: arm is not an :class:`Arm`, model not a ``mujoco.MjModel`` or prefix not
+            a string.
     """
 
     def __init__(self, arm: Arm, model: mujoco.MjModel, prefix: str = ""):
+        as_instance(arm, Arm, "arm")
+        as_instance(model, mujoco.MjModel, "model", "a mujoco.MjModel")
+        as_instance(prefix, str, "prefix")
         self.arm, self.model, self.prefix = arm, model, prefix
         self.names = tuple(prefix + name for name in arm.joint_names)
         ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name) for name in self.names]
@@ -138,6 +144,9 @@ class ArmRoot:
 
     def __init__(self, joints: ArmJoints, frame_name: str | None = None, frame_type: str | None = None):
         arm, model = joints.arm, joints.model
+        for name, value in (("frame_name", frame_name), ("frame_type", frame_type)):
+            if value is not None:
+                as_instance(value, str, name)
         self.joints = joints
         self.frame_name = frame_name or joints.prefix + (arm.frame_name or DEFAULT_SITE)
         self.frame_type = frame_type or arm.frame_type or "site"

@@ -38,7 +38,7 @@ import mujoco
 import numpy as np
 
 from ..kinematics.arm import Arm
-from ..validation import as_positive
+from ..validation import as_instance, as_positive
 
 DEFAULT_SITE = "end_effector"
 RADIUS_PER_REACH = 0.03  # default capsule radius over the stretched length of the chain
@@ -57,7 +57,8 @@ def arm_mjcf(arm: Arm, *, prefix: str = "", radius: float | None = None) -> str:
         A ``<mujoco>`` document.
 
     Raises:
-        InvalidInput: radius is not a positive finite number.
+        InvalidInput: arm is not an :class:`~om_redundant.Arm`, prefix not a string, or radius
+            not a positive finite number.
     """
     return _text(_arm_tree(arm, prefix, radius, scene=False))
 
@@ -78,6 +79,8 @@ def scene_mjcf(arm: Arm, *, prefix: str = "", radius: float | None = None) -> st
 
 
 def _arm_tree(arm: Arm, prefix: str, radius: float | None, scene: bool) -> ET.Element:
+    as_instance(arm, Arm, "arm")
+    as_instance(prefix, str, "prefix")
     P, P_tail = arm.chain.joint_placements()
     n = arm.dof
     ends = np.vstack([P[:, :3, 3], P_tail[:3, 3]])  # segment of body k: origin -> ends[k]

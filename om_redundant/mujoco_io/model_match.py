@@ -27,10 +27,12 @@ import numpy as np
 
 from ..exceptions import InvalidInput
 from ..kinematics.arm import Arm
+from ..validation import as_count, as_instance, as_positive
 from .mjcf import DEFAULT_SITE
 
 #: Default largest accepted difference: metres for positions and limits, radians for angles.
 DEFAULT_TOLERANCE = 1e-9
+MAX_SAMPLES = 100_000  # random joint vectors of the kinematic comparison
 
 
 @dataclass(frozen=True)
@@ -150,12 +152,17 @@ def compare_mujoco_model(
         tolerance: Largest accepted difference (m for positions and limits, rad for angles).
 
     Raises:
-        InvalidInput: samples or tolerance out of range, or the root body does not exist.
+        InvalidInput: An argument of the wrong type; samples (1 to 100,000), seed or tolerance
+            out of range; the root body does not exist.
     """
-    if int(samples) < 1:
-        raise InvalidInput(f"samples must be at least 1, got {samples}")
-    if not (math.isfinite(tolerance) and tolerance > 0.0):
-        raise InvalidInput(f"tolerance must be a positive number, got {tolerance}")
+    as_instance(arm, Arm, "arm")
+    as_instance(model, mujoco.MjModel, "model", "a mujoco.MjModel")
+    for name, value in (("frame", frame), ("prefix", prefix), ("root", root)):
+        if value is not None:
+            as_instance(value, str, name)
+    samples = as_count(samples, "samples", 1, MAX_SAMPLES)
+    seed = as_count(seed, "seed", 0, 2**63 - 1)
+    tolerance = as_positive(tolerance, "tolerance")
     root_id = 0
     if root is not None:
         root_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, root)

@@ -6,7 +6,7 @@ import math
 from dataclasses import dataclass
 from itertools import product
 
-from ..exceptions import InvalidInput
+from ..validation import as_instance, as_number, as_redundancy, as_signs
 
 _TURN = 2.0 * math.pi
 
@@ -17,27 +17,30 @@ class Configuration:
 
     Attributes:
         signs: Branch signs of the model arm's closed form, each -1 or +1; for 6-DOF
-            arms ``(ARM, ELBOW, WRIST)``.
+            arms ``(ARM, ELBOW, WRIST)``. A sequence of numbers; ``True`` is refused.
         redundancy: Redundancy variables appended to c (the arm angle psi of a 7-DOF
-            arm); empty for 6-DOF arms.
+            arm); empty for 6-DOF arms. Finite real numbers, never text; one number is
+            taken as one value (``Configuration(signs, 0.3)`` is ``Configuration(signs,
+            (0.3,))``) and None as none.
+
+    Raises:
+        InvalidInput: Signs that are not a sequence of -1 and +1; redundancy values that are
+            not finite real numbers.
     """
 
     signs: tuple[int, ...]
     redundancy: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
-        signs = tuple(self.signs)
-        for s in signs:
-            if isinstance(s, bool) or s not in (-1, 1):
-                raise InvalidInput(f"configuration signs must be -1 or +1, got {signs}")
-        redundancy = tuple(float(r) for r in self.redundancy)
-        if not all(math.isfinite(r) for r in redundancy):
-            raise InvalidInput(f"configuration redundancy values must be finite, got {redundancy}")
-        object.__setattr__(self, "signs", tuple(int(s) for s in signs))
-        object.__setattr__(self, "redundancy", redundancy)
+        signs = as_signs(self.signs, None, "configuration signs")
+        redundancy = as_redundancy(self.redundancy, "configuration redundancy")
+        object.__setattr__(self, "signs", tuple(signs.tolist()))
+        object.__setattr__(self, "redundancy", tuple(redundancy.tolist()))
 
     def isclose(self, other: Configuration, atol: float = 1e-9) -> bool:
         """Same signs, and redundancy values (angles) equal within ``atol`` modulo 2 pi."""
+        as_instance(other, Configuration, "other")
+        atol = as_number(atol, "atol")
         if self.signs != other.signs or len(self.redundancy) != len(other.redundancy):
             return False
         # Each angle reduced first (exactly, as the solver does): a - b of a huge angle and a

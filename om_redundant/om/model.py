@@ -36,6 +36,7 @@ from .. import ckernels
 from ..exceptions import ModelError
 from ..kinematics.arm import Arm
 from ..kinematics.chain import DHRow, JointKind, KinematicChain
+from ..validation import as_instance
 from .families import six_dof, srs
 
 _ANGLE_EPS = 1e-9
@@ -94,7 +95,9 @@ def derive_model(arm: Arm) -> ModelArm:
     Raises:
         ModelError: The arm matches no family, or dp depends on more than one joint; the
             message names the condition.
+        InvalidInput: arm is not an :class:`~om_redundant.Arm`.
     """
+    as_instance(arm, Arm, "arm")
     if arm.dof == 6:
         model_chain, family, family_name, params = _six_dof_model(arm)
         shoulderless = arm.chain

@@ -43,11 +43,12 @@ import numpy as np
 from .. import ckernels
 from ..exceptions import InvalidInput
 from ..om.solver import OMSolver
-from ..validation import as_joint_vector
+from ..validation import as_instance, as_joint_vector
 
 
 def check_arm_angle(solver: OMSolver) -> None:
     """Raise :class:`InvalidInput` unless the solver's configurations carry an arm angle psi."""
+    as_instance(solver, OMSolver, "solver")
     if solver.redundancy_names != ("psi",):
         raise InvalidInput(f"arm '{solver.arm.name}' has no arm angle psi (it is not a 7-DOF arm)")
 
@@ -69,9 +70,7 @@ def arm_angle_and_gradient(solver: OMSolver, q: np.ndarray) -> tuple[float, np.n
         InvalidInput: The arm has no arm angle, or q is malformed.
     """
     check_arm_angle(solver)
-    q = as_joint_vector(q, solver.arm.dof)
-    if q.ndim != 1:
-        raise InvalidInput("arm_angle_and_gradient takes one joint vector")
+    q = as_joint_vector(q, solver.arm.dof, stack=False)
     grad = np.empty(solver.arm.dof)
     psi = ckernels.arm_angle_gradient(
         solver.om.params, solver.model.chain.table, np.ascontiguousarray(q), grad

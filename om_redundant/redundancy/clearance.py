@@ -39,7 +39,7 @@ from ..exceptions import InvalidInput
 from ..kinematics.arm import Arm
 from ..mujoco_io.arm_in_model import ArmJoints
 from ..mujoco_io.mjcf import arm_mjcf
-from ..validation import as_joint_vector, as_pose, as_positive
+from ..validation import as_instance, as_joint_vector, as_pose, as_positive, as_vector
 
 DEFAULT_DISTMAX = 1.0  # m: pairs farther apart report this distance
 
@@ -79,7 +79,7 @@ class Sphere:
     name: str = ""
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "center", _point(self.center, "Sphere center"))
+        object.__setattr__(self, "center", as_vector(self.center, 3, "Sphere center"))
         object.__setattr__(self, "radius", as_positive(self.radius, "Sphere radius"))
 
     def _geom(self, name: str) -> _Geom:
@@ -103,8 +103,8 @@ class Capsule:
     name: str = ""
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "start", _point(self.start, "Capsule start"))
-        object.__setattr__(self, "end", _point(self.end, "Capsule end"))
+        object.__setattr__(self, "start", as_vector(self.start, 3, "Capsule start"))
+        object.__setattr__(self, "end", as_vector(self.end, 3, "Capsule end"))
         object.__setattr__(self, "radius", as_positive(self.radius, "Capsule radius"))
         if np.linalg.norm(self.end - self.start) == 0.0:
             raise InvalidInput("Capsule start and end coincide; use a Sphere")
@@ -132,7 +132,7 @@ class Box:
     name: str = ""
 
     def __post_init__(self) -> None:
-        half = _point(self.half_sizes, "Box half_sizes")
+        half = as_vector(self.half_sizes, 3, "Box half_sizes")
         if not (half > 0.0).all():
             raise InvalidInput(f"Box half_sizes must be positive, got {half.tolist()}")
         object.__setattr__(self, "half_sizes", half)
@@ -178,6 +178,11 @@ class Clearance:
         prefix: str = "",
         distmax: float = DEFAULT_DISTMAX,
     ):
+        as_instance(model, mujoco.MjModel, "model", "a mujoco.MjModel")
+        as_instance(arm, Arm, "arm")
+        names = isinstance(obstacle_geoms, Sequence) and not isinstance(obstacle_geoms, str)
+        if not (names and all(isinstance(g, str) for g in obstacle_geoms)):
+            raise InvalidInput(f"obstacle_geoms must be a sequence of geom names, got {obstacle_geoms!r}")
         self.model, self.arm, self._dof = model, arm, arm.dof
         self.distmax = as_positive(distmax, "distmax")
         self._data = mujoco.MjData(model)
@@ -220,6 +225,7 @@ class Clearance:
             radius: Capsule radius of the arm's MJCF (default: :func:`~om_redundant.arm_mjcf`'s).
             distmax: As in :class:`Clearance`.
         """
+        as_instance(arm, Arm, "arm")
         geoms = _model_geoms(obstacles) if isinstance(obstacles, mujoco.MjModel) else _shape_geoms(obstacles)
         spec = mujoco.MjSpec.from_string(arm_mjcf(arm, radius=radius))
         taken = {g.name for g in spec.geoms}
@@ -243,9 +249,7 @@ class Clearance:
         return self._evaluate(q, gradient=True)
 
     def _evaluate(self, q: np.ndarray, gradient: bool) -> tuple[np.ndarray, np.ndarray]:
-        q = as_joint_vector(q, self._dof)
-        if q.ndim != 1:
-            raise InvalidInput("Clearance takes one joint vector")
+        q = as_joint_vector(q, self._dof, stack=False)
         m, d = self.model, self._data
         d.qpos[self._qpos] = q
         mujoco.mj_kinematics(m, d)
@@ -266,6 +270,7 @@ class Clearance:
 def _shape_geoms(obstacles: Sequence[Shape]) -> list[_Geom]:
     if isinstance(obstacles, Sphere | Capsule | Box):
         obstacles = [obstacles]
+    as_instance(obstacles, Sequence, "obstacles", "shapes (Sphere, Capsule, Box) or a MuJoCo model")
     geoms = []
     for k, shape in enumerate(obstacles):
         if isinstance(shape, mujoco.MjModel):
@@ -311,10 +316,3 @@ def _subtree(model: mujoco.MjModel, root: int) -> np.ndarray:
     for b in range(model.nbody):  # parents come before their children
         inside[b] = b == root or (b > 0 and inside[model.body_parentid[b]])
     return inside
-
-
-def _point(value: Any, name: str) -> np.ndarray:
-    point = np.asarray(value, dtype=np.float64)
-    if point.shape != (3,) or not np.isfinite(point).all():
-        raise InvalidInput(f"{name} must be 3 finite numbers, got {value!r}")
-    return point

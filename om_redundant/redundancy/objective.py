@@ -40,7 +40,7 @@ import numpy as np
 
 from ..exceptions import InvalidInput
 from ..kinematics.arm import Arm
-from ..validation import as_joint_vector
+from ..validation import as_instance, as_joint_vector, as_number
 from .clearance import Clearance
 
 
@@ -54,7 +54,7 @@ def joint_margins(arm: Arm, q: np.ndarray) -> np.ndarray:
     Returns:
         Margins of the same shape as q: 1 at mid-range, 0 on a limit, negative beyond.
     """
-    q = as_joint_vector(q, arm.dof)
+    q = as_joint_vector(q, as_instance(arm, Arm, "arm").dof)
     limited = np.isfinite(arm.lower) & np.isfinite(arm.upper)
     half = np.where(limited, (arm.upper - arm.lower) / 2.0, 1.0)
     return np.where(limited, np.minimum(*_limit_distances(q, arm.lower, arm.upper, half)), np.inf)
@@ -70,24 +70,14 @@ def _limit_distances(
 def check_weights(margin_weight: Any, clearance_weight: Any, clearance_cap: Any, min_clearance: Any) -> None:
     """Raise InvalidInput naming the first of the objective's numbers that is out of range."""
     for name, value in (("margin_weight", margin_weight), ("clearance_weight", clearance_weight)):
-        if not _number(value, name) >= 0.0:
+        if not as_number(value, name) >= 0.0:
             raise InvalidInput(f"{name} must be a finite number >= 0, got {value}")
-    if not _number(clearance_cap, "clearance_cap") > 0.0:
+    if not as_number(clearance_cap, "clearance_cap") > 0.0:
         raise InvalidInput(f"clearance_cap must be a positive number of metres, got {clearance_cap}")
-    if not 0.0 <= _number(min_clearance, "min_clearance") < clearance_cap:
+    if not 0.0 <= as_number(min_clearance, "min_clearance") < clearance_cap:
         raise InvalidInput(
             f"min_clearance must be >= 0 and below clearance_cap ({clearance_cap} m), got {min_clearance}"
         )
-
-
-def _number(value: Any, name: str) -> float:
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise InvalidInput(f"{name} must be a number, got {value!r}") from None
-    if not math.isfinite(number):
-        raise InvalidInput(f"{name} must be finite, got {value!r}")
-    return number
 
 
 @dataclass(frozen=True)
@@ -179,6 +169,7 @@ class Objective:
         clearance_cap: float = 0.1,
         min_clearance: float = 0.0,
     ):
+        as_instance(arm, Arm, "arm")
         check_weights(margin_weight, clearance_weight, clearance_cap, min_clearance)
         if clearance is not None and clearance.distmax < clearance_cap:
             raise InvalidInput(

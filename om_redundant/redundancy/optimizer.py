@@ -37,7 +37,7 @@ import numpy as np
 from ..exceptions import InvalidInput
 from ..om.configuration import Configuration
 from ..om.solver import OMSolver, Solution
-from ..validation import as_pose, as_signs
+from ..validation import as_count, as_instance, as_number, as_pose, as_signs
 from .clearance import DEFAULT_DISTMAX, Clearance, Shape
 from .climb import maximise
 from .intervals import PsiInterval, Run, feasible_runs
@@ -45,6 +45,8 @@ from .objective import Objective, check_weights
 from .paths import Path, Point, Probe, sweep_circle, sweep_window
 
 _WINDOW_POINTS = 4  # tracking samples on each side of the previous psi
+#: Bounds of ``grid_points`` (psi samples per branch; the sweep's cost grows with it).
+MIN_GRID_POINTS, MAX_GRID_POINTS = 16, 100_000
 
 
 @dataclass(frozen=True, eq=False)
@@ -86,8 +88,12 @@ class RedundancyOptimizer:
         margin_weight, clearance_weight, clearance_cap, min_clearance: The objective
             (:class:`~om_redundant.redundancy.objective.Objective`).
         branches: Allowed branch signs, e.g. ``[(1, -1, 1)]``; default all.
-        grid_points: psi samples per branch of the sweep, >= 16.
-        max_step: Largest psi change (rad) per tracking call.
+        grid_points: psi samples per branch of the sweep, a whole number from 16 to 100,000.
+        max_step: Largest psi change (rad) per tracking call, in (0, pi].
+
+    Raises:
+        InvalidInput: An argument of the wrong type or out of range (named); numbers must be
+            numbers (``"1"`` is refused).
 
     Example::
 
@@ -110,8 +116,7 @@ class RedundancyOptimizer:
         grid_points: int = 64,
         max_step: float = 0.05,
     ):
-        if not isinstance(solver, OMSolver):
-            raise InvalidInput(f"solver must be an OMSolver, got {type(solver).__name__}")
+        as_instance(solver, OMSolver, "solver")
         if len(solver.redundancy_names) != 1:
             raise InvalidInput(
                 f"arm '{solver.arm.name}' has {len(solver.redundancy_names)} redundancy variables; "
@@ -134,13 +139,13 @@ class RedundancyOptimizer:
         if branches is None:
             self.branches = every
         else:
-            signs = as_signs(branches, len(solver.sign_names), "branches").reshape(-1, len(solver.sign_names))
+            k = len(solver.sign_names)
+            signs = as_signs(branches, k, "branches", stack=True).reshape(-1, k)
             self.branches = list(dict.fromkeys(tuple(int(s) for s in row) for row in signs))
-        if int(grid_points) < 16:
-            raise InvalidInput(f"grid_points must be at least 16, got {grid_points}")
-        if not (math.isfinite(max_step) and 0.0 < max_step <= math.pi):
+        self.grid_points = as_count(grid_points, "grid_points", MIN_GRID_POINTS, MAX_GRID_POINTS)
+        self.max_step = as_number(max_step, "max_step")
+        if not 0.0 < self.max_step <= math.pi:
             raise InvalidInput(f"max_step must be in (0, pi] rad, got {max_step}")
-        self.grid_points, self.max_step = int(grid_points), float(max_step)
 
     def intervals(self, T: Any) -> list[PsiInterval]:
         """The feasible psi intervals of every allowed branch at pose T."""

@@ -34,7 +34,7 @@ def self_motion_tangent(solver: OMSolver, q: np.ndarray) -> np.ndarray:
         InvalidInput: The arm has no arm angle, or q is malformed.
     """
     check_arm_angle(solver)
-    q = as_joint_vector(q, solver.arm.dof)
+    q = as_joint_vector(q, solver.arm.dof, stack=False)
     null = np.linalg.svd(solver.arm.jacobian(q))[2][6:].T
     gradient = arm_angle_and_gradient(solver, q)[1]
     change = np.atleast_2d(gradient @ null)

@@ -11,8 +11,10 @@ from mink import Configuration as MinkConfiguration
 from mink import TargetNotSet
 from mink.exceptions import InvalidTarget
 
+from ..exceptions import InvalidInput
 from ..om.solver import OMSolver
 from ..redundancy.arm_angle import arm_angle_and_gradient, check_arm_angle
+from ..validation import as_number
 from .arm_task import ArmTask
 
 
@@ -58,14 +60,13 @@ class ArmAngleTask(ArmTask):
         self.target_psi: float | None = None
 
     def set_target(self, psi: float) -> None:
-        """Set the target arm angle psi* (rad)."""
+        """Set the target arm angle psi* (rad), a finite number (not text)."""
         try:
-            value = float(psi)
-        except (TypeError, ValueError):
-            value = math.nan
-        if not math.isfinite(value):
-            raise InvalidTarget(f"ArmAngleTask target must be a finite angle in radians, got {psi!r}")
-        self.target_psi = value
+            self.target_psi = as_number(psi, "target")
+        except InvalidInput:
+            raise InvalidTarget(
+                f"ArmAngleTask target must be a finite angle in radians, got {psi!r}"
+            ) from None
 
     def set_target_from_configuration(self, configuration: MinkConfiguration) -> None:
         """Hold the elbow where it is: psi* becomes the arm's current arm angle."""

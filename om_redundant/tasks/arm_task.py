@@ -8,8 +8,10 @@ import numpy.typing as npt
 from mink import Configuration as MinkConfiguration
 from mink import Task, TaskDefinitionError
 
+from ..exceptions import InvalidInput
 from ..mujoco_io.arm_in_model import ArmJoints
 from ..om.solver import OMSolver
+from ..validation import as_array, as_instance, as_number
 
 
 class ArmTask(Task):
@@ -25,6 +27,11 @@ class ArmTask(Task):
         cost: Cost, one value for every coordinate of the error or one per coordinate.
         gain: Task gain in [0, 1].
         lm_damping: Levenberg-Marquardt damping (see ``mink.Task``).
+
+    Raises:
+        InvalidInput: solver is not an :class:`~om_redundant.OMSolver` or model not a
+            ``mujoco.MjModel``.
+        TaskDefinitionError: A bad cost.
     """
 
     def __init__(
@@ -37,6 +44,11 @@ class ArmTask(Task):
         gain: float,
         lm_damping: float,
     ):
+        as_instance(solver, OMSolver, "solver")
+        try:
+            gain, lm_damping = as_number(gain, "gain"), as_number(lm_damping, "lm_damping")
+        except InvalidInput as exc:
+            raise TaskDefinitionError(f"{self.__class__.__name__} {exc}") from None
         super().__init__(cost=np.zeros(k), gain=gain, lm_damping=lm_damping)
         self.k = k
         self.solver = solver
@@ -45,7 +57,10 @@ class ArmTask(Task):
 
     def set_cost(self, cost: npt.ArrayLike) -> None:
         """Set the cost: one value for every coordinate of the error, or one per coordinate."""
-        cost = np.atleast_1d(np.asarray(cost, dtype=np.float64))
+        try:
+            cost = np.atleast_1d(as_array(cost, "cost", "numbers"))
+        except InvalidInput as exc:
+            raise TaskDefinitionError(f"{self.__class__.__name__} {exc}") from None
         if cost.ndim != 1 or cost.shape[0] not in (1, self.k):
             raise TaskDefinitionError(
                 f"{self.__class__.__name__} cost must be a vector of shape (1,) or ({self.k},), "

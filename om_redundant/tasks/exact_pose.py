@@ -21,7 +21,7 @@ from ..exceptions import UnreachableTarget
 from ..mujoco_io.arm_in_model import ArmRoot
 from ..om.configuration import Configuration
 from ..om.solver import OMSolver
-from ..validation import as_pose
+from ..validation import as_instance, as_pose
 from .arm_task import ArmTask
 
 #: Default cost of :class:`ExactPoseTask`, per radian (metre for prismatic joints). With
@@ -68,12 +68,18 @@ class ExactPoseTask(ArmTask):
 
     The arm's root may move (a mobile base, a mocap body): then :math:`q^*` is solved again
     whenever the root has moved, at the next :meth:`compute_error`; the Jacobian's columns
-    of the base stay zero (the base follows the other tasks).
+    of the base stay zero (the base follows the other tasks). :meth:`set_target` solves for
+    the root where the task last saw it (in the ``mink.Configuration`` of its last
+    ``compute_*``, :meth:`seed` or :meth:`set_target_from_configuration`); a target set
+    before the task has seen any is solved at the next ``compute_*``.
 
     Failure is never silent: if the pose is out of reach, has no solution in c, or only
-    solutions that break a joint limit, :meth:`set_target` (or, for a moving root, the
-    next ``compute_*``) raises :class:`~om_redundant.UnreachableTarget` naming the reason,
-    and the task keeps its previous target (catch it to hold the arm where it was going).
+    solutions that break a joint limit, :meth:`set_target` raises
+    :class:`~om_redundant.UnreachableTarget` naming the reason, and the task keeps its
+    previous target (catch it to hold the arm where it was going). A target is never taken
+    unsolved: when the first solve of a target set before the task saw its root fails, the
+    ``compute_*`` raises and the task goes back to its previous target (or to none). Later,
+    ``compute_*`` raises while the root stands where the target is out of the arm's reach.
 
     Args:
         solver: The OM solver of the arm.
@@ -108,6 +114,7 @@ class ExactPoseTask(ArmTask):
         gain: float = 1.0,
         lm_damping: float = 0.0,
     ):
+        as_instance(solver, OMSolver, "solver")
         if (arm_configuration is None) == (optimizer is None):
             raise TaskDefinitionError(
                 "ExactPoseTask takes either arm_configuration (a fixed om.Configuration) or optimizer"
@@ -122,6 +129,8 @@ class ExactPoseTask(ArmTask):
         self.choice: Any = None
         self._q_target: np.ndarray | None = None
         self._root_pose: np.ndarray | None = None
+        self._data: mujoco.MjData | None = None  # of the configuration last seen: where the root is
+        self._unsolved_fallback: tuple[SE3 | None, Configuration | None] | None = None
         self._jacobian = self.scatter(np.eye(self.k))
         self._jacobian.setflags(write=False)
 
@@ -138,7 +147,8 @@ class ExactPoseTask(ArmTask):
         """Set the hand's target pose in the world frame and solve it exactly.
 
         The solve starts from the previous :math:`q^*` (the root nearest it), so a moving
-        target keeps its branch and arm angle continuous.
+        target keeps its branch and arm angle continuous. With a moving root it is solved for
+        the root where the task last saw it (see the class docstring).
 
         Args:
             transform_target_to_world: ``mink.SE3`` or (4, 4) pose of the end-effector frame.
@@ -158,20 +168,24 @@ class ExactPoseTask(ArmTask):
             raise TaskDefinitionError("this ExactPoseTask takes its configurations from its optimizer")
         else:
             self.solver.check_configuration(arm_configuration)  # raises InvalidInput naming the problem
-        if self.root.fixed_pose is not None:
-            self._solve(T, self.root.fixed_pose, self._q_target, arm_configuration)
-        else:
-            self._root_pose = None  # the root moves: solved at the next compute_*
+        if self.root.fixed_pose is not None or self._data is not None:
+            self._solve(T, self.root.pose(self._data), self._q_target, arm_configuration)  # or raises
+            self._unsolved_fallback = None
+        else:  # the root moves and the task has not seen where: solved at the next compute_*
+            if self._unsolved_fallback is None:
+                self._unsolved_fallback = (self.transform_target_to_world, self.arm_configuration)
+            self._root_pose = None
         self.transform_target_to_world = SE3.from_matrix(T)
         self.arm_configuration = arm_configuration
 
     def set_target_from_configuration(self, configuration: MinkConfiguration) -> None:
         """Hold the arm where it is: the target becomes the hand's current pose and, without
         an optimiser, c becomes the arm's current configuration (branch signs and psi)."""
-        q = self.arm_q(configuration)
+        q = self._arm_q(configuration)
         T = configuration.get_transform_frame_to_world(self.root.frame_name, self.root.frame_type).as_matrix()
         c = self.solver.configuration_of(q) if self.optimizer is None else None
         self._solve(T, self.root.pose(configuration.data), q, c)
+        self._unsolved_fallback = None
         self.arm_configuration = c
         self.transform_target_to_world = SE3.from_matrix(T)
 
@@ -195,16 +209,30 @@ class ExactPoseTask(ArmTask):
 
     def _joint_target(self, configuration: MinkConfiguration) -> np.ndarray:
         """:math:`q^*` for the configuration's root pose, solved again if the root moved."""
-        self.arm_q(configuration)
+        self._arm_q(configuration)
         if self.transform_target_to_world is None:
             raise TargetNotSet(self.__class__.__name__)
         if self.root.fixed_pose is None:
             root = self.root.pose(configuration.data)
             if self._root_pose is None or not np.array_equal(root, self._root_pose):
                 T = self.transform_target_to_world.as_matrix()
-                self._solve(T, root, self._q_target, self.arm_configuration)
+                try:
+                    self._solve(T, root, self._q_target, self.arm_configuration)
+                except UnreachableTarget as exc:
+                    if self._unsolved_fallback is None:
+                        raise  # a solved target the root has moved away from: kept
+                    self.transform_target_to_world, self.arm_configuration = self._unsolved_fallback
+                    self._unsolved_fallback = None
+                    raise UnreachableTarget(f"{exc}; the target is dropped for the previous one") from None
+                self._unsolved_fallback = None
         assert self._q_target is not None
         return self._q_target
+
+    def _arm_q(self, configuration: MinkConfiguration) -> np.ndarray:
+        """The arm's joints (checked as :meth:`arm_q`); remembers where the root is."""
+        q = self.arm_q(configuration)
+        self._data = configuration.data
+        return q
 
     def _solve(
         self,
