@@ -36,6 +36,7 @@ MIN_QUATERNION_NORM = 1e-9
 
 _REAL_KINDS = "iuf"  # numpy dtype kinds of real numbers: signed, unsigned, floating
 _KIND_NAMES = {
+    "bool among numbers": "a boolean among the numbers",
     "b": "booleans",
     "c": "complex numbers",
     "U": "text",
@@ -131,10 +132,11 @@ def as_array(value: Any, name: str, expected: str) -> np.ndarray:
             array = np.asarray(value)
         except (TypeError, ValueError, OverflowError, RecursionError):  # ragged, or refuses to convert
             raise InvalidInput(f"{name} must be {expected}, got {_describe(value)}") from None
-    kind, what = array.dtype.kind, _KIND_NAMES.get(array.dtype.kind, f"dtype {array.dtype}")
+    kind = array.dtype.kind
     if kind in _REAL_KINDS and array is not value and _holds_bool(value):  # numpy made True a number
-        kind, what = "b", "a boolean among the numbers"
+        kind = "bool among numbers"
     if kind not in _REAL_KINDS:
+        what = _KIND_NAMES.get(kind, f"dtype {array.dtype}")  # formatted only here: str(dtype) is slow
         kind_wanted = "" if "numbers" in expected else " (real numbers)"
         raise InvalidInput(f"{name} must be {expected}{kind_wanted}, got {what}")
     return array.astype(np.float64, copy=False)
@@ -206,12 +208,14 @@ def _where(bad: np.ndarray, T: np.ndarray) -> str:
 
 
 def as_joint_vector(q: Any, dof: int, name: str = "q", *, stack: bool = True) -> np.ndarray:
-    """Return a validated joint vector of shape (dof,), or with ``stack`` also a stack (M, dof)."""
+    """Return a validated joint vector of shape (dof,), or with ``stack`` also a stack (M, dof),
+    as a C-contiguous float64 array."""
     shapes = f"({dof},) or (M, {dof})" if stack else f"({dof},)"
     q = as_array(q, name, f"a joint vector of shape {shapes}")
     if q.ndim not in ((1, 2) if stack else (1,)) or q.shape[-1] != dof:
         raise InvalidInput(f"{name} must have shape {shapes}, got {q.shape}")
-    if not np.isfinite(q).all():
+    q = np.ascontiguousarray(q)
+    if not ckernels.all_finite(q):
         raise InvalidInput(f"{name} contains NaN or inf")
     return q
 

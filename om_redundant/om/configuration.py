@@ -32,10 +32,14 @@ class Configuration:
     redundancy: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
-        signs = as_signs(self.signs, None, "configuration signs")
-        redundancy = as_redundancy(self.redundancy, "configuration redundancy")
-        object.__setattr__(self, "signs", tuple(signs.tolist()))
-        object.__setattr__(self, "redundancy", tuple(redundancy.tolist()))
+        # Tuples of plain ints +-1 and finite floats are kept as given (the solvers make
+        # them every call); anything else is checked and converted.
+        signs, redundancy = self.signs, self.redundancy
+        if not (type(signs) is tuple and all(type(s) is int and (s == 1 or s == -1) for s in signs)):
+            object.__setattr__(self, "signs", tuple(as_signs(signs, None, "configuration signs").tolist()))
+        if not (type(redundancy) is tuple and all(type(r) is float and math.isfinite(r) for r in redundancy)):
+            values = as_redundancy(redundancy, "configuration redundancy")
+            object.__setattr__(self, "redundancy", tuple(values.tolist()))
 
     def isclose(self, other: Configuration, atol: float = 1e-9) -> bool:
         """Same signs, and redundancy values (angles) equal within ``atol`` modulo 2 pi."""

@@ -210,8 +210,8 @@ class OMSolver:
         q = as_joint_vector(q, self.arm.dof, stack=False)
         values = np.empty(len(self.sign_names))
         redundancy = np.empty(len(self.redundancy_names))
-        self._kernel.configuration_values(system.as_kernel_array(q), values, redundancy)
-        return Configuration(tuple(np.where(values < 0.0, -1, 1).tolist()), tuple(redundancy.tolist()))
+        self._kernel.configuration_values(q, values, redundancy)
+        return Configuration(tuple(-1 if v < 0.0 else 1 for v in values.tolist()), tuple(redundancy.tolist()))
 
     def solve(self, T: Any, configuration: Configuration, q_hint: np.ndarray | None = None) -> Solution:
         """Joint vector reaching pose T in the given configuration.
@@ -368,4 +368,4 @@ class OMSolver:
         """The hint as the kernel takes it (None: no hint)."""
         if q_hint is None:
             return None
-        return system.as_kernel_array(as_joint_vector(q_hint, self.arm.dof, "q_hint", stack=False))
+        return as_joint_vector(q_hint, self.arm.dof, "q_hint", stack=False)
