@@ -28,7 +28,7 @@ setup(
             "om_redundant.ckernels",
             sources=sorted(str(path) for path in Path("csrc").glob("*.c")),
             include_dirs=["csrc"],
-            depends=["csrc/om_kernels.h"],
+            depends=sorted(str(path) for path in Path("csrc").glob("*.h")),
         )
     ],
     cmdclass={"build_ext": BuildExt},

@@ -1,0 +1,83 @@
+/* Buffers and sequences from Python, checked: the binding's only way to read arguments. */
+#include <string.h>
+
+#include "binding.h"
+
+/* ------------------------------------------------------------------------------------ */
+/* Buffers.                                                                               */
+
+
+/* Acquire obj's buffer as n items of the given kind, C-contiguous (writable if asked). */
+int get_buffer(PyObject *obj, Py_buffer *view, int kind, Py_ssize_t n, int writable, const char *name) {
+    int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (writable ? PyBUF_WRITABLE : 0);
+    if (PyObject_GetBuffer(obj, view, flags) < 0) {
+        PyErr_Clear();
+        PyErr_Format(PyExc_TypeError, "%s must be a C-contiguous%s array", name, writable ? " writable" : "");
+        return -1;
+    }
+    const char *f = view->format ? view->format : "B";
+    if (*f == '<' || *f == '=' || *f == '@') f++;
+    int ok;
+    switch (kind) {
+    case F64: ok = view->itemsize == 8 && f[0] == 'd' && f[1] == 0; break;
+    case I64: ok = view->itemsize == 8 && (f[0] == 'l' || f[0] == 'q') && f[1] == 0; break;
+    default: ok = view->itemsize == 1 && (f[0] == '?' || f[0] == 'B' || f[0] == 'b') && f[1] == 0; break;
+    }
+    if (!ok) {
+        PyErr_Format(PyExc_TypeError, "%s must be %s, got format '%s'", name,
+                     kind == F64 ? "float64" : kind == I64 ? "int64" : "bool", view->format ? view->format : "B");
+        PyBuffer_Release(view);
+        return -1;
+    }
+    if (n >= 0 && view->len != n * view->itemsize) {
+        PyErr_Format(PyExc_ValueError, "%s must have %zd entries, got %zd", name, n, view->len / view->itemsize);
+        PyBuffer_Release(view);
+        return -1;
+    }
+    return 0;
+}
+
+/* Parse a sequence of k numbers (ints for signs) into out. */
+int get_signs(PyObject *obj, int64_t *out, int k) {
+    PyObject *seq = PySequence_Fast(obj, "signs must be a sequence");
+    if (!seq) return -1;
+    if (PySequence_Fast_GET_SIZE(seq) != k) {
+        PyErr_Format(PyExc_ValueError, "signs must have %d entries, got %zd", k, PySequence_Fast_GET_SIZE(seq));
+        Py_DECREF(seq);
+        return -1;
+    }
+    for (int i = 0; i < k; i++) {
+        long long v = PyLong_AsLongLong(PySequence_Fast_GET_ITEM(seq, i));
+        if (v == -1 && PyErr_Occurred()) {
+            Py_DECREF(seq);
+            return -1;
+        }
+        if (v != 1 && v != -1) {
+            PyErr_SetString(PyExc_ValueError, "signs must be -1 or +1");
+            Py_DECREF(seq);
+            return -1;
+        }
+        out[i] = (int64_t)v;
+    }
+    Py_DECREF(seq);
+    return 0;
+}
+
+int get_doubles(PyObject *obj, double *out, int k, const char *name) {
+    PyObject *seq = PySequence_Fast(obj, "redundancy must be a sequence");
+    if (!seq) return -1;
+    if (PySequence_Fast_GET_SIZE(seq) != k) {
+        PyErr_Format(PyExc_ValueError, "%s must have %d entries, got %zd", name, k, PySequence_Fast_GET_SIZE(seq));
+        Py_DECREF(seq);
+        return -1;
+    }
+    for (int i = 0; i < k; i++) {
+        out[i] = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(seq, i));
+        if (out[i] == -1.0 && PyErr_Occurred()) {
+            Py_DECREF(seq);
+            return -1;
+        }
+    }
+    Py_DECREF(seq);
+    return 0;
+}

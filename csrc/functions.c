@@ -1,0 +1,291 @@
+/* Module functions: kinematics and the families' closed forms, on arrays. */
+#include "binding.h"
+
+/* ------------------------------------------------------------------------------------ */
+/* Module functions: kinematics and the families' closed forms.                           */
+
+/* Parse n buffers; kinds/sizes/writable per argument; -1 size: any. */
+typedef struct {
+    int kind;
+    Py_ssize_t n;
+    int writable;
+    const char *name;
+} spec;
+
+static int get_all(PyObject *const *args, Py_buffer *views, const spec *specs, int n) {
+    for (int i = 0; i < n; i++) {
+        if (get_buffer(args[i], &views[i], specs[i].kind, specs[i].n, specs[i].writable, specs[i].name) < 0) {
+            for (int j = 0; j < i; j++) PyBuffer_Release(&views[j]);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+static void release_all(Py_buffer *views, int n) {
+    for (int i = 0; i < n; i++) PyBuffer_Release(&views[i]);
+}
+
+static int check_nargs(Py_ssize_t nargs, Py_ssize_t want, const char *what) {
+    if (nargs != want) {
+        PyErr_Format(PyExc_TypeError, "%s takes %zd arguments, got %zd", what, want, nargs);
+        return -1;
+    }
+    return 0;
+}
+
+static Py_ssize_t table_rows(Py_buffer *table) {
+    return table->len / (6 * 8);
+}
+
+/* fk(table, base, tool, Q, out): out[m] = base @ A(Q[m]) @ tool; Q (M, dof), out (M, 4, 4). */
+static PyObject *k_fk(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 5, "fk") < 0) return NULL;
+    Py_buffer v[5];
+    spec sp[5] = {{F64, -1, 0, "table"}, {F64, 16, 0, "base"}, {F64, 16, 0, "tool"}, {F64, -1, 0, "Q"},
+                  {F64, -1, 1, "out"}};
+    if (get_all(args, v, sp, 5) < 0) return NULL;
+    Py_ssize_t rows = table_rows(&v[0]), dof = 0;
+    const double *t = v[0].buf;
+    for (Py_ssize_t i = 0; i < rows; i++) dof += t[6 * i + 5] != 2.0;
+    Py_ssize_t m = dof ? v[3].len / (8 * dof) : v[4].len / 128; /* no joints: one pose per out */
+    if (v[0].len != rows * 48 || v[3].len != m * dof * 8 || v[4].len != m * 128) {
+        release_all(v, 5);
+        PyErr_SetString(PyExc_ValueError, "fk: shapes of table, Q and out disagree");
+        return NULL;
+    }
+    Py_BEGIN_ALLOW_THREADS for (Py_ssize_t i = 0; i < m; i++) om_fk(t, (int)rows, v[1].buf, v[2].buf,
+                                                                       (const double *)v[3].buf + dof * i,
+                                                                       (double *)v[4].buf + 16 * i);
+    Py_END_ALLOW_THREADS release_all(v, 5);
+    Py_RETURN_NONE;
+}
+
+/* jacobian(table, base, tool, q, J): J (6, dof). */
+static PyObject *k_jacobian(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 5, "jacobian") < 0) return NULL;
+    Py_buffer v[5];
+    spec sp[5] = {{F64, -1, 0, "table"}, {F64, 16, 0, "base"}, {F64, 16, 0, "tool"}, {F64, -1, 0, "q"},
+                  {F64, -1, 1, "J"}};
+    if (get_all(args, v, sp, 5) < 0) return NULL;
+    Py_ssize_t rows = table_rows(&v[0]), dof = v[3].len / 8;
+    if (dof > OM_MAX_DOF || v[4].len != 6 * dof * 8) {
+        release_all(v, 5);
+        PyErr_SetString(PyExc_ValueError, "jacobian: shapes of q and J disagree");
+        return NULL;
+    }
+    om_jacobian(v[0].buf, (int)rows, v[1].buf, v[2].buf, v[3].buf, (int)dof, v[4].buf);
+    release_all(v, 5);
+    Py_RETURN_NONE;
+}
+
+/* flange(table, q, R, p): the last DH frame's pose in DH frame 0. */
+static PyObject *k_flange(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 4, "flange") < 0) return NULL;
+    Py_buffer v[4];
+    spec sp[4] = {{F64, -1, 0, "table"}, {F64, -1, 0, "q"}, {F64, 9, 1, "R"}, {F64, 3, 1, "p"}};
+    if (get_all(args, v, sp, 4) < 0) return NULL;
+    om_flange(v[0].buf, (int)table_rows(&v[0]), v[1].buf, v[2].buf, v[3].buf);
+    release_all(v, 4);
+    Py_RETURN_NONE;
+}
+
+/* flange_target(T, T_base_root, T_tool_flange, R, p): the flange pose in DH frame 0. */
+static PyObject *k_flange_target(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 5, "flange_target") < 0) return NULL;
+    Py_buffer v[5];
+    spec sp[5] = {{F64, 16, 0, "T"}, {F64, 16, 0, "T_base_root"}, {F64, 16, 0, "T_tool_flange"}, {F64, 9, 1, "R"},
+                  {F64, 3, 1, "p"}};
+    if (get_all(args, v, sp, 5) < 0) return NULL;
+    mat3 R;
+    vec3 p;
+    om_flange_target(v[0].buf, v[1].buf, v[2].buf, &R, &p);
+    double *Rb = v[3].buf, *pb = v[4].buf;
+    const vec3 rows[3] = {R.r0, R.r1, R.r2};
+    for (int i = 0; i < 3; i++) {
+        Rb[3 * i] = rows[i].x;
+        Rb[3 * i + 1] = rows[i].y;
+        Rb[3 * i + 2] = rows[i].z;
+    }
+    pb[0] = p.x;
+    pb[1] = p.y;
+    pb[2] = p.z;
+    release_all(v, 5);
+    Py_RETURN_NONE;
+}
+
+static mat3 load_mat(const double *R) {
+    return m_load(R, 0);
+}
+
+static vec3 load_vec(const double *p) {
+    return v_load(p, 0);
+}
+
+/* Families' arguments are checked against the parameter vector's length and q's size. */
+static int check_family(long family, Py_buffer *P, Py_ssize_t dof) {
+    Py_ssize_t need = family == OM_SRS ? SRS_N_PARAMS : SD_N_PARAMS;
+    Py_ssize_t want_dof = family == OM_SRS ? 7 : 6;
+    if (family < 0 || family > OM_SRS) {
+        PyErr_Format(PyExc_ValueError, "unknown family %ld", family);
+        return -1;
+    }
+    if (P->len != need * 8 || dof != want_dof) {
+        PyErr_Format(PyExc_ValueError, "family %ld takes %zd parameters and %zd joints", family, need, want_dof);
+        return -1;
+    }
+    return 0;
+}
+
+/* model_ik(family, P, table, R, p, signs, redundancy, q_prev, q, all_joints) -> margin. */
+static PyObject *k_model_ik(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 10, "model_ik") < 0) return NULL;
+    long family = PyLong_AsLong(args[0]);
+    int all_joints = PyObject_IsTrue(args[9]);
+    if (PyErr_Occurred() || all_joints < 0) return NULL;
+    Py_buffer v[8];
+    spec sp[8] = {{F64, -1, 0, "P"}, {F64, -1, 0, "table"}, {F64, 9, 0, "R"}, {F64, 3, 0, "p"},
+                  {I64, 3, 0, "signs"}, {F64, -1, 0, "redundancy"}, {F64, -1, 0, "q_prev"}, {F64, -1, 1, "q"}};
+    if (get_all(args + 1, v, sp, 8) < 0) return NULL;
+    if (check_family(family, &v[0], v[7].len / 8) < 0 || v[6].len != v[7].len ||
+        v[5].len != (family == OM_SRS ? 8 : 0)) {
+        if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "model_ik: shapes disagree");
+        release_all(v, 8);
+        return NULL;
+    }
+    mat3 R = load_mat(v[2].buf);
+    double margin = om_model_ik((int)family, v[0].buf, v[1].buf, &R, load_vec(v[3].buf), v[4].buf, v[5].buf,
+                                v[6].buf, v[7].buf, all_joints);
+    release_all(v, 8);
+    return PyFloat_FromDouble(margin);
+}
+
+/* model_ik_at_reach(P, R, p, signs, psi, q_prev, q) -> bool (S-R-S). */
+static PyObject *k_model_ik_at_reach(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 7, "model_ik_at_reach") < 0) return NULL;
+    double psi = PyFloat_AsDouble(args[4]);
+    if (PyErr_Occurred()) return NULL;
+    PyObject *const a[6] = {args[0], args[1], args[2], args[3], args[5], args[6]};
+    Py_buffer v[6];
+    spec sp[6] = {{F64, SRS_N_PARAMS, 0, "P"}, {F64, 9, 0, "R"}, {F64, 3, 0, "p"}, {I64, 3, 0, "signs"},
+                  {F64, 7, 0, "q_prev"}, {F64, 7, 1, "q"}};
+    if (get_all(a, v, sp, 6) < 0) return NULL;
+    mat3 R = load_mat(v[1].buf);
+    bool ok = om_srs_model_ik_at_reach(v[0].buf, &R, load_vec(v[2].buf), v[3].buf, psi, v[4].buf, v[5].buf);
+    release_all(v, 6);
+    return PyBool_FromLong(ok);
+}
+
+/* model_ik_lifted(P, R, p, signs, psi, q1, q7, phi4, q) -> (shoulder, wrist, elbow) residuals. */
+static PyObject *k_model_ik_lifted(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 9, "model_ik_lifted") < 0) return NULL;
+    double psi = PyFloat_AsDouble(args[4]), q1 = PyFloat_AsDouble(args[5]), q7 = PyFloat_AsDouble(args[6]),
+           phi4 = PyFloat_AsDouble(args[7]);
+    if (PyErr_Occurred()) return NULL;
+    PyObject *const a[5] = {args[0], args[1], args[2], args[3], args[8]};
+    Py_buffer v[5];
+    spec sp[5] = {{F64, SRS_N_PARAMS, 0, "P"}, {F64, 9, 0, "R"}, {F64, 3, 0, "p"}, {I64, 3, 0, "signs"},
+                  {F64, 7, 1, "q"}};
+    if (get_all(a, v, sp, 5) < 0) return NULL;
+    mat3 R = load_mat(v[1].buf);
+    vec3 r = om_srs_model_ik_lifted(v[0].buf, &R, load_vec(v[2].buf), v[3].buf, psi, q1, q7, phi4, v[4].buf);
+    release_all(v, 5);
+    return Py_BuildValue("(ddd)", r.x, r.y, r.z);
+}
+
+/* branch_values(family, P, q, out) and redundancy_values(family, P, q, out). */
+static PyObject *configuration_values(PyObject *const *args, Py_ssize_t nargs, int redundancy) {
+    if (check_nargs(nargs, 4, redundancy ? "redundancy_values" : "branch_values") < 0) return NULL;
+    long family = PyLong_AsLong(args[0]);
+    if (PyErr_Occurred()) return NULL;
+    Py_buffer v[3];
+    spec sp[3] = {{F64, -1, 0, "P"}, {F64, -1, 0, "q"}, {F64, -1, 1, "out"}};
+    if (get_all(args + 1, v, sp, 3) < 0) return NULL;
+    Py_ssize_t want = redundancy ? (family == OM_SRS ? 1 : 0) : 3;
+    if (check_family(family, &v[0], v[1].len / 8) < 0 || v[2].len < want * 8) {
+        if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "out is too short");
+        release_all(v, 3);
+        return NULL;
+    }
+    if (redundancy)
+        om_redundancy_values((int)family, v[0].buf, v[1].buf, v[2].buf);
+    else
+        om_branch_values((int)family, v[0].buf, v[1].buf, v[2].buf);
+    release_all(v, 3);
+    Py_RETURN_NONE;
+}
+
+static PyObject *k_branch_values(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    return configuration_values(args, nargs, 0);
+}
+
+static PyObject *k_redundancy_values(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    return configuration_values(args, nargs, 1);
+}
+
+/* arm_angle_gradient(P, table, q, grad) -> psi (S-R-S). */
+static PyObject *k_arm_angle_gradient(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 4, "arm_angle_gradient") < 0) return NULL;
+    Py_buffer v[4];
+    spec sp[4] = {{F64, SRS_N_PARAMS, 0, "P"}, {F64, -1, 0, "table"}, {F64, 7, 0, "q"}, {F64, 7, 1, "grad"}};
+    if (get_all(args, v, sp, 4) < 0) return NULL;
+    double psi = om_arm_angle_gradient(v[0].buf, v[1].buf, (int)table_rows(&v[1]), v[2].buf, v[3].buf);
+    release_all(v, 4);
+    return PyFloat_FromDouble(psi);
+}
+
+/* pose_is_valid(T, tolerance) -> bool: finite, last row [0 0 0 1], max|R^T R - I| <= tolerance, det > 0. */
+static PyObject *k_pose_is_valid(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 2, "pose_is_valid") < 0) return NULL;
+    double tol = PyFloat_AsDouble(args[1]);
+    if (PyErr_Occurred()) return NULL;
+    Py_buffer v;
+    if (get_buffer(args[0], &v, F64, 16, 0, "T") < 0) return NULL;
+    const double *T = v.buf;
+    int ok = 1;
+    for (int i = 0; i < 16; i++) ok = ok && isfinite(T[i]);
+    ok = ok && T[12] == 0.0 && T[13] == 0.0 && T[14] == 0.0 && T[15] == 1.0;
+    for (int i = 0; i < 3 && ok; i++)
+        for (int j = 0; j < 3; j++) {
+            double dot = T[i] * T[j] + T[4 + i] * T[4 + j] + T[8 + i] * T[8 + j];
+            if (fabs(dot - (i == j ? 1.0 : 0.0)) > tol) ok = 0;
+        }
+    if (ok) {
+        double det = T[0] * (T[5] * T[10] - T[6] * T[9]) - T[1] * (T[4] * T[10] - T[6] * T[8]) +
+                     T[2] * (T[4] * T[9] - T[5] * T[8]);
+        ok = det > 0.0;
+    }
+    PyBuffer_Release(&v);
+    return PyBool_FromLong(ok);
+}
+
+/* all_finite(values) -> bool: no NaN or inf among any number of float64 (numpy's
+ * isfinite(...).all() costs microseconds on a 7-vector). */
+static PyObject *k_all_finite(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 1, "all_finite") < 0) return NULL;
+    Py_buffer v;
+    if (get_buffer(args[0], &v, F64, -1, 0, "values") < 0) return NULL;
+    const double *x = v.buf;
+    int ok = 1;
+    for (Py_ssize_t i = 0; i < v.len / 8; i++) ok = ok && isfinite(x[i]);
+    PyBuffer_Release(&v);
+    return PyBool_FromLong(ok);
+}
+
+#define FAST(name, doc) {#name, (PyCFunction)(void (*)(void))k_##name, METH_FASTCALL, doc}
+
+PyMethodDef om_kernel_functions[] = {
+    FAST(fk, "fk(table, base, tool, Q, out)"),
+    FAST(jacobian, "jacobian(table, base, tool, q, J)"),
+    FAST(flange, "flange(table, q, R, p)"),
+    FAST(flange_target, "flange_target(T, T_base_root, T_tool_flange, R, p)"),
+    FAST(model_ik, "model_ik(family, P, table, R, p, signs, redundancy, q_prev, q, all_joints) -> margin"),
+    FAST(model_ik_at_reach, "model_ik_at_reach(P, R, p, signs, psi, q_prev, q) -> bool"),
+    FAST(model_ik_lifted, "model_ik_lifted(P, R, p, signs, psi, q1, q7, phi4, q) -> residuals"),
+    FAST(branch_values, "branch_values(family, P, q, out)"),
+    FAST(redundancy_values, "redundancy_values(family, P, q, out)"),
+    FAST(arm_angle_gradient, "arm_angle_gradient(P, table, q, grad) -> psi"),
+    FAST(pose_is_valid, "pose_is_valid(T, tolerance) -> bool"),
+    FAST(all_finite, "all_finite(values) -> bool"),
+    {NULL, NULL, 0, NULL},
+};

@@ -1,0 +1,298 @@
+/* The Solver type: a solver's fixed data, copied once, and its solve calls. */
+#include <string.h>
+
+#include "binding.h"
+
+/* ------------------------------------------------------------------------------------ */
+/* Solver: the solver's fixed data, copied once.                                          */
+
+typedef struct {
+    PyObject_HEAD
+    om_solver_data data;
+    double *storage; /* params, tables, limits */
+    uint8_t revolute[OM_MAX_DOF];
+} Solver;
+
+static void Solver_dealloc(Solver *self) {
+    PyMem_Free(self->storage);
+    Py_TYPE(self)->tp_free((PyObject *)self);
+}
+
+static int attr_long(PyObject *obj, const char *name, long *out) {
+    PyObject *v = PyObject_GetAttrString(obj, name);
+    if (!v) return -1;
+    *out = PyLong_AsLong(v);
+    Py_DECREF(v);
+    return (*out == -1 && PyErr_Occurred()) ? -1 : 0;
+}
+
+static int attr_double(PyObject *obj, const char *name, double *out) {
+    PyObject *v = PyObject_GetAttrString(obj, name);
+    if (!v) return -1;
+    *out = PyFloat_AsDouble(v);
+    Py_DECREF(v);
+    return (*out == -1.0 && PyErr_Occurred()) ? -1 : 0;
+}
+
+/* Copy the float64 array attribute `name` (n entries, or any size if n < 0) into dst (if
+ * not NULL); returns its entry count, -1 on error. */
+static Py_ssize_t attr_copy(PyObject *obj, const char *name, double *dst, Py_ssize_t n) {
+    PyObject *v = PyObject_GetAttrString(obj, name);
+    if (!v) return -1;
+    Py_buffer view;
+    int rc = get_buffer(v, &view, F64, n, 0, name);
+    Py_DECREF(v);
+    if (rc < 0) return -1;
+    Py_ssize_t count = view.len / 8;
+    if (dst) memcpy(dst, view.buf, view.len);
+    PyBuffer_Release(&view);
+    return count;
+}
+
+/* Solver(data): data is an om_redundant SolverData named tuple. */
+static int Solver_init(Solver *self, PyObject *args, PyObject *kwds) {
+    PyObject *d;
+    static char *kwlist[] = {"data", NULL};
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "O", kwlist, &d)) return -1;
+    om_solver_data *s = &self->data;
+    long family, mode, dp_joint, scan_points;
+    if (attr_long(d, "family", &family) || attr_long(d, "mode", &mode) || attr_long(d, "dp_joint", &dp_joint) ||
+        attr_long(d, "scan_points", &scan_points) || attr_double(d, "position_tolerance", &s->tol_pos) ||
+        attr_double(d, "orientation_tolerance", &s->tol_ori))
+        return -1;
+    Py_ssize_t n_params = attr_copy(d, "params", NULL, -1);
+    Py_ssize_t n_model = attr_copy(d, "model_table", NULL, -1);
+    Py_ssize_t n_real = attr_copy(d, "real_table", NULL, -1);
+    Py_ssize_t dof = attr_copy(d, "lower", NULL, -1);
+    if (n_params < 0 || n_model < 0 || n_real < 0 || dof < 0) return -1;
+    if (dof < 1 || dof > OM_MAX_DOF || n_model % 6 || n_real % 6) {
+        PyErr_SetString(PyExc_ValueError, "malformed solver data (dof or table shape)");
+        return -1;
+    }
+    PyMem_Free(self->storage);
+    self->storage = PyMem_Malloc(sizeof(double) * (n_params + n_model + n_real + 2 * dof));
+    if (!self->storage) {
+        PyErr_NoMemory();
+        return -1;
+    }
+    double *params = self->storage, *model = params + n_params, *real = model + n_model;
+    double *lower = real + n_real, *upper = lower + dof;
+    double D[18];
+    if (attr_copy(d, "params", params, n_params) < 0 || attr_copy(d, "model_table", model, n_model) < 0 ||
+        attr_copy(d, "real_table", real, n_real) < 0 || attr_copy(d, "lower", lower, dof) < 0 ||
+        attr_copy(d, "upper", upper, dof) < 0 || attr_copy(d, "dp_coefficients", D, 18) < 0 ||
+        attr_copy(d, "T_base_root", s->T_base_root, 16) < 0 || attr_copy(d, "T_tool_flange", s->T_tool_flange, 16) < 0)
+        return -1;
+    PyObject *rev = PyObject_GetAttrString(d, "revolute");
+    if (!rev) return -1;
+    Py_buffer view;
+    int rc = get_buffer(rev, &view, U8, dof, 0, "revolute");
+    Py_DECREF(rev);
+    if (rc < 0) return -1;
+    for (Py_ssize_t j = 0; j < dof; j++) self->revolute[j] = ((const uint8_t *)view.buf)[j] != 0;
+    PyBuffer_Release(&view);
+    memcpy(s->D, D, sizeof D);
+    s->family = (int)family;
+    s->mode = (int)mode;
+    s->dof = (int)dof;
+    s->n_signs = 3;
+    s->n_redundancy = family == OM_SRS ? 1 : 0;
+    s->dp_joint = (int)dp_joint;
+    s->params = params;
+    s->model_table = model;
+    s->n_model_rows = (int)(n_model / 6);
+    s->real_table = real;
+    s->n_real_rows = (int)(n_real / 6);
+    s->revolute = self->revolute;
+    s->lower = lower;
+    s->upper = upper;
+    s->scan_points = (int)scan_points;
+    if (s->scan_points < 8 || (s->mode == OM_CIRCLE && (dp_joint < 0 || dp_joint >= dof))) {
+        PyErr_SetString(PyExc_ValueError, "malformed solver data (scan points or dp joint)");
+        return -1;
+    }
+    return 0;
+}
+
+static PyObject *result_tuple(om_result r) {
+    return Py_BuildValue("(iddLO)", r.status, r.position_error, r.orientation_error, (long long)r.evaluations,
+                         r.within_limits ? Py_True : Py_False);
+}
+
+/* The target of a solve: signs and redundancy values (the configuration's tuples) and the
+ * pose T (16 float64). Returns -1 with an exception set. */
+static int get_target(const om_solver_data *s, PyObject *const *args, int64_t *signs, double *redundancy,
+                      Py_buffer *T) {
+    if (get_signs(args[1], signs, s->n_signs) < 0 || get_doubles(args[2], redundancy, s->n_redundancy, "redundancy") < 0)
+        return -1;
+    return get_buffer(args[0], T, F64, 16, 0, "T");
+}
+
+/* solve(T, signs, redundancy, hint, q_out) -> (status, position error, orientation error,
+ * evaluations, within limits). hint None: no hint. */
+static PyObject *Solver_solve(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
+    if (nargs != 5) {
+        PyErr_SetString(PyExc_TypeError, "solve takes (T, signs, redundancy, hint, q_out)");
+        return NULL;
+    }
+    const om_solver_data *s = &self->data;
+    int64_t signs[3];
+    double redundancy[1];
+    Py_buffer T, hint, q;
+    if (get_target(s, args, signs, redundancy, &T) < 0) return NULL;
+    int has_hint = args[3] != Py_None;
+    if (has_hint && get_buffer(args[3], &hint, F64, s->dof, 0, "q_hint") < 0) {
+        PyBuffer_Release(&T);
+        return NULL;
+    }
+    if (get_buffer(args[4], &q, F64, s->dof, 1, "q_out") < 0) {
+        PyBuffer_Release(&T);
+        if (has_hint) PyBuffer_Release(&hint);
+        return NULL;
+    }
+    om_result r;
+    Py_BEGIN_ALLOW_THREADS r = om_solve_one(s, T.buf, signs, redundancy, has_hint ? hint.buf : NULL, q.buf);
+    Py_END_ALLOW_THREADS PyBuffer_Release(&T);
+    if (has_hint) PyBuffer_Release(&hint);
+    PyBuffer_Release(&q);
+    return result_tuple(r);
+}
+
+/* solve_rows(Ts, signs, redundancy, hints, start, stop, q_out, info): rows start:stop of a
+ * batch; Ts (M, 4, 4), signs (M, k) int64, redundancy (M, r), hints (M, dof) or None,
+ * q_out (M, dof), info (M, 5) gets (status, position error, orientation error,
+ * evaluations, within limits). */
+static PyObject *Solver_solve_rows(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
+    if (nargs != 8) {
+        PyErr_SetString(PyExc_TypeError, "solve_rows takes (Ts, signs, redundancy, hints, start, stop, q_out, info)");
+        return NULL;
+    }
+    const om_solver_data *s = &self->data;
+    Py_ssize_t start = PyLong_AsSsize_t(args[4]), stop = PyLong_AsSsize_t(args[5]);
+    if (PyErr_Occurred()) return NULL;
+    Py_buffer bufs[6];
+    int n_bufs = 0, has_hint = args[3] != Py_None;
+    Py_buffer *T = &bufs[n_bufs];
+    if (get_buffer(args[0], T, F64, -1, 0, "Ts") < 0) return NULL;
+    n_bufs++;
+    Py_ssize_t m = T->len / (16 * 8);
+    PyObject *result = NULL;
+    if (T->len != m * 16 * 8 || start < 0 || stop > m || start > stop) {
+        PyErr_SetString(PyExc_ValueError, "Ts must be (M, 4, 4) and 0 <= start <= stop <= M");
+        goto done;
+    }
+    Py_buffer *signs = &bufs[n_bufs];
+    if (get_buffer(args[1], signs, I64, m * s->n_signs, 0, "signs") < 0) goto done;
+    n_bufs++;
+    Py_buffer *red = &bufs[n_bufs];
+    if (get_buffer(args[2], red, F64, m * s->n_redundancy, 0, "redundancy") < 0) goto done;
+    n_bufs++;
+    Py_buffer *hints = NULL;
+    if (has_hint) {
+        hints = &bufs[n_bufs];
+        if (get_buffer(args[3], hints, F64, m * s->dof, 0, "q_hint") < 0) goto done;
+        n_bufs++;
+    }
+    Py_buffer *q = &bufs[n_bufs];
+    if (get_buffer(args[6], q, F64, m * s->dof, 1, "q_out") < 0) goto done;
+    n_bufs++;
+    Py_buffer *info = &bufs[n_bufs];
+    if (get_buffer(args[7], info, F64, m * 5, 1, "info") < 0) goto done;
+    n_bufs++;
+    {
+        const double *Tb = T->buf, *rb = red->buf, *hb = has_hint ? hints->buf : NULL;
+        const int64_t *sb = signs->buf;
+        double *qb = q->buf, *ib = info->buf;
+        int dof = s->dof, k = s->n_signs, nr = s->n_redundancy;
+        Py_BEGIN_ALLOW_THREADS for (Py_ssize_t i = start; i < stop; i++) {
+            om_result r = om_solve_one(s, Tb + 16 * i, sb + k * i, rb + nr * i, hb ? hb + dof * i : NULL, qb + dof * i);
+            double *row = ib + 5 * i;
+            row[0] = r.status;
+            row[1] = r.position_error;
+            row[2] = r.orientation_error;
+            row[3] = (double)r.evaluations;
+            row[4] = r.within_limits;
+        }
+        Py_END_ALLOW_THREADS
+    }
+    result = Py_NewRef(Py_None);
+done:
+    for (int i = 0; i < n_bufs; i++) PyBuffer_Release(&bufs[i]);
+    return result;
+}
+
+/* solve_all(T, signs, redundancy, roots, info) -> (count, evaluations); roots (MAX_ROOTS,
+ * dof), info (MAX_ROOTS, 3) gets (position error, orientation error, within limits). */
+static PyObject *Solver_solve_all(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
+    if (nargs != 5) {
+        PyErr_SetString(PyExc_TypeError, "solve_all takes (T, signs, redundancy, roots, info)");
+        return NULL;
+    }
+    const om_solver_data *s = &self->data;
+    int64_t signs[3];
+    double redundancy[1];
+    Py_buffer T, roots, info;
+    if (get_target(s, args, signs, redundancy, &T) < 0) return NULL;
+    if (get_buffer(args[3], &roots, F64, OM_MAX_ROOTS * s->dof, 1, "roots") < 0) {
+        PyBuffer_Release(&T);
+        return NULL;
+    }
+    if (get_buffer(args[4], &info, F64, OM_MAX_ROOTS * 3, 1, "info") < 0) {
+        PyBuffer_Release(&T);
+        PyBuffer_Release(&roots);
+        return NULL;
+    }
+    int n;
+    int64_t evaluations;
+    Py_BEGIN_ALLOW_THREADS n = om_solve_all(s, T.buf, signs, redundancy, roots.buf, info.buf, &evaluations);
+    Py_END_ALLOW_THREADS PyBuffer_Release(&T);
+    PyBuffer_Release(&roots);
+    PyBuffer_Release(&info);
+    return Py_BuildValue("(iL)", n, (long long)evaluations);
+}
+
+/* configuration_values(q, branch, redundancy): the branch quantities and redundancy values at q. */
+static PyObject *Solver_configuration_values(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
+    if (nargs != 3) {
+        PyErr_SetString(PyExc_TypeError, "configuration_values takes (q, branch, redundancy)");
+        return NULL;
+    }
+    const om_solver_data *s = &self->data;
+    Py_buffer q, b, r;
+    if (get_buffer(args[0], &q, F64, s->dof, 0, "q") < 0) return NULL;
+    if (get_buffer(args[1], &b, F64, s->n_signs, 1, "branch") < 0) {
+        PyBuffer_Release(&q);
+        return NULL;
+    }
+    if (get_buffer(args[2], &r, F64, s->n_redundancy, 1, "redundancy") < 0) {
+        PyBuffer_Release(&q);
+        PyBuffer_Release(&b);
+        return NULL;
+    }
+    om_branch_values(s->family, s->params, q.buf, b.buf);
+    om_redundancy_values(s->family, s->params, q.buf, r.buf);
+    PyBuffer_Release(&q);
+    PyBuffer_Release(&b);
+    PyBuffer_Release(&r);
+    Py_RETURN_NONE;
+}
+
+static PyMethodDef Solver_methods[] = {
+    {"solve", (PyCFunction)(void (*)(void))Solver_solve, METH_FASTCALL, "One solve; see om_redundant.om.solver."},
+    {"solve_rows", (PyCFunction)(void (*)(void))Solver_solve_rows, METH_FASTCALL, "Rows of a batch."},
+    {"solve_all", (PyCFunction)(void (*)(void))Solver_solve_all, METH_FASTCALL, "Every root in a configuration."},
+    {"configuration_values", (PyCFunction)(void (*)(void))Solver_configuration_values, METH_FASTCALL,
+     "Branch quantities and redundancy values at q."},
+    {NULL, NULL, 0, NULL},
+};
+
+PyTypeObject om_SolverType = {
+    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "om_redundant.ckernels.Solver",
+    .tp_doc = "The OM solver's fixed data, compiled: Solver(SolverData).",
+    .tp_basicsize = sizeof(Solver),
+    .tp_flags = Py_TPFLAGS_DEFAULT,
+    .tp_new = PyType_GenericNew,
+    .tp_init = (initproc)Solver_init,
+    .tp_dealloc = (destructor)Solver_dealloc,
+    .tp_methods = Solver_methods,
+};
