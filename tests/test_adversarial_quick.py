@@ -1,0 +1,62 @@
+"""The adversarial benchmark's cheap classes on a tiny sample: no wrong ok, no stray exception.
+
+``python -m benchmarks.adversarial`` runs them at full size on every arm; here its own
+functions run on two arms (a 6-DOF arm and the 7-DOF torus arm with unlimited joints) in a
+few seconds. The singular class and the bad-input list are not asserted here.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+import om_redundant as om
+from benchmarks import adversarial as adv
+
+ARMS = ["ur5e", "gen3"]
+CLASSES = {
+    "random": lambda run: adv.run_random(run, 200),
+    "huge/tiny": lambda run: adv.run_huge_tiny(run, 20),
+    "layouts": lambda run: adv.run_layouts(run, 4),
+    "repeated": lambda run: adv.run_repeated(run, 30),
+}
+
+
+def _failures(run: adv.ArmRun) -> str:
+    return "\n".join(adv.reproducer(f) for f in run.result.failures)
+
+
+@pytest.mark.parametrize("cls", list(CLASSES))
+@pytest.mark.parametrize("name", ARMS)
+def test_no_wrong_ok_and_no_stray_exception(name, cls):
+    run = adv.ArmRun(name, seed=7)
+    tally = CLASSES[cls](run)
+    assert tally.calls > 0 and tally.ok > 0
+    assert tally.wrong_ok == 0, _failures(run)
+    assert tally.foreign == 0, _failures(run)
+    if cls in ("layouts", "repeated"):  # these classes exist to compare answers
+        assert tally.differs == 0, _failures(run)
+
+
+@pytest.mark.parametrize("name", ["ur5e", "panda"])
+def test_the_check_catches_a_wrong_answer(name):
+    """The benchmark's own check (deferred and vectorised, or one at a time) flags a miss of
+    1e-9 rad, a wrong within_limits, the other branch and (7-DOF) another psi."""
+
+    class Fake:
+        def __init__(self, q, within=True):
+            self.q, self.ok, self.status, self.within_limits = q, True, "ok", within
+
+    for deferred in (True, False):
+        run = adv.ArmRun(name, seed=1)
+        tally = run.tally("check")
+        q = run.random_q(1)[0]
+        T, c = run.arm.fk(q), run.solver.configuration_of(q)
+        run.pending = [] if deferred else None
+        cases = [(Fake(q), c), (Fake(q + 1e-9), c), (Fake(q, within=False), c), (Fake(q), adv.flipped(c, 2))]
+        if c.redundancy:
+            cases.append((Fake(q), om.Configuration(c.signs, (c.redundancy[0] + 2e-9,))))
+        for sol, config in cases:
+            run.judge(tally, "check", sol, T, config, True)
+        run.flush()
+        assert tally.ok == len(cases)
+        assert tally.wrong_ok == len(cases) - 1, _failures(run)
