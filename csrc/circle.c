@@ -1,8 +1,8 @@
 /* The bounded search on the circle: every root of g(w), the paper's guarantee
- * (port of om_redundant/_system/circle.py). */
+ * (the method: om_redundant/om/system.py). */
 #include "om_system.h"
 
-/* out[n] = v if there is room; returns the new count (numba assumed the room). */
+/* out[n] = v if there is room; returns the new count (the candidates' capacity is a bound, checked). */
 static int _put(double *out, int n, int cap, double v)
 {
     if (n >= cap)

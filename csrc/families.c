@@ -1,4 +1,4 @@
-/* Dispatch on the family code: a port of om_redundant/closed_form/families.py. */
+/* Dispatch on the family code (om_redundant/om/families/dispatch.py calls it from Python). */
 #include "om_kernels.h"
 
 /* Solve the model arm for the flange pose (R, p) in DH frame 0; write q. redundancy[0] is the arm

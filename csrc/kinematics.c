@@ -1,5 +1,5 @@
-/* DH chains: a port of the numba kernels of om_redundant/kinematics.py (fk and the Jacobian
- * in their BLAS-free form: explicit 4x4 products and rigid transforms, sums left to right).
+/* DH chains (om_redundant/kinematics/chain.py is the typed front): FK and the Jacobian as
+ * explicit 4x4 products and rigid transforms, sums left to right.
  * A table row is (a, d, theta, cos(alpha), sin(alpha), kind). */
 #include "om_kernels.h"
 

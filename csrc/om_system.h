@@ -1,5 +1,5 @@
 /* Private helpers of the OM system's kernels (residual.c ... solve.c): Python's float
- * semantics where the numba sources rely on them. Not part of the binding's contract. */
+ * semantics where the algorithm relies on them. Not part of the binding's contract. */
 #ifndef OM_SYSTEM_H
 #define OM_SYSTEM_H
 
@@ -17,8 +17,8 @@ static inline double py_min(double a, double b) { return b < a ? b : a; }
 /* Python's a % n for n > 0 (never negative). */
 static inline int py_mod(int a, int n) { int r = a % n; return r < 0 ? r + n : r; }
 
-/* numba's q = np.empty(dof) holds heap garbage that verify may read (see solve.c); a C
- * scratch joint vector starts as NaN instead, which verify always rejects. */
+/* A scratch joint vector starts as NaN: a check of joints never written (a local solve whose
+ * first point is out of reach) then always fails, never depends on what a previous call left. */
 static inline void nan_fill(double *q, int n) { for (int j = 0; j < n; j++) q[j] = NAN; }
 
 #endif

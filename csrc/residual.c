@@ -1,5 +1,5 @@
 /* The residual of the OM system (9), reduced to the circle or lifted on the torus
- * (port of om_redundant/_system/residual.py). Each evaluation counts in pb->counter. */
+ * (the method: om_redundant/om/system.py). Each evaluation counts in pb->counter. */
 #include "om_system.h"
 
 /* dp seen from the flange, delta(w) = D0 + D1 cos w + D2 sin w (rows 0-2 of D). */

@@ -1,5 +1,5 @@
 /* Root and extremum finders in one unknown w, on the residual g of the circle
- * (port of om_redundant/_system/scalar.py). */
+ * (the method: om_redundant/om/system.py). */
 #include "om_system.h"
 
 #define LAST_STEP 1e-5 /* a secant step (rad) below which the next iterate is evaluated with every joint */

@@ -1,5 +1,5 @@
 /* The solve strategies on one problem: local solve, bounded search, and what they answer
- * (port of om_redundant/_system/search.py). */
+ * (the method: om_redundant/om/system.py). */
 #include "om_system.h"
 
 #define TORUS_SIDE 0.75  /* the torus grid has TORUS_SIDE * scan points nodes per side */
@@ -12,7 +12,7 @@ int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre
 {
     const om_solver_data *data = pb->s;
     double q[OM_MAX_DOF];
-    nan_fill(q, OM_MAX_DOF); /* numba: np.empty */
+    nan_fill(q, OM_MAX_DOF); /* unwritten joints read as NaN, which verify rejects */
     if (data->mode == OM_FIXED) {
         double gw = om_g(pb, 0.0, q, true);
         return isnan(gw) ? 0 : om_add_root(pb, q, roots, 0);
@@ -74,7 +74,7 @@ bool om_local_solve(om_problem *pb, const double *start, double *q, double *pos,
 }
 
 /* Whether any configuration other than the problem's has a solution. The other
- * configurations' evaluations count in pb->counter (numba shares the counter array). */
+ * configurations' evaluations count in pb->counter (one counter per solve). */
 bool om_exists_other(om_problem *pb)
 {
     const int64_t *signs = pb->signs;

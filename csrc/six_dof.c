@@ -1,5 +1,5 @@
-/* 6-DOF model arms with a spherical wrist (RRR and RRP position families): a port of
- * om_redundant/closed_form/six_dof.py, BLAS-free form (see its docstrings for the math). */
+/* 6-DOF model arms with a spherical wrist (RRR and RRP position families): the math is in
+ * om_redundant/om/families/six_dof.py. */
 #include "om_kernels.h"
 
 /* Python's max(a, b) and min(a, b) on floats: the first unless the second compares greater (less). */
@@ -36,7 +36,7 @@ static double position_and_wrist(int family, const double *P, const double *tabl
     double phi2;
     if (family == OM_RRR_SPHERICAL_WRIST) {
         double l3 = P[SD_ELL3];
-        double outer = fabs(a2) + l3, inner = fabs(a2) - l3; /* (.)**2 is x * x in numba */
+        double outer = fabs(a2) + l3, inner = fabs(a2) - l3; 
         k = (outer * outer - D) * (D - inner * inner);
         margin = py_min(margin, k / py_max(D * D, 1.0));
         if (margin < -OM_REACH_SLACK)

@@ -1,5 +1,5 @@
 /* The entry points: one solve, and every root of one configuration
- * (port of om_redundant/_system/entry.py's solve_one and solve_all). */
+ * (the method: om_redundant/om/system.py). */
 #include "om_system.h"
 
 #define START_POINTS 8 /* starts on the dp circle when p_d is out of reach or a first root out of limits */
@@ -106,8 +106,8 @@ om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *
     problem.counter = 0;
     om_problem *pb = &problem;
     double q[OM_MAX_DOF], start[OM_MAX_DOF];
-    /* numba: np.empty. local_solve verifies q even where the secant's first point is out of
-     * reach and q was never written; NaN makes that verification fail deterministically. */
+    /* local_solve verifies q even where the secant's first point is out of reach and q was
+     * never written; NaN makes that verification fail deterministically. */
     nan_fill(q, OM_MAX_DOF);
     memcpy(start, hint, (size_t)dof * sizeof(double));
     bool found = has_hint;

@@ -1,6 +1,6 @@
-/* 7-DOF S-R-S model arms (spherical shoulder, elbow, spherical wrist): a port of
- * om_redundant/closed_form/srs.py and of arm_angle_gradient_kernel in om_redundant/arm_angle.py
- * (see their docstrings for the math and the parameter layout). */
+/* 7-DOF S-R-S model arms (spherical shoulder, elbow, spherical wrist) and the arm angle's
+ * gradient: the math and the parameter layout are in the docstrings of
+ * om_redundant/om/families/srs.py and om_redundant/redundancy/arm_angle.py. */
 #include "om_kernels.h"
 
 #define DEGENERATE 1e-12 /* |W - S|^2 below which the wrist centre is at the shoulder centre */

@@ -1,5 +1,5 @@
 /* Damped Newton on the lifted system, and the bounded search on the torus
- * (port of om_redundant/_system/torus.py). */
+ * (the method: om_redundant/om/system.py). */
 #include "om_system.h"
 
 #define TORUS_SIDE 0.75        /* the torus grid has TORUS_SIDE * scan points nodes per side (search.c) */
@@ -19,7 +19,7 @@ double om_newton(om_problem *pb, vec3 x, double *q, const double *known, int n_k
     double r = om_max_norm(F);
     double eps = 1e-7;
     int slow = 0;
-    vec3 Fn = v3(NAN, NAN, NAN); /* numba: unbound until the first damped step (see the report) */
+    vec3 Fn = v3(NAN, NAN, NAN); /* set by the first damped step; NaN until then */
     for (int it = 0; it < 30; it++) {
         if (!(r < INFINITY) || r < 1e-15 || slow == STALL)
             break;
@@ -82,8 +82,8 @@ static bool _crosses(const double *A, int m, int i, int j)
     return lo <= 0.0 && 0.0 <= hi && hi - lo < OM_PI;
 }
 
-/* The known roots: numba's (64, 3) array, grown here rather than written past its end
- * (torus_roots can append beyond _MAX_KNOWN; see the report). */
+/* The known roots (n x 3), grown as needed: the fold-partner search can add roots after the
+ * first MAX_KNOWN, and must never write past the end. */
 typedef struct {
     double *x; /* cap x 3 */
     int cap;
@@ -190,7 +190,7 @@ static int _fold_partners(om_problem *pb, vec3 x, double reach, double *q, vec3 
 int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, double radius)
 {
     double q[OM_MAX_DOF];
-    nan_fill(q, OM_MAX_DOF); /* numba: np.empty (read as E where W = S at the first node) */
+    nan_fill(q, OM_MAX_DOF); /* read as E where W = S at the first node: NaN */
     bool whole = radius >= OM_PI;
     double lo1, lo7, span;
     if (whole) {
