@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 
 import om_redundant as om
+from benchmarks.menagerie import frame_pose
 from om_redundant.cli import main
 from om_redundant.mujoco_io.arm_import import IMPORT_TOLERANCE
 from tests.conftest import MENAGERIE, random_q, wrap
@@ -85,21 +86,6 @@ def same_arm(a: om.Arm, b: om.Arm) -> bool:
         and (a.name, a.joint_names, a.description) == (b.name, b.joint_names, b.description)
         and (a.mujoco_model, a.frame_name, a.frame_type) == (b.mujoco_model, b.frame_name, b.frame_type)
     )
-
-
-def frame_pose(model: mujoco.MjModel, data: mujoco.MjData, arm: om.Arm, q: np.ndarray) -> np.ndarray:
-    """MuJoCo's own pose of the arm's frame at qpos = q (the reference models hold only the arm
-    and, for some, fingers at qpos0)."""
-    ids = [model.joint(n).id for n in arm.joint_names]
-    data.qpos[:] = model.qpos0
-    data.qpos[model.jnt_qposadr[ids]] = q
-    mujoco.mj_kinematics(model, data)
-    T = np.eye(4)
-    if arm.frame_type == "site":
-        T[:3, :3], T[:3, 3] = data.site(arm.frame_name).xmat.reshape(3, 3), data.site(arm.frame_name).xpos
-    else:
-        T[:3, :3], T[:3, 3] = data.body(arm.frame_name).xmat.reshape(3, 3), data.body(arm.frame_name).xpos
-    return T
 
 
 # ---------------------------------------------------------------------------------------

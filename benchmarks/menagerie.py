@@ -1,0 +1,161 @@
+"""Arms brought by their MuJoCo models: every reference Menagerie arm imported and solved.
+
+Run: ``python -m benchmarks.menagerie [--n 10000] [--seed 0]``; writes
+``results/menagerie.md``. For each arm in ``../shared/reference/menagerie`` (kinematics-only
+copies of MuJoCo Menagerie models): ``om.arm_from_mujoco`` imports it, ``check-model``'s
+comparison measures the arm file against the model over 1,000 random q, and where
+``OMSolver`` accepts the arm, N random in-limit q are solved against MuJoCo's OWN frame pose
+(``mj_kinematics`` of the Menagerie model at qpos = q): q among ``solve_all(T, c)`` with c its
+configuration, every root reaching T (1e-10 m, 1e-10 rad, MuJoCo's FK) in configuration c,
+and the hinted solve returning q or a root nearer the hint. An arm OMSolver refuses is listed
+with its ModelError.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+import om_redundant as om
+
+from .report import write_page
+
+MENAGERIE = Path(__file__).resolve().parents[2] / "shared" / "reference" / "menagerie"
+
+#: name: (model file, frame, frame type).
+REFERENCE = {
+    "panda_nohand": ("franka_emika_panda/panda_nohand.xml", "attachment_site", "site"),
+    "fr3": ("franka_fr3/fr3.xml", "attachment_site", "site"),
+    "iiwa14": ("kuka_iiwa_14/iiwa14.xml", "attachment_site", "site"),
+    "gen3": ("kinova_gen3/gen3.xml", "pinch_site", "site"),
+    "xarm7_nohand": ("ufactory_xarm7/xarm7_nohand.xml", "attachment_site", "site"),
+    "sawyer": ("rethink_robotics_sawyer/sawyer.xml", "attachment_site", "site"),
+    "ur5e": ("universal_robots_ur5e/ur5e.xml", "wrist_3_link", "body"),
+    "ur10e": ("universal_robots_ur10e/ur10e.xml", "attachment_site", "site"),
+    "flexiv_rizon4": ("flexiv_rizon4/flexiv_rizon4.xml", "link7", "body"),
+    "wx250s": ("trossen_wx250s/wx250s.xml", "wx250s/gripper_link", "body"),
+    "piper": ("agilex_piper/piper.xml", "link6", "body"),
+    "lite6": ("ufactory_lite6/lite6.xml", "attachment_site", "site"),
+}
+
+
+def import_reference(name: str) -> tuple[om.Arm, mujoco.MjModel]:
+    """The imported arm of a reference model, and the model (meshes and textures skipped)."""
+    path, frame, frame_type = REFERENCE[name]
+    return om.arm_from_mujoco(MENAGERIE / path, frame, frame_type), om.load_mujoco_model(MENAGERIE / path)
+
+
+def frame_pose(model: mujoco.MjModel, data: mujoco.MjData, arm: om.Arm, q: np.ndarray) -> np.ndarray:
+    """MuJoCo's own pose of the arm's frame at qpos = q (other joints, e.g. fingers, at qpos0)."""
+    ids = [model.joint(n).id for n in arm.joint_names]
+    data.qpos[:] = model.qpos0
+    data.qpos[model.jnt_qposadr[ids]] = q
+    mujoco.mj_kinematics(model, data)
+    frame = data.site(arm.frame_name) if arm.frame_type == "site" else data.body(arm.frame_name)
+    T = np.eye(4)
+    T[:3, :3], T[:3, 3] = frame.xmat.reshape(3, 3), frame.xpos
+    return T
+
+
+def _random_q(arm: om.Arm, n: int, rng: np.random.Generator) -> np.ndarray:
+    lower = np.where(np.isfinite(arm.lower), arm.lower, -np.pi)
+    upper = np.where(np.isfinite(arm.upper), arm.upper, np.pi)
+    return rng.uniform(lower, upper, (n, arm.dof))
+
+
+def _distance(arm: om.Arm, a: np.ndarray, b: np.ndarray) -> float:
+    d = a - b
+    return float(np.abs(np.where(arm.revolute, np.remainder(d + np.pi, 2 * np.pi) - np.pi, d)).max())
+
+
+def _angle(R: np.ndarray, S: np.ndarray) -> float:
+    E = R.T @ S
+    s = 0.5 * np.linalg.norm([E[2, 1] - E[1, 2], E[0, 2] - E[2, 0], E[1, 0] - E[0, 1]])
+    return float(np.arctan2(s, 0.5 * (np.trace(E) - 1.0)))
+
+
+def measure(name: str, n: int, seed: int) -> dict:
+    """One arm's row: import, check-model, acceptance and the exact solves."""
+    arm, model = import_reference(name)
+    row: dict = {"arm": name, "model": REFERENCE[name][0], "dof": arm.dof}
+    comparison = om.compare_mujoco_model(arm, model, samples=1000)
+    row["check-model"] = f"{comparison.max_position_error:.1e} m / {comparison.max_orientation_error:.1e} rad"
+    try:
+        solver = om.OMSolver(arm)
+    except om.ModelError as error:
+        row["solver"] = f"refused: {error}"
+        return row
+    row["solver"] = f"accepted ({solver.om.family_name.split(':')[0]})"
+    data = mujoco.MjData(model)
+    among = hinted = nearer = wrong = roots_total = 0
+    worst_position = worst_orientation = 0.0
+    start = time.perf_counter()
+    for q in _random_q(arm, n, np.random.default_rng(seed)):
+        T = frame_pose(model, data, arm, q)
+        c = solver.configuration_of(q)
+        roots = solver.solve_all(T, c)
+        roots_total += len(roots)
+        among += any(_distance(arm, r.q, q) < 1e-7 for r in roots)
+        for root in roots:
+            reached = frame_pose(model, data, arm, root.q)
+            position = float(np.linalg.norm(reached[:3, 3] - T[:3, 3]))
+            orientation = _angle(T[:3, :3], reached[:3, :3])
+            worst_position, worst_orientation = (
+                max(worst_position, position),
+                max(worst_orientation, orientation),
+            )
+            wrong += position > 1e-10 or orientation > 1e-10 or not solver.configuration_of(root.q).isclose(c)
+        sol = solver.solve(T, c, q_hint=q)
+        if sol.ok and _distance(arm, sol.q, q) < 1e-7:
+            hinted += 1
+        elif sol.ok:
+            nearer += (
+                float(np.linalg.norm(sol.q - q))
+                <= min((float(np.linalg.norm(r.q - q)) for r in roots), default=np.inf) + 1e-9
+            )
+    row.update(
+        {
+            "q among solve_all": f"{100 * among / n:.3f} %",
+            "hinted solve returns q": f"{100 * hinted / n:.3f} %",
+            "... or a nearer root": f"{100 * (hinted + nearer) / n:.3f} %",
+            "roots per (pose, c)": f"{roots_total / n:.3f}",
+            "roots not exact or not in c": str(wrong),
+            "max error (MuJoCo's FK)": f"{worst_position:.1e} m / {worst_orientation:.1e} rad",
+            "s": f"{time.perf_counter() - start:.0f}",
+        }
+    )
+    return row
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--n", type=int, default=10_000, help="random joint vectors per arm")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--arms", nargs="+", default=list(REFERENCE), choices=list(REFERENCE))
+    args = parser.parse_args()
+    rows = []
+    for name in args.arms:
+        rows.append(measure(name, args.n, args.seed))
+        print(rows[-1], flush=True)
+    keys = [k for k in rows[0] if k not in ("model", "dof")] if rows else []
+    solved_keys = [
+        k for k in (rows[0] if "q among solve_all" in rows[0] else {}) if k not in ("model", "dof")
+    ]
+    keys = solved_keys or keys
+    lines = [
+        f"# Menagerie arms imported and solved ({args.n:,} random q per accepted arm, seed {args.seed})",
+        "",
+        "| " + " | ".join(keys) + " |",
+        "|---" * len(keys) + "|",
+    ]
+    for row in rows:
+        lines.append("| " + " | ".join(str(row.get(k, "-")).replace("|", "\\|") for k in keys) + " |")
+    write_page("menagerie.md", "\n".join(lines) + "\n")
+
+
+if __name__ == "__main__":
+    main()
