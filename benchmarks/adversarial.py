@@ -939,22 +939,29 @@ def ask(solver: om.OMSolver, call: str, T: np.ndarray, c: om.Configuration, hint
     return solver.solve(T, c, q_hint=hint)
 
 
+def answer_all(run: ArmRun, t: Tally, qs: list) -> list[Any]:
+    """Ask every question once, judging each answer; returns their keys (None where a call
+    raised), the reference that later answers must equal."""
+    keys: list[Any] = []
+    for call, T, c, hint, q in qs:
+        done, answer = run.attempt(
+            t, call, lambda call=call, T=T, c=c, h=hint: ask(run.solver, call, T, c, h), q=q, T=T, c=c
+        )
+        keys.append(answer_key(answer) if done else None)
+        if done and call == "solve_all":
+            run.judge_all(t, answer, T, c, False, q=q)
+        elif done:
+            run.judge(t, call, answer, T, c, False, q=q, hint=hint)
+    return keys
+
+
 def run_threads(run: ArmRun, n: int) -> Tally:
     """4 threads sharing the solver agree bit for bit with serial calls; batches equal rows."""
     t = run.tally("threads")
     solver, start = run.solver, time.perf_counter()
     qs = questions(run, n, singular=False)
     t.poses = len(qs)
-    serial: list[Any] = []
-    for call, T, c, hint, q in qs:
-        done, answer = run.attempt(
-            t, call, lambda call=call, T=T, c=c, h=hint: ask(solver, call, T, c, h), q=q, T=T, c=c
-        )
-        serial.append(answer_key(answer) if done else None)
-        if done and call == "solve_all":
-            run.judge_all(t, answer, T, c, False, q=q)
-        elif done:
-            run.judge(t, call, answer, T, c, False, q=q, hint=hint)
+    serial = answer_all(run, t, qs)
     orders = [run.rng.permutation(len(qs)) for _ in range(THREADS)]
 
     def worker(order: np.ndarray) -> list[tuple[int, Any]]:
@@ -1019,16 +1026,7 @@ def run_repeated(run: ArmRun, n: int) -> Tally:
             solver.solve_batch(T[None], c.signs, red, q_hint=None if hint is None else hint[None])
         )[0]
 
-    first: list[Any] = []
-    for call, T, c, hint, q in qs:
-        done, answer = run.attempt(
-            t, call, lambda call=call, T=T, c=c, h=hint: ask(solver, call, T, c, h), q=q, T=T, c=c
-        )
-        first.append(answer_key(answer) if done else None)
-        if done and call == "solve_all":
-            run.judge_all(t, answer, T, c, False, q=q)
-        elif done:
-            run.judge(t, call, answer, T, c, False, q=q, hint=hint)
+    first = answer_all(run, t, qs)
     for i in rng.permutation(len(qs)):
         j = int(rng.integers(len(qs)))  # another question first, by another call
         call, T, c, hint, q = qs[j]
