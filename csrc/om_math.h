@@ -102,4 +102,9 @@ static inline mat3 m_rz_times(double phi, mat3 X)
     return C;
 }
 
+/* Python's max(a, b) on floats: b if b > a else a (so max(NaN, x) is NaN, max(x, NaN) is x). */
+static inline double py_max(double a, double b) { return b > a ? b : a; }
+/* Python's min(a, b) on floats: b if b < a else a. */
+static inline double py_min(double a, double b) { return b < a ? b : a; }
+
 #endif

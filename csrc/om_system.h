@@ -10,10 +10,6 @@
 #include "om_kernels.h"
 
 
-/* Python's max(a, b) on floats: b if b > a else a (so max(NaN, x) is NaN, max(x, NaN) is x). */
-static inline double py_max(double a, double b) { return b > a ? b : a; }
-/* Python's min(a, b) on floats: b if b < a else a. */
-static inline double py_min(double a, double b) { return b < a ? b : a; }
 /* Python's a % n for n > 0 (never negative). */
 static inline int py_mod(int a, int n) { int r = a % n; return r < 0 ? r + n : r; }
 

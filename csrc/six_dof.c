@@ -2,9 +2,6 @@
  * om_redundant/om/families/six_dof.py. */
 #include "om_kernels.h"
 
-/* Python's max(a, b) and min(a, b) on floats: the first unless the second compares greater (less). */
-static double py_max(double a, double b) { return b > a ? b : a; }
-static double py_min(double a, double b) { return b < a ? b : a; }
 
 /* Joints 1-3 for the flange pose (R, p) in DH frame 0 and the ARM and ELBOW signs, into q,
  * and the wrist's rotation M = Rz(phi4) Rx(alpha4) Rz(phi5) Rx(alpha5) Rz(phi6) into *M.

@@ -5,9 +5,6 @@
 
 #define DEGENERATE 1e-12 /* |W - S|^2 below which the wrist centre is at the shoulder centre */
 
-/* Python's max(a, b) and min(a, b) on floats: the first unless the second compares greater (less). */
-static double py_max(double a, double b) { return b > a ? b : a; }
-static double py_min(double a, double b) { return b < a ? b : a; }
 
 /* Rx(alpha) with sin(alpha) = sigma = +-1. */
 static mat3 rx(double sigma)

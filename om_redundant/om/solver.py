@@ -109,16 +109,12 @@ class OMSolver:
     Raises:
         InvalidInput: An argument of the wrong type or out of range (named).
         UnknownArm, ArmFileError: The arm cannot be loaded.
-        ModelError: The OM method has no model arm for this arm.
-
-    Raises:
         ModelError: The arm has no closed-form model (:func:`~.model.derive_model` names the
             condition), or it fails to solve its own pose ``arm.fk(q)`` in the configuration
             of q at one of ``SELF_CHECK_SAMPLES`` seeded random joint vectors within the limits
             (the message names q and the status). An accepted arm's "unreachable" means
             unreachable. The check takes about a millisecond and is done once per
             :class:`Arm` instance and tolerances.
-        InvalidInput: A tolerance or scan_points out of range.
 
     Example::
 
@@ -281,7 +277,6 @@ class OMSolver:
             hints = as_joint_vector(q_hint, self.arm.dof, "q_hint").reshape(-1, self.arm.dof)
             if len(hints) != m:
                 raise InvalidInput(f"q_hint must have {m} rows, got {len(hints)}")
-            hints = system.as_kernel_array(hints)
         q = np.empty((m, self.arm.dof))
         info = np.empty((m, 5))  # status, position error, orientation error, evaluations, within limits
         kernel = self._kernel
