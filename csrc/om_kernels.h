@@ -182,6 +182,21 @@ int om_add_root(om_problem *pb, const double *q, double *roots, int count); /* r
 bool om_representative(double *q, int dof, const uint8_t *revolute, const double *lower, const double *upper,
                        const double *hint, bool has_hint);
 
+/* polish.c: damped Gauss-Newton on the REAL arm's chain toward the flange pose (R, p) in DH
+ * frame 0 and, with P not NULL (an S-R-S model's parameters and model table), the arm angle psi. */
+typedef struct {
+    const double *table; /* the real arm's DH table, n_rows x 6 */
+    int n_rows, dof;
+    const double *P, *model_table; /* P NULL: no arm-angle row */
+    int n_model_rows;
+    mat3 R;
+    vec3 p;
+    double psi;
+} om_polish_task;
+
+/* Refine q in place (at most `iterations` Jacobians); returns the residual's norm at the end. */
+double om_polish(const om_polish_task *t, int iterations, double *q);
+
 /* search.c */
 int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre, double radius);
 bool om_local_solve(om_problem *pb, const double *start, double *q, double *pos, double *ori);
