@@ -22,7 +22,7 @@ def _solver(name: str) -> om.OMSolver:
 
 
 def _assert_exact(solver: om.OMSolver, q: np.ndarray, T: np.ndarray, c: om.Configuration) -> None:
-    """q reaches T within the solver's tolerances (1e-10 m, 1e-9 rad), in configuration c."""
+    """q reaches T within the solver's tolerances (1e-10 m, 1e-10 rad), in configuration c (holds)."""
     reached = solver.arm.fk(q)
     position_tolerance, orientation_tolerance = solver.tolerances
     assert np.linalg.norm(reached[:3, 3] - T[:3, 3]) <= position_tolerance

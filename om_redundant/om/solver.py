@@ -27,7 +27,7 @@ from .configuration import Configuration
 from .model import ModelArm, derive_model
 
 DEFAULT_POSITION_TOLERANCE = 1e-10
-DEFAULT_ORIENTATION_TOLERANCE = 1e-9
+DEFAULT_ORIENTATION_TOLERANCE = 1e-10
 DEFAULT_SCAN_POINTS = 64
 #: |branch quantity| within which a joint vector belongs to both neighbouring configurations
 #: (the singular boundary's band; see :meth:`OMSolver.holds`).
