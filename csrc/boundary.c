@@ -5,33 +5,54 @@
 #include "om_system.h"
 
 #define NEAR_BOUNDARY 1e-2 /* |branch quantity| under which a failed candidate is polished */
-#define POLISH_STEPS 12    /* Jacobians per refinement (it converges in 2-4 where it can) */
-#define ELBOW_SIGN 1       /* (SHOULDER or ARM, ELBOW, WRIST) in every family */
+#define POLISH_STEPS 40    /* Jacobians per refinement: 2-4 at a simple root, more at a double one */
+#define SHOULDER_SIGN 0    /* (SHOULDER or ARM, ELBOW, WRIST) in every family */
+#define ELBOW_SIGN 1
+#define SHOULDER_STARTS 8  /* starts of q1 where the wrist centre is on joint 1's axis */
 #define GATE_POINTS 8      /* free-angle samples of the cheap test before a neighbour's search */
 #define GATE_NEAR 0.2      /* |branch quantity| at a sample that lets a neighbour be searched */
 
-/* Whether some branch quantity of q is within NEAR_BOUNDARY of zero (false for NaN). */
-static bool near_boundary(const om_solver_data *s, const double *q)
+/* The smallest |branch quantity| of q and its index (NaN-safe: INFINITY for NaN). */
+static double nearest_branch(const om_solver_data *s, const double *q, int *index)
 {
-    double values[3];
+    double values[3], nearest = INFINITY;
     om_branch_values(s->family, s->params, q, values);
-    for (int i = 0; i < s->n_signs; i++)
-        if (fabs(values[i]) < NEAR_BOUNDARY)
-            return true;
-    return false;
+    for (int i = 0; i < s->n_signs; i++) {
+        if (fabs(values[i]) < nearest) {
+            nearest = fabs(values[i]);
+            *index = i;
+        }
+    }
+    return nearest;
 }
 
 bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori)
 {
     const om_solver_data *s = pb->s;
-    if (!near_boundary(s, q))
+    int branch = -1;
+    if (!(nearest_branch(s, q, &branch) < NEAR_BOUNDARY))
         return false;
     bool srs = s->family == OM_SRS;
     om_polish_task t = {s->real_table, s->n_real_rows, s->dof, srs ? s->params : NULL,
                         srs ? s->model_table : NULL, s->n_model_rows, pb->R, pb->p,
                         srs ? pb->redundancy[0] : 0.0, srs ? (double)pb->signs[ELBOW_SIGN] : 0.0};
+    double start[OM_MAX_DOF];
+    memcpy(start, q, (size_t)s->dof * sizeof(double));
     om_polish(&t, POLISH_STEPS, q);
-    return om_verify(pb, q, pos, ori);
+    if (om_verify(pb, q, pos, ori))
+        return true;
+    if (branch != SHOULDER_SIGN)
+        return false;
+    /* The wrist centre on joint 1's axis: the model's q1 is arbitrary there (atan2 of a
+     * vanishing pair), the real arm's is not. Starts around the circle of q1. */
+    for (int k = 1; k < SHOULDER_STARTS; k++) {
+        memcpy(q, start, (size_t)s->dof * sizeof(double));
+        q[0] = start[0] + 2.0 * OM_PI * (double)k / (double)SHOULDER_STARTS;
+        om_polish(&t, POLISH_STEPS, q);
+        if (om_verify(pb, q, pos, ori))
+            return true;
+    }
+    return false;
 }
 
 int om_add_candidate(om_problem *pb, double *q, double *roots, int count)
@@ -59,28 +80,41 @@ static om_problem neighbour(const om_problem *pb, int i, int64_t *signs, double 
     return other;
 }
 
-/* Which branches may meet zero, so that a neighbour's root may lie in the band (the cheap
- * test before a neighbour's bounded search): near[i] if branch i of the model's solution in
- * the problem's configuration comes within GATE_NEAR of zero at GATE_POINTS samples of the
- * free angle. (A straight elbow is an edge of reach, found by the touch candidates of the
- * problem's own search.) On the torus every branch is marked. */
-static void may_meet_zero(om_problem *pb, bool *near)
+/* Touch points: GATE_POINTS samples of the free angle w in the problem's own configuration.
+ * Where the model's solution has a branch quantity within NEAR_BOUNDARY of zero, it is a
+ * candidate from the crossing (q_J = w), refined and verified into roots (a singular wrist
+ * aligned to the last bit keeps the previous wrist joint, so g there never crosses zero).
+ * Also the cheap test before a neighbour's bounded search: near[i] if branch i comes within
+ * GATE_NEAR of zero at a sample. (A straight elbow is an edge of reach, found by the touch
+ * candidates of the problem's own search.) On the torus every branch is marked, no touch
+ * point is tried. Returns the root count. */
+static int touch_points(om_problem *pb, bool *near, double *roots)
 {
     const om_solver_data *s = pb->s;
     bool torus = s->mode == OM_TORUS;
     for (int i = 0; i < s->n_signs; i++)
         near[i] = torus;
     if (torus)
-        return;
+        return 0;
     double q[OM_MAX_DOF], values[3];
-    int points = s->mode == OM_FIXED ? 1 : GATE_POINTS;
+    int points = s->mode == OM_FIXED ? 1 : GATE_POINTS, count = 0;
     for (int k = 0; k < points; k++) {
-        if (om_model_ik_at(pb, -OM_PI + 2.0 * OM_PI * (double)k / (double)points, q, true) < -OM_REACH_SLACK)
+        double w = -OM_PI + 2.0 * OM_PI * (double)k / (double)points;
+        if (om_model_ik_at(pb, w, q, true) < -OM_REACH_SLACK)
             continue;
         om_branch_values(s->family, s->params, q, values);
-        for (int i = 0; i < s->n_signs; i++)
+        double nearest = INFINITY;
+        for (int i = 0; i < s->n_signs; i++) {
             near[i] = near[i] || fabs(values[i]) < GATE_NEAR;
+            nearest = py_min(nearest, fabs(values[i]));
+        }
+        if (nearest < NEAR_BOUNDARY) {
+            if (s->mode == OM_CIRCLE)
+                q[s->dp_joint] = w;
+            count = om_add_candidate(pb, q, roots, count);
+        }
     }
+    return count;
 }
 
 int om_band_roots(om_problem *pb, double *roots, bool *neighbour_reached)
@@ -88,9 +122,8 @@ int om_band_roots(om_problem *pb, double *roots, bool *neighbour_reached)
     const om_solver_data *s = pb->s;
     int64_t signs[64];
     double redundancy[1], found[OM_MAX_ROOTS * OM_MAX_DOF];
-    int count = 0;
     bool near[3];
-    may_meet_zero(pb, near);
+    int count = touch_points(pb, near, roots);
     *neighbour_reached = false;
     for (int i = 0; i < s->n_signs; i++) {
         if (!near[i])

@@ -213,8 +213,10 @@ bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori);
 /* om_add_root of q, polished first where it fails verification near the boundary. */
 int om_add_candidate(om_problem *pb, double *q, double *roots, int count);
 
-/* The roots of the neighbouring configurations (one branch flipped) that hold the problem's
- * own (their flipped branch quantity within OM_BRANCH_BAND of zero), verified, into roots
+/* For a configuration whose bounded search found no root: the roots at its touch points
+ * (samples of the free angle where the model's solution meets a branch zero, refined), and
+ * those of the neighbouring configurations (one branch flipped) that hold the problem's own
+ * (their flipped branch quantity within OM_BRANCH_BAND of zero), verified, into roots
  * (OM_MAX_ROOTS x dof); returns the count. *neighbour_reached: some neighbour had a root. */
 int om_band_roots(om_problem *pb, double *roots, bool *neighbour_reached);
 
