@@ -40,10 +40,16 @@ PyMODINIT_FUNC PyInit_ckernels(void) {
     if (PyModule_AddObjectRef(m, "Solver", (PyObject *)&om_SolverType) < 0) goto fail;
     for (size_t i = 0; i < sizeof constants / sizeof constants[0]; i++)
         if (PyModule_AddIntConstant(m, constants[i].name, constants[i].value) < 0) goto fail;
-    PyObject *slack = PyFloat_FromDouble(OM_REACH_SLACK);
-    if (!slack || PyModule_AddObject(m, "REACH_SLACK", slack) < 0) {
-        Py_XDECREF(slack);
-        goto fail;
+    const struct {
+        const char *name;
+        double value;
+    } floats[] = {{"REACH_SLACK", OM_REACH_SLACK}, {"BRANCH_BAND", OM_BRANCH_BAND}};
+    for (size_t i = 0; i < sizeof floats / sizeof floats[0]; i++) {
+        PyObject *v = PyFloat_FromDouble(floats[i].value);
+        if (!v || PyModule_AddObject(m, floats[i].name, v) < 0) {
+            Py_XDECREF(v);
+            goto fail;
+        }
     }
     return m;
 fail:
