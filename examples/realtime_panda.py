@@ -33,6 +33,10 @@ import om_redundant as om
 
 RATE = 500.0  # Hz, the control loop
 MARGIN = 0.03  # m of clearance the optimiser keeps
+# rad: psi moves at most this per tick, 2.5 rad/s at 500 Hz, which the joints can follow
+# within the velocity limit (the optimiser's default 0.05 suits 100 Hz; at 500 Hz psi would
+# chase the optimum at 25 rad/s and the joints lag, the hand 3 cm off its target)
+MAX_STEP = 0.005
 PERIOD = 8.0  # s, one figure eight
 FPS = 30  # frames per second of the video
 HOME = np.array([0.0, -0.3, 0.0, -2.2, 0.0, 1.9, 0.785])  # hand down in front, elbow up
@@ -80,7 +84,7 @@ def main() -> dict:
     configuration = mink.Configuration(model)
     data = configuration.data
     clearance = om.Clearance(model, arm, list(OBSTACLES))
-    optimizer = om.RedundancyOptimizer(solver, clearance, min_clearance=MARGIN)
+    optimizer = om.RedundancyOptimizer(solver, clearance, min_clearance=MARGIN, max_step=MAX_STEP)
     hand = mink.FrameTask(arm.frame_name, "site", position_cost=1.0, orientation_cost=1.0)
     exact = om.ExactPoseTask(solver, model, optimizer=optimizer)
     tasks = [hand, exact]
