@@ -154,8 +154,9 @@ static PyObject *k_model_ik(PyObject *mod, PyObject *const *args, Py_ssize_t nar
         return NULL;
     }
     mat3 R = load_mat(v[2].buf);
-    double margin = om_model_ik((int)family, v[0].buf, v[1].buf, &R, load_vec(v[3].buf), v[4].buf, v[5].buf,
-                                v[6].buf, v[7].buf, all_joints);
+    om_target t = om_target_at((int)family, v[0].buf, &R, v[5].buf);
+    double margin = om_model_ik((int)family, v[0].buf, v[1].buf, &t, load_vec(v[3].buf), v[4].buf, v[6].buf,
+                                v[7].buf, all_joints);
     release_all(v, 8);
     return PyFloat_FromDouble(margin);
 }
@@ -171,7 +172,8 @@ static PyObject *k_model_ik_at_reach(PyObject *mod, PyObject *const *args, Py_ss
                   {F64, 7, 0, "q_prev"}, {F64, 7, 1, "q"}};
     if (get_all(a, v, sp, 6) < 0) return NULL;
     mat3 R = load_mat(v[1].buf);
-    bool ok = om_srs_model_ik_at_reach(v[0].buf, &R, load_vec(v[2].buf), v[3].buf, psi, v[4].buf, v[5].buf);
+    om_target t = om_target_at(OM_SRS, v[0].buf, &R, &psi);
+    bool ok = om_srs_model_ik_at_reach(v[0].buf, &t, load_vec(v[2].buf), v[3].buf, v[4].buf, v[5].buf);
     release_all(v, 6);
     return PyBool_FromLong(ok);
 }
@@ -188,7 +190,8 @@ static PyObject *k_model_ik_lifted(PyObject *mod, PyObject *const *args, Py_ssiz
                   {F64, 7, 1, "q"}};
     if (get_all(a, v, sp, 5) < 0) return NULL;
     mat3 R = load_mat(v[1].buf);
-    vec3 r = om_srs_model_ik_lifted(v[0].buf, &R, load_vec(v[2].buf), v[3].buf, psi, q1, q7, phi4, v[4].buf);
+    om_target t = om_target_at(OM_SRS, v[0].buf, &R, &psi);
+    vec3 r = om_srs_model_ik_lifted(v[0].buf, &t, load_vec(v[2].buf), v[3].buf, q1, q7, phi4, v[4].buf);
     release_all(v, 5);
     return Py_BuildValue("(ddd)", r.x, r.y, r.z);
 }
