@@ -161,9 +161,10 @@ static PyObject *k_model_ik(PyObject *mod, PyObject *const *args, Py_ssize_t nar
     return PyFloat_FromDouble(margin);
 }
 
-/* model_ik_at_reach(P, R, p, signs, psi, q_prev, q) -> bool (S-R-S). */
-static PyObject *k_model_ik_at_reach(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
-    if (check_nargs(nargs, 7, "model_ik_at_reach") < 0) return NULL;
+/* model_ik_at_reach(P, R, p, signs, psi, q_prev, q) -> bool and srs_model_q7(the same) -> margin:
+ * the S-R-S closed form's variants (q7_alone: q7 alone, as the circle residual takes it). */
+static PyObject *srs_variant(PyObject *const *args, Py_ssize_t nargs, int q7_alone) {
+    if (check_nargs(nargs, 7, q7_alone ? "srs_model_q7" : "model_ik_at_reach") < 0) return NULL;
     double psi = PyFloat_AsDouble(args[4]);
     if (PyErr_Occurred()) return NULL;
     PyObject *const a[6] = {args[0], args[1], args[2], args[3], args[5], args[6]};
@@ -173,9 +174,19 @@ static PyObject *k_model_ik_at_reach(PyObject *mod, PyObject *const *args, Py_ss
     if (get_all(a, v, sp, 6) < 0) return NULL;
     mat3 R = load_mat(v[1].buf);
     om_target t = om_target_at(OM_SRS, v[0].buf, &R, &psi);
-    bool ok = om_srs_model_ik_at_reach(v[0].buf, &t, load_vec(v[2].buf), v[3].buf, v[4].buf, v[5].buf);
+    vec3 p = load_vec(v[2].buf);
+    PyObject *out = q7_alone ? PyFloat_FromDouble(om_srs_model_q7(v[0].buf, &t, p, v[3].buf, v[4].buf, v[5].buf))
+                             : PyBool_FromLong(om_srs_model_ik_at_reach(v[0].buf, &t, p, v[3].buf, v[4].buf, v[5].buf));
     release_all(v, 6);
-    return PyBool_FromLong(ok);
+    return out;
+}
+
+static PyObject *k_model_ik_at_reach(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    return srs_variant(args, nargs, 0);
+}
+
+static PyObject *k_srs_model_q7(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    return srs_variant(args, nargs, 1);
 }
 
 /* model_ik_lifted(P, R, p, signs, psi, q1, q7, phi4, q) -> (shoulder, wrist, elbow) residuals. */
@@ -284,6 +295,7 @@ PyMethodDef om_kernel_functions[] = {
     FAST(flange_target, "flange_target(T, T_base_root, T_tool_flange, R, p)"),
     FAST(model_ik, "model_ik(family, P, table, R, p, signs, redundancy, q_prev, q, all_joints) -> margin"),
     FAST(model_ik_at_reach, "model_ik_at_reach(P, R, p, signs, psi, q_prev, q) -> bool"),
+    FAST(srs_model_q7, "srs_model_q7(P, R, p, signs, psi, q_prev, q) -> margin"),
     FAST(model_ik_lifted, "model_ik_lifted(P, R, p, signs, psi, q1, q7, phi4, q) -> residuals"),
     FAST(branch_values, "branch_values(family, P, q, out)"),
     FAST(redundancy_values, "redundancy_values(family, P, q, out)"),

@@ -100,6 +100,9 @@ void om_six_dof_target(const double *P, om_target *t); /* fills RE and wrist fro
 /* With shoulder false, joints 1-3 are not written. Returns the reach margin 1 - x^2. */
 double om_srs_model_ik(const double *P, const om_target *t, vec3 p, const int64_t *signs, const double *q_prev,
                        double *q, bool shoulder);
+/* q7 alone (q[6]; the rest of q untouched), for the circle residual. Returns the margin. */
+double om_srs_model_q7(const double *P, const om_target *t, vec3 p, const int64_t *signs, const double *q_prev,
+                       double *q);
 bool om_srs_model_ik_at_reach(const double *P, const om_target *t, vec3 p, const int64_t *signs,
                               const double *q_prev, double *q);
 /* phi4 NaN: the elbow equation's root in the ELBOW branch. Returns (shoulder, wrist, elbow) residuals. */

@@ -22,11 +22,14 @@ static vec3 circle_point(om_problem *pb, double w)
 }
 
 /* Model IK for p_m = p_d + R delta(w), one residual evaluation; returns the reach margin
- * (negative beyond OM_REACH_SLACK: out of the model's reach, q not written). */
+ * (negative beyond OM_REACH_SLACK: out of the model's reach, q not written). all_joints false
+ * writes only what g needs: q_J (an S-R-S arm whose dp turns with q7: q7 alone), or more. */
 double om_model_ik_at(om_problem *pb, double w, double *q, bool all_joints)
 {
     const om_solver_data *data = pb->s;
     vec3 pm = circle_point(pb, w);
+    if (!all_joints && data->family == OM_SRS && data->dp_joint == 6)
+        return om_srs_model_q7(data->params, &pb->t, pm, pb->signs, pb->q_prev, q);
     return om_model_ik(data->family, data->params, data->model_table, &pb->t, pm, pb->signs, pb->q_prev, q,
                        all_joints);
 }

@@ -4,6 +4,9 @@
 #include "om_kernels.h"
 
 #define DEGENERATE 1e-12 /* |W - S|^2 below which the wrist centre is at the shoulder centre */
+/* |sin phi6 sin beta| below which om_srs_model_q7 leaves q7 to the closed form: q7 is
+ * ill-conditioned there (rounding / |sin phi6|), and both ways must round alike. */
+#define NEAR_SINGULAR_WRIST 1e-3
 
 
 /* Rx(alpha) with sin(alpha) = sigma = +-1. */
@@ -104,6 +107,46 @@ double om_srs_model_ik(const double *P, const om_target *t, vec3 p, const int64_
     if (margin < -OM_REACH_SLACK)
         return margin;
     ik_with_elbow(P, t, w, L2, elbow_root(P, x, (double)signs[1]), signs, q_prev, q, shoulder);
+    return margin;
+}
+
+/* Joint 7 alone, as om_srs_model_ik computes it (q[6] written, the rest of q untouched): what
+ * the circle residual g needs of the model. The wrist's M = R04^T R E^T =
+ * Rz(phi5) Rx(alpha5) Rz(phi6) Rx(beta) Rz(phi7) is not formed: its last column gives
+ * (sin phi6, cos phi6 cos beta) up to one positive factor (the Euler decomposition's phi6), and
+ * its last row is sigma5 (u cos phi7 + v sin phi7, v cos phi7 - u sin phi7) for that pair
+ * (u, v), which gives phi7 without phi5. Near the wrist singularity (u = 0), where the
+ * closed form takes phi5 from q_prev, it decides. Returns the reach margin as om_srs_model_ik. */
+double om_srs_model_q7(const double *P, const om_target *t, vec3 p, const int64_t *signs, const double *q_prev,
+                       double *q)
+{
+    vec3 w = v_add(p, t->wrist);
+    double L2 = v_dot(w, w);
+    if (L2 < DEGENERATE)
+        return -1.0;
+    double x = (L2 - P[SRS_K0]) / P[SRS_K];
+    double margin = 1.0 - x * x;
+    if (margin < -OM_REACH_SLACK)
+        return margin;
+    double elbow = (double)signs[1];
+    double phi4 = elbow_root(P, x, elbow);
+    double c4 = cos(phi4), s4 = sin(phi4);
+    mat3 R04 = m_mm(rotation_03_at(P, t, w, L2, c4, s4, elbow), m_rz_cs_times(c4, s4, m_load(P, SRS_X4)));
+    mat3 RE_cols = m_transpose(t->RE);
+    vec3 z4 = m_col(R04, 2); /* M[i][j] = (column i of R04) . (column j of R E^T) */
+    double ax = v_dot(m_col(R04, 0), RE_cols.r2), ay = v_dot(m_col(R04, 1), RE_cols.r2), az = v_dot(z4, RE_cols.r2);
+    double sigma = P[SRS_SIGMA5], sin_b = P[SRS_SIN_BETA], cos_b = P[SRS_COS_BETA];
+    double radial_2 = ax * ax + ay * ay - cos_b * cos_b; /* as om_euler_zxzxz */
+    double radial = sqrt(0.0 > radial_2 ? 0.0 : radial_2);
+    if (!(radial > NEAR_SINGULAR_WRIST)) {
+        double wrist_joints[7];
+        ik_with_elbow(P, t, w, L2, phi4, signs, q_prev, wrist_joints, false);
+        q[6] = wrist_joints[6];
+        return margin;
+    }
+    double u = (double)signs[2] * radial, v = -sigma * (sin_b > 0.0 ? 1.0 : -1.0) * az * cos_b;
+    double m20 = v_dot(z4, RE_cols.r0), m21 = v_dot(z4, RE_cols.r1);
+    q[6] = om_wrap(atan2(sigma * (v * m20 - u * m21), sigma * (u * m20 + v * m21)) - P[SRS_THETA + 6]);
     return margin;
 }
 
