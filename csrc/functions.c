@@ -248,14 +248,8 @@ static PyObject *k_arm_angle_gradient(PyObject *mod, PyObject *const *args, Py_s
     return PyFloat_FromDouble(psi);
 }
 
-/* pose_is_valid(T, tolerance) -> bool: finite, last row [0 0 0 1], max|R^T R - I| <= tolerance, det > 0. */
-static PyObject *k_pose_is_valid(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
-    if (check_nargs(nargs, 2, "pose_is_valid") < 0) return NULL;
-    double tol = PyFloat_AsDouble(args[1]);
-    if (PyErr_Occurred()) return NULL;
-    Py_buffer v;
-    if (get_buffer(args[0], &v, F64, 16, 0, "T") < 0) return NULL;
-    const double *T = v.buf;
+/* Whether T is a homogeneous transform: finite, last row [0 0 0 1], max|R^T R - I| <= tol, det > 0. */
+int om_pose_is_valid(const double *T, double tol) {
     int ok = 1;
     for (int i = 0; i < 16; i++) ok = ok && isfinite(T[i]);
     ok = ok && T[12] == 0.0 && T[13] == 0.0 && T[14] == 0.0 && T[15] == 1.0;
@@ -269,6 +263,17 @@ static PyObject *k_pose_is_valid(PyObject *mod, PyObject *const *args, Py_ssize_
                      T[2] * (T[4] * T[9] - T[5] * T[8]);
         ok = det > 0.0;
     }
+    return ok;
+}
+
+/* pose_is_valid(T, tolerance) -> bool (om_pose_is_valid). */
+static PyObject *k_pose_is_valid(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 2, "pose_is_valid") < 0) return NULL;
+    double tol = PyFloat_AsDouble(args[1]);
+    if (PyErr_Occurred()) return NULL;
+    Py_buffer v;
+    if (get_buffer(args[0], &v, F64, 16, 0, "T") < 0) return NULL;
+    int ok = om_pose_is_valid(v.buf, tol);
     PyBuffer_Release(&v);
     return PyBool_FromLong(ok);
 }

@@ -7,6 +7,8 @@
  */
 #include "binding.h"
 
+PyObject *om_status_names;
+
 static struct PyModuleDef module = {
     PyModuleDef_HEAD_INIT, "ckernels", "om_redundant's compiled core (see csrc/om_kernels.h).", -1, om_kernel_functions,
 };
@@ -40,11 +42,21 @@ PyMODINIT_FUNC PyInit_ckernels(void) {
     if (PyModule_AddObjectRef(m, "Solver", (PyObject *)&om_SolverType) < 0) goto fail;
     for (size_t i = 0; i < sizeof constants / sizeof constants[0]; i++)
         if (PyModule_AddIntConstant(m, constants[i].name, constants[i].value) < 0) goto fail;
-    PyObject *slack = PyFloat_FromDouble(OM_REACH_SLACK);
-    if (!slack || PyModule_AddObject(m, "REACH_SLACK", slack) < 0) {
-        Py_XDECREF(slack);
-        goto fail;
+    const struct {
+        const char *name;
+        double value;
+    } floats[] = {{"REACH_SLACK", OM_REACH_SLACK}, {"ORTHONORMALITY_TOLERANCE", OM_ORTHONORMALITY_TOL}};
+    for (size_t i = 0; i < sizeof floats / sizeof floats[0]; i++) {
+        PyObject *value = PyFloat_FromDouble(floats[i].value);
+        if (!value || PyModule_AddObject(m, floats[i].name, value) < 0) {
+            Py_XDECREF(value);
+            goto fail;
+        }
     }
+    /* By status code: OM_OK, OM_UNREACHABLE, OM_NO_SOLUTION_IN_CONFIGURATION. */
+    if (!om_status_names)
+        om_status_names = Py_BuildValue("(sss)", "ok", "unreachable", "no solution in this configuration");
+    if (!om_status_names || PyModule_AddObjectRef(m, "STATUS_NAMES", om_status_names) < 0) goto fail;
     return m;
 fail:
     Py_DECREF(m);
