@@ -58,8 +58,8 @@ static int _pair(om_problem *pb, double a, double ga, double x0, double b, doubl
 {
     double gw;
     double w = om_extremum(pb, a, b, x0, -om_sign(ga), false, q, &gw, NULL);
-    if (isnan(gw) || gw * ga > 0.0)
-        return n;
+    if (isnan(gw) || gw * ga > 0.0) /* no crossing; a touch of zero is a boundary candidate */
+        return fabs(gw) < OM_TOUCH ? _put(out, n, cap, w) : n;
     if (gw == 0.0)
         return _put(out, n, cap, w);
     double r0 = om_refine_bracket(pb, a, ga, w, gw, q);
@@ -69,11 +69,19 @@ static int _pair(om_problem *pb, double a, double ga, double x0, double b, doubl
 }
 
 /* Add the roots on a run of reachable points (w ascending) to out[n:]; returns the count.
- * Sign changes bracket roots; local minima of |g| are searched for close pairs. A cyclic
- * run covers the whole circle. */
+ * Sign changes bracket roots; local minima of |g| are searched for close pairs; a touch of
+ * zero (|g| < OM_TOUCH without a crossing, also at an edge of reach) is a candidate for the
+ * singular boundary, where the closed form's last digits are lost. A cyclic run covers the
+ * whole circle. */
 static int _run_roots(om_problem *pb, const double *pw, const double *pg, int L, bool cyclic, double *q,
                       double *out, int n, int cap)
 {
+    if (!cyclic) { /* g near zero at an edge of reach: a root at the singular boundary there */
+        if (fabs(pg[0]) < OM_TOUCH)
+            n = _put(out, n, cap, pw[0]);
+        if (L > 1 && fabs(pg[L - 1]) < OM_TOUCH)
+            n = _put(out, n, cap, pw[L - 1]);
+    }
     for (int i = 0; i < L - 1 + (int)cyclic; i++) {
         int j = (i + 1) % L;
         double wj = pw[j] + (j == 0 ? 2.0 * OM_PI : 0.0);

@@ -291,6 +291,44 @@ static PyObject *k_all_finite(PyObject *mod, PyObject *const *args, Py_ssize_t n
     return PyBool_FromLong(ok);
 }
 
+/* polish(table, R, p, q, iterations, P, model_table, psi) -> residual: om_polish of q in place
+ * toward the flange pose (R (9), p (3)) in DH frame 0 of the chain `table`; P and model_table
+ * None: no arm-angle row, else an S-R-S model's parameters and table with target psi. */
+static PyObject *k_polish(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 8, "polish") < 0) return NULL;
+    long iterations = PyLong_AsLong(args[4]);
+    double psi = PyFloat_AsDouble(args[7]);
+    if (PyErr_Occurred()) return NULL;
+    int with_psi = args[5] != Py_None;
+    PyObject *const a[6] = {args[0], args[1], args[2], args[3], args[5], args[6]};
+    Py_buffer v[6];
+    spec sp[6] = {{F64, -1, 0, "table"}, {F64, 9, 0, "R"}, {F64, 3, 0, "p"}, {F64, -1, 1, "q"},
+                  {F64, SRS_N_PARAMS, 0, "P"}, {F64, -1, 0, "model_table"}};
+    if (get_all(a, v, sp, with_psi ? 6 : 4) < 0) return NULL;
+    om_polish_task t;
+    t.table = v[0].buf;
+    t.n_rows = (int)table_rows(&v[0]);
+    t.dof = (int)(v[3].len / 8);
+    Py_ssize_t dof = 0;
+    for (Py_ssize_t i = 0; i < t.n_rows; i++) dof += ((const double *)v[0].buf)[6 * i + 5] != 2.0;
+    if (v[0].len != t.n_rows * 48 || dof != t.dof || t.dof > OM_MAX_DOF || (with_psi && t.dof != 7)) {
+        release_all(v, with_psi ? 6 : 4);
+        PyErr_SetString(PyExc_ValueError, "polish: table, q (and a 7-joint arm for psi) disagree");
+        return NULL;
+    }
+    t.P = with_psi ? v[4].buf : NULL;
+    t.model_table = with_psi ? v[5].buf : NULL;
+    t.n_model_rows = with_psi ? (int)table_rows(&v[5]) : 0;
+    t.R = load_mat(v[1].buf);
+    t.p = load_vec(v[2].buf);
+    t.psi = psi;
+    t.elbow = 0.0;
+    double r;
+    Py_BEGIN_ALLOW_THREADS r = om_polish(&t, (int)iterations, v[3].buf);
+    Py_END_ALLOW_THREADS release_all(v, with_psi ? 6 : 4);
+    return PyFloat_FromDouble(r);
+}
+
 #define FAST(name, doc) {#name, (PyCFunction)(void (*)(void))k_##name, METH_FASTCALL, doc}
 
 PyMethodDef om_kernel_functions[] = {
@@ -307,5 +345,6 @@ PyMethodDef om_kernel_functions[] = {
     FAST(arm_angle_gradient, "arm_angle_gradient(P, table, q, grad) -> psi"),
     FAST(pose_is_valid, "pose_is_valid(T, tolerance) -> bool"),
     FAST(all_finite, "all_finite(values) -> bool"),
+    FAST(polish, "polish(table, R, p, q, iterations, P, model_table, psi) -> residual"),
     {NULL, NULL, 0, NULL},
 };

@@ -45,11 +45,12 @@ PyMODINIT_FUNC PyInit_ckernels(void) {
     const struct {
         const char *name;
         double value;
-    } floats[] = {{"REACH_SLACK", OM_REACH_SLACK}, {"ORTHONORMALITY_TOLERANCE", OM_ORTHONORMALITY_TOL}};
+    } floats[] = {
+        {"REACH_SLACK", OM_REACH_SLACK}, {"BRANCH_BAND", OM_BRANCH_BAND}, {"ORTHONORMALITY_TOLERANCE", OM_ORTHONORMALITY_TOL}};
     for (size_t i = 0; i < sizeof floats / sizeof floats[0]; i++) {
-        PyObject *value = PyFloat_FromDouble(floats[i].value);
-        if (!value || PyModule_AddObject(m, floats[i].name, value) < 0) {
-            Py_XDECREF(value);
+        PyObject *v = PyFloat_FromDouble(floats[i].value);
+        if (!v || PyModule_AddObject(m, floats[i].name, v) < 0) {
+            Py_XDECREF(v);
             goto fail;
         }
     }

@@ -112,6 +112,7 @@ void om_srs_target(const double *P, om_target *t); /* fills RE, wrist, cos_psi, 
 /* The arm angle's reference direction n(w_hat) into *n, and w_hat x n into *nw. */
 void om_srs_reference(const double *P, vec3 w_hat, vec3 *n, vec3 *nw);
 double om_srs_arm_angle(const double *P, const double *q);
+double om_srs_arm_angle_in(const double *P, const double *q, double elbow);
 void om_srs_branch_values(const double *P, const double *q, double *out);
 /* psi at q of the S-R-S model with parameters P and DH table; writes d psi / dq (7). */
 double om_arm_angle_gradient(const double *P, const double *table, int n_rows, const double *q, double *grad);
@@ -132,6 +133,8 @@ enum { OM_OK = 0, OM_UNREACHABLE = 1, OM_NO_SOLUTION_IN_CONFIGURATION = 2 };
 
 #define OM_ROOT_TOL 1e-13   /* a residual (rad) accepted as a root before verification */
 #define OM_SAME_ROOT 1e-9   /* joint-space distance under which two roots are one */
+#define OM_BRANCH_BAND 1e-7 /* |branch quantity| within which q holds both neighbouring configurations */
+#define OM_TOUCH 1e-3      /* |g| (rad) of a touch of zero or an edge of reach tried as a candidate */
 #define OM_PAIR_SEARCH 1.0  /* |g| (rad) below which a local minimum is searched for a root pair */
 
 /* The solver's fixed data (the binding owns the arrays). */
@@ -155,7 +158,8 @@ typedef struct {
 /* One target. */
 typedef struct {
     const om_solver_data *s;
-    om_target t; /* flange orientation in DH frame 0, with its per-target constants */
+    om_target t; /* flange orientation in DH frame 0, with its per-target constants (those of
+                  * redundancy too: other redundancy values need om_target_at again) */
     vec3 p;      /* flange position in DH frame 0 */
     const int64_t *signs;
     const double *redundancy;
@@ -194,15 +198,50 @@ double om_lifted_solve(om_problem *pb, const double *start, double *q);
 int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, double radius);
 
 /* verify.c */
+/* Whether q is in the configuration (signs, redundancy): every branch quantity of q has the
+ * requested sign or lies within OM_BRANCH_BAND of zero (q belongs to both neighbouring
+ * configurations there), and the redundancy values, read in the requested branches, are
+ * the requested ones. */
+bool om_in_configuration(const om_solver_data *s, const double *q, const int64_t *signs, const double *redundancy);
 bool om_verify(om_problem *pb, const double *q, double *pos, double *ori); /* returns accepted */
 int om_add_root(om_problem *pb, const double *q, double *roots, int count); /* roots: OM_MAX_ROOTS x dof */
 bool om_representative(double *q, int dof, const uint8_t *revolute, const double *lower, const double *upper,
                        const double *hint, bool has_hint);
 
+/* polish.c: damped Gauss-Newton on the REAL arm's chain toward the flange pose (R, p) in DH
+ * frame 0 and, with P not NULL (an S-R-S model's parameters and model table), the arm angle psi. */
+typedef struct {
+    const double *table; /* the real arm's DH table, n_rows x 6 */
+    int n_rows, dof;
+    const double *P, *model_table; /* P NULL: no arm-angle row */
+    int n_model_rows;
+    mat3 R;
+    vec3 p;
+    double psi;
+    double elbow; /* psi read in this ELBOW branch (+-1); 0: in q's own */
+} om_polish_task;
+
+/* Refine q in place (at most `iterations` Jacobians); returns the residual's norm at the end. */
+double om_polish(const om_polish_task *t, int iterations, double *q);
+
+/* boundary.c */
+/* A candidate q that failed verification, refined on the real arm where a branch quantity is
+ * within 1e-2 of zero (else left as it is); returns whether it now verifies. */
+bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori);
+/* om_add_root of q, polished first where it fails verification near the boundary. */
+int om_add_candidate(om_problem *pb, double *q, double *roots, int count);
+
+/* For a configuration whose bounded search found no root: the roots at its touch points
+ * (samples of the free angle where the model's solution meets a branch zero, refined), and
+ * those of the neighbouring configurations (one branch flipped) that hold the problem's own
+ * (their flipped branch quantity within OM_BRANCH_BAND of zero), verified, into roots
+ * (OM_MAX_ROOTS x dof); returns the count. *neighbour_reached: some neighbour had a root. */
+int om_band_roots(om_problem *pb, double *roots, bool *neighbour_reached);
+
 /* search.c */
 int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre, double radius);
 bool om_local_solve(om_problem *pb, const double *start, double *q, double *pos, double *ori);
-bool om_exists_other(om_problem *pb);
+bool om_exists_other(om_problem *pb, bool skip_neighbours);
 bool om_nearest_in_window(om_problem *pb, const double *hint, double *q);
 
 /* solve.c */

@@ -15,7 +15,7 @@ int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre
     nan_fill(q, OM_MAX_DOF); /* unwritten joints read as NaN, which verify rejects */
     if (data->mode == OM_FIXED) {
         double gw = om_g(pb, 0.0, q, true);
-        return isnan(gw) ? 0 : om_add_root(pb, q, roots, 0);
+        return isnan(gw) ? 0 : om_add_candidate(pb, q, roots, 0);
     }
     if (data->mode == OM_TORUS) {
         int side = (int)(TORUS_SIDE * (double)n_scan);
@@ -39,15 +39,18 @@ int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre
         int before = count;
         count = om_add_root(pb, q, roots, count);
         if (count == before && !isnan(om_g(pb, cands[i], q, true))) {
-            /* A steep crossing at a singular wrist: solved where it is smooth. */
-            if (lifted) {
-                double start[OM_MAX_DOF];
-                memcpy(start, q, (size_t)data->dof * sizeof(double));
-                om_lifted_solve(pb, start, q);
-            } else {
+            /* A steep crossing at a singular wrist: solved where it is smooth, from the
+             * crossing itself (q_J = w; the model's q_J is off by the jump of g there). */
+            double at_candidate[OM_MAX_DOF];
+            memcpy(at_candidate, q, (size_t)data->dof * sizeof(double));
+            at_candidate[data->dp_joint] = cands[i];
+            if (lifted)
+                om_lifted_solve(pb, at_candidate, q);
+            else
                 om_wrist_secant(pb, cands[i], q);
-            }
-            count = om_add_root(pb, q, roots, count);
+            count = om_add_candidate(pb, q, roots, count);
+            if (count == before) /* a touch of zero: refined from the candidate itself */
+                count = om_add_candidate(pb, at_candidate, roots, count);
         }
     }
     free(cands);
@@ -55,7 +58,8 @@ int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre
 }
 
 /* Local solve from the joint vector start, verified with the real arm: the secant on g from
- * its q_J; on the torus, and on a 7-DOF circle arm where the secant fails, the lifted Newton.
+ * its q_J; on the torus, and on a 7-DOF circle arm where the secant fails, the lifted Newton;
+ * near the singular boundary, the refinement on the real arm last.
  * Returns accepted (errors into *pos, *ori); q holds the model IK at the end. */
 bool om_local_solve(om_problem *pb, const double *start, double *q, double *pos, double *ori)
 {
@@ -70,24 +74,25 @@ bool om_local_solve(om_problem *pb, const double *start, double *q, double *pos,
         om_lifted_solve(pb, start, q);
         accepted = om_verify(pb, q, pos, ori);
     }
-    return accepted;
+    return accepted || om_polish_candidate(pb, q, pos, ori);
 }
 
-/* Whether any configuration other than the problem's has a solution. The other
- * configurations' evaluations count in pb->counter (one counter per solve). */
-bool om_exists_other(om_problem *pb)
+/* Whether any configuration other than the problem's has a solution (with skip_neighbours,
+ * those one branch away are not searched: om_band_roots has). The other configurations'
+ * evaluations count in pb->counter (one counter per solve). */
+bool om_exists_other(om_problem *pb, bool skip_neighbours)
 {
     const int64_t *signs = pb->signs;
     int k = pb->s->n_signs;
     int64_t other[64];
     double roots[OM_MAX_ROOTS * OM_MAX_DOF];
     for (int64_t code = 0; code < ((int64_t)1 << k); code++) {
-        bool same = true;
+        int flips = 0;
         for (int i = 0; i < k; i++) {
             other[i] = ((code >> i) & 1) ? 1 : -1;
-            same = same && other[i] == signs[i];
+            flips += other[i] != signs[i];
         }
-        if (same)
+        if (flips == 0 || (skip_neighbours && flips == 1))
             continue;
         om_problem with_signs = *pb;
         with_signs.signs = other;

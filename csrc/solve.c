@@ -165,11 +165,14 @@ om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *
     }
     double roots[OM_MAX_ROOTS * OM_MAX_DOF];
     int n = om_all_roots(pb, s->scan_points, roots, hint, INFINITY);
+    bool neighbour_reached = false;
+    if (n == 0) /* the boundary contract: a neighbour's root in the band holds this configuration */
+        n = om_band_roots(pb, roots, &neighbour_reached);
     if (n == 0) {
         for (int j = 0; j < dof; j++)
             q_out[j] = NAN;
-        int status = om_exists_other(pb) ? OM_NO_SOLUTION_IN_CONFIGURATION : OM_UNREACHABLE;
-        return _result(status, NAN, NAN, problem.counter, false);
+        bool other = neighbour_reached || om_exists_other(pb, true);
+        return _result(other ? OM_NO_SOLUTION_IN_CONFIGURATION : OM_UNREACHABLE, NAN, NAN, problem.counter, false);
     }
     /* The root nearest the hint; without one, a root within the limits first, then the one
      * nearest the fixed-point start. */
@@ -217,6 +220,9 @@ int om_solve_all(const om_solver_data *s, const double *T, const int64_t *signs,
     problem.q_prev = zeros;
     problem.counter = 0;
     int n = om_all_roots(&problem, s->scan_points, roots, zeros, INFINITY);
+    bool neighbour_reached;
+    if (n == 0)
+        n = om_band_roots(&problem, roots, &neighbour_reached);
     for (int r = 0; r < n; r++) {
         double root[OM_MAX_DOF];
         memcpy(root, roots + r * dof, (size_t)dof * sizeof(double));

@@ -276,6 +276,24 @@ static PyObject *Solver_configuration_values(Solver *self, PyObject *const *args
     Py_RETURN_NONE;
 }
 
+/* holds(q, signs, redundancy) -> bool: om_in_configuration (the band contract). */
+static PyObject *Solver_holds(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
+    if (nargs != 3) {
+        PyErr_SetString(PyExc_TypeError, "holds takes (q, signs, redundancy)");
+        return NULL;
+    }
+    const om_solver_data *s = &self->data;
+    int64_t signs[3];
+    double redundancy[1];
+    Py_buffer q;
+    if (get_signs(args[1], signs, s->n_signs) < 0 || get_doubles(args[2], redundancy, s->n_redundancy, "redundancy") < 0)
+        return NULL;
+    if (get_buffer(args[0], &q, F64, s->dof, 0, "q") < 0) return NULL;
+    bool in = om_in_configuration(s, q.buf, signs, redundancy);
+    PyBuffer_Release(&q);
+    return PyBool_FromLong(in);
+}
+
 static PyMethodDef Solver_methods[] = {
     {"solve", (PyCFunction)(void (*)(void))Solver_solve, METH_FASTCALL, "One solve; see om_redundant.om.solver."},
     {"solve_pose", (PyCFunction)(void (*)(void))om_solver_solve_pose, METH_FASTCALL,
@@ -284,6 +302,7 @@ static PyMethodDef Solver_methods[] = {
     {"solve_all", (PyCFunction)(void (*)(void))Solver_solve_all, METH_FASTCALL, "Every root in a configuration."},
     {"configuration_values", (PyCFunction)(void (*)(void))Solver_configuration_values, METH_FASTCALL,
      "Branch quantities and redundancy values at q."},
+    {"holds", (PyCFunction)(void (*)(void))Solver_holds, METH_FASTCALL, "Whether q is in a configuration (band)."},
     {NULL, NULL, 0, NULL},
 };
 

@@ -208,12 +208,18 @@ static mat3 rotation_03(const double *P, const double *q)
 /* The model's arm angle psi at joint vector q (arm_angle). */
 double om_srs_arm_angle(const double *P, const double *q)
 {
+    return om_srs_arm_angle_in(P, q, sin(q[3] + P[SRS_THETA + 3] - P[SRS_PHI_STAR]) < 0.0 ? -1.0 : 1.0);
+}
+
+/* psi at q read in the ELBOW branch `elbow` (+-1): the elbow plane's normal flips with the
+ * branch, so at a straight elbow (both branches) psi is the requested branch's. */
+double om_srs_arm_angle_in(const double *P, const double *q, double elbow)
+{
     mat3 R03 = rotation_03(P, q);
     double phi4 = q[3] + P[SRS_THETA + 3];
     vec3 w_hat = v_unit(m_mv(R03, elbow_vector(P, cos(phi4), sin(phi4))));
     vec3 n, nw;
     om_srs_reference(P, w_hat, &n, &nw);
-    double elbow = sin(phi4 - P[SRS_PHI_STAR]) < 0.0 ? -1.0 : 1.0;
     vec3 b = v_scale(elbow * P[SRS_BEND], v_cross(m_col(R03, 2), w_hat));
     return atan2(v_dot(nw, b), v_dot(n, b));
 }

@@ -256,13 +256,13 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
                 }
                 if (n_known == first)
                     continue;
-                count = om_add_root(pb, q, roots, count);
+                count = om_add_candidate(pb, q, roots, count);
                 while (n_known < MAX_KNOWN) { /* deflated, from the same start */
                     int found = n_known;
                     n_known = _new_root(pb, x, true, &known, n_known, q);
                     if (n_known == found)
                         break;
-                    count = om_add_root(pb, q, roots, count);
+                    count = om_add_candidate(pb, q, roots, count);
                 }
                 int k = first;
                 while (k < n_known && n_known < MAX_KNOWN) {
@@ -277,7 +277,7 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
                             n_known = _new_root(pb, halfway, true, &known, n_known, q);
                         }
                         if (n_known > found)
-                            count = om_add_root(pb, q, roots, count);
+                            count = om_add_candidate(pb, q, roots, count);
                     }
                 }
             }

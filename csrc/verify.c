@@ -3,7 +3,21 @@
 #include "om_system.h"
 
 #define REDUNDANCY_TOL 1e-9 /* a solution's redundancy values (rad) must equal the requested ones */
-#define MAX_VALUES 16       /* branch and redundancy values of a family (3 and 1 today) */
+#define SRS_ELBOW_SIGN 1    /* (SHOULDER, ELBOW, WRIST) */
+#define MAX_VALUES 16       /* branch values of a family (3 today) */
+
+bool om_in_configuration(const om_solver_data *s, const double *q, const int64_t *signs, const double *redundancy)
+{
+    double values[MAX_VALUES];
+    om_branch_values(s->family, s->params, q, values);
+    for (int i = 0; i < s->n_signs; i++)
+        if (!(values[i] * (double)signs[i] >= 0.0 || fabs(values[i]) <= OM_BRANCH_BAND)) /* NaN: not in it */
+            return false;
+    if (s->family == OM_SRS) /* psi: the only redundancy value; in the requested ELBOW branch */
+        return fabs(om_wrap(om_srs_arm_angle_in(s->params, q, (double)signs[SRS_ELBOW_SIGN]) - redundancy[0])) <=
+               REDUNDANCY_TOL;
+    return true;
+}
 
 /* Position and orientation error of the REAL arm at q (into *pos, *ori), and the
  * configuration check; returns whether q is accepted. */
@@ -18,24 +32,12 @@ bool om_verify(om_problem *pb, const double *q, double *pos, double *ori)
     double e0 = E.r2.y - E.r1.z, e1 = E.r0.z - E.r2.x, e2 = E.r1.x - E.r0.y;
     double s = 0.5 * sqrt(e0 * e0 + e1 * e1 + e2 * e2);
     double orientation = atan2(s, 0.5 * (E.r0.x + E.r1.y + E.r2.z - 1.0));
-    double values[MAX_VALUES];
-    om_branch_values(data->family, data->params, q, values);
-    bool same = true;
-    for (int i = 0; i < data->n_signs; i++) {
-        /* A branch quantity at zero (a singular joint) belongs to both branches. */
-        if (values[i] * (double)pb->signs[i] < -1e-12)
-            same = false;
-    }
-    om_redundancy_values(data->family, data->params, q, values);
-    for (int i = 0; i < data->n_redundancy; i++) {
-        if (fabs(om_wrap(values[i] - pb->redundancy[i])) > REDUNDANCY_TOL)
-            same = false;
-    }
     if (pos)
         *pos = position;
     if (ori)
         *ori = orientation;
-    return same && position <= data->tol_pos && orientation <= data->tol_ori;
+    return position <= data->tol_pos && orientation <= data->tol_ori &&
+           om_in_configuration(data, q, pb->signs, pb->redundancy);
 }
 
 /* Append q to roots (OM_MAX_ROOTS x dof) if the real arm verifies it and it is new;

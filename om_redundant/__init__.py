@@ -31,7 +31,7 @@ from .mujoco_io import (
     scene_mjcf,
     without_meshes,
 )
-from .om import BatchSolution, Configuration, ModelArm, OMSolver, Solution, derive_model
+from .om import BRANCH_BAND, BatchSolution, Configuration, ModelArm, OMSolver, Solution, derive_model
 from .redundancy import (
     Box,
     Capsule,
@@ -41,6 +41,7 @@ from .redundancy import (
     PsiInterval,
     RedundancyChoice,
     RedundancyOptimizer,
+    Singularity,
     Sphere,
     arm_angle_and_gradient,
     joint_margins,
@@ -51,6 +52,7 @@ from .tasks import ArmAngleTask, ExactPoseTask
 __version__ = "0.1.0"
 
 __all__ = [
+    "BRANCH_BAND",
     "Arm",
     "ArmAngleTask",
     "ArmFileError",
@@ -79,6 +81,7 @@ __all__ = [
     "PsiInterval",
     "RedundancyChoice",
     "RedundancyOptimizer",
+    "Singularity",
     "Solution",
     "Sphere",
     "UnknownArm",

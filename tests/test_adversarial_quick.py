@@ -55,7 +55,8 @@ def test_the_check_catches_a_wrong_answer(name):
         q = run.random_q(1)[0]
         T, c = run.arm.fk(q), run.solver.configuration_of(q)
         run.pending = [] if deferred else None
-        cases = [(Fake(q), c), (Fake(q + 1e-9), c), (Fake(q, within=False), c), (Fake(q), adv.flipped(c, 2))]
+        flipped = adv.flipped(c, 2, run.solver.sign_names)
+        cases = [(Fake(q), c), (Fake(q + 1e-9), c), (Fake(q, within=False), c), (Fake(q), flipped)]
         if c.redundancy:
             cases.append((Fake(q), om.Configuration(c.signs, (c.redundancy[0] + 2e-9,))))
         for sol, config in cases:

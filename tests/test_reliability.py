@@ -22,7 +22,7 @@ def _solver(name: str) -> om.OMSolver:
 
 
 def _assert_exact(solver: om.OMSolver, q: np.ndarray, T: np.ndarray, c: om.Configuration) -> None:
-    """q reaches T within the solver's tolerances (1e-10 m, 1e-9 rad), in configuration c."""
+    """q reaches T within the solver's tolerances (1e-10 m, 1e-10 rad), in configuration c (holds)."""
     reached = solver.arm.fk(q)
     position_tolerance, orientation_tolerance = solver.tolerances
     assert np.linalg.norm(reached[:3, 3] - T[:3, 3]) <= position_tolerance
@@ -32,7 +32,91 @@ def _assert_exact(solver: om.OMSolver, q: np.ndarray, T: np.ndarray, c: om.Confi
         0.5 * (np.trace(E) - 1.0),
     )
     assert angle <= orientation_tolerance
-    assert solver.configuration_of(q).isclose(c)
+    assert solver.holds(q, c)
+
+
+def _wrist_joint(solver: om.OMSolver) -> tuple[int, float]:
+    """The wrist's middle joint and its DH offset: the WRIST branch quantity is sin(q_j + theta)."""
+    families = om.om.families
+    if solver.om.family == families.SRS:
+        return 5, solver.om.params[families.srs.THETA + 5]
+    return 4, solver.om.params[families.six_dof.THETA5]
+
+
+def _at_wrist_boundary(solver: om.OMSolver, rng: np.random.Generator, offset: float) -> np.ndarray | None:
+    """A random q whose WRIST branch quantity is about ``offset``, within the limits (None: none)."""
+    q = random_q(solver.arm, 1, rng)[0]
+    joint, theta = _wrist_joint(solver)
+    candidates = [k * math.pi - theta + (-1) ** k * offset for k in range(-2, 3)]
+    inside = [v for v in candidates if solver.arm.lower[joint] <= v <= solver.arm.upper[joint]]
+    if not inside:
+        return None
+    q[joint] = inside[int(rng.integers(len(inside)))]
+    return q
+
+
+def _flipped(solver: om.OMSolver, c: om.Configuration, index: int) -> om.Configuration:
+    """c with branch ``index`` flipped (psi read in the flipped ELBOW branch is psi + pi)."""
+    signs = list(c.signs)
+    signs[index] = -signs[index]
+    turn = math.pi if solver.sign_names[index] == "ELBOW" else 0.0
+    return om.Configuration(
+        tuple(signs), tuple(math.remainder(r + turn, 2.0 * math.pi) for r in c.redundancy)
+    )
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    name=st.sampled_from(["panda", "ur5e", "gen3", "spherical"]),
+    seed=st.integers(0, 2**32 - 1),
+    exponent=st.floats(-14.0, -2.0),
+    side=st.sampled_from([-1.0, 1.0]),
+)
+def test_holds_takes_both_sides_within_the_band_and_one_beyond(name, seed, exponent, side):
+    """holds(q, c): a branch quantity within BRANCH_BAND of zero holds both signs (psi read in
+    the requested ELBOW branch), beyond it only its own."""
+    solver = _solver(name)
+    q = _at_wrist_boundary(solver, np.random.default_rng(seed), side * 10.0**exponent)
+    if q is None:
+        return
+    c = solver.configuration_of(q)
+    wrist = solver.sign_names.index("WRIST")
+    value = float(np.sin(q[_wrist_joint(solver)[0]] + _wrist_joint(solver)[1]))
+    assert solver.holds(q, c)
+    assert solver.holds(q, _flipped(solver, c, wrist)) == (abs(value) <= om.BRANCH_BAND)
+
+
+def test_holds_reads_psi_in_the_requested_elbow_branch():
+    """A straight elbow holds both ELBOW branches, at psi in one and psi + pi in the other."""
+    panda = _solver("panda")
+    q = random_q(panda.arm, 1, np.random.default_rng(2))[0]
+    q[3] = panda.om.params[om.om.families.srs.PHI_STAR] - panda.om.params[om.om.families.srs.THETA + 3]
+    c = panda.configuration_of(q)
+    elbow = panda.sign_names.index("ELBOW")
+    flipped = _flipped(panda, c, elbow)
+    assert panda.holds(q, c) and panda.holds(q, flipped)
+    assert not panda.holds(q, om.Configuration(flipped.signs, c.redundancy))
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    name=st.sampled_from(["panda", "fr3", "xarm7", "ur5e", "gen3"]),
+    seed=st.integers(0, 2**32 - 1),
+    exponent=st.floats(-14.0, -7.05),
+    side=st.sampled_from([-1.0, 1.0]),
+)
+def test_a_pose_in_the_band_is_solved_in_both_configurations(name, seed, exponent, side):
+    """The boundary contract: T = FK(q) with the WRIST branch quantity within BRANCH_BAND of
+    zero is solved exactly in configuration_of(q) and in the one with WRIST flipped."""
+    solver = _solver(name)
+    q = _at_wrist_boundary(solver, np.random.default_rng(seed), side * 10.0**exponent)
+    if q is None:
+        return
+    T, c = solver.arm.fk(q), solver.configuration_of(q)
+    for asked in (c, _flipped(solver, c, solver.sign_names.index("WRIST"))):
+        sol = solver.solve(T, asked)
+        assert sol.ok, (asked, sol.status)
+        _assert_exact(solver, sol.q, T, asked)
 
 
 @settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])

@@ -4,9 +4,10 @@ search (:mod:`.system`), and the solver that fronts them (:mod:`.solver`)."""
 
 from .configuration import Configuration
 from .model import ModelArm, derive_model
-from .solver import BatchSolution, OMSolver, Solution
+from .solver import BRANCH_BAND, BatchSolution, OMSolver, Solution
 
 __all__ = [
+    "BRANCH_BAND",
     "BatchSolution",
     "Configuration",
     "ModelArm",

@@ -27,8 +27,11 @@ from .configuration import Configuration
 from .model import ModelArm, derive_model
 
 DEFAULT_POSITION_TOLERANCE = 1e-10
-DEFAULT_ORIENTATION_TOLERANCE = 1e-9
+DEFAULT_ORIENTATION_TOLERANCE = 1e-10
 DEFAULT_SCAN_POINTS = 64
+#: |branch quantity| within which a joint vector belongs to both neighbouring configurations
+#: (the singular boundary's band; see :meth:`OMSolver.holds`).
+BRANCH_BAND: float = ckernels.BRANCH_BAND
 #: Seeded random joint vectors within the limits whose poses a new solver must solve.
 SELF_CHECK_SAMPLES = 12
 
@@ -210,6 +213,25 @@ class OMSolver:
         redundancy = np.empty(len(self.redundancy_names))
         self._kernel.configuration_values(q, values, redundancy)
         return Configuration(tuple(-1 if v < 0.0 else 1 for v in values.tolist()), tuple(redundancy.tolist()))
+
+    def holds(self, q: np.ndarray, configuration: Configuration) -> bool:
+        """Whether joint vector q is in the configuration, by the boundary contract.
+
+        Each branch quantity b_i(q) (the values whose signs :meth:`configuration_of` reads)
+        must have the requested sign s_i, or lie in the band |b_i(q)| <= :data:`BRANCH_BAND`,
+        where q belongs to both neighbouring configurations: s_i b_i(q) >= 0 or
+        |b_i(q)| <= 1e-7. A 7-DOF arm's arm angle psi(q) must equal the requested one within
+        1e-9 rad modulo 2 pi, psi read in the requested ELBOW branch (the elbow plane's
+        normal flips with the branch, so at a straight elbow psi is the requested branch's).
+        Every ``ok`` answer of :meth:`solve`, :meth:`solve_all` and :meth:`solve_batch`
+        holds its configuration.
+
+        Raises:
+            InvalidInput: q is malformed, or the configuration does not fit this arm.
+        """
+        q = as_joint_vector(q, self.arm.dof, stack=False)
+        self.check_configuration(configuration)
+        return self._kernel.holds(q, configuration.signs, configuration.redundancy)
 
     def solve(self, T: Any, configuration: Configuration, q_hint: np.ndarray | None = None) -> Solution:
         """Joint vector reaching pose T in the given configuration.

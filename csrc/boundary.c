@@ -1,0 +1,140 @@
+/* The singular boundary: candidates that the model's closed form leaves a few digits short
+ * where a branch quantity vanishes (an angle from acos or atan2 of a vanishing pair), made
+ * exact by the Gauss-Newton refinement on the REAL arm (polish.c) and then verified like
+ * every other candidate (verify.c). */
+#include "om_system.h"
+
+#define NEAR_BOUNDARY 1e-2 /* |branch quantity| under which a failed candidate is polished */
+#define POLISH_STEPS 40    /* Jacobians per refinement: 2-4 at a simple root, more at a double one */
+#define SHOULDER_SIGN 0    /* (SHOULDER or ARM, ELBOW, WRIST) in every family */
+#define ELBOW_SIGN 1
+#define SHOULDER_STARTS 8  /* starts of q1 where the wrist centre is on joint 1's axis */
+#define GATE_POINTS 8      /* free-angle samples of the cheap test before a neighbour's search */
+#define GATE_NEAR 0.2      /* |branch quantity| at a sample that lets a neighbour be searched */
+
+/* The smallest |branch quantity| of q and its index (NaN-safe: INFINITY for NaN). */
+static double nearest_branch(const om_solver_data *s, const double *q, int *index)
+{
+    double values[3], nearest = INFINITY;
+    om_branch_values(s->family, s->params, q, values);
+    for (int i = 0; i < s->n_signs; i++) {
+        if (fabs(values[i]) < nearest) {
+            nearest = fabs(values[i]);
+            *index = i;
+        }
+    }
+    return nearest;
+}
+
+bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori)
+{
+    const om_solver_data *s = pb->s;
+    int branch = -1;
+    if (!(nearest_branch(s, q, &branch) < NEAR_BOUNDARY))
+        return false;
+    bool srs = s->family == OM_SRS;
+    om_polish_task t = {s->real_table, s->n_real_rows, s->dof, srs ? s->params : NULL,
+                        srs ? s->model_table : NULL, s->n_model_rows, pb->t.R, pb->p,
+                        srs ? pb->redundancy[0] : 0.0, srs ? (double)pb->signs[ELBOW_SIGN] : 0.0};
+    double start[OM_MAX_DOF];
+    memcpy(start, q, (size_t)s->dof * sizeof(double));
+    om_polish(&t, POLISH_STEPS, q);
+    if (om_verify(pb, q, pos, ori))
+        return true;
+    if (branch != SHOULDER_SIGN)
+        return false;
+    /* The wrist centre on joint 1's axis: the model's q1 is arbitrary there (atan2 of a
+     * vanishing pair), the real arm's is not. Starts around the circle of q1. */
+    for (int k = 1; k < SHOULDER_STARTS; k++) {
+        memcpy(q, start, (size_t)s->dof * sizeof(double));
+        q[0] = start[0] + 2.0 * OM_PI * (double)k / (double)SHOULDER_STARTS;
+        om_polish(&t, POLISH_STEPS, q);
+        if (om_verify(pb, q, pos, ori))
+            return true;
+    }
+    return false;
+}
+
+int om_add_candidate(om_problem *pb, double *q, double *roots, int count)
+{
+    if (!om_verify(pb, q, NULL, NULL) && !om_polish_candidate(pb, q, NULL, NULL))
+        return count;
+    return om_add_root(pb, q, roots, count);
+}
+
+/* The problem with branch i flipped: the neighbouring configuration across that boundary.
+ * psi's reference flips with the ELBOW branch, so there psi becomes psi + pi. */
+static om_problem neighbour(const om_problem *pb, int i, int64_t *signs, double *redundancy)
+{
+    const om_solver_data *s = pb->s;
+    om_problem other = *pb;
+    memcpy(signs, pb->signs, (size_t)s->n_signs * sizeof(int64_t));
+    signs[i] = -signs[i];
+    for (int r = 0; r < s->n_redundancy; r++)
+        redundancy[r] = pb->redundancy[r];
+    if (s->family == OM_SRS && i == ELBOW_SIGN)
+        redundancy[0] = om_wrap(redundancy[0] + OM_PI);
+    other.signs = signs;
+    other.redundancy = redundancy;
+    other.t = om_target_at(s->family, s->params, &pb->t.R, redundancy); /* the target's psi with it */
+    other.counter = 0;
+    return other;
+}
+
+/* Touch points: GATE_POINTS samples of the free angle w in the problem's own configuration.
+ * Where the model's solution has a branch quantity within NEAR_BOUNDARY of zero, it is a
+ * candidate from the crossing (q_J = w), refined and verified into roots (a singular wrist
+ * aligned to the last bit keeps the previous wrist joint, so g there never crosses zero).
+ * Also the cheap test before a neighbour's bounded search: near[i] if branch i comes within
+ * GATE_NEAR of zero at a sample. (A straight elbow is an edge of reach, found by the touch
+ * candidates of the problem's own search.) On the torus every branch is marked, no touch
+ * point is tried. Returns the root count. */
+static int touch_points(om_problem *pb, bool *near, double *roots)
+{
+    const om_solver_data *s = pb->s;
+    bool torus = s->mode == OM_TORUS;
+    for (int i = 0; i < s->n_signs; i++)
+        near[i] = torus;
+    if (torus)
+        return 0;
+    double q[OM_MAX_DOF], values[3];
+    int points = s->mode == OM_FIXED ? 1 : GATE_POINTS, count = 0;
+    for (int k = 0; k < points; k++) {
+        double w = -OM_PI + 2.0 * OM_PI * (double)k / (double)points;
+        if (om_model_ik_at(pb, w, q, true) < -OM_REACH_SLACK)
+            continue;
+        om_branch_values(s->family, s->params, q, values);
+        double nearest = INFINITY;
+        for (int i = 0; i < s->n_signs; i++) {
+            near[i] = near[i] || fabs(values[i]) < GATE_NEAR;
+            nearest = py_min(nearest, fabs(values[i]));
+        }
+        if (nearest < NEAR_BOUNDARY) {
+            if (s->mode == OM_CIRCLE)
+                q[s->dp_joint] = w;
+            count = om_add_candidate(pb, q, roots, count);
+        }
+    }
+    return count;
+}
+
+int om_band_roots(om_problem *pb, double *roots, bool *neighbour_reached)
+{
+    const om_solver_data *s = pb->s;
+    int64_t signs[64];
+    double redundancy[1], found[OM_MAX_ROOTS * OM_MAX_DOF];
+    bool near[3];
+    int count = touch_points(pb, near, roots);
+    *neighbour_reached = false;
+    for (int i = 0; i < s->n_signs; i++) {
+        if (!near[i])
+            continue;
+        om_problem other = neighbour(pb, i, signs, redundancy);
+        int n = om_all_roots(&other, s->scan_points, found, pb->q_prev, INFINITY);
+        pb->counter += other.counter;
+        *neighbour_reached = *neighbour_reached || n > 0;
+        for (int r = 0; r < n; r++) /* verified again in the problem's own configuration */
+            count = om_add_root(pb, found + r * s->dof, roots, count);
+    }
+    return count;
+}

@@ -1,0 +1,133 @@
+/* A damped Gauss-Newton refinement of a joint vector on the REAL arm's chain: the last
+ * digits of a candidate that the model's closed form loses where it is singular (a branch
+ * quantity at zero, where an angle comes from acos or atan2 of a vanishing pair). Any start
+ * q; whatever it returns is checked by the caller with the real FK and the configuration. */
+#include "om_system.h"
+
+#define POLISH_ROWS 7          /* pose (6) + the arm angle */
+#define POLISH_DAMPING 1e-12   /* initial lambda^2, relative to the largest diagonal of J J^T */
+#define POLISH_DAMPING_MAX 1e-2 /* a step refused at this damping ends the refinement */
+#define POLISH_DONE 1e-15      /* residual (m, rad) below which the refinement stops */
+
+static const double IDENTITY[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+
+/* The residual e (rows: p - p(q); the rotation vector of R R(q)^T; psi - psi(q)) in DH frame 0,
+ * its squared norm returned; with J not NULL, the Jacobian of the pose and psi (rows x dof). */
+static double residual(const om_polish_task *t, const double *q, double *e, double *J)
+{
+    double Rc[9], pc[3];
+    om_flange(t->table, t->n_rows, q, Rc, pc);
+    e[0] = t->p.x - pc[0];
+    e[1] = t->p.y - pc[1];
+    e[2] = t->p.z - pc[2];
+    mat3 E = m_mmt(t->R, m_load(Rc, 0)); /* R R(q)^T: the rotation still to go, in frame 0 */
+    vec3 w = v3(0.5 * (E.r2.y - E.r1.z), 0.5 * (E.r0.z - E.r2.x), 0.5 * (E.r1.x - E.r0.y));
+    double s = sqrt(v_dot(w, w));
+    double angle = atan2(s, 0.5 * (E.r0.x + E.r1.y + E.r2.z - 1.0));
+    double k = s > 0.0 ? angle / s : 1.0; /* rotation vector = angle * axis */
+    e[3] = k * w.x;
+    e[4] = k * w.y;
+    e[5] = k * w.z;
+    int rows = t->P ? 7 : 6;
+    if (J)
+        om_jacobian(t->table, t->n_rows, IDENTITY, IDENTITY, q, t->dof, J);
+    if (t->P) {
+        double grad[7];
+        double psi = om_arm_angle_gradient(t->P, t->model_table, t->n_model_rows, q, grad);
+        /* psi's reference flips by pi with the ELBOW branch: read it in the requested one */
+        bool flipped = t->elbow != 0.0 && (sin(q[3] + t->P[SRS_THETA + 3] - t->P[SRS_PHI_STAR]) < 0.0 ? -1.0 : 1.0) != t->elbow;
+        e[6] = om_wrap(t->psi + (flipped ? OM_PI : 0.0) - psi);
+        if (J)
+            memcpy(J + 6 * t->dof, grad, 7 * sizeof(double));
+    }
+    double cost = 0.0;
+    for (int i = 0; i < rows; i++)
+        cost += e[i] * e[i];
+    return cost;
+}
+
+/* Solve the symmetric positive definite A y = b (n x n, A overwritten by its Cholesky
+ * factor); returns false if A is not positive definite to working precision. */
+static bool cholesky_solve(double *A, double *b, int n)
+{
+    for (int j = 0; j < n; j++) {
+        double d = A[j * n + j];
+        for (int k = 0; k < j; k++)
+            d -= A[j * n + k] * A[j * n + k];
+        if (!(d > 0.0))
+            return false;
+        A[j * n + j] = sqrt(d);
+        for (int i = j + 1; i < n; i++) {
+            double v = A[i * n + j];
+            for (int k = 0; k < j; k++)
+                v -= A[i * n + k] * A[j * n + k];
+            A[i * n + j] = v / A[j * n + j];
+        }
+    }
+    for (int i = 0; i < n; i++) { /* L z = b */
+        for (int k = 0; k < i; k++)
+            b[i] -= A[i * n + k] * b[k];
+        b[i] /= A[i * n + i];
+    }
+    for (int i = n - 1; i >= 0; i--) { /* L^T y = z */
+        for (int k = i + 1; k < n; k++)
+            b[i] -= A[k * n + i] * b[k];
+        b[i] /= A[i * n + i];
+    }
+    return true;
+}
+
+/* Refine q in place by damped Gauss-Newton steps dq = J^T (J J^T + lambda^2 I)^-1 e: the
+ * minimum-norm step, well defined where J loses rank (the singular boundary). lambda grows
+ * by 100 on a step that does not lower |e| and shrinks by 10 on one that does; at most
+ * `iterations` Jacobians. Returns |e| at the end (q is only ever replaced by a better one). */
+double om_polish(const om_polish_task *t, int iterations, double *q)
+{
+    int dof = t->dof, rows = t->P ? 7 : 6;
+    double e[POLISH_ROWS], e_try[POLISH_ROWS], J[POLISH_ROWS * OM_MAX_DOF], A[POLISH_ROWS * POLISH_ROWS];
+    double y[POLISH_ROWS], q_try[OM_MAX_DOF];
+    double cost = residual(t, q, e, J);
+    double damping = POLISH_DAMPING;
+    for (int it = 0; it < iterations && cost > POLISH_DONE * POLISH_DONE && isfinite(cost); it++) {
+        double scale = 0.0;
+        for (int a = 0; a < rows; a++) {
+            double d = 0.0;
+            for (int j = 0; j < dof; j++)
+                d += J[a * dof + j] * J[a * dof + j];
+            scale = py_max(scale, d);
+        }
+        bool improved = false;
+        while (!improved && damping <= POLISH_DAMPING_MAX) {
+            for (int a = 0; a < rows; a++) {
+                for (int b = 0; b < rows; b++) {
+                    double d = 0.0;
+                    for (int j = 0; j < dof; j++)
+                        d += J[a * dof + j] * J[b * dof + j];
+                    A[a * rows + b] = d;
+                }
+                A[a * rows + a] += damping * scale;
+                y[a] = e[a];
+            }
+            if (cholesky_solve(A, y, rows)) {
+                for (int j = 0; j < dof; j++) {
+                    double dq = 0.0;
+                    for (int a = 0; a < rows; a++)
+                        dq += J[a * dof + j] * y[a];
+                    q_try[j] = q[j] + dq;
+                }
+                double c = residual(t, q_try, e_try, NULL);
+                improved = c < cost;
+                if (improved) {
+                    memcpy(q, q_try, (size_t)dof * sizeof(double));
+                    cost = residual(t, q, e, J);
+                    damping = py_max(damping / 10.0, POLISH_DAMPING);
+                    break;
+                }
+            }
+            damping *= 100.0;
+        }
+        if (!improved)
+            break;
+    }
+    return sqrt(cost);
+}
