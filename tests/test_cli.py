@@ -22,7 +22,7 @@ from om_redundant.cli import build_parser, main
 from om_redundant.cli.common import UsageError
 from om_redundant.cli.sweep import Progress, build_request, parse_obstacle, psi_grid, read_path
 from om_redundant.om.model import derive_model
-from om_redundant.redundancy.sweep import SweepResult, compute_sweep
+from om_redundant.redundancy.sweep import SweepResult, compute_sweep, optimizer_for
 from tests.conftest import MENAGERIE, ROOT, checkout_env, run_python
 
 Q_PANDA = np.array([0.2, 0.4, -0.3, -1.8, 0.5, 1.9, 0.6])
@@ -135,6 +135,8 @@ def test_bad_input_exits_2_with_one_line_and_no_traceback(argv, message):
         (["sweep", "--plot", "sweep.jpg"], "use a file ending in .png or .svg"),
         (["sweep", "--csv", "no/such/dir/sweep.csv"], "directory 'no/such/dir' does not exist"),
         (["sweep", "--csv", "--json"], "cannot both go to standard output"),
+        (["sweep", "--singularity-weight", "-1"], "--singularity-weight must be a finite number >= 0"),
+        (["sweep", "--singularity-weight", "inf"], "--singularity-weight must be a finite number >= 0"),
     ],
 )
 def test_more_bad_input_one_line(capsys, argv, message):
@@ -502,7 +504,7 @@ def test_sweep_request_defaults():
     np.testing.assert_array_equal(request.poses, solver.arm.fk(Q_PANDA)[None])
     assert request.branches == tuple(c.signs for c in solver.configurations())
     assert len(request.psi) == 360 and request.psi[0] == -math.pi and request.psi[-1] < math.pi
-    assert request.scene is None
+    assert request.scene is None and request.singularity_weight == 0.1
 
 
 def test_sweep_request_with_everything(tmp_path):
@@ -517,7 +519,7 @@ def test_sweep_request_with_everything(tmp_path):
         "--obstacle", "sphere:0.4,0,0.3,0.05", "--obstacle", "capsule:0,0,0,0,0,1,0.1",
         "--obstacle", "box:0.5,0,0,0.1,0.2,0.3", "--scene", str(scene),
         "--csv", str(tmp_path / "s.csv"), "--json", str(tmp_path / "s.json"),
-        "--plot", str(tmp_path / "map.svg"),
+        "--plot", str(tmp_path / "map.svg"), "--singularity-weight", "0.5",
     )  # fmt: skip
     assert request.path and request.poses.shape == (2, 4, 4) and request.branches == ((1, -1, 1),)
     np.testing.assert_allclose(request.poses[1, :3, 3], [0.5, 0.1, 0.4])
@@ -525,6 +527,7 @@ def test_sweep_request_with_everything(tmp_path):
     assert len(request.psi) == 63 and np.allclose(np.diff(request.psi), 2 * math.pi / 63)
     assert [o.kind for o in request.obstacles] == ["sphere", "capsule", "box"]
     assert request.scene.ngeom == 1
+    assert request.singularity_weight == 0.5 and optimizer_for(request).objective.singularity_weight == 0.5
 
 
 def test_sweep_json_agrees_with_the_optimiser(tmp_path):

@@ -22,6 +22,7 @@ import numpy as np
 from ..mujoco_io.model_match import load_mujoco_model
 from ..om.configuration import Configuration
 from ..om.solver import OMSolver
+from ..redundancy.objective import DEFAULT_SINGULARITY_WEIGHT
 from ..redundancy.sweep import SHAPES, Obstacle, SweepRequest, compute_sweep
 from .common import (
     UsageError,
@@ -75,6 +76,14 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--scene", metavar="FILE.xml", help="MuJoCo scene whose geoms are obstacles")
     parser.add_argument(
+        "--singularity-weight",
+        type=float,
+        default=DEFAULT_SINGULARITY_WEIGHT,
+        metavar="W",
+        help="weight of the optimiser's distance from the wrist, elbow and shoulder singularities "
+        f"(0: ignore them; default {DEFAULT_SINGULARITY_WEIGHT:g}, the joint-limit margin's is 1)",
+    )
+    parser.add_argument(
         "--resolution",
         type=float,
         default=DEFAULT_RESOLUTION,
@@ -109,6 +118,8 @@ def build_request(args: argparse.Namespace) -> SweepRequest:
             "use 'om-redundant solve'"
         )
     psi = psi_grid(args.resolution)
+    if not (math.isfinite(args.singularity_weight) and args.singularity_weight >= 0.0):
+        raise UsageError(f"--singularity-weight must be a finite number >= 0, got {args.singularity_weight}")
     branches = parse_signs(args.signs, solver)
     obstacles = tuple(parse_obstacle(text) for text in args.obstacle)
     if args.path is not None:
@@ -132,6 +143,7 @@ def build_request(args: argparse.Namespace) -> SweepRequest:
         psi=psi,
         obstacles=obstacles,
         scene=scene,
+        singularity_weight=args.singularity_weight,
         progress=Progress(len(poses), enabled=args.path is not None and not getattr(args, "quiet", False)),
     )
 

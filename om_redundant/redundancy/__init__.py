@@ -1,8 +1,9 @@
 """The redundancy of 7-DOF arms: the arm angle (:mod:`.arm_angle`) and the self-motion
-(:mod:`.self_motion`), the objective (:mod:`.objective`, :mod:`.clearance`), solution paths
-along psi (:mod:`.paths`), feasible intervals (:mod:`.intervals`), the climb (:mod:`.climb`),
-the optimiser that combines them (:mod:`.optimizer`), and the sweep of psi for a pose or a
-path that ``om-redundant sweep`` shows (:mod:`.sweep`)."""
+(:mod:`.self_motion`), the objective (:mod:`.objective`, :mod:`.clearance`,
+:mod:`.singularity`), solution paths along psi (:mod:`.paths`), feasible intervals
+(:mod:`.intervals`), the climb (:mod:`.climb`), the optimiser that combines them
+(:mod:`.optimizer`), and the sweep of psi for a pose or a path that ``om-redundant sweep``
+shows (:mod:`.sweep`)."""
 
 from .arm_angle import arm_angle_and_gradient
 from .clearance import Box, Capsule, Clearance, Sphere
@@ -10,6 +11,7 @@ from .intervals import PsiInterval
 from .objective import Evaluation, Objective, joint_margins
 from .optimizer import RedundancyChoice, RedundancyOptimizer
 from .self_motion import self_motion_tangent
+from .singularity import Singularity
 from .sweep import (
     BranchSweep,
     Choice,
@@ -34,6 +36,7 @@ __all__ = [
     "PsiInterval",
     "RedundancyChoice",
     "RedundancyOptimizer",
+    "Singularity",
     "Sphere",
     "SweepRequest",
     "SweepResult",

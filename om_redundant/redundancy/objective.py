@@ -1,4 +1,5 @@
-r"""What the redundancy optimiser maximises: joint-limit margin and obstacle clearance.
+r"""What the redundancy optimiser maximises: joint-limit margin, obstacle clearance and
+distance from singularities.
 
 Joint-limit margin of joint i (limited joints only), normalised by half its range
 :math:`h_i = (u_i - l_i)/2`:
@@ -14,19 +15,26 @@ margin; :mod:`om_redundant.redundancy.paths`.) Each
 Clearance :math:`D(q) = \min_k d_k(q)` (:mod:`om_redundant.redundancy.clearance`), capped at
 :math:`d_{cap}` and normalised by it.
 
-The objective, maximised over the redundancy variables, with weights :math:`w_m, w_c \ge 0`:
+Singularity distance :math:`S(q) = \min_k s_k(q)`, :math:`s_k = |\sin x_k|` for the model's
+wrist, elbow and shoulder angles :math:`x_k` (:mod:`om_redundant.redundancy.singularity`),
+capped at :data:`SINGULARITY_CAP` :math:`= s_{cap}` and normalised by it.
 
-.. math::  f(q) = w_m\, M(q) + w_c \min\big(1,\ D(q)/d_{cap}\big),
+The objective, maximised over the redundancy variables, with weights :math:`w_m, w_c, w_s \ge 0`:
+
+.. math::  f(q) = w_m\, M(q) + w_c \min\big(1,\ D(q)/d_{cap}\big) + w_s \min\big(1,\ S(q)/s_{cap}\big),
 
 and q is feasible when it is within the limits and clear: :math:`M(q) \ge 0` and
-:math:`D(q) \ge d_{min}`. Both terms are dimensionless in [0, 1] on the feasible set, so the
+:math:`D(q) \ge d_{min}`. The terms are dimensionless in [0, 1] on the feasible set, so the
 weights trade them directly: with the defaults, 1 cm of clearance below the cap of 0.1 m is
 worth 0.1 of normalised margin. Capping the clearance stops far obstacles from pulling the
-arm away from mid-range.
+arm away from mid-range. The singularity term is no constraint (every S >= 0 is
+feasible): it moves the optimum off a singular wrist, elbow or shoulder where that costs
+less margin and clearance than it gains, and beyond 30 degrees from every singularity
+(:math:`S \ge s_{cap} = \sin 30^\circ`) it earns nothing more.
 
 Each term is a *group*: a weight w, a floor (the feasibility bound: 0 for M,
-:math:`d_{min}/d_{cap}` for the clearance), a cap (none for M, 1 for the clearance), and
-pieces :math:`v_j(q)` whose minimum it takes. The QP linearises every piece
+:math:`d_{min}/d_{cap}` for the clearance, none for S), a cap (none for M, 1 for the
+clearance and S), and pieces :math:`v_j(q)` whose minimum it takes. The QP linearises every piece
 (:func:`~om_redundant.redundancy.climb.maximise`).
 """
 
@@ -42,6 +50,12 @@ from ..exceptions import InvalidInput
 from ..kinematics.arm import Arm
 from ..validation import as_instance, as_joint_vector, as_number
 from .clearance import Clearance
+from .singularity import Singularity
+
+#: s_cap: a singularity distance |sin x| beyond this (30 degrees) earns nothing more.
+SINGULARITY_CAP = 0.5
+#: Default weights: w_m, w_c, w_s (module docstring).
+DEFAULT_MARGIN_WEIGHT, DEFAULT_CLEARANCE_WEIGHT, DEFAULT_SINGULARITY_WEIGHT = 1.0, 1.0, 0.1
 
 
 def joint_margins(arm: Arm, q: np.ndarray) -> np.ndarray:
@@ -67,9 +81,20 @@ def _limit_distances(
     return (q - lower) / half, (upper - q) / half
 
 
-def check_weights(margin_weight: Any, clearance_weight: Any, clearance_cap: Any, min_clearance: Any) -> None:
+def check_weights(
+    margin_weight: Any,
+    clearance_weight: Any,
+    clearance_cap: Any,
+    min_clearance: Any,
+    singularity_weight: Any = DEFAULT_SINGULARITY_WEIGHT,
+) -> None:
     """Raise InvalidInput naming the first of the objective's numbers that is out of range."""
-    for name, value in (("margin_weight", margin_weight), ("clearance_weight", clearance_weight)):
+    weights = (
+        ("margin_weight", margin_weight),
+        ("clearance_weight", clearance_weight),
+        ("singularity_weight", singularity_weight),
+    )
+    for name, value in weights:
         if not as_number(value, name) >= 0.0:
             raise InvalidInput(f"{name} must be a finite number >= 0, got {value}")
     if not as_number(clearance_cap, "clearance_cap") > 0.0:
@@ -86,9 +111,9 @@ class Group:
     ``min_j values_j >= floor``.
 
     Attributes:
-        kind: ``"margin"`` or ``"clearance"``.
+        kind: ``"margin"``, ``"clearance"`` or ``"singularity"``.
         weight: w >= 0.
-        floor: Feasibility bound on the minimum.
+        floor: Feasibility bound on the minimum; -inf for none (no constraint).
         cap: Upper cap of the term (inf for none).
         values: (p,) the pieces v_j.
         jacobian: (p, n) their derivatives by n variables (q, or the redundancy variables),
@@ -113,7 +138,10 @@ class Group:
         (by the first variable of the jacobian). A joint's two margin pieces count as one
         function, the smaller: 1 - |q_i - c_i| / h_i about mid-range c_i, continuous also
         where a revolute joint's angle is taken modulo 2 pi at the representative nearest c_i.
+        A group without a floor has none.
         """
+        if self.floor == -math.inf:
+            return np.zeros(0), np.zeros(0)
         v, d = self.values - self.floor, self.jacobian[:, 0]
         if self.kind != "margin":
             return v, d
@@ -135,12 +163,15 @@ class Evaluation:
         margin: M(q), the smallest normalised joint-limit margin (inf if no joint is limited).
         clearance: D(q) in metres (inf without obstacles).
         slack: The smallest of M(q) and (D(q) - d_min) / d_cap; q is feasible iff >= 0.
+        singularity: S(q), the smallest |sin| of the model's singular angles (inf without
+            the term).
     """
 
     value: float
     margin: float
     clearance: float
     slack: float
+    singularity: float = math.inf
 
     @property
     def feasible(self) -> bool:
@@ -153,8 +184,11 @@ class Objective:
     Args:
         arm: The arm.
         clearance: Obstacle distances, or None for no obstacles.
+        singularity: The model's singularities (``Singularity.of(solver.om)``), or None for
+            no singularity term.
         margin_weight: w_m >= 0.
         clearance_weight: w_c >= 0 (ignored without obstacles).
+        singularity_weight: w_s >= 0 (ignored without ``singularity``).
         clearance_cap: d_cap > 0 (m): clearance beyond it earns nothing more.
         min_clearance: d_min (m), 0 <= d_min < d_cap: the clearance every choice must keep.
     """
@@ -163,20 +197,26 @@ class Objective:
         self,
         arm: Arm,
         clearance: Clearance | None = None,
+        singularity: Singularity | None = None,
         *,
-        margin_weight: float = 1.0,
-        clearance_weight: float = 1.0,
+        margin_weight: float = DEFAULT_MARGIN_WEIGHT,
+        clearance_weight: float = DEFAULT_CLEARANCE_WEIGHT,
+        singularity_weight: float = DEFAULT_SINGULARITY_WEIGHT,
         clearance_cap: float = 0.1,
         min_clearance: float = 0.0,
     ):
         as_instance(arm, Arm, "arm")
-        check_weights(margin_weight, clearance_weight, clearance_cap, min_clearance)
+        check_weights(margin_weight, clearance_weight, clearance_cap, min_clearance, singularity_weight)
+        if singularity is not None and as_instance(singularity, Singularity, "singularity").dof != arm.dof:
+            raise InvalidInput(f"the singularity's arm has {singularity.dof} joints, the arm {arm.dof}")
         if clearance is not None and clearance.distmax < clearance_cap:
             raise InvalidInput(
                 f"the clearance's distmax ({clearance.distmax} m) is below clearance_cap ({clearance_cap} m)"
             )
         self.arm, self.clearance, self._dof = arm, clearance, arm.dof
+        self.singularity = singularity
         self.margin_weight, self.clearance_weight = float(margin_weight), float(clearance_weight)
+        self.singularity_weight = float(singularity_weight)
         self.clearance_cap, self.min_clearance = float(clearance_cap), float(min_clearance)
         self._limited = np.flatnonzero(np.isfinite(arm.lower) & np.isfinite(arm.upper))
         self._lower, self._upper = arm.lower[self._limited], arm.upper[self._limited]
@@ -185,23 +225,25 @@ class Objective:
         self._margin_jacobian = np.vstack([eye, -eye])  # pieces (q - l)/h, then (u - q)/h
 
     def groups(self, q: np.ndarray, jacobian: bool = False) -> list[Group]:
-        """The groups at q (module docstring): margin (if any joint is limited), then
-        clearance (if there are obstacles); their jacobians by q if asked."""
+        """The groups at q (module docstring): margin (if any joint is limited), clearance
+        (if there are obstacles), then singularity (if given); their jacobians by q if asked."""
         groups = [self._margin(q, jacobian)] if len(self._limited) else []
-        return groups + ([self._clearance(q, jacobian)] if self.clearance is not None else [])
+        groups += [self._clearance(q, jacobian)] if self.clearance is not None else []
+        return groups + ([self._singularity(q, jacobian)] if self.singularity is not None else [])
 
     def evaluate(self, q: np.ndarray) -> Evaluation:
         """f(q), M(q), D(q) and the feasibility slack."""
         return self.evaluation(self.groups(as_joint_vector(q, self._dof)))
 
     def evaluation(self, groups: list[Group]) -> Evaluation:
-        """f, M, D and the slack from the groups at one joint vector."""
+        """f, M, D, the slack and S from the groups at one joint vector."""
         kinds = {g.kind: float(g.values.min()) for g in groups}
         return Evaluation(
             sum(g.term() for g in groups),
             kinds.get("margin", math.inf),
             kinds.get("clearance", math.inf) * self.clearance_cap,
             min((g.slack() for g in groups), default=math.inf),
+            kinds.get("singularity", math.inf) * SINGULARITY_CAP,
         )
 
     def _margin(self, q: np.ndarray, jacobian: bool) -> Group:
@@ -212,8 +254,22 @@ class Objective:
         )
 
     def _clearance(self, q: np.ndarray, jacobian: bool) -> Group:
-        cap, floor = self.clearance_cap, self.min_clearance / self.clearance_cap
-        if jacobian:
-            d, grad = self.clearance.distances_and_gradients(q)
-            return Group("clearance", self.clearance_weight, floor, 1.0, d / cap, grad / cap)
-        return Group("clearance", self.clearance_weight, floor, 1.0, self.clearance.distances(q) / cap)
+        floor = self.min_clearance / self.clearance_cap
+        return _capped(
+            "clearance", self.clearance_weight, floor, self.clearance, self.clearance_cap, q, jacobian
+        )
+
+    def _singularity(self, q: np.ndarray, jacobian: bool) -> Group:
+        return _capped(
+            "singularity", self.singularity_weight, -math.inf, self.singularity, SINGULARITY_CAP, q, jacobian
+        )
+
+
+def _capped(
+    kind: str, weight: float, floor: float, source: Any, cap: float, q: np.ndarray, jacobian: bool
+) -> Group:
+    """The group of distances capped at ``cap``: ``source.distances(q) / cap``, cap 1."""
+    if jacobian:
+        d, grad = source.distances_and_gradients(q)
+        return Group(kind, weight, floor, 1.0, d / cap, grad / cap)
+    return Group(kind, weight, floor, 1.0, source.distances(q) / cap)

@@ -1,8 +1,10 @@
-r"""The redundancy optimiser: a QP picks the arm angle for joint-limit margin and clearance.
+r"""The redundancy optimiser: a QP picks the arm angle for joint-limit margin, clearance and
+distance from singularities.
 
 For a pose T, :meth:`RedundancyOptimizer.choose` returns the configuration
 c = (signs, psi) that maximises the objective f of :mod:`om_redundant.redundancy.objective` (weighted
-normalised joint-limit margin and capped obstacle clearance) over the feasible set (within
+normalised joint-limit margin, capped obstacle clearance and capped distance from the
+model's singularities) over the feasible set (within
 the limits, clearance >= d_min), and the exact OM solution in it:
 
 1. **Sweep.** Every allowed branch's exact solutions are sampled on a psi grid and linked
@@ -41,8 +43,15 @@ from ..validation import as_count, as_instance, as_number, as_pose, as_signs
 from .clearance import DEFAULT_DISTMAX, Clearance, Shape
 from .climb import maximise
 from .intervals import PsiInterval, Run, feasible_runs
-from .objective import Objective, check_weights
+from .objective import (
+    DEFAULT_CLEARANCE_WEIGHT,
+    DEFAULT_MARGIN_WEIGHT,
+    DEFAULT_SINGULARITY_WEIGHT,
+    Objective,
+    check_weights,
+)
 from .paths import Path, Point, Probe, sweep_circle, sweep_window
+from .singularity import Singularity
 
 _WINDOW_POINTS = 4  # tracking samples on each side of the previous psi
 #: Bounds of ``grid_points`` (psi samples per branch; the sweep's cost grows with it).
@@ -78,15 +87,17 @@ class RedundancyChoice:
 
 
 class RedundancyOptimizer:
-    """Picks the arm angle psi (and branch) of a 7-DOF arm for margin and clearance.
+    """Picks the arm angle psi (and branch) of a 7-DOF arm for margin, clearance and distance
+    from singularities.
 
     Args:
         solver: The OM solver of an arm with one redundancy variable.
         obstacles: None; shapes (:class:`~om_redundant.Sphere`, ``Capsule``, ``Box``) or a
             MuJoCo model of obstacles, in the arm's root frame (combined with the project's
             MJCF of the arm); or a :class:`~om_redundant.Clearance` (e.g. of your own model).
-        margin_weight, clearance_weight, clearance_cap, min_clearance: The objective
-            (:class:`~om_redundant.redundancy.objective.Objective`).
+        margin_weight, clearance_weight, singularity_weight, clearance_cap, min_clearance: The
+            objective (:class:`~om_redundant.redundancy.objective.Objective`; the singularity
+            term is the model's, ``Singularity.of(solver.om)``).
         branches: Allowed branch signs, e.g. ``[(1, -1, 1)]``; default all.
         grid_points: psi samples per branch of the sweep, a whole number from 16 to 100,000.
         max_step: Largest psi change (rad) per tracking call, in (0, pi].
@@ -108,8 +119,9 @@ class RedundancyOptimizer:
         solver: OMSolver,
         obstacles: Sequence[Shape] | mujoco.MjModel | Clearance | None = None,
         *,
-        margin_weight: float = 1.0,
-        clearance_weight: float = 1.0,
+        margin_weight: float = DEFAULT_MARGIN_WEIGHT,
+        clearance_weight: float = DEFAULT_CLEARANCE_WEIGHT,
+        singularity_weight: float = DEFAULT_SINGULARITY_WEIGHT,
         clearance_cap: float = 0.1,
         min_clearance: float = 0.0,
         branches: Sequence[Sequence[int]] | None = None,
@@ -122,7 +134,7 @@ class RedundancyOptimizer:
                 f"arm '{solver.arm.name}' has {len(solver.redundancy_names)} redundancy variables; "
                 "the optimiser needs one (a 7-DOF arm's arm angle)"
             )
-        check_weights(margin_weight, clearance_weight, clearance_cap, min_clearance)
+        check_weights(margin_weight, clearance_weight, clearance_cap, min_clearance, singularity_weight)
         if obstacles is not None and not isinstance(obstacles, Clearance):
             distmax = max(DEFAULT_DISTMAX, 2.0 * clearance_cap)
             obstacles = Clearance.for_arm(solver.arm, obstacles, distmax=distmax)
@@ -130,8 +142,10 @@ class RedundancyOptimizer:
         self.objective = Objective(
             solver.arm,
             obstacles,
+            Singularity.of(solver.om),
             margin_weight=margin_weight,
             clearance_weight=clearance_weight,
+            singularity_weight=singularity_weight,
             clearance_cap=clearance_cap,
             min_clearance=min_clearance,
         )

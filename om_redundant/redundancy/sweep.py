@@ -20,7 +20,7 @@ import numpy as np
 from ..om.configuration import Configuration
 from ..om.solver import OMSolver
 from .clearance import Box, Capsule, Clearance, Shape, Sphere
-from .objective import joint_margins
+from .objective import DEFAULT_SINGULARITY_WEIGHT, joint_margins
 from .optimizer import RedundancyChoice, RedundancyOptimizer
 
 #: Obstacle shapes: the numbers each takes, in order (metres, in the arm's root frame).
@@ -68,6 +68,8 @@ class SweepRequest:
         obstacles: Obstacles given with ``--obstacle``.
         scene: The ``--scene`` model (compiled, meshes dropped if their files are missing),
             whose geoms are further obstacles; None without one.
+        singularity_weight: The optimiser's weight of the distance from singularities
+            (``--singularity-weight``).
         progress: Call with the number of poses done so far (drives the progress bar).
     """
 
@@ -78,6 +80,7 @@ class SweepRequest:
     psi: np.ndarray
     obstacles: tuple[Obstacle, ...] = ()
     scene: mujoco.MjModel | None = None
+    singularity_weight: float = DEFAULT_SINGULARITY_WEIGHT
     progress: Callable[[int], None] = field(default=lambda done: None)
 
 
@@ -142,14 +145,17 @@ class SweepResult:
 
 def optimizer_for(request: SweepRequest) -> RedundancyOptimizer:
     """The redundancy optimiser of the request: its arm, branches and obstacles (shapes and
-    scene in one :class:`~om_redundant.Clearance`), default objective."""
+    scene in one :class:`~om_redundant.Clearance`), singularity weight, default objective
+    otherwise."""
     shapes: list[Shape | mujoco.MjModel] = [
         o.shape(f"cli_{o.kind}{k}") for k, o in enumerate(request.obstacles)
     ]
     if request.scene is not None:
         shapes.append(request.scene)
     obstacles = Clearance.for_arm(request.solver.arm, shapes) if shapes else None
-    return RedundancyOptimizer(request.solver, obstacles, branches=request.branches)
+    return RedundancyOptimizer(
+        request.solver, obstacles, branches=request.branches, singularity_weight=request.singularity_weight
+    )
 
 
 def compute_sweep(request: SweepRequest) -> SweepResult:
