@@ -13,9 +13,11 @@ bool om_in_configuration(const om_solver_data *s, const double *q, const int64_t
     for (int i = 0; i < s->n_signs; i++)
         if (!(values[i] * (double)signs[i] >= 0.0 || fabs(values[i]) <= OM_BRANCH_BAND)) /* NaN: not in it */
             return false;
-    if (s->family == OM_SRS) /* psi: the only redundancy value; in the requested ELBOW branch */
-        return fabs(om_wrap(om_srs_arm_angle_in(s->params, q, (double)signs[SRS_ELBOW_SIGN]) - redundancy[0])) <=
-               REDUNDANCY_TOL;
+    if (s->family == OM_SRS) { /* psi: the only redundancy value; in the requested ELBOW branch */
+        double psi = om_srs_arm_angle_in(s->params, q, (double)signs[SRS_ELBOW_SIGN]);
+        /* reduced exactly first: a huge requested psi (1e16) is one well-defined angle */
+        return fabs(om_wrap(psi - remainder(redundancy[0], 2.0 * OM_PI))) <= REDUNDANCY_TOL;
+    }
     return true;
 }
 

@@ -52,7 +52,7 @@ class Solution:
         q: Joint vector of the REAL arm (NaN when no solution). Revolute joints are
             shifted by multiples of 2 pi into the limits, nearest to the hint.
         ok: True only if the real arm reaches the pose within tolerance in the requested
-            configuration.
+            configuration (as :meth:`OMSolver.holds` reads it: within the branch band, both).
         status: ``"ok"``, ``"unreachable"`` (no configuration reaches the pose) or
             ``"no solution in this configuration"``.
         configuration: The configuration asked for.
