@@ -20,7 +20,8 @@ the limits, clearance >= d_min), and the exact OM solution in it:
    solution, within the interval. The result is the best point's own exact solve.
 
 **Tracking** (``choose(T, previous)``): the previous branch only, psi within ``max_step``
-of the previous psi, every solution continued from the previous joints. The branch is left
+of the previous psi, every solution continued from the previous joints; among the optima
+within :data:`PLATEAU` of the best, the one nearest the previous psi. The branch is left
 only when it has no feasible psi at all at this pose, and the result says so
 (``branch_flipped``, ``reason``); if it is feasible only farther than ``max_step`` away, the
 result is not ok and names where.
@@ -50,10 +51,12 @@ from .objective import (
     Objective,
     check_weights,
 )
-from .paths import Path, Point, Probe, sweep_circle, sweep_window
+from .paths import END_TOLERANCE, Path, Point, Probe, sweep_circle, sweep_window
 from .singularity import Singularity
 
 _WINDOW_POINTS = 4  # tracking samples on each side of the previous psi
+#: Tracking: optima within this of the best objective value are equal; the nearest wins.
+PLATEAU = 1e-6
 #: Bounds of ``grid_points`` (psi samples per branch; the sweep's cost grows with it).
 MIN_GRID_POINTS, MAX_GRID_POINTS = 16, 100_000
 
@@ -218,7 +221,7 @@ class RedundancyOptimizer:
         window = sweep_window(probe, psi, previous.solution.q, self.max_step, _WINDOW_POINTS)
         runs = [run for path in window for run in feasible_runs(probe, path)]
         if runs:
-            return self._result(T, self._climb_all(T, runs, wrapped=False), runs)
+            return self._result(T, self._climb_all(T, runs, near=psi), runs)
         ((_, paths, branch_runs),) = self._sweep(T, [signs])
         if branch_runs:
             where = ", ".join(f"[{r.interval.lo:+.3f}, {r.interval.hi:+.3f}]" for r in branch_runs)
@@ -234,8 +237,16 @@ class RedundancyOptimizer:
             return replace(choice, reason=f"{why}; {choice.reason}")
         return replace(choice, branch_flipped=True, reason=f"{why}; switched to {choice.configuration.signs}")
 
-    def _climb_all(self, T: np.ndarray, runs: list[Run], wrapped: bool = True) -> tuple[Run, Point]:
-        """The global maximum over the runs: climbs from the best starts (module docstring)."""
+    def _climb_all(self, T: np.ndarray, runs: list[Run], near: float | None = None) -> tuple[Run, Point]:
+        """The global maximum over the runs: climbs from the best starts (module docstring).
+
+        With ``near`` (tracking: the previous psi; distances modulo 2 pi), the sample at
+        ``near`` is a start too, and the optimum is the one nearest ``near`` among those
+        within :data:`PLATEAU` of the best: on a flat
+        objective (a joint that the self-motion does not move binding the margin, the
+        clearance at its cap) psi stays where it was instead of jumping to whichever sample
+        rounding favours, which the joints could not follow in one tick.
+        """
         slope = 0.0
         starts = []
         for run in runs:
@@ -244,19 +255,25 @@ class RedundancyOptimizer:
             if len(f) > 1:
                 slope = max(slope, float(np.max(np.abs(np.diff(f)) / np.maximum(np.diff(psi), 1e-12))))
             for k in range(len(f)):
-                if (k == 0 or f[k] >= f[k - 1]) and (k == len(f) - 1 or f[k] >= f[k + 1]):
+                at_near = near is not None and _distance(psi[k], near) <= END_TOLERANCE
+                if at_near or ((k == 0 or f[k] >= f[k - 1]) and (k == len(f) - 1 or f[k] >= f[k + 1])):
                     gap = max(psi[min(k + 1, len(f) - 1)] - psi[k], psi[k] - psi[max(k - 1, 0)])
                     starts.append((f[k], gap, run, run.points[k]))
         starts.sort(key=lambda s: -s[0])
-        best_run, best = starts[0][2], starts[0][3]
+        tolerance = 0.0 if near is None else PLATEAU
+        found = [(starts[0][2], starts[0][3])]
         for value, gap, run, start in starts:
-            if value + 2.0 * slope * gap < best.evaluation.value:
+            best = max(point.evaluation.value for _, point in found)
+            if value + 2.0 * slope * gap < best - tolerance:
                 continue
             lo, hi = (-math.inf, math.inf) if run.interval.closed else (run.interval.lo, run.interval.hi)
-            point = maximise(self._probe(T, run.interval.signs, wrapped), start, lo, hi, max(gap, 1e-6))
-            if point.evaluation.value > best.evaluation.value:
-                best_run, best = run, point
-        return best_run, best
+            probe = self._probe(T, run.interval.signs, wrapped=near is None)
+            found.append((run, maximise(probe, start, lo, hi, max(gap, 1e-6))))
+        best = max(point.evaluation.value for _, point in found)
+        if near is None:
+            return next((run, point) for run, point in found if point.evaluation.value == best)
+        optima = [(run, point) for run, point in found if point.evaluation.value >= best - PLATEAU]
+        return min(optima, key=lambda found: _distance(found[1].psi, near))
 
     def _result(self, T: np.ndarray, best: tuple[Run, Point], runs: list[Run]) -> RedundancyChoice:
         run, point = best
@@ -301,6 +318,11 @@ class RedundancyOptimizer:
             f"branch {signs}: clearance below {self.objective.min_clearance} m wherever within the limits "
             f"(best {best:.4f} m)"
         )
+
+
+def _distance(a: float, b: float) -> float:
+    """The distance of two angles on the circle."""
+    return abs(math.remainder(a - b, 2.0 * math.pi))
 
 
 def _failure(intervals: tuple[PsiInterval, ...], reason: str) -> RedundancyChoice:
