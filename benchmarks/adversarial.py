@@ -1299,7 +1299,7 @@ def markdown(
         "",
         "Reading the notes: a wrong ok marked *within the solver's own tolerance* misses by more "
         "than this page's 1e-10 but less than the solver's own `position_tolerance` / "
-        "`orientation_tolerance` (defaults 1e-10 m and **1e-9 rad**); *solve_all without q*: "
+        "`orientation_tolerance` (defaults 1e-10 m and 1e-10 rad); *solve_all without q*: "
         f"`solve_all` returned roots, none within {ROOT_MATCH:g} of q; *far: status not 'unreachable'*: "
         "a pose translated 1e3 ... 1e300 m answered otherwise; *library exception*: an `om.OMError` "
         "raised for a valid input.",

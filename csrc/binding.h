@@ -17,6 +17,37 @@ int get_signs(PyObject *obj, int64_t *out, int k);
 /* A sequence of k numbers into out. */
 int get_doubles(PyObject *obj, double *out, int k, const char *name);
 
+/* Largest accepted deviation max|R^T R - I| of a pose's rotation block (validation.py takes it
+ * from here: ckernels.ORTHONORMALITY_TOLERANCE). */
+#define OM_ORTHONORMALITY_TOL 1e-9
+/* T (16 float64, row-major 4x4): finite, last row [0 0 0 1], max|R^T R - I| <= tol, det R > 0. */
+int om_pose_is_valid(const double *T, double tol);
+
+/* The status names by status code (ckernels.STATUS_NAMES), made at import (module.c). */
+extern PyObject *om_status_names;
+
+/* The fields of a solve's result type (om_redundant.om.solver.Solution), in this order. */
+#define OM_SOLUTION_FIELDS \
+    { "q", "ok", "status", "configuration", "position_error", "orientation_error", "iterations", "within_limits" }
+enum { OM_N_SOLUTION_FIELDS = 8 };
+
+/* A Solver: the solver's fixed data, copied once (solver_type.c), and what solve_pose needs
+ * to answer a whole solve in one call (solve_pose.c). */
+typedef struct {
+    PyObject_HEAD
+    om_solver_data data;
+    double *storage; /* params, tables, limits */
+    uint8_t revolute[OM_MAX_DOF];
+    PyObject *solution_type, *configuration_type; /* NULL: solve_pose answers None */
+    PyObject *solution_fields[OM_N_SOLUTION_FIELDS]; /* solution_type's slot descriptors */
+    PyObject *empty;                                 /* numpy.empty */
+} om_Solver;
+
+/* solve_pose.c: Solver(..., solution_type=, configuration_type=) and Solver.solve_pose. */
+int om_solver_set_types(om_Solver *self, PyObject *solution_type, PyObject *configuration_type);
+void om_solver_clear_types(om_Solver *self);
+PyObject *om_solver_solve_pose(om_Solver *self, PyObject *const *args, Py_ssize_t nargs);
+
 extern PyTypeObject om_SolverType;        /* solver_type.c: Solver(SolverData) */
 extern PyMethodDef om_kernel_functions[]; /* functions.c: kinematics and closed forms */
 

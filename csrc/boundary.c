@@ -34,7 +34,7 @@ bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori)
         return false;
     bool srs = s->family == OM_SRS;
     om_polish_task t = {s->real_table, s->n_real_rows, s->dof, srs ? s->params : NULL,
-                        srs ? s->model_table : NULL, s->n_model_rows, pb->R, pb->p,
+                        srs ? s->model_table : NULL, s->n_model_rows, pb->t.R, pb->p,
                         srs ? pb->redundancy[0] : 0.0, srs ? (double)pb->signs[ELBOW_SIGN] : 0.0};
     double start[OM_MAX_DOF];
     memcpy(start, q, (size_t)s->dof * sizeof(double));
@@ -76,6 +76,7 @@ static om_problem neighbour(const om_problem *pb, int i, int64_t *signs, double 
         redundancy[0] = om_wrap(redundancy[0] + OM_PI);
     other.signs = signs;
     other.redundancy = redundancy;
+    other.t = om_target_at(s->family, s->params, &pb->t.R, redundancy); /* the target's psi with it */
     other.counter = 0;
     return other;
 }
@@ -85,9 +86,10 @@ static om_problem neighbour(const om_problem *pb, int i, int64_t *signs, double 
  * candidate from the crossing (q_J = w), refined and verified into roots (a singular wrist
  * aligned to the last bit keeps the previous wrist joint, so g there never crosses zero).
  * Also the cheap test before a neighbour's bounded search: near[i] if branch i comes within
- * GATE_NEAR of zero at a sample. (A straight elbow is an edge of reach, found by the touch
- * candidates of the problem's own search.) On the torus every branch is marked, no touch
- * point is tried. Returns the root count. */
+ * GATE_NEAR of zero at a sample, or within its change to a neighbouring sample (it may dip to
+ * zero between them); every branch where no sample is within reach. (A straight elbow is an
+ * edge of reach, found by the touch candidates of the problem's own search.) On the torus
+ * every branch is marked, no touch point is tried. Returns the root count. */
 static int touch_points(om_problem *pb, bool *near, double *roots)
 {
     const om_solver_data *s = pb->s;
@@ -96,23 +98,34 @@ static int touch_points(om_problem *pb, bool *near, double *roots)
         near[i] = torus;
     if (torus)
         return 0;
-    double q[OM_MAX_DOF], values[3];
+    double q[OM_MAX_DOF], values[GATE_POINTS][3];
     int points = s->mode == OM_FIXED ? 1 : GATE_POINTS, count = 0;
     for (int k = 0; k < points; k++) {
         double w = -OM_PI + 2.0 * OM_PI * (double)k / (double)points;
-        if (om_model_ik_at(pb, w, q, true) < -OM_REACH_SLACK)
+        double *v = values[k];
+        if (om_model_ik_at(pb, w, q, true) < -OM_REACH_SLACK) {
+            v[0] = v[1] = v[2] = NAN;
             continue;
-        om_branch_values(s->family, s->params, q, values);
-        double nearest = INFINITY;
-        for (int i = 0; i < s->n_signs; i++) {
-            near[i] = near[i] || fabs(values[i]) < GATE_NEAR;
-            nearest = py_min(nearest, fabs(values[i]));
         }
+        om_branch_values(s->family, s->params, q, v);
+        double nearest = INFINITY;
+        for (int i = 0; i < s->n_signs; i++)
+            nearest = py_min(nearest, fabs(v[i]));
         if (nearest < NEAR_BOUNDARY) {
             if (s->mode == OM_CIRCLE)
                 q[s->dp_joint] = w;
             count = om_add_candidate(pb, q, roots, count);
         }
+    }
+    bool seen = false; /* no sample within reach: nothing known, every neighbour is searched */
+    for (int k = 0; k < points; k++)
+        seen = seen || !isnan(values[k][0]);
+    for (int i = 0; i < s->n_signs; i++)
+        near[i] = !seen;
+    for (int k = 0; k < points; k++) {
+        const double *v = values[k], *next = values[(k + 1) % points];
+        for (int i = 0; i < s->n_signs; i++) /* false for NaN (out of reach) */
+            near[i] = near[i] || fabs(v[i]) < GATE_NEAR || fabs(v[i]) <= fabs(next[i] - v[i]);
     }
     return count;
 }

@@ -1,15 +1,27 @@
 /* Dispatch on the family code (om_redundant/om/families/dispatch.py calls it from Python). */
 #include "om_kernels.h"
 
-/* Solve the model arm for the flange pose (R, p) in DH frame 0; write q. redundancy[0] is the arm
- * angle of an S-R-S arm (unused for 6-DOF); all_joints false lets the S-R-S family skip the
- * shoulder. Returns the reach margin (negative beyond OM_REACH_SLACK: out of reach, q not written). */
-double om_model_ik(int family, const double *P, const double *table, const mat3 *R, vec3 p, const int64_t *signs,
-                   const double *redundancy, const double *q_prev, double *q, bool all_joints)
+/* The target for the flange orientation R (and, S-R-S, the arm angle redundancy[0]): what
+ * every model solve for this orientation shares, computed once. */
+om_target om_target_at(int family, const double *P, const mat3 *R, const double *redundancy)
+{
+    om_target t = {.R = *R, .psi = family == OM_SRS ? redundancy[0] : 0.0};
+    if (family == OM_SRS)
+        om_srs_target(P, &t);
+    else
+        om_six_dof_target(P, &t);
+    return t;
+}
+
+/* Solve the model arm for the target t's orientation and the position p in DH frame 0; write q.
+ * all_joints false lets the S-R-S family skip the shoulder. Returns the reach margin (negative
+ * beyond OM_REACH_SLACK: out of reach, q not written). */
+double om_model_ik(int family, const double *P, const double *table, const om_target *t, vec3 p,
+                   const int64_t *signs, const double *q_prev, double *q, bool all_joints)
 {
     if (family == OM_SRS)
-        return om_srs_model_ik(P, R, p, signs, redundancy[0], q_prev, q, all_joints);
-    return om_six_dof_model_ik(family, P, table, R, p, signs, q_prev, q);
+        return om_srs_model_ik(P, t, p, signs, q_prev, q, all_joints);
+    return om_six_dof_model_ik(family, P, table, t, p, signs, q_prev, q);
 }
 
 /* The quantities whose signs are the configuration's branch signs at q. */

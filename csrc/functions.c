@@ -154,15 +154,17 @@ static PyObject *k_model_ik(PyObject *mod, PyObject *const *args, Py_ssize_t nar
         return NULL;
     }
     mat3 R = load_mat(v[2].buf);
-    double margin = om_model_ik((int)family, v[0].buf, v[1].buf, &R, load_vec(v[3].buf), v[4].buf, v[5].buf,
-                                v[6].buf, v[7].buf, all_joints);
+    om_target t = om_target_at((int)family, v[0].buf, &R, v[5].buf);
+    double margin = om_model_ik((int)family, v[0].buf, v[1].buf, &t, load_vec(v[3].buf), v[4].buf, v[6].buf,
+                                v[7].buf, all_joints);
     release_all(v, 8);
     return PyFloat_FromDouble(margin);
 }
 
-/* model_ik_at_reach(P, R, p, signs, psi, q_prev, q) -> bool (S-R-S). */
-static PyObject *k_model_ik_at_reach(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
-    if (check_nargs(nargs, 7, "model_ik_at_reach") < 0) return NULL;
+/* model_ik_at_reach(P, R, p, signs, psi, q_prev, q) -> bool and srs_model_q7(the same) -> margin:
+ * the S-R-S closed form's variants (q7_alone: q7 alone, as the circle residual takes it). */
+static PyObject *srs_variant(PyObject *const *args, Py_ssize_t nargs, int q7_alone) {
+    if (check_nargs(nargs, 7, q7_alone ? "srs_model_q7" : "model_ik_at_reach") < 0) return NULL;
     double psi = PyFloat_AsDouble(args[4]);
     if (PyErr_Occurred()) return NULL;
     PyObject *const a[6] = {args[0], args[1], args[2], args[3], args[5], args[6]};
@@ -171,9 +173,20 @@ static PyObject *k_model_ik_at_reach(PyObject *mod, PyObject *const *args, Py_ss
                   {F64, 7, 0, "q_prev"}, {F64, 7, 1, "q"}};
     if (get_all(a, v, sp, 6) < 0) return NULL;
     mat3 R = load_mat(v[1].buf);
-    bool ok = om_srs_model_ik_at_reach(v[0].buf, &R, load_vec(v[2].buf), v[3].buf, psi, v[4].buf, v[5].buf);
+    om_target t = om_target_at(OM_SRS, v[0].buf, &R, &psi);
+    vec3 p = load_vec(v[2].buf);
+    PyObject *out = q7_alone ? PyFloat_FromDouble(om_srs_model_q7(v[0].buf, &t, p, v[3].buf, v[4].buf, v[5].buf))
+                             : PyBool_FromLong(om_srs_model_ik_at_reach(v[0].buf, &t, p, v[3].buf, v[4].buf, v[5].buf));
     release_all(v, 6);
-    return PyBool_FromLong(ok);
+    return out;
+}
+
+static PyObject *k_model_ik_at_reach(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    return srs_variant(args, nargs, 0);
+}
+
+static PyObject *k_srs_model_q7(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    return srs_variant(args, nargs, 1);
 }
 
 /* model_ik_lifted(P, R, p, signs, psi, q1, q7, phi4, q) -> (shoulder, wrist, elbow) residuals. */
@@ -188,7 +201,8 @@ static PyObject *k_model_ik_lifted(PyObject *mod, PyObject *const *args, Py_ssiz
                   {F64, 7, 1, "q"}};
     if (get_all(a, v, sp, 5) < 0) return NULL;
     mat3 R = load_mat(v[1].buf);
-    vec3 r = om_srs_model_ik_lifted(v[0].buf, &R, load_vec(v[2].buf), v[3].buf, psi, q1, q7, phi4, v[4].buf);
+    om_target t = om_target_at(OM_SRS, v[0].buf, &R, &psi);
+    vec3 r = om_srs_model_ik_lifted(v[0].buf, &t, load_vec(v[2].buf), v[3].buf, q1, q7, phi4, v[4].buf);
     release_all(v, 5);
     return Py_BuildValue("(ddd)", r.x, r.y, r.z);
 }
@@ -234,14 +248,8 @@ static PyObject *k_arm_angle_gradient(PyObject *mod, PyObject *const *args, Py_s
     return PyFloat_FromDouble(psi);
 }
 
-/* pose_is_valid(T, tolerance) -> bool: finite, last row [0 0 0 1], max|R^T R - I| <= tolerance, det > 0. */
-static PyObject *k_pose_is_valid(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
-    if (check_nargs(nargs, 2, "pose_is_valid") < 0) return NULL;
-    double tol = PyFloat_AsDouble(args[1]);
-    if (PyErr_Occurred()) return NULL;
-    Py_buffer v;
-    if (get_buffer(args[0], &v, F64, 16, 0, "T") < 0) return NULL;
-    const double *T = v.buf;
+/* Whether T is a homogeneous transform: finite, last row [0 0 0 1], max|R^T R - I| <= tol, det > 0. */
+int om_pose_is_valid(const double *T, double tol) {
     int ok = 1;
     for (int i = 0; i < 16; i++) ok = ok && isfinite(T[i]);
     ok = ok && T[12] == 0.0 && T[13] == 0.0 && T[14] == 0.0 && T[15] == 1.0;
@@ -255,6 +263,17 @@ static PyObject *k_pose_is_valid(PyObject *mod, PyObject *const *args, Py_ssize_
                      T[2] * (T[4] * T[9] - T[5] * T[8]);
         ok = det > 0.0;
     }
+    return ok;
+}
+
+/* pose_is_valid(T, tolerance) -> bool (om_pose_is_valid). */
+static PyObject *k_pose_is_valid(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 2, "pose_is_valid") < 0) return NULL;
+    double tol = PyFloat_AsDouble(args[1]);
+    if (PyErr_Occurred()) return NULL;
+    Py_buffer v;
+    if (get_buffer(args[0], &v, F64, 16, 0, "T") < 0) return NULL;
+    int ok = om_pose_is_valid(v.buf, tol);
     PyBuffer_Release(&v);
     return PyBool_FromLong(ok);
 }
@@ -319,6 +338,7 @@ PyMethodDef om_kernel_functions[] = {
     FAST(flange_target, "flange_target(T, T_base_root, T_tool_flange, R, p)"),
     FAST(model_ik, "model_ik(family, P, table, R, p, signs, redundancy, q_prev, q, all_joints) -> margin"),
     FAST(model_ik_at_reach, "model_ik_at_reach(P, R, p, signs, psi, q_prev, q) -> bool"),
+    FAST(srs_model_q7, "srs_model_q7(P, R, p, signs, psi, q_prev, q) -> margin"),
     FAST(model_ik_lifted, "model_ik_lifted(P, R, p, signs, psi, q1, q7, phi4, q) -> residuals"),
     FAST(branch_values, "branch_values(family, P, q, out)"),
     FAST(redundancy_values, "redundancy_values(family, P, q, out)"),

@@ -7,6 +7,8 @@
  */
 #include "binding.h"
 
+PyObject *om_status_names;
+
 static struct PyModuleDef module = {
     PyModuleDef_HEAD_INIT, "ckernels", "om_redundant's compiled core (see csrc/om_kernels.h).", -1, om_kernel_functions,
 };
@@ -43,7 +45,8 @@ PyMODINIT_FUNC PyInit_ckernels(void) {
     const struct {
         const char *name;
         double value;
-    } floats[] = {{"REACH_SLACK", OM_REACH_SLACK}, {"BRANCH_BAND", OM_BRANCH_BAND}};
+    } floats[] = {
+        {"REACH_SLACK", OM_REACH_SLACK}, {"BRANCH_BAND", OM_BRANCH_BAND}, {"ORTHONORMALITY_TOLERANCE", OM_ORTHONORMALITY_TOL}};
     for (size_t i = 0; i < sizeof floats / sizeof floats[0]; i++) {
         PyObject *v = PyFloat_FromDouble(floats[i].value);
         if (!v || PyModule_AddObject(m, floats[i].name, v) < 0) {
@@ -51,6 +54,10 @@ PyMODINIT_FUNC PyInit_ckernels(void) {
             goto fail;
         }
     }
+    /* By status code: OM_OK, OM_UNREACHABLE, OM_NO_SOLUTION_IN_CONFIGURATION. */
+    if (!om_status_names)
+        om_status_names = Py_BuildValue("(sss)", "ok", "unreachable", "no solution in this configuration");
+    if (!om_status_names || PyModule_AddObjectRef(m, "STATUS_NAMES", om_status_names) < 0) goto fail;
     return m;
 fail:
     Py_DECREF(m);

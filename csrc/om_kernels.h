@@ -78,22 +78,37 @@ enum {
     SRS_N_PARAMS = 70
 };
 
+/* A model solve's target orientation, with what depends on it alone computed once
+ * (om_target_at): every residual evaluation of one solve shares it. */
+typedef struct {
+    mat3 R;       /* the flange orientation in DH frame 0 */
+    mat3 RE;      /* R E^T, E the family's constant wrist rotation (SD_E_ROT, SRS_E_ROT) */
+    vec3 wrist;   /* R w - s: the wrist centre for hand position p is p + wrist (S-R-S: less the shoulder s) */
+    double psi;   /* S-R-S: the arm angle, and its cos and sin */
+    double cos_psi, sin_psi;
+} om_target;
+
 /* Returns the reach margin (negative beyond OM_REACH_SLACK: out of reach, q not written). */
-double om_six_dof_model_ik(int family, const double *P, const double *table, const mat3 *R, vec3 p,
+double om_six_dof_model_ik(int family, const double *P, const double *table, const om_target *t, vec3 p,
                            const int64_t *signs, const double *q_prev, double *q);
 void om_six_dof_branch_values(int family, const double *P, const double *q, double *out);
 /* q6 given: smooth at the wrist singularity; *residual the wrist's consistency. Returns the margin. */
-double om_six_dof_model_ik_q6(int family, const double *P, const double *table, const mat3 *R, vec3 p,
+double om_six_dof_model_ik_q6(int family, const double *P, const double *table, const om_target *t, vec3 p,
                               const int64_t *signs, const double *q_prev, double q6, double *q, double *residual);
+void om_six_dof_target(const double *P, om_target *t); /* fills RE and wrist from t->R */
 
 /* With shoulder false, joints 1-3 are not written. Returns the reach margin 1 - x^2. */
-double om_srs_model_ik(const double *P, const mat3 *R, vec3 p, const int64_t *signs, double psi,
-                       const double *q_prev, double *q, bool shoulder);
-bool om_srs_model_ik_at_reach(const double *P, const mat3 *R, vec3 p, const int64_t *signs, double psi,
+double om_srs_model_ik(const double *P, const om_target *t, vec3 p, const int64_t *signs, const double *q_prev,
+                       double *q, bool shoulder);
+/* q7 alone (q[6]; the rest of q untouched), for the circle residual. Returns the margin. */
+double om_srs_model_q7(const double *P, const om_target *t, vec3 p, const int64_t *signs, const double *q_prev,
+                       double *q);
+bool om_srs_model_ik_at_reach(const double *P, const om_target *t, vec3 p, const int64_t *signs,
                               const double *q_prev, double *q);
 /* phi4 NaN: the elbow equation's root in the ELBOW branch. Returns (shoulder, wrist, elbow) residuals. */
-vec3 om_srs_model_ik_lifted(const double *P, const mat3 *R, vec3 p, const int64_t *signs, double psi, double q1,
-                            double q7, double phi4, double *q);
+vec3 om_srs_model_ik_lifted(const double *P, const om_target *t, vec3 p, const int64_t *signs, double q1, double q7,
+                            double phi4, double *q);
+void om_srs_target(const double *P, om_target *t); /* fills RE, wrist, cos_psi, sin_psi from t->R, t->psi */
 /* The arm angle's reference direction n(w_hat) into *n, and w_hat x n into *nw. */
 void om_srs_reference(const double *P, vec3 w_hat, vec3 *n, vec3 *nw);
 double om_srs_arm_angle(const double *P, const double *q);
@@ -103,8 +118,10 @@ void om_srs_branch_values(const double *P, const double *q, double *out);
 double om_arm_angle_gradient(const double *P, const double *table, int n_rows, const double *q, double *grad);
 
 /* Dispatch on the family (families.c). */
-double om_model_ik(int family, const double *P, const double *table, const mat3 *R, vec3 p, const int64_t *signs,
-                   const double *redundancy, const double *q_prev, double *q, bool all_joints);
+/* The target for flange orientation R and the redundancy values (S-R-S: the arm angle). */
+om_target om_target_at(int family, const double *P, const mat3 *R, const double *redundancy);
+double om_model_ik(int family, const double *P, const double *table, const om_target *t, vec3 p,
+                   const int64_t *signs, const double *q_prev, double *q, bool all_joints);
 void om_branch_values(int family, const double *P, const double *q, double *out);
 void om_redundancy_values(int family, const double *P, const double *q, double *out);
 
@@ -141,8 +158,9 @@ typedef struct {
 /* One target. */
 typedef struct {
     const om_solver_data *s;
-    mat3 R; /* flange pose in DH frame 0 */
-    vec3 p;
+    om_target t; /* flange orientation in DH frame 0, with its per-target constants (those of
+                  * redundancy too: other redundancy values need om_target_at again) */
+    vec3 p;      /* flange position in DH frame 0 */
     const int64_t *signs;
     const double *redundancy;
     const double *q_prev; /* joints kept at singularities */

@@ -94,13 +94,15 @@ static inline mat3 m_mmt(mat3 A, mat3 B)
 /* A.T @ B. */
 static inline mat3 m_mtm(mat3 A, mat3 B) { return m_mm(m_transpose(A), B); }
 
-/* Rz(phi) @ X. */
-static inline mat3 m_rz_times(double phi, mat3 X)
+/* Rz(phi) @ X for c = cos(phi), s = sin(phi). */
+static inline mat3 m_rz_cs_times(double c, double s, mat3 X)
 {
-    double c = cos(phi), s = sin(phi);
     mat3 C = {v_sub(v_scale(c, X.r0), v_scale(s, X.r1)), v_add(v_scale(s, X.r0), v_scale(c, X.r1)), X.r2};
     return C;
 }
+
+/* Rz(phi) @ X. */
+static inline mat3 m_rz_times(double phi, mat3 X) { return m_rz_cs_times(cos(phi), sin(phi), X); }
 
 /* Python's max(a, b) on floats: b if b > a else a (so max(NaN, x) is NaN, max(x, NaN) is x). */
 static inline double py_max(double a, double b) { return b > a ? b : a; }

@@ -35,7 +35,8 @@ static double residual(const om_polish_task *t, const double *q, double *e, doub
         double grad[7];
         double psi = om_arm_angle_gradient(t->P, t->model_table, t->n_model_rows, q, grad);
         /* psi's reference flips by pi with the ELBOW branch: read it in the requested one */
-        bool flipped = t->elbow != 0.0 && (sin(q[3] + t->P[SRS_THETA + 3] - t->P[SRS_PHI_STAR]) < 0.0 ? -1.0 : 1.0) != t->elbow;
+        double own = sin(q[3] + t->P[SRS_THETA + 3] - t->P[SRS_PHI_STAR]) < 0.0 ? -1.0 : 1.0;
+        bool flipped = t->elbow != 0.0 && own != t->elbow;
         e[6] = om_wrap(t->psi + (flipped ? OM_PI : 0.0) - psi);
         if (J)
             memcpy(J + 6 * t->dof, grad, 7 * sizeof(double));

@@ -15,20 +15,23 @@ static vec3 circle_point(om_problem *pb, double w)
 {
     pb->counter++;
     vec3 d = om_delta(pb->s->D, w);
-    const mat3 *R = &pb->R;
+    const mat3 *R = &pb->t.R;
     vec3 p = pb->p;
     return v3(p.x + R->r0.x * d.x + R->r0.y * d.y + R->r0.z * d.z, p.y + R->r1.x * d.x + R->r1.y * d.y + R->r1.z * d.z,
               p.z + R->r2.x * d.x + R->r2.y * d.y + R->r2.z * d.z);
 }
 
 /* Model IK for p_m = p_d + R delta(w), one residual evaluation; returns the reach margin
- * (negative beyond OM_REACH_SLACK: out of the model's reach, q not written). */
+ * (negative beyond OM_REACH_SLACK: out of the model's reach, q not written). all_joints false
+ * writes only what g needs: q_J (an S-R-S arm whose dp turns with q7: q7 alone), or more. */
 double om_model_ik_at(om_problem *pb, double w, double *q, bool all_joints)
 {
     const om_solver_data *data = pb->s;
     vec3 pm = circle_point(pb, w);
-    return om_model_ik(data->family, data->params, data->model_table, &pb->R, pm, pb->signs, pb->redundancy,
-                       pb->q_prev, q, all_joints);
+    if (!all_joints && data->family == OM_SRS && data->dp_joint == 6)
+        return om_srs_model_q7(data->params, &pb->t, pm, pb->signs, pb->q_prev, q);
+    return om_model_ik(data->family, data->params, data->model_table, &pb->t, pm, pb->signs, pb->q_prev, q,
+                       all_joints);
 }
 
 /* The wrist's consistency at p_m = p_d + R delta(w) with the wrist joint J = w given, for a
@@ -39,7 +42,7 @@ double om_wrist_residual(om_problem *pb, double w, double *q)
     const om_solver_data *data = pb->s;
     vec3 pm = circle_point(pb, w);
     double residual;
-    double margin = om_six_dof_model_ik_q6(data->family, data->params, data->model_table, &pb->R, pm, pb->signs,
+    double margin = om_six_dof_model_ik_q6(data->family, data->params, data->model_table, &pb->t, pm, pb->signs,
                                            pb->q_prev, w, q, &residual);
     return margin < -OM_REACH_SLACK ? NAN : residual;
 }
@@ -70,7 +73,7 @@ vec3 om_lifted_residual(om_problem *pb, vec3 x, double *q)
 {
     const om_solver_data *data = pb->s;
     const double(*D)[3] = data->D;
-    const mat3 *R = &pb->R;
+    const mat3 *R = &pb->t.R;
     vec3 p = pb->p;
     pb->counter++;
     double c1 = cos(x.x), s1 = sin(x.x);
@@ -78,7 +81,7 @@ vec3 om_lifted_residual(om_problem *pb, vec3 x, double *q)
     vec3 pm = v3(p.x + D[3][0] + D[4][0] * c1 + D[5][0] * s1 + R->r0.x * d.x + R->r0.y * d.y + R->r0.z * d.z,
                  p.y + D[3][1] + D[4][1] * c1 + D[5][1] * s1 + R->r1.x * d.x + R->r1.y * d.y + R->r1.z * d.z,
                  p.z + D[3][2] + D[4][2] * c1 + D[5][2] * s1 + R->r2.x * d.x + R->r2.y * d.y + R->r2.z * d.z);
-    return om_srs_model_ik_lifted(data->params, R, pm, pb->signs, pb->redundancy[0], x.x, x.y, x.z, q);
+    return om_srs_model_ik_lifted(data->params, &pb->t, pm, pb->signs, x.x, x.y, x.z, q);
 }
 
 /* The lifted residual times prod_k (1 + 1 / |x - x_k|^2) over the known roots x_k

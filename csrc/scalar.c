@@ -4,22 +4,38 @@
 
 #define LAST_STEP 1e-5 /* a secant step (rad) below which the next iterate is evaluated with every joint */
 
-/* Secant (1-D Broyden) iteration from w0 with a finite-difference slope; returns |g| at the
- * end, q holding the model IK (every joint) at the last iterate. */
+/* The secant (1-D Broyden) method from w0. Its first step is one of the fixed-point
+ * iteration of system (9), w <- q_J(w) = w + g(w) (the secant with slope -1: g' = -1 +
+ * dq_J/dw, and q_J turns little with w where dp is small against the arm); where that step
+ * does not halve |g|, the secant starts again from w0 with a finite-difference slope. It stops
+ * before a step below rounding. Returns |g| at the end, q holding the model IK (every joint)
+ * at the last iterate. */
 double om_secant(om_problem *pb, double w0, double *q)
 {
     double g0 = om_g(pb, w0, q, false);
     if (pb->s->mode == OM_FIXED || isnan(g0))
         return fabs(g0);
-    double h = 1e-7;
-    double g1 = om_g(pb, w0 + h, q, false);
-    double slope = !isnan(g1) ? (g1 - g0) / h : -1.0;
-    double w = w0, gw = g0;
+    double w = w0, gw = g0, slope = -1.0;
+    if (g0 != 0.0) {
+        double step = fabs(g0) > 0.5 ? 0.5 * om_sign(g0) : g0;
+        double g1 = om_g(pb, w0 + step, q, false);
+        if (fabs(g1) <= 0.5 * fabs(g0)) { /* false for NaN */
+            slope = (g1 - g0) / step;
+            w = w0 + step;
+            gw = g1;
+        } else {
+            double h = 1e-7;
+            double gh = om_g(pb, w0 + h, q, false);
+            slope = !isnan(gh) ? (gh - g0) / h : -1.0;
+        }
+    }
     bool complete = false; /* whether q holds every joint at w */
     for (int it = 0; it < 40; it++) {
         if (gw == 0.0 || slope == 0.0 || isnan(slope))
             break;
         double step = -gw / slope;
+        if (fabs(step) < 1e-15 * py_max(1.0, fabs(w)))
+            break;
         if (fabs(step) > 0.5)
             step = 0.5 * om_sign(step);
         bool last = fabs(step) < LAST_STEP;
@@ -32,7 +48,7 @@ double om_secant(om_problem *pb, double w0, double *q)
         w = w + step;
         gw = g_new;
         complete = last;
-        if (fabs(step) < 1e-15 * py_max(1.0, fabs(w)) || fabs(gw) < 1e-16)
+        if (fabs(gw) < 1e-16)
             break;
     }
     if (!complete)

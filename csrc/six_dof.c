@@ -3,15 +3,14 @@
 #include "om_kernels.h"
 
 
-/* Joints 1-3 for the flange pose (R, p) in DH frame 0 and the ARM and ELBOW signs, into q,
+/* Joints 1-3 for the flange pose (t->R, p) in DH frame 0 and the ARM and ELBOW signs, into q,
  * and the wrist's rotation M = Rz(phi4) Rx(alpha4) Rz(phi5) Rx(alpha5) Rz(phi6) into *M.
  * Returns the reach margin: below -OM_REACH_SLACK the pose is out of reach and neither is
  * written. */
-static double position_and_wrist(int family, const double *P, const double *table, const mat3 *R, vec3 p,
+static double position_and_wrist(int family, const double *P, const double *table, const om_target *t, vec3 p,
                                  const int64_t *signs, const double *q_prev, double *q, mat3 *M)
 {
-    mat3 Rt = *R;
-    vec3 pw = v_add(m_mv(Rt, v_load(P, SD_WRIST_CENTRE)), p);
+    vec3 pw = v_add(t->wrist, p);
     /* Shoulder. */
     double h = P[SD_LATERAL];
     double r2 = pw.x * pw.x + pw.y * pw.y;
@@ -72,18 +71,26 @@ static double position_and_wrist(int family, const double *P, const double *tabl
             j++;
         }
     }
-    *M = m_mmt(m_mtm(m_load(Rin, 0), Rt), m_load(P, SD_E_ROT));
+    *M = m_mtm(m_load(Rin, 0), t->RE);
     return margin;
 }
 
-/* Solve the model arm for the flange pose (R, p) in DH frame 0 and the branch signs
+/* What the closed form needs of the target orientation R alone: R E^T and R times the
+ * wrist centre's offset from the flange. */
+void om_six_dof_target(const double *P, om_target *t)
+{
+    t->RE = m_mmt(t->R, m_load(P, SD_E_ROT));
+    t->wrist = m_mv(t->R, v_load(P, SD_WRIST_CENTRE));
+}
+
+/* Solve the model arm for the flange pose (t->R, p) in DH frame 0 and the branch signs
  * (ARM, ELBOW, WRIST); write q. Returns the reach margin (model_ik): below -OM_REACH_SLACK the
  * pose is out of reach and q is not written. */
-double om_six_dof_model_ik(int family, const double *P, const double *table, const mat3 *R, vec3 p,
+double om_six_dof_model_ik(int family, const double *P, const double *table, const om_target *t, vec3 p,
                            const int64_t *signs, const double *q_prev, double *q)
 {
     mat3 M;
-    double margin = position_and_wrist(family, P, table, R, p, signs, q_prev, q, &M);
+    double margin = position_and_wrist(family, P, table, t, p, signs, q_prev, q, &M);
     if (margin < -OM_REACH_SLACK)
         return margin;
     vec3 phi = om_euler_zxzxz(M, P[SD_SIGMA4], P[SD_SIGMA5], 0.0, (double)signs[2], q_prev[3] + P[SD_THETA4]);
@@ -98,11 +105,11 @@ double om_six_dof_model_ik(int family, const double *P, const double *table, con
  * Rz(-phi4) with phi6 first (om_euler_zxzxz_given_first), which is smooth also at the wrist
  * singularity sin(phi5) = 0, where the closed form's q4 and q6 swing by pi. Writes q (q6 as
  * given) and *residual, the wrist's consistency (zero iff q6 fits M); returns the margin. */
-double om_six_dof_model_ik_q6(int family, const double *P, const double *table, const mat3 *R, vec3 p,
+double om_six_dof_model_ik_q6(int family, const double *P, const double *table, const om_target *t, vec3 p,
                               const int64_t *signs, const double *q_prev, double q6, double *q, double *residual)
 {
     mat3 M;
-    double margin = position_and_wrist(family, P, table, R, p, signs, q_prev, q, &M);
+    double margin = position_and_wrist(family, P, table, t, p, signs, q_prev, q, &M);
     if (margin < -OM_REACH_SLACK)
         return margin;
     vec3 neg = om_euler_zxzxz_given_first(m_transpose(M), -P[SD_SIGMA5], 0.0, -P[SD_SIGMA4], -(q6 + P[SD_THETA6]));

@@ -75,6 +75,16 @@ static void _reduce(const om_solver_data *s, const double *redundancy, double *r
         reduced[i] = remainder(redundancy[i], 2.0 * OM_PI);
 }
 
+/* The problem's target: the flange pose for the end-effector pose T, with the per-target
+ * constants of the model's closed form (redundancy reduced). */
+static void _set_target(om_problem *pb, const double *T, const double *redundancy)
+{
+    const om_solver_data *s = pb->s;
+    mat3 R;
+    om_flange_target(T, s->T_base_root, s->T_tool_flange, &R, &pb->p);
+    pb->t = om_target_at(s->family, s->params, &R, redundancy);
+}
+
 static om_result _result(int status, double pos, double ori, int64_t evaluations, bool inside)
 {
     om_result result = {status, pos, ori, evaluations, inside};
@@ -96,10 +106,10 @@ om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *
         hint = zeros; /* what the Python side passes without a hint */
     om_problem problem;
     problem.s = s;
-    om_flange_target(T, s->T_base_root, s->T_tool_flange, &problem.R, &problem.p);
     double psi[1];
     _reduce(s, redundancy, psi);
     redundancy = psi;
+    _set_target(&problem, T, redundancy);
     problem.signs = signs;
     problem.redundancy = redundancy;
     problem.q_prev = hint; /* the hint, or zeros */
@@ -114,12 +124,11 @@ om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *
     vec3 pd = problem.p;
     double pos = NAN, ori = NAN;
     if (!has_hint) { /* the paper's fixed-point start, p_m = p_d */
-        found = om_model_ik(family, P, mtab, &problem.R, pd, signs, redundancy, problem.q_prev, start, true) >=
-                -OM_REACH_SLACK;
+        found = om_model_ik(family, P, mtab, &problem.t, pd, signs, problem.q_prev, start, true) >= -OM_REACH_SLACK;
         if (!found && family == OM_SRS && mode != OM_FIXED) {
             /* p_d is outside the model's reach: the elbow held at the edge of reach instead,
              * a start for the lifted Newton (see local_solve). */
-            found = om_srs_model_ik_at_reach(P, &problem.R, pd, signs, redundancy[0], problem.q_prev, start);
+            found = om_srs_model_ik_at_reach(P, &problem.t, pd, signs, problem.q_prev, start);
         } else if (!found && mode == OM_CIRCLE) {
             /* p_d is outside the model's reach: start from the point of the dp circle that
              * the model reaches with the smallest residual. */
@@ -205,7 +214,7 @@ int om_solve_all(const om_solver_data *s, const double *T, const int64_t *signs,
     _reduce(s, redundancy, psi);
     om_problem problem;
     problem.s = s;
-    om_flange_target(T, s->T_base_root, s->T_tool_flange, &problem.R, &problem.p);
+    _set_target(&problem, T, psi);
     problem.signs = signs;
     problem.redundancy = psi;
     problem.q_prev = zeros;

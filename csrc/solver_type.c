@@ -6,15 +6,11 @@
 /* ------------------------------------------------------------------------------------ */
 /* Solver: the solver's fixed data, copied once.                                          */
 
-typedef struct {
-    PyObject_HEAD
-    om_solver_data data;
-    double *storage; /* params, tables, limits */
-    uint8_t revolute[OM_MAX_DOF];
-} Solver;
+typedef om_Solver Solver;
 
 static void Solver_dealloc(Solver *self) {
     PyMem_Free(self->storage);
+    om_solver_clear_types(self);
     Py_TYPE(self)->tp_free((PyObject *)self);
 }
 
@@ -49,11 +45,14 @@ static Py_ssize_t attr_copy(PyObject *obj, const char *name, double *dst, Py_ssi
     return count;
 }
 
-/* Solver(data): data is an om_redundant SolverData named tuple. */
+/* Solver(data, solution_type=None, configuration_type=None): data is an om_redundant
+ * SolverData named tuple; the two types (Solution, Configuration) let solve_pose answer. */
 static int Solver_init(Solver *self, PyObject *args, PyObject *kwds) {
-    PyObject *d;
-    static char *kwlist[] = {"data", NULL};
-    if (!PyArg_ParseTupleAndKeywords(args, kwds, "O", kwlist, &d)) return -1;
+    PyObject *d, *solution_type = Py_None, *configuration_type = Py_None;
+    static char *kwlist[] = {"data", "solution_type", "configuration_type", NULL};
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "O|$OO", kwlist, &d, &solution_type, &configuration_type))
+        return -1;
+    if (om_solver_set_types(self, solution_type, configuration_type) < 0) return -1;
     om_solver_data *s = &self->data;
     long family, mode, dp_joint, scan_points;
     if (attr_long(d, "family", &family) || attr_long(d, "mode", &mode) || attr_long(d, "dp_joint", &dp_joint) ||
@@ -297,6 +296,8 @@ static PyObject *Solver_holds(Solver *self, PyObject *const *args, Py_ssize_t na
 
 static PyMethodDef Solver_methods[] = {
     {"solve", (PyCFunction)(void (*)(void))Solver_solve, METH_FASTCALL, "One solve; see om_redundant.om.solver."},
+    {"solve_pose", (PyCFunction)(void (*)(void))om_solver_solve_pose, METH_FASTCALL,
+     "solve_pose(T, configuration) -> Solution, or None: the whole unhinted solve in one call."},
     {"solve_rows", (PyCFunction)(void (*)(void))Solver_solve_rows, METH_FASTCALL, "Rows of a batch."},
     {"solve_all", (PyCFunction)(void (*)(void))Solver_solve_all, METH_FASTCALL, "Every root in a configuration."},
     {"configuration_values", (PyCFunction)(void (*)(void))Solver_configuration_values, METH_FASTCALL,
@@ -307,7 +308,7 @@ static PyMethodDef Solver_methods[] = {
 
 PyTypeObject om_SolverType = {
     PyVarObject_HEAD_INIT(NULL, 0).tp_name = "om_redundant.ckernels.Solver",
-    .tp_doc = "The OM solver's fixed data, compiled: Solver(SolverData).",
+    .tp_doc = "The OM solver's fixed data, compiled: Solver(SolverData, solution_type=None, configuration_type=None).",
     .tp_basicsize = sizeof(Solver),
     .tp_flags = Py_TPFLAGS_DEFAULT,
     .tp_new = PyType_GenericNew,

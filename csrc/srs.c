@@ -4,6 +4,9 @@
 #include "om_kernels.h"
 
 #define DEGENERATE 1e-12 /* |W - S|^2 below which the wrist centre is at the shoulder centre */
+/* |sin phi6 sin beta| below which om_srs_model_q7 leaves q7 to the closed form: q7 is
+ * ill-conditioned there (rounding / |sin phi6|), and both ways must round alike. */
+#define NEAR_SINGULAR_WRIST 1e-3
 
 
 /* Rx(alpha) with sin(alpha) = sigma = +-1. */
@@ -23,18 +26,22 @@ void om_srs_reference(const double *P, vec3 w_hat, vec3 *n, vec3 *nw)
     *nw = v_cross(w_hat, *n);
 }
 
-/* v(phi4) = Rz(phi4) u - s3: W - S in frame 3. */
-static vec3 elbow_vector(const double *P, double phi4)
+/* v(phi4) = Rz(phi4) u - s3: W - S in frame 3, for c4 = cos(phi4), s4 = sin(phi4). */
+static vec3 elbow_vector(const double *P, double c4, double s4)
 {
-    double c4 = cos(phi4), s4 = sin(phi4);
     vec3 u = v_load(P, SRS_U), s3 = v_load(P, SRS_S3);
     return v3(c4 * u.x - s4 * u.y - s3.x, s4 * u.x + c4 * u.y - s3.y, u.z - s3.z);
 }
 
-/* W - S in DH frame 0 for the flange pose (R, p). */
-static vec3 wrist_centre(const double *P, mat3 Rt, vec3 p)
+/* What every model solve for the target orientation R and arm angle psi shares: cos and sin
+ * of psi, R E^T, and R w_F - S (the wrist centre less the shoulder for flange position p is
+ * p + wrist). */
+void om_srs_target(const double *P, om_target *t)
 {
-    return v_sub(v_add(p, m_mv(Rt, v_load(P, SRS_WRIST))), v_load(P, SRS_SHOULDER));
+    t->cos_psi = cos(t->psi);
+    t->sin_psi = sin(t->psi);
+    t->RE = m_mmt(t->R, m_load(P, SRS_E_ROT));
+    t->wrist = v_sub(m_mv(t->R, v_load(P, SRS_WRIST)), v_load(P, SRS_SHOULDER));
 }
 
 /* The root phi4 of x = cos(phi4 - phi*) in the ELBOW branch, x clamped into [-1, 1]. */
@@ -44,15 +51,16 @@ static double elbow_root(const double *P, double x, double elbow)
     return P[SRS_PHI_STAR] + atan2(elbow * sqrt(1.0 - xc * xc), xc);
 }
 
-/* R03 for W - S = w, the elbow angle phi4 and the arm angle psi: it maps the frame-3 triad
- * (v_hat, b3_hat, v_hat x b3_hat) onto (w_hat, m, w_hat x m). */
-static mat3 rotation_03_at(const double *P, vec3 w, double L2, double phi4, double elbow, double psi)
+/* R03 for W - S = w, the elbow angle phi4 (cos c4, sin c4) and the target's arm angle: it
+ * maps the frame-3 triad (v_hat, b3_hat, v_hat x b3_hat) onto (w_hat, m, w_hat x m). */
+static mat3 rotation_03_at(const double *P, const om_target *t, vec3 w, double L2, double c4, double s4,
+                           double elbow)
 {
     vec3 w_hat = v_scale(1.0 / sqrt(L2), w);
     vec3 n, nw;
     om_srs_reference(P, w_hat, &n, &nw);
-    vec3 m = v_add(v_scale(cos(psi), n), v_scale(sin(psi), nw));
-    vec3 v = elbow_vector(P, phi4);
+    vec3 m = v_add(v_scale(t->cos_psi, n), v_scale(t->sin_psi, nw));
+    vec3 v = elbow_vector(P, c4, s4);
     vec3 v_hat = v_unit(v);
     vec3 b3 = v_unit(v_scale(elbow * P[SRS_BEND], v3(-v.y, v.x, 0.0)));
     mat3 A = {w_hat, m, v_cross(w_hat, m)};
@@ -60,12 +68,13 @@ static mat3 rotation_03_at(const double *P, vec3 w, double L2, double phi4, doub
     return m_mtm(A, B);
 }
 
-/* Joints 1-3 (if shoulder) and 4-7 for the elbow angle phi4, W - S = w and the arm angle psi. */
-static void ik_with_elbow(const double *P, mat3 Rt, vec3 w, double L2, double phi4, const int64_t *signs,
-                          double psi, const double *q_prev, double *q, bool shoulder)
+/* Joints 1-3 (if shoulder) and 4-7 for the elbow angle phi4, W - S = w and the target t. */
+static void ik_with_elbow(const double *P, const om_target *t, vec3 w, double L2, double phi4,
+                          const int64_t *signs, const double *q_prev, double *q, bool shoulder)
 {
     const double *th = P + SRS_THETA;
-    mat3 R03 = rotation_03_at(P, w, L2, phi4, (double)signs[1], psi);
+    double c4 = cos(phi4), s4 = sin(phi4);
+    mat3 R03 = rotation_03_at(P, t, w, L2, c4, s4, (double)signs[1]);
     if (shoulder) {
         vec3 phi = om_euler_zxzxz(m_mmt(m_mtm(m_load(P, SRS_R_PRE), R03), m_load(P, SRS_X3)), P[SRS_SIGMA1],
                                   P[SRS_SIGMA2], 0.0, (double)signs[0], q_prev[0] + th[0]);
@@ -74,8 +83,8 @@ static void ik_with_elbow(const double *P, mat3 Rt, vec3 w, double L2, double ph
         q[2] = om_wrap(phi.z - th[2]);
     }
     q[3] = om_wrap(phi4 - th[3]);
-    mat3 R04 = m_mm(R03, m_rz_times(phi4, m_load(P, SRS_X4)));
-    mat3 M = m_mmt(m_mtm(R04, Rt), m_load(P, SRS_E_ROT));
+    mat3 R04 = m_mm(R03, m_rz_cs_times(c4, s4, m_load(P, SRS_X4)));
+    mat3 M = m_mtm(R04, t->RE);
     vec3 phi = om_euler_zxzxz(M, P[SRS_SIGMA5], P[SRS_SIN_BETA], P[SRS_COS_BETA], (double)signs[2],
                               q_prev[4] + th[4]);
     q[4] = om_wrap(phi.x - th[4]);
@@ -83,14 +92,13 @@ static void ik_with_elbow(const double *P, mat3 Rt, vec3 w, double L2, double ph
     q[6] = om_wrap(phi.z - th[6]);
 }
 
-/* Solve the model for the flange pose (R, p) in DH frame 0, the branch signs
- * (SHOULDER, ELBOW, WRIST) and the arm angle psi (model_ik). Returns the reach margin 1 - x^2;
- * below -OM_REACH_SLACK (or -1 where W = S) q is not written. */
-double om_srs_model_ik(const double *P, const mat3 *R, vec3 p, const int64_t *signs, double psi,
-                       const double *q_prev, double *q, bool shoulder)
+/* Solve the model for the flange pose (t->R, p) in DH frame 0, the branch signs
+ * (SHOULDER, ELBOW, WRIST) and the target's arm angle (model_ik). Returns the reach margin
+ * 1 - x^2; below -OM_REACH_SLACK (or -1 where W = S) q is not written. */
+double om_srs_model_ik(const double *P, const om_target *t, vec3 p, const int64_t *signs, const double *q_prev,
+                       double *q, bool shoulder)
 {
-    mat3 Rt = *R;
-    vec3 w = wrist_centre(P, Rt, p);
+    vec3 w = v_add(p, t->wrist);
     double L2 = v_dot(w, w);
     if (L2 < DEGENERATE) /* wrist centre at the shoulder centre */
         return -1.0;
@@ -98,32 +106,70 @@ double om_srs_model_ik(const double *P, const mat3 *R, vec3 p, const int64_t *si
     double margin = 1.0 - x * x;
     if (margin < -OM_REACH_SLACK)
         return margin;
-    ik_with_elbow(P, Rt, w, L2, elbow_root(P, x, (double)signs[1]), signs, psi, q_prev, q, shoulder);
+    ik_with_elbow(P, t, w, L2, elbow_root(P, x, (double)signs[1]), signs, q_prev, q, shoulder);
+    return margin;
+}
+
+/* Joint 7 alone, as om_srs_model_ik computes it (q[6] written, the rest of q untouched): what
+ * the circle residual g needs of the model. The wrist's M = R04^T R E^T =
+ * Rz(phi5) Rx(alpha5) Rz(phi6) Rx(beta) Rz(phi7) is not formed: its last column gives
+ * (sin phi6, cos phi6 cos beta) up to one positive factor (the Euler decomposition's phi6), and
+ * its last row is sigma5 (u cos phi7 + v sin phi7, v cos phi7 - u sin phi7) for that pair
+ * (u, v), which gives phi7 without phi5. Near the wrist singularity (u = 0), where the
+ * closed form takes phi5 from q_prev, it decides. Returns the reach margin as om_srs_model_ik. */
+double om_srs_model_q7(const double *P, const om_target *t, vec3 p, const int64_t *signs, const double *q_prev,
+                       double *q)
+{
+    vec3 w = v_add(p, t->wrist);
+    double L2 = v_dot(w, w);
+    if (L2 < DEGENERATE)
+        return -1.0;
+    double x = (L2 - P[SRS_K0]) / P[SRS_K];
+    double margin = 1.0 - x * x;
+    if (margin < -OM_REACH_SLACK)
+        return margin;
+    double elbow = (double)signs[1];
+    double phi4 = elbow_root(P, x, elbow);
+    double c4 = cos(phi4), s4 = sin(phi4);
+    mat3 R04 = m_mm(rotation_03_at(P, t, w, L2, c4, s4, elbow), m_rz_cs_times(c4, s4, m_load(P, SRS_X4)));
+    mat3 RE_cols = m_transpose(t->RE);
+    vec3 z4 = m_col(R04, 2); /* M[i][j] = (column i of R04) . (column j of R E^T) */
+    double ax = v_dot(m_col(R04, 0), RE_cols.r2), ay = v_dot(m_col(R04, 1), RE_cols.r2), az = v_dot(z4, RE_cols.r2);
+    double sigma = P[SRS_SIGMA5], sin_b = P[SRS_SIN_BETA], cos_b = P[SRS_COS_BETA];
+    double radial_2 = ax * ax + ay * ay - cos_b * cos_b; /* as om_euler_zxzxz */
+    double radial = sqrt(0.0 > radial_2 ? 0.0 : radial_2);
+    if (!(radial > NEAR_SINGULAR_WRIST)) {
+        double wrist_joints[7];
+        ik_with_elbow(P, t, w, L2, phi4, signs, q_prev, wrist_joints, false);
+        q[6] = wrist_joints[6];
+        return margin;
+    }
+    double u = (double)signs[2] * radial, v = -sigma * (sin_b > 0.0 ? 1.0 : -1.0) * az * cos_b;
+    double m20 = v_dot(z4, RE_cols.r0), m21 = v_dot(z4, RE_cols.r1);
+    q[6] = om_wrap(atan2(sigma * (v * m20 - u * m21), sigma * (u * m20 + v * m21)) - P[SRS_THETA + 6]);
     return margin;
 }
 
 /* om_srs_model_ik with the elbow held at the edge of reach beyond it (model_ik_at_reach);
  * false, q untouched, only where W = S. */
-bool om_srs_model_ik_at_reach(const double *P, const mat3 *R, vec3 p, const int64_t *signs, double psi,
+bool om_srs_model_ik_at_reach(const double *P, const om_target *t, vec3 p, const int64_t *signs,
                               const double *q_prev, double *q)
 {
-    mat3 Rt = *R;
-    vec3 w = wrist_centre(P, Rt, p);
+    vec3 w = v_add(p, t->wrist);
     double L2 = v_dot(w, w);
     if (L2 < DEGENERATE)
         return false;
-    ik_with_elbow(P, Rt, w, L2, elbow_root(P, (L2 - P[SRS_K0]) / P[SRS_K], (double)signs[1]), signs, psi, q_prev,
-                  q, true);
+    ik_with_elbow(P, t, w, L2, elbow_root(P, (L2 - P[SRS_K0]) / P[SRS_K], (double)signs[1]), signs, q_prev, q,
+                  true);
     return true;
 }
 
 /* The model IK with q1, q7 and the elbow angle phi4 given (phi4 NaN: the elbow root in the ELBOW
  * branch); writes q and returns the (shoulder, wrist, elbow) residuals (model_ik_lifted). */
-vec3 om_srs_model_ik_lifted(const double *P, const mat3 *R, vec3 p, const int64_t *signs, double psi, double q1,
-                            double q7, double phi4, double *q)
+vec3 om_srs_model_ik_lifted(const double *P, const om_target *t, vec3 p, const int64_t *signs, double q1, double q7,
+                            double phi4, double *q)
 {
-    mat3 Rt = *R;
-    vec3 w = wrist_centre(P, Rt, p);
+    vec3 w = v_add(p, t->wrist);
     double L2 = v_dot(w, w);
     if (L2 < DEGENERATE)
         return v3(NAN, NAN, NAN);
@@ -131,11 +177,12 @@ vec3 om_srs_model_ik_lifted(const double *P, const mat3 *R, vec3 p, const int64_
     if (isnan(phi4))
         phi4 = elbow_root(P, x, (double)signs[1]);
     const double *th = P + SRS_THETA;
-    mat3 R03 = rotation_03_at(P, w, L2, phi4, (double)signs[1], psi);
+    double c4 = cos(phi4), s4 = sin(phi4);
+    mat3 R03 = rotation_03_at(P, t, w, L2, c4, s4, (double)signs[1]);
     vec3 sh = om_euler_zxzxz_given_first(m_mmt(m_mtm(m_load(P, SRS_R_PRE), R03), m_load(P, SRS_X3)), P[SRS_SIGMA1],
                                          0.0, P[SRS_SIGMA2], q1 + th[0]);
-    mat3 R04 = m_mm(R03, m_rz_times(phi4, m_load(P, SRS_X4)));
-    mat3 M = m_mmt(m_mtm(R04, Rt), m_load(P, SRS_E_ROT));
+    mat3 R04 = m_mm(R03, m_rz_cs_times(c4, s4, m_load(P, SRS_X4)));
+    mat3 M = m_mtm(R04, t->RE);
     /* The wrist's M^T = Rz(-phi7) Rx(-beta) Rz(-phi6) Rx(-alpha5) Rz(-phi5): phi7 comes first. */
     vec3 wr = om_euler_zxzxz_given_first(m_transpose(M), -P[SRS_SIN_BETA], P[SRS_COS_BETA], -P[SRS_SIGMA5],
                                          -(q7 + th[6]));
@@ -170,7 +217,7 @@ double om_srs_arm_angle_in(const double *P, const double *q, double elbow)
 {
     mat3 R03 = rotation_03(P, q);
     double phi4 = q[3] + P[SRS_THETA + 3];
-    vec3 w_hat = v_unit(m_mv(R03, elbow_vector(P, phi4)));
+    vec3 w_hat = v_unit(m_mv(R03, elbow_vector(P, cos(phi4), sin(phi4))));
     vec3 n, nw;
     om_srs_reference(P, w_hat, &n, &nw);
     vec3 b = v_scale(elbow * P[SRS_BEND], v_cross(m_col(R03, 2), w_hat));

@@ -13,9 +13,11 @@ bool om_in_configuration(const om_solver_data *s, const double *q, const int64_t
     for (int i = 0; i < s->n_signs; i++)
         if (!(values[i] * (double)signs[i] >= 0.0 || fabs(values[i]) <= OM_BRANCH_BAND)) /* NaN: not in it */
             return false;
-    if (s->family == OM_SRS) /* psi: the only redundancy value; in the requested ELBOW branch */
-        return fabs(om_wrap(om_srs_arm_angle_in(s->params, q, (double)signs[SRS_ELBOW_SIGN]) - redundancy[0])) <=
-               REDUNDANCY_TOL;
+    if (s->family == OM_SRS) { /* psi: the only redundancy value; in the requested ELBOW branch */
+        double psi = om_srs_arm_angle_in(s->params, q, (double)signs[SRS_ELBOW_SIGN]);
+        /* reduced exactly first: a huge requested psi (1e16) is one well-defined angle */
+        return fabs(om_wrap(psi - remainder(redundancy[0], 2.0 * OM_PI))) <= REDUNDANCY_TOL;
+    }
     return true;
 }
 
@@ -28,7 +30,7 @@ bool om_verify(om_problem *pb, const double *q, double *pos, double *ori)
     om_flange(data->real_table, data->n_real_rows, q, Rr, pr);
     vec3 d = v3(pr[0] - pb->p.x, pr[1] - pb->p.y, pr[2] - pb->p.z);
     double position = sqrt(v_dot(d, d));
-    mat3 E = m_mtm(pb->R, m_load(Rr, 0));
+    mat3 E = m_mtm(pb->t.R, m_load(Rr, 0));
     double e0 = E.r2.y - E.r1.z, e1 = E.r0.z - E.r2.x, e2 = E.r1.x - E.r0.y;
     double s = 0.5 * sqrt(e0 * e0 + e1 * e1 + e2 * e2);
     double orientation = atan2(s, 0.5 * (E.r0.x + E.r1.y + E.r2.z - 1.0));

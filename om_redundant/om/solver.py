@@ -52,7 +52,7 @@ class Solution:
         q: Joint vector of the REAL arm (NaN when no solution). Revolute joints are
             shifted by multiples of 2 pi into the limits, nearest to the hint.
         ok: True only if the real arm reaches the pose within tolerance in the requested
-            configuration.
+            configuration (as :meth:`OMSolver.holds` reads it: within the branch band, both).
         status: ``"ok"``, ``"unreachable"`` (no configuration reaches the pose) or
             ``"no solution in this configuration"``.
         configuration: The configuration asked for.
@@ -144,7 +144,9 @@ class OMSolver:
         )
         self.scan_points = as_count(scan_points, "scan_points", MIN_SCAN_POINTS, MAX_SCAN_POINTS)
         self.om: ModelArm = derive_model(self.arm)
-        self._kernel = ckernels.Solver(self.solver_data())
+        self._kernel = ckernels.Solver(
+            self.solver_data(), solution_type=Solution, configuration_type=Configuration
+        )
         self._check_solves_itself()
 
     def solver_data(self) -> system.SolverData:
@@ -245,6 +247,10 @@ class OMSolver:
             A :class:`Solution`; ``ok`` is False (with a status saying why) when no solution
             exists in this configuration.
         """
+        if q_hint is None:  # the common case, in one compiled call; None: the checks below decide
+            solution = self._kernel.solve_pose(T, configuration)
+            if solution is not None:
+                return solution
         T = as_pose(T)
         self.check_configuration(configuration)
         q = np.empty(self.arm.dof)

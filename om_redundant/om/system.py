@@ -57,16 +57,16 @@ import numpy as np
 
 from .. import ckernels
 
-# Status codes of a solve (csrc/om_kernels.h).
-OK = 0
-UNREACHABLE = 1
-NO_SOLUTION_IN_CONFIGURATION = 2
-STATUS_NAMES = ("ok", "unreachable", "no solution in this configuration")
+# Status codes of a solve, and their names by code (defined in csrc/: om_kernels.h, module.c).
+OK = ckernels.OK
+UNREACHABLE = ckernels.UNREACHABLE
+NO_SOLUTION_IN_CONFIGURATION = ckernels.NO_SOLUTION_IN_CONFIGURATION
+STATUS_NAMES: tuple[str, ...] = ckernels.STATUS_NAMES
 
-# How the solutions of system (9) are searched (SolverData.mode).
-FIXED = 0  # dp = 0: the model is the real arm, one evaluation of the closed form
-CIRCLE = 1  # dp depends on one wrist joint w = q_J: a circle
-TORUS = 2  # shoulder offsets too: dp depends on (q_1, q_7), a torus
+# How the solutions of system (9) are searched (SolverData.mode; csrc/om_kernels.h).
+FIXED = ckernels.FIXED  # dp = 0: the model is the real arm, one evaluation of the closed form
+CIRCLE = ckernels.CIRCLE  # dp depends on one wrist joint w = q_J: a circle
+TORUS = ckernels.TORUS  # shoulder offsets too: dp depends on (q_1, q_7), a torus
 
 #: Roots kept per configuration.
 MAX_ROOTS = ckernels.MAX_ROOTS
