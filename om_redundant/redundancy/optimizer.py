@@ -4,8 +4,8 @@ distance from singularities.
 For a pose T, :meth:`RedundancyOptimizer.choose` returns the configuration
 c = (signs, psi) that maximises the objective f of :mod:`om_redundant.redundancy.objective` (weighted
 normalised joint-limit margin, capped obstacle clearance and capped distance from the
-model's singularities) over the feasible set (within
-the limits, clearance >= d_min), and the exact OM solution in it:
+model's singularities) over the feasible set (within the limits, clearance >= d_min), and
+the exact OM solution in it:
 
 1. **Sweep.** Every allowed branch's exact solutions are sampled on a psi grid and linked
    into solution paths (:mod:`om_redundant.redundancy.paths`), which are cut into feasible intervals
@@ -242,10 +242,10 @@ class RedundancyOptimizer:
 
         With ``near`` (tracking: the previous psi; distances modulo 2 pi), the sample at
         ``near`` is a start too, and the optimum is the one nearest ``near`` among those
-        within :data:`PLATEAU` of the best: on a flat
-        objective (a joint that the self-motion does not move binding the margin, the
-        clearance at its cap) psi stays where it was instead of jumping to whichever sample
-        rounding favours, which the joints could not follow in one tick.
+        within :data:`PLATEAU` of the best: on a flat objective (a joint that the
+        self-motion does not move binding the margin, the clearance at its cap) psi stays
+        where it was instead of jumping to whichever sample rounding favours, farther than
+        the joints can follow in one tick.
         """
         slope = 0.0
         starts = []
