@@ -103,6 +103,8 @@ double om_srs_model_ik(const double *P, const om_target *t, vec3 p, const int64_
 /* q7 alone (q[6]; the rest of q untouched), for the circle residual. Returns the margin. */
 double om_srs_model_q7(const double *P, const om_target *t, vec3 p, const int64_t *signs, const double *q_prev,
                        double *q);
+bool om_srs_model_q7_at_reach(const double *P, const om_target *t, vec3 p, const int64_t *signs,
+                              const double *q_prev, double *q);
 bool om_srs_model_ik_at_reach(const double *P, const om_target *t, vec3 p, const int64_t *signs,
                               const double *q_prev, double *q);
 /* phi4 NaN: the elbow equation's root in the ELBOW branch. Returns (shoulder, wrist, elbow) residuals. */
@@ -180,6 +182,8 @@ double om_wrist_residual(om_problem *pb, double w, double *q);
 
 /* scalar.c */
 double om_secant(om_problem *pb, double w0, double *q);
+/* om_secant from w0 or, out of the model's reach there, the nearest reachable probe around the circle. */
+double om_secant_in_reach(om_problem *pb, double w0, double *q);
 double om_refine_bracket(om_problem *pb, double a, double ga, double b, double gb, double *q);
 double om_reach_edge(om_problem *pb, double inside, double outside, double *q);
 /* The secant on om_wrist_residual from w0; returns |residual| at the end. */
@@ -240,7 +244,10 @@ int om_band_roots(om_problem *pb, double *roots, bool *neighbour_reached);
 
 /* search.c */
 int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre, double radius);
-bool om_local_solve(om_problem *pb, const double *start, double *q, double *pos, double *ori);
+/* The fixed-point start: where only q_J of it is known (*complete false), every joint of the
+ * model IK at p_m = p_d (S-R-S: at the edge of reach beyond it) into start. */
+void om_complete_start(om_problem *pb, double *start, bool *complete);
+bool om_local_solve(om_problem *pb, double *start, bool *start_complete, double *q, double *pos, double *ori);
 bool om_exists_other(om_problem *pb, bool skip_neighbours);
 bool om_nearest_in_window(om_problem *pb, const double *hint, double *q);
 
