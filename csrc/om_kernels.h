@@ -100,6 +100,8 @@ void om_six_dof_target(const double *P, om_target *t); /* fills RE and wrist fro
 /* With shoulder false, joints 1-3 are not written. Returns the reach margin 1 - x^2. */
 double om_srs_model_ik(const double *P, const om_target *t, vec3 p, const int64_t *signs, const double *q_prev,
                        double *q, bool shoulder);
+/* The reach margin of om_srs_model_ik alone (the same arithmetic) and, unless W = S, the elbow's x. */
+double om_srs_reach(const double *P, const om_target *t, vec3 p, double *x);
 /* q7 alone (q[6]; the rest of q untouched), for the circle residual. Returns the margin. */
 double om_srs_model_q7(const double *P, const om_target *t, vec3 p, const int64_t *signs, const double *q_prev,
                        double *q);
@@ -174,6 +176,10 @@ vec3 om_delta(const double D[6][3], double w);
 double om_model_ik_at(om_problem *pb, double w, double *q, bool all_joints); /* returns the reach margin */
 double om_g_margin(om_problem *pb, double w, double *q, bool all_joints, double *margin); /* g (NaN out of reach) */
 double om_g(om_problem *pb, double w, double *q, bool all_joints);
+/* om_g_margin's margin alone (S-R-S: no joint solved, not counted). */
+double om_reach_margin(om_problem *pb, double w, double *q);
+/* S-R-S: whether the model may reach the circle's points somewhere in [a, b] (a bound; see residual.c). */
+bool om_srs_reach_possible(om_problem *pb, double a, double b);
 vec3 om_lifted_residual(om_problem *pb, vec3 x, double *q);
 vec3 om_deflated_residual(om_problem *pb, vec3 x, double *q, const double *known, int n_known); /* known: n x 3 */
 double om_max_norm(vec3 F);

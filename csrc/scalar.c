@@ -141,11 +141,8 @@ double om_refine_bracket(om_problem *pb, double a, double ga, double b, double g
  * Illinois regula falsi on the reach margin. */
 double om_reach_edge(om_problem *pb, double inside, double outside, double *q)
 {
-    double fi, fo, fc;
-    om_g_margin(pb, inside, q, false, &fi);
-    fi = fi + OM_REACH_SLACK;
-    om_g_margin(pb, outside, q, false, &fo);
-    fo = fo + OM_REACH_SLACK;
+    double fi = om_reach_margin(pb, inside, q) + OM_REACH_SLACK;
+    double fo = om_reach_margin(pb, outside, q) + OM_REACH_SLACK;
     int side = 0;
     for (int it = 0; it < 80; it++) {
         if (fabs(outside - inside) <= 4e-16 * py_max(1.0, fabs(inside)))
@@ -153,8 +150,7 @@ double om_reach_edge(om_problem *pb, double inside, double outside, double *q)
         double c = (inside * fo - outside * fi) / (fo - fi);
         if (!(py_min(inside, outside) < c && c < py_max(inside, outside)))
             c = 0.5 * (inside + outside);
-        om_g_margin(pb, c, q, false, &fc);
-        fc = fc + OM_REACH_SLACK;
+        double fc = om_reach_margin(pb, c, q) + OM_REACH_SLACK;
         if (fc >= 0.0) {
             inside = c;
             fi = fc;
@@ -172,16 +168,18 @@ double om_reach_edge(om_problem *pb, double inside, double outside, double *q)
     return inside;
 }
 
-/* sign * g(w) (unreachable: -inf), or the reach margin; and g and the margin. */
+/* sign * g(w) (unreachable: -inf), or the reach margin; and g (NaN where only the margin
+ * is sought) and the margin. */
 static double _objective(om_problem *pb, double w, double sign, bool of_margin, double *q, double *g_out,
                          double *m_out)
 {
-    double m;
-    double gw = om_g_margin(pb, w, q, false, &m);
+    if (of_margin) {
+        *g_out = NAN;
+        *m_out = om_reach_margin(pb, w, q);
+        return *m_out;
+    }
+    double gw = om_g_margin(pb, w, q, false, m_out);
     *g_out = gw;
-    *m_out = m;
-    if (of_margin)
-        return m;
     return isnan(gw) ? -INFINITY : sign * gw;
 }
 
@@ -198,7 +196,7 @@ double om_extremum(om_problem *pb, double a, double b, double x0, double sign, b
     double fw = fx, fv = fx;
     double d = 0.0, e = 0.0;
     for (int it = 0; it < 60; it++) {
-        if (!of_margin ? fx > 0.0 : !isnan(gx))
+        if (!of_margin ? fx > 0.0 : mx >= -OM_REACH_SLACK)
             break;
         double xm = 0.5 * (a + b);
         double tol = 1e-10 * fabs(x) + 1e-11;

@@ -106,18 +106,34 @@ static void ik_with_elbow(const double *P, const om_target *t, vec3 w, double L2
     q[6] = om_wrap(phi.z - th[6]);
 }
 
+/* W - S = w for the flange position p, L2 = |w|^2 and the elbow's x = (L2 - k0) / K; returns
+ * the reach margin 1 - x^2 (-1 where W = S: x not written). */
+static double reach(const double *P, const om_target *t, vec3 p, vec3 *w, double *L2, double *x)
+{
+    *w = v_add(p, t->wrist);
+    *L2 = v_dot(*w, *w);
+    if (*L2 < DEGENERATE) /* wrist centre at the shoulder centre */
+        return -1.0;
+    *x = (*L2 - P[SRS_K0]) / P[SRS_K];
+    return 1.0 - *x * *x;
+}
+
+double om_srs_reach(const double *P, const om_target *t, vec3 p, double *x)
+{
+    vec3 w;
+    double L2;
+    return reach(P, t, p, &w, &L2, x);
+}
+
 /* Solve the model for the flange pose (t->R, p) in DH frame 0, the branch signs
  * (SHOULDER, ELBOW, WRIST) and the target's arm angle (model_ik). Returns the reach margin
  * 1 - x^2; below -OM_REACH_SLACK (or -1 where W = S) q is not written. */
 double om_srs_model_ik(const double *P, const om_target *t, vec3 p, const int64_t *signs, const double *q_prev,
                        double *q, bool shoulder)
 {
-    vec3 w = v_add(p, t->wrist);
-    double L2 = v_dot(w, w);
-    if (L2 < DEGENERATE) /* wrist centre at the shoulder centre */
-        return -1.0;
-    double x = (L2 - P[SRS_K0]) / P[SRS_K];
-    double margin = 1.0 - x * x;
+    vec3 w;
+    double L2, x;
+    double margin = reach(P, t, p, &w, &L2, &x);
     if (margin < -OM_REACH_SLACK)
         return margin;
     ik_with_elbow(P, t, w, L2, x, signs, q_prev, q, shoulder);
@@ -160,12 +176,9 @@ static void q7_with_elbow(const double *P, const om_target *t, vec3 w, double L2
 double om_srs_model_q7(const double *P, const om_target *t, vec3 p, const int64_t *signs, const double *q_prev,
                        double *q)
 {
-    vec3 w = v_add(p, t->wrist);
-    double L2 = v_dot(w, w);
-    if (L2 < DEGENERATE)
-        return -1.0;
-    double x = (L2 - P[SRS_K0]) / P[SRS_K];
-    double margin = 1.0 - x * x;
+    vec3 w;
+    double L2, x;
+    double margin = reach(P, t, p, &w, &L2, &x);
     if (margin < -OM_REACH_SLACK)
         return margin;
     q7_with_elbow(P, t, w, L2, x, signs, q_prev, q);
