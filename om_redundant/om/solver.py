@@ -178,6 +178,11 @@ class OMSolver:
         )
 
     @property
+    def kernel(self) -> ckernels.Solver:
+        """The compiled solver, for kernels that solve with it (``ckernels.track_step``)."""
+        return self._kernel
+
+    @property
     def model(self) -> Arm:
         """The offset-modified model arm."""
         return self.om.model
