@@ -22,6 +22,8 @@ their rate.
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 
 from .. import ckernels
@@ -35,6 +37,8 @@ POLISH_ITERATIONS = 30
 FIXED_POINT_STEPS = 20
 #: Joint-space distance (rad) under which two roots are one (csrc's OM_SAME_ROOT).
 SAME_ROOT = 1e-9
+#: Fractions by which a target the seeds do not lead to is pulled toward the base.
+PULL = (1e-4, 1e-3, 1e-2)
 
 
 class NearKernel:
@@ -64,6 +68,7 @@ class NearKernel:
         self._P = system.as_kernel_array(om.params) if seven else None
         self._model_table = system.as_kernel_array(om.model.chain.table) if seven else None
         self._tolerances = (data.position_tolerance, data.orientation_tolerance)
+        self._all_signs = list(itertools.product((1, -1), repeat=len(om.sign_names)))
 
     # -- the Solver interface -------------------------------------------------------------
 
@@ -112,23 +117,40 @@ class NearKernel:
     # -- the method -----------------------------------------------------------------------
 
     def _roots(self, T, signs, redundancy) -> tuple[list[tuple[np.ndarray, float, float]], int]:
-        """Verified roots (real coordinates, position and orientation errors), evaluations."""
+        """Verified roots (real coordinates, position and orientation errors), evaluations.
+
+        Seeds, stage by stage until one leads to a root: the nominal roots in c; in every
+        other configuration (near a branch boundary the real arm's root may be the nominal
+        arm's in the neighbouring one); of the target pulled toward the base by ``PULL`` in
+        every configuration (the real arm may reach a little farther than the nominal one).
+        A seed that polish does not bring home takes the fixed point on T D(q)."""
         T = system.as_kernel_array(T)
-        seeds, evals = self._nominal_roots(T, signs, redundancy)
         R, p = system.flange_target(T, self._T_base_root, self._T_tool_flange)
         R = np.ascontiguousarray(R).ravel()
         psi = float(redundancy[0]) if self._P is not None else 0.0
+        signs = tuple(int(s) for s in signs)
+        others = [s for s in self._all_signs if s != signs]
+        stages = [[(T, signs)], [(T, s) for s in others]]
+        stages.append([(_pulled(T, f), s) for f in PULL for s in self._all_signs])
         roots: list[tuple[np.ndarray, float, float]] = []
-        for seed in seeds:
-            found = self._refined(T, R, p, psi, seed, signs, redundancy)
-            if found is None:
-                start = self._fixed_point(T, seed, signs, redundancy)
-                found = self._refined(T, R, p, psi, start, signs, redundancy)
-            if found is not None and all(_distance(found[0], q) >= SAME_ROOT for q, _, _ in roots):
-                roots.append(found)
-        return roots, evals + len(seeds) * POLISH_ITERATIONS
+        evals = 0
+        for stage in stages:
+            for target, seed_signs in stage:
+                seeds, n = self._nominal_roots(target, seed_signs, redundancy)
+                evals += n + len(seeds) * POLISH_ITERATIONS
+                for seed in seeds:
+                    found = self._refined(T, R, p, psi, seed, signs, redundancy)
+                    if found is None:
+                        start = self._fixed_point(T, seed, signs, redundancy)
+                        found = self._refined(T, R, p, psi, start, signs, redundancy)
+                    if found is not None and all(_distance(found[0], q) >= SAME_ROOT for q, _, _ in roots):
+                        roots.append(found)
+            if roots:
+                break
+        return roots, evals
 
     def _nominal_roots(self, T, signs, redundancy) -> tuple[list[np.ndarray], int]:
+        """The nominal arm's roots of T in a configuration (nominal coordinates), evaluations."""
         roots = np.empty((system.MAX_ROOTS, self._real.dof))
         info = np.empty((system.MAX_ROOTS, 3))
         n, evals = self._nominal.solve_all(T, signs, redundancy, roots, info)
@@ -196,6 +218,13 @@ def _wrap(angle):
 
 def _distance(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.abs(_wrap(a - b)).max())
+
+
+def _pulled(T: np.ndarray, fraction: float) -> np.ndarray:
+    """T with its position pulled toward the root frame's origin by a fraction of it."""
+    pulled = T.copy()
+    pulled[:3, 3] *= 1.0 - fraction
+    return pulled
 
 
 def _errors(reached: np.ndarray, T: np.ndarray) -> tuple[float, float]:
