@@ -2,7 +2,7 @@
  * (the method: om_redundant/om/system.py). */
 #include "om_system.h"
 
-#define LAST_STEP 1e-5 /* a secant step (rad) below which the next iterate is evaluated with every joint */
+#define LAST_STEP 1e-8 /* a secant step (rad) below which the next iterate is evaluated with every joint */
 #define REACH_PROBES 8 /* probes each way around the circle for a reachable first point */
 #define BACKTRACK 4    /* halvings of a secant step that leaves the model's reach */
 #define STALL 4        /* secant steps in a row without PROGRESS after which it gives up */
