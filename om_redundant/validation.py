@@ -184,7 +184,7 @@ def _is_se3(value: Any) -> bool:
 
 
 def _check_poses(T: np.ndarray, name: str) -> None:
-    if len(T) == 0:
+    if len(T) == 0 or ckernels.pose_is_valid(T, ORTHONORMALITY_TOLERANCE):  # fast path
         return
     bad = ~np.isfinite(T).all(axis=(1, 2))
     if bad.any():

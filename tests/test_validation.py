@@ -91,6 +91,27 @@ def test_batch_input_is_checked(solver, pose):
         solver.solve_batch(np.stack([pose]), (1, 0, 1))
 
 
+_DEFECTS = {
+    "not orthonormal": lambda T: T.__setitem__((0, 0), T[0, 0] + 1e-6),
+    "determinant -1": lambda T: T.__setitem__((slice(None, 3), 2), -T[:3, 2]),
+    r"last row": lambda T: T.__setitem__((3, 0), 1e-12),
+    "NaN or inf": lambda T: T.__setitem__((1, 1), np.inf),
+}
+
+
+@settings(max_examples=40, deadline=None)
+@given(m=st.integers(1, 300), data=st.data(), defect=st.sampled_from(sorted(_DEFECTS)))
+def test_one_bad_pose_in_a_batch_is_named(solver, pose, m, data, defect):
+    """The batch's check (one compiled pass over every pose) lets no bad pose through, and the
+    message names the first bad one."""
+    k = data.draw(st.integers(0, m - 1))
+    poses = np.repeat(pose[None], m, axis=0)
+    _DEFECTS[defect](poses[k])
+    where = rf"T\[{k}\]" if m > 1 and defect != "last row" else "T"
+    with pytest.raises(om.InvalidInput, match=rf"{where}.*{defect}"):
+        solver.solve_batch(poses, (1, 1, 1))
+
+
 def test_unreachable_pose_says_so(solver, pose):
     far = pose.copy()
     far[:3, 3] = (3.0, 0.0, 0.5)
