@@ -4,9 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..exceptions import SingularSelfMotion
 from ..om.solver import OMSolver
 from ..validation import as_joint_vector
 from .arm_angle import arm_angle_and_gradient, check_arm_angle
+
+#: dq/dpsi is taken as singular where |Dpsi N| is below this times |Dpsi|.
+FOLD = 1e-9
 
 
 def self_motion_tangent(solver: OMSolver, q: np.ndarray) -> np.ndarray:
@@ -32,10 +36,18 @@ def self_motion_tangent(solver: OMSolver, q: np.ndarray) -> np.ndarray:
 
     Raises:
         InvalidInput: The arm has no arm angle, or q is malformed.
+        SingularSelfMotion: psi does not move along the self-motion at q (a fold, or J of
+            rank below 6): :math:`|D\psi\,N|` below :data:`FOLD` times :math:`|D\psi|`.
     """
     check_arm_angle(solver)
     q = as_joint_vector(q, solver.arm.dof, stack=False)
     null = np.linalg.svd(solver.arm.jacobian(q))[2][6:].T
     gradient = arm_angle_and_gradient(solver, q)[1]
     change = np.atleast_2d(gradient @ null)
+    scale = np.linalg.svd(change, compute_uv=False)
+    if not scale.min() > FOLD * max(float(np.linalg.norm(gradient)), 1e-300):
+        raise SingularSelfMotion(
+            f"the arm angle does not move along the self-motion at q = {np.round(q, 6).tolist()} "
+            "(a fold of the solution path, or the Jacobian lost rank)"
+        )
     return np.linalg.solve(change.T, null.T).T
