@@ -9,9 +9,6 @@ from ..om.solver import OMSolver
 from ..validation import as_joint_vector
 from .arm_angle import arm_angle_and_gradient, check_arm_angle
 
-#: dq/dpsi is taken as singular where |Dpsi N| is below this times |Dpsi|.
-FOLD = 1e-9
-
 
 def self_motion_tangent(solver: OMSolver, q: np.ndarray) -> np.ndarray:
     r"""dq/dpsi: how the joints move per unit of the redundancy variables, hand fixed.
@@ -36,18 +33,22 @@ def self_motion_tangent(solver: OMSolver, q: np.ndarray) -> np.ndarray:
 
     Raises:
         InvalidInput: The arm has no arm angle, or q is malformed.
-        SingularSelfMotion: psi does not move along the self-motion at q (a fold, or J of
-            rank below 6): :math:`|D\psi\,N|` below :data:`FOLD` times :math:`|D\psi|`.
+        SingularSelfMotion: psi does not move along the self-motion at q: :math:`D\psi\,N`
+            is singular to rounding (exactly at a fold, or J of rank below 6). Near a fold
+            dq/dpsi is large but finite, and returned.
     """
     check_arm_angle(solver)
     q = as_joint_vector(q, solver.arm.dof, stack=False)
     null = np.linalg.svd(solver.arm.jacobian(q))[2][6:].T
     gradient = arm_angle_and_gradient(solver, q)[1]
     change = np.atleast_2d(gradient @ null)
-    scale = np.linalg.svd(change, compute_uv=False)
-    if not scale.min() > FOLD * max(float(np.linalg.norm(gradient)), 1e-300):
+    try:
+        tangent = np.linalg.solve(change.T, null.T).T
+    except np.linalg.LinAlgError:
+        tangent = np.full_like(null, np.nan)
+    if not np.isfinite(tangent).all():
         raise SingularSelfMotion(
             f"the arm angle does not move along the self-motion at q = {np.round(q, 6).tolist()} "
-            "(a fold of the solution path, or the Jacobian lost rank)"
+            "(exactly at a fold of the solution path, or where the Jacobian lost rank)"
         )
-    return np.linalg.solve(change.T, null.T).T
+    return tangent
