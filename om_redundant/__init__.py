@@ -15,6 +15,7 @@ from .exceptions import (
     ModelError,
     ModelMismatch,
     OMError,
+    SingularSelfMotion,
     UnknownArm,
     UnreachableTarget,
 )
@@ -81,6 +82,7 @@ __all__ = [
     "PsiInterval",
     "RedundancyChoice",
     "RedundancyOptimizer",
+    "SingularSelfMotion",
     "Singularity",
     "Solution",
     "Sphere",

@@ -154,6 +154,8 @@ class Tracker:
             d, grad = objective.clearance.distances_within(q_new, self._reach, gradient=True)
             self._last = (q_new, d, grad)
             clearance = float(d.min())
+            if clearance >= self._reach:  # every pair beyond the reach: D itself, uncapped
+                clearance = objective.clearance.minimum(q_new)
             value += objective.clearance_weight * min(1.0, clearance / objective.clearance_cap)
         if not (margin >= 0.0 and clearance >= objective.min_clearance):
             return None
