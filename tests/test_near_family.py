@@ -148,3 +148,24 @@ def test_an_arm_that_cannot_be_solved_is_refused_at_construction(name, row, fiel
     changed = arm.with_chain(arm.chain.replace_rows(rows), f"{name}-changed")
     with pytest.raises(om.ModelError, match=cause):
         om.OMSolver(changed)
+
+
+@pytest.mark.parametrize("joint", [1, 3])
+def test_arm_angle_and_singularities_of_a_reversed_joint(joint):
+    """A 7-DOF arm with a reversed axis: the redundancy package reads psi and the
+    singularities in the model's coordinates flip * q: psi is configuration_of's, its gradient
+    the finite difference's, the singularities' distances the model's at flip * q."""
+    solver = om.OMSolver(reversed_joint(om.load_arm("panda"), joint))
+    assert solver.flip[joint] == -1
+    singularity = om.Singularity.of(solver.om, solver.flip)
+    for q in random_q(solver.arm, 10, np.random.default_rng(joint)):
+        psi, grad = om.arm_angle_and_gradient(solver, q)
+        assert abs(wrap(psi - solver.configuration_of(q).redundancy[0])) < 1e-12
+        step = 1e-6
+        for j in range(7):
+            dq = np.zeros(7)
+            dq[j] = step
+            fd = wrap(om.arm_angle_and_gradient(solver, q + dq)[0] - psi) / step
+            assert abs(fd - grad[j]) < 1e-5
+        nominal = om.Singularity.of(solver.om).distances(solver.flip * q)
+        np.testing.assert_allclose(singularity.distances(q), nominal, rtol=0, atol=1e-15)
