@@ -165,6 +165,11 @@ class OMSolver:
         return kernel_data(arm, self.om, self.tolerances, self.scan_points)
 
     @property
+    def kernel(self) -> ckernels.Solver:
+        """The compiled solver, for kernels that solve with it (``ckernels.track_step``)."""
+        return self._kernel
+
+    @property
     def model(self) -> Arm:
         """The offset-modified model arm (of the nominal arm for an arm near a family, in the
         model's joint coordinates ``flip * q``)."""
