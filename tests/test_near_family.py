@@ -169,3 +169,23 @@ def test_arm_angle_and_singularities_of_a_reversed_joint(joint):
             assert abs(fd - grad[j]) < 1e-5
         nominal = om.Singularity.of(solver.om).distances(solver.flip * q)
         np.testing.assert_allclose(singularity.distances(q), nominal, rtol=0, atol=1e-15)
+
+
+@pytest.mark.parametrize(
+    "arm",
+    [bent(om.load_arm("panda"), 1e-4, np.random.default_rng(0)), reversed_joint(om.load_arm("panda"), 3)],
+    ids=lambda a: a.name,
+)
+def test_the_redundancy_optimizer_tracks_on_a_near_arm(arm):
+    """The optimiser's global choice and its tracking steps (no compiled tracking kernel for
+    a near arm: the windowed search) give exact answers in their configuration."""
+    solver = om.OMSolver(arm)
+    optimizer = om.RedundancyOptimizer(solver, [om.Sphere([0.4, 0.2, 0.5], 0.05)])
+    T = arm.fk(np.array([0.1, -0.3, 0.2, -2.0, 0.1, 1.8, 0.5]))
+    choice = optimizer.choose(T)
+    for _ in range(3):
+        assert choice.ok and solver.holds(choice.solution.q, choice.configuration)
+        assert np.abs(arm.fk(choice.solution.q) - T).max() < EXACT
+        T = T.copy()
+        T[0, 3] += 0.002
+        choice = optimizer.choose(T, choice)

@@ -165,8 +165,9 @@ class OMSolver:
         return kernel_data(arm, self.om, self.tolerances, self.scan_points)
 
     @property
-    def kernel(self) -> ckernels.Solver:
-        """The compiled solver, for kernels that solve with it (``ckernels.track_step``)."""
+    def kernel(self) -> ckernels.Solver | NearKernel:
+        """The compiled solver, for kernels that solve with it (``ckernels.track_step``); a
+        :class:`~om_redundant.om.near.NearKernel` for an arm near a family."""
         return self._kernel
 
     @property
