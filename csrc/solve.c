@@ -85,6 +85,19 @@ static void _set_target(om_problem *pb, const double *T, const double *redundanc
     pb->t = om_target_at(s->family, s->params, &R, redundancy);
 }
 
+/* The START_POINTS starts -pi + 2 pi (k + 1/2) / START_POINTS into order, the farthest from
+ * w first (w NaN: in order of k). */
+static void _starts_away_from(double w, double *order)
+{
+    int k0 = 0; /* the start farthest from w, then alternately its neighbours */
+    if (!isnan(w))
+        k0 = py_mod((int)floor((om_wrap(w + OM_PI) + OM_PI) * START_POINTS / (2.0 * OM_PI)), START_POINTS);
+    for (int i = 0; i < START_POINTS; i++) {
+        int step = (i + 1) / 2, k = isnan(w) ? i : py_mod(k0 + (i % 2 ? step : -step), START_POINTS);
+        order[i] = -OM_PI + 2.0 * OM_PI * ((double)k + 0.5) / START_POINTS;
+    }
+}
+
 static om_result _result(int status, double pos, double ori, int64_t evaluations, bool inside)
 {
     om_result result = {status, pos, ori, evaluations, inside};
@@ -122,7 +135,7 @@ om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *
     memcpy(start, hint, (size_t)dof * sizeof(double));
     bool found = has_hint;
     vec3 pd = problem.p;
-    double pos = NAN, ori = NAN;
+    double pos = NAN, ori = NAN, outside_w = NAN; /* q_J of a local root out of the limits */
     /* Whether start holds every joint; on an S-R-S circle arm whose dp turns with q7, the
      * local solve needs q7 alone, and the rest is computed where needed (om_complete_start). */
     bool start_complete = has_hint || !(mode == OM_CIRCLE && family == OM_SRS && s->dp_joint == 6);
@@ -158,13 +171,18 @@ om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *
             if (inside || has_hint || mode == OM_FIXED)
                 return _result(OM_OK, pos, ori, problem.counter, inside);
             /* Without a hint, a root within the limits is preferred: search for one. */
+            outside_w = q[s->dp_joint];
         }
     }
     if (!has_hint && mode == OM_CIRCLE) {
         /* Other starts on the circle first: cheaper than the bounded search, and a root
-         * within the limits is usually among their roots. */
+         * within the limits is usually among their roots. Where the local root lies out of
+         * the limits, the starts farthest from it go first (the nearer ones mostly find it
+         * again). */
+        double order[START_POINTS];
+        _starts_away_from(outside_w, order);
         for (int k = 0; k < START_POINTS; k++) {
-            om_secant(pb, -OM_PI + 2.0 * OM_PI * ((double)k + 0.5) / START_POINTS, q);
+            om_secant(pb, order[k], q);
             if (om_verify(pb, q, &pos, &ori) && _finish(pb, q, hint, false, q_out, &pos, &ori))
                 return _result(OM_OK, pos, ori, problem.counter, true);
         }
