@@ -14,8 +14,8 @@ static double _secant_from(om_problem *pb, double w0, double g0, double *q);
  * iteration of system (9), w <- q_J(w) = w + g(w) (the secant with slope -1: g' = -1 +
  * dq_J/dw, and q_J turns little with w where dp is small against the arm); where that step
  * does not halve |g|, the secant starts again from w0 with a finite-difference slope. A step
- * that leaves the model's reach is halved (BACKTRACK times at most). It stops before a step
- * below rounding, and gives up after STALL steps without PROGRESS (g near an extremum that
+ * that leaves the model's reach is halved (BACKTRACK times at most). It stops at |g| below
+ * OM_ROOT_TOL or before a step below rounding, and gives up after STALL steps without PROGRESS (g near an extremum that
  * does not cross zero, or a root beyond the edge of reach). Returns |g| at the end, q
  * holding the model IK (every joint) at the last iterate. */
 double om_secant(om_problem *pb, double w0, double *q)
@@ -83,7 +83,7 @@ static double _secant_from(om_problem *pb, double w0, double g0, double *q)
         w = w + step;
         gw = g_new;
         complete = last;
-        if (fabs(gw) < 1e-16)
+        if (fabs(gw) < OM_ROOT_TOL) /* q_J and w agree to 1e-13 rad: dp to about 1e-14 m */
             break;
         stalled = fabs(gw) < PROGRESS * best ? 0 : stalled + 1;
         best = py_min(best, fabs(gw));

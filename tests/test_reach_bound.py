@@ -18,8 +18,12 @@ from tests.conftest import random_q
 COARSE, DENSE = 16, 1024
 
 
-def _root_set(solver: om.OMSolver, T: np.ndarray, c: om.Configuration) -> list[tuple[float, ...]]:
-    return sorted(tuple(np.round(r.q, 7)) for r in solver.solve_all(T, c))
+def _same_roots(a: list[om.Solution], b: list[om.Solution]) -> bool:
+    """One to one within 1e-9 rad (the same root refined from other samples differs in its
+    last digits)."""
+    return len(a) == len(b) and all(
+        any(np.abs(np.remainder(x.q - y.q + np.pi, 2 * np.pi) - np.pi).max() < 1e-9 for y in b) for x in a
+    )
 
 
 @pytest.fixture(scope="module", params=["panda", "xarm7", "fr3"])
@@ -34,4 +38,4 @@ def test_a_coarse_search_finds_every_root_of_a_dense_one(solvers, seed):
     q = random_q(coarse.arm, 1, np.random.default_rng(seed))[0]
     T = coarse.arm.fk(q)
     for c in coarse.configurations(coarse.configuration_of(q).redundancy):
-        assert _root_set(coarse, T, c) == _root_set(dense, T, c), c
+        assert _same_roots(coarse.solve_all(T, c), dense.solve_all(T, c)), c
