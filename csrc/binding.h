@@ -12,6 +12,19 @@ enum { F64, I64, U8 }; /* buffer kinds: float64, int64, bool */
 /* Acquire obj's buffer as n items of the given kind (n < 0: any), C-contiguous (writable if
  * asked). Returns -1 with a TypeError or ValueError naming the argument. */
 int get_buffer(PyObject *obj, Py_buffer *view, int kind, Py_ssize_t n, int writable, const char *name);
+/* A TypeError naming what takes `want` arguments where nargs came; -1 then. */
+int check_nargs(Py_ssize_t nargs, Py_ssize_t want, const char *what);
+/* What get_buffers asks of one argument: kind, entries (n < 0: any), writable, name. */
+typedef struct {
+    int kind;
+    Py_ssize_t n;
+    int writable;
+    const char *name;
+} buffer_spec;
+/* Acquire objs[i]'s buffer by specs[i] for i < n, all or none (-1: those acquired released). */
+int get_buffers(PyObject *const *objs, Py_buffer *views, const buffer_spec *specs, int n);
+/* Release views[0:n]. */
+void release_buffers(Py_buffer *views, int n);
 /* A sequence of k signs, each -1 or +1, into out. */
 int get_signs(PyObject *obj, int64_t *out, int k);
 /* A sequence of k numbers into out. */

@@ -37,6 +37,28 @@ int get_buffer(PyObject *obj, Py_buffer *view, int kind, Py_ssize_t n, int writa
     return 0;
 }
 
+int check_nargs(Py_ssize_t nargs, Py_ssize_t want, const char *what) {
+    if (nargs != want) {
+        PyErr_Format(PyExc_TypeError, "%s takes %zd arguments, got %zd", what, want, nargs);
+        return -1;
+    }
+    return 0;
+}
+
+int get_buffers(PyObject *const *objs, Py_buffer *views, const buffer_spec *specs, int n) {
+    for (int i = 0; i < n; i++) {
+        if (get_buffer(objs[i], &views[i], specs[i].kind, specs[i].n, specs[i].writable, specs[i].name) < 0) {
+            release_buffers(views, i);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+void release_buffers(Py_buffer *views, int n) {
+    for (int i = 0; i < n; i++) PyBuffer_Release(&views[i]);
+}
+
 /* Parse a sequence of k numbers (ints for signs) into out. */
 int get_signs(PyObject *obj, int64_t *out, int k) {
     PyObject *seq = PySequence_Fast(obj, "signs must be a sequence");

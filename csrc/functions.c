@@ -4,36 +4,6 @@
 /* ------------------------------------------------------------------------------------ */
 /* Module functions: kinematics and the families' closed forms.                           */
 
-/* Parse n buffers; kinds/sizes/writable per argument; -1 size: any. */
-typedef struct {
-    int kind;
-    Py_ssize_t n;
-    int writable;
-    const char *name;
-} spec;
-
-static int get_all(PyObject *const *args, Py_buffer *views, const spec *specs, int n) {
-    for (int i = 0; i < n; i++) {
-        if (get_buffer(args[i], &views[i], specs[i].kind, specs[i].n, specs[i].writable, specs[i].name) < 0) {
-            for (int j = 0; j < i; j++) PyBuffer_Release(&views[j]);
-            return -1;
-        }
-    }
-    return 0;
-}
-
-static void release_all(Py_buffer *views, int n) {
-    for (int i = 0; i < n; i++) PyBuffer_Release(&views[i]);
-}
-
-static int check_nargs(Py_ssize_t nargs, Py_ssize_t want, const char *what) {
-    if (nargs != want) {
-        PyErr_Format(PyExc_TypeError, "%s takes %zd arguments, got %zd", what, want, nargs);
-        return -1;
-    }
-    return 0;
-}
-
 static Py_ssize_t table_rows(Py_buffer *table) {
     return table->len / (6 * 8);
 }
@@ -42,22 +12,22 @@ static Py_ssize_t table_rows(Py_buffer *table) {
 static PyObject *k_fk(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
     if (check_nargs(nargs, 5, "fk") < 0) return NULL;
     Py_buffer v[5];
-    spec sp[5] = {{F64, -1, 0, "table"}, {F64, 16, 0, "base"}, {F64, 16, 0, "tool"}, {F64, -1, 0, "Q"},
-                  {F64, -1, 1, "out"}};
-    if (get_all(args, v, sp, 5) < 0) return NULL;
+    buffer_spec sp[5] = {{F64, -1, 0, "table"}, {F64, 16, 0, "base"}, {F64, 16, 0, "tool"}, {F64, -1, 0, "Q"},
+                         {F64, -1, 1, "out"}};
+    if (get_buffers(args, v, sp, 5) < 0) return NULL;
     Py_ssize_t rows = table_rows(&v[0]), dof = 0;
     const double *t = v[0].buf;
     for (Py_ssize_t i = 0; i < rows; i++) dof += t[6 * i + 5] != 2.0;
     Py_ssize_t m = dof ? v[3].len / (8 * dof) : v[4].len / 128; /* no joints: one pose per out */
     if (v[0].len != rows * 48 || v[3].len != m * dof * 8 || v[4].len != m * 128) {
-        release_all(v, 5);
+        release_buffers(v, 5);
         PyErr_SetString(PyExc_ValueError, "fk: shapes of table, Q and out disagree");
         return NULL;
     }
     Py_BEGIN_ALLOW_THREADS for (Py_ssize_t i = 0; i < m; i++) om_fk(t, (int)rows, v[1].buf, v[2].buf,
                                                                        (const double *)v[3].buf + dof * i,
                                                                        (double *)v[4].buf + 16 * i);
-    Py_END_ALLOW_THREADS release_all(v, 5);
+    Py_END_ALLOW_THREADS release_buffers(v, 5);
     Py_RETURN_NONE;
 }
 
@@ -65,17 +35,17 @@ static PyObject *k_fk(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
 static PyObject *k_jacobian(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
     if (check_nargs(nargs, 5, "jacobian") < 0) return NULL;
     Py_buffer v[5];
-    spec sp[5] = {{F64, -1, 0, "table"}, {F64, 16, 0, "base"}, {F64, 16, 0, "tool"}, {F64, -1, 0, "q"},
-                  {F64, -1, 1, "J"}};
-    if (get_all(args, v, sp, 5) < 0) return NULL;
+    buffer_spec sp[5] = {{F64, -1, 0, "table"}, {F64, 16, 0, "base"}, {F64, 16, 0, "tool"}, {F64, -1, 0, "q"},
+                         {F64, -1, 1, "J"}};
+    if (get_buffers(args, v, sp, 5) < 0) return NULL;
     Py_ssize_t rows = table_rows(&v[0]), dof = v[3].len / 8;
     if (dof > OM_MAX_DOF || v[4].len != 6 * dof * 8) {
-        release_all(v, 5);
+        release_buffers(v, 5);
         PyErr_SetString(PyExc_ValueError, "jacobian: shapes of q and J disagree");
         return NULL;
     }
     om_jacobian(v[0].buf, (int)rows, v[1].buf, v[2].buf, v[3].buf, (int)dof, v[4].buf);
-    release_all(v, 5);
+    release_buffers(v, 5);
     Py_RETURN_NONE;
 }
 
@@ -83,10 +53,10 @@ static PyObject *k_jacobian(PyObject *mod, PyObject *const *args, Py_ssize_t nar
 static PyObject *k_flange(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
     if (check_nargs(nargs, 4, "flange") < 0) return NULL;
     Py_buffer v[4];
-    spec sp[4] = {{F64, -1, 0, "table"}, {F64, -1, 0, "q"}, {F64, 9, 1, "R"}, {F64, 3, 1, "p"}};
-    if (get_all(args, v, sp, 4) < 0) return NULL;
+    buffer_spec sp[4] = {{F64, -1, 0, "table"}, {F64, -1, 0, "q"}, {F64, 9, 1, "R"}, {F64, 3, 1, "p"}};
+    if (get_buffers(args, v, sp, 4) < 0) return NULL;
     om_flange(v[0].buf, (int)table_rows(&v[0]), v[1].buf, v[2].buf, v[3].buf);
-    release_all(v, 4);
+    release_buffers(v, 4);
     Py_RETURN_NONE;
 }
 
@@ -94,9 +64,9 @@ static PyObject *k_flange(PyObject *mod, PyObject *const *args, Py_ssize_t nargs
 static PyObject *k_flange_target(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
     if (check_nargs(nargs, 5, "flange_target") < 0) return NULL;
     Py_buffer v[5];
-    spec sp[5] = {{F64, 16, 0, "T"}, {F64, 16, 0, "T_base_root"}, {F64, 16, 0, "T_tool_flange"}, {F64, 9, 1, "R"},
-                  {F64, 3, 1, "p"}};
-    if (get_all(args, v, sp, 5) < 0) return NULL;
+    buffer_spec sp[5] = {{F64, 16, 0, "T"}, {F64, 16, 0, "T_base_root"}, {F64, 16, 0, "T_tool_flange"},
+                         {F64, 9, 1, "R"}, {F64, 3, 1, "p"}};
+    if (get_buffers(args, v, sp, 5) < 0) return NULL;
     mat3 R;
     vec3 p;
     om_flange_target(v[0].buf, v[1].buf, v[2].buf, &R, &p);
@@ -110,7 +80,7 @@ static PyObject *k_flange_target(PyObject *mod, PyObject *const *args, Py_ssize_
     pb[0] = p.x;
     pb[1] = p.y;
     pb[2] = p.z;
-    release_all(v, 5);
+    release_buffers(v, 5);
     Py_RETURN_NONE;
 }
 
@@ -144,20 +114,20 @@ static PyObject *k_model_ik(PyObject *mod, PyObject *const *args, Py_ssize_t nar
     int all_joints = PyObject_IsTrue(args[9]);
     if (PyErr_Occurred() || all_joints < 0) return NULL;
     Py_buffer v[8];
-    spec sp[8] = {{F64, -1, 0, "P"}, {F64, -1, 0, "table"}, {F64, 9, 0, "R"}, {F64, 3, 0, "p"},
-                  {I64, 3, 0, "signs"}, {F64, -1, 0, "redundancy"}, {F64, -1, 0, "q_prev"}, {F64, -1, 1, "q"}};
-    if (get_all(args + 1, v, sp, 8) < 0) return NULL;
+    buffer_spec sp[8] = {{F64, -1, 0, "P"}, {F64, -1, 0, "table"}, {F64, 9, 0, "R"}, {F64, 3, 0, "p"},
+                         {I64, 3, 0, "signs"}, {F64, -1, 0, "redundancy"}, {F64, -1, 0, "q_prev"}, {F64, -1, 1, "q"}};
+    if (get_buffers(args + 1, v, sp, 8) < 0) return NULL;
     if (check_family(family, &v[0], v[7].len / 8) < 0 || v[6].len != v[7].len ||
         v[5].len != (family == OM_SRS ? 8 : 0)) {
         if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "model_ik: shapes disagree");
-        release_all(v, 8);
+        release_buffers(v, 8);
         return NULL;
     }
     mat3 R = load_mat(v[2].buf);
     om_target t = om_target_at((int)family, v[0].buf, &R, v[5].buf);
     double margin = om_model_ik((int)family, v[0].buf, v[1].buf, &t, load_vec(v[3].buf), v[4].buf, v[6].buf,
                                 v[7].buf, all_joints);
-    release_all(v, 8);
+    release_buffers(v, 8);
     return PyFloat_FromDouble(margin);
 }
 
@@ -169,15 +139,15 @@ static PyObject *srs_variant(PyObject *const *args, Py_ssize_t nargs, int q7_alo
     if (PyErr_Occurred()) return NULL;
     PyObject *const a[6] = {args[0], args[1], args[2], args[3], args[5], args[6]};
     Py_buffer v[6];
-    spec sp[6] = {{F64, SRS_N_PARAMS, 0, "P"}, {F64, 9, 0, "R"}, {F64, 3, 0, "p"}, {I64, 3, 0, "signs"},
-                  {F64, 7, 0, "q_prev"}, {F64, 7, 1, "q"}};
-    if (get_all(a, v, sp, 6) < 0) return NULL;
+    buffer_spec sp[6] = {{F64, SRS_N_PARAMS, 0, "P"}, {F64, 9, 0, "R"}, {F64, 3, 0, "p"}, {I64, 3, 0, "signs"},
+                         {F64, 7, 0, "q_prev"}, {F64, 7, 1, "q"}};
+    if (get_buffers(a, v, sp, 6) < 0) return NULL;
     mat3 R = load_mat(v[1].buf);
     om_target t = om_target_at(OM_SRS, v[0].buf, &R, &psi);
     vec3 p = load_vec(v[2].buf);
     PyObject *out = q7_alone ? PyFloat_FromDouble(om_srs_model_q7(v[0].buf, &t, p, v[3].buf, v[4].buf, v[5].buf))
                              : PyBool_FromLong(om_srs_model_ik_at_reach(v[0].buf, &t, p, v[3].buf, v[4].buf, v[5].buf));
-    release_all(v, 6);
+    release_buffers(v, 6);
     return out;
 }
 
@@ -197,13 +167,13 @@ static PyObject *k_model_ik_lifted(PyObject *mod, PyObject *const *args, Py_ssiz
     if (PyErr_Occurred()) return NULL;
     PyObject *const a[5] = {args[0], args[1], args[2], args[3], args[8]};
     Py_buffer v[5];
-    spec sp[5] = {{F64, SRS_N_PARAMS, 0, "P"}, {F64, 9, 0, "R"}, {F64, 3, 0, "p"}, {I64, 3, 0, "signs"},
-                  {F64, 7, 1, "q"}};
-    if (get_all(a, v, sp, 5) < 0) return NULL;
+    buffer_spec sp[5] = {{F64, SRS_N_PARAMS, 0, "P"}, {F64, 9, 0, "R"}, {F64, 3, 0, "p"}, {I64, 3, 0, "signs"},
+                         {F64, 7, 1, "q"}};
+    if (get_buffers(a, v, sp, 5) < 0) return NULL;
     mat3 R = load_mat(v[1].buf);
     om_target t = om_target_at(OM_SRS, v[0].buf, &R, &psi);
     vec3 r = om_srs_model_ik_lifted(v[0].buf, &t, load_vec(v[2].buf), v[3].buf, q1, q7, phi4, v[4].buf);
-    release_all(v, 5);
+    release_buffers(v, 5);
     return Py_BuildValue("(ddd)", r.x, r.y, r.z);
 }
 
@@ -213,19 +183,19 @@ static PyObject *configuration_values(PyObject *const *args, Py_ssize_t nargs, i
     long family = PyLong_AsLong(args[0]);
     if (PyErr_Occurred()) return NULL;
     Py_buffer v[3];
-    spec sp[3] = {{F64, -1, 0, "P"}, {F64, -1, 0, "q"}, {F64, -1, 1, "out"}};
-    if (get_all(args + 1, v, sp, 3) < 0) return NULL;
+    buffer_spec sp[3] = {{F64, -1, 0, "P"}, {F64, -1, 0, "q"}, {F64, -1, 1, "out"}};
+    if (get_buffers(args + 1, v, sp, 3) < 0) return NULL;
     Py_ssize_t want = redundancy ? (family == OM_SRS ? 1 : 0) : 3;
     if (check_family(family, &v[0], v[1].len / 8) < 0 || v[2].len < want * 8) {
         if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "out is too short");
-        release_all(v, 3);
+        release_buffers(v, 3);
         return NULL;
     }
     if (redundancy)
         om_redundancy_values((int)family, v[0].buf, v[1].buf, v[2].buf);
     else
         om_branch_values((int)family, v[0].buf, v[1].buf, v[2].buf);
-    release_all(v, 3);
+    release_buffers(v, 3);
     Py_RETURN_NONE;
 }
 
@@ -241,10 +211,10 @@ static PyObject *k_redundancy_values(PyObject *mod, PyObject *const *args, Py_ss
 static PyObject *k_arm_angle_gradient(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
     if (check_nargs(nargs, 4, "arm_angle_gradient") < 0) return NULL;
     Py_buffer v[4];
-    spec sp[4] = {{F64, SRS_N_PARAMS, 0, "P"}, {F64, -1, 0, "table"}, {F64, 7, 0, "q"}, {F64, 7, 1, "grad"}};
-    if (get_all(args, v, sp, 4) < 0) return NULL;
+    buffer_spec sp[4] = {{F64, SRS_N_PARAMS, 0, "P"}, {F64, -1, 0, "table"}, {F64, 7, 0, "q"}, {F64, 7, 1, "grad"}};
+    if (get_buffers(args, v, sp, 4) < 0) return NULL;
     double psi = om_arm_angle_gradient(v[0].buf, v[1].buf, (int)table_rows(&v[1]), v[2].buf, v[3].buf);
-    release_all(v, 4);
+    release_buffers(v, 4);
     return PyFloat_FromDouble(psi);
 }
 
@@ -302,9 +272,9 @@ static PyObject *k_polish(PyObject *mod, PyObject *const *args, Py_ssize_t nargs
     int with_psi = args[5] != Py_None;
     PyObject *const a[6] = {args[0], args[1], args[2], args[3], args[5], args[6]};
     Py_buffer v[6];
-    spec sp[6] = {{F64, -1, 0, "table"}, {F64, 9, 0, "R"}, {F64, 3, 0, "p"}, {F64, -1, 1, "q"},
-                  {F64, SRS_N_PARAMS, 0, "P"}, {F64, -1, 0, "model_table"}};
-    if (get_all(a, v, sp, with_psi ? 6 : 4) < 0) return NULL;
+    buffer_spec sp[6] = {{F64, -1, 0, "table"}, {F64, 9, 0, "R"}, {F64, 3, 0, "p"}, {F64, -1, 1, "q"},
+                         {F64, SRS_N_PARAMS, 0, "P"}, {F64, -1, 0, "model_table"}};
+    if (get_buffers(a, v, sp, with_psi ? 6 : 4) < 0) return NULL;
     om_polish_task t;
     t.table = v[0].buf;
     t.n_rows = (int)table_rows(&v[0]);
@@ -312,7 +282,7 @@ static PyObject *k_polish(PyObject *mod, PyObject *const *args, Py_ssize_t nargs
     Py_ssize_t dof = 0;
     for (Py_ssize_t i = 0; i < t.n_rows; i++) dof += ((const double *)v[0].buf)[6 * i + 5] != 2.0;
     if (v[0].len != t.n_rows * 48 || dof != t.dof || t.dof > OM_MAX_DOF || (with_psi && t.dof != 7)) {
-        release_all(v, with_psi ? 6 : 4);
+        release_buffers(v, with_psi ? 6 : 4);
         PyErr_SetString(PyExc_ValueError, "polish: table, q (and a 7-joint arm for psi) disagree");
         return NULL;
     }
@@ -325,7 +295,7 @@ static PyObject *k_polish(PyObject *mod, PyObject *const *args, Py_ssize_t nargs
     t.elbow = 0.0;
     double r;
     Py_BEGIN_ALLOW_THREADS r = om_polish(&t, (int)iterations, v[3].buf);
-    Py_END_ALLOW_THREADS release_all(v, with_psi ? 6 : 4);
+    Py_END_ALLOW_THREADS release_buffers(v, with_psi ? 6 : 4);
     return PyFloat_FromDouble(r);
 }
 

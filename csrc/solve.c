@@ -123,7 +123,13 @@ om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *
     bool found = has_hint;
     vec3 pd = problem.p;
     double pos = NAN, ori = NAN;
-    if (!has_hint) { /* the paper's fixed-point start, p_m = p_d */
+    /* Whether start holds every joint; on an S-R-S circle arm whose dp turns with q7, the
+     * local solve needs q7 alone, and the rest is computed where needed (om_complete_start). */
+    bool start_complete = has_hint || !(mode == OM_CIRCLE && family == OM_SRS && s->dp_joint == 6);
+    if (!start_complete) { /* the fixed-point start's q7, at the edge of reach beyond it */
+        found = om_srs_model_q7(P, &problem.t, pd, signs, problem.q_prev, start) >= -OM_REACH_SLACK ||
+                om_srs_model_q7_at_reach(P, &problem.t, pd, signs, problem.q_prev, start);
+    } else if (!has_hint) { /* the paper's fixed-point start, p_m = p_d */
         found = om_model_ik(family, P, mtab, &problem.t, pd, signs, problem.q_prev, start, true) >= -OM_REACH_SLACK;
         if (!found && family == OM_SRS && mode != OM_FIXED) {
             /* p_d is outside the model's reach: the elbow held at the edge of reach instead,
@@ -144,7 +150,7 @@ om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *
         }
     }
     if (found) {
-        bool verified = om_local_solve(pb, start, q, &pos, &ori);
+        bool verified = om_local_solve(pb, start, &start_complete, q, &pos, &ori);
         if (verified) {
             if (has_hint && mode != OM_FIXED && om_nearest_in_window(pb, hint, q))
                 om_verify(pb, q, &pos, &ori);
@@ -174,6 +180,8 @@ om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *
         bool other = neighbour_reached || om_exists_other(pb, true);
         return _result(other ? OM_NO_SOLUTION_IN_CONFIGURATION : OM_UNREACHABLE, NAN, NAN, problem.counter, false);
     }
+    if (found)
+        om_complete_start(pb, start, &start_complete);
     /* The root nearest the hint; without one, a root within the limits first, then the one
      * nearest the fixed-point start. */
     int best = 0;

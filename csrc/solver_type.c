@@ -118,42 +118,35 @@ static PyObject *result_tuple(om_result r) {
                          r.within_limits ? Py_True : Py_False);
 }
 
-/* The target of a solve: signs and redundancy values (the configuration's tuples) and the
- * pose T (16 float64). Returns -1 with an exception set. */
-static int get_target(const om_solver_data *s, PyObject *const *args, int64_t *signs, double *redundancy,
-                      Py_buffer *T) {
-    if (get_signs(args[1], signs, s->n_signs) < 0 || get_doubles(args[2], redundancy, s->n_redundancy, "redundancy") < 0)
-        return -1;
-    return get_buffer(args[0], T, F64, 16, 0, "T");
+/* A configuration's signs and redundancy values, as the kernels take them. */
+typedef struct {
+    int64_t signs[3];
+    double redundancy[1];
+} configuration;
+
+/* The arguments of a call in one configuration: nargs checked against want (the call's name
+ * in the error), the configuration's tuples read from args[1] (signs) and args[2]
+ * (redundancy). Returns -1 with an exception set. */
+static int get_call(const om_solver_data *s, PyObject *const *args, Py_ssize_t nargs, Py_ssize_t want,
+                    const char *what, configuration *c) {
+    if (check_nargs(nargs, want, what) < 0 || get_signs(args[1], c->signs, s->n_signs) < 0) return -1;
+    return get_doubles(args[2], c->redundancy, s->n_redundancy, "redundancy");
 }
 
 /* solve(T, signs, redundancy, hint, q_out) -> (status, position error, orientation error,
  * evaluations, within limits). hint None: no hint. */
 static PyObject *Solver_solve(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
-    if (nargs != 5) {
-        PyErr_SetString(PyExc_TypeError, "solve takes (T, signs, redundancy, hint, q_out)");
-        return NULL;
-    }
     const om_solver_data *s = &self->data;
-    int64_t signs[3];
-    double redundancy[1];
-    Py_buffer T, hint, q;
-    if (get_target(s, args, signs, redundancy, &T) < 0) return NULL;
-    int has_hint = args[3] != Py_None;
-    if (has_hint && get_buffer(args[3], &hint, F64, s->dof, 0, "q_hint") < 0) {
-        PyBuffer_Release(&T);
-        return NULL;
-    }
-    if (get_buffer(args[4], &q, F64, s->dof, 1, "q_out") < 0) {
-        PyBuffer_Release(&T);
-        if (has_hint) PyBuffer_Release(&hint);
-        return NULL;
-    }
+    configuration c;
+    if (get_call(s, args, nargs, 5, "solve", &c) < 0) return NULL;
+    int n = args[3] != Py_None ? 3 : 2; /* the hint last, if there is one */
+    PyObject *objs[3] = {args[0], args[4], args[3]};
+    buffer_spec specs[3] = {{F64, 16, 0, "T"}, {F64, s->dof, 1, "q_out"}, {F64, s->dof, 0, "q_hint"}};
+    Py_buffer v[3];
+    if (get_buffers(objs, v, specs, n) < 0) return NULL;
     om_result r;
-    Py_BEGIN_ALLOW_THREADS r = om_solve_one(s, T.buf, signs, redundancy, has_hint ? hint.buf : NULL, q.buf);
-    Py_END_ALLOW_THREADS PyBuffer_Release(&T);
-    if (has_hint) PyBuffer_Release(&hint);
-    PyBuffer_Release(&q);
+    Py_BEGIN_ALLOW_THREADS r = om_solve_one(s, v[0].buf, c.signs, c.redundancy, n == 3 ? v[2].buf : NULL, v[1].buf);
+    Py_END_ALLOW_THREADS release_buffers(v, n);
     return result_tuple(r);
 }
 
@@ -162,134 +155,83 @@ static PyObject *Solver_solve(Solver *self, PyObject *const *args, Py_ssize_t na
  * q_out (M, dof), info (M, 5) gets (status, position error, orientation error,
  * evaluations, within limits). */
 static PyObject *Solver_solve_rows(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
-    if (nargs != 8) {
-        PyErr_SetString(PyExc_TypeError, "solve_rows takes (Ts, signs, redundancy, hints, start, stop, q_out, info)");
+    if (check_nargs(nargs, 8, "solve_rows") < 0)
         return NULL;
-    }
     const om_solver_data *s = &self->data;
     Py_ssize_t start = PyLong_AsSsize_t(args[4]), stop = PyLong_AsSsize_t(args[5]);
     if (PyErr_Occurred()) return NULL;
-    Py_buffer bufs[6];
-    int n_bufs = 0, has_hint = args[3] != Py_None;
-    Py_buffer *T = &bufs[n_bufs];
-    if (get_buffer(args[0], T, F64, -1, 0, "Ts") < 0) return NULL;
-    n_bufs++;
-    Py_ssize_t m = T->len / (16 * 8);
-    PyObject *result = NULL;
-    if (T->len != m * 16 * 8 || start < 0 || stop > m || start > stop) {
+    Py_buffer v[6]; /* Ts, then signs, redundancy, q_out, info and the hints last */
+    if (get_buffer(args[0], &v[0], F64, -1, 0, "Ts") < 0) return NULL;
+    Py_ssize_t m = v[0].len / (16 * 8);
+    if (v[0].len != m * 16 * 8 || start < 0 || stop > m || start > stop) {
         PyErr_SetString(PyExc_ValueError, "Ts must be (M, 4, 4) and 0 <= start <= stop <= M");
-        goto done;
+        release_buffers(v, 1);
+        return NULL;
     }
-    Py_buffer *signs = &bufs[n_bufs];
-    if (get_buffer(args[1], signs, I64, m * s->n_signs, 0, "signs") < 0) goto done;
-    n_bufs++;
-    Py_buffer *red = &bufs[n_bufs];
-    if (get_buffer(args[2], red, F64, m * s->n_redundancy, 0, "redundancy") < 0) goto done;
-    n_bufs++;
-    Py_buffer *hints = NULL;
-    if (has_hint) {
-        hints = &bufs[n_bufs];
-        if (get_buffer(args[3], hints, F64, m * s->dof, 0, "q_hint") < 0) goto done;
-        n_bufs++;
+    int dof = s->dof, k = s->n_signs, nr = s->n_redundancy, n = args[3] != Py_None ? 5 : 4;
+    PyObject *objs[5] = {args[1], args[2], args[6], args[7], args[3]};
+    buffer_spec specs[5] = {{I64, m * k, 0, "signs"}, {F64, m * nr, 0, "redundancy"}, {F64, m * dof, 1, "q_out"},
+                            {F64, m * 5, 1, "info"}, {F64, m * dof, 0, "q_hint"}};
+    if (get_buffers(objs, v + 1, specs, n) < 0) {
+        release_buffers(v, 1);
+        return NULL;
     }
-    Py_buffer *q = &bufs[n_bufs];
-    if (get_buffer(args[6], q, F64, m * s->dof, 1, "q_out") < 0) goto done;
-    n_bufs++;
-    Py_buffer *info = &bufs[n_bufs];
-    if (get_buffer(args[7], info, F64, m * 5, 1, "info") < 0) goto done;
-    n_bufs++;
-    {
-        const double *Tb = T->buf, *rb = red->buf, *hb = has_hint ? hints->buf : NULL;
-        const int64_t *sb = signs->buf;
-        double *qb = q->buf, *ib = info->buf;
-        int dof = s->dof, k = s->n_signs, nr = s->n_redundancy;
-        Py_BEGIN_ALLOW_THREADS for (Py_ssize_t i = start; i < stop; i++) {
-            om_result r = om_solve_one(s, Tb + 16 * i, sb + k * i, rb + nr * i, hb ? hb + dof * i : NULL, qb + dof * i);
-            double *row = ib + 5 * i;
-            row[0] = r.status;
-            row[1] = r.position_error;
-            row[2] = r.orientation_error;
-            row[3] = (double)r.evaluations;
-            row[4] = r.within_limits;
-        }
-        Py_END_ALLOW_THREADS
+    const double *Tb = v[0].buf, *rb = v[2].buf, *hb = n == 5 ? v[5].buf : NULL;
+    const int64_t *sb = v[1].buf;
+    double *qb = v[3].buf, *ib = v[4].buf;
+    Py_BEGIN_ALLOW_THREADS for (Py_ssize_t i = start; i < stop; i++) {
+        om_result r = om_solve_one(s, Tb + 16 * i, sb + k * i, rb + nr * i, hb ? hb + dof * i : NULL, qb + dof * i);
+        double *row = ib + 5 * i;
+        row[0] = r.status;
+        row[1] = r.position_error;
+        row[2] = r.orientation_error;
+        row[3] = (double)r.evaluations;
+        row[4] = r.within_limits;
     }
-    result = Py_NewRef(Py_None);
-done:
-    for (int i = 0; i < n_bufs; i++) PyBuffer_Release(&bufs[i]);
-    return result;
+    Py_END_ALLOW_THREADS release_buffers(v, n + 1);
+    Py_RETURN_NONE;
 }
 
 /* solve_all(T, signs, redundancy, roots, info) -> (count, evaluations); roots (MAX_ROOTS,
  * dof), info (MAX_ROOTS, 3) gets (position error, orientation error, within limits). */
 static PyObject *Solver_solve_all(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
-    if (nargs != 5) {
-        PyErr_SetString(PyExc_TypeError, "solve_all takes (T, signs, redundancy, roots, info)");
-        return NULL;
-    }
     const om_solver_data *s = &self->data;
-    int64_t signs[3];
-    double redundancy[1];
-    Py_buffer T, roots, info;
-    if (get_target(s, args, signs, redundancy, &T) < 0) return NULL;
-    if (get_buffer(args[3], &roots, F64, OM_MAX_ROOTS * s->dof, 1, "roots") < 0) {
-        PyBuffer_Release(&T);
-        return NULL;
-    }
-    if (get_buffer(args[4], &info, F64, OM_MAX_ROOTS * 3, 1, "info") < 0) {
-        PyBuffer_Release(&T);
-        PyBuffer_Release(&roots);
-        return NULL;
-    }
+    configuration c;
+    if (get_call(s, args, nargs, 5, "solve_all", &c) < 0) return NULL;
+    PyObject *objs[3] = {args[0], args[3], args[4]};
+    buffer_spec specs[3] = {{F64, 16, 0, "T"}, {F64, OM_MAX_ROOTS * s->dof, 1, "roots"},
+                            {F64, OM_MAX_ROOTS * 3, 1, "info"}};
+    Py_buffer v[3];
+    if (get_buffers(objs, v, specs, 3) < 0) return NULL;
     int n;
     int64_t evaluations;
-    Py_BEGIN_ALLOW_THREADS n = om_solve_all(s, T.buf, signs, redundancy, roots.buf, info.buf, &evaluations);
-    Py_END_ALLOW_THREADS PyBuffer_Release(&T);
-    PyBuffer_Release(&roots);
-    PyBuffer_Release(&info);
+    Py_BEGIN_ALLOW_THREADS n = om_solve_all(s, v[0].buf, c.signs, c.redundancy, v[1].buf, v[2].buf, &evaluations);
+    Py_END_ALLOW_THREADS release_buffers(v, 3);
     return Py_BuildValue("(iL)", n, (long long)evaluations);
 }
 
 /* configuration_values(q, branch, redundancy): the branch quantities and redundancy values at q. */
 static PyObject *Solver_configuration_values(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
-    if (nargs != 3) {
-        PyErr_SetString(PyExc_TypeError, "configuration_values takes (q, branch, redundancy)");
-        return NULL;
-    }
+    if (check_nargs(nargs, 3, "configuration_values") < 0) return NULL;
     const om_solver_data *s = &self->data;
-    Py_buffer q, b, r;
-    if (get_buffer(args[0], &q, F64, s->dof, 0, "q") < 0) return NULL;
-    if (get_buffer(args[1], &b, F64, s->n_signs, 1, "branch") < 0) {
-        PyBuffer_Release(&q);
-        return NULL;
-    }
-    if (get_buffer(args[2], &r, F64, s->n_redundancy, 1, "redundancy") < 0) {
-        PyBuffer_Release(&q);
-        PyBuffer_Release(&b);
-        return NULL;
-    }
-    om_branch_values(s->family, s->params, q.buf, b.buf);
-    om_redundancy_values(s->family, s->params, q.buf, r.buf);
-    PyBuffer_Release(&q);
-    PyBuffer_Release(&b);
-    PyBuffer_Release(&r);
+    buffer_spec specs[3] = {{F64, s->dof, 0, "q"}, {F64, s->n_signs, 1, "branch"},
+                            {F64, s->n_redundancy, 1, "redundancy"}};
+    Py_buffer v[3];
+    if (get_buffers(args, v, specs, 3) < 0) return NULL;
+    om_branch_values(s->family, s->params, v[0].buf, v[1].buf);
+    om_redundancy_values(s->family, s->params, v[0].buf, v[2].buf);
+    release_buffers(v, 3);
     Py_RETURN_NONE;
 }
 
 /* holds(q, signs, redundancy) -> bool: om_in_configuration (the band contract). */
 static PyObject *Solver_holds(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
-    if (nargs != 3) {
-        PyErr_SetString(PyExc_TypeError, "holds takes (q, signs, redundancy)");
-        return NULL;
-    }
     const om_solver_data *s = &self->data;
-    int64_t signs[3];
-    double redundancy[1];
+    configuration c;
+    if (get_call(s, args, nargs, 3, "holds", &c) < 0) return NULL;
     Py_buffer q;
-    if (get_signs(args[1], signs, s->n_signs) < 0 || get_doubles(args[2], redundancy, s->n_redundancy, "redundancy") < 0)
-        return NULL;
     if (get_buffer(args[0], &q, F64, s->dof, 0, "q") < 0) return NULL;
-    bool in = om_in_configuration(s, q.buf, signs, redundancy);
+    bool in = om_in_configuration(s, q.buf, c.signs, c.redundancy);
     PyBuffer_Release(&q);
     return PyBool_FromLong(in);
 }

@@ -44,11 +44,22 @@ void om_srs_target(const double *P, om_target *t)
     t->wrist = v_sub(m_mv(t->R, v_load(P, SRS_WRIST)), v_load(P, SRS_SHOULDER));
 }
 
-/* The root phi4 of x = cos(phi4 - phi*) in the ELBOW branch, x clamped into [-1, 1]. */
-static double elbow_root(const double *P, double x, double elbow)
+/* The root phi4 of x = cos(phi4 - phi*) in the ELBOW branch, x clamped into [-1, 1]: its
+ * cos and sin without trig, cos(phi4 - phi*) = x and sin(phi4 - phi*) = ELBOW sqrt(1 - x^2)
+ * turned by phi*; and (phi4 not NULL) the angle itself. */
+typedef struct {
+    double c4, s4;
+} elbow_cs;
+
+static elbow_cs elbow_root(const double *P, double x, double elbow, double *phi4)
 {
     double xc = py_min(py_max(x, -1.0), 1.0);
-    return P[SRS_PHI_STAR] + atan2(elbow * sqrt(1.0 - xc * xc), xc);
+    double y = elbow * sqrt(1.0 - xc * xc);
+    double c = P[SRS_COS_PHI_STAR], s = P[SRS_SIN_PHI_STAR];
+    if (phi4)
+        *phi4 = P[SRS_PHI_STAR] + atan2(y, xc);
+    elbow_cs e = {c * xc - s * y, s * xc + c * y};
+    return e;
 }
 
 /* R03 for W - S = w, the elbow angle phi4 (cos c4, sin c4) and the target's arm angle: it
@@ -68,12 +79,15 @@ static mat3 rotation_03_at(const double *P, const om_target *t, vec3 w, double L
     return m_mtm(A, B);
 }
 
-/* Joints 1-3 (if shoulder) and 4-7 for the elbow angle phi4, W - S = w and the target t. */
-static void ik_with_elbow(const double *P, const om_target *t, vec3 w, double L2, double phi4,
+/* Joints 1-3 (if shoulder) and 4-7 for the elbow's root at x (elbow_root), W - S = w and the
+ * target t. */
+static void ik_with_elbow(const double *P, const om_target *t, vec3 w, double L2, double x,
                           const int64_t *signs, const double *q_prev, double *q, bool shoulder)
 {
     const double *th = P + SRS_THETA;
-    double c4 = cos(phi4), s4 = sin(phi4);
+    double phi4;
+    elbow_cs e = elbow_root(P, x, (double)signs[1], &phi4);
+    double c4 = e.c4, s4 = e.s4;
     mat3 R03 = rotation_03_at(P, t, w, L2, c4, s4, (double)signs[1]);
     if (shoulder) {
         vec3 phi = om_euler_zxzxz(m_mmt(m_mtm(m_load(P, SRS_R_PRE), R03), m_load(P, SRS_X3)), P[SRS_SIGMA1],
@@ -92,45 +106,53 @@ static void ik_with_elbow(const double *P, const om_target *t, vec3 w, double L2
     q[6] = om_wrap(phi.z - th[6]);
 }
 
+/* W - S = w for the flange position p, L2 = |w|^2 and the elbow's x = (L2 - k0) / K; returns
+ * the reach margin 1 - x^2 (-1 where W = S: x not written). */
+static double reach(const double *P, const om_target *t, vec3 p, vec3 *w, double *L2, double *x)
+{
+    *w = v_add(p, t->wrist);
+    *L2 = v_dot(*w, *w);
+    if (*L2 < DEGENERATE) /* wrist centre at the shoulder centre */
+        return -1.0;
+    *x = (*L2 - P[SRS_K0]) / P[SRS_K];
+    return 1.0 - *x * *x;
+}
+
+double om_srs_reach(const double *P, const om_target *t, vec3 p, double *x)
+{
+    vec3 w;
+    double L2;
+    return reach(P, t, p, &w, &L2, x);
+}
+
 /* Solve the model for the flange pose (t->R, p) in DH frame 0, the branch signs
  * (SHOULDER, ELBOW, WRIST) and the target's arm angle (model_ik). Returns the reach margin
  * 1 - x^2; below -OM_REACH_SLACK (or -1 where W = S) q is not written. */
 double om_srs_model_ik(const double *P, const om_target *t, vec3 p, const int64_t *signs, const double *q_prev,
                        double *q, bool shoulder)
 {
-    vec3 w = v_add(p, t->wrist);
-    double L2 = v_dot(w, w);
-    if (L2 < DEGENERATE) /* wrist centre at the shoulder centre */
-        return -1.0;
-    double x = (L2 - P[SRS_K0]) / P[SRS_K];
-    double margin = 1.0 - x * x;
+    vec3 w;
+    double L2, x;
+    double margin = reach(P, t, p, &w, &L2, &x);
     if (margin < -OM_REACH_SLACK)
         return margin;
-    ik_with_elbow(P, t, w, L2, elbow_root(P, x, (double)signs[1]), signs, q_prev, q, shoulder);
+    ik_with_elbow(P, t, w, L2, x, signs, q_prev, q, shoulder);
     return margin;
 }
 
-/* Joint 7 alone, as om_srs_model_ik computes it (q[6] written, the rest of q untouched): what
- * the circle residual g needs of the model. The wrist's M = R04^T R E^T =
- * Rz(phi5) Rx(alpha5) Rz(phi6) Rx(beta) Rz(phi7) is not formed: its last column gives
- * (sin phi6, cos phi6 cos beta) up to one positive factor (the Euler decomposition's phi6), and
- * its last row is sigma5 (u cos phi7 + v sin phi7, v cos phi7 - u sin phi7) for that pair
- * (u, v), which gives phi7 without phi5. Near the wrist singularity (u = 0), where the
- * closed form takes phi5 from q_prev, it decides. Returns the reach margin as om_srs_model_ik. */
-double om_srs_model_q7(const double *P, const om_target *t, vec3 p, const int64_t *signs, const double *q_prev,
-                       double *q)
+/* Joint 7 alone, as ik_with_elbow computes it for the elbow's root at x (q[6] written, the
+ * rest of q untouched): what the circle residual g needs of the model. The wrist's
+ * M = R04^T R E^T = Rz(phi5) Rx(alpha5) Rz(phi6) Rx(beta) Rz(phi7) is not formed: its last
+ * column gives (sin phi6, cos phi6 cos beta) up to one positive factor (the Euler
+ * decomposition's phi6), and its last row is sigma5 (u cos phi7 + v sin phi7, v cos phi7 -
+ * u sin phi7) for that pair (u, v), which gives phi7 without phi5. Near the wrist singularity
+ * (u = 0), where the closed form takes phi5 from q_prev, it decides. */
+static void q7_with_elbow(const double *P, const om_target *t, vec3 w, double L2, double x, const int64_t *signs,
+                          const double *q_prev, double *q)
 {
-    vec3 w = v_add(p, t->wrist);
-    double L2 = v_dot(w, w);
-    if (L2 < DEGENERATE)
-        return -1.0;
-    double x = (L2 - P[SRS_K0]) / P[SRS_K];
-    double margin = 1.0 - x * x;
-    if (margin < -OM_REACH_SLACK)
-        return margin;
     double elbow = (double)signs[1];
-    double phi4 = elbow_root(P, x, elbow);
-    double c4 = cos(phi4), s4 = sin(phi4);
+    elbow_cs e = elbow_root(P, x, elbow, NULL);
+    double c4 = e.c4, s4 = e.s4;
     mat3 R04 = m_mm(rotation_03_at(P, t, w, L2, c4, s4, elbow), m_rz_cs_times(c4, s4, m_load(P, SRS_X4)));
     mat3 RE_cols = m_transpose(t->RE);
     vec3 z4 = m_col(R04, 2); /* M[i][j] = (column i of R04) . (column j of R E^T) */
@@ -140,14 +162,39 @@ double om_srs_model_q7(const double *P, const om_target *t, vec3 p, const int64_
     double radial = sqrt(0.0 > radial_2 ? 0.0 : radial_2);
     if (!(radial > NEAR_SINGULAR_WRIST)) {
         double wrist_joints[7];
-        ik_with_elbow(P, t, w, L2, phi4, signs, q_prev, wrist_joints, false);
+        ik_with_elbow(P, t, w, L2, x, signs, q_prev, wrist_joints, false);
         q[6] = wrist_joints[6];
-        return margin;
+        return;
     }
     double u = (double)signs[2] * radial, v = -sigma * (sin_b > 0.0 ? 1.0 : -1.0) * az * cos_b;
     double m20 = v_dot(z4, RE_cols.r0), m21 = v_dot(z4, RE_cols.r1);
     q[6] = om_wrap(atan2(sigma * (v * m20 - u * m21), sigma * (u * m20 + v * m21)) - P[SRS_THETA + 6]);
+}
+
+/* Joint 7 alone, as om_srs_model_ik computes it (q7_with_elbow). Returns the reach margin as
+ * om_srs_model_ik. */
+double om_srs_model_q7(const double *P, const om_target *t, vec3 p, const int64_t *signs, const double *q_prev,
+                       double *q)
+{
+    vec3 w;
+    double L2, x;
+    double margin = reach(P, t, p, &w, &L2, &x);
+    if (margin < -OM_REACH_SLACK)
+        return margin;
+    q7_with_elbow(P, t, w, L2, x, signs, q_prev, q);
     return margin;
+}
+
+/* Joint 7 alone, as om_srs_model_ik_at_reach computes it; false, q untouched, only where W = S. */
+bool om_srs_model_q7_at_reach(const double *P, const om_target *t, vec3 p, const int64_t *signs,
+                              const double *q_prev, double *q)
+{
+    vec3 w = v_add(p, t->wrist);
+    double L2 = v_dot(w, w);
+    if (L2 < DEGENERATE)
+        return false;
+    q7_with_elbow(P, t, w, L2, (L2 - P[SRS_K0]) / P[SRS_K], signs, q_prev, q);
+    return true;
 }
 
 /* om_srs_model_ik with the elbow held at the edge of reach beyond it (model_ik_at_reach);
@@ -159,8 +206,7 @@ bool om_srs_model_ik_at_reach(const double *P, const om_target *t, vec3 p, const
     double L2 = v_dot(w, w);
     if (L2 < DEGENERATE)
         return false;
-    ik_with_elbow(P, t, w, L2, elbow_root(P, (L2 - P[SRS_K0]) / P[SRS_K], (double)signs[1]), signs, q_prev, q,
-                  true);
+    ik_with_elbow(P, t, w, L2, (L2 - P[SRS_K0]) / P[SRS_K], signs, q_prev, q, true);
     return true;
 }
 
@@ -174,10 +220,16 @@ vec3 om_srs_model_ik_lifted(const double *P, const om_target *t, vec3 p, const i
     if (L2 < DEGENERATE)
         return v3(NAN, NAN, NAN);
     double x = (L2 - P[SRS_K0]) / P[SRS_K];
-    if (isnan(phi4))
-        phi4 = elbow_root(P, x, (double)signs[1]);
     const double *th = P + SRS_THETA;
-    double c4 = cos(phi4), s4 = sin(phi4);
+    double c4, s4;
+    if (isnan(phi4)) {
+        elbow_cs e = elbow_root(P, x, (double)signs[1], &phi4);
+        c4 = e.c4;
+        s4 = e.s4;
+    } else {
+        c4 = cos(phi4);
+        s4 = sin(phi4);
+    }
     mat3 R03 = rotation_03_at(P, t, w, L2, c4, s4, (double)signs[1]);
     vec3 sh = om_euler_zxzxz_given_first(m_mmt(m_mtm(m_load(P, SRS_R_PRE), R03), m_load(P, SRS_X3)), P[SRS_SIGMA1],
                                          0.0, P[SRS_SIGMA2], q1 + th[0]);

@@ -154,7 +154,7 @@ class RedundancyOptimizer:
         self.objective = Objective(
             solver.arm,
             obstacles,
-            Singularity.of(solver.om),
+            Singularity.of(solver.om, solver.flip),
             margin_weight=margin_weight,
             clearance_weight=clearance_weight,
             singularity_weight=singularity_weight,

@@ -121,7 +121,8 @@ class Tracker:
             np.zeros(arm.dof),
             np.zeros(_N_OUT),
         )
-        self._kernel = solver.kernel
+        # An arm near a family solves through om.near.NearKernel: no compiled tracking step.
+        self._kernel = solver.kernel if isinstance(solver.kernel, ckernels.Solver) else None
         self._reach = 2.0 * objective.clearance_cap  # capped pieces beyond it change nothing
         self._last: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # q, values, gradients
 
@@ -134,6 +135,8 @@ class Tracker:
             (solution, psi, margin, clearance, value, curvature) at the new psi, or None when
             the step cannot be taken or lands on an infeasible point (module docstring).
         """
+        if self._kernel is None:
+            return None
         work, objective = self.work, self.objective
         work.setup[_PSI] = psi
         work.setup[_CURVATURE] = curvature if math.isfinite(curvature) else INITIAL_CURVATURE
