@@ -207,6 +207,12 @@ bool om_verify(om_problem *pb, const double *q, double *pos, double *ori); /* re
 int om_add_root(om_problem *pb, const double *q, double *roots, int count); /* roots: OM_MAX_ROOTS x dof */
 bool om_representative(double *q, int dof, const uint8_t *revolute, const double *lower, const double *upper,
                        const double *hint, bool has_hint);
+/* The hint as a solve uses it (dof entries into out): a revolute joint's value beyond
+ * HUGE_HINT (1e4 rad) reduced exactly into [-pi, pi] by remainder. A joint value of
+ * magnitude |h| carries rounding of ulp(|h|) / 2 (3e-11 rad at 3e5), which the FK's
+ * q + theta and two FKs' different sums turn into pose errors of 1e-10, and a local solve
+ * started there keeps that magnitude; at 1e4 rad the rounding is 1e-12. */
+void om_usable_hint(const om_solver_data *s, const double *hint, double *out);
 
 /* polish.c: damped Gauss-Newton on the REAL arm's chain toward the flange pose (R, p) in DH
  * frame 0 and, with P not NULL (an S-R-S model's parameters and model table), the arm angle psi. */

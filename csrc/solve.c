@@ -101,9 +101,10 @@ om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *
     const uint8_t *revolute = s->revolute;
     const double *lower = s->lower, *upper = s->upper;
     bool has_hint = hint != NULL;
-    double zeros[OM_MAX_DOF] = {0.0};
-    if (!has_hint)
-        hint = zeros; /* what the Python side passes without a hint */
+    double zeros[OM_MAX_DOF] = {0.0}, usable[OM_MAX_DOF];
+    if (has_hint)
+        om_usable_hint(s, hint, usable);
+    hint = has_hint ? usable : zeros; /* zeros: what the Python side passes without a hint */
     om_problem problem;
     problem.s = s;
     double psi[1];
