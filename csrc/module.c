@@ -34,12 +34,14 @@ PyMODINIT_FUNC PyInit_ckernels(void) {
         {"SRS_WRIST", SRS_WRIST}, {"SRS_S3", SRS_S3}, {"SRS_U", SRS_U}, {"SRS_K0", SRS_K0}, {"SRS_K", SRS_K},
         {"SRS_PHI_STAR", SRS_PHI_STAR}, {"SRS_R_PRE", SRS_R_PRE}, {"SRS_X3", SRS_X3}, {"SRS_X4", SRS_X4},
         {"SRS_E_ROT", SRS_E_ROT}, {"SRS_UP", SRS_UP}, {"SRS_REF", SRS_REF}, {"SRS_BEND", SRS_BEND},
-        {"SRS_COS_BETA", SRS_COS_BETA}, {"SRS_N_PARAMS", SRS_N_PARAMS},
+        {"SRS_COS_BETA", SRS_COS_BETA},
+        {"SRS_COS_PHI_STAR", SRS_COS_PHI_STAR}, {"SRS_SIN_PHI_STAR", SRS_SIN_PHI_STAR}, {"SRS_N_PARAMS", SRS_N_PARAMS},
         {"RRR_SPHERICAL_WRIST", OM_RRR_SPHERICAL_WRIST}, {"RRP_SPHERICAL_WRIST", OM_RRP_SPHERICAL_WRIST},
         {"SRS", OM_SRS}, {"FIXED", OM_FIXED}, {"CIRCLE", OM_CIRCLE}, {"TORUS", OM_TORUS}, {"OK", OM_OK},
         {"UNREACHABLE", OM_UNREACHABLE}, {"NO_SOLUTION_IN_CONFIGURATION", OM_NO_SOLUTION_IN_CONFIGURATION},
     };
     if (PyModule_AddObjectRef(m, "Solver", (PyObject *)&om_SolverType) < 0) goto fail;
+    if (PyModule_AddFunctions(m, om_tracking_functions) < 0) goto fail;
     for (size_t i = 0; i < sizeof constants / sizeof constants[0]; i++)
         if (PyModule_AddIntConstant(m, constants[i].name, constants[i].value) < 0) goto fail;
     const struct {

@@ -75,7 +75,7 @@ enum {
     SRS_SIGMA1 = 0, SRS_SIGMA2 = 1, SRS_SIGMA5 = 2, SRS_SIN_BETA = 3, SRS_THETA = 4, SRS_SHOULDER = 11,
     SRS_WRIST = 14, SRS_S3 = 17, SRS_U = 20, SRS_K0 = 23, SRS_K = 24, SRS_PHI_STAR = 25, SRS_R_PRE = 26,
     SRS_X3 = 35, SRS_X4 = 44, SRS_E_ROT = 53, SRS_UP = 62, SRS_REF = 65, SRS_BEND = 68, SRS_COS_BETA = 69,
-    SRS_N_PARAMS = 70
+    SRS_COS_PHI_STAR = 70, SRS_SIN_PHI_STAR = 71, SRS_N_PARAMS = 72
 };
 
 /* A model solve's target orientation, with what depends on it alone computed once

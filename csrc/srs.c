@@ -44,11 +44,22 @@ void om_srs_target(const double *P, om_target *t)
     t->wrist = v_sub(m_mv(t->R, v_load(P, SRS_WRIST)), v_load(P, SRS_SHOULDER));
 }
 
-/* The root phi4 of x = cos(phi4 - phi*) in the ELBOW branch, x clamped into [-1, 1]. */
-static double elbow_root(const double *P, double x, double elbow)
+/* The root phi4 of x = cos(phi4 - phi*) in the ELBOW branch, x clamped into [-1, 1]: its
+ * cos and sin without trig, cos(phi4 - phi*) = x and sin(phi4 - phi*) = ELBOW sqrt(1 - x^2)
+ * turned by phi*; and (phi4 not NULL) the angle itself. */
+typedef struct {
+    double c4, s4;
+} elbow_cs;
+
+static elbow_cs elbow_root(const double *P, double x, double elbow, double *phi4)
 {
     double xc = py_min(py_max(x, -1.0), 1.0);
-    return P[SRS_PHI_STAR] + atan2(elbow * sqrt(1.0 - xc * xc), xc);
+    double y = elbow * sqrt(1.0 - xc * xc);
+    double c = P[SRS_COS_PHI_STAR], s = P[SRS_SIN_PHI_STAR];
+    if (phi4)
+        *phi4 = P[SRS_PHI_STAR] + atan2(y, xc);
+    elbow_cs e = {c * xc - s * y, s * xc + c * y};
+    return e;
 }
 
 /* R03 for W - S = w, the elbow angle phi4 (cos c4, sin c4) and the target's arm angle: it
@@ -68,12 +79,15 @@ static mat3 rotation_03_at(const double *P, const om_target *t, vec3 w, double L
     return m_mtm(A, B);
 }
 
-/* Joints 1-3 (if shoulder) and 4-7 for the elbow angle phi4, W - S = w and the target t. */
-static void ik_with_elbow(const double *P, const om_target *t, vec3 w, double L2, double phi4,
+/* Joints 1-3 (if shoulder) and 4-7 for the elbow's root at x (elbow_root), W - S = w and the
+ * target t. */
+static void ik_with_elbow(const double *P, const om_target *t, vec3 w, double L2, double x,
                           const int64_t *signs, const double *q_prev, double *q, bool shoulder)
 {
     const double *th = P + SRS_THETA;
-    double c4 = cos(phi4), s4 = sin(phi4);
+    double phi4;
+    elbow_cs e = elbow_root(P, x, (double)signs[1], &phi4);
+    double c4 = e.c4, s4 = e.s4;
     mat3 R03 = rotation_03_at(P, t, w, L2, c4, s4, (double)signs[1]);
     if (shoulder) {
         vec3 phi = om_euler_zxzxz(m_mmt(m_mtm(m_load(P, SRS_R_PRE), R03), m_load(P, SRS_X3)), P[SRS_SIGMA1],
@@ -106,7 +120,7 @@ double om_srs_model_ik(const double *P, const om_target *t, vec3 p, const int64_
     double margin = 1.0 - x * x;
     if (margin < -OM_REACH_SLACK)
         return margin;
-    ik_with_elbow(P, t, w, L2, elbow_root(P, x, (double)signs[1]), signs, q_prev, q, shoulder);
+    ik_with_elbow(P, t, w, L2, x, signs, q_prev, q, shoulder);
     return margin;
 }
 
@@ -129,8 +143,8 @@ double om_srs_model_q7(const double *P, const om_target *t, vec3 p, const int64_
     if (margin < -OM_REACH_SLACK)
         return margin;
     double elbow = (double)signs[1];
-    double phi4 = elbow_root(P, x, elbow);
-    double c4 = cos(phi4), s4 = sin(phi4);
+    elbow_cs e = elbow_root(P, x, elbow, NULL);
+    double c4 = e.c4, s4 = e.s4;
     mat3 R04 = m_mm(rotation_03_at(P, t, w, L2, c4, s4, elbow), m_rz_cs_times(c4, s4, m_load(P, SRS_X4)));
     mat3 RE_cols = m_transpose(t->RE);
     vec3 z4 = m_col(R04, 2); /* M[i][j] = (column i of R04) . (column j of R E^T) */
@@ -140,7 +154,7 @@ double om_srs_model_q7(const double *P, const om_target *t, vec3 p, const int64_
     double radial = sqrt(0.0 > radial_2 ? 0.0 : radial_2);
     if (!(radial > NEAR_SINGULAR_WRIST)) {
         double wrist_joints[7];
-        ik_with_elbow(P, t, w, L2, phi4, signs, q_prev, wrist_joints, false);
+        ik_with_elbow(P, t, w, L2, x, signs, q_prev, wrist_joints, false);
         q[6] = wrist_joints[6];
         return margin;
     }
@@ -159,8 +173,7 @@ bool om_srs_model_ik_at_reach(const double *P, const om_target *t, vec3 p, const
     double L2 = v_dot(w, w);
     if (L2 < DEGENERATE)
         return false;
-    ik_with_elbow(P, t, w, L2, elbow_root(P, (L2 - P[SRS_K0]) / P[SRS_K], (double)signs[1]), signs, q_prev, q,
-                  true);
+    ik_with_elbow(P, t, w, L2, (L2 - P[SRS_K0]) / P[SRS_K], signs, q_prev, q, true);
     return true;
 }
 
@@ -174,10 +187,16 @@ vec3 om_srs_model_ik_lifted(const double *P, const om_target *t, vec3 p, const i
     if (L2 < DEGENERATE)
         return v3(NAN, NAN, NAN);
     double x = (L2 - P[SRS_K0]) / P[SRS_K];
-    if (isnan(phi4))
-        phi4 = elbow_root(P, x, (double)signs[1]);
     const double *th = P + SRS_THETA;
-    double c4 = cos(phi4), s4 = sin(phi4);
+    double c4, s4;
+    if (isnan(phi4)) {
+        elbow_cs e = elbow_root(P, x, (double)signs[1], &phi4);
+        c4 = e.c4;
+        s4 = e.s4;
+    } else {
+        c4 = cos(phi4);
+        s4 = sin(phi4);
+    }
     mat3 R03 = rotation_03_at(P, t, w, L2, c4, s4, (double)signs[1]);
     vec3 sh = om_euler_zxzxz_given_first(m_mmt(m_mtm(m_load(P, SRS_R_PRE), R03), m_load(P, SRS_X3)), P[SRS_SIGMA1],
                                          0.0, P[SRS_SIGMA2], q1 + th[0]);

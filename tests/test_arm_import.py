@@ -36,25 +36,12 @@ REFERENCE = {
     "ur10e": ("universal_robots_ur10e/ur10e.xml", "attachment_site", "site", None),
     "flexiv_rizon4": ("flexiv_rizon4/flexiv_rizon4.xml", "link7", "body", None),
     "wx250s": ("trossen_wx250s/wx250s.xml", "wx250s/gripper_link", "body", None),
-    # Twists 90 deg +- 4.2e-6 rad (rounded quaternions): the 6-DOF closed form needs them exact.
-    "piper": (
-        "agilex_piper/piper.xml",
-        "link6",
-        "body",
-        r"rows of joints 4, 5, 6 to follow one another; fixed rows after joint 4 \(alpha -0.000243085502 "
-        r"deg; axes 4 and 5 90.00024309 deg apart, 4.2e-06 rad from 90 deg\)",
-    ),
-    # Joint 3's axis opposite to joint 2's, 7.3e-6 rad from antiparallel.
-    "lite6": (
-        "ufactory_lite6/lite6.xml",
-        "attachment_site",
-        "site",
-        r"rows of joints 1, 2, 3 to follow one another; fixed rows after joint 2 \(alpha 179.9995791 deg, "
-        r"theta -89.99976816 deg; axes 2 and 3 179.9995791 deg apart, 7.3e-06 rad from 180 deg\)",
-    ),
+    # Twists 90 deg +- 4.2e-6 rad (rounded quaternions): solved through the nominal arm.
+    "piper": ("agilex_piper/piper.xml", "link6", "body", None),
+    # Joint 3's axis opposite to joint 2's, 7.3e-6 rad from antiparallel: joint 3 flipped.
+    "lite6": ("ufactory_lite6/lite6.xml", "attachment_site", "site", None),
 }
 SOLVED = [name for name, entry in REFERENCE.items() if entry[3] is None]
-REFUSED = [name for name, entry in REFERENCE.items() if entry[3] is not None]
 
 
 def reference_path(name: str):
@@ -174,12 +161,6 @@ def test_accepted_imports_solve_exactly(name):
             assert solver.configuration_of(root.q).isclose(c, 1e-7)
         hinted = solver.solve(T, c, q_hint=q)
         assert hinted.ok and np.abs(hinted.q - q).max() < 1e-7
-
-
-@pytest.mark.parametrize("name", REFUSED)
-def test_refused_imports_name_the_reason(name):
-    with pytest.raises(om.ModelError, match=REFERENCE[name][3]):
-        om.OMSolver(imported(name))
 
 
 # ---------------------------------------------------------------------------------------
@@ -315,13 +296,17 @@ def test_urdf_imports_through_mujocos_loader(tmp_path):
 
 def test_an_axis_opposite_to_the_previous_one_is_a_twist_of_180_deg(tmp_path):
     """The elbow turning about -z, against the shoulder: the rows hold it exactly (alpha_2 =
-    180 deg); the 6-DOF closed form does not take it yet and says so."""
+    180 deg); the nominal arm flips joint 3 (q -> -q) and the solver is exact."""
     path = ur_like_urdf(tmp_path, elbow=-1)
     arm = om.arm_from_mujoco(path, "tool0", "body")
     assert abs(arm.chain.rows[1].alpha) == math.pi
     assert om.compare_mujoco_model(arm, om.load_mujoco_model(path), tolerance=IMPORT_TOLERANCE).ok
-    with pytest.raises(om.ModelError, match="alpha_2 = 180 deg is not supported"):
-        om.OMSolver(arm)
+    solver = om.OMSolver(arm)
+    assert solver.nominal is not None and list(solver.nominal.flip) == [1, 1, -1, 1, 1, 1]
+    for q in random_q(arm, 20, np.random.default_rng(6)):
+        T = arm.fk(q)
+        solution = solver.solve(T, solver.configuration_of(q))
+        assert solution.ok and np.abs(arm.fk(solution.q) - T).max() < 1e-10
 
 
 def test_prefix_and_root(tmp_path):

@@ -157,17 +157,18 @@ def test_solve_all_returns_nothing_when_the_configuration_has_no_solution(spheri
 
 
 def test_an_arm_that_cannot_solve_is_refused_at_construction(monkeypatch):
-    """The issue's case: a twist 4e-6 rad off 90 deg, let through by a loose acceptance check,
-    solved nothing. The solver's own check refuses it, naming q and the status."""
+    """A twist 1e-2 rad off 90 deg (beyond the nominal arm's NEAR_TWIST), let through by a
+    loosened acceptance check, solves nothing. The solver's own check refuses it, naming q and
+    the status. (The issue's 4e-6 rad is near the family: tests/test_near_family.py.)"""
     ur5e = om.load_arm("ur5e")
     rows = list(ur5e.chain.rows)
-    rows[3] = om.DHRow(a=rows[3].a, alpha=rows[3].alpha + 4e-6, d=rows[3].d, theta=rows[3].theta)
+    rows[3] = om.DHRow(a=rows[3].a, alpha=rows[3].alpha + 1e-2, d=rows[3].d, theta=rows[3].theta)
     bent = ur5e.with_chain(ur5e.chain.replace_rows(rows), "bent")
     with pytest.raises(
-        om.ModelError, match=r"joints 4 and 5 perpendicular .*got 90.00022918 deg \(4e-06 rad off\)"
+        om.ModelError, match=r"joints 4 and 5 perpendicular .*got 90.5729578 deg \(0.01 rad off\)"
     ):
         om.OMSolver(bent)
-    monkeypatch.setattr(model_module, "_RIGHT_ANGLE_EPS", 1e-5)
+    monkeypatch.setattr(model_module, "_RIGHT_ANGLE_EPS", 1e-1)
     om.derive_model(bent)  # accepted by the loosened check ...
     with pytest.raises(
         om.ModelError,

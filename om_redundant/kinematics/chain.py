@@ -143,7 +143,7 @@ class KinematicChain:
             if row.is_joint:
                 placements.append(current)
                 current = np.eye(4)
-            current = current @ _row_transform(row)
+            current = current @ row_transform(row)
         return np.array(placements).reshape(-1, 4, 4), current @ self.T_flange_tool
 
     def fk(self, q: np.ndarray) -> np.ndarray:
@@ -179,7 +179,7 @@ class KinematicChain:
         return J
 
 
-def _row_transform(row: DHRow) -> np.ndarray:
+def row_transform(row: DHRow) -> np.ndarray:
     """The constant part :math:`R_z(\\theta) T_z(d) T_x(a) R_x(\\alpha)` of a row (4x4)."""
     ct, st, ca, sa = np.cos(row.theta), np.sin(row.theta), np.cos(row.alpha), np.sin(row.alpha)
     return np.array(

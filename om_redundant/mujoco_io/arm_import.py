@@ -48,7 +48,7 @@ import numpy as np
 
 from ..exceptions import FrameNotFound, InvalidInput, ModelMismatch
 from ..kinematics.arm import Arm, exact_angle, exact_pose
-from ..kinematics.chain import DHRow, JointKind, KinematicChain, _row_transform
+from ..kinematics.chain import DHRow, JointKind, KinematicChain, row_transform
 from .model_match import compare_mujoco_model, load_mujoco_model
 
 #: Largest length (m) and angle (rad) taken for round-off of 0 or of a multiple of 90 deg.
@@ -170,7 +170,7 @@ def dh_chain(lines: np.ndarray, kinds: list[JointKind], T_ee: np.ndarray) -> Kin
         else:
             new = [DHRow(d=_snap_length((R.T @ (T_ee[:3, 3] - o))[2]), kind=kinds[i])]
         for row in new:
-            F = F @ _row_transform(row)
+            F = F @ row_transform(row)
         rows += new
     T_flange_tool = exact_pose(np.linalg.solve(F, T_ee))
     return KinematicChain(tuple(rows), T_root_base, T_flange_tool)

@@ -240,6 +240,7 @@ def _srs_model(arm: Arm) -> tuple[KinematicChain, KinematicChain, np.ndarray]:
     P[srs.S3 : srs.S3 + 3] = s3
     P[srs.U : srs.U + 3] = u
     P[srs.K0], P[srs.K], P[srs.PHI_STAR] = k0, np.hypot(k1, k2), np.arctan2(k2, k1)
+    P[srs.COS_PHI_STAR], P[srs.SIN_PHI_STAR] = k1 / P[srs.K], k2 / P[srs.K]
     P[srs.R_PRE : srs.R_PRE + 9] = _pose(table[: jr[0]], q0[:0])[0].ravel()
     P[srs.X3 : srs.X3 + 9] = _rotx(rows[jr[2]].alpha).ravel()
     P[srs.X4 : srs.X4 + 9] = _rotx(rows[jr[3]].alpha).ravel()

@@ -24,7 +24,10 @@ from ..validation import (
 )
 from . import system
 from .configuration import Configuration
-from .model import ModelArm, derive_model
+from .kernel_data import kernel_data
+from .model import ModelArm
+from .near import NearKernel
+from .nominal import NominalArm, closed_form
 
 DEFAULT_POSITION_TOLERANCE = 1e-10
 DEFAULT_ORIENTATION_TOLERANCE = 1e-10
@@ -143,39 +146,27 @@ class OMSolver:
             as_positive(orientation_tolerance, "orientation_tolerance"),
         )
         self.scan_points = as_count(scan_points, "scan_points", MIN_SCAN_POINTS, MAX_SCAN_POINTS)
-        self.om: ModelArm = derive_model(self.arm)
-        self._kernel = ckernels.Solver(
-            self.solver_data(), solution_type=Solution, configuration_type=Configuration
-        )
+        self.om: ModelArm
+        #: The nominal arm the model is derived from, for an arm NEAR a family; else None.
+        self.nominal: NominalArm | None
+        self.om, self.nominal = closed_form(self.arm)
+        types = {"solution_type": Solution, "configuration_type": Configuration}
+        if self.nominal is not None:  # near a family: the nominal arm's roots seed the exact ones
+            self._kernel = NearKernel(self.nominal, self.om, self.solver_data(), **types)
+        else:
+            self._kernel = ckernels.Solver(self.solver_data(), **types)
         self._check_solves_itself()
 
     def solver_data(self) -> system.SolverData:
-        """The fixed data of the compiled kernel (see :class:`~om_redundant.om.system.SolverData`)."""
-        om, chain = self.om, self.arm.chain
-        if om.shoulder.any():  # dp turns with q1 and q7: the torus (q1, q7)
-            mode, dp_joint = system.TORUS, 0
-        elif om.dp_joint >= 0:
-            mode, dp_joint = system.CIRCLE, om.dp_joint
-        else:
-            mode, dp_joint = system.FIXED, 0
-        c = system.as_kernel_array
-        return system.SolverData(
-            family=int(om.family),
-            mode=mode,
-            params=c(om.params),
-            model_table=c(om.model.chain.table),
-            real_table=c(chain.table),
-            dp_joint=int(dp_joint),
-            dp_coefficients=c(np.vstack([om.delta, om.shoulder])),
-            T_base_root=c(np.linalg.inv(chain.T_root_base)),
-            T_tool_flange=c(np.linalg.inv(chain.T_flange_tool)),
-            revolute=np.ascontiguousarray(self.arm.revolute, dtype=np.bool_),
-            lower=c(self.arm.lower),
-            upper=c(self.arm.upper),
-            scan_points=self.scan_points,
-            position_tolerance=self.tolerances[0],
-            orientation_tolerance=self.tolerances[1],
-        )
+        """The fixed data of the compiled kernel (see :class:`~om_redundant.om.system.SolverData`):
+        of the arm, or of its nominal arm for an arm near a family (:attr:`nominal`)."""
+        arm = self.arm if self.nominal is None else self.nominal.arm
+        return kernel_data(arm, self.om, self.tolerances, self.scan_points)
+
+    @property
+    def kernel(self) -> ckernels.Solver:
+        """The compiled solver, for kernels that solve with it (``ckernels.track_step``)."""
+        return self._kernel
 
     @property
     def model(self) -> Arm:

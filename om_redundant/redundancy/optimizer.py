@@ -53,6 +53,7 @@ from .objective import (
 )
 from .paths import END_TOLERANCE, Path, Point, Probe, sweep_circle, sweep_window
 from .singularity import Singularity
+from .tracking import Tracker
 
 _WINDOW_POINTS = 4  # tracking samples on each side of the previous psi
 #: Tracking: optima within this of the best objective value are equal; the nearest wins.
@@ -76,6 +77,9 @@ class RedundancyChoice:
             mode those within ``max_step`` of the previous psi.
         reason: Why nothing is feasible, or why the branch flipped; "" otherwise.
         branch_flipped: Tracking mode left the previous branch (it had no feasible psi).
+        curvature: The curvature (per rad^2) of the objective along psi that the next
+            tracking step's model takes (:mod:`~om_redundant.redundancy.tracking`); nan:
+            its initial value.
     """
 
     ok: bool
@@ -87,6 +91,7 @@ class RedundancyChoice:
     intervals: tuple[PsiInterval, ...]
     reason: str = ""
     branch_flipped: bool = False
+    curvature: float = math.nan
 
 
 class RedundancyOptimizer:
@@ -163,6 +168,7 @@ class RedundancyOptimizer:
         self.max_step = as_number(max_step, "max_step")
         if not 0.0 < self.max_step <= math.pi:
             raise InvalidInput(f"max_step must be in (0, pi] rad, got {max_step}")
+        self._tracker = Tracker(solver, self.objective, self.max_step)
 
     def intervals(self, T: Any) -> list[PsiInterval]:
         """The feasible psi intervals of every allowed branch at pose T."""
@@ -217,6 +223,12 @@ class RedundancyOptimizer:
 
     def _track(self, T: np.ndarray, previous: RedundancyChoice) -> RedundancyChoice:
         signs, (psi,) = previous.configuration.signs, previous.configuration.redundancy
+        step = self._tracker.step(T, signs, psi, previous.solution.q, previous.curvature)
+        if step is not None:
+            solution, _, margin, clearance, value, curvature = step
+            return RedundancyChoice(
+                True, solution.configuration, solution, margin, clearance, value, (), curvature=curvature
+            )
         probe = self._probe(T, signs, wrapped=False)  # the joints move continuously
         window = sweep_window(probe, psi, previous.solution.q, self.max_step, _WINDOW_POINTS)
         runs = [run for path in window for run in feasible_runs(probe, path)]

@@ -79,7 +79,8 @@ UP = 62  # 3: the root frame's up axis, in DH frame 0
 REF = 65  # 3: the reference direction r, in DH frame 0
 BEND = 68  # sigma: the bend direction's sign
 COS_BETA = 69  # cos(beta); 0 on most arms
-N_PARAMS = 70
+COS_PHI_STAR, SIN_PHI_STAR = 70, 71  # cos and sin of phi*: the elbow's cos and sin without trig
+N_PARAMS = 72
 
 
 def model_ik_lifted(

@@ -1,0 +1,314 @@
+"""Redundancy resolution at control rate (issue 16): the optimiser's tracking step inside a
+500 Hz mink loop, against plain mink's tick in the same run; writes results/control_rate.md.
+
+For the Panda and the iiwa14, with 0, 1 and 3 obstacles (a sphere, a capsule, a box), a
+target moves along a figure eight around the hand (TICKS ticks of dt = 2 ms, one lap).
+Every tick, interleaved:
+
+* **plain mink**: FrameTask + PostureTask (cost 1e-2) + ConfigurationLimit, ``solve_ik``
+  with daqp, then ``integrate_inplace``;
+* **OM**: FrameTask + ``ExactPoseTask(optimizer=RedundancyOptimizer(...))`` +
+  ConfigurationLimit, same solver: ``set_target`` of both tasks (the optimiser's tracking
+  ``choose(T, previous)``) + ``solve_ik`` + ``integrate_inplace``;
+* **tracking alone**: ``choose(T, previous)`` along the same path.
+
+Times are wall (``perf_counter``) and process CPU (``process_time``), since the machine is
+shared. Quality along the path: the hand exact (1e-10 m) on the optimiser's choice every
+tick, clearance >= min_clearance and margins >= 0 every tick, branch flips counted. Then
+the global ``choose(T)`` on GLOBAL_POSES poses of the path (3 obstacles), and, on
+``--quality`` random poses per arm (3 obstacles), the convergence check
+(:func:`converged_gap`): the tracked psi after convergence against the global optimiser's
+climb from it.
+
+Run: ``python -m benchmarks.control_rate [--ticks 2000] [--quality 200]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import mink
+import numpy as np
+
+import om_redundant as om
+from om_redundant.redundancy.climb import maximise
+from om_redundant.redundancy.optimizer import RedundancyChoice
+from om_redundant.redundancy.paths import Probe
+
+from .report import cpu_model, write_page
+
+TICKS = 2000
+DT = 0.002
+SOLVER = "daqp"
+DAMPING = 1e-3
+MIN_CLEARANCE = 0.03
+MAX_STEP = 0.005  # rad per tick (the realtime example's): 2.5 rad/s at 500 Hz
+GLOBAL_POSES = 10
+HOMES = {
+    "panda": np.array([0.0, -0.3, 0.0, -2.2, 0.0, 1.9, 0.785]),
+    "iiwa14": np.array([0.0, 0.6, 0.0, -1.4, 0.0, 1.0, 0.0]),
+}
+EXACT = 1e-10  # m: the hand on the choice's target
+CONVERGED = 1e-12  # rad: tracking at one pose has converged when psi moves less
+MAX_ITERATIONS = 200  # tracking steps at one pose
+PSI_GAP, VALUE_GAP = 1e-3, 1e-6  # the issue's bars
+
+
+def obstacles(hand: np.ndarray, count: int) -> list[om.Sphere | om.Capsule | om.Box]:
+    """0, 1 or 3 obstacles placed about the home hand position (root frame)."""
+    box_pose = np.eye(4)
+    box_pose[:3, 3] = hand + [0.0, -0.35, 0.25]
+    shapes = [
+        om.Sphere(hand + [0.0, 0.3, 0.2], 0.05),
+        om.Capsule(hand + [-0.25, -0.3, -0.3], hand + [-0.25, 0.3, -0.3], 0.03),
+        om.Box([0.05, 0.05, 0.05], box_pose),
+    ]
+    return shapes[:count]
+
+
+def figure_eight(T_home: np.ndarray, k: int, ticks: int) -> np.ndarray:
+    """The target at tick k: a figure eight of 10 x 20 cm about the home hand, one lap."""
+    phase = 2.0 * math.pi * k / ticks
+    T = T_home.copy()
+    T[:3, 3] += [0.05 * math.sin(2.0 * phase), 0.1 * math.sin(phase), 0.03 * math.sin(3.0 * phase)]
+    return T
+
+
+def timed(call: Callable[[], object]) -> tuple[object, float, float]:
+    """call()'s result, wall and process CPU time (s)."""
+    wall, cpu = time.perf_counter(), time.process_time()
+    result = call()
+    return result, time.perf_counter() - wall, time.process_time() - cpu
+
+
+@dataclass
+class Run:
+    """One arm and obstacle count: times (ms) per tick and the quality counts."""
+
+    arm: str
+    obstacles: int
+    track_wall: np.ndarray
+    track_cpu: np.ndarray
+    om_wall: np.ndarray
+    om_cpu: np.ndarray
+    mink_wall: np.ndarray
+    mink_cpu: np.ndarray
+    not_exact: int
+    infeasible: int
+    flips: int
+    failed: int
+
+
+def run(name: str, count: int, ticks: int) -> Run:
+    solver = om.OMSolver(name)
+    arm = solver.arm
+    T_home = arm.fk(HOMES[name])
+    shapes = obstacles(T_home[:3, 3], count)
+
+    def optimizer() -> om.RedundancyOptimizer:
+        return om.RedundancyOptimizer(solver, shapes or None, min_clearance=MIN_CLEARANCE, max_step=MAX_STEP)
+
+    model = om.arm_model(arm)
+    frame = arm.frame_name
+    path = [figure_eight(T_home, k, ticks) for k in range(ticks)]
+
+    # tracking alone, with the quality checks
+    tracker = optimizer()
+    choice = tracker.choose(path[0])
+    walls, cpus = [], []
+    not_exact = infeasible = flips = failed = 0
+    for T in path[1:]:
+        previous = choice
+        choice, wall, cpu = timed(lambda T=T, previous=previous: tracker.choose(T, previous))
+        walls.append(wall)
+        cpus.append(cpu)
+        if not choice.ok:
+            failed += 1
+            choice = tracker.choose(T)
+            continue
+        flips += choice.branch_flipped
+        reached = arm.fk(choice.solution.q)
+        not_exact += np.linalg.norm(reached[:3, 3] - T[:3, 3]) > EXACT
+        infeasible += choice.margin < 0.0 or choice.clearance < MIN_CLEARANCE
+
+    # the mink loops, interleaved tick by tick
+    plain_conf, om_conf = mink.Configuration(model), mink.Configuration(model)
+    home = HOMES[name]
+    plain_conf.update(home.copy())
+    om_conf.update(home.copy())
+    plain_hand = mink.FrameTask(frame, "site", position_cost=1.0, orientation_cost=1.0, lm_damping=1.0)
+    posture = mink.PostureTask(model, cost=1e-2)
+    posture.set_target(home)
+    om_hand = mink.FrameTask(frame, "site", position_cost=1.0, orientation_cost=1.0, lm_damping=1.0)
+    exact = om.ExactPoseTask(solver, model, optimizer=optimizer())
+    plain_limits, om_limits = [mink.ConfigurationLimit(model)], [mink.ConfigurationLimit(model)]
+    exact.set_target(path[0])
+    exact.seed(om_conf)
+
+    def plain_tick(target: mink.SE3) -> None:
+        plain_hand.set_target(target)
+        v = mink.solve_ik(plain_conf, [plain_hand, posture], DT, SOLVER, damping=DAMPING, limits=plain_limits)
+        plain_conf.integrate_inplace(v, DT)
+
+    def om_tick(target: mink.SE3) -> None:
+        om_hand.set_target(target)
+        exact.set_target(target)
+        v = mink.solve_ik(om_conf, [om_hand, exact], DT, SOLVER, damping=DAMPING, limits=om_limits)
+        om_conf.integrate_inplace(v, DT)
+
+    times = {"om": ([], []), "mink": ([], [])}
+    for T in path[1:]:
+        target = mink.SE3.from_matrix(T)
+        for key, tick in (("mink", plain_tick), ("om", om_tick)):
+            _, wall, cpu = timed(lambda tick=tick: tick(target))
+            times[key][0].append(wall)
+            times[key][1].append(cpu)
+    ms = lambda x: np.array(x) * 1e3  # noqa: E731
+    return Run(
+        name,
+        count,
+        ms(walls),
+        ms(cpus),
+        ms(times["om"][0]),
+        ms(times["om"][1]),
+        ms(times["mink"][0]),
+        ms(times["mink"][1]),
+        not_exact,
+        infeasible,
+        flips,
+        failed,
+    )
+
+
+def global_times(name: str, poses: int, ticks: int) -> tuple[np.ndarray, np.ndarray]:
+    """Wall and CPU times (ms) of the global choose(T) with 3 obstacles on poses of the path."""
+    solver = om.OMSolver(name)
+    T_home = solver.arm.fk(HOMES[name])
+    optimizer = om.RedundancyOptimizer(solver, obstacles(T_home[:3, 3], 3), min_clearance=MIN_CLEARANCE)
+    walls, cpus = [], []
+    for k in np.linspace(0, ticks, poses, endpoint=False).astype(int):
+        T = figure_eight(T_home, int(k), ticks)
+        _, wall, cpu = timed(lambda T=T: optimizer.choose(T))
+        walls.append(wall)
+        cpus.append(cpu)
+    return np.array(walls) * 1e3, np.array(cpus) * 1e3
+
+
+def converged_gap(optimizer: om.RedundancyOptimizer, q: np.ndarray) -> tuple[float, float] | None:
+    """Tracking at pose fk(q) from q itself until psi stops moving, against the global
+    optimiser's climb (:func:`~om_redundant.redundancy.climb.maximise`) from the tracked
+    optimum on the same branch: (|psi gap|, value gain of the climb over the tracked value).
+    None where q is infeasible (outside the limits or too near an obstacle) or tracking
+    leaves it (the branch has nothing feasible within reach of q's psi)."""
+    solver = optimizer.solver
+    T, c = solver.arm.fk(q), solver.configuration_of(q)
+    solution = solver.solve(T, c, q_hint=q)
+    ev = optimizer.objective.evaluate(solution.q)
+    if not (solution.ok and ev.feasible):
+        return None
+    choice = RedundancyChoice(True, c, solution, ev.margin, ev.clearance, ev.value, ())
+    for _ in range(MAX_ITERATIONS):
+        step = optimizer.choose(T, choice)
+        if not step.ok or step.branch_flipped:
+            return None
+        moved = abs(math.remainder(step.configuration.redundancy[0] - choice.configuration.redundancy[0], 2 * math.pi))
+        choice = step
+        if moved <= CONVERGED:
+            break
+    probe = Probe(solver, optimizer.objective, T, choice.configuration.signs, wrapped=False)
+    start = probe.at(choice.configuration.redundancy[0], choice.solution.q)
+    climbed = maximise(probe, start, -math.inf, math.inf, optimizer.max_step)
+    gap = abs(math.remainder(climbed.psi - start.psi, 2 * math.pi))
+    return gap, climbed.evaluation.value - start.evaluation.value
+
+
+def quality(name: str, n: int, seed: int) -> tuple[int, int, float, float]:
+    """(poses checked, poses failing both bars, worst psi gap, worst value gain)."""
+    solver = om.OMSolver(name)
+    T_home = solver.arm.fk(HOMES[name])
+    optimizer = om.RedundancyOptimizer(solver, obstacles(T_home[:3, 3], 3), min_clearance=MIN_CLEARANCE)
+    rng = np.random.default_rng(seed)
+    checked = bad = 0
+    worst_gap = worst_gain = 0.0
+    for q in rng.uniform(solver.arm.lower, solver.arm.upper, (n, solver.arm.dof)):
+        result = converged_gap(optimizer, q)
+        if result is None:
+            continue
+        gap, gain = result
+        checked += 1
+        bad += gap > PSI_GAP and gain > VALUE_GAP
+        worst_gap, worst_gain = max(worst_gap, gap), max(worst_gain, gain)
+    return checked, bad, worst_gap, worst_gain
+
+
+def _stats(x: np.ndarray) -> str:
+    return f"{np.median(x):.3f} / {np.percentile(x, 99):.3f}"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--ticks", type=int, default=TICKS)
+    parser.add_argument("--quality", type=int, default=200, help="random poses per arm for the convergence check")
+    parser.add_argument("--globals", type=int, default=GLOBAL_POSES, help="poses timed for the global choose")
+    parser.add_argument("--seed", type=int, default=0)
+    args = parser.parse_args()
+    load = os.getloadavg()
+    rows, global_rows, quality_rows = [], [], []
+    for name in HOMES:
+        for count in (0, 1, 3):
+            r = run(name, count, args.ticks)
+            ratio_wall = np.median(r.om_wall) / np.median(r.mink_wall)
+            ratio_cpu = np.median(r.om_cpu) / np.median(r.mink_cpu)
+            rows.append(
+                f"| {name} | {count} | {_stats(r.track_wall)} | {_stats(r.track_cpu)} | {_stats(r.om_wall)} | "
+                f"{_stats(r.om_cpu)} | {_stats(r.mink_wall)} | {_stats(r.mink_cpu)} | {ratio_wall:.2f} | "
+                f"{ratio_cpu:.2f} | {r.not_exact} | {r.infeasible} | {r.flips} | {r.failed} |"
+            )
+            print(rows[-1], flush=True)
+        walls, cpus = global_times(name, args.globals, args.ticks)
+        global_rows.append(f"| {name} | {len(walls)} | {_stats(walls)} | {_stats(cpus)} |")
+        print(global_rows[-1], flush=True)
+        if args.quality:
+            checked, bad, gap, gain = quality(name, args.quality, args.seed)
+            quality_rows.append(f"| {name} | {args.quality} | {checked} | {bad} | {gap:.2e} | {gain:.2e} |")
+            print(quality_rows[-1], flush=True)
+    load_after = os.getloadavg()
+    text = "\n".join(
+        [
+            "# Redundancy resolution at control rate",
+            "",
+            f"CPU: {cpu_model()}; load average {load[0]:.1f} at the start, {load_after[0]:.1f} at the end. "
+            f"{args.ticks} ticks of dt = {DT * 1e3:.0f} ms, QP solver {SOLVER}, min_clearance {MIN_CLEARANCE} m, "
+            f"max_step {MAX_STEP} rad. Times in ms, median / p99; wall and process CPU.",
+            "",
+            "| arm | obstacles | tracking wall | tracking CPU | OM tick wall | OM tick CPU | mink tick wall | "
+            "mink tick CPU | OM / mink wall | OM / mink CPU | not exact | infeasible | flips | failed |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+            *rows,
+            "",
+            "Global `choose(T)`, 3 obstacles, poses of the path (ms, median / p99):",
+            "",
+            "| arm | poses | wall | CPU |",
+            "|---|---|---|---|",
+            *global_rows,
+            "",
+            f"Convergence (3 obstacles): tracking from q at fk(q) until psi moves < {CONVERGED} rad, then the "
+            f"global optimiser's climb from there; a pose fails if the climb moves psi > {PSI_GAP} rad and gains "
+            f"> {VALUE_GAP}.",
+            "",
+            "| arm | random poses | feasible, checked | failing | worst psi gap | worst value gain |",
+            "|---|---|---|---|---|---|",
+            *quality_rows,
+            "",
+        ]
+    )
+    write_page("control_rate.md", text)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,267 @@
+/* The redundancy optimiser's tracking step in one call (om_redundant/redundancy/tracking.py):
+ * the exact solve at the previous arm angle, the objective's pieces and their rates along
+ * the self-motion, the step of the 1-variable box QP, the exact solve at the new arm angle.
+ *
+ * Pieces v_j (normalised, see objective.py) in three groups g: the joint-limit margins
+ * (q_i - l_i)/h_i and (u_i - q_i)/h_i (floor 0, no cap), the clearances d_k/d_cap linearised
+ * about the joints where Python last evaluated them (floor d_min/d_cap, cap 1), the
+ * singularity distances |sin(q_j + c_j)|/s_cap (no floor, cap 1). Their rates
+ * a_j = dv_j/dq . dq/dpsi use the self-motion tangent dq/dpsi = n / (dpsi/dq . n), n the
+ * null vector of the 6 x 7 Jacobian J by cofactors, n_i = (-1)^i det J_{-i} (smooth in q, no
+ * factorisation to pick a sign). The step maximises the concave model
+ *     phi(d) = sum_g w_g min(cap_g, min_j v_j + a_j d) - b d^2 / 2
+ * over the box |d| <= radius intersected with the floors v_j + a_j d >= floor_g: phi's right
+ * derivative is non-increasing, and bisection on its sign gives the maximiser to rounding. */
+#include <string.h>
+
+#include "binding.h"
+
+enum { TR_OK = 0, TR_NO_SOLUTION = 1, TR_SINGULAR = 2, TR_INFEASIBLE = 3, TR_LOST = 4 };
+/* layout of the setup vector */
+enum {
+    S_PSI, S_WM, S_WC, S_WS, S_FLOOR_C, S_SING_CAP, S_MAX_STEP, S_CURVATURE, S_JOINT_STEP, S_N_SING, S_N_CLEAR,
+    S_HEAD
+};
+/* layout of the output vector after q (dof) */
+enum { O_PSI, O_STEP, O_CURVATURE, O_MARGIN, O_SINGULARITY, O_CLEARANCE, O_POS, O_ORI, O_EVALS, O_WITHIN, O_N };
+
+#define MAX_PIECES 512
+#define BISECTIONS 80
+#define HALVINGS 6
+#define MIN_CURVATURE 1e-3
+#define MAX_CURVATURE 1e3
+
+typedef struct {
+    int n, n_margin, n_clear, n_sing;
+    double v[MAX_PIECES], a[MAX_PIECES];
+    int group[MAX_PIECES];
+} pieces;
+
+typedef struct {
+    const om_solver_data *s;
+    const double *setup, *lower, *upper, *sing_joint, *sing_offset, *q_ref, *clear_d, *clear_g;
+    double weight[3], floor[3], cap[3];
+} tracking;
+
+/* det of the n x n matrix A (row-major, destroyed) by elimination with partial pivoting. */
+static double det(double *A, int n) {
+    double d = 1.0;
+    for (int k = 0; k < n; k++) {
+        int p = k;
+        for (int i = k + 1; i < n; i++)
+            if (fabs(A[i * n + k]) > fabs(A[p * n + k])) p = i;
+        if (A[p * n + k] == 0.0) return 0.0;
+        if (p != k) {
+            for (int j = 0; j < n; j++) {
+                double t = A[k * n + j];
+                A[k * n + j] = A[p * n + j];
+                A[p * n + j] = t;
+            }
+            d = -d;
+        }
+        d *= A[k * n + k];
+        for (int i = k + 1; i < n; i++) {
+            double f = A[i * n + k] / A[k * n + k];
+            for (int j = k; j < n; j++) A[i * n + j] -= f * A[k * n + j];
+        }
+    }
+    return d;
+}
+
+/* dq/dpsi at q into t (dof = 7); false where psi does not move along the self-motion. */
+static bool tangent(const om_solver_data *s, const double *q, double *t) {
+    static const double eye[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    double J[6 * 7], M[36], grad[7], n[7], scale = 0.0;
+    om_jacobian(s->real_table, s->n_real_rows, eye, eye, q, 7, J);
+    for (int c = 0; c < 7; c++) {
+        for (int i = 0; i < 6; i++)
+            for (int j = 0, k = 0; j < 7; j++)
+                if (j != c) M[i * 6 + k++] = J[i * 7 + j];
+        n[c] = (c % 2 ? -1.0 : 1.0) * det(M, 6);
+    }
+    om_arm_angle_gradient(s->params, s->model_table, s->n_model_rows, q, grad);
+    double dot = 0.0, gn = 0.0, nn = 0.0;
+    for (int i = 0; i < 7; i++) {
+        dot += grad[i] * n[i];
+        gn += grad[i] * grad[i];
+        nn += n[i] * n[i];
+    }
+    scale = sqrt(gn * nn);
+    if (!(fabs(dot) > 1e-9 * scale) || !isfinite(dot)) return false;
+    for (int i = 0; i < 7; i++) t[i] = n[i] / dot;
+    return true;
+}
+
+/* The pieces and their rates at q with tangent t. */
+static void pieces_at(const tracking *tr, const double *q, const double *t, pieces *P) {
+    const om_solver_data *s = tr->s;
+    int n = 0, dof = s->dof;
+    for (int i = 0; i < dof; i++) {
+        if (!(isfinite(tr->lower[i]) && isfinite(tr->upper[i]))) continue;
+        double h = (tr->upper[i] - tr->lower[i]) / 2.0;
+        P->v[n] = (q[i] - tr->lower[i]) / h, P->a[n] = t[i] / h, P->group[n++] = 0;
+        P->v[n] = (tr->upper[i] - q[i]) / h, P->a[n] = -t[i] / h, P->group[n++] = 0;
+    }
+    P->n_margin = n;
+    int n_clear = (int)tr->setup[S_N_CLEAR], n_sing = (int)tr->setup[S_N_SING];
+    for (int k = 0; k < n_clear; k++) {
+        const double *g = tr->clear_g + k * dof;
+        double v = tr->clear_d[k], a = 0.0;
+        for (int i = 0; i < dof; i++) v += g[i] * (q[i] - tr->q_ref[i]), a += g[i] * t[i];
+        P->v[n] = v, P->a[n] = a, P->group[n++] = 1;
+    }
+    for (int k = 0; k < n_sing; k++) {
+        int j = (int)tr->sing_joint[k];
+        double x = q[j] + tr->sing_offset[k], sn = sin(x), cap = tr->setup[S_SING_CAP];
+        P->v[n] = fabs(sn) / cap, P->a[n] = (sn < 0.0 ? -1.0 : 1.0) * cos(x) * t[j] / cap, P->group[n++] = 2;
+    }
+    P->n = n, P->n_clear = n_clear, P->n_sing = n_sing;
+}
+
+/* The right derivative of the model phi at d. */
+static double slope(const tracking *tr, const pieces *P, double b, double d) {
+    double low[3] = {INFINITY, INFINITY, INFINITY}, rate[3] = {0.0, 0.0, 0.0};
+    for (int j = 0; j < P->n; j++) {
+        int g = P->group[j];
+        double v = P->v[j] + P->a[j] * d;
+        if (v < low[g] || (v == low[g] && P->a[j] < rate[g])) low[g] = v, rate[g] = P->a[j];
+    }
+    double D = -b * d;
+    for (int g = 0; g < 3; g++)
+        if (low[g] < tr->cap[g] || (low[g] == tr->cap[g] && rate[g] < 0.0)) D += tr->weight[g] * rate[g];
+    return D;
+}
+
+/* The maximiser of the model over the box and the floors; false if they leave nothing. */
+static bool box_step(const tracking *tr, const pieces *P, double b, double radius, double *step) {
+    double lo = -radius, hi = radius;
+    for (int j = 0; j < P->n; j++) {
+        double floor = tr->floor[P->group[j]], a = P->a[j], gap = floor - P->v[j];
+        if (floor == -INFINITY) continue;
+        if (a > 0.0) lo = fmax(lo, gap / a);
+        else if (a < 0.0) hi = fmin(hi, gap / a);
+        else if (gap > 0.0) return false;
+    }
+    if (!(lo <= hi)) return false;
+    if (slope(tr, P, b, lo) <= 0.0) return *step = lo, true;
+    double left = lo, right = hi;
+    if (slope(tr, P, b, hi) >= 0.0) return *step = hi, true;
+    for (int k = 0; k < BISECTIONS && right - left > 0.0; k++) {
+        double mid = 0.5 * (left + right);
+        if (mid == left || mid == right) break;
+        if (slope(tr, P, b, mid) > 0.0) left = mid;
+        else right = mid;
+    }
+    *step = left; /* the right derivative is positive at left and not at right: the kink or stationary point */
+    return true;
+}
+
+/* Whether q1 (at psi + d) continues the self-motion from q0 with tangent t (paths.py's test);
+ * t NULL: only that no joint jumped. */
+static bool continues(int dof, const double *q0, const double *q1, const double *t, double d) {
+    double moved = 0.0, error = 0.0;
+    for (int i = 0; i < dof; i++) {
+        double m = q1[i] - q0[i];
+        moved = fmax(moved, fabs(m));
+        error = fmax(error, t ? fabs(m - t[i] * d) : 0.0);
+    }
+    return moved <= 1.0 && error <= 0.5 * moved + 1e-6;
+}
+
+static int track(const tracking *tr, const double *T, const int64_t *signs, const double *q_prev, double *q1,
+                 double *out) {
+    const om_solver_data *s = tr->s;
+    int dof = s->dof;
+    double psi = tr->setup[S_PSI], q0[OM_MAX_DOF], t0[OM_MAX_DOF], t1[OM_MAX_DOF];
+    om_result r = om_solve_one(s, T, signs, &psi, q_prev, q0);
+    if (r.status != OM_OK || !continues(dof, q_prev, q0, NULL, 0.0)) return TR_NO_SOLUTION;
+    if (!tangent(s, q0, t0)) return TR_SINGULAR;
+    static pieces P0, P1; /* (the GIL is held: one call at a time) */
+    pieces_at(tr, q0, t0, &P0);
+    double b = fmin(fmax(tr->setup[S_CURVATURE], MIN_CURVATURE), MAX_CURVATURE), tmax = 0.0;
+    for (int i = 0; i < dof; i++) tmax = fmax(tmax, fabs(t0[i]));
+    double radius = fmin(tr->setup[S_MAX_STEP], tr->setup[S_JOINT_STEP] / fmax(tmax, 1e-12)), d;
+    if (!box_step(tr, &P0, b, radius, &d)) return TR_INFEASIBLE;
+    double psi1 = psi + d;
+    for (int k = 0;; k++) {
+        psi1 = psi + d;
+        r = om_solve_one(s, T, signs, &psi1, q0, q1);
+        if (r.status == OM_OK && continues(dof, q0, q1, t0, d) && tangent(s, q1, t1)) break;
+        if (k == HALVINGS) return TR_LOST;
+        d /= 2.0;
+    }
+    pieces_at(tr, q1, t1, &P1);
+    /* b: the secant of each uncapped group's active piece's rate, weighted */
+    double low[3] = {INFINITY, INFINITY, INFINITY}, y = 0.0;
+    int active[3] = {-1, -1, -1};
+    for (int j = 0; j < P1.n; j++)
+        if (P1.v[j] < low[P1.group[j]]) low[P1.group[j]] = P1.v[j], active[P1.group[j]] = j;
+    for (int g = 0; g < 3; g++)
+        if (active[g] >= 0 && low[g] < tr->cap[g]) y += tr->weight[g] * (P1.a[active[g]] - P0.a[active[g]]);
+    if (fabs(d) > 1e-12 && isfinite(y)) b = fmin(fmax(-y / d, MIN_CURVATURE), MAX_CURVATURE);
+    double margin = INFINITY, sing = INFINITY, clear = INFINITY;
+    for (int j = 0; j < P1.n; j++) {
+        if (P1.group[j] == 0) margin = fmin(margin, P1.v[j]);
+        else if (P1.group[j] == 1) clear = fmin(clear, P1.v[j]);
+        else sing = fmin(sing, P1.v[j]);
+    }
+    double values[O_N] = {psi1, d, b, margin, sing, clear, r.position_error, r.orientation_error,
+                          (double)r.evaluations, r.within_limits};
+    memcpy(out, values, sizeof values);
+    return TR_OK;
+}
+
+/* track_step(solver, T, signs, q_prev, setup, lower, upper, sing_joint, sing_offset, q_ref, clear_d,
+ * clear_g, q_out, out) -> status: see tracking.py's TrackingWork for the layouts. */
+PyObject *om_track_step(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (nargs != 14) {
+        PyErr_Format(PyExc_TypeError, "track_step takes 14 arguments, got %zd", nargs);
+        return NULL;
+    }
+    if (!PyObject_TypeCheck(args[0], &om_SolverType)) {
+        PyErr_SetString(PyExc_TypeError, "track_step: solver must be a ckernels.Solver");
+        return NULL;
+    }
+    const om_solver_data *s = &((om_Solver *)args[0])->data;
+    if (s->family != OM_SRS || s->dof != 7) {
+        PyErr_SetString(PyExc_ValueError, "track_step: the solver must be a 7-DOF arm's (S-R-S model)");
+        return NULL;
+    }
+    Py_buffer v[13];
+    const struct {
+        int kind;
+        Py_ssize_t n;
+        int writable;
+        const char *name;
+    } sp[13] = {{F64, 16, 0, "T"},           {I64, s->n_signs, 0, "signs"}, {F64, 7, 0, "q_prev"},
+                {F64, -1, 0, "setup"},       {F64, 7, 0, "lower"},          {F64, 7, 0, "upper"},
+                {F64, -1, 0, "sing_joint"},  {F64, -1, 0, "sing_offset"},   {F64, 7, 0, "q_ref"},
+                {F64, -1, 0, "clear_d"},     {F64, -1, 0, "clear_g"},       {F64, 7, 1, "q_out"},
+                {F64, O_N, 1, "out"}};
+    int got = 0;
+    for (; got < 13; got++)
+        if (get_buffer(args[got + 1], &v[got], sp[got].kind, sp[got].n, sp[got].writable, sp[got].name) < 0) break;
+    int status = -1;
+    if (got == 13) {
+        const double *setup = v[3].buf;
+        Py_ssize_t n_sing = v[6].len / 8, n_clear = v[9].len / 8;
+        if (v[3].len < S_HEAD * 8 || setup[S_N_SING] != (double)n_sing || v[7].len != v[6].len ||
+            setup[S_N_CLEAR] != (double)n_clear || v[10].len != n_clear * 7 * 8 || 14 + n_clear + n_sing > MAX_PIECES)
+            PyErr_SetString(PyExc_ValueError, "track_step: sizes of setup, singularities and clearances disagree");
+        else {
+            tracking tr = {s, setup, v[4].buf, v[5].buf, v[6].buf, v[7].buf, v[8].buf, v[9].buf, v[10].buf,
+                           {setup[S_WM], setup[S_WC], setup[S_WS]}, {0.0, setup[S_FLOOR_C], -INFINITY},
+                           {INFINITY, 1.0, 1.0}};
+            status = track(&tr, v[0].buf, v[1].buf, v[2].buf, v[11].buf, v[12].buf);
+        }
+    }
+    for (int i = 0; i < got; i++) PyBuffer_Release(&v[i]);
+    return status < 0 ? NULL : PyLong_FromLong(status);
+}
+
+PyMethodDef om_tracking_functions[] = {
+    {"track_step", (PyCFunction)(void (*)(void))om_track_step, METH_FASTCALL,
+     "track_step(solver, T, signs, q_prev, setup, lower, upper, sing_joint, sing_offset, q_ref, clear_d, clear_g, "
+     "q_out, out) -> status"},
+    {NULL, NULL, 0, NULL},
+};

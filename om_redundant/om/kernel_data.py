@@ -1,0 +1,48 @@
+"""The fixed data of the compiled solver kernel for an arm and its model."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..kinematics.arm import Arm
+from . import system
+from .model import ModelArm
+
+
+def kernel_data(
+    arm: Arm, om: ModelArm, tolerances: tuple[float, float], scan_points: int
+) -> system.SolverData:
+    """The :class:`~om_redundant.om.system.SolverData` of ``ckernels.Solver`` for an arm
+    (``om.real``) and its closed-form model.
+
+    Args:
+        arm: The arm whose FK verifies every answer (``om.real``).
+        om: Its closed-form model (:func:`~om_redundant.om.model.derive_model`).
+        tolerances: Accepted position and orientation errors (m, rad).
+        scan_points: Grid points of the bounded search.
+    """
+    chain = arm.chain
+    if om.shoulder.any():  # dp turns with q1 and q7: the torus (q1, q7)
+        mode, dp_joint = system.TORUS, 0
+    elif om.dp_joint >= 0:
+        mode, dp_joint = system.CIRCLE, om.dp_joint
+    else:
+        mode, dp_joint = system.FIXED, 0
+    c = system.as_kernel_array
+    return system.SolverData(
+        family=int(om.family),
+        mode=mode,
+        params=c(om.params),
+        model_table=c(om.model.chain.table),
+        real_table=c(chain.table),
+        dp_joint=int(dp_joint),
+        dp_coefficients=c(np.vstack([om.delta, om.shoulder])),
+        T_base_root=c(np.linalg.inv(chain.T_root_base)),
+        T_tool_flange=c(np.linalg.inv(chain.T_flange_tool)),
+        revolute=np.ascontiguousarray(arm.revolute, dtype=np.bool_),
+        lower=c(arm.lower),
+        upper=c(arm.upper),
+        scan_points=scan_points,
+        position_tolerance=tolerances[0],
+        orientation_tolerance=tolerances[1],
+    )

@@ -1,0 +1,150 @@
+r"""The nominal arm: the closed-form structure an arm is NEAR, and the arm in its coordinates.
+
+Arms brought from CAD or from MuJoCo models miss the closed-form families by little:
+twists of 90 deg +- 4e-6 rad from rounded quaternions, a joint whose axis is reversed (a
+twist of 180 deg), fixed rows between joints. The nominal arm is the OM method's *model
+side* of such an arm:
+
+* every twist within :data:`NEAR_TWIST` of 0, +-90 or 180 deg is snapped to that value;
+* a twist of (about) 180 deg becomes 0 and the next joint flips: since
+  :math:`R_x(\pi) R_z(\theta + q) T_z(d) T_x(a) R_x(\alpha) =
+  R_z(-\theta - q) T_z(-d) T_x(a) R_x(\alpha + \pi) R_x(\pi)`, the half turn moves past the
+  row (to the tool at the end), the row's :math:`\theta, d` change sign and the joint's
+  nominal coordinate is :math:`q_n = -q`;
+* fixed rows before joint 1 go into the base; a fixed row that is a pure :math:`R_z T_z`
+  merges into the next row (:math:`\theta, d` add, they commute with the joint's motion),
+  one that is a pure :math:`T_x R_x` into the previous row (:math:`a, \alpha` add).
+
+The real arm keeps its exact table: :attr:`NominalArm.exact` is the same chain as the real
+arm's, only re-expressed in the nominal joint coordinates :math:`q_n = f \odot q`
+(:attr:`NominalArm.flip`, the half turns moved but not snapped), so its FK at :math:`q_n`
+is the real arm's at q. The solver (:mod:`om_redundant.om.near`) takes the nominal arm's
+closed-form roots as seeds and corrects the difference on the exact chain.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..exceptions import ModelError
+from ..kinematics.arm import Arm
+from ..kinematics.chain import DHRow, JointKind, KinematicChain, row_transform
+from .model import ModelArm, derive_model
+
+#: Largest deviation (rad) of a twist from 0, +-90 or 180 deg that the nominal arm snaps.
+NEAR_TWIST = 1e-3
+
+_HALF_TURN = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, -1.0, 0.0, 0.0], [0.0, 0.0, -1.0, 0.0], [0, 0, 0, 1.0]])
+
+
+@dataclass(frozen=True, eq=False)
+class NominalArm:
+    """An arm and the closed-form structure it is near.
+
+    Attributes:
+        real: The real arm.
+        arm: The nominal arm, in nominal joint coordinates (limits mapped).
+        exact: The real arm's chain in nominal joint coordinates (its FK at ``flip * q`` is
+            the real arm's at q).
+        flip: (dof,) +1, or -1 where a joint's axis is reversed.
+        differs: Whether the nominal arm's table differs from the real one.
+    """
+
+    real: Arm
+    arm: Arm
+    exact: KinematicChain
+    flip: np.ndarray
+    differs: bool
+
+
+def nominal_arm(arm: Arm) -> NominalArm:
+    """The nominal arm of a real arm (see the module)."""
+    exact, flip = _flipped(arm.chain, snap=False)
+    snapped, _ = _flipped(arm.chain, snap=True)
+    nominal = KinematicChain(tuple(_merged(list(snapped.rows))), snapped.T_root_base, snapped.T_flange_tool)
+    lower = np.where(flip < 0, -arm.upper, arm.lower)
+    upper = np.where(flip < 0, -arm.lower, arm.upper)
+    differs = (
+        nominal.table.shape != arm.chain.table.shape
+        or not np.array_equal(nominal.table, arm.chain.table)
+        or not np.array_equal(nominal.T_root_base, arm.chain.T_root_base)
+        or not np.array_equal(nominal.T_flange_tool, arm.chain.T_flange_tool)
+    )
+    model = Arm(arm.name, nominal, arm.joint_names, lower, upper, arm.description)
+    return NominalArm(arm, model, exact, flip, bool(differs))
+
+
+def closed_form(arm: Arm) -> tuple[ModelArm, NominalArm | None]:
+    """The closed-form model of an arm: of the arm itself where a family takes it exactly,
+    else of its nominal arm, returned too (None in the first case).
+
+    Raises:
+        ModelError: Neither the arm nor its nominal arm has a model; the message names what
+            stands in the way (in the nominal arm, where it differs from the arm).
+    """
+    try:
+        return derive_model(arm), None
+    except ModelError:
+        nominal = nominal_arm(arm)
+        if not nominal.differs:
+            raise
+    return derive_model(nominal.arm), nominal
+
+
+def _nearest_right_angle(alpha: float) -> float:
+    """The multiple of 90 deg nearest to alpha, in (-180, 180] deg."""
+    k = int(np.round(alpha / (np.pi / 2))) % 4
+    return (0.0, np.pi / 2, np.pi, -np.pi / 2)[k]
+
+
+def _off(alpha: float, nominal: float) -> float:
+    return abs(float(np.remainder(alpha - nominal + np.pi, 2 * np.pi) - np.pi))
+
+
+def _flipped(chain: KinematicChain, snap: bool) -> tuple[KinematicChain, np.ndarray]:
+    """Leading fixed rows into the base, half turns moved past the rows that follow them (the
+    joints flipped), twists snapped if ``snap``."""
+    rows = list(chain.rows)
+    base = chain.T_root_base.copy()
+    while rows and not rows[0].is_joint:
+        base = base @ row_transform(rows.pop(0))
+    out, flip, half_turn = [], [], False
+    for row in rows:
+        alpha = row.alpha
+        if half_turn:
+            row = DHRow(a=row.a, alpha=alpha + np.pi, d=-row.d, theta=-row.theta, kind=row.kind)
+        if row.is_joint:
+            flip.append(-1.0 if half_turn else 1.0)
+        nominal = _nearest_right_angle(row.alpha)
+        near = _off(row.alpha, nominal) <= NEAR_TWIST
+        half_turn = near and nominal == np.pi
+        if half_turn:
+            alpha = 0.0 if snap else row.alpha - np.pi
+        else:
+            alpha = nominal if snap and near else row.alpha
+        out.append(DHRow(a=row.a, alpha=alpha, d=row.d, theta=row.theta, kind=row.kind))
+    tool = _HALF_TURN @ chain.T_flange_tool if half_turn else chain.T_flange_tool
+    return KinematicChain(tuple(out), base, tool), np.array(flip)
+
+
+def _merged(rows: list[DHRow]) -> list[DHRow]:
+    """Fixed rows merged into their neighbours where the product allows it (see the module)."""
+    out: list[DHRow] = []
+    carry = DHRow(kind=JointKind.FIXED)  # a pure Rz Tz waiting for the next row
+    for row in rows:
+        row = DHRow(row.a, row.alpha, row.d + carry.d, row.theta + carry.theta, row.kind)
+        carry = DHRow(kind=JointKind.FIXED)
+        if row.is_joint:
+            out.append(row)
+        elif row.a == 0.0 and row.alpha == 0.0:
+            carry = row
+        elif row.d == 0.0 and row.theta == 0.0 and out:  # Tx and Rx commute
+            last = out[-1]
+            out[-1] = DHRow(last.a + row.a, last.alpha + row.alpha, last.d, last.theta, last.kind)
+        else:
+            out.append(row)
+    if carry.d != 0.0 or carry.theta != 0.0:
+        out.append(carry)
+    return out

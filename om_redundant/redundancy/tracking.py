@@ -1,0 +1,185 @@
+r"""The tracking step: the optimiser's choice for the next pose of a path in one compiled call.
+
+From the previous choice (branch signs, psi, joints q'), :func:`ckernels.track_step
+<om_redundant.ckernels>` (``csrc/tracking.c``) does, for the new pose T:
+
+1. the exact solution :math:`q_0` at the previous psi, hinted by :math:`q'`;
+2. the self-motion tangent :math:`t = dq/d\psi = n / (D\psi(q_0)\,n)`, n the null vector of
+   the Jacobian by cofactors, :math:`n_i = (-1)^i \det J_{-i}` (no factorisation);
+3. every piece :math:`v_j` of the objective (:mod:`om_redundant.redundancy.objective`) at
+   :math:`q_0` and its rate :math:`a_j = \nabla v_j \cdot t` -- the margins and the
+   singularity distances exactly, the clearances linearised about the joints where they were
+   last evaluated, :math:`d_k + \nabla d_k \cdot (q_0 - q_{ref})`;
+4. the step :math:`\delta` of the box QP in the N - 6 = 1 redundancy variable,
+
+   .. math::  \max_\delta\ \sum_g w_g \min\big(cap_g, \min_{j\in g} v_j + a_j\delta\big)
+              - \tfrac12 b\,\delta^2 \quad\text{s.t.}\quad v_j + a_j\delta \ge floor_g,
+              \ |\delta| \le \min(\Delta_{max}, 0.25 / |t|_\infty),
+
+   solved exactly (concave, its right derivative non-increasing: bisection on its sign,
+   to rounding), b the curvature carried from the previous step
+   (:attr:`RedundancyChoice.curvature`: the secant of the active pieces' rates);
+5. the exact solution at :math:`\psi + \delta`, hinted by :math:`q_0` and checked to
+   continue the self-motion (else :math:`\delta` is halved).
+
+Python then evaluates the clearance exactly at the new joints (for the feasibility check and
+as the next step's linearisation, :meth:`~om_redundant.Clearance.distances_within`), and the
+result is a :class:`~om_redundant.RedundancyChoice`. A step that cannot be taken (no exact
+solution, a fold of the self-motion, nothing feasible within the step, the result
+infeasible) answers None: the optimiser then takes its general path, which flips the
+branch or says why. Repeated at one pose the steps converge to a local optimum of the
+objective on the branch (a Newton-like iteration on the crossing of the active pieces).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+
+from .. import ckernels
+from ..om.configuration import Configuration
+from ..om.solver import OMSolver, Solution
+from .objective import SINGULARITY_CAP, Objective
+
+#: Curvature b of the first tracking step's model (per rad^2).
+INITIAL_CURVATURE = 0.1
+_JOINT_STEP = 0.25  # rad: the step keeps the linearised joint motion within this
+# setup vector layout (csrc/tracking.c)
+_PSI, _CURVATURE, _N_SETUP = 0, 7, 11
+# output layout after q (csrc/tracking.c)
+_O_PSI, _O_CURVATURE, _O_MARGIN, _O_SINGULARITY = 0, 2, 3, 4
+_O_POS, _O_ORI, _O_EVALS, _O_WITHIN, _N_OUT = 6, 7, 8, 9, 10
+
+
+class TrackingWork(NamedTuple):
+    """The arrays ``ckernels.track_step`` reads and writes, set up once per optimiser.
+
+    Attributes:
+        setup: psi, w_m, w_c, w_s, d_min/d_cap, s_cap, max_step, curvature, joint step,
+            number of singularities, number of clearance pairs.
+        lower, upper: (7,) joint limits (inf: not limited).
+        singular_joints, singular_offsets: (k,) the singularities' joints (as floats) and
+            constants (:class:`~om_redundant.Singularity`).
+        clearance_at: (7,) joints where the clearances were evaluated.
+        clearance_values: (P,) clearances there over d_cap.
+        clearance_gradients: (P, 7) their gradients over d_cap.
+        q: (7,) the new joints (output).
+        out: the step's results (output).
+    """
+
+    setup: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+    singular_joints: np.ndarray
+    singular_offsets: np.ndarray
+    clearance_at: np.ndarray
+    clearance_values: np.ndarray
+    clearance_gradients: np.ndarray
+    q: np.ndarray
+    out: np.ndarray
+
+
+class Tracker:
+    """The tracking step of one optimiser (module docstring).
+
+    Args:
+        solver: The solver of a 7-DOF arm.
+        objective: The optimiser's objective.
+        max_step: Largest psi change per step (rad).
+    """
+
+    def __init__(self, solver: OMSolver, objective: Objective, max_step: float):
+        self.solver, self.objective = solver, objective
+        sing, clearance = objective.singularity, objective.clearance
+        n_sing = 0 if sing is None or objective.singularity_weight == 0.0 else len(sing.joints)
+        n_pairs = 0 if clearance is None else len(clearance.pairs)
+        setup = np.zeros(_N_SETUP)
+        setup[1:_N_SETUP] = (
+            objective.margin_weight,
+            objective.clearance_weight,
+            objective.singularity_weight,
+            objective.min_clearance / objective.clearance_cap,
+            SINGULARITY_CAP,
+            max_step,
+            INITIAL_CURVATURE,
+            _JOINT_STEP,
+            n_sing,
+            n_pairs,
+        )
+        arm = solver.arm
+        self.work = TrackingWork(
+            setup,
+            np.ascontiguousarray(arm.lower, dtype=float),
+            np.ascontiguousarray(arm.upper, dtype=float),
+            np.array(sing.joints[:n_sing] if n_sing else [], dtype=float),
+            np.array(sing.offsets[:n_sing] if n_sing else [], dtype=float),
+            np.zeros(arm.dof),
+            np.zeros(n_pairs),
+            np.zeros((n_pairs, arm.dof)),
+            np.zeros(arm.dof),
+            np.zeros(_N_OUT),
+        )
+        self._kernel = solver.kernel
+        self._reach = 2.0 * objective.clearance_cap  # capped pieces beyond it change nothing
+        self._last: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # q, values, gradients
+
+    def step(
+        self, T: np.ndarray, signs: tuple[int, ...], psi: float, q: np.ndarray, curvature: float
+    ) -> tuple[Solution, float, float, float, float, float] | None:
+        """One tracking step from (signs, psi, q) to pose T.
+
+        Returns:
+            (solution, psi, margin, clearance, value, curvature) at the new psi, or None when
+            the step cannot be taken or lands on an infeasible point (module docstring).
+        """
+        work, objective = self.work, self.objective
+        work.setup[_PSI] = psi
+        work.setup[_CURVATURE] = curvature if math.isfinite(curvature) else INITIAL_CURVATURE
+        if objective.clearance is not None:
+            self._linearise_at(q)
+        status = ckernels.track_step(
+            self._kernel, T, np.asarray(signs, dtype=np.int64), q, *work[:-2], work.q, work.out
+        )
+        if status != 0:
+            return None
+        out, q_new = work.out, work.q.copy()
+        margin = out[_O_MARGIN]
+        clearance = math.inf
+        value = objective.margin_weight * margin if math.isfinite(margin) else 0.0
+        if work.singular_joints.size:
+            value += objective.singularity_weight * min(1.0, out[_O_SINGULARITY])
+        if objective.clearance is not None:
+            d, grad = objective.clearance.distances_within(q_new, self._reach, gradient=True)
+            self._last = (q_new, d, grad)
+            clearance = float(d.min())
+            value += objective.clearance_weight * min(1.0, clearance / objective.clearance_cap)
+        if not (margin >= 0.0 and clearance >= objective.min_clearance):
+            return None
+        psi_new = math.remainder(out[_O_PSI], 2.0 * math.pi)
+        configuration = Configuration(signs, (-math.pi if psi_new >= math.pi else psi_new,))
+        solution = Solution(
+            q_new,
+            True,
+            "ok",
+            configuration,
+            out[_O_POS],
+            out[_O_ORI],
+            int(out[_O_EVALS]),
+            bool(out[_O_WITHIN]),
+        )
+        return solution, out[_O_PSI], margin, clearance, value, out[_O_CURVATURE]
+
+    def _linearise_at(self, q: np.ndarray) -> None:
+        """The clearances and their gradients at q, over d_cap, into the work arrays (those
+        of the last step's result when q is its joints)."""
+        last = self._last
+        if last is None or not np.array_equal(last[0], q):
+            d, grad = self.objective.clearance.distances_within(q, self._reach, gradient=True)
+            last = (q, d, grad)
+        cap = self.objective.clearance_cap
+        work = self.work
+        work.clearance_at[:] = last[0]
+        np.divide(last[1], cap, out=work.clearance_values)
+        np.divide(last[2], cap, out=work.clearance_gradients)
