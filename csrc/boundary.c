@@ -5,10 +5,10 @@
 #include "om_system.h"
 
 #define NEAR_BOUNDARY 1e-2 /* |branch quantity| under which a failed candidate is polished */
-#define POLISH_STEPS 40    /* Jacobians per refinement: 2-4 at a simple root, more at a double one */
+#define POLISH_STEPS 100   /* Jacobians per refinement: 2-4 at a simple root, more at a double one */
 #define SHOULDER_SIGN 0    /* (SHOULDER or ARM, ELBOW, WRIST) in every family */
 #define ELBOW_SIGN 1
-#define SHOULDER_STARTS 8  /* starts of q1 where the wrist centre is on joint 1's axis */
+#define SPLIT_STARTS 16    /* starts of q1 (wrist centre on joint 1's axis) or of the aligned wrist's split */
 #define GATE_POINTS 8      /* free-angle samples of the cheap test before a neighbour's search */
 #define GATE_NEAR 0.2      /* |branch quantity| at a sample that lets a neighbour be searched */
 
@@ -41,16 +41,29 @@ bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori)
     om_polish(&t, POLISH_STEPS, q);
     if (om_verify(pb, q, pos, ori))
         return true;
-    if (branch != SHOULDER_SIGN)
+    if (branch == ELBOW_SIGN)
         return false;
     /* The wrist centre on joint 1's axis: the model's q1 is arbitrary there (atan2 of a
-     * vanishing pair), the real arm's is not. Starts around the circle of q1. */
-    for (int k = 1; k < SHOULDER_STARTS; k++) {
-        memcpy(q, start, (size_t)s->dof * sizeof(double));
-        q[0] = start[0] + 2.0 * OM_PI * (double)k / (double)SHOULDER_STARTS;
-        om_polish(&t, POLISH_STEPS, q);
-        if (om_verify(pb, q, pos, ori))
-            return true;
+     * vanishing pair), the real arm's is not: starts around the circle of q1. The wrist
+     * aligned (its middle joint m = dof - 2 at zero): the model splits q_{m-1} +- q_{m+1}
+     * by the previous q, the real arm's offsets do not: starts that turn q_{m-1} by a and
+     * q_{m+1} by -+a (the model's pose kept for either alignment of the two axes). */
+    bool shoulder = branch == SHOULDER_SIGN;
+    int m = s->dof - 2;
+    for (int k = 1; k < SPLIT_STARTS; k++) {
+        double a = 2.0 * OM_PI * (double)k / (double)SPLIT_STARTS;
+        for (int turn = shoulder ? 0 : -1; turn <= (shoulder ? 0 : 1); turn += 2) {
+            memcpy(q, start, (size_t)s->dof * sizeof(double));
+            if (shoulder) {
+                q[0] += a;
+            } else {
+                q[m - 1] += a;
+                q[m + 1] += (double)turn * a;
+            }
+            om_polish(&t, POLISH_STEPS, q);
+            if (om_verify(pb, q, pos, ori))
+                return true;
+        }
     }
     return false;
 }
@@ -114,6 +127,10 @@ static int touch_points(om_problem *pb, bool *near, double *roots)
         if (nearest < NEAR_BOUNDARY) {
             if (s->mode == OM_CIRCLE)
                 q[s->dp_joint] = w;
+            count = om_add_candidate(pb, q, roots, count);
+        }
+        if (s->mode == OM_CIRCLE) { /* the local solve from this sample, as a hint there would start it */
+            om_secant(pb, w, q);
             count = om_add_candidate(pb, q, roots, count);
         }
     }

@@ -246,6 +246,11 @@ int om_band_roots(om_problem *pb, double *roots, bool *neighbour_reached);
 
 /* search.c */
 int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre, double radius);
+/* The paper's fixed-point start p_m = p_d: the model's IK at the target into start; where
+ * p_d is outside the model's reach, the elbow held at the edge of reach (S-R-S) or the point
+ * of the dp circle the model reaches with the smallest residual (q: scratch, dof). Returns
+ * whether there is a start. */
+bool om_fixed_point_start(om_problem *pb, double *q, double *start);
 bool om_local_solve(om_problem *pb, const double *start, double *q, double *pos, double *ori);
 bool om_exists_other(om_problem *pb, bool skip_neighbours);
 bool om_nearest_in_window(om_problem *pb, const double *hint, double *q);
