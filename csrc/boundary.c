@@ -11,6 +11,7 @@
 #define SPLIT_STARTS 16    /* starts of q1 (wrist centre on joint 1's axis) or of the aligned wrist's split */
 #define GATE_POINTS 8      /* free-angle samples of the cheap test before a neighbour's search */
 #define GATE_NEAR 0.2      /* |branch quantity| at a sample that lets a neighbour be searched */
+#define DIP_STEPS 40       /* golden-section steps to a dip's bottom: (0.618)^40 of a cell, 1e-8 */
 
 /* The smallest |branch quantity| of q and its index (NaN-safe: INFINITY for NaN). */
 static double nearest_branch(const om_solver_data *s, const double *q, int *index)
@@ -94,6 +95,55 @@ static om_problem neighbour(const om_problem *pb, int i, int64_t *signs, double 
     return other;
 }
 
+/* |branch quantity i| of the model's solution at free angle w (INFINITY out of reach); q gets it. */
+static double branch_at(om_problem *pb, int i, double w, double *q)
+{
+    double v[3];
+    if (om_model_ik_at(pb, w, q, true) < -OM_REACH_SLACK)
+        return INFINITY;
+    om_branch_values(pb->s->family, pb->s->params, q, v);
+    return isnan(v[i]) ? INFINITY : fabs(v[i]);
+}
+
+/* A dip of branch i between samples: where the model's branch quantity comes near zero, q_J
+ * swings and g has its narrow features (a close pair of roots inside one cell of the scan,
+ * a steep crossing). From a sample where |b_i| is a local minimum among the samples, golden
+ * section on [w - h, w + h] finds the dip's bottom w*; there the model's solution is refined
+ * on the real arm and the secant starts. Returns the root count. */
+static int dip_roots(om_problem *pb, int i, double w, double h, double *roots, int count)
+{
+    const double ratio = 0.6180339887498949;
+    double q[OM_MAX_DOF], a = w - h, b = w + h;
+    double c = b - ratio * (b - a), d = a + ratio * (b - a);
+    double fc = branch_at(pb, i, c, q), fd = branch_at(pb, i, d, q);
+    for (int it = 0; it < DIP_STEPS; it++) {
+        if (fc < fd) {
+            b = d;
+            d = c;
+            fd = fc;
+            c = b - ratio * (b - a);
+            fc = branch_at(pb, i, c, q);
+        } else {
+            a = c;
+            c = d;
+            fc = fd;
+            d = a + ratio * (b - a);
+            fd = branch_at(pb, i, d, q);
+        }
+    }
+    double bottom = fc < fd ? c : d;
+    if (!(branch_at(pb, i, bottom, q) < NEAR_BOUNDARY))
+        return count;
+    if (pb->s->mode == OM_CIRCLE)
+        q[pb->s->dp_joint] = bottom;
+    double start[OM_MAX_DOF], pos, ori;
+    memcpy(start, q, (size_t)pb->s->dof * sizeof(double));
+    count = om_add_candidate(pb, q, roots, count);
+    if (om_local_solve(pb, start, q, &pos, &ori)) /* as a hint at the bottom would */
+        count = om_add_root(pb, q, roots, count);
+    return count;
+}
+
 /* Touch points: GATE_POINTS samples of the free angle w in the problem's own configuration.
  * Where the model's solution has a branch quantity within NEAR_BOUNDARY of zero, it is a
  * candidate from the crossing (q_J = w), refined and verified into roots (a singular wrist
@@ -132,6 +182,15 @@ static int touch_points(om_problem *pb, bool *near, double *roots)
         if (s->mode == OM_CIRCLE) { /* the local solve from this sample, as a hint there would start it */
             om_secant(pb, w, q);
             count = om_add_candidate(pb, q, roots, count);
+        }
+    }
+    for (int i = 0; i < s->n_signs && points > 1; i++) { /* the dips between samples */
+        for (int k = 0; k < points; k++) {
+            double v = fabs(values[k][i]), before = fabs(values[(k + points - 1) % points][i]);
+            double after = fabs(values[(k + 1) % points][i]);
+            if (v <= (isnan(before) ? INFINITY : before) && v <= (isnan(after) ? INFINITY : after)) /* not NaN */
+                count = dip_roots(pb, i, -OM_PI + 2.0 * OM_PI * (double)k / (double)points, 2.0 * OM_PI / points,
+                                  roots, count);
         }
     }
     bool seen = false; /* no sample within reach: nothing known, every neighbour is searched */
