@@ -9,9 +9,10 @@
 #define SHOULDER_SIGN 0    /* (SHOULDER or ARM, ELBOW, WRIST) in every family */
 #define ELBOW_SIGN 1
 #define SPLIT_STARTS 16    /* starts of q1 (wrist centre on joint 1's axis) or of the aligned wrist's split */
+#define SPLIT_NEAR 1e-6    /* |branch quantity| under which the model's split is arbitrary: SPLIT_STARTS */
 #define GATE_POINTS 8      /* free-angle samples of the cheap test before a neighbour's search */
 #define GATE_NEAR 0.2      /* |branch quantity| at a sample that lets a neighbour be searched */
-#define DIP_STEPS 40       /* golden-section steps to a dip's bottom: (0.618)^40 of a cell, 1e-8 */
+#define DIP_STEPS 24       /* golden-section steps to a dip's bottom: 0.618^24 of two cells, 1e-5 rad */
 
 /* The smallest |branch quantity| of q and its index (NaN-safe: INFINITY for NaN). */
 static double nearest_branch(const om_solver_data *s, const double *q, int *index)
@@ -31,7 +32,8 @@ bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori)
 {
     const om_solver_data *s = pb->s;
     int branch = -1;
-    if (!(nearest_branch(s, q, &branch) < NEAR_BOUNDARY))
+    double nearest = nearest_branch(s, q, &branch);
+    if (!(nearest < NEAR_BOUNDARY))
         return false;
     bool srs = s->family == OM_SRS;
     om_polish_task t = {s->real_table, s->n_real_rows, s->dof, srs ? s->params : NULL,
@@ -42,7 +44,7 @@ bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori)
     om_polish(&t, POLISH_STEPS, q);
     if (om_verify(pb, q, pos, ori))
         return true;
-    if (branch == ELBOW_SIGN)
+    if (branch == ELBOW_SIGN || (branch != SHOULDER_SIGN && !(nearest < SPLIT_NEAR)))
         return false;
     /* The wrist centre on joint 1's axis: the model's q1 is arbitrary there (atan2 of a
      * vanishing pair), the real arm's is not: starts around the circle of q1. The wrist
@@ -138,7 +140,6 @@ static int dip_roots(om_problem *pb, int i, double w, double h, double *roots, i
         q[pb->s->dp_joint] = bottom;
     double start[OM_MAX_DOF], pos, ori;
     memcpy(start, q, (size_t)pb->s->dof * sizeof(double));
-    count = om_add_candidate(pb, q, roots, count);
     if (om_local_solve(pb, start, q, &pos, &ori)) /* as a hint at the bottom would */
         count = om_add_root(pb, q, roots, count);
     return count;
