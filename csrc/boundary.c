@@ -139,8 +139,9 @@ static int dip_roots(om_problem *pb, int i, double w, double h, double *roots, i
     if (pb->s->mode == OM_CIRCLE)
         q[pb->s->dp_joint] = bottom;
     double start[OM_MAX_DOF], pos, ori;
+    bool complete = true;
     memcpy(start, q, (size_t)pb->s->dof * sizeof(double));
-    if (om_local_solve(pb, start, q, &pos, &ori)) /* as a hint at the bottom would */
+    if (om_local_solve(pb, start, &complete, q, &pos, &ori)) /* as a hint at the bottom would */
         count = om_add_root(pb, q, roots, count);
     return count;
 }

@@ -110,6 +110,21 @@ static int _run_roots(om_problem *pb, const double *pw, const double *pg, int L,
     return n;
 }
 
+/* Whether the model may reach some point of the cell [ws[i], ws[i + 1]] (both ends out of
+ * reach): on an S-R-S arm by a bound (om_srs_reach_possible); otherwise where the margin,
+ * which can peak between the ends by about half its change across a cell, could reach zero. */
+static bool _island_possible(om_problem *pb, const double *ws, const double *ms, int i, int count)
+{
+    if (pb->s->family == OM_SRS)
+        return om_srs_reach_possible(pb, ws[i], ws[i + 1]);
+    double change = fabs(ms[i + 1] - ms[i]);
+    if (i > 0)
+        change = py_max(change, fabs(ms[i] - ms[i - 1]));
+    if (i + 2 < count)
+        change = py_max(change, fabs(ms[i + 2] - ms[i + 1]));
+    return py_max(ms[i], ms[i + 1]) + change > 0.0;
+}
+
 /* Candidate roots of g on [lo, hi] (the whole circle if full_circle) into cands (capacity
  * cap); returns the count. g and the reach margin are sampled at n_pts points; runs of
  * reach (extended to its edges) and islands of reach between samples are searched. */
@@ -178,15 +193,9 @@ int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool f
             L = 0;
         }
         if (i + 1 < count && isnan(gs[i + 1])) {
-            /* Both ends of this cell are out of reach. The margin can peak between them by
-             * about half its change across a cell; if that could reach zero, look for an
-             * island of reach. */
-            double change = fabs(ms[i + 1] - ms[i]);
-            if (i > 0)
-                change = py_max(change, fabs(ms[i] - ms[i - 1]));
-            if (i + 2 < count)
-                change = py_max(change, fabs(ms[i + 2] - ms[i + 1]));
-            if (py_max(ms[i], ms[i + 1]) + change > 0.0) {
+            /* Both ends of this cell are out of reach: look for an island of reach between
+             * them where the model may reach. */
+            if (_island_possible(pb, ws, ms, i, count)) {
                 double gc;
                 double c = om_extremum(pb, w, ws[i + 1], 0.5 * (w + ws[i + 1]), 1.0, true, q, &gc, NULL);
                 if (!isnan(gc)) { /* an island of reach around c */

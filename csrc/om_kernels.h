@@ -100,9 +100,13 @@ void om_six_dof_target(const double *P, om_target *t); /* fills RE and wrist fro
 /* With shoulder false, joints 1-3 are not written. Returns the reach margin 1 - x^2. */
 double om_srs_model_ik(const double *P, const om_target *t, vec3 p, const int64_t *signs, const double *q_prev,
                        double *q, bool shoulder);
+/* The reach margin of om_srs_model_ik alone (the same arithmetic) and, unless W = S, the elbow's x. */
+double om_srs_reach(const double *P, const om_target *t, vec3 p, double *x);
 /* q7 alone (q[6]; the rest of q untouched), for the circle residual. Returns the margin. */
 double om_srs_model_q7(const double *P, const om_target *t, vec3 p, const int64_t *signs, const double *q_prev,
                        double *q);
+bool om_srs_model_q7_at_reach(const double *P, const om_target *t, vec3 p, const int64_t *signs,
+                              const double *q_prev, double *q);
 bool om_srs_model_ik_at_reach(const double *P, const om_target *t, vec3 p, const int64_t *signs,
                               const double *q_prev, double *q);
 /* phi4 NaN: the elbow equation's root in the ELBOW branch. Returns (shoulder, wrist, elbow) residuals. */
@@ -172,6 +176,10 @@ vec3 om_delta(const double D[6][3], double w);
 double om_model_ik_at(om_problem *pb, double w, double *q, bool all_joints); /* returns the reach margin */
 double om_g_margin(om_problem *pb, double w, double *q, bool all_joints, double *margin); /* g (NaN out of reach) */
 double om_g(om_problem *pb, double w, double *q, bool all_joints);
+/* om_g_margin's margin alone (S-R-S: no joint solved, not counted). */
+double om_reach_margin(om_problem *pb, double w, double *q);
+/* S-R-S: whether the model may reach the circle's points somewhere in [a, b] (a bound; see residual.c). */
+bool om_srs_reach_possible(om_problem *pb, double a, double b);
 vec3 om_lifted_residual(om_problem *pb, vec3 x, double *q);
 vec3 om_deflated_residual(om_problem *pb, vec3 x, double *q, const double *known, int n_known); /* known: n x 3 */
 double om_max_norm(vec3 F);
@@ -180,6 +188,8 @@ double om_wrist_residual(om_problem *pb, double w, double *q);
 
 /* scalar.c */
 double om_secant(om_problem *pb, double w0, double *q);
+/* om_secant from w0 or, out of the model's reach there, the nearest reachable probe around the circle. */
+double om_secant_in_reach(om_problem *pb, double w0, double *q);
 double om_refine_bracket(om_problem *pb, double a, double ga, double b, double gb, double *q);
 double om_reach_edge(om_problem *pb, double inside, double outside, double *q);
 /* The secant on om_wrist_residual from w0; returns |residual| at the end. */
@@ -246,12 +256,15 @@ int om_band_roots(om_problem *pb, double *roots, bool *neighbour_reached);
 
 /* search.c */
 int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre, double radius);
-/* The paper's fixed-point start p_m = p_d: the model's IK at the target into start; where
- * p_d is outside the model's reach, the elbow held at the edge of reach (S-R-S) or the point
- * of the dp circle the model reaches with the smallest residual (q: scratch, dof). Returns
- * whether there is a start. */
+/* The fixed-point start: where only q_J of it is known (*complete false), every joint of the
+ * model IK at p_m = p_d (S-R-S: at the edge of reach beyond it) into start. */
+void om_complete_start(om_problem *pb, double *start, bool *complete);
+/* The paper's fixed-point start p_m = p_d, every joint: the model's IK at the target into
+ * start; where p_d is outside the model's reach, the elbow held at the edge of reach (S-R-S)
+ * or the point of the dp circle the model reaches with the smallest residual (q: scratch,
+ * dof). Returns whether there is a start. */
 bool om_fixed_point_start(om_problem *pb, double *q, double *start);
-bool om_local_solve(om_problem *pb, const double *start, double *q, double *pos, double *ori);
+bool om_local_solve(om_problem *pb, double *start, bool *start_complete, double *q, double *pos, double *ori);
 bool om_exists_other(om_problem *pb, bool skip_neighbours);
 bool om_nearest_in_window(om_problem *pb, const double *hint, double *q);
 

@@ -2,6 +2,8 @@
  * (the method: om_redundant/om/system.py). Each evaluation counts in pb->counter. */
 #include "om_system.h"
 
+#define REACH_BOUND_SLACK 1e-9 /* of the elbow's x, for rounding (x itself is rounded to about 1e-16) */
+
 /* dp seen from the flange, delta(w) = D0 + D1 cos w + D2 sin w (rows 0-2 of D). */
 vec3 om_delta(const double D[6][3], double w)
 {
@@ -10,15 +12,21 @@ vec3 om_delta(const double D[6][3], double w)
               D[0][2] + D[1][2] * c + D[2][2] * s);
 }
 
-/* The model's hand position on the circle, p_m = p_d + R delta(w); counts one evaluation. */
-static vec3 circle_point(om_problem *pb, double w)
+/* The model's hand position on the circle, p_m = p_d + R delta(w). */
+static vec3 on_circle(const om_problem *pb, double w)
 {
-    pb->counter++;
     vec3 d = om_delta(pb->s->D, w);
     const mat3 *R = &pb->t.R;
     vec3 p = pb->p;
     return v3(p.x + R->r0.x * d.x + R->r0.y * d.y + R->r0.z * d.z, p.y + R->r1.x * d.x + R->r1.y * d.y + R->r1.z * d.z,
               p.z + R->r2.x * d.x + R->r2.y * d.y + R->r2.z * d.z);
+}
+
+/* on_circle, counted as one residual evaluation. */
+static vec3 circle_point(om_problem *pb, double w)
+{
+    pb->counter++;
+    return on_circle(pb, w);
 }
 
 /* Model IK for p_m = p_d + R delta(w), one residual evaluation; returns the reach margin
@@ -59,6 +67,49 @@ double om_g_margin(om_problem *pb, double w, double *q, bool all_joints, double 
     if (fixed)
         return 0.0;
     return om_wrap(q[pb->s->dp_joint] - w);
+}
+
+/* The reach margin of om_g_margin alone: on an S-R-S arm no joint is solved for it (not a
+ * residual evaluation, not counted); on the others it is om_g_margin's (q written). */
+double om_reach_margin(om_problem *pb, double w, double *q)
+{
+    if (pb->s->family == OM_SRS) {
+        double x;
+        return om_srs_reach(pb->s->params, &pb->t, on_circle(pb, w), &x);
+    }
+    double margin;
+    om_g_margin(pb, w, q, false, &margin);
+    return margin;
+}
+
+/* Whether an S-R-S model may reach p_d + R delta(w) for some w in [a, b], where it reaches
+ * neither end: the elbow's x(w) = (L2(w) - k0) / K must come within [-1, 1]. With e = p_d +
+ * R D0 + R w_F - S, u1 = R D1, u2 = R D2, L2(w) = |e + u1 cos w + u2 sin w|^2 = c0 + a1 cos w
+ * + b1 sin w + a2 cos 2w + b2 sin 2w (a1 = 2 e.u1, b1 = 2 e.u2, a2 = (|u1|^2 - |u2|^2) / 2,
+ * b2 = u1.u2), so |x''| <= (|(a1, b1)| + 4 |(a2, b2)|) / K, and x stays within
+ * (b - a)^2 / 8 times that of the chord through its ends: a proof that no island of reach
+ * lies between two samples, without searching. */
+bool om_srs_reach_possible(om_problem *pb, double a, double b)
+{
+    const double *P = pb->s->params;
+    const double(*D)[3] = pb->s->D;
+    const mat3 *R = &pb->t.R;
+    double xa = NAN, xb = NAN;
+    om_srs_reach(P, &pb->t, on_circle(pb, a), &xa);
+    om_srs_reach(P, &pb->t, on_circle(pb, b), &xb);
+    if (isnan(xa) || isnan(xb)) /* W = S at an end */
+        return true;
+    vec3 e = v_add(v_add(pb->p, pb->t.wrist), m_mv(*R, v_load(D[0], 0)));
+    vec3 u1 = m_mv(*R, v_load(D[1], 0)), u2 = m_mv(*R, v_load(D[2], 0));
+    double a1 = 2.0 * v_dot(e, u1), b1 = 2.0 * v_dot(e, u2);
+    double a2 = 0.5 * (v_dot(u1, u1) - v_dot(u2, u2)), b2 = v_dot(u1, u2);
+    double curvature = (sqrt(a1 * a1 + b1 * b1) + 4.0 * sqrt(a2 * a2 + b2 * b2)) / P[SRS_K];
+    double sag = 0.125 * (b - a) * (b - a) * curvature + REACH_BOUND_SLACK;
+    if (xa > 1.0 && xb > 1.0)
+        return py_min(xa, xb) - sag <= 1.0;
+    if (xa < -1.0 && xb < -1.0)
+        return py_max(xa, xb) + sag >= -1.0;
+    return true;
 }
 
 /* Residual g(w) of the reduced system, NaN if unreachable (see om_g_margin). */

@@ -3,16 +3,44 @@
 #include "om_system.h"
 
 #define LAST_STEP 1e-5 /* a secant step (rad) below which the next iterate is evaluated with every joint */
+#define REACH_PROBES 8 /* probes each way around the circle for a reachable first point */
+#define BACKTRACK 4    /* halvings of a secant step that leaves the model's reach */
+#define STALL 4        /* secant steps in a row without PROGRESS after which it gives up */
+#define PROGRESS 0.9   /* the factor by which a step must lower the least |g| so far */
+
+static double _secant_from(om_problem *pb, double w0, double g0, double *q);
 
 /* The secant (1-D Broyden) method from w0. Its first step is one of the fixed-point
  * iteration of system (9), w <- q_J(w) = w + g(w) (the secant with slope -1: g' = -1 +
  * dq_J/dw, and q_J turns little with w where dp is small against the arm); where that step
- * does not halve |g|, the secant starts again from w0 with a finite-difference slope. It stops
- * before a step below rounding. Returns |g| at the end, q holding the model IK (every joint)
- * at the last iterate. */
+ * does not halve |g|, the secant starts again from w0 with a finite-difference slope. A step
+ * that leaves the model's reach is halved (BACKTRACK times at most). It stops before a step
+ * below rounding, and gives up after STALL steps without PROGRESS (g near an extremum that
+ * does not cross zero, or a root beyond the edge of reach). Returns |g| at the end, q
+ * holding the model IK (every joint) at the last iterate. */
 double om_secant(om_problem *pb, double w0, double *q)
 {
+    return _secant_from(pb, w0, om_g(pb, w0, q, false), q);
+}
+
+/* om_secant from w0, or where the model does not reach p_d + R delta(w0), from the nearest
+ * reachable of REACH_PROBES probes each way around the circle (spaced pi / REACH_PROBES). */
+double om_secant_in_reach(om_problem *pb, double w0, double *q)
+{
     double g0 = om_g(pb, w0, q, false);
+    for (int k = 1; k <= REACH_PROBES && isnan(g0) && pb->s->mode == OM_CIRCLE; k++) {
+        for (int side = 1; side >= -1 && isnan(g0); side -= 2) {
+            double w = w0 + (double)side * OM_PI * (double)k / (double)REACH_PROBES;
+            g0 = om_g(pb, w, q, false);
+            if (!isnan(g0))
+                w0 = w;
+        }
+    }
+    return _secant_from(pb, w0, g0, q);
+}
+
+static double _secant_from(om_problem *pb, double w0, double g0, double *q)
+{
     if (pb->s->mode == OM_FIXED || isnan(g0))
         return fabs(g0);
     double w = w0, gw = g0, slope = -1.0;
@@ -30,7 +58,9 @@ double om_secant(om_problem *pb, double w0, double *q)
         }
     }
     bool complete = false; /* whether q holds every joint at w */
-    for (int it = 0; it < 40; it++) {
+    double best = fabs(gw);
+    int stalled = 0;
+    for (int it = 0; it < 40 && stalled < STALL; it++) {
         if (gw == 0.0 || slope == 0.0 || isnan(slope))
             break;
         double step = -gw / slope;
@@ -40,6 +70,11 @@ double om_secant(om_problem *pb, double w0, double *q)
             step = 0.5 * om_sign(step);
         bool last = fabs(step) < LAST_STEP;
         double g_new = om_g(pb, w + step, q, last);
+        for (int k = 0; k < BACKTRACK && isnan(g_new); k++) {
+            step *= 0.5;
+            last = fabs(step) < LAST_STEP;
+            g_new = om_g(pb, w + step, q, last);
+        }
         if (isnan(g_new)) {
             complete = false;
             break;
@@ -50,6 +85,8 @@ double om_secant(om_problem *pb, double w0, double *q)
         complete = last;
         if (fabs(gw) < 1e-16)
             break;
+        stalled = fabs(gw) < PROGRESS * best ? 0 : stalled + 1;
+        best = py_min(best, fabs(gw));
     }
     if (!complete)
         gw = om_g(pb, w, q, true);
@@ -104,11 +141,8 @@ double om_refine_bracket(om_problem *pb, double a, double ga, double b, double g
  * Illinois regula falsi on the reach margin. */
 double om_reach_edge(om_problem *pb, double inside, double outside, double *q)
 {
-    double fi, fo, fc;
-    om_g_margin(pb, inside, q, false, &fi);
-    fi = fi + OM_REACH_SLACK;
-    om_g_margin(pb, outside, q, false, &fo);
-    fo = fo + OM_REACH_SLACK;
+    double fi = om_reach_margin(pb, inside, q) + OM_REACH_SLACK;
+    double fo = om_reach_margin(pb, outside, q) + OM_REACH_SLACK;
     int side = 0;
     for (int it = 0; it < 80; it++) {
         if (fabs(outside - inside) <= 4e-16 * py_max(1.0, fabs(inside)))
@@ -116,8 +150,7 @@ double om_reach_edge(om_problem *pb, double inside, double outside, double *q)
         double c = (inside * fo - outside * fi) / (fo - fi);
         if (!(py_min(inside, outside) < c && c < py_max(inside, outside)))
             c = 0.5 * (inside + outside);
-        om_g_margin(pb, c, q, false, &fc);
-        fc = fc + OM_REACH_SLACK;
+        double fc = om_reach_margin(pb, c, q) + OM_REACH_SLACK;
         if (fc >= 0.0) {
             inside = c;
             fi = fc;
@@ -135,16 +168,18 @@ double om_reach_edge(om_problem *pb, double inside, double outside, double *q)
     return inside;
 }
 
-/* sign * g(w) (unreachable: -inf), or the reach margin; and g and the margin. */
+/* sign * g(w) (unreachable: -inf), or the reach margin; and g (NaN where only the margin
+ * is sought) and the margin. */
 static double _objective(om_problem *pb, double w, double sign, bool of_margin, double *q, double *g_out,
                          double *m_out)
 {
-    double m;
-    double gw = om_g_margin(pb, w, q, false, &m);
+    if (of_margin) {
+        *g_out = NAN;
+        *m_out = om_reach_margin(pb, w, q);
+        return *m_out;
+    }
+    double gw = om_g_margin(pb, w, q, false, m_out);
     *g_out = gw;
-    *m_out = m;
-    if (of_margin)
-        return m;
     return isnan(gw) ? -INFINITY : sign * gw;
 }
 
@@ -161,7 +196,7 @@ double om_extremum(om_problem *pb, double a, double b, double x0, double sign, b
     double fw = fx, fv = fx;
     double d = 0.0, e = 0.0;
     for (int it = 0; it < 60; it++) {
-        if (!of_margin ? fx > 0.0 : !isnan(gx))
+        if (!of_margin ? fx > 0.0 : mx >= -OM_REACH_SLACK)
             break;
         double xm = 0.5 * (a + b);
         double tol = 1e-10 * fabs(x) + 1e-11;

@@ -58,6 +58,15 @@ int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre
     return count;
 }
 
+void om_complete_start(om_problem *pb, double *start, bool *complete)
+{
+    const om_solver_data *s = pb->s;
+    if (!*complete && om_model_ik(s->family, s->params, s->model_table, &pb->t, pb->p, pb->signs, pb->q_prev, start,
+                                  true) < -OM_REACH_SLACK)
+        om_srs_model_ik_at_reach(s->params, &pb->t, pb->p, pb->signs, pb->q_prev, start);
+    *complete = true;
+}
+
 bool om_fixed_point_start(om_problem *pb, double *q, double *start)
 {
     const om_solver_data *s = pb->s;
@@ -83,19 +92,20 @@ bool om_fixed_point_start(om_problem *pb, double *q, double *start)
 }
 
 /* Local solve from the joint vector start, verified with the real arm: the secant on g from
- * its q_J; on the torus, and on a 7-DOF circle arm where the secant fails, the lifted Newton;
- * near the singular boundary, the refinement on the real arm last.
- * Returns accepted (errors into *pos, *ori); q holds the model IK at the end. */
-bool om_local_solve(om_problem *pb, const double *start, double *q, double *pos, double *ori)
+ * its q_J; on the torus, and on a 7-DOF circle arm where the secant fails, the lifted Newton
+ * (from the whole start: see om_complete_start); near the singular boundary, the refinement
+ * on the real arm last. Returns accepted (errors into *pos, *ori); q holds the model IK at the end. */
+bool om_local_solve(om_problem *pb, double *start, bool *start_complete, double *q, double *pos, double *ori)
 {
     const om_solver_data *data = pb->s;
     if (data->mode == OM_TORUS) {
         om_lifted_solve(pb, start, q);
         return om_verify(pb, q, pos, ori);
     }
-    om_secant(pb, data->mode == OM_CIRCLE ? start[data->dp_joint] : 0.0, q);
+    om_secant_in_reach(pb, data->mode == OM_CIRCLE ? start[data->dp_joint] : 0.0, q);
     bool accepted = om_verify(pb, q, pos, ori);
     if (!accepted && data->family == OM_SRS && data->mode == OM_CIRCLE) {
+        om_complete_start(pb, start, start_complete);
         om_lifted_solve(pb, start, q);
         accepted = om_verify(pb, q, pos, ori);
     }

@@ -96,7 +96,8 @@ static om_result _result(int status, double pos, double ori, int64_t evaluations
 om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
                        const double *hint, double *q_out)
 {
-    int mode = s->mode, dof = s->dof;
+    int family = s->family, mode = s->mode, dof = s->dof;
+    const double *P = s->params;
     const uint8_t *revolute = s->revolute;
     const double *lower = s->lower, *upper = s->upper;
     bool has_hint = hint != NULL;
@@ -120,10 +121,20 @@ om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *
      * never written; NaN makes that verification fail deterministically. */
     nan_fill(q, OM_MAX_DOF);
     memcpy(start, hint, (size_t)dof * sizeof(double));
-    bool found = has_hint || om_fixed_point_start(pb, q, start);
+    bool found = has_hint;
+    vec3 pd = problem.p;
     double pos = NAN, ori = NAN;
+    /* Whether start holds every joint; on an S-R-S circle arm whose dp turns with q7, the
+     * local solve needs q7 alone, and the rest is computed where needed (om_complete_start). */
+    bool start_complete = has_hint || !(mode == OM_CIRCLE && family == OM_SRS && s->dp_joint == 6);
+    if (!start_complete) { /* the fixed-point start's q7, at the edge of reach beyond it */
+        found = om_srs_model_q7(P, &problem.t, pd, signs, problem.q_prev, start) >= -OM_REACH_SLACK ||
+                om_srs_model_q7_at_reach(P, &problem.t, pd, signs, problem.q_prev, start);
+    } else if (!has_hint) { /* the paper's fixed-point start, p_m = p_d */
+        found = om_fixed_point_start(pb, q, start);
+    }
     if (found) {
-        bool verified = om_local_solve(pb, start, q, &pos, &ori);
+        bool verified = om_local_solve(pb, start, &start_complete, q, &pos, &ori);
         if (verified) {
             if (has_hint && mode != OM_FIXED && om_nearest_in_window(pb, hint, q))
                 om_verify(pb, q, &pos, &ori);
@@ -153,6 +164,8 @@ om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *
         bool other = neighbour_reached || om_exists_other(pb, true);
         return _result(other ? OM_NO_SOLUTION_IN_CONFIGURATION : OM_UNREACHABLE, NAN, NAN, problem.counter, false);
     }
+    if (found)
+        om_complete_start(pb, start, &start_complete);
     /* The root nearest the hint; without one, a root within the limits first, then the one
      * nearest the fixed-point start. */
     int best = 0;
@@ -199,15 +212,14 @@ int om_solve_all(const om_solver_data *s, const double *T, const int64_t *signs,
     problem.q_prev = zeros;
     problem.counter = 0;
     int n = om_all_roots(&problem, s->scan_points, roots, zeros, INFINITY);
-    bool neighbour_reached;
-    if (n == 0) { /* what solve finds, solve_all holds: its local solve from the fixed-point start */
+    bool neighbour_reached, complete = true;
+    if (n == 0) { /* the band's roots, and what solve finds: its local solve from the fixed-point start */
+        n = om_band_roots(&problem, roots, &neighbour_reached);
         double q[OM_MAX_DOF], start[OM_MAX_DOF], pos, ori;
         nan_fill(q, OM_MAX_DOF);
-        if (om_fixed_point_start(&problem, q, start) && om_local_solve(&problem, start, q, &pos, &ori))
-            n = om_add_root(&problem, q, roots, 0);
+        if (om_fixed_point_start(&problem, q, start) && om_local_solve(&problem, start, &complete, q, &pos, &ori))
+            n = om_add_root(&problem, q, roots, n);
     }
-    if (n == 0)
-        n = om_band_roots(&problem, roots, &neighbour_reached);
     for (int r = 0; r < n; r++) {
         double root[OM_MAX_DOF];
         memcpy(root, roots + r * dof, (size_t)dof * sizeof(double));

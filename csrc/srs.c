@@ -106,42 +106,50 @@ static void ik_with_elbow(const double *P, const om_target *t, vec3 w, double L2
     q[6] = om_wrap(phi.z - th[6]);
 }
 
+/* W - S = w for the flange position p, L2 = |w|^2 and the elbow's x = (L2 - k0) / K; returns
+ * the reach margin 1 - x^2 (-1 where W = S: x not written). */
+static double reach(const double *P, const om_target *t, vec3 p, vec3 *w, double *L2, double *x)
+{
+    *w = v_add(p, t->wrist);
+    *L2 = v_dot(*w, *w);
+    if (*L2 < DEGENERATE) /* wrist centre at the shoulder centre */
+        return -1.0;
+    *x = (*L2 - P[SRS_K0]) / P[SRS_K];
+    return 1.0 - *x * *x;
+}
+
+double om_srs_reach(const double *P, const om_target *t, vec3 p, double *x)
+{
+    vec3 w;
+    double L2;
+    return reach(P, t, p, &w, &L2, x);
+}
+
 /* Solve the model for the flange pose (t->R, p) in DH frame 0, the branch signs
  * (SHOULDER, ELBOW, WRIST) and the target's arm angle (model_ik). Returns the reach margin
  * 1 - x^2; below -OM_REACH_SLACK (or -1 where W = S) q is not written. */
 double om_srs_model_ik(const double *P, const om_target *t, vec3 p, const int64_t *signs, const double *q_prev,
                        double *q, bool shoulder)
 {
-    vec3 w = v_add(p, t->wrist);
-    double L2 = v_dot(w, w);
-    if (L2 < DEGENERATE) /* wrist centre at the shoulder centre */
-        return -1.0;
-    double x = (L2 - P[SRS_K0]) / P[SRS_K];
-    double margin = 1.0 - x * x;
+    vec3 w;
+    double L2, x;
+    double margin = reach(P, t, p, &w, &L2, &x);
     if (margin < -OM_REACH_SLACK)
         return margin;
     ik_with_elbow(P, t, w, L2, x, signs, q_prev, q, shoulder);
     return margin;
 }
 
-/* Joint 7 alone, as om_srs_model_ik computes it (q[6] written, the rest of q untouched): what
- * the circle residual g needs of the model. The wrist's M = R04^T R E^T =
- * Rz(phi5) Rx(alpha5) Rz(phi6) Rx(beta) Rz(phi7) is not formed: its last column gives
- * (sin phi6, cos phi6 cos beta) up to one positive factor (the Euler decomposition's phi6), and
- * its last row is sigma5 (u cos phi7 + v sin phi7, v cos phi7 - u sin phi7) for that pair
- * (u, v), which gives phi7 without phi5. Near the wrist singularity (u = 0), where the
- * closed form takes phi5 from q_prev, it decides. Returns the reach margin as om_srs_model_ik. */
-double om_srs_model_q7(const double *P, const om_target *t, vec3 p, const int64_t *signs, const double *q_prev,
-                       double *q)
+/* Joint 7 alone, as ik_with_elbow computes it for the elbow's root at x (q[6] written, the
+ * rest of q untouched): what the circle residual g needs of the model. The wrist's
+ * M = R04^T R E^T = Rz(phi5) Rx(alpha5) Rz(phi6) Rx(beta) Rz(phi7) is not formed: its last
+ * column gives (sin phi6, cos phi6 cos beta) up to one positive factor (the Euler
+ * decomposition's phi6), and its last row is sigma5 (u cos phi7 + v sin phi7, v cos phi7 -
+ * u sin phi7) for that pair (u, v), which gives phi7 without phi5. Near the wrist singularity
+ * (u = 0), where the closed form takes phi5 from q_prev, it decides. */
+static void q7_with_elbow(const double *P, const om_target *t, vec3 w, double L2, double x, const int64_t *signs,
+                          const double *q_prev, double *q)
 {
-    vec3 w = v_add(p, t->wrist);
-    double L2 = v_dot(w, w);
-    if (L2 < DEGENERATE)
-        return -1.0;
-    double x = (L2 - P[SRS_K0]) / P[SRS_K];
-    double margin = 1.0 - x * x;
-    if (margin < -OM_REACH_SLACK)
-        return margin;
     double elbow = (double)signs[1];
     elbow_cs e = elbow_root(P, x, elbow, NULL);
     double c4 = e.c4, s4 = e.s4;
@@ -156,12 +164,37 @@ double om_srs_model_q7(const double *P, const om_target *t, vec3 p, const int64_
         double wrist_joints[7];
         ik_with_elbow(P, t, w, L2, x, signs, q_prev, wrist_joints, false);
         q[6] = wrist_joints[6];
-        return margin;
+        return;
     }
     double u = (double)signs[2] * radial, v = -sigma * (sin_b > 0.0 ? 1.0 : -1.0) * az * cos_b;
     double m20 = v_dot(z4, RE_cols.r0), m21 = v_dot(z4, RE_cols.r1);
     q[6] = om_wrap(atan2(sigma * (v * m20 - u * m21), sigma * (u * m20 + v * m21)) - P[SRS_THETA + 6]);
+}
+
+/* Joint 7 alone, as om_srs_model_ik computes it (q7_with_elbow). Returns the reach margin as
+ * om_srs_model_ik. */
+double om_srs_model_q7(const double *P, const om_target *t, vec3 p, const int64_t *signs, const double *q_prev,
+                       double *q)
+{
+    vec3 w;
+    double L2, x;
+    double margin = reach(P, t, p, &w, &L2, &x);
+    if (margin < -OM_REACH_SLACK)
+        return margin;
+    q7_with_elbow(P, t, w, L2, x, signs, q_prev, q);
     return margin;
+}
+
+/* Joint 7 alone, as om_srs_model_ik_at_reach computes it; false, q untouched, only where W = S. */
+bool om_srs_model_q7_at_reach(const double *P, const om_target *t, vec3 p, const int64_t *signs,
+                              const double *q_prev, double *q)
+{
+    vec3 w = v_add(p, t->wrist);
+    double L2 = v_dot(w, w);
+    if (L2 < DEGENERATE)
+        return false;
+    q7_with_elbow(P, t, w, L2, (L2 - P[SRS_K0]) / P[SRS_K], signs, q_prev, q);
+    return true;
 }
 
 /* om_srs_model_ik with the elbow held at the edge of reach beyond it (model_ik_at_reach);

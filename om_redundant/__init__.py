@@ -15,6 +15,7 @@ from .exceptions import (
     ModelError,
     ModelMismatch,
     OMError,
+    SingularSelfMotion,
     UnknownArm,
     UnreachableTarget,
 )
@@ -31,7 +32,18 @@ from .mujoco_io import (
     scene_mjcf,
     without_meshes,
 )
-from .om import BRANCH_BAND, BatchSolution, Configuration, ModelArm, OMSolver, Solution, derive_model
+from .om import (
+    BRANCH_BAND,
+    NEAR_TWIST,
+    BatchSolution,
+    Configuration,
+    ModelArm,
+    NominalArm,
+    OMSolver,
+    Solution,
+    derive_model,
+    nominal_arm,
+)
 from .redundancy import (
     Box,
     Capsule,
@@ -53,6 +65,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "BRANCH_BAND",
+    "NEAR_TWIST",
     "Arm",
     "ArmAngleTask",
     "ArmFileError",
@@ -75,12 +88,14 @@ __all__ = [
     "ModelComparison",
     "ModelError",
     "ModelMismatch",
+    "NominalArm",
     "OMError",
     "OMSolver",
     "Objective",
     "PsiInterval",
     "RedundancyChoice",
     "RedundancyOptimizer",
+    "SingularSelfMotion",
     "Singularity",
     "Solution",
     "Sphere",
@@ -96,6 +111,7 @@ __all__ = [
     "joint_margins",
     "load_arm",
     "load_mujoco_model",
+    "nominal_arm",
     "scene_mjcf",
     "self_motion_tangent",
     "without_meshes",

@@ -85,3 +85,9 @@ class UnreachableTarget(OMError, InvalidTarget):
     The pose is out of reach, the requested configuration has no solution for it, or every
     solution breaks a joint limit; the message says which. Also a ``mink.InvalidTarget``.
     """
+
+
+class SingularSelfMotion(OMError, ArithmeticError):
+    """The arm angle does not move along the self-motion at this joint vector (a fold of the
+    solution path, or a Jacobian that lost rank, e.g. a stretched arm), so dq/dpsi does not
+    exist there. The message names the joint vector."""

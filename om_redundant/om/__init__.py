@@ -1,17 +1,22 @@
 """The offset modification method: configurations (:mod:`.configuration`), the model arm
 (:mod:`.model`) with its closed-form families (:mod:`.families`), system (9) and its bounded
-search (:mod:`.system`), and the solver that fronts them (:mod:`.solver`)."""
+search (:mod:`.system`), arms near a family (:mod:`.nominal`, :mod:`.near`), and the solver
+that fronts them (:mod:`.solver`)."""
 
 from .configuration import Configuration
 from .model import ModelArm, derive_model
+from .nominal import NEAR_TWIST, NominalArm, nominal_arm
 from .solver import BRANCH_BAND, BatchSolution, OMSolver, Solution
 
 __all__ = [
     "BRANCH_BAND",
+    "NEAR_TWIST",
     "BatchSolution",
     "Configuration",
     "ModelArm",
+    "NominalArm",
     "OMSolver",
     "Solution",
     "derive_model",
+    "nominal_arm",
 ]

@@ -150,6 +150,7 @@ class OMSolver:
         #: The nominal arm the model is derived from, for an arm NEAR a family; else None.
         self.nominal: NominalArm | None
         self.om, self.nominal = closed_form(self.arm)
+        self._flip = np.ones(self.arm.dof) if self.nominal is None else self.nominal.flip
         types = {"solution_type": Solution, "configuration_type": Configuration}
         if self.nominal is not None:  # near a family: the nominal arm's roots seed the exact ones
             self._kernel = NearKernel(self.nominal, self.om, self.solver_data(), **types)
@@ -164,14 +165,22 @@ class OMSolver:
         return kernel_data(arm, self.om, self.tolerances, self.scan_points)
 
     @property
-    def kernel(self) -> ckernels.Solver:
-        """The compiled solver, for kernels that solve with it (``ckernels.track_step``)."""
+    def kernel(self) -> ckernels.Solver | NearKernel:
+        """The compiled solver, for kernels that solve with it (``ckernels.track_step``); a
+        :class:`~om_redundant.om.near.NearKernel` for an arm near a family."""
         return self._kernel
 
     @property
     def model(self) -> Arm:
-        """The offset-modified model arm."""
+        """The offset-modified model arm (of the nominal arm for an arm near a family, in the
+        model's joint coordinates ``flip * q``)."""
         return self.om.model
+
+    @property
+    def flip(self) -> np.ndarray:
+        """(dof,) +-1: the model's joint coordinates are ``flip * q`` (-1 where an arm near a
+        family has a reversed axis, see :mod:`~om_redundant.om.nominal`)."""
+        return self._flip
 
     @property
     def dp_max(self) -> float:

@@ -72,7 +72,8 @@ def arm_angle_and_gradient(solver: OMSolver, q: np.ndarray) -> tuple[float, np.n
     check_arm_angle(solver)
     q = as_joint_vector(q, solver.arm.dof, stack=False)
     grad = np.empty(solver.arm.dof)
+    flip = solver.flip  # the model's joint coordinates are flip * q
     psi = ckernels.arm_angle_gradient(
-        solver.om.params, solver.model.chain.table, np.ascontiguousarray(q), grad
+        solver.om.params, solver.model.chain.table, np.ascontiguousarray(flip * q), grad
     )
-    return float(psi), grad
+    return float(psi), flip * grad

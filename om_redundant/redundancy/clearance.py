@@ -42,6 +42,7 @@ from ..mujoco_io.mjcf import arm_mjcf
 from ..validation import as_instance, as_joint_vector, as_pose, as_positive, as_vector
 
 DEFAULT_DISTMAX = 1.0  # m: pairs farther apart report this distance
+_NEXT, _PREVIOUS = [1, 2, 0], [2, 0, 1]  # (a x b)_i = a_{i+1} b_{i+2} - a_{i+2} b_{i+1}
 
 _PRIMITIVES = {
     mujoco.mjtGeom.mjGEOM_PLANE,
@@ -205,6 +206,7 @@ class Clearance:
         # bounding-sphere radii of each pair (MuJoCo's rbound; 0 means unbounded, a plane)
         rbound = np.where(model.geom_rbound > 0.0, model.geom_rbound, np.inf)
         self._bounds = rbound[self._pairs[:, 0]] + rbound[self._pairs[:, 1]]
+        self._bodies = model.geom_bodyid[self._pairs[:, 0]]
         self.pairs: tuple[tuple[str, str], ...] = tuple(
             (model.geom(a).name, model.geom(o).name) for a, o in self._pairs
         )
@@ -272,25 +274,45 @@ class Clearance:
     def _evaluate(
         self, q: np.ndarray, gradient: bool, reach: float | None = None
     ) -> tuple[np.ndarray, np.ndarray]:
+        r"""Distances capped at reach (default distmax), and their gradients if asked.
+
+        The gradient of pair k on arm body b, from the body's Jacobians at its origin x_b
+        (``mj_jacBody``, once per body), with :math:`r_k = p_A - x_b`:
+        :math:`J_p(p_A) = J_v - [r_k]_\times J_\omega`, so
+        :math:`\partial d_k/\partial q = -n_k^T J_v + (n_k \times r_k)^T J_\omega`.
+        """
         q = as_joint_vector(q, self._dof, stack=False)
         m, d = self.model, self._data
         reach = self.distmax if reach is None else reach
         d.qpos[self._qpos] = q
         mujoco.mj_kinematics(m, d)
-        if gradient:
-            mujoco.mj_comPos(m, d)
-        dist = np.full(len(self._pairs), reach)
-        grad = np.zeros((len(self._pairs), self._dof))
+        n_pairs = len(self._pairs)
+        dist = np.full(n_pairs, reach)
+        grad = np.zeros((n_pairs, self._dof))
         a_all, o_all = self._pairs[:, 0], self._pairs[:, 1]
         apart = np.linalg.norm(d.geom_xpos[a_all] - d.geom_xpos[o_all], axis=1) - self._bounds
-        fromto, jacp = np.zeros(6), np.zeros((3, m.nv))
-        for k in np.flatnonzero(apart < reach):
-            a, o = a_all[k], o_all[k]
-            dist[k] = mujoco.mj_geomDistance(m, d, a, o, reach, fromto)
-            if gradient and dist[k] < reach and dist[k] != 0.0:
-                normal = (fromto[3:] - fromto[:3]) / dist[k]
-                mujoco.mj_jac(m, d, jacp, None, fromto[:3], m.geom_bodyid[a])
-                grad[k] = -normal @ jacp[:, self._dofs]
+        near = np.flatnonzero(apart < reach)
+        fromto = np.zeros((len(near), 6))
+        for i, k in enumerate(near):
+            dist[k] = mujoco.mj_geomDistance(m, d, a_all[k], o_all[k], reach, fromto[i])
+        if not gradient:
+            return dist, grad
+        moving = (dist[near] < reach) & (dist[near] != 0.0)
+        near, fromto = near[moving], fromto[moving]
+        if not len(near):
+            return dist, grad
+        mujoco.mj_comPos(m, d)
+        normal = (fromto[:, 3:] - fromto[:, :3]) / dist[near, None]
+        bodies = self._bodies[near]
+        jacp, jacr = np.zeros((3, m.nv)), np.zeros((3, m.nv))
+        r = fromto[:, :3] - d.xpos[bodies]
+        n_cross_r = (
+            normal[:, _NEXT] * r[:, _PREVIOUS] - normal[:, _PREVIOUS] * r[:, _NEXT]
+        )  # np.cross is slow
+        for b in set(bodies.tolist()):
+            mujoco.mj_jacBody(m, d, jacp, jacr, b)
+            on = bodies == b
+            grad[near[on]] = -normal[on] @ jacp[:, self._dofs] + n_cross_r[on] @ jacr[:, self._dofs]
         return dist, grad
 
 

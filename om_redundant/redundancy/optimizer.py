@@ -19,9 +19,12 @@ the exact OM solution in it:
    whose QP, solved by OSQP, linearises margins and clearances around the current exact
    solution, within the interval. The result is the best point's own exact solve.
 
-**Tracking** (``choose(T, previous)``): the previous branch only, psi within ``max_step``
-of the previous psi, every solution continued from the previous joints; among the optima
-within :data:`PLATEAU` of the best, the one nearest the previous psi. The branch is left
+**Tracking** (``choose(T, previous)``): first the one-call tracking step of
+:mod:`~om_redundant.redundancy.tracking` (an exact solve at the previous psi, the 1-variable
+box QP along the self-motion, an exact solve at the new psi); where it cannot step or lands
+on an infeasible point, the window search: the previous branch only, psi within
+``max_step`` of the previous psi, every solution continued from the previous joints; among
+the optima within :data:`PLATEAU` of the best, the one nearest the previous psi. The branch is left
 only when it has no feasible psi at all at this pose, and the result says so
 (``branch_flipped``, ``reason``); if it is feasible only farther than ``max_step`` away, the
 result is not ok and names where.
@@ -74,7 +77,8 @@ class RedundancyChoice:
         clearance: Clearance D(q) in metres (inf without obstacles, nan if not ok).
         value: The objective f(q) (nan if not ok).
         intervals: The feasible intervals searched: every allowed branch's, or in tracking
-            mode those within ``max_step`` of the previous psi.
+            mode those within ``max_step`` of the previous psi; empty from the one-call
+            tracking step (:mod:`~om_redundant.redundancy.tracking`), which searches none.
         reason: Why nothing is feasible, or why the branch flipped; "" otherwise.
         branch_flipped: Tracking mode left the previous branch (it had no feasible psi).
         curvature: The curvature (per rad^2) of the objective along psi that the next
@@ -150,7 +154,7 @@ class RedundancyOptimizer:
         self.objective = Objective(
             solver.arm,
             obstacles,
-            Singularity.of(solver.om),
+            Singularity.of(solver.om, solver.flip),
             margin_weight=margin_weight,
             clearance_weight=clearance_weight,
             singularity_weight=singularity_weight,
@@ -186,6 +190,11 @@ class RedundancyOptimizer:
         Returns:
             A :class:`RedundancyChoice`; ``ok`` is False, with the reason, when nothing is
             feasible.
+
+        Raises:
+            InvalidInput: A malformed pose or previous choice.
+            SingularSelfMotion: A solution met where psi does not move along the
+                self-motion (a stretched arm, e.g. the iiwa14 at q = 0), so no rates exist.
         """
         T = as_pose(T)
         if previous is None or (isinstance(previous, RedundancyChoice) and not previous.ok):

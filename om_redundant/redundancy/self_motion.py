@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..exceptions import SingularSelfMotion
 from ..om.solver import OMSolver
 from ..validation import as_joint_vector
 from .arm_angle import arm_angle_and_gradient, check_arm_angle
@@ -32,10 +33,22 @@ def self_motion_tangent(solver: OMSolver, q: np.ndarray) -> np.ndarray:
 
     Raises:
         InvalidInput: The arm has no arm angle, or q is malformed.
+        SingularSelfMotion: psi does not move along the self-motion at q: :math:`D\psi\,N`
+            is singular to rounding (exactly at a fold, or J of rank below 6). Near a fold
+            dq/dpsi is large but finite, and returned.
     """
     check_arm_angle(solver)
     q = as_joint_vector(q, solver.arm.dof, stack=False)
     null = np.linalg.svd(solver.arm.jacobian(q))[2][6:].T
     gradient = arm_angle_and_gradient(solver, q)[1]
     change = np.atleast_2d(gradient @ null)
-    return np.linalg.solve(change.T, null.T).T
+    try:
+        tangent = np.linalg.solve(change.T, null.T).T
+    except np.linalg.LinAlgError:
+        tangent = np.full_like(null, np.nan)
+    if not np.isfinite(tangent).all():
+        raise SingularSelfMotion(
+            f"the arm angle does not move along the self-motion at q = {np.round(q, 6).tolist()} "
+            "(exactly at a fold of the solution path, or where the Jacobian lost rank)"
+        )
+    return tangent

@@ -49,8 +49,14 @@ class Singularity:
     dof: int
 
     @classmethod
-    def of(cls, model: ModelArm) -> Singularity:
-        """The singularities of a model arm (module docstring), from its family's parameters."""
+    def of(cls, model: ModelArm, flip: np.ndarray | None = None) -> Singularity:
+        """The singularities of a model arm (module docstring), from its family's parameters.
+
+        Args:
+            model: The model arm.
+            flip: (dof,) +-1: the model's joint coordinates are ``flip * q`` (an arm near a
+                family with a reversed axis, ``OMSolver.flip``); None for all +1.
+        """
         P = as_instance(model, ModelArm, "model").params
         if model.family == SRS:
             theta = P[srs.THETA : srs.THETA + 7]
@@ -64,7 +70,10 @@ class Singularity:
         else:
             rows = (("wrist", 4, P[six_dof.THETA5]),)
         names, joints, offsets = zip(*rows, strict=True)
-        return cls(names, np.array(joints), np.array(offsets, dtype=float), model.real.dof)
+        joints, offsets = np.array(joints), np.array(offsets, dtype=float)
+        if flip is not None:  # |sin(-q + c)| = |sin(q - c)|
+            offsets *= np.asarray(flip, dtype=float)[joints]
+        return cls(names, joints, offsets, model.real.dof)
 
     def distances(self, q: np.ndarray) -> np.ndarray:
         r"""The distances :math:`s_k(q) = |\sin(q_{j_k} + c_k)|`.

@@ -121,7 +121,8 @@ class Tracker:
             np.zeros(arm.dof),
             np.zeros(_N_OUT),
         )
-        self._kernel = solver.kernel
+        # An arm near a family solves through om.near.NearKernel: no compiled tracking step.
+        self._kernel = solver.kernel if isinstance(solver.kernel, ckernels.Solver) else None
         self._reach = 2.0 * objective.clearance_cap  # capped pieces beyond it change nothing
         self._last: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # q, values, gradients
 
@@ -134,6 +135,8 @@ class Tracker:
             (solution, psi, margin, clearance, value, curvature) at the new psi, or None when
             the step cannot be taken or lands on an infeasible point (module docstring).
         """
+        if self._kernel is None:
+            return None
         work, objective = self.work, self.objective
         work.setup[_PSI] = psi
         work.setup[_CURVATURE] = curvature if math.isfinite(curvature) else INITIAL_CURVATURE
@@ -154,6 +157,8 @@ class Tracker:
             d, grad = objective.clearance.distances_within(q_new, self._reach, gradient=True)
             self._last = (q_new, d, grad)
             clearance = float(d.min())
+            if clearance >= self._reach:  # every pair beyond the reach: D itself, uncapped
+                clearance = objective.clearance.minimum(q_new)
             value += objective.clearance_weight * min(1.0, clearance / objective.clearance_cap)
         if not (margin >= 0.0 and clearance >= objective.min_clearance):
             return None

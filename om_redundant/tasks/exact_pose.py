@@ -121,6 +121,8 @@ class ExactPoseTask(ArmTask):
             )
         super().__init__(solver, model, solver.arm.dof, prefix, cost, gain, lm_damping)
         self.root = ArmRoot(self.joints, frame_name, frame_type)
+        fixed = self.root.fixed_pose
+        self._root_at_origin = fixed is not None and np.array_equal(fixed, np.eye(4))
         self.optimizer = optimizer
         self.arm_configuration = arm_configuration
         if arm_configuration is not None:
@@ -175,7 +177,9 @@ class ExactPoseTask(ArmTask):
             if self._unsolved_fallback is None:
                 self._unsolved_fallback = (self.transform_target_to_world, self.arm_configuration)
             self._root_pose = None
-        self.transform_target_to_world = SE3.from_matrix(T)
+        # (an SE3 given is kept as it is: SE3.from_matrix costs as much as the tracking step)
+        given = transform_target_to_world
+        self.transform_target_to_world = given if isinstance(given, SE3) else SE3.from_matrix(T)
         self.arm_configuration = arm_configuration
 
     def set_target_from_configuration(self, configuration: MinkConfiguration) -> None:
@@ -242,10 +246,13 @@ class ExactPoseTask(ArmTask):
         arm_configuration: Configuration | None,
     ) -> None:
         """Solve T_world for the root at root_pose and, only if that succeeds, take it."""
-        R, p = root_pose[:3, :3], root_pose[:3, 3]
-        T_root = np.eye(4)
-        T_root[:3, :3] = R.T @ T_world[:3, :3]
-        T_root[:3, 3] = R.T @ (T_world[:3, 3] - p)
+        if root_pose is self.root.fixed_pose and self._root_at_origin:
+            T_root = T_world
+        else:
+            R, p = root_pose[:3, :3], root_pose[:3, 3]
+            T_root = np.eye(4)
+            T_root[:3, :3] = R.T @ T_world[:3, :3]
+            T_root[:3, 3] = R.T @ (T_world[:3, 3] - p)
         if arm_configuration is None:
             choice = self.optimizer.choose(T_root, previous=self.choice)
             if not choice.ok:
