@@ -1,8 +1,10 @@
 """Arms brought by their MuJoCo models: every reference Menagerie arm imported and solved.
 
-Run: ``python -m benchmarks.menagerie [--n 10000] [--seed 0]``; writes
+Run: ``python -m benchmarks.menagerie [--n 10000] [--seed 0] [--extra DIR]``; writes
 ``results/menagerie.md``. For each arm in ``../shared/reference/menagerie`` (kinematics-only
-copies of MuJoCo Menagerie models): ``om.arm_from_mujoco`` imports it, ``check-model``'s
+copies of MuJoCo Menagerie models) and, with ``--extra DIR``, each arm of ``EXTRA`` whose
+model file is present under DIR (kinematics-only MJCF text of further Menagerie models, kept
+outside the project; absent files are skipped): ``om.arm_from_mujoco`` imports it, ``check-model``'s
 comparison measures the arm file against the model over 1,000 random q, and where
 ``OMSolver`` accepts the arm, N random in-limit q are solved against MuJoCo's OWN frame pose
 (``mj_kinematics`` of the Menagerie model at qpos = q): q among ``solve_all(T, c)`` with c its
@@ -16,6 +18,7 @@ from __future__ import annotations
 import argparse
 import time
 from pathlib import Path
+from typing import NamedTuple
 
 import mujoco
 import numpy as np
@@ -26,27 +29,55 @@ from .report import write_page
 
 MENAGERIE = Path(__file__).resolve().parents[2] / "shared" / "reference" / "menagerie"
 
-#: name: (model file, frame, frame type).
+
+class Entry(NamedTuple):
+    """Where an arm is in a Menagerie model: file, frame and the chain's prefix and root."""
+
+    path: str
+    frame: str
+    frame_type: str
+    prefix: str = ""
+    root: str | None = None
+
+
+#: The reference copies in ``MENAGERIE``.
 REFERENCE = {
-    "panda_nohand": ("franka_emika_panda/panda_nohand.xml", "attachment_site", "site"),
-    "fr3": ("franka_fr3/fr3.xml", "attachment_site", "site"),
-    "iiwa14": ("kuka_iiwa_14/iiwa14.xml", "attachment_site", "site"),
-    "gen3": ("kinova_gen3/gen3.xml", "pinch_site", "site"),
-    "xarm7_nohand": ("ufactory_xarm7/xarm7_nohand.xml", "attachment_site", "site"),
-    "sawyer": ("rethink_robotics_sawyer/sawyer.xml", "attachment_site", "site"),
-    "ur5e": ("universal_robots_ur5e/ur5e.xml", "wrist_3_link", "body"),
-    "ur10e": ("universal_robots_ur10e/ur10e.xml", "attachment_site", "site"),
-    "flexiv_rizon4": ("flexiv_rizon4/flexiv_rizon4.xml", "link7", "body"),
-    "wx250s": ("trossen_wx250s/wx250s.xml", "wx250s/gripper_link", "body"),
-    "piper": ("agilex_piper/piper.xml", "link6", "body"),
-    "lite6": ("ufactory_lite6/lite6.xml", "attachment_site", "site"),
+    "panda_nohand": Entry("franka_emika_panda/panda_nohand.xml", "attachment_site", "site"),
+    "fr3": Entry("franka_fr3/fr3.xml", "attachment_site", "site"),
+    "iiwa14": Entry("kuka_iiwa_14/iiwa14.xml", "attachment_site", "site"),
+    "gen3": Entry("kinova_gen3/gen3.xml", "pinch_site", "site"),
+    "xarm7_nohand": Entry("ufactory_xarm7/xarm7_nohand.xml", "attachment_site", "site"),
+    "sawyer": Entry("rethink_robotics_sawyer/sawyer.xml", "attachment_site", "site"),
+    "ur5e": Entry("universal_robots_ur5e/ur5e.xml", "wrist_3_link", "body"),
+    "ur10e": Entry("universal_robots_ur10e/ur10e.xml", "attachment_site", "site"),
+    "flexiv_rizon4": Entry("flexiv_rizon4/flexiv_rizon4.xml", "link7", "body"),
+    "wx250s": Entry("trossen_wx250s/wx250s.xml", "wx250s/gripper_link", "body"),
+    "piper": Entry("agilex_piper/piper.xml", "link6", "body"),
+    "lite6": Entry("ufactory_lite6/lite6.xml", "attachment_site", "site"),
 }
+
+#: Further Menagerie arms, measured with ``--extra DIR`` when DIR holds their model files
+#: (the kinematic MJCF text of google-deepmind/mujoco_menagerie, meshes and inertials dropped).
+EXTRA = {
+    "m1013": Entry("doosan_robotics_m1013/m1013.xml", "link_6", "body"),
+    "fr3v2": Entry("franka_fr3_v2/fr3v2.xml", "fr3v2_link8", "body"),
+    "flexiv_rizon4s": Entry("flexiv_rizon4s/flexiv_rizon4s.xml", "link7", "body"),
+    "arx_l5": Entry("arx_l5/arx_l5.xml", "link6", "body"),
+    "z1": Entry("unitree_z1/z1.xml", "link06", "body"),
+    "yam": Entry("i2rt_yam/yam.xml", "grasp_site", "site"),
+}
+
+
+def import_arm(entry: Entry, folder: Path = MENAGERIE) -> tuple[om.Arm, mujoco.MjModel]:
+    """The imported arm of a Menagerie model under ``folder``, and the model (meshes skipped)."""
+    path = folder / entry.path
+    arm = om.arm_from_mujoco(path, entry.frame, entry.frame_type, entry.prefix, entry.root)
+    return arm, om.load_mujoco_model(path)
 
 
 def import_reference(name: str) -> tuple[om.Arm, mujoco.MjModel]:
     """The imported arm of a reference model, and the model (meshes and textures skipped)."""
-    path, frame, frame_type = REFERENCE[name]
-    return om.arm_from_mujoco(MENAGERIE / path, frame, frame_type), om.load_mujoco_model(MENAGERIE / path)
+    return import_arm(REFERENCE[name])
 
 
 def frame_pose(model: mujoco.MjModel, data: mujoco.MjData, arm: om.Arm, q: np.ndarray) -> np.ndarray:
@@ -78,10 +109,11 @@ def _angle(R: np.ndarray, S: np.ndarray) -> float:
     return float(np.arctan2(s, 0.5 * (np.trace(E) - 1.0)))
 
 
-def measure(name: str, n: int, seed: int) -> dict:
+def measure(name: str, n: int, seed: int, entry: Entry | None = None, folder: Path = MENAGERIE) -> dict:
     """One arm's row: import, check-model, acceptance and the exact solves."""
-    arm, model = import_reference(name)
-    row: dict = {"arm": name, "model": REFERENCE[name][0], "dof": arm.dof}
+    entry = entry or REFERENCE[name]
+    arm, model = import_arm(entry, folder)
+    row: dict = {"arm": name, "model": entry.path, "dof": arm.dof}
     comparison = om.compare_mujoco_model(arm, model, samples=1000)
     row["check-model"] = f"{comparison.max_position_error:.1e} m / {comparison.max_orientation_error:.1e} rad"
     try:
@@ -131,21 +163,38 @@ def measure(name: str, n: int, seed: int) -> dict:
     return row
 
 
+def available(extra: Path | None = None) -> dict[str, tuple[Entry, Path]]:
+    """The arms to measure and their folders: every reference arm, and EXTRA's present in ``extra``.
+
+    An EXTRA arm whose model file is absent from ``extra`` (or every one, without ``extra``) is
+    skipped with a note, so the benchmark runs where Menagerie is not at hand (CI).
+    """
+    arms = {name: (entry, MENAGERIE) for name, entry in REFERENCE.items()}
+    if extra is not None:
+        for name, entry in EXTRA.items():
+            if (extra / entry.path).is_file():
+                arms[name] = (entry, extra)
+            else:
+                print(f"{name}: {extra / entry.path} absent, skipped", flush=True)
+    return arms
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--n", type=int, default=10_000, help="random joint vectors per arm")
     parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--arms", nargs="+", default=list(REFERENCE), choices=list(REFERENCE))
+    parser.add_argument("--extra", type=Path, help="folder holding EXTRA's model files")
+    parser.add_argument("--arms", nargs="+", choices=[*REFERENCE, *EXTRA])
     args = parser.parse_args()
+    arms = available(args.extra)
     rows = []
-    for name in args.arms:
-        rows.append(measure(name, args.n, args.seed))
+    for name in args.arms or list(arms):
+        if name not in arms:
+            print(f"{name}: not available (give --extra DIR with its model file)", flush=True)
+            continue
+        rows.append(measure(name, args.n, args.seed, *arms[name]))
         print(rows[-1], flush=True)
-    keys = [k for k in rows[0] if k not in ("model", "dof")] if rows else []
-    solved_keys = [
-        k for k in (rows[0] if "q among solve_all" in rows[0] else {}) if k not in ("model", "dof")
-    ]
-    keys = solved_keys or keys
+    keys = list(dict.fromkeys(k for row in rows for k in row if k not in ("model", "dof")))
     lines = [
         f"# Menagerie arms imported and solved ({args.n:,} random q per accepted arm, seed {args.seed})",
         "",

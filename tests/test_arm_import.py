@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 import om_redundant as om
-from benchmarks.menagerie import frame_pose
+from benchmarks.menagerie import EXTRA, available, frame_pose
 from om_redundant.cli import main
 from om_redundant.mujoco_io.arm_import import IMPORT_TOLERANCE
 from tests.conftest import MENAGERIE, random_q, wrap
@@ -415,3 +415,15 @@ def test_import_arm_json_and_errors(capsys, tmp_path):
         assert main(argv) == 2
         err = capsys.readouterr().err
         assert re.search(message, err) and err.count("\n") == 1, err
+
+
+def test_menagerie_benchmark_skips_absent_extra_arms(tmp_path):
+    """``--extra DIR`` measures the EXTRA arms whose files DIR holds and skips the others."""
+    assert set(available()) == set(REFERENCE)
+    assert set(available(tmp_path)) == set(REFERENCE)
+    name, entry = next(iter(EXTRA.items()))
+    (tmp_path / entry.path).parent.mkdir(parents=True)
+    (tmp_path / entry.path).write_text("<mujoco/>")
+    arms = available(tmp_path)
+    assert set(arms) == set(REFERENCE) | {name}
+    assert arms[name] == (entry, tmp_path)
