@@ -62,6 +62,7 @@ EXTRA = {
     "m1013": Entry("doosan_robotics_m1013/m1013.xml", "link_6", "body"),
     "fr3v2": Entry("franka_fr3_v2/fr3v2.xml", "fr3v2_link8", "body"),
     "flexiv_rizon4s": Entry("flexiv_rizon4s/flexiv_rizon4s.xml", "link7", "body"),
+    "gen3_lite": Entry("kinova_gen3_lite/gen3_lite.xml", "ee_site", "site"),
     "arx_l5": Entry("arx_l5/arx_l5.xml", "link6", "body"),
     "z1": Entry("unitree_z1/z1.xml", "link06", "body"),
     "yam": Entry("i2rt_yam/yam.xml", "grasp_site", "site"),
