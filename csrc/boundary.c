@@ -5,12 +5,14 @@
 #include "om_system.h"
 
 #define NEAR_BOUNDARY 1e-2 /* |branch quantity| under which a failed candidate is polished */
-#define POLISH_STEPS 40    /* Jacobians per refinement: 2-4 at a simple root, more at a double one */
+#define POLISH_STEPS 100   /* Jacobians per refinement: 2-4 at a simple root, more at a double one */
 #define SHOULDER_SIGN 0    /* (SHOULDER or ARM, ELBOW, WRIST) in every family */
 #define ELBOW_SIGN 1
-#define SHOULDER_STARTS 8  /* starts of q1 where the wrist centre is on joint 1's axis */
+#define SPLIT_STARTS 16    /* starts of q1 (wrist centre on joint 1's axis) or of the aligned wrist's split */
+#define SPLIT_NEAR 1e-6    /* |branch quantity| under which the model's split is arbitrary: SPLIT_STARTS */
 #define GATE_POINTS 8      /* free-angle samples of the cheap test before a neighbour's search */
 #define GATE_NEAR 0.2      /* |branch quantity| at a sample that lets a neighbour be searched */
+#define DIP_STEPS 24       /* golden-section steps to a dip's bottom: 0.618^24 of two cells, 1e-5 rad */
 
 /* The smallest |branch quantity| of q and its index (NaN-safe: INFINITY for NaN). */
 static double nearest_branch(const om_solver_data *s, const double *q, int *index)
@@ -30,7 +32,8 @@ bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori)
 {
     const om_solver_data *s = pb->s;
     int branch = -1;
-    if (!(nearest_branch(s, q, &branch) < NEAR_BOUNDARY))
+    double nearest = nearest_branch(s, q, &branch);
+    if (!(nearest < NEAR_BOUNDARY))
         return false;
     bool srs = s->family == OM_SRS;
     om_polish_task t = {s->real_table, s->n_real_rows, s->dof, srs ? s->params : NULL,
@@ -41,16 +44,29 @@ bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori)
     om_polish(&t, POLISH_STEPS, q);
     if (om_verify(pb, q, pos, ori))
         return true;
-    if (branch != SHOULDER_SIGN)
+    if (branch == ELBOW_SIGN || (branch != SHOULDER_SIGN && !(nearest < SPLIT_NEAR)))
         return false;
     /* The wrist centre on joint 1's axis: the model's q1 is arbitrary there (atan2 of a
-     * vanishing pair), the real arm's is not. Starts around the circle of q1. */
-    for (int k = 1; k < SHOULDER_STARTS; k++) {
-        memcpy(q, start, (size_t)s->dof * sizeof(double));
-        q[0] = start[0] + 2.0 * OM_PI * (double)k / (double)SHOULDER_STARTS;
-        om_polish(&t, POLISH_STEPS, q);
-        if (om_verify(pb, q, pos, ori))
-            return true;
+     * vanishing pair), the real arm's is not: starts around the circle of q1. The wrist
+     * aligned (its middle joint m = dof - 2 at zero): the model splits q_{m-1} +- q_{m+1}
+     * by the previous q, the real arm's offsets do not: starts that turn q_{m-1} by a and
+     * q_{m+1} by -+a (the model's pose kept for either alignment of the two axes). */
+    bool shoulder = branch == SHOULDER_SIGN;
+    int m = s->dof - 2;
+    for (int k = 1; k < SPLIT_STARTS; k++) {
+        double a = 2.0 * OM_PI * (double)k / (double)SPLIT_STARTS;
+        for (int turn = shoulder ? 0 : -1; turn <= (shoulder ? 0 : 1); turn += 2) {
+            memcpy(q, start, (size_t)s->dof * sizeof(double));
+            if (shoulder) {
+                q[0] += a;
+            } else {
+                q[m - 1] += a;
+                q[m + 1] += (double)turn * a;
+            }
+            om_polish(&t, POLISH_STEPS, q);
+            if (om_verify(pb, q, pos, ori))
+                return true;
+        }
     }
     return false;
 }
@@ -79,6 +95,55 @@ static om_problem neighbour(const om_problem *pb, int i, int64_t *signs, double 
     other.t = om_target_at(s->family, s->params, &pb->t.R, redundancy); /* the target's psi with it */
     other.counter = 0;
     return other;
+}
+
+/* |branch quantity i| of the model's solution at free angle w (INFINITY out of reach); q gets it. */
+static double branch_at(om_problem *pb, int i, double w, double *q)
+{
+    double v[3];
+    if (om_model_ik_at(pb, w, q, true) < -OM_REACH_SLACK)
+        return INFINITY;
+    om_branch_values(pb->s->family, pb->s->params, q, v);
+    return isnan(v[i]) ? INFINITY : fabs(v[i]);
+}
+
+/* A dip of branch i between samples: where the model's branch quantity comes near zero, q_J
+ * swings and g has its narrow features (a close pair of roots inside one cell of the scan,
+ * a steep crossing). From a sample where |b_i| is a local minimum among the samples, golden
+ * section on [w - h, w + h] finds the dip's bottom w*; there the model's solution is refined
+ * on the real arm and the secant starts. Returns the root count. */
+static int dip_roots(om_problem *pb, int i, double w, double h, double *roots, int count)
+{
+    const double ratio = 0.6180339887498949;
+    double q[OM_MAX_DOF], a = w - h, b = w + h;
+    double c = b - ratio * (b - a), d = a + ratio * (b - a);
+    double fc = branch_at(pb, i, c, q), fd = branch_at(pb, i, d, q);
+    for (int it = 0; it < DIP_STEPS; it++) {
+        if (fc < fd) {
+            b = d;
+            d = c;
+            fd = fc;
+            c = b - ratio * (b - a);
+            fc = branch_at(pb, i, c, q);
+        } else {
+            a = c;
+            c = d;
+            fc = fd;
+            d = a + ratio * (b - a);
+            fd = branch_at(pb, i, d, q);
+        }
+    }
+    double bottom = fc < fd ? c : d;
+    if (!(branch_at(pb, i, bottom, q) < NEAR_BOUNDARY))
+        return count;
+    if (pb->s->mode == OM_CIRCLE)
+        q[pb->s->dp_joint] = bottom;
+    double start[OM_MAX_DOF], pos, ori;
+    bool complete = true;
+    memcpy(start, q, (size_t)pb->s->dof * sizeof(double));
+    if (om_local_solve(pb, start, &complete, q, &pos, &ori)) /* as a hint at the bottom would */
+        count = om_add_root(pb, q, roots, count);
+    return count;
 }
 
 /* Touch points: GATE_POINTS samples of the free angle w in the problem's own configuration.
@@ -115,6 +180,19 @@ static int touch_points(om_problem *pb, bool *near, double *roots)
             if (s->mode == OM_CIRCLE)
                 q[s->dp_joint] = w;
             count = om_add_candidate(pb, q, roots, count);
+        }
+        if (s->mode == OM_CIRCLE) { /* the local solve from this sample, as a hint there would start it */
+            om_secant(pb, w, q);
+            count = om_add_candidate(pb, q, roots, count);
+        }
+    }
+    for (int i = 0; i < s->n_signs && points > 1; i++) { /* the dips between samples */
+        for (int k = 0; k < points; k++) {
+            double v = fabs(values[k][i]), before = fabs(values[(k + points - 1) % points][i]);
+            double after = fabs(values[(k + 1) % points][i]);
+            if (v <= (isnan(before) ? INFINITY : before) && v <= (isnan(after) ? INFINITY : after)) /* not NaN */
+                count = dip_roots(pb, i, -OM_PI + 2.0 * OM_PI * (double)k / (double)points, 2.0 * OM_PI / points,
+                                  roots, count);
         }
     }
     bool seen = false; /* no sample within reach: nothing known, every neighbour is searched */

@@ -217,6 +217,12 @@ bool om_verify(om_problem *pb, const double *q, double *pos, double *ori); /* re
 int om_add_root(om_problem *pb, const double *q, double *roots, int count); /* roots: OM_MAX_ROOTS x dof */
 bool om_representative(double *q, int dof, const uint8_t *revolute, const double *lower, const double *upper,
                        const double *hint, bool has_hint);
+/* The hint as a solve uses it (dof entries into out): a revolute joint's value beyond
+ * HUGE_HINT (1e4 rad) reduced exactly into [-pi, pi] by remainder. A joint value of
+ * magnitude |h| carries rounding of ulp(|h|) / 2 (3e-11 rad at 3e5), which the FK's
+ * q + theta and two FKs' different sums turn into pose errors of 1e-10, and a local solve
+ * started there keeps that magnitude; at 1e4 rad the rounding is 1e-12. */
+void om_usable_hint(const om_solver_data *s, const double *hint, double *out);
 
 /* polish.c: damped Gauss-Newton on the REAL arm's chain toward the flange pose (R, p) in DH
  * frame 0 and, with P not NULL (an S-R-S model's parameters and model table), the arm angle psi. */
@@ -253,6 +259,11 @@ int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre
 /* The fixed-point start: where only q_J of it is known (*complete false), every joint of the
  * model IK at p_m = p_d (S-R-S: at the edge of reach beyond it) into start. */
 void om_complete_start(om_problem *pb, double *start, bool *complete);
+/* The paper's fixed-point start p_m = p_d, every joint: the model's IK at the target into
+ * start; where p_d is outside the model's reach, the elbow held at the edge of reach (S-R-S)
+ * or the point of the dp circle the model reaches with the smallest residual (q: scratch,
+ * dof). Returns whether there is a start. */
+bool om_fixed_point_start(om_problem *pb, double *q, double *start);
 bool om_local_solve(om_problem *pb, double *start, bool *start_complete, double *q, double *pos, double *ori);
 bool om_exists_other(om_problem *pb, bool skip_neighbours);
 bool om_nearest_in_window(om_problem *pb, const double *hint, double *q);

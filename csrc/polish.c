@@ -6,6 +6,7 @@
 
 #define POLISH_ROWS 7          /* pose (6) + the arm angle */
 #define POLISH_DAMPING 1e-12   /* initial lambda^2, relative to the largest diagonal of J J^T */
+#define POLISH_DAMPING_MIN 1e-18 /* its floor as steps succeed */
 #define POLISH_DAMPING_MAX 1e-2 /* a step refused at this damping ends the refinement */
 #define POLISH_DONE 1e-15      /* residual (m, rad) below which the refinement stops */
 
@@ -121,7 +122,7 @@ double om_polish(const om_polish_task *t, int iterations, double *q)
                 if (improved) {
                     memcpy(q, q_try, (size_t)dof * sizeof(double));
                     cost = residual(t, q, e, J);
-                    damping = py_max(damping / 10.0, POLISH_DAMPING);
+                    damping = py_max(damping / 10.0, POLISH_DAMPING_MIN);
                     break;
                 }
             }

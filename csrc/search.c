@@ -4,6 +4,7 @@
 
 #define TORUS_SIDE 0.75  /* the torus grid has TORUS_SIDE * scan points nodes per side */
 #define WINDOW_POINTS 8  /* samples of the window searched around a hint */
+#define START_POINTS 8   /* points of the dp circle tried when p_d is out of the model's reach */
 
 /* Bounded search: every verified solution in this configuration into roots (OM_MAX_ROOTS x
  * dof); returns the count. With radius < pi, only roots whose scanned joints lie within
@@ -64,6 +65,30 @@ void om_complete_start(om_problem *pb, double *start, bool *complete)
                                   true) < -OM_REACH_SLACK)
         om_srs_model_ik_at_reach(s->params, &pb->t, pb->p, pb->signs, pb->q_prev, start);
     *complete = true;
+}
+
+bool om_fixed_point_start(om_problem *pb, double *q, double *start)
+{
+    const om_solver_data *s = pb->s;
+    const int64_t *signs = pb->signs;
+    if (om_model_ik(s->family, s->params, s->model_table, &pb->t, pb->p, signs, pb->q_prev, start, true) >=
+        -OM_REACH_SLACK)
+        return true;
+    if (s->family == OM_SRS && s->mode != OM_FIXED) /* the elbow held at the edge of reach */
+        return om_srs_model_ik_at_reach(s->params, &pb->t, pb->p, signs, pb->q_prev, start);
+    if (s->mode != OM_CIRCLE)
+        return false;
+    bool found = false; /* the point of the dp circle the model reaches with the smallest residual */
+    double best = INFINITY;
+    for (int k = 0; k < START_POINTS; k++) {
+        double gk = om_g(pb, -OM_PI + 2.0 * OM_PI * (double)k / START_POINTS, q, true);
+        if (fabs(gk) < best) { /* false for NaN */
+            best = fabs(gk);
+            found = true;
+            memcpy(start, q, (size_t)s->dof * sizeof(double));
+        }
+    }
+    return found;
 }
 
 /* Local solve from the joint vector start, verified with the real arm: the secant on g from

@@ -2,7 +2,7 @@
  * (the method: om_redundant/om/system.py). */
 #include "om_system.h"
 
-#define START_POINTS 8 /* starts on the dp circle when p_d is out of reach or a first root out of limits */
+#define START_POINTS 8 /* starts on the dp circle where a first root is out of limits */
 
 /* The flange pose in DH frame 0 for an end-effector pose T (4x4 row-major) in the root frame. */
 void om_flange_target(const double *T, const double *T_base_root, const double *T_tool_flange, mat3 *R, vec3 *p)
@@ -110,13 +110,14 @@ om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *
                        const double *hint, double *q_out)
 {
     int family = s->family, mode = s->mode, dof = s->dof;
-    const double *P = s->params, *mtab = s->model_table;
+    const double *P = s->params;
     const uint8_t *revolute = s->revolute;
     const double *lower = s->lower, *upper = s->upper;
     bool has_hint = hint != NULL;
-    double zeros[OM_MAX_DOF] = {0.0};
-    if (!has_hint)
-        hint = zeros; /* what the Python side passes without a hint */
+    double zeros[OM_MAX_DOF] = {0.0}, usable[OM_MAX_DOF];
+    if (has_hint)
+        om_usable_hint(s, hint, usable);
+    hint = has_hint ? usable : zeros; /* zeros: what the Python side passes without a hint */
     om_problem problem;
     problem.s = s;
     double psi[1];
@@ -143,24 +144,7 @@ om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *
         found = om_srs_model_q7(P, &problem.t, pd, signs, problem.q_prev, start) >= -OM_REACH_SLACK ||
                 om_srs_model_q7_at_reach(P, &problem.t, pd, signs, problem.q_prev, start);
     } else if (!has_hint) { /* the paper's fixed-point start, p_m = p_d */
-        found = om_model_ik(family, P, mtab, &problem.t, pd, signs, problem.q_prev, start, true) >= -OM_REACH_SLACK;
-        if (!found && family == OM_SRS && mode != OM_FIXED) {
-            /* p_d is outside the model's reach: the elbow held at the edge of reach instead,
-             * a start for the lifted Newton (see local_solve). */
-            found = om_srs_model_ik_at_reach(P, &problem.t, pd, signs, problem.q_prev, start);
-        } else if (!found && mode == OM_CIRCLE) {
-            /* p_d is outside the model's reach: start from the point of the dp circle that
-             * the model reaches with the smallest residual. */
-            double best = INFINITY;
-            for (int k = 0; k < START_POINTS; k++) {
-                double gk = om_g(pb, -OM_PI + 2.0 * OM_PI * (double)k / START_POINTS, q, true);
-                if (fabs(gk) < best) { /* false for NaN */
-                    best = fabs(gk);
-                    found = true;
-                    memcpy(start, q, (size_t)dof * sizeof(double));
-                }
-            }
-        }
+        found = om_fixed_point_start(pb, q, start);
     }
     if (found) {
         bool verified = om_local_solve(pb, start, &start_complete, q, &pos, &ori);
@@ -246,9 +230,14 @@ int om_solve_all(const om_solver_data *s, const double *T, const int64_t *signs,
     problem.q_prev = zeros;
     problem.counter = 0;
     int n = om_all_roots(&problem, s->scan_points, roots, zeros, INFINITY);
-    bool neighbour_reached;
-    if (n == 0)
+    bool neighbour_reached, complete = true;
+    if (n == 0) { /* the band's roots, and what solve finds: its local solve from the fixed-point start */
         n = om_band_roots(&problem, roots, &neighbour_reached);
+        double q[OM_MAX_DOF], start[OM_MAX_DOF], pos, ori;
+        nan_fill(q, OM_MAX_DOF);
+        if (om_fixed_point_start(&problem, q, start) && om_local_solve(&problem, start, &complete, q, &pos, &ori))
+            n = om_add_root(&problem, q, roots, n);
+    }
     for (int r = 0; r < n; r++) {
         double root[OM_MAX_DOF];
         memcpy(root, roots + r * dof, (size_t)dof * sizeof(double));

@@ -5,6 +5,7 @@
 #define REDUNDANCY_TOL 1e-9 /* a solution's redundancy values (rad) must equal the requested ones */
 #define SRS_ELBOW_SIGN 1    /* (SHOULDER, ELBOW, WRIST) */
 #define MAX_VALUES 16       /* branch values of a family (3 today) */
+#define HUGE_HINT 1e4       /* rad: a revolute joint's hint beyond it is reduced exactly (remainder) first */
 
 bool om_in_configuration(const om_solver_data *s, const double *q, const int64_t *signs, const double *redundancy)
 {
@@ -93,4 +94,10 @@ bool om_representative(double *q, int dof, const uint8_t *revolute, const double
         inside = inside && found;
     }
     return inside;
+}
+
+void om_usable_hint(const om_solver_data *s, const double *hint, double *out)
+{
+    for (int j = 0; j < s->dof; j++)
+        out[j] = s->revolute[j] && fabs(hint[j]) > HUGE_HINT ? remainder(hint[j], 2.0 * OM_PI) : hint[j];
 }

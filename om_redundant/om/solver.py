@@ -240,7 +240,9 @@ class OMSolver:
             T: Target pose of the end-effector frame in the root frame: 4x4 or ``mink.SE3``.
             configuration: Branch signs (and redundancy values for redundant arms).
             q_hint: Optional joint vector; among several solutions the nearest is returned,
-                and 2 pi shifts are chosen nearest to it. Without a hint, a solution within
+                and 2 pi shifts are chosen nearest to it (a revolute joint's hint beyond
+                1e4 rad counts modulo 2 pi, reduced exactly: at that magnitude a joint value's
+                own rounding reaches the 1e-10 tolerances). Without a hint, a solution within
                 the joint limits is preferred.
 
         Returns:
