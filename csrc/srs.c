@@ -185,29 +185,35 @@ double om_srs_model_q7(const double *P, const om_target *t, vec3 p, const int64_
     return margin;
 }
 
-/* Joint 7 alone, as om_srs_model_ik_at_reach computes it; false, q untouched, only where W = S. */
-bool om_srs_model_q7_at_reach(const double *P, const om_target *t, vec3 p, const int64_t *signs,
-                              const double *q_prev, double *q)
+/* The model IK with the elbow held at the edge of reach beyond it: every joint, or joint 7 alone
+ * (as ik_with_elbow computes it); false, q untouched, only where W = S. */
+static bool at_reach(const double *P, const om_target *t, vec3 p, const int64_t *signs, const double *q_prev,
+                     double *q, bool every_joint)
 {
     vec3 w = v_add(p, t->wrist);
     double L2 = v_dot(w, w);
     if (L2 < DEGENERATE)
         return false;
-    q7_with_elbow(P, t, w, L2, (L2 - P[SRS_K0]) / P[SRS_K], signs, q_prev, q);
+    double x = (L2 - P[SRS_K0]) / P[SRS_K];
+    if (every_joint)
+        ik_with_elbow(P, t, w, L2, x, signs, q_prev, q, true);
+    else
+        q7_with_elbow(P, t, w, L2, x, signs, q_prev, q);
     return true;
 }
 
-/* om_srs_model_ik with the elbow held at the edge of reach beyond it (model_ik_at_reach);
- * false, q untouched, only where W = S. */
+/* Joint 7 alone, as om_srs_model_ik_at_reach computes it. */
+bool om_srs_model_q7_at_reach(const double *P, const om_target *t, vec3 p, const int64_t *signs,
+                              const double *q_prev, double *q)
+{
+    return at_reach(P, t, p, signs, q_prev, q, false);
+}
+
+/* om_srs_model_ik with the elbow held at the edge of reach beyond it (model_ik_at_reach). */
 bool om_srs_model_ik_at_reach(const double *P, const om_target *t, vec3 p, const int64_t *signs,
                               const double *q_prev, double *q)
 {
-    vec3 w = v_add(p, t->wrist);
-    double L2 = v_dot(w, w);
-    if (L2 < DEGENERATE)
-        return false;
-    ik_with_elbow(P, t, w, L2, (L2 - P[SRS_K0]) / P[SRS_K], signs, q_prev, q, true);
-    return true;
+    return at_reach(P, t, p, signs, q_prev, q, true);
 }
 
 /* The model IK with q1, q7 and the elbow angle phi4 given (phi4 NaN: the elbow root in the ELBOW

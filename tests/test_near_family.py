@@ -53,9 +53,15 @@ def check_exact(solver: om.OMSolver, q: np.ndarray, strict: bool) -> None:
 
 
 def well_conditioned(solver: om.OMSolver, q: np.ndarray) -> bool:
+    """Away from the singular boundaries: the map to (pose, psi) on a 7-DOF arm (its Jacobian
+    with the arm angle's gradient as a seventh row; a fold of the psi-constrained map is where
+    two roots of (T, c) meet), the pose map on a 6-DOF arm, and every branch quantity."""
     values = np.empty(len(solver.sign_names))
     ckernels.branch_values(solver.om.family, solver.om.params, solver.nominal.flip * q, values)
-    sigma = np.linalg.svd(solver.arm.jacobian(q), compute_uv=False)[-1]
+    jacobian = solver.arm.jacobian(q)
+    if solver.arm.dof == 7:
+        jacobian = np.vstack([jacobian, om.arm_angle_and_gradient(solver, q)[1]])
+    sigma = np.linalg.svd(jacobian, compute_uv=False)[-1]
     return sigma > WELL_CONDITIONED and np.abs(values).min() > WELL_CONDITIONED
 
 

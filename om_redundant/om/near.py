@@ -77,8 +77,14 @@ class NearKernel:
         return None
 
     def solve(self, T, signs, redundancy, hint, q_out) -> tuple[int, float, float, int, bool]:
-        """One solve: the root nearest the hint (without one, the first within the limits)."""
+        """One solve: the root nearest the hint (without one, the first within the limits).
+
+        The hint itself is a seed too: at a fold of the psi-constrained map the nominal arm may
+        lack the root next to the hint that the real arm has, and polish from the hint finds it."""
         roots, evals = self._roots(T, signs, redundancy)
+        if hint is not None:
+            roots, n = self._with_hint(T, signs, redundancy, hint, roots)
+            evals += n
         if not roots:
             q_out[:] = np.nan
             return self._failure(T, signs, redundancy), np.nan, np.nan, evals, False
@@ -148,6 +154,17 @@ class NearKernel:
             if roots:
                 break
         return roots, evals
+
+    def _with_hint(self, T, signs, redundancy, hint, roots) -> tuple[list, int]:
+        """The roots with the hint's own polished root added (if new), evaluations spent."""
+        T = system.as_kernel_array(T)
+        R, p = system.flange_target(T, self._T_base_root, self._T_tool_flange)
+        psi = float(redundancy[0]) if self._P is not None else 0.0
+        seed = self._flip * np.asarray(hint, dtype=np.float64)
+        found = self._refined(T, np.ascontiguousarray(R).ravel(), p, psi, seed, signs, redundancy)
+        if found is not None and all(_distance(found[0], q) >= SAME_ROOT for q, _, _ in roots):
+            roots = [*roots, found]
+        return roots, POLISH_ITERATIONS
 
     def _nominal_roots(self, T, signs, redundancy) -> tuple[list[np.ndarray], int]:
         """The nominal arm's roots of T in a configuration (nominal coordinates), evaluations."""

@@ -207,6 +207,9 @@ class Clearance:
         rbound = np.where(model.geom_rbound > 0.0, model.geom_rbound, np.inf)
         self._bounds = rbound[self._pairs[:, 0]] + rbound[self._pairs[:, 1]]
         self._bodies = model.geom_bodyid[self._pairs[:, 0]]
+        self._arm_geoms, self._obstacle_geoms = self._pairs[:, 0].copy(), self._pairs[:, 1].copy()
+        arm_bodies, self._body_index = np.unique(self._bodies, return_inverse=True)
+        self._arm_bodies = arm_bodies.tolist()
         self.pairs: tuple[tuple[str, str], ...] = tuple(
             (model.geom(a).name, model.geom(o).name) for a, o in self._pairs
         )
@@ -289,12 +292,11 @@ class Clearance:
         n_pairs = len(self._pairs)
         dist = np.full(n_pairs, reach)
         grad = np.zeros((n_pairs, self._dof))
-        a_all, o_all = self._pairs[:, 0], self._pairs[:, 1]
-        apart = np.linalg.norm(d.geom_xpos[a_all] - d.geom_xpos[o_all], axis=1) - self._bounds
-        near = np.flatnonzero(apart < reach)
+        apart = np.linalg.norm(d.geom_xpos[self._arm_geoms] - d.geom_xpos[self._obstacle_geoms], axis=1)
+        near = np.flatnonzero(apart - self._bounds < reach)
         fromto = np.zeros((len(near), 6))
-        for i, k in enumerate(near):
-            dist[k] = mujoco.mj_geomDistance(m, d, a_all[k], o_all[k], reach, fromto[i])
+        pairs = zip(self._arm_geoms[near].tolist(), self._obstacle_geoms[near].tolist(), fromto, strict=True)
+        dist[near] = [mujoco.mj_geomDistance(m, d, a, o, reach, row) for a, o, row in pairs]
         if not gradient:
             return dist, grad
         moving = (dist[near] < reach) & (dist[near] != 0.0)
@@ -304,15 +306,15 @@ class Clearance:
         mujoco.mj_comPos(m, d)
         normal = (fromto[:, 3:] - fromto[:, :3]) / dist[near, None]
         bodies = self._bodies[near]
-        jacp, jacr = np.zeros((3, m.nv)), np.zeros((3, m.nv))
         r = fromto[:, :3] - d.xpos[bodies]
         n_cross_r = (
             normal[:, _NEXT] * r[:, _PREVIOUS] - normal[:, _PREVIOUS] * r[:, _NEXT]
         )  # np.cross is slow
-        for b in set(bodies.tolist()):
-            mujoco.mj_jacBody(m, d, jacp, jacr, b)
-            on = bodies == b
-            grad[near[on]] = -normal[on] @ jacp[:, self._dofs] + n_cross_r[on] @ jacr[:, self._dofs]
+        jac = np.zeros((len(self._arm_bodies), 6, m.nv))  # each body's (J_v; J_omega)
+        for b in np.unique(self._body_index[near]).tolist():
+            mujoco.mj_jacBody(m, d, jac[b, :3], jac[b, 3:], self._arm_bodies[b])
+        jac = jac[:, :, self._dofs][self._body_index[near]]
+        grad[near] = np.einsum("ki,kij->kj", np.hstack([-normal, n_cross_r]), jac)
         return dist, grad
 
 

@@ -254,10 +254,16 @@ class Objective:
         )
 
     def _clearance(self, q: np.ndarray, jacobian: bool) -> Group:
-        floor = self.min_clearance / self.clearance_cap
-        return _capped(
-            "clearance", self.clearance_weight, floor, self.clearance, self.clearance_cap, q, jacobian
-        )
+        """The clearance pieces d_k / d_cap, computed only for the pairs within 2 d_cap (the
+        others report 2 with zero gradient: beyond the cap they change neither the term,
+        the slack's minimum nor, far above the floor, a feasibility model); all of them
+        exactly when no pair is that near, so that D(q) is exact."""
+        floor, cap = self.min_clearance / self.clearance_cap, self.clearance_cap
+        d, grad = self.clearance.distances_within(q, 2.0 * cap, gradient=jacobian)
+        if d.min() < 2.0 * cap:
+            scaled = grad / cap if jacobian else None
+            return Group("clearance", self.clearance_weight, floor, 1.0, d / cap, scaled)
+        return _capped("clearance", self.clearance_weight, floor, self.clearance, cap, q, jacobian)
 
     def _singularity(self, q: np.ndarray, jacobian: bool) -> Group:
         return _capped(

@@ -134,15 +134,23 @@ class Probe:
 
     def point(self, psi: float | np.ndarray, q: np.ndarray, solution: Solution | None = None) -> Point:
         """The point of solution q at psi, q at its representative (see the class)."""
-        q = np.where(self._centred, self._centre + _wrap(q - self._centre), q)
+        return self._point(psi, self._represent(q), solution)
+
+    def _represent(self, q: np.ndarray) -> np.ndarray:
+        return np.where(self._centred, self._centre + _wrap(q - self._centre), q)
+
+    def _point(self, psi: float | np.ndarray, q: np.ndarray, solution: Solution | None) -> Point:
         tangent = self_motion_tangent(self.solver, q)
         groups = [g.along(tangent) for g in self.objective.groups(q, jacobian=True)]
         return Point(psi, q, self.objective.evaluation(groups), groups, tangent, solution)
 
     def at(self, psi: float | np.ndarray, hint: np.ndarray) -> Point | None:
         """The solution at psi nearest ``hint``, if there is one."""
-        sol = self.solver.solve(self.T, Configuration(self.signs, tuple(np.atleast_1d(psi))), q_hint=hint)
+        sol = self._solve(psi, hint)
         return self.point(psi, sol.q, sol) if sol.ok else None
+
+    def _solve(self, psi: float | np.ndarray, hint: np.ndarray) -> Solution:
+        return self.solver.solve(self.T, Configuration(self.signs, tuple(np.atleast_1d(psi))), q_hint=hint)
 
     def continues(self, point: Point, other: Point) -> bool:
         r"""Whether ``other`` continues point's path: its joints moved at most :data:`JUMP` and
@@ -150,14 +158,21 @@ class Probe:
         :math:`|\Delta q - (dq/d\psi)\,\Delta\psi|_\infty \le \frac12 |\Delta q|_\infty`. (A
         solution on another path, however near, is off by the paths' separation, which no
         shorter step of psi shrinks.)"""
-        moved = self._delta(point.q, other.q)
-        error = moved - point.tangent @ np.atleast_1d(other.psi - point.psi)
+        return self._continues(point, other.psi, other.q)
+
+    def _continues(self, point: Point, psi: float | np.ndarray, q: np.ndarray) -> bool:
+        moved = self._delta(point.q, q)
+        error = moved - point.tangent @ np.atleast_1d(psi - point.psi)
         return np.abs(moved).max() <= JUMP and np.abs(error).max() <= 0.5 * np.abs(moved).max() + _SAME
 
     def next(self, point: Point, psi: float | np.ndarray) -> Point | None:
-        """The solution at psi nearest point, if it continues point's path."""
-        nxt = self.at(psi, point.q)
-        return nxt if nxt is not None and self.continues(point, nxt) else None
+        """The solution at psi nearest point, if it continues point's path (the objective
+        evaluated only then)."""
+        sol = self._solve(psi, point.q)
+        if not sol.ok:
+            return None
+        q = self._represent(sol.q)
+        return self._point(psi, q, sol) if self._continues(point, psi, q) else None
 
     def follow(self, start: Point, psi: float) -> tuple[Point, bool]:
         """Continue start's path towards psi (module docstring).

@@ -9,13 +9,18 @@ from ..om.solver import OMSolver
 from ..validation import as_joint_vector
 from .arm_angle import arm_angle_and_gradient, check_arm_angle
 
+_MINORS = np.array([[j for j in range(7) if j != i] for i in range(7)])  # J without column i
+_COFACTOR_SIGNS = (-1.0) ** np.arange(7)
+
 
 def self_motion_tangent(solver: OMSolver, q: np.ndarray) -> np.ndarray:
     r"""dq/dpsi: how the joints move per unit of the redundancy variables, hand fixed.
 
     The self-motion keeps the hand still, :math:`J(q)\,\dot q = 0`, so
-    :math:`\dot q = N a` with N (dof x r) an orthonormal basis of the null space of the
-    real arm's Jacobian J (6 x dof; its last r right singular vectors). The redundancy
+    :math:`\dot q = N a` with N (dof x r) a basis of the null space of the
+    real arm's Jacobian J (6 x dof; for r = 1 the vector of its signed 6x6 minors,
+    :math:`n_i = (-1)^i \det J_{(i)}` with column i removed, else its last r right singular
+    vectors; N's scale cancels below). The redundancy
     variables (the model's arm angle psi(q)) change by :math:`\dot\psi = D\psi(q)\,N a`, so
 
     .. math::  \frac{dq}{d\psi} = N\,\big(D\psi(q)\,N\big)^{-1},
@@ -39,13 +44,19 @@ def self_motion_tangent(solver: OMSolver, q: np.ndarray) -> np.ndarray:
     """
     check_arm_angle(solver)
     q = as_joint_vector(q, solver.arm.dof, stack=False)
-    null = np.linalg.svd(solver.arm.jacobian(q))[2][6:].T
+    jacobian = solver.arm.jacobian(q)
     gradient = arm_angle_and_gradient(solver, q)[1]
-    change = np.atleast_2d(gradient @ null)
-    try:
-        tangent = np.linalg.solve(change.T, null.T).T
-    except np.linalg.LinAlgError:
-        tangent = np.full_like(null, np.nan)
+    if jacobian.shape[1] == 7:  # one variable: the null vector of cofactors, n_i = (-1)^i det J_(i)
+        null = _COFACTOR_SIGNS * np.linalg.det(jacobian[:, _MINORS].transpose(1, 0, 2))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            tangent = (null / (gradient @ null))[:, None]
+    else:
+        null = np.linalg.svd(jacobian)[2][6:].T
+        change = np.atleast_2d(gradient @ null)
+        try:
+            tangent = np.linalg.solve(change.T, null.T).T
+        except np.linalg.LinAlgError:
+            tangent = np.full_like(null, np.nan)
     if not np.isfinite(tangent).all():
         raise SingularSelfMotion(
             f"the arm angle does not move along the self-motion at q = {np.round(q, 6).tolist()} "
