@@ -77,14 +77,8 @@ class NearKernel:
         return None
 
     def solve(self, T, signs, redundancy, hint, q_out) -> tuple[int, float, float, int, bool]:
-        """One solve: the root nearest the hint (without one, the first within the limits).
-
-        The hint itself is a seed too: at a fold of the psi-constrained map the nominal arm may
-        lack the root next to the hint that the real arm has, and polish from the hint finds it."""
-        roots, evals = self._roots(T, signs, redundancy)
-        if hint is not None:
-            roots, n = self._with_hint(T, signs, redundancy, hint, roots)
-            evals += n
+        """One solve: the root nearest the hint (without one, the first within the limits)."""
+        roots, evals = self._roots(T, signs, redundancy, hint)
         if not roots:
             q_out[:] = np.nan
             return self._failure(T, signs, redundancy), np.nan, np.nan, evals, False
@@ -122,14 +116,16 @@ class NearKernel:
 
     # -- the method -----------------------------------------------------------------------
 
-    def _roots(self, T, signs, redundancy) -> tuple[list[tuple[np.ndarray, float, float]], int]:
+    def _roots(self, T, signs, redundancy, hint=None) -> tuple[list[tuple[np.ndarray, float, float]], int]:
         """Verified roots (real coordinates, position and orientation errors), evaluations.
 
         Seeds, stage by stage until one leads to a root: the nominal roots in c; in every
         other configuration (near a branch boundary the real arm's root may be the nominal
         arm's in the neighbouring one); of the target pulled toward the base by ``PULL`` in
         every configuration (the real arm may reach a little farther than the nominal one).
-        A seed that polish does not bring home takes the fixed point on T D(q)."""
+        A seed that polish does not bring home takes the fixed point on T D(q). The hint, if
+        any, is a seed too: at a fold of the psi-constrained map the nominal arm may lack the
+        root next to the hint that the real arm has."""
         T = system.as_kernel_array(T)
         R, p = system.flange_target(T, self._T_base_root, self._T_tool_flange)
         R = np.ascontiguousarray(R).ravel()
@@ -149,22 +145,13 @@ class NearKernel:
                     if found is None:
                         start = self._fixed_point(T, seed, signs, redundancy)
                         found = self._refined(T, R, p, psi, start, signs, redundancy)
-                    if found is not None and all(_distance(found[0], q) >= SAME_ROOT for q, _, _ in roots):
-                        roots.append(found)
+                    _add_root(roots, found)
             if roots:
                 break
+        if hint is not None:
+            evals += POLISH_ITERATIONS
+            _add_root(roots, self._refined(T, R, p, psi, self._flip * hint, signs, redundancy))
         return roots, evals
-
-    def _with_hint(self, T, signs, redundancy, hint, roots) -> tuple[list, int]:
-        """The roots with the hint's own polished root added (if new), evaluations spent."""
-        T = system.as_kernel_array(T)
-        R, p = system.flange_target(T, self._T_base_root, self._T_tool_flange)
-        psi = float(redundancy[0]) if self._P is not None else 0.0
-        seed = self._flip * np.asarray(hint, dtype=np.float64)
-        found = self._refined(T, np.ascontiguousarray(R).ravel(), p, psi, seed, signs, redundancy)
-        if found is not None and all(_distance(found[0], q) >= SAME_ROOT for q, _, _ in roots):
-            roots = [*roots, found]
-        return roots, POLISH_ITERATIONS
 
     def _nominal_roots(self, T, signs, redundancy) -> tuple[list[np.ndarray], int]:
         """The nominal arm's roots of T in a configuration (nominal coordinates), evaluations."""
@@ -227,6 +214,12 @@ class NearKernel:
                     inside = False
             q[j] = best
         return q, inside
+
+
+def _add_root(roots: list, found: tuple[np.ndarray, float, float] | None) -> None:
+    """Append a verified root unless it is None or one already found (within SAME_ROOT)."""
+    if found is not None and all(_distance(found[0], q) >= SAME_ROOT for q, _, _ in roots):
+        roots.append(found)
 
 
 def _wrap(angle):
