@@ -190,11 +190,11 @@ double om_srs_model_q7(const double *P, const om_target *t, vec3 p, const int64_
 static bool at_reach(const double *P, const om_target *t, vec3 p, const int64_t *signs, const double *q_prev,
                      double *q, bool every_joint)
 {
-    vec3 w = v_add(p, t->wrist);
-    double L2 = v_dot(w, w);
-    if (L2 < DEGENERATE)
+    vec3 w;
+    double L2, x;
+    reach(P, t, p, &w, &L2, &x);
+    if (L2 < DEGENERATE) /* x not written */
         return false;
-    double x = (L2 - P[SRS_K0]) / P[SRS_K];
     if (every_joint)
         ik_with_elbow(P, t, w, L2, x, signs, q_prev, q, true);
     else

@@ -32,7 +32,7 @@ enum { O_PSI, O_STEP, O_CURVATURE, O_MARGIN, O_SINGULARITY, O_CLEARANCE, O_POS, 
 #define MAX_CURVATURE 1e3
 
 typedef struct {
-    int n, n_margin, n_clear, n_sing;
+    int n;
     double v[MAX_PIECES], a[MAX_PIECES];
     int group[MAX_PIECES];
 } pieces;
@@ -102,7 +102,6 @@ static void pieces_at(const tracking *tr, const double *q, const double *t, piec
         P->v[n] = (q[i] - tr->lower[i]) / h, P->a[n] = t[i] / h, P->group[n++] = 0;
         P->v[n] = (tr->upper[i] - q[i]) / h, P->a[n] = -t[i] / h, P->group[n++] = 0;
     }
-    P->n_margin = n;
     int n_clear = (int)tr->setup[S_N_CLEAR], n_sing = (int)tr->setup[S_N_SING];
     for (int k = 0; k < n_clear; k++) {
         const double *g = tr->clear_g + k * dof;
@@ -115,7 +114,7 @@ static void pieces_at(const tracking *tr, const double *q, const double *t, piec
         double x = q[j] + tr->sing_offset[k], sn = sin(x), cap = tr->setup[S_SING_CAP];
         P->v[n] = fabs(sn) / cap, P->a[n] = (sn < 0.0 ? -1.0 : 1.0) * cos(x) * t[j] / cap, P->group[n++] = 2;
     }
-    P->n = n, P->n_clear = n_clear, P->n_sing = n_sing;
+    P->n = n;
 }
 
 /* The right derivative of the model phi at d. */
@@ -199,13 +198,8 @@ static int track(const tracking *tr, const double *T, const int64_t *signs, cons
     for (int g = 0; g < 3; g++)
         if (active[g] >= 0 && low[g] < tr->cap[g]) y += tr->weight[g] * (P1.a[active[g]] - P0.a[active[g]]);
     if (fabs(d) > 1e-12 && isfinite(y)) b = fmin(fmax(-y / d, MIN_CURVATURE), MAX_CURVATURE);
-    double margin = INFINITY, sing = INFINITY, clear = INFINITY;
-    for (int j = 0; j < P1.n; j++) {
-        if (P1.group[j] == 0) margin = fmin(margin, P1.v[j]);
-        else if (P1.group[j] == 1) clear = fmin(clear, P1.v[j]);
-        else sing = fmin(sing, P1.v[j]);
-    }
-    double values[O_N] = {psi1, d, b, margin, sing, clear, r.position_error, r.orientation_error,
+    /* low: each group's smallest piece, the margin, clearance and singularity reported */
+    double values[O_N] = {psi1, d, b, low[0], low[2], low[1], r.position_error, r.orientation_error,
                           (double)r.evaluations, r.within_limits};
     memcpy(out, values, sizeof values);
     return TR_OK;
@@ -214,10 +208,8 @@ static int track(const tracking *tr, const double *T, const int64_t *signs, cons
 /* track_step(solver, T, signs, q_prev, setup, lower, upper, sing_joint, sing_offset, q_ref, clear_d,
  * clear_g, q_out, out) -> status: see tracking.py's TrackingWork for the layouts. */
 PyObject *om_track_step(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
-    if (nargs != 14) {
-        PyErr_Format(PyExc_TypeError, "track_step takes 14 arguments, got %zd", nargs);
+    if (check_nargs(nargs, 14, "track_step") < 0)
         return NULL;
-    }
     if (!PyObject_TypeCheck(args[0], &om_SolverType)) {
         PyErr_SetString(PyExc_TypeError, "track_step: solver must be a ckernels.Solver");
         return NULL;
@@ -228,34 +220,26 @@ PyObject *om_track_step(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) 
         return NULL;
     }
     Py_buffer v[13];
-    const struct {
-        int kind;
-        Py_ssize_t n;
-        int writable;
-        const char *name;
-    } sp[13] = {{F64, 16, 0, "T"},           {I64, s->n_signs, 0, "signs"}, {F64, 7, 0, "q_prev"},
+    const buffer_spec sp[13] = {{F64, 16, 0, "T"},           {I64, s->n_signs, 0, "signs"}, {F64, 7, 0, "q_prev"},
                 {F64, -1, 0, "setup"},       {F64, 7, 0, "lower"},          {F64, 7, 0, "upper"},
                 {F64, -1, 0, "sing_joint"},  {F64, -1, 0, "sing_offset"},   {F64, 7, 0, "q_ref"},
                 {F64, -1, 0, "clear_d"},     {F64, -1, 0, "clear_g"},       {F64, 7, 1, "q_out"},
                 {F64, O_N, 1, "out"}};
-    int got = 0;
-    for (; got < 13; got++)
-        if (get_buffer(args[got + 1], &v[got], sp[got].kind, sp[got].n, sp[got].writable, sp[got].name) < 0) break;
+    if (get_buffers(args + 1, v, sp, 13) < 0)
+        return NULL;
     int status = -1;
-    if (got == 13) {
-        const double *setup = v[3].buf;
-        Py_ssize_t n_sing = v[6].len / 8, n_clear = v[9].len / 8;
-        if (v[3].len < S_HEAD * 8 || setup[S_N_SING] != (double)n_sing || v[7].len != v[6].len ||
-            setup[S_N_CLEAR] != (double)n_clear || v[10].len != n_clear * 7 * 8 || 14 + n_clear + n_sing > MAX_PIECES)
-            PyErr_SetString(PyExc_ValueError, "track_step: sizes of setup, singularities and clearances disagree");
-        else {
-            tracking tr = {s, setup, v[4].buf, v[5].buf, v[6].buf, v[7].buf, v[8].buf, v[9].buf, v[10].buf,
-                           {setup[S_WM], setup[S_WC], setup[S_WS]}, {0.0, setup[S_FLOOR_C], -INFINITY},
-                           {INFINITY, 1.0, 1.0}};
-            status = track(&tr, v[0].buf, v[1].buf, v[2].buf, v[11].buf, v[12].buf);
-        }
+    const double *setup = v[3].buf;
+    Py_ssize_t n_sing = v[6].len / 8, n_clear = v[9].len / 8;
+    if (v[3].len < S_HEAD * 8 || setup[S_N_SING] != (double)n_sing || v[7].len != v[6].len ||
+        setup[S_N_CLEAR] != (double)n_clear || v[10].len != n_clear * 7 * 8 || 14 + n_clear + n_sing > MAX_PIECES)
+        PyErr_SetString(PyExc_ValueError, "track_step: sizes of setup, singularities and clearances disagree");
+    else {
+        tracking tr = {s, setup, v[4].buf, v[5].buf, v[6].buf, v[7].buf, v[8].buf, v[9].buf, v[10].buf,
+                       {setup[S_WM], setup[S_WC], setup[S_WS]}, {0.0, setup[S_FLOOR_C], -INFINITY},
+                       {INFINITY, 1.0, 1.0}};
+        status = track(&tr, v[0].buf, v[1].buf, v[2].buf, v[11].buf, v[12].buf);
     }
-    for (int i = 0; i < got; i++) PyBuffer_Release(&v[i]);
+    release_buffers(v, 13);
     return status < 0 ? NULL : PyLong_FromLong(status);
 }
 
