@@ -76,11 +76,6 @@ def import_arm(entry: Entry, folder: Path = MENAGERIE) -> tuple[om.Arm, mujoco.M
     return arm, om.load_mujoco_model(path)
 
 
-def import_reference(name: str) -> tuple[om.Arm, mujoco.MjModel]:
-    """The imported arm of a reference model, and the model (meshes and textures skipped)."""
-    return import_arm(REFERENCE[name])
-
-
 def frame_pose(model: mujoco.MjModel, data: mujoco.MjData, arm: om.Arm, q: np.ndarray) -> np.ndarray:
     """MuJoCo's own pose of the arm's frame at qpos = q (other joints, e.g. fingers, at qpos0)."""
     ids = [model.joint(n).id for n in arm.joint_names]

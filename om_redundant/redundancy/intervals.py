@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
+from .arm_angle import wrap_psi
 from .paths import END_TOLERANCE, Path, Point, Probe
 
 SLACK_TOLERANCE = 1e-12  # a refined end whose feasibility slack is this small is on the boundary
@@ -100,8 +101,7 @@ def _run(probe: Probe, path: Path, points: list[Point], k_first: int, k_last: in
             else after
         )
         points = [*points, refine_end(probe, points[-1], after)]
-    lo = math.remainder(points[0].psi, 2.0 * math.pi)
-    lo = -math.pi if lo >= math.pi else lo
+    lo = wrap_psi(points[0].psi)
     shift = lo - points[0].psi
     points = [replace(p, psi=p.psi + shift) for p in points]
     return Run(PsiInterval(probe.signs, lo, points[-1].psi), points)

@@ -44,6 +44,7 @@ from ..exceptions import InvalidInput
 from ..om.configuration import Configuration
 from ..om.solver import OMSolver, Solution
 from ..validation import as_count, as_instance, as_number, as_pose, as_signs
+from .arm_angle import wrap_psi
 from .clearance import DEFAULT_DISTMAX, Clearance, Shape
 from .climb import maximise
 from .intervals import PsiInterval, Run, feasible_runs
@@ -234,7 +235,7 @@ class RedundancyOptimizer:
         signs, (psi,) = previous.configuration.signs, previous.configuration.redundancy
         step = self._tracker.step(T, signs, psi, previous.solution.q, previous.curvature)
         if step is not None:
-            solution, _, margin, clearance, value, curvature = step
+            solution, margin, clearance, value, curvature = step
             return RedundancyChoice(
                 True, solution.configuration, solution, margin, clearance, value, (), curvature=curvature
             )
@@ -298,8 +299,7 @@ class RedundancyOptimizer:
 
     def _result(self, T: np.ndarray, best: tuple[Run, Point], runs: list[Run]) -> RedundancyChoice:
         run, point = best
-        psi = math.remainder(point.psi, 2.0 * math.pi)
-        configuration = Configuration(run.interval.signs, (-math.pi if psi >= math.pi else psi,))
+        configuration = Configuration(run.interval.signs, (wrap_psi(point.psi),))
         # The point's own solve (a batch sample is solved again, nearest itself), at the
         # point's representative of the joints: where psi has several roots near a singular
         # wrist, a fresh solve might return another one.

@@ -41,6 +41,7 @@ import numpy as np
 from .. import ckernels
 from ..om.configuration import Configuration
 from ..om.solver import OMSolver, Solution
+from .arm_angle import wrap_psi
 from .objective import SINGULARITY_CAP, Objective
 
 #: Curvature b of the first tracking step's model (per rad^2).
@@ -128,11 +129,11 @@ class Tracker:
 
     def step(
         self, T: np.ndarray, signs: tuple[int, ...], psi: float, q: np.ndarray, curvature: float
-    ) -> tuple[Solution, float, float, float, float, float] | None:
+    ) -> tuple[Solution, float, float, float, float] | None:
         """One tracking step from (signs, psi, q) to pose T.
 
         Returns:
-            (solution, psi, margin, clearance, value, curvature) at the new psi, or None when
+            (solution, margin, clearance, value, curvature) at the new psi, or None when
             the step cannot be taken or lands on an infeasible point (module docstring).
         """
         if self._kernel is None:
@@ -162,8 +163,7 @@ class Tracker:
             value += objective.clearance_weight * min(1.0, clearance / objective.clearance_cap)
         if not (margin >= 0.0 and clearance >= objective.min_clearance):
             return None
-        psi_new = math.remainder(out[_O_PSI], 2.0 * math.pi)
-        configuration = Configuration(signs, (-math.pi if psi_new >= math.pi else psi_new,))
+        configuration = Configuration(signs, (wrap_psi(out[_O_PSI]),))
         solution = Solution(
             q_new,
             True,
@@ -174,7 +174,7 @@ class Tracker:
             int(out[_O_EVALS]),
             bool(out[_O_WITHIN]),
         )
-        return solution, out[_O_PSI], margin, clearance, value, out[_O_CURVATURE]
+        return solution, margin, clearance, value, out[_O_CURVATURE]
 
     def _linearise_at(self, q: np.ndarray) -> None:
         """The clearances and their gradients at q, over d_cap, into the work arrays (those
