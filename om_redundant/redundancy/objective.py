@@ -218,6 +218,8 @@ class Objective:
         self.margin_weight, self.clearance_weight = float(margin_weight), float(clearance_weight)
         self.singularity_weight = float(singularity_weight)
         self.clearance_cap, self.min_clearance = float(clearance_cap), float(min_clearance)
+        #: 2 d_cap: pairs farther apart change neither the capped term nor the slack's minimum.
+        self.clearance_reach = 2.0 * self.clearance_cap
         self._limited = np.flatnonzero(np.isfinite(arm.lower) & np.isfinite(arm.upper))
         self._lower, self._upper = arm.lower[self._limited], arm.upper[self._limited]
         self._half = (self._upper - self._lower) / 2.0
@@ -259,8 +261,8 @@ class Objective:
         the slack's minimum nor, far above the floor, a feasibility model); all of them
         exactly when no pair is that near, so that D(q) is exact."""
         floor, cap = self.min_clearance / self.clearance_cap, self.clearance_cap
-        d, grad = self.clearance.distances_within(q, 2.0 * cap, gradient=jacobian)
-        if d.min() < 2.0 * cap:
+        d, grad = self.clearance.distances_within(q, self.clearance_reach, gradient=jacobian)
+        if d.min() < self.clearance_reach:
             scaled = grad / cap if jacobian else None
             return Group("clearance", self.clearance_weight, floor, 1.0, d / cap, scaled)
         return _capped("clearance", self.clearance_weight, floor, self.clearance, cap, q, jacobian)

@@ -124,7 +124,6 @@ class Tracker:
         )
         # An arm near a family solves through om.near.NearKernel: no compiled tracking step.
         self._kernel = solver.kernel if isinstance(solver.kernel, ckernels.Solver) else None
-        self._reach = 2.0 * objective.clearance_cap  # capped pieces beyond it change nothing
         self._last: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # q, values, gradients
 
     def step(
@@ -155,10 +154,10 @@ class Tracker:
         if work.singular_joints.size:
             value += objective.singularity_weight * min(1.0, out[_O_SINGULARITY])
         if objective.clearance is not None:
-            d, grad = objective.clearance.distances_within(q_new, self._reach, gradient=True)
+            d, grad = objective.clearance.distances_within(q_new, objective.clearance_reach, gradient=True)
             self._last = (q_new, d, grad)
             clearance = float(d.min())
-            if clearance >= self._reach:  # every pair beyond the reach: D itself, uncapped
+            if clearance >= objective.clearance_reach:  # every pair beyond the reach: D itself, uncapped
                 clearance = objective.clearance.minimum(q_new)
             value += objective.clearance_weight * min(1.0, clearance / objective.clearance_cap)
         if not (margin >= 0.0 and clearance >= objective.min_clearance):
@@ -181,7 +180,9 @@ class Tracker:
         of the last step's result when q is its joints)."""
         last = self._last
         if last is None or not np.array_equal(last[0], q):
-            d, grad = self.objective.clearance.distances_within(q, self._reach, gradient=True)
+            d, grad = self.objective.clearance.distances_within(
+                q, self.objective.clearance_reach, gradient=True
+            )
             last = (q, d, grad)
         cap = self.objective.clearance_cap
         work = self.work
