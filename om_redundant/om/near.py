@@ -37,8 +37,11 @@ POLISH_ITERATIONS = 30
 FIXED_POINT_STEPS = 20
 #: Joint-space distance (rad) under which two roots are one (csrc's OM_SAME_ROOT).
 SAME_ROOT = 1e-9
-#: Fractions by which a target the seeds do not lead to is pulled toward the base.
-PULL = (1e-4, 1e-3, 1e-2)
+#: Fractions by which a target the seeds do not lead to is pulled toward the base (positive)
+#: or pushed away from it (negative): a fold of the real arm's roots in c may lie on either
+#: side of the nominal arm's (the edge of reach, where the real arm reaches a little farther,
+#: or an inner fold, where two roots in c meet and the nominal arm's pair begins farther out).
+PULL = (1e-4, -1e-4, 1e-3, -1e-3, 1e-2, -1e-2)
 
 
 class NearKernel:
@@ -121,8 +124,9 @@ class NearKernel:
 
         Seeds, stage by stage until one leads to a root: the nominal roots in c; in every
         other configuration (near a branch boundary the real arm's root may be the nominal
-        arm's in the neighbouring one); of the target pulled toward the base by ``PULL`` in
-        every configuration (the real arm may reach a little farther than the nominal one).
+        arm's in the neighbouring one); of the target pulled toward the base or pushed away
+        from it by ``PULL`` in every configuration (at a fold the real arm may reach a little
+        farther, or less far, than the nominal one).
         A seed that polish does not bring home takes the fixed point on T D(q). The hint, if
         any, is a seed too: at a fold of the psi-constrained map the nominal arm may lack the
         root next to the hint that the real arm has."""
@@ -231,7 +235,8 @@ def _distance(a: np.ndarray, b: np.ndarray) -> float:
 
 
 def _pulled(T: np.ndarray, fraction: float) -> np.ndarray:
-    """T with its position pulled toward the root frame's origin by a fraction of it."""
+    """T with its position pulled toward the root frame's origin by a fraction of it (pushed
+    away from it for a negative fraction)."""
     pulled = T.copy()
     pulled[:3, 3] *= 1.0 - fraction
     return pulled
