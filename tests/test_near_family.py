@@ -13,6 +13,7 @@ from hypothesis import strategies as st
 
 import om_redundant as om
 from benchmarks.near_family import bent, fixed_row_between, reversed_joint
+from om_redundant import ckernels
 from om_redundant.om.nominal import NEAR_TWIST, nominal_arm
 from tests.conftest import EXACT, check_exact, random_q, well_conditioned, wrap
 
@@ -151,3 +152,25 @@ def test_the_redundancy_optimizer_tracks_on_a_near_arm(arm):
         T = T.copy()
         T[0, 3] += 0.002
         choice = optimizer.choose(T, choice)
+
+
+@pytest.mark.parametrize(
+    "q",
+    [
+        [-3.726494, -2.316568, 1.573041, -2.759467, -0.186096, 6.041126],
+        [-4.343524, -0.54011, -2.23673, 2.731576, -2.810936, -4.597611],
+        [-3.802659, -1.229439, -0.717211, 1.431248, -3.138834, -5.020617],
+        [4.922068, -0.86922, -1.477057, -6.033637, -2.654594, 3.527687],
+    ],
+)
+def test_targets_at_the_shoulder_boundary_of_a_near_arm(q):
+    """The wrist centre within 2 mm of the cylinder of the lateral offset about joint 1's axis
+    (the ARM quantity, twists 2e-4 rad off, as on the Doosan M1013): c may hold two real roots
+    where the nominal arm has one in c and one in the neighbouring configuration, or none at
+    all (near.BOUNDARY seeds, near.SHIFT and the fold partners). Each missed q before."""
+    solver = bent_solver("ur5e", np.log10(2e-4), 0)
+    q = np.array(q)
+    values = np.empty(3)
+    ckernels.branch_values(solver.om.family, solver.om.params, solver.flip * q, values)
+    assert abs(values[0]) < 2e-3
+    check_exact(solver, q, strict=True)
