@@ -139,13 +139,13 @@ class NearKernel:
         """Verified roots (real coordinates, position and orientation errors), evaluations.
 
         Seeds, stage by stage until one leads to a root: the nominal roots in c, and those of
-        the other configurations within :data:`BOUNDARY` of c's branches (there c may hold
-        two real roots, one of which the nominal arm has in the neighbouring configuration); in every
+        the neighbouring configurations (one branch flipped) within :data:`BOUNDARY` of it (c
+        may hold two real roots where the nominal arm has one in c and one there); in every
         other configuration (near a branch boundary the real arm's root may be the nominal
         arm's in the neighbouring one); of the target pulled toward the base by ``PULL`` in
         every configuration (the real arm may reach a little farther than the nominal one);
         then, whatever the stages found, in c, of the target pushed away from the base by
-        ``PULL`` or shifted by ``SHIFT`` along each axis (a fold of the roots in c in another
+        ``PUSH`` or shifted by ``SHIFT`` along each axis (a fold of the roots in c in another
         direction, which may lie beside roots already found). Every exact root, in c or
         (reached from another configuration's seed) not, is searched for a fold partner in c.
         A seed that polish does not bring home takes the fixed point on T D(q). The hint, if
