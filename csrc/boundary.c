@@ -47,7 +47,7 @@ bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori)
     om_polish(&t, POLISH_STEPS, q);
     if (om_verify(pb, q, pos, ori))
         return true;
-    if (branch == ELBOW_SIGN || (branch != SHOULDER_SIGN && !(nearest < SPLIT_NEAR)))
+    if (branch == ELBOW_SIGN || !(nearest < SPLIT_NEAR))
         return false;
     /* The wrist centre on joint 1's axis: the model's q1 is arbitrary there (atan2 of a
      * vanishing pair), the real arm's is not: starts around the circle of q1. The wrist
@@ -182,25 +182,42 @@ static int wrist_bracket(om_problem *pb, double in, double r_in, double e, doubl
     return om_add_candidate(pb, q, roots, count);
 }
 
+/* Whether the model may reach some point between two samples it reaches at neither: where
+ * the margin, which can peak between them by about its change across a cell (this one's or a
+ * neighbour's, ms cyclic of n), could reach zero (as the circle search's island test). */
+static bool island_possible(const double *ms, int k, int n)
+{
+    double a = ms[k], b = ms[(k + 1) % n];
+    double change = py_max(fabs(b - a), py_max(fabs(a - ms[(k + n - 1) % n]), fabs(ms[(k + 2) % n] - b)));
+    return py_max(a, b) + change > 0.0;
+}
+
 /* A 6-DOF circle arm's roots from the wrist's consistency residual r(w) with q_J = w given
  * (om_wrist_residual): smooth where the model's wrist is singular, where g's q_J is the
  * arbitrary split of the aligned wrist (g may then miss zero by far over a whole run of
  * reach, the wrist aligned all along it). r is sampled at the scan points; a sign change
  * between two samples, or between a sample and the edge of reach, is bisected; a cell with
- * both ends out of reach is searched from the maximum of the reach margin inside it. Its
- * roots hold either WRIST sign (verified in the problem's). Returns the root count. */
+ * both ends out of reach is searched from the maximum of the reach margin inside it where
+ * the margin may reach zero. Its roots hold either WRIST sign (verified in the problem's).
+ * Returns the root count. */
 static int wrist_roots(om_problem *pb, double *roots, int count)
 {
     int n = pb->s->scan_points;
     double q[OM_MAX_DOF], h = 2.0 * OM_PI / (double)n;
-    double a = -OM_PI, ra = om_wrist_residual(pb, a, q);
-    for (int k = 1; k <= n; k++) {
-        double b = -OM_PI + h * (double)k, rb = om_wrist_residual(pb, b, q);
+    double *rs = malloc(2 * (size_t)n * sizeof(double)), *ms = rs + n;
+    if (!rs)
+        return count;
+    for (int k = 0; k < n; k++) {
+        rs[k] = om_wrist_residual(pb, -OM_PI + h * (double)k, q);
+        ms[k] = isnan(rs[k]) ? om_reach_margin(pb, -OM_PI + h * (double)k, q) : 0.0;
+    }
+    for (int k = 0; k < n; k++) {
+        double a = -OM_PI + h * (double)k, b = a + h, ra = rs[k], rb = rs[(k + 1) % n];
         if (!isnan(ra))
             count = wrist_bracket(pb, a, ra, b, rb, roots, count);
         else if (!isnan(rb))
             count = wrist_bracket(pb, b, rb, a, ra, roots, count);
-        else { /* an island of reach between two unreachable samples */
+        else if (island_possible(ms, k, n)) {
             double gc, c = om_extremum(pb, a, b, 0.5 * (a + b), 1.0, true, q, &gc, NULL);
             double rc = isnan(gc) ? NAN : om_wrist_residual(pb, c, q);
             if (!isnan(rc)) {
@@ -208,9 +225,8 @@ static int wrist_roots(om_problem *pb, double *roots, int count)
                 count = wrist_bracket(pb, c, rc, b, NAN, roots, count);
             }
         }
-        a = b;
-        ra = rb;
     }
+    free(rs);
     return count;
 }
 
