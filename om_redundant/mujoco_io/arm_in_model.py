@@ -89,7 +89,7 @@ class ArmJoints:
 
     def within_limits(self, q: np.ndarray) -> bool:
         """Whether the arm's joint vector q is within :attr:`lower` and :attr:`upper`."""
-        return bool(np.all((q >= self.lower) & (q <= self.upper)))
+        return bool(((q >= self.lower) & (q <= self.upper)).all())
 
     def nearest_turn(self, q_target: np.ndarray, q: np.ndarray) -> np.ndarray:
         """q_target with each revolute joint shifted by a multiple of 2 pi to the value nearest

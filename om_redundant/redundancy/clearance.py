@@ -194,7 +194,9 @@ class Clearance:
         self.distmax = as_positive(distmax, "distmax")
         self._data = mujoco.MjData(model)
         joints = ArmJoints(arm, model, prefix)
-        self._qpos = joints.qpos_ids
+        ids = joints.qpos_ids
+        consecutive = np.array_equal(ids, np.arange(ids[0], ids[0] + len(ids)))
+        self._qpos = slice(int(ids[0]), int(ids[0]) + len(ids)) if consecutive else ids  # a slice sets faster
         self._dofs = joints.dof_ids
         moving = _subtree(model, model.jnt_bodyid[joints.joint_ids[0]])
         arm_geoms = [
@@ -305,8 +307,8 @@ class Clearance:
             for k in np.flatnonzero(np.isnan(dist)).tolist():
                 a, o = self._pairs[k].tolist()
                 dist[k] = mujoco.mj_geomDistance(m, d, a, o, reach, fromto[k])
-        grad = np.zeros((n_pairs, self._dof))
-        if gradient:
+        grad = np.empty((n_pairs, self._dof)) if gradient else np.zeros((n_pairs, self._dof))
+        if gradient:  # every row written
             ckernels.distance_gradients(
                 dist, fromto, reach, d.xanchor, d.xaxis, geoms.joints, geoms.slide, geoms.moves, grad
             )
