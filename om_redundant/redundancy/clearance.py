@@ -215,6 +215,19 @@ class Clearance:
         self.pairs: tuple[tuple[str, str], ...] = tuple(
             (model.geom(a).name, model.geom(o).name) for a, o in self._pairs
         )
+        #: A bound (m, at least 1) on every |dd_k/dq_i|: a point of an arm geom lies at most
+        #: this far from any joint's axis (the bodies' offsets, the joints' anchors, the
+        #: farthest geom point from its body's origin, summed), and a prismatic joint moves
+        #: it at unit speed.
+        geom_reach = np.linalg.norm(model.geom_pos[arm_geoms], axis=1) + rbound[arm_geoms]
+        self.lever = max(
+            1.0,
+            float(
+                np.linalg.norm(model.body_pos[moving], axis=1).sum()
+                + np.linalg.norm(model.jnt_pos[joints.joint_ids], axis=1).sum()
+                + geom_reach.max(initial=0.0)
+            ),
+        )
 
     @classmethod
     def for_arm(
@@ -275,6 +288,34 @@ class Clearance:
             (P,) distances and (P, dof) gradients, in the order of :attr:`pairs`.
         """
         return self._evaluate(q, gradient, min(as_positive(reach, "reach"), self.distmax))
+
+    def minima(self, q: np.ndarray) -> np.ndarray:
+        r"""The clearance D(q) of every row of q, as :meth:`minimum` gives it, computing few pairs.
+
+        Each geom contains its centre, so the centres' distance :math:`c_k` bounds a pair's
+        distance from above and :math:`c_k - r_k` (the bounding-sphere radii) from below: only
+        the pairs with :math:`c_k - r_k \le \min_j c_j` can be the smallest. The bounds of all
+        rows are one vectorised test on the geoms' centres.
+
+        Args:
+            q: (M, dof) joint vectors.
+
+        Returns:
+            (M,) clearances in metres (at most ``distmax``).
+        """
+        q = as_joint_vector(q, self._dof).reshape(-1, self._dof)
+        m, d = self.model, self._data
+        centres = np.empty((len(q), m.ngeom, 3))
+        for row, xpos in zip(q, centres, strict=True):
+            d.qpos[self._qpos] = row
+            mujoco.mj_kinematics(m, d)
+            xpos[:] = d.geom_xpos
+        apart = np.linalg.norm(centres[:, self._pairs[:, 0]] - centres[:, self._pairs[:, 1]], axis=2)
+        candidates = apart - self._geoms.bounds <= np.minimum(apart.min(axis=1), self.distmax)[:, None]
+        out = np.full(len(q), self.distmax)
+        for i in np.flatnonzero(candidates.any(axis=1)).tolist():
+            out[i] = self._evaluate(q[i], gradient=False)[0].min()  # the compiled pairs, as minimum()
+        return out
 
     def _evaluate(
         self, q: np.ndarray, gradient: bool, reach: float | None = None
