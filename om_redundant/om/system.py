@@ -12,6 +12,8 @@ seen from the flange and depends on one wrist joint, :math:`w = q_J` (see
 
 and a root gives the real arm's joints :math:`q = \mathrm{IK}_{model}(\ldots)` with
 :math:`|p_{real}(q) - p_d| = |\delta(w) - \delta(q_J)| \le \Delta p_{max}\,|g(w)|`.
+A 6-DOF wrist with :math:`a_4 \ne 0` has the circle :math:`p_m = p_d + \Delta p(w)`,
+:math:`w = q_1`, instead (:mod:`om_redundant.om.model`, ``csrc/wrist_offset.c``).
 
 Arms with shoulder offsets (Gen3, Sawyer) add :math:`a(q_1)`, so solutions lie on a torus
 :math:`(w_1, w_7) = (q_1, q_7)`: :math:`p_m = p_d + a(w_1) + R_d\,\delta(w_7)`. There the
