@@ -41,7 +41,7 @@ bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori)
     bool srs = s->family == OM_SRS;
     om_polish_task t = {s->real_table, s->n_real_rows, s->dof, srs ? s->params : NULL,
                         srs ? s->model_table : NULL, s->n_model_rows, pb->t.R, pb->p,
-                        srs ? pb->redundancy[0] : 0.0, srs ? (double)pb->signs[ELBOW_SIGN] : 0.0};
+                        srs ? pb->redundancy[0] : 0.0, srs ? (double)pb->signs[ELBOW_SIGN] : 0.0, true};
     double start[OM_MAX_DOF];
     memcpy(start, q, (size_t)s->dof * sizeof(double));
     om_polish(&t, POLISH_STEPS, q);

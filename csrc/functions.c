@@ -303,6 +303,7 @@ static PyObject *k_polish(PyObject *mod, PyObject *const *args, Py_ssize_t nargs
     t.p = load_vec(v[2].buf);
     t.psi = psi;
     t.elbow = 0.0;
+    t.give_up_crawl = false;
     double r;
     Py_BEGIN_ALLOW_THREADS r = om_polish(&t, (int)iterations, v[3].buf);
     Py_END_ALLOW_THREADS release_buffers(v, with_psi ? 6 : 4);

@@ -239,6 +239,7 @@ typedef struct {
     vec3 p;
     double psi;
     double elbow; /* psi read in this ELBOW branch (+-1); 0: in q's own */
+    bool give_up_crawl; /* stop a crawl far from a root (see om_polish) */
 } om_polish_task;
 
 /* Refine q in place (at most `iterations` Jacobians); returns the residual's norm at the end. */

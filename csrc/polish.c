@@ -9,6 +9,8 @@
 #define POLISH_DAMPING_MIN 1e-18 /* its floor as steps succeed */
 #define POLISH_DAMPING_MAX 1e-2 /* a step refused at this damping ends the refinement */
 #define POLISH_DONE 1e-15      /* residual (m, rad) below which the refinement stops */
+#define POLISH_WINDOW 10       /* Jacobians over which |e| must at least halve while above POLISH_FAR */
+#define POLISH_FAR 1e-6        /* residual (m, rad) above which a crawl is given up */
 
 static const double IDENTITY[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
 
@@ -82,7 +84,10 @@ static bool cholesky_solve(double *A, double *b, int n)
 /* Refine q in place by damped Gauss-Newton steps dq = J^T (J J^T + lambda^2 I)^-1 e: the
  * minimum-norm step, well defined where J loses rank (the singular boundary). lambda grows
  * by 100 on a step that does not lower |e| and shrinks by 10 on one that does; at most
- * `iterations` Jacobians. Returns |e| at the end (q is only ever replaced by a better one). */
+ * `iterations` Jacobians; with t->give_up_crawl, none more once |e|, still above POLISH_FAR,
+ * has not halved over the last POLISH_WINDOW (near a root, even a double one, it falls by far
+ * more; far from one, that is a crawl along a valley of |e| that does not reach zero).
+ * Returns |e| at the end (q is only ever replaced by a better one). */
 double om_polish(const om_polish_task *t, int iterations, double *q)
 {
     int dof = t->dof, rows = t->P ? 7 : 6;
@@ -90,7 +95,13 @@ double om_polish(const om_polish_task *t, int iterations, double *q)
     double y[POLISH_ROWS], q_try[OM_MAX_DOF];
     double cost = residual(t, q, e, J);
     double damping = POLISH_DAMPING;
+    double window_cost = cost; /* the cost POLISH_WINDOW Jacobians ago */
     for (int it = 0; it < iterations && cost > POLISH_DONE * POLISH_DONE && isfinite(cost); it++) {
+        if (it > 0 && it % POLISH_WINDOW == 0) { /* a crawl, not a root's convergence */
+            if (t->give_up_crawl && cost > POLISH_FAR * POLISH_FAR && cost > 0.25 * window_cost)
+                break;
+            window_cost = cost;
+        }
         double scale = 0.0;
         for (int a = 0; a < rows; a++) {
             double d = 0.0;
