@@ -61,8 +61,8 @@ def test_batched_tangents_equal_the_single_ones(seed, name):
 @given(seed=st.integers(0, 2**32 - 1), name=st.sampled_from(list(HOMES)), count=st.sampled_from([1, 3]))
 def test_constraint_bounds_bound_the_feasibility_functions_and_their_rates(seed, name, count):
     """Objective.constraint_bounds: the margin entries are the margin feasibility functions
-    and their rates' sizes exactly; the clearance entry is at most every clearance function,
-    and its rate bound (Clearance.lever) at least every clearance function's rate."""
+    and their rates' sizes exactly; the clearance entries are at most the clearance
+    functions, and their rate bounds (Clearance.pair_bounds) at least their rates."""
     optimizer = optimizer_of(name, count)
     objective, solver = optimizer.objective, optimizer.solver
     for row in joints(optimizer, seed, 10):
@@ -72,6 +72,21 @@ def test_constraint_bounds_bound_the_feasibility_functions_and_their_rates(seed,
         margin, clearance = (g.constraints() for g in groups[:2])
         np.testing.assert_allclose(values[exact], margin[0], rtol=0, atol=1e-15)
         np.testing.assert_allclose(rates[exact], np.abs(margin[1]), rtol=1e-15, atol=0)
-        ((value,), (rate,)) = values[~exact], rates[~exact]
-        assert (clearance[0] >= value - 1e-15).all()
-        assert (np.abs(clearance[1]) <= rate).all()
+        assert (clearance[0] >= values[~exact] - 1e-12).all()
+        assert (np.abs(clearance[1]) <= rates[~exact] * (1 + 1e-9) + 1e-12).all()
+
+
+@settings(max_examples=6, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), name=st.sampled_from(list(HOMES)))
+def test_pair_bounds_bound_the_distances_and_their_rates(seed, name):
+    """Clearance.pair_bounds: below every pair's exact distance, and above the size of its
+    derivative along any joint velocity (a random one and the self-motion)."""
+    optimizer = optimizer_of(name, 3)
+    clearance = optimizer.objective.clearance
+    rng = np.random.default_rng(seed)
+    for row in joints(optimizer, seed, 10):
+        d, grad = clearance.distances_and_gradients(row)
+        for rate in (rng.normal(size=len(row)), om.self_motion_tangent(optimizer.solver, row)[:, 0]):
+            lower, speed = clearance.pair_bounds(row, rate)
+            assert (np.minimum(lower, clearance.distmax) <= d + 1e-12).all()  # d: at most distmax
+            assert (np.abs(grad @ rate) <= speed * (1 + 1e-9) + 1e-12).all()

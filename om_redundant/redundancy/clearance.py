@@ -213,19 +213,8 @@ class Clearance:
         self.pairs: tuple[tuple[str, str], ...] = tuple(
             (model.geom(a).name, model.geom(o).name) for a, o in self._pairs
         )
-        #: A bound (m, at least 1) on every |dd_k/dq_i|: a point of an arm geom lies at most
-        #: this far from any joint's axis (the bodies' offsets, the joints' anchors, the
-        #: farthest geom point from its body's origin, summed), and a prismatic joint moves
-        #: it at unit speed.
-        geom_reach = np.linalg.norm(model.geom_pos[arm_geoms], axis=1) + rbound[arm_geoms]
-        self.lever = max(
-            1.0,
-            float(
-                np.linalg.norm(model.body_pos[moving], axis=1).sum()
-                + np.linalg.norm(model.jnt_pos[joints.joint_ids], axis=1).sum()
-                + geom_reach.max(initial=0.0)
-            ),
-        )
+        self._arm_rbound = rbound[self._arm_geoms]
+        self._roots = model.body_rootid[self._bodies]
 
     @classmethod
     def for_arm(
@@ -319,6 +308,40 @@ class Clearance:
             pairs = zip(arm, obstacle, strict=True)
             out[i] = min(mujoco.mj_geomDistance(m, d, a, o, self.distmax, None) for a, o in pairs)
         return out
+
+    def pair_bounds(self, q: np.ndarray, rate: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        r"""Bounds of every pair's distance and of its rate when the joints move at ``rate``.
+
+        The lower bound is the geoms' centres' distance less their bounding-sphere radii.
+        The rate :math:`|\dot d_k| = |n_k \cdot v(p_A)|` is at most the speed of the arm
+        geom's fastest point, :math:`|v(x_g)| + |\omega_b|\, r_g` (x_g its centre, r_g its
+        bounding radius, :math:`v, \omega` its body's velocity, MuJoCo's ``mj_comVel`` with
+        the joint velocities ``rate``).
+
+        Args:
+            q: (dof,) joint vector.
+            rate: (dof,) joint velocities, e.g. dq/dpsi.
+
+        Returns:
+            (P,) lower bounds of d_k (m) and (P,) upper bounds of |dd_k/dt|, in the order of
+            :attr:`pairs`.
+        """
+        q = as_joint_vector(q, self._dof, stack=False)
+        rate = as_joint_vector(rate, self._dof, "rate", stack=False)
+        m, d = self.model, self._data
+        d.qpos[self._qpos] = q
+        d.qvel[:] = 0.0
+        d.qvel[self._dofs] = rate
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_comPos(m, d)
+        mujoco.mj_comVel(m, d)
+        centre = d.geom_xpos[self._arm_geoms]
+        lower = np.linalg.norm(centre - d.geom_xpos[self._obstacle_geoms], axis=1) - self._bounds
+        omega, linear = d.cvel[self._bodies, :3], d.cvel[self._bodies, 3:]
+        r = centre - d.subtree_com[self._roots]
+        velocity = linear + omega[:, _NEXT] * r[:, _PREVIOUS] - omega[:, _PREVIOUS] * r[:, _NEXT]
+        speed = np.linalg.norm(velocity, axis=1) + np.linalg.norm(omega, axis=1) * self._arm_rbound
+        return lower, speed
 
     def _evaluate(
         self, q: np.ndarray, gradient: bool, reach: float | None = None
