@@ -13,6 +13,8 @@ from hypothesis import strategies as st
 
 import om_redundant as om
 from benchmarks.control_rate import HOMES, MIN_CLEARANCE, obstacles
+from om_redundant.redundancy.box_qp import maximise_1d
+from om_redundant.redundancy.objective import Group
 from om_redundant.redundancy.self_motion import self_motion_tangents
 
 
@@ -90,3 +92,46 @@ def test_pair_bounds_bound_the_distances_and_their_rates(seed, name):
             lower, speed = clearance.pair_bounds(row, rate)
             assert (np.minimum(lower, clearance.distmax) <= d + 1e-12).all()  # d: at most distmax
             assert (np.abs(grad @ rate) <= speed * (1 + 1e-9) + 1e-12).all()
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    pieces=st.integers(1, 6),
+    curvature=st.floats(1e-3, 1e3),
+    reach=st.floats(1e-4, 1.0),
+)
+def test_the_one_variable_qp_step_is_the_models_maximiser(seed, pieces, curvature, reach):
+    """box_qp.maximise_1d, from a point within the floors as the climb's: a delta within the
+    box and the floors whose model value no point of a dense grid of the feasible interval
+    beats, and multipliers in [0, w_g] per group."""
+    rng = np.random.default_rng(seed)
+    groups = [
+        Group(
+            kind, weight, floor, cap, rng.uniform(max(floor, 0.0), 1.5, pieces), rng.normal(size=(pieces, 1))
+        )
+        for kind, weight, floor, cap in (
+            ("margin", rng.uniform(0, 2), 0.0, np.inf),
+            ("clearance", rng.uniform(0, 2), 0.3, 1.0),
+            ("singularity", rng.uniform(0, 1), -np.inf, 1.0),
+        )
+    ]
+    lower, upper = -reach * rng.uniform(), reach * rng.uniform()
+    grid = np.linspace(lower, upper, 20001)
+    pieces_at = [g.values[None, :] + g.jacobian[None, :, 0] * grid[:, None] for g in groups]
+    floors_kept = np.all([p.min(axis=1) >= g.floor for g, p in zip(groups, pieces_at, strict=True)], axis=0)
+    model = sum(
+        (g.weight * np.minimum(g.cap, p.min(axis=1)) for g, p in zip(groups, pieces_at, strict=True)),
+        start=-0.5 * curvature * grid**2,
+    )
+    delta, multipliers = maximise_1d(groups, curvature, lower, upper)
+    assert lower <= delta <= upper
+    at = [g.values + g.jacobian[:, 0] * delta for g in groups]
+    assert all(v.min() >= g.floor - 1e-12 for g, v in zip(groups, at, strict=True))
+    value = sum(
+        (g.weight * min(g.cap, v.min()) for g, v in zip(groups, at, strict=True)), -0.5 * curvature * delta**2
+    )
+    assert value >= model[floors_kept].max(initial=-np.inf) - 1e-12
+    assert all(
+        (z >= 0.0).all() and z.sum() <= g.weight + 1e-12 for g, z in zip(groups, multipliers, strict=True)
+    )
