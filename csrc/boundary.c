@@ -8,11 +8,14 @@
 #define POLISH_STEPS 100   /* Jacobians per refinement: 2-4 at a simple root, more at a double one */
 #define SHOULDER_SIGN 0    /* (SHOULDER or ARM, ELBOW, WRIST) in every family */
 #define ELBOW_SIGN 1
+#define WRIST_SIGN 2
 #define SPLIT_STARTS 16    /* starts of q1 (wrist centre on joint 1's axis) or of the aligned wrist's split */
 #define SPLIT_NEAR 1e-6    /* |branch quantity| under which the model's split is arbitrary: SPLIT_STARTS */
 #define GATE_POINTS 8      /* free-angle samples of the cheap test before a neighbour's search */
 #define GATE_NEAR 0.2      /* |branch quantity| at a sample that lets a neighbour be searched */
 #define DIP_STEPS 24       /* golden-section steps to a dip's bottom: 0.618^24 of two cells, 1e-5 rad */
+#define SWING 1.5          /* rad: a change of g across one scan cell that is a swing of q_J (pi), not its slope */
+#define WRIST_BISECTIONS 64 /* halvings of a cell of the wrist residual's sign change: to the last bit */
 
 /* The smallest |branch quantity| of q and its index (NaN-safe: INFINITY for NaN). */
 static double nearest_branch(const om_solver_data *s, const double *q, int *index)
@@ -44,7 +47,7 @@ bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori)
     om_polish(&t, POLISH_STEPS, q);
     if (om_verify(pb, q, pos, ori))
         return true;
-    if (branch == ELBOW_SIGN || (branch != SHOULDER_SIGN && !(nearest < SPLIT_NEAR)))
+    if (branch == ELBOW_SIGN || !(nearest < SPLIT_NEAR))
         return false;
     /* The wrist centre on joint 1's axis: the model's q1 is arbitrary there (atan2 of a
      * vanishing pair), the real arm's is not: starts around the circle of q1. The wrist
@@ -146,6 +149,87 @@ static int dip_roots(om_problem *pb, int i, double w, double h, double *roots, i
     return count;
 }
 
+/* The root of the wrist's consistency residual r (om_wrist_residual) on [a, b], where ra and
+ * rb differ in sign, by bisection to the last bit; its model IK into q. */
+static void wrist_bisect(om_problem *pb, double a, double ra, double b, double *q)
+{
+    for (int it = 0; it < WRIST_BISECTIONS && a < 0.5 * (a + b) && 0.5 * (a + b) < b; it++) {
+        double c = 0.5 * (a + b), rc = om_wrist_residual(pb, c, q);
+        if (!(rc * ra > 0.0)) /* also NaN: the bracket's ends are reachable, keep the inner part */
+            b = c;
+        else {
+            a = c;
+            ra = rc;
+        }
+    }
+    om_wrist_residual(pb, a, q);
+}
+
+/* The roots of r on the part of [a, b] (a run of reach, or an island in it) from inside a reachable
+ * point with residual r_in toward the end e: e itself if reachable (r_e), else the edge of
+ * reach. Returns the root count. */
+static int wrist_bracket(om_problem *pb, double in, double r_in, double e, double r_e, double *roots, int count)
+{
+    double q[OM_MAX_DOF];
+    if (isnan(r_e)) {
+        e = om_reach_edge(pb, in, e, q);
+        r_e = om_wrist_residual(pb, e, q);
+    }
+    if (isnan(r_e) || r_in * r_e > 0.0)
+        return count;
+    bool up = e > in;
+    wrist_bisect(pb, up ? in : e, up ? r_in : r_e, up ? e : in, q);
+    return om_add_candidate(pb, q, roots, count);
+}
+
+/* Whether the model may reach some point between two samples it reaches at neither: where
+ * the margin, which can peak between them by about its change across a cell (this one's or a
+ * neighbour's, ms cyclic of n), could reach zero (as the circle search's island test). */
+static bool island_possible(const double *ms, int k, int n)
+{
+    double a = ms[k], b = ms[(k + 1) % n];
+    double change = py_max(fabs(b - a), py_max(fabs(a - ms[(k + n - 1) % n]), fabs(ms[(k + 2) % n] - b)));
+    return py_max(a, b) + change > 0.0;
+}
+
+/* A 6-DOF circle arm's roots from the wrist's consistency residual r(w) with q_J = w given
+ * (om_wrist_residual): smooth where the model's wrist is singular, where g's q_J is the
+ * arbitrary split of the aligned wrist (g may then miss zero by far over a whole run of
+ * reach, the wrist aligned all along it). r is sampled at the scan points; a sign change
+ * between two samples, or between a sample and the edge of reach, is bisected; a cell with
+ * both ends out of reach is searched from the maximum of the reach margin inside it where
+ * the margin may reach zero. Its roots hold either WRIST sign (verified in the problem's).
+ * Returns the root count. */
+static int wrist_roots(om_problem *pb, double *roots, int count)
+{
+    int n = pb->s->scan_points;
+    double q[OM_MAX_DOF], h = 2.0 * OM_PI / (double)n;
+    double *rs = malloc(2 * (size_t)n * sizeof(double)), *ms = rs + n;
+    if (!rs)
+        return count;
+    for (int k = 0; k < n; k++) {
+        rs[k] = om_wrist_residual(pb, -OM_PI + h * (double)k, q);
+        ms[k] = isnan(rs[k]) ? om_reach_margin(pb, -OM_PI + h * (double)k, q) : 0.0;
+    }
+    for (int k = 0; k < n; k++) {
+        double a = -OM_PI + h * (double)k, b = a + h, ra = rs[k], rb = rs[(k + 1) % n];
+        if (!isnan(ra))
+            count = wrist_bracket(pb, a, ra, b, rb, roots, count);
+        else if (!isnan(rb))
+            count = wrist_bracket(pb, b, rb, a, ra, roots, count);
+        else if (island_possible(ms, k, n)) {
+            double gc, c = om_extremum(pb, a, b, 0.5 * (a + b), 1.0, true, q, &gc, NULL);
+            double rc = isnan(gc) ? NAN : om_wrist_residual(pb, c, q);
+            if (!isnan(rc)) {
+                count = wrist_bracket(pb, c, rc, a, NAN, roots, count);
+                count = wrist_bracket(pb, c, rc, b, NAN, roots, count);
+            }
+        }
+    }
+    free(rs);
+    return count;
+}
+
 /* Touch points: GATE_POINTS samples of the free angle w in the problem's own configuration.
  * Where the model's solution has a branch quantity within NEAR_BOUNDARY of zero, it is a
  * candidate from the crossing (q_J = w), refined and verified into roots (a singular wrist
@@ -208,6 +292,24 @@ static int touch_points(om_problem *pb, bool *near, double *roots)
     return count;
 }
 
+/* Whether q_J swings between two neighbouring scan points of the circle: g changes by more
+ * than SWING (modulo 2 pi, a wrap of g is no change) across one cell. The closed form's q_J
+ * swings by pi where its joint's neighbour in the wrist passes its singularity (sin -> 0), in
+ * a dip of the WRIST quantity that can be far narrower than the gate's samples; there the
+ * neighbour across the WRIST boundary may hold a root in the band that no sample shows. */
+static bool q_j_swings(om_problem *pb)
+{
+    int n = pb->s->scan_points;
+    double q[OM_MAX_DOF], h = 2.0 * OM_PI / (double)n, first = om_g(pb, -OM_PI, q, false), before = first;
+    for (int k = 1; k <= n; k++) {
+        double gk = k < n ? om_g(pb, -OM_PI + h * (double)k, q, false) : first;
+        if (fabs(om_wrap(gk - before)) > SWING) /* false for NaN (out of reach) */
+            return true;
+        before = gk;
+    }
+    return false;
+}
+
 int om_band_roots(om_problem *pb, double *roots, bool *neighbour_reached)
 {
     const om_solver_data *s = pb->s;
@@ -215,6 +317,10 @@ int om_band_roots(om_problem *pb, double *roots, bool *neighbour_reached)
     double redundancy[1], found[OM_MAX_ROOTS * OM_MAX_DOF];
     bool near[3];
     int count = touch_points(pb, near, roots);
+    if (s->family != OM_SRS && s->mode == OM_CIRCLE && s->dp_joint == 5) /* q6 given: not for a4 != 0 */
+        count = wrist_roots(pb, roots, count);
+    if (s->mode == OM_CIRCLE && WRIST_SIGN < s->n_signs && !near[WRIST_SIGN])
+        near[WRIST_SIGN] = q_j_swings(pb);
     *neighbour_reached = false;
     for (int i = 0; i < s->n_signs; i++) {
         if (!near[i])

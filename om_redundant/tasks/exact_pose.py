@@ -123,6 +123,7 @@ class ExactPoseTask(ArmTask):
         self.root = ArmRoot(self.joints, frame_name, frame_type)
         fixed = self.root.fixed_pose
         self._root_at_origin = fixed is not None and np.array_equal(fixed, np.eye(4))
+        self._world_to_fixed_root = None if fixed is None else _inverse(fixed)
         self.optimizer = optimizer
         self.arm_configuration = arm_configuration
         if arm_configuration is not None:
@@ -195,13 +196,12 @@ class ExactPoseTask(ArmTask):
 
     def seed(self, configuration: MinkConfiguration) -> None:
         """Put the arm's joints of ``configuration`` at :math:`q^*` (the other joints stay)."""
-        q_target = self._joint_target(configuration)
+        _, q_target = self._joint_target(configuration)
         configuration.update(self.joints.qpos_with(configuration.data.qpos, q_target))
 
     def compute_error(self, configuration: MinkConfiguration) -> np.ndarray:
         r"""The joint error :math:`e(q) = q_{arm} - \tilde q^*` (dof,)."""
-        q_target = self._joint_target(configuration)
-        q = self.joints.q(configuration.data.qpos)
+        q, q_target = self._joint_target(configuration)
         return q - self.joints.nearest_turn(q_target, q)
 
     def compute_jacobian(self, configuration: MinkConfiguration) -> np.ndarray:
@@ -211,9 +211,10 @@ class ExactPoseTask(ArmTask):
 
     # -----------------------------------------------------------------------------------
 
-    def _joint_target(self, configuration: MinkConfiguration) -> np.ndarray:
-        """:math:`q^*` for the configuration's root pose, solved again if the root moved."""
-        self._arm_q(configuration)
+    def _joint_target(self, configuration: MinkConfiguration) -> tuple[np.ndarray, np.ndarray]:
+        """The arm's joints q and :math:`q^*` for the configuration's root pose, solved again
+        if the root moved."""
+        q = self._arm_q(configuration)
         if self.transform_target_to_world is None:
             raise TargetNotSet(self.__class__.__name__)
         if self.root.fixed_pose is None:
@@ -230,7 +231,7 @@ class ExactPoseTask(ArmTask):
                     raise UnreachableTarget(f"{exc}; the target is dropped for the previous one") from None
                 self._unsolved_fallback = None
         assert self._q_target is not None
-        return self._q_target
+        return q, self._q_target
 
     def _arm_q(self, configuration: MinkConfiguration) -> np.ndarray:
         """The arm's joints (checked as :meth:`arm_q`); remembers where the root is."""
@@ -246,8 +247,8 @@ class ExactPoseTask(ArmTask):
         arm_configuration: Configuration | None,
     ) -> None:
         """Solve T_world for the root at root_pose and, only if that succeeds, take it."""
-        if root_pose is self.root.fixed_pose and self._root_at_origin:
-            T_root = T_world
+        if root_pose is self.root.fixed_pose:
+            T_root = T_world if self._root_at_origin else self._world_to_fixed_root @ T_world
         else:
             R, p = root_pose[:3, :3], root_pose[:3, 3]
             T_root = np.eye(4)
@@ -282,3 +283,11 @@ class ExactPoseTask(ArmTask):
                 f"ExactPoseTask: every solution for the target in configuration {c} breaks a joint limit"
             )
         return min(inside, key=lambda q: float(np.linalg.norm(q - solution.q)))
+
+
+def _inverse(pose: np.ndarray) -> np.ndarray:
+    """The inverse of a homogeneous transform, [[R^T, -R^T p], [0, 1]]."""
+    inverse = np.eye(4)
+    inverse[:3, :3] = pose[:3, :3].T
+    inverse[:3, 3] = -pose[:3, :3].T @ pose[:3, 3]
+    return inverse
