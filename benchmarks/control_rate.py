@@ -20,7 +20,8 @@ the global ``choose(T)`` on GLOBAL_POSES poses of the path (3 obstacles), and, o
 (:func:`converged_gap`): the tracked psi after convergence against the global optimiser's
 climb from it.
 
-Run: ``python -m benchmarks.control_rate [--ticks 2000] [--quality 200]``.
+Run: ``python -m benchmarks.control_rate [--ticks 2000] [--quality 200]``; ``--global-only``
+times the global choose alone (``results/control_rate_global.md``).
 """
 
 from __future__ import annotations
@@ -251,6 +252,30 @@ def quality(name: str, n: int, seed: int) -> tuple[int, int, float, float]:
     return checked, bad, worst_gap, worst_gain
 
 
+def global_page(poses: int, ticks: int) -> str:
+    """The global choose alone (``--global-only``): its table, with the load."""
+    load = os.getloadavg()
+    rows = []
+    for name in HOMES:
+        walls, cpus = global_times(name, poses, ticks)
+        rows.append(f"| {name} | {len(walls)} | {_stats(walls)} | {_stats(cpus)} |")
+        print(rows[-1], flush=True)
+    return "\n".join(
+        [
+            "# Redundancy resolution at control rate: the global choose",
+            "",
+            f"CPU: {cpu_model()}; load average {load[0]:.1f} at the start, "
+            f"{os.getloadavg()[0]:.1f} at the end. Global `choose(T)`, 3 obstacles, "
+            f"min_clearance {MIN_CLEARANCE} m, poses of the path (ms, median / p99):",
+            "",
+            "| arm | poses | wall | CPU |",
+            "|---|---|---|---|",
+            *rows,
+            "",
+        ]
+    )
+
+
 def _stats(x: np.ndarray) -> str:
     return f"{np.median(x):.3f} / {np.percentile(x, 99):.3f}"
 
@@ -264,7 +289,13 @@ def main() -> None:
     parser.add_argument("--globals", type=int, default=GLOBAL_POSES, help="poses timed for the global choose")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--quality-only", action="store_true", help="only the convergence check")
+    parser.add_argument(
+        "--global-only", action="store_true", help="only the global choose (writes control_rate_global.md)"
+    )
     args = parser.parse_args()
+    if args.global_only:
+        write_page("control_rate_global.md", global_page(args.globals, args.ticks))
+        return
     load = os.getloadavg()
     rows, global_rows, quality_rows = [], [], []
     for name in HOMES:

@@ -9,8 +9,9 @@ clearance, the feasible intervals and the reason when nothing is feasible.
 
 ``--save FILE`` writes the choices as JSON; ``--compare FILE`` checks them against such a
 file written by another version (e.g. ``main`` before a change): the answers "feasible or
-not" must be identical, and a pose counts as *different* when the branch differs or psi
-differs by more than PSI_GAP rad while the objective differs by more than VALUE_GAP.
+not" must be identical, and a choice on another branch or farther than PSI_GAP rad in psi
+must not be worse than theirs by more than VALUE_GAP (the issue's bars); such choices are
+counted as worse, better or ties.
 
 Run: ``python -m benchmarks.global_choose [--poses 50] [--arms panda iiwa14] [--save F | --compare F]``.
 """
@@ -67,23 +68,28 @@ def run(name: str, count: int, poses: int, seed: int) -> tuple[list[dict], np.nd
     return choices, np.array(cpus) * 1e3, np.array(walls) * 1e3
 
 
-def differences(mine: list[dict], theirs: list[dict]) -> tuple[int, int, float]:
-    """(feasibility answers that differ, choices that differ, largest psi gap among the
-    choices that do not) between two runs over the same poses."""
-    answers = choices = 0
+def differences(mine: list[dict], theirs: list[dict]) -> tuple[int, int, int, int, float]:
+    """Between two runs over the same poses: (feasibility answers that differ; choices
+    elsewhere (another branch, or psi farther than PSI_GAP) whose objective is worse than
+    theirs by more than VALUE_GAP, better by more than VALUE_GAP, within VALUE_GAP (ties);
+    the largest psi gap among the choices on the same branch within PSI_GAP)."""
+    answers = worse = better = ties = 0
     worst = 0.0
-    for a, b in zip(mine, theirs, strict=True):
+    for a, b in zip(mine, theirs[: len(mine)], strict=True):  # (the same seed draws the same first poses)
         if a["ok"] != b["ok"]:
             answers += 1
-            continue
-        if not a["ok"]:
+        if not (a["ok"] and b["ok"]):
             continue
         gap = abs(math.remainder(a["psi"] - b["psi"], 2.0 * math.pi))
-        if a["signs"] != b["signs"] or (gap > PSI_GAP and abs(a["value"] - b["value"]) > VALUE_GAP):
-            choices += 1
-        elif a["signs"] == b["signs"]:
+        if a["signs"] == b["signs"] and gap <= PSI_GAP:
             worst = max(worst, gap)
-    return answers, choices, worst
+        elif a["value"] < b["value"] - VALUE_GAP:
+            worse += 1
+        elif a["value"] > b["value"] + VALUE_GAP:
+            better += 1
+        else:
+            ties += 1
+    return answers, worse, better, ties, worst
 
 
 def main() -> None:
@@ -110,8 +116,9 @@ def main() -> None:
             saved[key] = choices
             compared = ""
             if key in reference:
-                answers, differ, worst = differences(choices, reference[key])
-                compared = f"answers differ {answers}, choices differ {differ}, psi gap <= {worst:.1e}"
+                answers, worse, better, ties, worst = differences(choices, reference[key])
+                compared = f"answers differ {answers}; elsewhere: worse {worse}, better {better}, "
+                compared += f"ties {ties}; psi gap otherwise <= {worst:.1e}"
             feasible = sum(c["ok"] for c in choices)
             stats = [f"{np.median(x):.1f} / {np.percentile(x, 99):.1f}" for x in (cpus, walls)]
             cells = [name, count, len(choices), feasible, *stats, compared]

@@ -13,6 +13,8 @@ from hypothesis import strategies as st
 
 import om_redundant as om
 from benchmarks.control_rate import HOMES, MIN_CLEARANCE, obstacles
+from om_redundant.redundancy.box_qp import maximise_1d
+from om_redundant.redundancy.objective import Group
 from om_redundant.redundancy.self_motion import self_motion_tangents
 
 
@@ -61,8 +63,8 @@ def test_batched_tangents_equal_the_single_ones(seed, name):
 @given(seed=st.integers(0, 2**32 - 1), name=st.sampled_from(list(HOMES)), count=st.sampled_from([1, 3]))
 def test_constraint_bounds_bound_the_feasibility_functions_and_their_rates(seed, name, count):
     """Objective.constraint_bounds: the margin entries are the margin feasibility functions
-    and their rates' sizes exactly; the clearance entry is at most every clearance function,
-    and its rate bound (Clearance.lever) at least every clearance function's rate."""
+    and their rates' sizes exactly; the clearance entries are at most the clearance
+    functions, and their rate bounds (Clearance.pair_bounds) at least their rates."""
     optimizer = optimizer_of(name, count)
     objective, solver = optimizer.objective, optimizer.solver
     for row in joints(optimizer, seed, 10):
@@ -72,6 +74,64 @@ def test_constraint_bounds_bound_the_feasibility_functions_and_their_rates(seed,
         margin, clearance = (g.constraints() for g in groups[:2])
         np.testing.assert_allclose(values[exact], margin[0], rtol=0, atol=1e-15)
         np.testing.assert_allclose(rates[exact], np.abs(margin[1]), rtol=1e-15, atol=0)
-        ((value,), (rate,)) = values[~exact], rates[~exact]
-        assert (clearance[0] >= value - 1e-15).all()
-        assert (np.abs(clearance[1]) <= rate).all()
+        assert (clearance[0] >= values[~exact] - 1e-12).all()
+        assert (np.abs(clearance[1]) <= rates[~exact] * (1 + 1e-9) + 1e-12).all()
+
+
+@settings(max_examples=6, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), name=st.sampled_from(list(HOMES)))
+def test_pair_bounds_bound_the_distances_and_their_rates(seed, name):
+    """Clearance.pair_bounds: below every pair's exact distance, and above the size of its
+    derivative along any joint velocity (a random one and the self-motion)."""
+    optimizer = optimizer_of(name, 3)
+    clearance = optimizer.objective.clearance
+    rng = np.random.default_rng(seed)
+    for row in joints(optimizer, seed, 10):
+        d, grad = clearance.distances_and_gradients(row)
+        for rate in (rng.normal(size=len(row)), om.self_motion_tangent(optimizer.solver, row)[:, 0]):
+            lower, speed = clearance.pair_bounds(row, rate)
+            assert (np.minimum(lower, clearance.distmax) <= d + 1e-12).all()  # d: at most distmax
+            assert (np.abs(grad @ rate) <= speed * (1 + 1e-9) + 1e-12).all()
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    pieces=st.integers(1, 6),
+    curvature=st.floats(1e-3, 1e3),
+    reach=st.floats(1e-4, 1.0),
+)
+def test_the_one_variable_qp_step_is_the_models_maximiser(seed, pieces, curvature, reach):
+    """box_qp.maximise_1d, from a point within the floors as the climb's: a delta within the
+    box and the floors whose model value no point of a dense grid of the feasible interval
+    beats, and multipliers in [0, w_g] per group."""
+    rng = np.random.default_rng(seed)
+    groups = [
+        Group(
+            kind, weight, floor, cap, rng.uniform(max(floor, 0.0), 1.5, pieces), rng.normal(size=(pieces, 1))
+        )
+        for kind, weight, floor, cap in (
+            ("margin", rng.uniform(0, 2), 0.0, np.inf),
+            ("clearance", rng.uniform(0, 2), 0.3, 1.0),
+            ("singularity", rng.uniform(0, 1), -np.inf, 1.0),
+        )
+    ]
+    lower, upper = -reach * rng.uniform(), reach * rng.uniform()
+    grid = np.linspace(lower, upper, 20001)
+    pieces_at = [g.values[None, :] + g.jacobian[None, :, 0] * grid[:, None] for g in groups]
+    floors_kept = np.all([p.min(axis=1) >= g.floor for g, p in zip(groups, pieces_at, strict=True)], axis=0)
+    model = sum(
+        (g.weight * np.minimum(g.cap, p.min(axis=1)) for g, p in zip(groups, pieces_at, strict=True)),
+        start=-0.5 * curvature * grid**2,
+    )
+    delta, multipliers = maximise_1d(groups, curvature, lower, upper)
+    assert lower <= delta <= upper
+    at = [g.values + g.jacobian[:, 0] * delta for g in groups]
+    assert all(v.min() >= g.floor - 1e-12 for g, v in zip(groups, at, strict=True))
+    value = sum(
+        (g.weight * min(g.cap, v.min()) for g, v in zip(groups, at, strict=True)), -0.5 * curvature * delta**2
+    )
+    assert value >= model[floors_kept].max(initial=-np.inf) - 1e-12
+    assert all(
+        (z >= 0.0).all() and z.sum() <= g.weight + 1e-12 for g, z in zip(groups, multipliers, strict=True)
+    )

@@ -215,19 +215,11 @@ class Clearance:
         self.pairs: tuple[tuple[str, str], ...] = tuple(
             (model.geom(a).name, model.geom(o).name) for a, o in self._pairs
         )
-        #: A bound (m, at least 1) on every |dd_k/dq_i|: a point of an arm geom lies at most
-        #: this far from any joint's axis (the bodies' offsets, the joints' anchors, the
-        #: farthest geom point from its body's origin, summed), and a prismatic joint moves
-        #: it at unit speed.
-        geom_reach = np.linalg.norm(model.geom_pos[arm_geoms], axis=1) + rbound[arm_geoms]
-        self.lever = max(
-            1.0,
-            float(
-                np.linalg.norm(model.body_pos[moving], axis=1).sum()
-                + np.linalg.norm(model.jnt_pos[joints.joint_ids], axis=1).sum()
-                + geom_reach.max(initial=0.0)
-            ),
-        )
+        # for the batched bounds (minima, pair_bounds)
+        self._arm_geoms, self._obstacle_geoms = self._pairs[:, 0].copy(), self._pairs[:, 1].copy()
+        self._bounds, self._bodies = self._geoms.bounds, model.geom_bodyid[self._arm_geoms]
+        self._arm_rbound = rbound[self._arm_geoms]
+        self._roots = model.body_rootid[self._bodies]
 
     @classmethod
     def for_arm(
@@ -316,6 +308,40 @@ class Clearance:
         for i in np.flatnonzero(candidates.any(axis=1)).tolist():
             out[i] = self._evaluate(q[i], gradient=False)[0].min()  # the compiled pairs, as minimum()
         return out
+
+    def pair_bounds(self, q: np.ndarray, rate: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        r"""Bounds of every pair's distance and of its rate when the joints move at ``rate``.
+
+        The lower bound is the geoms' centres' distance less their bounding-sphere radii.
+        The rate :math:`|\dot d_k| = |n_k \cdot v(p_A)|` is at most the speed of the arm
+        geom's fastest point, :math:`|v(x_g)| + |\omega_b|\, r_g` (x_g its centre, r_g its
+        bounding radius, :math:`v, \omega` its body's velocity, MuJoCo's ``mj_comVel`` with
+        the joint velocities ``rate``).
+
+        Args:
+            q: (dof,) joint vector.
+            rate: (dof,) joint velocities, e.g. dq/dpsi.
+
+        Returns:
+            (P,) lower bounds of d_k (m) and (P,) upper bounds of |dd_k/dt|, in the order of
+            :attr:`pairs`.
+        """
+        q = as_joint_vector(q, self._dof, stack=False)
+        rate = as_joint_vector(rate, self._dof, "rate", stack=False)
+        m, d = self.model, self._data
+        d.qpos[self._qpos] = q
+        d.qvel[:] = 0.0
+        d.qvel[self._dofs] = rate
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_comPos(m, d)
+        mujoco.mj_comVel(m, d)
+        centre = d.geom_xpos[self._arm_geoms]
+        lower = np.linalg.norm(centre - d.geom_xpos[self._obstacle_geoms], axis=1) - self._bounds
+        omega, linear = d.cvel[self._bodies, :3], d.cvel[self._bodies, 3:]
+        r = centre - d.subtree_com[self._roots]
+        velocity = linear + np.cross(omega, r)
+        speed = np.linalg.norm(velocity, axis=1) + np.linalg.norm(omega, axis=1) * self._arm_rbound
+        return lower, speed
 
     def _evaluate(
         self, q: np.ndarray, gradient: bool, reach: float | None = None

@@ -11,7 +11,8 @@ and the QP
            |\delta|_\infty \le \Delta,\quad lo \le \psi + \delta \le hi
 
 (the epigraph form of the max-min objective; the floors keep the linearised margins >= 0
-and clearances >= d_min) is solved by OSQP through qpsolvers. B is a damped BFGS estimate of
+and clearances >= d_min) is solved exactly with one variable (:mod:`~om_redundant.redundancy.box_qp`),
+else by OSQP through qpsolvers. B is a damped BFGS estimate of
 the curvature of the Lagrangian, from the QP's multipliers z_j:
 :math:`s = \delta`, :math:`y = -\sum_j z_j (a_j^{new} - a_j^{old})`. The step is solved
 exactly (the current q as hint); it is accepted when the exact point is feasible and gains
@@ -31,6 +32,7 @@ import numpy as np
 import qpsolvers
 import scipy.sparse as sp
 
+from .box_qp import maximise_1d
 from .objective import Group
 from .paths import Point, Probe
 
@@ -72,13 +74,44 @@ def qp_step(groups: list[Group], curvature: np.ndarray, lower: np.ndarray, upper
         lower, upper: (r,) bounds of delta (trust region and interval), lower <= 0 <= upper.
 
     Returns:
-        The step, or None when OSQP returns no iterate. OSQP's iterate is taken even when it
-        did not meet its tolerances (on nearly degenerate problems, at a kink the climb has
-        already reached): the climb checks every step exactly.
+        The step, or None when the QP has no solution or OSQP returns no iterate. With one
+        variable the QP is solved exactly (:func:`~om_redundant.redundancy.box_qp.maximise_1d`);
+        otherwise by OSQP, whose iterate is taken even when it did not meet its tolerances
+        (on nearly degenerate problems, at a kink the climb has already reached): the climb
+        checks every step exactly.
     """
     r = len(lower)
     reach = np.maximum(-lower, upper)
     keep = [_may_be_least(g, reach) for g in groups]
+    if r == 1:
+        pairs = zip(groups, keep, strict=True)
+        kept = [replace(g, values=g.values[k], jacobian=g.jacobian[k]) for g, k in pairs]
+        found = maximise_1d(kept, float(curvature[0, 0]), float(lower[0]), float(upper[0]))
+        if found is None:
+            return None
+        delta, duals = np.array([found[0]]), found[1]
+    else:
+        found = _osqp_step(groups, keep, curvature, lower, upper, reach)
+        if found is None:
+            return None
+        delta, duals = found
+    gain = _model(groups, delta) - 0.5 * delta @ curvature @ delta - _model(groups, np.zeros(r))
+    multipliers = [np.zeros(len(g.values)) for g in groups]
+    for full, k, z in zip(multipliers, keep, duals, strict=True):
+        full[k] = z
+    return _Step(delta, gain, multipliers)
+
+
+def _osqp_step(
+    groups: list[Group],
+    keep: list[np.ndarray],
+    curvature: np.ndarray,
+    lower: np.ndarray,
+    upper: np.ndarray,
+    reach: np.ndarray,
+) -> tuple[np.ndarray, list[np.ndarray]] | None:
+    """The QP solved by OSQP: delta and the kept pieces' multipliers per group."""
+    r = len(lower)
     scale = _scale(np.vstack([g.jacobian[k] for g, k in zip(groups, keep, strict=True)]), reach)
     problem = _problem(groups, keep, curvature, scale, lower, upper)
     start = np.concatenate([np.zeros(r), [min(g.cap, g.values.min()) for g in groups]])  # delta = 0
@@ -87,13 +120,8 @@ def qp_step(groups: list[Group], curvature: np.ndarray, lower: np.ndarray, upper
         solution = qpsolvers.solve_problem(problem, solver="osqp", initvals=start, **_OSQP)
     if solution.x is None or not np.isfinite(solution.x).all():
         return None
-    delta = solution.x[:r] * scale
-    gain = _model(groups, delta) - 0.5 * delta @ curvature @ delta - _model(groups, np.zeros(r))
     duals = np.split(np.maximum(solution.z, 0.0), np.cumsum([k.sum() for k in keep])[:-1])
-    multipliers = [np.zeros(len(g.values)) for g in groups]
-    for full, k, z in zip(multipliers, keep, duals, strict=True):
-        full[k] = z
-    return _Step(delta, gain, multipliers)
+    return solution.x[:r] * scale, duals
 
 
 def _may_be_least(group: Group, reach: np.ndarray) -> np.ndarray:

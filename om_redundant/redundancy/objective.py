@@ -276,22 +276,25 @@ class Objective:
 
         Each limited joint's margin function :math:`1 - |q_i - c_i|/h_i` exactly, with its
         rate's size :math:`|t_i|/h_i` (t = dq/dpsi, ``tangent`` (dof, 1)); then, with
-        obstacles, the smallest clearance function :math:`(D - d_{min})/d_{cap}` (every
-        clearance function is at least this) and a bound on every clearance function's rate,
-        :math:`\ell \sum_i |t_i| / d_{cap}` (:attr:`Clearance.lever <om_redundant.Clearance.lever>`).
+        obstacles, per pair a lower bound of its clearance function,
+        :math:`(\min(\max(D, \underline{d}_k), 2 d_{cap}) - d_{min})/d_{cap}` (the pieces
+        beyond 2 d_cap report 2 d_cap), and a bound on its rate, from
+        :meth:`Clearance.pair_bounds <om_redundant.Clearance.pair_bounds>`.
 
         Returns:
-            (values, rate bounds, exact): exact marks the entries that are one function each
-            (the margins), not a lower bound of several.
+            (values, rate bounds, exact): exact marks the entries that are the functions
+            themselves (the margins), not lower bounds.
         """
         lim = self._limited
         values = [np.minimum(*_limit_distances(q[lim], self._lower, self._upper, self._half))]
         rates, exact = [np.abs(tangent[lim, 0]) / self._half], [np.ones(len(lim), dtype=bool)]
         if self.clearance is not None:
             cap = self.clearance_cap
-            values.append([(evaluation.clearance / cap) - self.min_clearance / cap])
-            rates.append([self.clearance.lever * float(np.abs(tangent).sum()) / cap])
-            exact.append([False])
+            lower, speed = self.clearance.pair_bounds(q, tangent[:, 0])
+            near = np.minimum(np.maximum(lower, evaluation.clearance), self.clearance_reach)
+            values.append((near - self.min_clearance) / cap)
+            rates.append(speed / cap)
+            exact.append(np.zeros(len(lower), dtype=bool))
         return np.concatenate(values), np.concatenate(rates), np.concatenate(exact)
 
     def evaluation(self, groups: list[Group]) -> Evaluation:

@@ -66,12 +66,18 @@ class _Terms:
         self, objective: Objective, q: np.ndarray, tangent: np.ndarray, evaluation: Evaluation | None
     ):
         self.objective, self.q, self.tangent = objective, q, tangent
-        self.evaluation, self.groups = evaluation, None
+        self.evaluation, self.groups, self.bounds = evaluation, None, None
 
     def get_evaluation(self) -> Evaluation:
         if self.evaluation is None:
             self.evaluation = self.objective.evaluation(self.objective.groups(self.q))
         return self.evaluation
+
+    def get_bounds(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`~om_redundant.redundancy.objective.Objective.constraint_bounds` here."""
+        if self.bounds is None:
+            self.bounds = self.objective.constraint_bounds(self.q, self.tangent, self.get_evaluation())
+        return self.bounds
 
     def get_groups(self) -> list[Group]:
         if self.groups is None:
@@ -425,9 +431,7 @@ def _quiet(a: Point, b: Point) -> bool:
     feasible = a.evaluation.feasible
     if feasible != b.evaluation.feasible:
         return False
-    objective = a.terms.objective
-    ga, ra, exact = objective.constraint_bounds(a.q, a.tangent, a.evaluation)
-    gb, rb, _ = objective.constraint_bounds(b.q, b.tangent, b.evaluation)
+    (ga, ra, exact), (gb, rb, _) = a.terms.get_bounds(), b.terms.get_bounds()
     spread = 4.0 / 27.0 * abs(b.psi - a.psi) * (ra + rb) + _BOUND_SLACK
     if feasible:
         return bool((np.minimum(ga, gb) - spread > 0.0).all())

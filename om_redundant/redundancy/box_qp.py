@@ -1,0 +1,111 @@
+r"""The climb's QP (:mod:`om_redundant.redundancy.climb`) in one redundancy variable, solved exactly.
+
+With one variable the epigraph QP is the maximisation of the concave, piecewise quadratic
+
+.. math::  \phi(\delta) = \sum_g w_g \min\big(cap_g,\ \min_{j \in g} v_j + a_j\delta\big)
+           - \tfrac12 b\,\delta^2
+
+over the interval where every group with a floor keeps :math:`\min_j v_j + a_j\delta \ge
+floor_g`, within the box [lower, upper]. Between its breakpoints (two pieces of a group
+crossing, a piece crossing its group's cap) phi is one quadratic, with slope
+:math:`D_k - b\delta` (:math:`D_k` the weighted rates of the uncapped groups' least pieces),
+so the maximiser is a breakpoint, an end, or a segment's stationary point :math:`D_k/b`:
+all of them are evaluated at once and the best taken. The multipliers of the pieces are
+those of the epigraph's KKT conditions: each uncapped group's weight on its least piece, or
+at a kink split between the least and the most increasing of the pieces that meet there so
+that the slope balances :math:`b\delta`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .objective import Group
+
+_TIE = 1e-12  # pieces within this of their group's minimum meet there
+
+
+def maximise_1d(
+    groups: list[Group], curvature: float, lower: float, upper: float
+) -> tuple[float, list[np.ndarray]] | None:
+    """The maximiser delta of phi (module docstring) and each group's multipliers.
+
+    Args:
+        groups: Groups with jacobians (p_g, 1) by the redundancy variable.
+        curvature: b > 0.
+        lower, upper: Bounds of delta, lower <= 0 <= upper.
+
+    Returns:
+        (delta, multipliers per group), or None when the floors leave no delta.
+    """
+    v = [g.values for g in groups]
+    a = [g.jacobian[:, 0] for g in groups]
+    lo, hi = lower, upper
+    for g, vg, ag in zip(groups, v, a, strict=True):
+        if g.floor == -np.inf:
+            continue
+        gap = g.floor - vg
+        with np.errstate(divide="ignore", invalid="ignore"):
+            bound = gap / ag
+        if (gap[ag == 0.0] > 0.0).any():
+            return None
+        lo = max(lo, float(bound[ag > 0.0].max(initial=-np.inf)))
+        hi = min(hi, float(bound[ag < 0.0].min(initial=np.inf)))
+    if not lo <= hi:
+        return None
+    points = [np.array([lo, hi])]
+    for g, vg, ag in zip(groups, v, a, strict=True):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            crossings = (vg[None, :] - vg[:, None]) / (ag[:, None] - ag[None, :])
+            points += [crossings.ravel(), (g.cap - vg) / ag]
+    points = np.concatenate(points)
+    points = np.unique(points[np.isfinite(points) & (points >= lo) & (points <= hi)])
+    middles = (points[:-1] + points[1:]) / 2.0
+    slopes = sum(
+        (g.weight * _least_rate(g, vg, ag, middles) for g, vg, ag in zip(groups, v, a, strict=True)),
+        start=np.zeros(len(middles)),
+    )
+    stationary = np.clip(slopes / curvature, points[:-1], points[1:])
+    candidates = np.concatenate([points, stationary])
+    values = sum(
+        (
+            g.weight * np.minimum(g.cap, (vg[None, :] + ag[None, :] * candidates[:, None]).min(axis=1))
+            for g, vg, ag in zip(groups, v, a, strict=True)
+        ),
+        start=-0.5 * curvature * candidates**2,
+    )
+    delta = float(candidates[np.argmax(values)])
+    return delta, _multipliers(groups, v, a, curvature, delta)
+
+
+def _least_rate(group: Group, v: np.ndarray, a: np.ndarray, at: np.ndarray) -> np.ndarray:
+    """The rate of the group's term at each point of ``at`` (inside a segment): its least
+    piece's rate, 0 where the term is capped."""
+    values = v[None, :] + a[None, :] * at[:, None]
+    least = values.argmin(axis=1)
+    return np.where(values[np.arange(len(at)), least] < group.cap, a[least], 0.0)
+
+
+def _multipliers(
+    groups: list[Group], v: list[np.ndarray], a: list[np.ndarray], curvature: float, delta: float
+) -> list[np.ndarray]:
+    """Each piece's multiplier at delta (module docstring)."""
+    multipliers = [np.zeros(len(vg)) for vg in v]
+    kinks, balance = [], curvature * delta
+    for g, vg, ag, z in zip(groups, v, a, multipliers, strict=True):
+        values = vg + ag * delta
+        least = values.min()
+        if least > g.cap + _TIE or g.weight == 0.0:
+            continue
+        meeting = np.flatnonzero(values <= least + _TIE)
+        if len(meeting) == 1:
+            z[meeting[0]] = g.weight
+            balance -= g.weight * ag[meeting[0]]
+        else:
+            kinks.append((g.weight, ag, z, meeting[np.argmin(ag[meeting])], meeting[np.argmax(ag[meeting])]))
+    for weight, ag, z, falling, rising in kinks:  # z_f a_f + z_r a_r = balance share, z_f + z_r = w
+        spread = ag[rising] - ag[falling]
+        share = balance / len(kinks)
+        z[rising] = min(max((share - weight * ag[falling]) / spread, 0.0), weight) if spread > 0.0 else weight
+        z[falling] = weight - z[rising]
+    return multipliers
