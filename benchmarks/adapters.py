@@ -81,13 +81,15 @@ class BatchMethod:
     Attributes:
         name: What is called, for the table.
         prepare: ``(T (N, 4, 4), q_true (N, dof)) -> argument`` (untimed).
-        call: ``argument -> result`` (timed).
+        call: ``argument -> result`` (timed), on the library's own threads.
+        one_thread: The same call on one thread (its CPU time is measured).
         solutions: ``(argument, result) -> [(k, dof) per target]`` (untimed).
     """
 
     name: str
     prepare: Callable[[np.ndarray, np.ndarray], Any]
     call: Callable[[Any], Any]
+    one_thread: Callable[[Any], Any]
     solutions: Callable[[Any, Any], list[np.ndarray]]
 
 
@@ -209,6 +211,7 @@ def om_redundant_peer(arm: om.Arm, rng: np.random.Generator) -> Peer:
             "om_redundant solve_batch (C, threads)",
             batch_prepare,
             lambda argument: solver.solve_batch(*argument),
+            lambda argument: solver.solve_batch(*argument, threads=1),
             batch_solutions,
         ),
     )
@@ -309,6 +312,7 @@ def eaik_peer(arm: om.Arm, rng: np.random.Generator) -> Peer:
         f"EAIK calculate_IK_batched ({threads} threads)",
         batch_prepare,
         lambda argument: robot.calculate_IK_batched(argument[0], threads),
+        lambda argument: robot.calculate_IK_batched(argument[0], 1),
         batch_solutions,
     )
     return peer

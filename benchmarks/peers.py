@@ -26,7 +26,7 @@ import om_redundant as om
 from om_redundant.om.experiment import run as run_paper_experiment
 
 from .adapters import PEERS, Peer, Unavailable
-from .protocols import PROTOCOLS, Targets, measure, measure_batch
+from .protocols import PROTOCOLS, Targets, measure, measure_batches
 from .report import Results, markdown, plot
 from .robots import check_fk
 
@@ -62,7 +62,7 @@ def _set_up(name: str, arm: om.Arm, results: Results, seed: int, fk_samples: int
     return None
 
 
-def _run_peer(peer: Peer, targets: Targets, results: Results, repeats: int) -> None:
+def _run_peer(peer: Peer, targets: Targets, results: Results) -> None:
     for protocol in PROTOCOLS:
         if getattr(peer, protocol) is None:
             continue
@@ -87,16 +87,24 @@ def _run_peer(peer: Peer, targets: Targets, results: Results, repeats: int) -> N
             f"median {outcome.median_us:.1f} us, p99 {outcome.p99_us:.1f} us "
             f"({time.perf_counter() - start:.1f} s)"
         )
-    if peer.batch is not None:
-        try:
-            throughput = measure_batch(peer.batch, targets, repeats, peer.limit_tolerance)
-        except Exception as exc:
-            _say(f"  {peer.batch.name}: crashed ({type(exc).__name__}: {exc}); skipped")
-            return
-        results.throughputs.append(throughput)
+
+
+def _run_batches(peers: list[Peer], targets: Targets, results: Results, repeats: int) -> None:
+    """The peers' batch calls, timed in turn in each round (see measure_batches)."""
+    methods = [(p.batch, p.limit_tolerance) for p in peers if p.batch is not None]
+    if not methods:
+        return
+    try:
+        throughputs = measure_batches(methods, targets, repeats)
+    except Exception as exc:
+        _say(f"  batch calls: crashed ({type(exc).__name__}: {exc}); skipped")
+        results.skipped.append((targets.arm.name, "batch calls", f"crashed ({type(exc).__name__})"))
+        return
+    results.throughputs += throughputs
+    for t in throughputs:
         _say(
-            f"  {throughput.peer}: {throughput.per_second:,.0f} solves/s, "
-            f"success {100 * throughput.success:.1f} %"
+            f"  {t.peer}: {t.per_second:,.0f} solves/s, one thread {t.cpu_ms_per_1000:.2f} ms CPU "
+            f"per 1,000, success {100 * t.success:.1f} %"
         )
 
 
@@ -122,7 +130,7 @@ def main(argv: list[str] | None = None) -> Results:
         parser.error(f"unknown arms {unknown_arms}; known: {om.arm_names()}")
     out = args.out or RESULTS / ("peers_quick.md" if args.quick else "peers.md")
     command = "python -m benchmarks.peers " + " ".join(argv if argv is not None else sys.argv[1:])
-    repeats = 2 if args.quick else 5
+    repeats = 3 if args.quick else 11
     results = Results(n=n, seed=args.seed, arms=arms, command=command.strip(), batch_repeats=repeats)
     load_start = os.getloadavg()[0]
     start = time.perf_counter()
@@ -131,10 +139,13 @@ def main(argv: list[str] | None = None) -> Results:
         arm = om.load_arm(name)
         _say(f"[{name}] {arm.description}: {n} targets, seed {args.seed}")
         targets = Targets.random(arm, n, args.seed)
+        ready = []
         for peer_name in peers:
             peer = _set_up(peer_name, arm, results, args.seed, fk_samples=16 if args.quick else 64)
             if peer is not None:
-                _run_peer(peer, targets, results, repeats)
+                _run_peer(peer, targets, results)
+                ready.append(peer)
+        _run_batches(ready, targets, results, repeats)
         if name == "spherical":
             _say(f"[spherical] the OM paper's experiment, {n} targets")
             results.paper_table = run_paper_experiment("spherical", n, args.seed).table()

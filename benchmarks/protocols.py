@@ -17,6 +17,7 @@ import gc
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -179,13 +180,16 @@ def _timed(call: Callable, arguments: list) -> tuple[list, list[float]]:
 
 @dataclass(frozen=True)
 class Throughput:
-    """Solves per second of one batch call over all targets.
+    """Solves per second of one batch call over all targets, by wall time and by CPU time.
 
     Attributes:
         arm: Arm name.
         peer: Peer name and call.
         n: Targets in the batch.
-        seconds: Median wall time of the batch call over the repeats.
+        seconds: Median wall time of the batch call (its own threads) over the repeats.
+        cpu_seconds: Median CPU time of the same call on one thread (``time.process_time``,
+            so threads the library starts count too) over the repeats: what the work costs,
+            whatever else shares the cores.
         success: Fraction of targets solved (same test as the other protocols).
     """
 
@@ -193,27 +197,64 @@ class Throughput:
     peer: str
     n: int
     seconds: float
+    cpu_seconds: float
     success: float
 
     @property
     def per_second(self) -> float:
         return self.n / self.seconds
 
+    @property
+    def cpu_ms_per_1000(self) -> float:
+        return 1e6 * self.cpu_seconds / self.n
 
-def measure_batch(
-    method: BatchMethod, targets: Targets, repeats: int = 5, limit_tolerance: float = 0.0
-) -> Throughput:
-    """Time ``repeats`` batch calls over all targets; the median counts."""
-    argument = method.prepare(targets.T, targets.q)
-    method.call(argument)  # warm up
-    results, seconds = _timed(method.call, [argument] * repeats)
-    found = method.solutions(argument, results[-1])
-    success = np.mean(
-        [
-            judge(targets.arm, T, q, Q, limit_tolerance).success
-            for T, q, Q in zip(targets.T, targets.q, found, strict=True)
-        ]
-    )
-    return Throughput(
-        targets.arm.name, method.name, len(targets.q), float(np.median(seconds)), float(success)
-    )
+
+def measure_batches(
+    methods: list[tuple[BatchMethod, float]], targets: Targets, repeats: int = 5
+) -> list[Throughput]:
+    """Time ``repeats`` rounds of every batch method (with its limit tolerance) over all targets.
+
+    Each round runs every method's threaded call (wall time) and its one-thread call (CPU
+    time) in turn, so that other work on the machine weighs on all methods alike; the
+    medians count.
+    """
+    arguments = [method.prepare(targets.T, targets.q) for method, _ in methods]
+    for (method, _), argument in zip(methods, arguments, strict=True):  # warm up
+        method.call(argument)
+        method.one_thread(argument)
+    walls = np.empty((repeats, len(methods)))
+    cpus = np.empty((repeats, len(methods)))
+    results: list[Any] = [None] * len(methods)
+    gc.collect()
+    gc.disable()
+    try:
+        for r in range(repeats):
+            for i, ((method, _), argument) in enumerate(zip(methods, arguments, strict=True)):
+                start = time.perf_counter()
+                results[i] = method.call(argument)
+                walls[r, i] = time.perf_counter() - start
+                start = time.process_time()
+                method.one_thread(argument)
+                cpus[r, i] = time.process_time() - start
+    finally:
+        gc.enable()
+    throughputs = []
+    for i, (method, tolerance) in enumerate(methods):
+        found = method.solutions(arguments[i], results[i])
+        success = np.mean(
+            [
+                judge(targets.arm, T, q, Q, tolerance).success
+                for T, q, Q in zip(targets.T, targets.q, found, strict=True)
+            ]
+        )
+        throughputs.append(
+            Throughput(
+                targets.arm.name,
+                method.name,
+                len(targets.q),
+                float(np.median(walls[:, i])),
+                float(np.median(cpus[:, i])),
+                float(success),
+            )
+        )
+    return throughputs

@@ -64,5 +64,6 @@ PyObject *om_solver_solve_pose(om_Solver *self, PyObject *const *args, Py_ssize_
 extern PyTypeObject om_SolverType;        /* solver_type.c: Solver(SolverData) */
 extern PyMethodDef om_kernel_functions[]; /* functions.c: kinematics and closed forms */
 extern PyMethodDef om_tracking_functions[]; /* tracking.c: the redundancy optimiser's tracking step */
+extern PyMethodDef om_clearance_functions[]; /* clearance.c: distances of arm and obstacle geoms */
 
 #endif

@@ -28,7 +28,8 @@ PyMODINIT_FUNC PyInit_ckernels(void) {
         {"SD_BETA", SD_BETA}, {"SD_THETA3", SD_THETA3}, {"SD_SIGMA2", SD_SIGMA2}, {"SD_D3", SD_D3},
         {"SD_SIGMA4", SD_SIGMA4}, {"SD_SIGMA5", SD_SIGMA5}, {"SD_THETA4", SD_THETA4}, {"SD_THETA5", SD_THETA5},
         {"SD_THETA6", SD_THETA6}, {"SD_WRIST_CENTRE", SD_WRIST_CENTRE}, {"SD_E_ROT", SD_E_ROT},
-        {"SD_WRIST_ROW", SD_WRIST_ROW}, {"SD_N_PARAMS", SD_N_PARAMS},
+        {"SD_WRIST_ROW", SD_WRIST_ROW}, {"SD_WRIST_OFFSET", SD_WRIST_OFFSET}, {"SD_AXIS4", SD_AXIS4},
+        {"SD_AXIS6", SD_AXIS6}, {"SD_N_PARAMS", SD_N_PARAMS},
         {"SRS_SIGMA1", SRS_SIGMA1}, {"SRS_SIGMA2", SRS_SIGMA2}, {"SRS_SIGMA5", SRS_SIGMA5},
         {"SRS_SIN_BETA", SRS_SIN_BETA}, {"SRS_THETA", SRS_THETA}, {"SRS_SHOULDER", SRS_SHOULDER},
         {"SRS_WRIST", SRS_WRIST}, {"SRS_S3", SRS_S3}, {"SRS_U", SRS_U}, {"SRS_K0", SRS_K0}, {"SRS_K", SRS_K},
@@ -42,6 +43,7 @@ PyMODINIT_FUNC PyInit_ckernels(void) {
     };
     if (PyModule_AddObjectRef(m, "Solver", (PyObject *)&om_SolverType) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_tracking_functions) < 0) goto fail;
+    if (PyModule_AddFunctions(m, om_clearance_functions) < 0) goto fail;
     for (size_t i = 0; i < sizeof constants / sizeof constants[0]; i++)
         if (PyModule_AddIntConstant(m, constants[i].name, constants[i].value) < 0) goto fail;
     const struct {

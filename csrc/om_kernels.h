@@ -67,7 +67,8 @@ enum {
     SD_ELL3 = 7, SD_BETA = 8, SD_THETA3 = 9, /* RRR */
     SD_SIGMA2 = 7, SD_D3 = 8,                /* RRP */
     SD_SIGMA4 = 10, SD_SIGMA5 = 11, SD_THETA4 = 12, SD_THETA5 = 13, SD_THETA6 = 14,
-    SD_WRIST_CENTRE = 15, SD_E_ROT = 18, SD_WRIST_ROW = 27, SD_N_PARAMS = 28
+    SD_WRIST_CENTRE = 15, SD_E_ROT = 18, SD_WRIST_ROW = 27,
+    SD_WRIST_OFFSET = 28, SD_AXIS4 = 31, SD_AXIS6 = 40, SD_N_PARAMS = 43 /* a4 != 0: wrist_offset.c */
 };
 
 /* srs.py parameter layout */
@@ -96,6 +97,9 @@ void om_six_dof_branch_values(int family, const double *P, const double *q, doub
 double om_six_dof_model_ik_q6(int family, const double *P, const double *table, const om_target *t, vec3 p,
                               const int64_t *signs, const double *q_prev, double q6, double *q, double *residual);
 void om_six_dof_target(const double *P, om_target *t); /* fills RE and wrist from t->R */
+/* wrist_offset.c: for a4 != 0 (P[SD_WRIST_OFFSET] != 0), the model's hand position
+ * p_m = p_d + dp(w) on the circle w = q1 of the WRIST sign wrist (NaN at a singular wrist). */
+vec3 om_wrist_offset_point(const double *P, const om_target *t, vec3 p, double wrist, double w);
 
 /* With shoulder false, joints 1-3 are not written. Returns the reach margin 1 - x^2. */
 double om_srs_model_ik(const double *P, const om_target *t, vec3 p, const int64_t *signs, const double *q_prev,

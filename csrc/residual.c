@@ -12,9 +12,12 @@ vec3 om_delta(const double D[6][3], double w)
               D[0][2] + D[1][2] * c + D[2][2] * s);
 }
 
-/* The model's hand position on the circle, p_m = p_d + R delta(w). */
+/* The model's hand position on the circle, p_m = p_d + R delta(w) (a wrist with a4 != 0:
+ * p_d + dp(w), w = q1, see wrist_offset.c). */
 static vec3 on_circle(const om_problem *pb, double w)
 {
+    if (pb->s->family != OM_SRS && pb->s->params[SD_WRIST_OFFSET] != 0.0)
+        return om_wrist_offset_point(pb->s->params, &pb->t, pb->p, (double)pb->signs[2], w);
     vec3 d = om_delta(pb->s->D, w);
     const mat3 *R = &pb->t.R;
     vec3 p = pb->p;
@@ -36,6 +39,8 @@ double om_model_ik_at(om_problem *pb, double w, double *q, bool all_joints)
 {
     const om_solver_data *data = pb->s;
     vec3 pm = circle_point(pb, w);
+    if (!isfinite(pm.x)) /* a singular wrist with a4 != 0: no point of the circle */
+        return -1.0;
     if (!all_joints && data->family == OM_SRS && data->dp_joint == 6)
         return om_srs_model_q7(data->params, &pb->t, pm, pb->signs, pb->q_prev, q);
     return om_model_ik(data->family, data->params, data->model_table, &pb->t, pm, pb->signs, pb->q_prev, q,

@@ -47,7 +47,7 @@ int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre
             at_candidate[data->dp_joint] = cands[i];
             if (lifted)
                 om_lifted_solve(pb, at_candidate, q);
-            else
+            else if (data->dp_joint == 5) /* q6 given (not a wrist with a4 != 0, whose w is q1) */
                 om_wrist_secant(pb, cands[i], q);
             count = om_add_candidate(pb, q, roots, count);
             if (count == before) /* a touch of zero: refined from the candidate itself */

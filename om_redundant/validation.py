@@ -24,6 +24,8 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
+import mink
+import mujoco
 import numpy as np
 
 from . import ckernels
@@ -147,7 +149,7 @@ def as_pose(T: Any, name: str = "T") -> np.ndarray:
     """Return a validated (4, 4) homogeneous transform from an array or a ``mink.SE3``."""
     if type(T) is not np.ndarray or T.dtype != np.float64:  # the fast path takes float64 arrays as given
         if _is_se3(T):
-            T = T.as_matrix()
+            T = _se3_matrix(T)
         T = as_array(T, name, "a (4, 4) homogeneous transform")
     if T.shape != (4, 4):
         raise InvalidInput(f"{name} must be a (4, 4) homogeneous transform, got shape {T.shape}")
@@ -181,6 +183,22 @@ def as_poses(T: Any, name: str = "T") -> np.ndarray:
 
 def _is_se3(value: Any) -> bool:
     return hasattr(value, "as_matrix") and not isinstance(value, np.ndarray)
+
+
+def _se3_matrix(T: Any) -> np.ndarray:
+    """``T.as_matrix()``; for a ``mink.SE3`` (quaternion w, x, y, z and translation in
+    ``wxyz_xyz``) the same matrix by the same ``mju_quat2Mat``, without mink's intermediate
+    SO3 and arrays (a third of the time: :meth:`ExactPoseTask.set_target` takes SE3 every tick)."""
+    wxyz_xyz = getattr(T, "wxyz_xyz", None)
+    if type(T) is not mink.SE3 or type(wxyz_xyz) is not np.ndarray or wxyz_xyz.shape != (7,):
+        return T.as_matrix()
+    rotation = np.empty(9)
+    mujoco.mju_quat2Mat(rotation, wxyz_xyz[:4])
+    matrix = np.zeros((4, 4))
+    matrix[:3, :3] = rotation.reshape(3, 3)
+    matrix[:3, 3] = wxyz_xyz[4:]
+    matrix[3, 3] = 1.0
+    return matrix
 
 
 def _check_poses(T: np.ndarray, name: str) -> None:

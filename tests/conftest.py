@@ -13,6 +13,8 @@ import numpy as np
 import pytest
 from hypothesis import settings
 
+import om_redundant as om
+from om_redundant import ckernels
 from om_redundant.mujoco_io.model_match import load_mujoco_model
 
 # The suite's property tests draw the same examples on every run, so that CI answers for the
@@ -23,6 +25,12 @@ settings.register_profile("explore", derandomize=False)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "repeatable"))
 
 ROOT = Path(__file__).resolve().parents[1]
+#: A solve's accepted errors (m, rad): every root must reach its pose within them.
+EXACT = 1e-10
+#: Away from the singular boundaries and the edge of reach (smallest singular value of the
+#: real arm's Jacobian, and |branch quantity|), where a miss is a failure of a test; the
+#: miss rate nearer them is measured by benchmarks/near_family.py and benchmarks/menagerie.py.
+WELL_CONDITIONED = 0.05
 MENAGERIE = ROOT.parent / "shared" / "reference" / "menagerie"
 
 
@@ -69,3 +77,41 @@ def arm_without_a_model(tmp_path) -> Path:
     path = tmp_path / "bent.toml"
     path.write_text(text)
     return path
+
+
+def distance(arm: om.Arm, a: np.ndarray, b: np.ndarray) -> float:
+    """Largest joint difference, revolute joints modulo 2 pi."""
+    return float(np.abs(np.where(arm.revolute, wrap(a - b), a - b)).max())
+
+
+def check_exact(solver: om.OMSolver, q: np.ndarray, strict: bool) -> None:
+    """Every root of solve_all(fk(q), c) reaches the pose (1e-10 m, 1e-10 rad) in c; where
+    ``strict``, q is among them and the hinted solve returns it."""
+    arm = solver.arm
+    T = arm.fk(q)
+    c = solver.configuration_of(q)
+    roots = solver.solve_all(T, c)
+    for root in roots:
+        reached = arm.fk(root.q)
+        assert np.linalg.norm(reached[:3, 3] - T[:3, 3]) <= EXACT
+        assert np.abs(reached[:3, :3] - T[:3, :3]).max() <= EXACT
+        assert solver.holds(root.q, c)
+        assert arm.within_limits(root.q) == root.within_limits
+    if strict:
+        assert any(distance(arm, r.q, q) < 1e-7 for r in roots), q
+        hinted = solver.solve(T, c, q_hint=q)
+        assert hinted.ok and distance(arm, hinted.q, q) < 1e-7
+
+
+def well_conditioned(solver: om.OMSolver, q: np.ndarray) -> bool:
+    """Away from the singular boundaries: the map to (pose, psi) on a 7-DOF arm (its Jacobian
+    with the arm angle's gradient as a seventh row; a fold of the psi-constrained map is where
+    two roots of (T, c) meet), the pose map on a 6-DOF arm, and every branch quantity (of the
+    model, at ``solver.flip * q``)."""
+    values = np.empty(len(solver.sign_names))
+    ckernels.branch_values(solver.om.family, solver.om.params, solver.flip * q, values)
+    jacobian = solver.arm.jacobian(q)
+    if solver.arm.dof == 7:
+        jacobian = np.vstack([jacobian, om.arm_angle_and_gradient(solver, q)[1]])
+    sigma = np.linalg.svd(jacobian, compute_uv=False)[-1]
+    return sigma > WELL_CONDITIONED and np.abs(values).min() > WELL_CONDITIONED

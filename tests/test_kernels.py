@@ -83,6 +83,28 @@ def test_batch_equals_one_solve_per_row_across_threads(panda):
         assert batch.status[m] == sol.status and batch.iterations[m] == sol.iterations
 
 
+@pytest.mark.parametrize("threads", [1, 2, 3, 64.0])
+def test_batch_answers_do_not_depend_on_the_threads(panda, threads):
+    """threads=1 solves on the calling thread; more take chunks from a shared queue: same rows."""
+    Q = random_q(panda.arm, 200, np.random.default_rng(4))
+    T = panda.arm.fk(Q)
+    cs = [panda.configuration_of(q) for q in Q]
+    signs, psi = np.array([c.signs for c in cs]), np.array([c.redundancy for c in cs])
+    reference = panda.solve_batch(T, signs, psi)
+    batch = panda.solve_batch(T, signs, psi, threads=threads)
+    np.testing.assert_array_equal(batch.q, reference.q)
+    np.testing.assert_array_equal(batch.status_code, reference.status_code)
+    np.testing.assert_array_equal(batch.iterations, reference.iterations)
+
+
+@pytest.mark.parametrize("threads", [0, -1, 2.5, "2", True, 1025])
+def test_batch_refuses_a_bad_thread_count(panda, threads):
+    T = panda.arm.fk(np.zeros(7))[None]
+    c = panda.configuration_of(np.zeros(7))
+    with pytest.raises(om.InvalidInput, match="threads"):
+        panda.solve_batch(T, c.signs, c.redundancy, threads=threads)
+
+
 def test_threads_sharing_one_solver_agree_with_serial_calls(panda):
     targets = [_target(panda, seed) for seed in range(40)]
     serial = [panda.solve(T, c).q for _, T, c in targets]

@@ -29,7 +29,6 @@ def modified(arm: om.Arm, joint: int, **changes) -> om.Arm:
         (3, {"alpha": 0.0}, "non-parallel"),
         (4, {"alpha": np.pi}, "non-parallel"),
         (4, {"alpha": np.pi / 3}, "alpha_5 = \\+-90"),
-        (3, {"a": 0.05}, "a4 = 0.05"),
         (1, {"kind": om.JointKind.PRISMATIC}, "joints 1 and 2 must be revolute"),
         (0, {"alpha": 0.0}, "perpendicular"),
         (2, {"kind": om.JointKind.PRISMATIC}, "no closed-form family"),

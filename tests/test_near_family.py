@@ -15,54 +15,12 @@ import om_redundant as om
 from benchmarks.near_family import bent, fixed_row_between, reversed_joint
 from om_redundant import ckernels
 from om_redundant.om.nominal import NEAR_TWIST, nominal_arm
-from tests.conftest import random_q, wrap
-
-EXACT = 1e-10
-#: Away from the singular boundaries and the edge of reach (smallest singular value of the
-#: real arm's Jacobian, and |branch quantity|), where a miss is a failure of this test; the
-#: miss rate nearer them is measured by benchmarks/near_family.py.
-WELL_CONDITIONED = 0.05
+from tests.conftest import EXACT, check_exact, random_q, well_conditioned, wrap
 
 
 @cache
 def bent_solver(name: str, exponent: float, seed: int) -> om.OMSolver:
     return om.OMSolver(bent(om.load_arm(name), 10.0**exponent, np.random.default_rng(seed)))
-
-
-def distance(arm: om.Arm, a: np.ndarray, b: np.ndarray) -> float:
-    return float(np.abs(np.where(arm.revolute, wrap(a - b), a - b)).max())
-
-
-def check_exact(solver: om.OMSolver, q: np.ndarray, strict: bool) -> None:
-    """Every root of solve_all(fk(q), c) reaches the pose (1e-10 m, 1e-10 rad) in c; where
-    ``strict``, q is among them and the hinted solve returns it."""
-    arm = solver.arm
-    T = arm.fk(q)
-    c = solver.configuration_of(q)
-    roots = solver.solve_all(T, c)
-    for root in roots:
-        reached = arm.fk(root.q)
-        assert np.linalg.norm(reached[:3, 3] - T[:3, 3]) <= EXACT
-        assert np.abs(reached[:3, :3] - T[:3, :3]).max() <= EXACT
-        assert solver.holds(root.q, c)
-        assert arm.within_limits(root.q) == root.within_limits
-    if strict:
-        assert any(distance(arm, r.q, q) < 1e-7 for r in roots), q
-        hinted = solver.solve(T, c, q_hint=q)
-        assert hinted.ok and distance(arm, hinted.q, q) < 1e-7
-
-
-def well_conditioned(solver: om.OMSolver, q: np.ndarray) -> bool:
-    """Away from the singular boundaries: the map to (pose, psi) on a 7-DOF arm (its Jacobian
-    with the arm angle's gradient as a seventh row; a fold of the psi-constrained map is where
-    two roots of (T, c) meet), the pose map on a 6-DOF arm, and every branch quantity."""
-    values = np.empty(len(solver.sign_names))
-    ckernels.branch_values(solver.om.family, solver.om.params, solver.nominal.flip * q, values)
-    jacobian = solver.arm.jacobian(q)
-    if solver.arm.dof == 7:
-        jacobian = np.vstack([jacobian, om.arm_angle_and_gradient(solver, q)[1]])
-    sigma = np.linalg.svd(jacobian, compute_uv=False)[-1]
-    return sigma > WELL_CONDITIONED and np.abs(values).min() > WELL_CONDITIONED
 
 
 @settings(max_examples=40, deadline=None)
@@ -139,13 +97,12 @@ def test_batch_and_single_solves_agree_on_a_near_arm():
     ("name", "row", "field", "value", "cause"),
     [
         ("ur5e", 3, "alpha", np.pi / 2 + 2e-3, r"joints 4 and 5 perpendicular .*\(0.002 rad off\)"),
-        ("ur5e", 3, "a", 0.07, r"a4 = 0.07 != 0 makes dp depend on joints 5 and 6"),
         ("panda", 1, "a", 0.01, r"shoulder offset a2 = 0.01 m makes dp depend on q2"),
     ],
 )
 def test_an_arm_that_cannot_be_solved_is_refused_at_construction(name, row, field, value, cause):
-    """Beyond what the nominal arm absorbs (a twist 2e-3 rad off, twice NEAR_TWIST), a4 != 0 on
-    a 6-DOF wrist, a2 != 0 on a 7-DOF arm: a ModelError naming the cause."""
+    """Beyond what the nominal arm absorbs (a twist 2e-3 rad off, twice NEAR_TWIST), a2 != 0 on
+    a 7-DOF arm: a ModelError naming the cause (a4 != 0: tests/test_wrist_offset.py)."""
     arm = om.load_arm(name)
     rows = list(arm.chain.rows)
     old = rows[row]
@@ -195,3 +152,25 @@ def test_the_redundancy_optimizer_tracks_on_a_near_arm(arm):
         T = T.copy()
         T[0, 3] += 0.002
         choice = optimizer.choose(T, choice)
+
+
+@pytest.mark.parametrize(
+    "q",
+    [
+        [-3.726494, -2.316568, 1.573041, -2.759467, -0.186096, 6.041126],
+        [-4.343524, -0.54011, -2.23673, 2.731576, -2.810936, -4.597611],
+        [-3.802659, -1.229439, -0.717211, 1.431248, -3.138834, -5.020617],
+        [4.922068, -0.86922, -1.477057, -6.033637, -2.654594, 3.527687],
+    ],
+)
+def test_targets_at_the_shoulder_boundary_of_a_near_arm(q):
+    """The wrist centre within 2 mm of the cylinder of the lateral offset about joint 1's axis
+    (the ARM quantity, twists 2e-4 rad off, as on the Doosan M1013): c may hold two real roots
+    where the nominal arm has one in c and one in the neighbouring configuration, or none at
+    all (near.BOUNDARY seeds, near.SHIFT and the fold partners). Each missed q before."""
+    solver = bent_solver("ur5e", np.log10(2e-4), 0)
+    q = np.array(q)
+    values = np.empty(3)
+    ckernels.branch_values(solver.om.family, solver.om.params, solver.flip * q, values)
+    assert abs(values[0]) < 2e-3
+    check_exact(solver, q, strict=True)

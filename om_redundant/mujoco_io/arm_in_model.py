@@ -89,11 +89,13 @@ class ArmJoints:
 
     def within_limits(self, q: np.ndarray) -> bool:
         """Whether the arm's joint vector q is within :attr:`lower` and :attr:`upper`."""
-        return bool(np.all((q >= self.lower) & (q <= self.upper)))
+        return bool(((q >= self.lower) & (q <= self.upper)).all())
 
     def nearest_turn(self, q_target: np.ndarray, q: np.ndarray) -> np.ndarray:
         """q_target with each revolute joint shifted by a multiple of 2 pi to the value nearest
         q, where that value is within the limits (else the joint keeps q_target's value)."""
+        if np.abs(q - q_target).max() < np.pi:  # every joint within half a turn: no shift
+            return q_target
         turns = np.round((q - q_target) / (2.0 * np.pi))
         shifted = q_target + 2.0 * np.pi * np.where(self.arm.revolute, turns, 0.0)
         inside = (shifted >= self.lower) & (shifted <= self.upper)

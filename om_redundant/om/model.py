@@ -18,7 +18,11 @@ For equal joints the hand orientations agree and the positions differ by
 
 where :math:`\delta`, the wrist offsets' dp seen from the flange, depends on one wrist joint
 J: joint 6 of UR5e and the Spherical arm (:math:`a_4 = 0`), joint 7 of the 7-DOF arms (the
-iiwa14 has :math:`\delta = 0`). The shoulder offsets' dp :math:`a(q_1)`, in DH frame 0,
+iiwa14 has :math:`\delta = 0`). A 6-DOF wrist with :math:`a_4 \ne 0` (Menagerie's ARX L5,
+Unitree Z1, i2rt YAM) makes :math:`\delta` depend on joints 5 and 6; where joint 4's axis
+turns with q1 alone (joints 2, 3 and 4 parallel), dp at a solution is a function of q1 and
+the target's orientation instead (:func:`_wrist_offset`): the solutions again lie on a
+circle, in :math:`w = q_1`. The shoulder offsets' dp :math:`a(q_1)`, in DH frame 0,
 turns with joint 1 alone, because :math:`a_1` lies along :math:`x_1` and :math:`d_2` along
 joint 2's axis, both fixed in frame 1; it is zero when joints 1-3 meet. The solutions of
 the OM system (9) then lie on a circle (a torus with shoulder offsets) in the ball
@@ -58,7 +62,9 @@ class ModelArm:
         sign_names: Names of the configuration's branch signs.
         redundancy_names: Names of the configuration's redundancy values (``("psi",)`` for a
             7-DOF arm, empty for 6-DOF).
-        dp_joint: Index of the joint that :math:`\\delta` depends on, or -1 for none.
+        dp_joint: Index of the joint that :math:`\\delta` depends on, or -1 for none; 0 (q1)
+            for a wrist with :math:`a_4 \\ne 0`, whose dp turns with q1 (``six_dof.WRIST_OFFSET``
+            in ``params``; ``delta`` and ``shoulder`` are then zero).
         delta: (3, 3) coefficients of dp seen from the flange, rows :math:`D_0, D_1, D_2`:
             :math:`\\delta(q_J) = D_0 + D_1 \\cos q_J + D_2 \\sin q_J` (a revolute joint's
             angle enters the flange frame through one rotation about z).
@@ -109,19 +115,24 @@ def derive_model(arm: Arm) -> ModelArm:
     else:
         raise ModelError(f"arm '{arm.name}' has {arm.dof} joints; models exist for 6- and 7-DOF arms")
     model = arm.with_chain(model_chain, f"{arm.name}-model")
-    dp_joint = _dp_joint(arm.name, shoulderless, model_chain)
-    delta = _circle_fit(
-        arm, "dp seen from the flange", dp_joint, lambda q: _delta(shoulderless, model_chain, q)
-    )
-    shoulder = _circle_fit(
-        arm,
-        "the shoulder offsets' dp",
-        0,
-        lambda q: _pose(shoulderless.table, q)[1] - _pose(arm.chain.table, q)[1],
-    )
-    w = np.linspace(-np.pi, np.pi, 3601)
-    cs = np.stack([np.ones_like(w), np.cos(w), np.sin(w)], axis=1)
-    dp_max = float(np.linalg.norm(cs @ delta, axis=1).max() + np.linalg.norm(cs @ shoulder, axis=1).max())
+    if arm.dof == 6 and params[six_dof.WRIST_OFFSET] != 0.0:  # dp turns with q1: see _wrist_offset
+        a4, d5, a5 = params[six_dof.WRIST_OFFSET : six_dof.WRIST_OFFSET + 3]
+        dp_joint, delta, shoulder = 0, np.zeros((3, 3)), np.zeros((3, 3))
+        dp_max = float(np.hypot(a4, d5) + abs(a5))
+    else:
+        dp_joint = _dp_joint(arm.name, shoulderless, model_chain)
+        delta = _circle_fit(
+            arm, "dp seen from the flange", dp_joint, lambda q: _delta(shoulderless, model_chain, q)
+        )
+        shoulder = _circle_fit(
+            arm,
+            "the shoulder offsets' dp",
+            0,
+            lambda q: _pose(shoulderless.table, q)[1] - _pose(arm.chain.table, q)[1],
+        )
+        w = np.linspace(-np.pi, np.pi, 3601)
+        cs = np.stack([np.ones_like(w), np.cos(w), np.sin(w)], axis=1)
+        dp_max = float(np.linalg.norm(cs @ delta, axis=1).max() + np.linalg.norm(cs @ shoulder, axis=1).max())
     return ModelArm(
         arm,
         model,
@@ -147,11 +158,7 @@ def _six_dof_model(arm: Arm) -> tuple[KinematicChain, int, str, np.ndarray]:
     _refuse_fixed_rows(arm.name, rows, jr, (3, 4, 5))
     for j in (3, 4):
         _check_right_angle(arm.name, rows[jr[j]], j)
-    if abs(rows[jr[3]].a) > 0.0:
-        raise ModelError(
-            f"arm '{arm.name}': a4 = {rows[jr[3]].a:g} != 0 makes dp depend on joints 5 and 6; "
-            "the bounded search handles arms whose dp depends on one wrist joint"
-        )
+    offsets = (rows[jr[3]].a, rows[jr[4]].d, rows[jr[4]].a)  # a4, d5, a5 of the real arm
     rows[jr[3]] = dataclasses.replace(rows[jr[3]], a=0.0)
     rows[jr[4]] = dataclasses.replace(rows[jr[4]], a=0.0, d=0.0)
     model_chain = arm.chain.replace_rows(rows)
@@ -167,7 +174,66 @@ def _six_dof_model(arm: Arm) -> tuple[KinematicChain, int, str, np.ndarray]:
     _, o4 = _pose(model_chain.table[: jr[3] + 1], q0[:4])
     R_fl, p_fl = _pose(model_chain.table, q0)
     params[six_dof.WRIST_CENTRE : six_dof.WRIST_CENTRE + 3] = R_fl.T @ (o4 - p_fl)
+    if offsets[0] != 0.0:
+        _wrist_offset(arm, model_chain, offsets, params)
+        family_name += ", wrist offset a4 (dp turns with q1)"
     return model_chain, family, family_name, params
+
+
+def _wrist_offset(
+    arm: Arm, model_chain: KinematicChain, offsets: tuple[float, ...], params: np.ndarray
+) -> None:
+    r"""The dp circle of a 6-DOF wrist with :math:`a_4 \ne 0`, into ``params`` (``six_dof.WRIST_OFFSET``).
+
+    Seen from the flange, dp then turns with joints 5 and 6; in DH frame 0 it turns with q1
+    alone. Joint 5's axis :math:`z_4` is normal to joint 4's, :math:`z_3`, and to joint 6's,
+    :math:`z_5`: :math:`z_3 \times z_5 = -\sigma_4 \sigma_5 \sin\varphi_5\, z_4`. The offsets
+    lie along :math:`x_4 = \sigma_4\, z_3 \times z_4` (:math:`a_4`), :math:`z_4` (:math:`d_5`)
+    and :math:`x_5 = \sigma_5\, z_4 \times z_5` (:math:`a_5`), so for equal joints
+
+    .. math::
+
+        \Delta p = -(a_4 x_4 + d_5 z_4 + a_5 x_5), \quad
+        z_4 = -\sigma_4 \sigma_5\,\mathrm{WRIST}\,\frac{z_3 \times z_5}{|z_3 \times z_5|}.
+
+    At a solution :math:`z_5 = R_d\,a_6` (:math:`a_6` joint 6's axis in the flange frame) is the
+    target's, and where joints 2, 3 and 4 are parallel :math:`z_3 = C_0 + C_1 \cos q_1 + C_2
+    \sin q_1`: the solutions of system (9) in a configuration lie on the circle
+    :math:`p_m = p_d + \Delta p(w)`, :math:`w = q_1` (``csrc/wrist_offset.c``), undefined only
+    at the singular wrist :math:`\sin\varphi_5 = 0`.
+
+    Raises:
+        ModelError: Joint 4 is not parallel to joint 2 (dp would turn with two joints), or
+            the formula does not give the arm's dp (checked at random joint vectors).
+    """
+    jr = arm.chain.joint_rows
+    table = model_chain.table
+    try:
+        axis4 = _circle_fit(arm, "joint 4's axis", 0, lambda q: _pose(table[: jr[3]], q[:3])[0][:, 2])
+    except ModelError:
+        raise ModelError(
+            f"arm '{arm.name}': a4 = {offsets[0]:g} != 0 makes dp depend on joints 5 and 6; the bounded "
+            "search handles a4 != 0 where joint 4's axis turns with q1 alone (parallel to joint 2's, as "
+            "when joints 2, 3 and 4 are parallel): dp then turns with q1"
+        ) from None
+    q0 = np.zeros(6)
+    axis6 = _pose(table, q0)[0].T @ _pose(table[: jr[5]], q0[:5])[0][:, 2]
+    params[six_dof.WRIST_OFFSET : six_dof.WRIST_OFFSET + 3] = offsets
+    params[six_dof.AXIS4 : six_dof.AXIS4 + 9] = axis4.ravel()
+    params[six_dof.AXIS6 : six_dof.AXIS6 + 3] = axis6
+    a4, d5, a5 = offsets
+    s4, s5 = params[six_dof.SIGMA4], params[six_dof.SIGMA5]
+    rng = np.random.default_rng(2)
+    for _ in range(16):
+        q = rng.uniform(-np.pi, np.pi, 6)
+        R, p_model = _pose(table, q)
+        z3 = axis4.T @ [1.0, np.cos(q[0]), np.sin(q[0])]
+        z5 = R @ axis6
+        n = np.cross(z3, z5)
+        z4 = -s4 * s5 * np.sign(np.sin(q[4] + params[six_dof.THETA5])) * n / np.linalg.norm(n)
+        dp = -(a4 * s4 * np.cross(z3, z4) + d5 * z4 + a5 * s5 * np.cross(z4, z5))
+        if np.abs(dp - (p_model - _pose(arm.chain.table, q)[1])).max() > 1e-12:
+            raise ModelError(f"arm '{arm.name}': the wrist offsets' dp does not turn with q1 alone")
 
 
 def _srs_model(arm: Arm) -> tuple[KinematicChain, KinematicChain, np.ndarray]:

@@ -37,8 +37,25 @@ POLISH_ITERATIONS = 30
 FIXED_POINT_STEPS = 20
 #: Joint-space distance (rad) under which two roots are one (csrc's OM_SAME_ROOT).
 SAME_ROOT = 1e-9
-#: Fractions by which a target the seeds do not lead to is pulled toward the base.
+#: Fractions by which a target the seeds do not lead to is pulled toward the base (the real
+#: arm may reach a little farther than the nominal one), then pushed away from it (an inner
+#: fold, where two roots in c meet and the nominal arm's pair begins farther out).
 PULL = (1e-4, 1e-3, 1e-2)
+#: Distances (m) by which a target that none of those leads to is shifted along each axis of
+#: the root frame, both ways: a fold of the real arm's roots lies in any direction of the
+#: pose space (e.g. the shoulder's, where the wrist centre meets the cylinder of the lateral
+#: offset about joint 1's axis, and the real arm has a pair of roots the nominal arm lacks).
+SHIFT = (1e-3, 1e-2)
+#: |Branch quantity| of a nominal root in a neighbouring configuration within which it also
+#: seeds c's roots from the start (the real arm's branch boundary lies elsewhere).
+BOUNDARY = 0.05
+#: Smallest singular value of the exact chain's Jacobian (with the arm angle's gradient on a
+#: 7-DOF arm) below which an exact root is searched for a fold partner.
+FOLD = 1e-2
+#: Multiples of a fold partner's estimated distance tried as seeds.
+PARTNER_STEPS = (1.0, 0.5, 2.0)
+#: Step (rad) of the second difference along the fold's null direction.
+FOLD_STEP = 1e-4
 
 
 class NearKernel:
@@ -119,10 +136,16 @@ class NearKernel:
     def _roots(self, T, signs, redundancy, hint=None) -> tuple[list[tuple[np.ndarray, float, float]], int]:
         """Verified roots (real coordinates, position and orientation errors), evaluations.
 
-        Seeds, stage by stage until one leads to a root: the nominal roots in c; in every
+        Seeds, stage by stage until one leads to a root: the nominal roots in c, and those of
+        the other configurations within :data:`BOUNDARY` of c's branches (there c may hold
+        two real roots, one of which the nominal arm has in the neighbouring configuration); in every
         other configuration (near a branch boundary the real arm's root may be the nominal
         arm's in the neighbouring one); of the target pulled toward the base by ``PULL`` in
-        every configuration (the real arm may reach a little farther than the nominal one).
+        every configuration (the real arm may reach a little farther than the nominal one);
+        in c, of the target pushed away from the base by ``PULL`` or shifted by ``SHIFT``
+        along each axis (a fold of the roots in c in another direction). Every exact root, in
+        c or (reached from another configuration's seed) not, is searched for a fold partner
+        in c.
         A seed that polish does not bring home takes the fixed point on T D(q). The hint, if
         any, is a seed too: at a fold of the psi-constrained map the nominal arm may lack the
         root next to the hint that the real arm has."""
@@ -132,26 +155,44 @@ class NearKernel:
         psi = float(redundancy[0]) if self._P is not None else 0.0
         signs = tuple(int(s) for s in signs)
         others = [s for s in self._all_signs if s != signs]
-        stages = [[(T, signs)], [(T, s) for s in others]]
-        stages.append([(_pulled(T, f), s) for f in PULL for s in self._all_signs])
+        # (target, the seeds' configuration, only seeds within BOUNDARY of c's branches)
+        stages = [[(T, signs, False)] + [(T, s, True) for s in others], [(T, s, False) for s in others]]
+        stages.append([(_pulled(T, f), s, False) for f in PULL for s in self._all_signs])
+        folds = [_pulled(T, -f) for f in PULL]
+        folds += [_shifted(T, axis, d) for d in SHIFT for axis in range(3) for d in (d, -d)]
+        stages.append([(target, signs, False) for target in folds])
         roots: list[tuple[np.ndarray, float, float]] = []
+        anchors: list[np.ndarray] = []  # exact roots of T in other configurations
         evals = 0
         for stage in stages:
-            for target, seed_signs in stage:
+            for target, seed_signs, boundary in stage:
                 seeds, n = self._nominal_roots(target, seed_signs, redundancy)
+                if boundary:
+                    seeds = [seed for seed in seeds if self._at_boundary(seed, seed_signs, signs)]
                 evals += n + len(seeds) * POLISH_ITERATIONS
                 for seed in seeds:
-                    found = self._refined(T, R, p, psi, seed, signs, redundancy)
+                    found = self._refined(T, R, p, psi, seed, signs, redundancy, anchors)
                     if found is None:
                         start = self._fixed_point(T, seed, signs, redundancy)
-                        found = self._refined(T, R, p, psi, start, signs, redundancy)
+                        found = self._refined(T, R, p, psi, start, signs, redundancy, anchors)
                     _add_root(roots, found)
             if roots:
                 break
+        for q in [self._flip * q for q, _, _ in roots] + anchors:  # the other root of a close pair
+            for seed in self._fold_partners(T, q, psi):
+                evals += POLISH_ITERATIONS
+                _add_root(roots, self._refined(T, R, p, psi, seed, signs, redundancy))
         if hint is not None:
             evals += POLISH_ITERATIONS
             _add_root(roots, self._refined(T, R, p, psi, self._flip * hint, signs, redundancy))
         return roots, evals
+
+    def _at_boundary(self, seed: np.ndarray, seed_signs: tuple, signs: tuple) -> bool:
+        """Whether each branch quantity in which the seed's configuration differs from c is
+        within :data:`BOUNDARY` of zero at the seed (nominal coordinates)."""
+        values = np.empty(len(signs))
+        self._nominal.configuration_values(seed, values, np.empty(1 if self._P is not None else 0))
+        return all(abs(v) < BOUNDARY for v, a, b in zip(values, seed_signs, signs, strict=True) if a != b)
 
     def _nominal_roots(self, T, signs, redundancy) -> tuple[list[np.ndarray], int]:
         """The nominal arm's roots of T in a configuration (nominal coordinates), evaluations."""
@@ -160,8 +201,11 @@ class NearKernel:
         n, evals = self._nominal.solve_all(T, signs, redundancy, roots, info)
         return [roots[r].copy() for r in range(n)], evals
 
-    def _refined(self, T, R, p, psi, seed, signs, redundancy) -> tuple[np.ndarray, float, float] | None:
-        """The seed (nominal coordinates) polished on the exact chain and verified; None if not."""
+    def _refined(
+        self, T, R, p, psi, seed, signs, redundancy, anchors: list | None = None
+    ) -> tuple[np.ndarray, float, float] | None:
+        """The seed (nominal coordinates) polished on the exact chain and verified; None if not
+        (an exact root in another configuration is appended to ``anchors``, if given)."""
         if seed is None:
             return None
         q = np.ascontiguousarray(seed, dtype=np.float64).copy()
@@ -171,7 +215,49 @@ class NearKernel:
         exact = pos <= self._tolerances[0] and ori <= self._tolerances[1]
         if exact and self.holds(q_real, signs, redundancy):
             return q_real, pos, ori
+        if exact and anchors is not None:
+            anchors.append(q)
         return None
+
+    def _fold_partners(self, T, q, psi) -> list[np.ndarray]:
+        r"""Seeds for the fold partner of the exact root q (nominal coordinates).
+
+        Where the exact chain's Jacobian J (with the arm angle's gradient on a 7-DOF arm) is
+        nearly singular, :math:`J v = \sigma u` with :math:`\sigma` < :data:`FOLD`, two roots of
+        (T, psi) meet along v: :math:`u \cdot e(q + t v) \approx \sigma t + c t^2 / 2`, e the
+        pose (and psi) error, so the partner lies near :math:`t = -2 \sigma / c`, c from a
+        second difference. The nominal arm may have neither root of the pair, or only one
+        (its fold lies elsewhere): the partner is the one no nominal seed leads to."""
+        J = self._exact.jacobian(q)
+        if self._P is not None:
+            grad = np.empty(self._real.dof)
+            ckernels.arm_angle_gradient(self._P, self._model_table, np.ascontiguousarray(q), grad)
+            J = np.vstack([J, grad])
+        U, S, Vt = np.linalg.svd(J)
+        sigma, u, v = S[-1], U[:, -1], Vt[-1]
+        if sigma >= FOLD:
+            return []
+        h = FOLD_STEP
+        c = u @ (
+            self._error(T, q + h * v, psi) - 2.0 * self._error(T, q, psi) + self._error(T, q - h * v, psi)
+        )
+        t = -2.0 * sigma / (c / h**2) if c != 0.0 else np.nan
+        return [q + k * t * v for k in PARTNER_STEPS] if np.isfinite(t) else []
+
+    def _error(self, T, q, psi) -> np.ndarray:
+        """The exact chain's pose error at q (nominal coordinates) against T: position, the
+        rotation vector of :math:`R(q) R_T^T` (small angles), and on a 7-DOF arm psi's."""
+        F = self._exact.fk(q)
+        E = F[:3, :3] @ T[:3, :3].T
+        error = [
+            F[:3, 3] - T[:3, 3],
+            0.5 * np.array([E[2, 1] - E[1, 2], E[0, 2] - E[2, 0], E[1, 0] - E[0, 1]]),
+        ]
+        if self._P is not None:
+            grad = np.empty(self._real.dof)
+            psi_q = ckernels.arm_angle_gradient(self._P, self._model_table, np.ascontiguousarray(q), grad)
+            error.append([_wrap(psi_q - psi)])
+        return np.concatenate(error)
 
     def _fixed_point(self, T, seed, signs, redundancy) -> np.ndarray | None:
         """The OM fixed point q = IK_nom(T D(q), c) from a seed (nominal coordinates)."""
@@ -231,10 +317,18 @@ def _distance(a: np.ndarray, b: np.ndarray) -> float:
 
 
 def _pulled(T: np.ndarray, fraction: float) -> np.ndarray:
-    """T with its position pulled toward the root frame's origin by a fraction of it."""
+    """T with its position pulled toward the root frame's origin by a fraction of it (pushed
+    away from it for a negative fraction)."""
     pulled = T.copy()
     pulled[:3, 3] *= 1.0 - fraction
     return pulled
+
+
+def _shifted(T: np.ndarray, axis: int, distance: float) -> np.ndarray:
+    """T with its position moved by ``distance`` (m) along an axis of the root frame."""
+    moved = T.copy()
+    moved[axis, 3] += distance
+    return moved
 
 
 def _errors(reached: np.ndarray, T: np.ndarray) -> tuple[float, float]:

@@ -45,6 +45,8 @@ _SELF_CHECKED: weakref.WeakKeyDictionary[Arm, set[tuple]] = weakref.WeakKeyDicti
 #: (the Gen3's torus) costs the square of it: one ``solve_all`` takes 0.7 s at 1024 points
 #: (11 s at 4096), 6 ms at the default 64.
 MIN_SCAN_POINTS, MAX_SCAN_POINTS = 8, 1024
+#: Most worker threads ``solve_batch`` accepts (it uses at most one per core).
+MAX_THREADS = 1024
 
 
 @dataclass(frozen=True, eq=False, slots=True)
@@ -281,6 +283,7 @@ class OMSolver:
         signs: Any,
         redundancy: Any = None,
         q_hint: Any = None,
+        threads: int | None = None,
     ) -> BatchSolution:
         """Solve many targets at once, in parallel.
 
@@ -290,6 +293,9 @@ class OMSolver:
             redundancy: Redundancy values (M, r) or (r,) (a 7-DOF arm's arm angle psi, r = 1;
                 then also (M,) or one number); None for 6-DOF arms.
             q_hint: Optional (M, dof) hints.
+            threads: Worker threads, 1 to :data:`MAX_THREADS` (at most one per core is
+                used); None: one per core. 1 solves every row on the calling thread. The
+                answers do not depend on it.
 
         Returns:
             A :class:`BatchSolution` with M rows. An empty batch (M = 0) gives empty rows.
@@ -302,6 +308,7 @@ class OMSolver:
         k = len(self.sign_names)
         signs = np.ascontiguousarray(np.broadcast_to(as_signs(signs, k, stack=True, rows=m), (m, k)))
         redundancy = self._redundancy_rows(redundancy, m)
+        threads = None if threads is None else as_count(threads, "threads", 1, MAX_THREADS)
         hints = None
         if q_hint is not None:
             hints = as_joint_vector(q_hint, self.arm.dof, "q_hint").reshape(-1, self.arm.dof)
@@ -315,7 +322,7 @@ class OMSolver:
             kernel.solve_rows(T, signs, redundancy, hints, start, stop, q, info)
 
         if m:
-            system.run_rows(solve_range, m)
+            system.run_rows(solve_range, m, threads)
         status = info[:, 0].astype(np.int64)
         return BatchSolution(
             q,

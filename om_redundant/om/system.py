@@ -12,6 +12,8 @@ seen from the flange and depends on one wrist joint, :math:`w = q_J` (see
 
 and a root gives the real arm's joints :math:`q = \mathrm{IK}_{model}(\ldots)` with
 :math:`|p_{real}(q) - p_d| = |\delta(w) - \delta(q_J)| \le \Delta p_{max}\,|g(w)|`.
+A 6-DOF wrist with :math:`a_4 \ne 0` has the circle :math:`p_m = p_d + \Delta p(w)`,
+:math:`w = q_1`, instead (:mod:`om_redundant.om.model`, ``csrc/wrist_offset.c``).
 
 Arms with shoulder offsets (Gen3, Sawyer) add :math:`a(q_1)`, so solutions lie on a torus
 :math:`(w_1, w_7) = (q_1, q_7)`: :math:`p_m = p_d + a(w_1) + R_d\,\delta(w_7)`. There the
@@ -134,21 +136,32 @@ _pool: ThreadPoolExecutor | None = None
 _pool_lock = threading.Lock()
 
 
-def run_rows(solve_range: Callable[[int, int], None], rows: int) -> None:
-    """Run ``solve_range(start, stop)`` over ``range(rows)`` in chunks, on every core.
+def run_rows(solve_range: Callable[[int, int], None], rows: int, threads: int | None = None) -> None:
+    """Run ``solve_range(start, stop)`` over ``range(rows)`` in chunks, on ``threads`` threads.
 
-    The kernels release the GIL, so threads run them in parallel; chunks are handed out as
-    threads come free, which balances targets of unequal cost.
+    The kernels release the GIL, so threads run them in parallel; each thread takes the next
+    chunk as it comes free, which balances targets of unequal cost. ``threads`` None: one
+    per core (at most that many in any case); 1: every row on the calling thread, in one call.
     """
     global _pool
-    workers = os.cpu_count() or 1
+    cores = os.cpu_count() or 1
+    workers = cores if threads is None else min(cores, threads)
     if rows <= BATCH_CHUNK or workers == 1:
         solve_range(0, rows)
         return
     with _pool_lock:
         if _pool is None:
-            _pool = ThreadPoolExecutor(workers, thread_name_prefix="om_redundant")
+            _pool = ThreadPoolExecutor(cores, thread_name_prefix="om_redundant")
     chunk = max(1, min(BATCH_CHUNK, -(-rows // workers)))
-    futures = [_pool.submit(solve_range, s, min(s + chunk, rows)) for s in range(0, rows, chunk)]
-    for future in futures:
+    starts, lock = iter(range(0, rows, chunk)), threading.Lock()
+
+    def drain() -> None:
+        while True:
+            with lock:
+                start = next(starts, None)
+            if start is None:
+                return
+            solve_range(start, min(start + chunk, rows))
+
+    for future in [_pool.submit(drain) for _ in range(workers)]:
         future.result()

@@ -1,22 +1,28 @@
-r"""Obstacle clearance of an arm, computed by MuJoCo.
+r"""Obstacle clearance of an arm, computed with MuJoCo's kinematics.
 
 The clearance of joint vector q is the smallest signed distance between the arm's collision
 geoms and the obstacle geoms,
 
 .. math::  D(q) = \min_k d_k(q), \qquad d_k(q) = \mathrm{dist}\big(A_k(q), O_k\big),
 
-over the pairs k of (arm geom :math:`A_k`, obstacle geom :math:`O_k`), each computed by
-``mujoco.mj_geomDistance`` (negative when the geoms overlap, capped at ``distmax``). With
+over the pairs k of (arm geom :math:`A_k`, obstacle geom :math:`O_k`), negative when the
+geoms overlap, capped at ``distmax``. One ``mj_kinematics`` places the geoms; a compiled
+kernel (``ckernels.geom_distances``, ``csrc/clearance.c``) computes the pairs of a sphere or
+capsule arm geom and a sphere, capsule or box obstacle that do not touch, exactly (closest
+points of segments, and of a segment and a box, in closed form), and
+``mujoco.mj_geomDistance`` the rest (other kinds, touching or overlapping geoms);
+``tests/test_clearance.py`` checks the kernel against ``mj_geomDistance``. With
 :math:`p_A, p_O` the nearest points and :math:`n_k = (p_O - p_A)/d_k` the unit direction
 from the arm geom to the obstacle (the division by the signed distance keeps it pointing
 that way when the geoms overlap), moving the arm point by :math:`dp` changes the distance
 by :math:`-n_k \cdot dp`, so
 
-.. math::  \frac{\partial d_k}{\partial q} = -n_k^T J_p(p_A),
+.. math::  \frac{\partial d_k}{\partial q_j} = -n_k \cdot \big(a_j \times (p_A - o_j)\big)
 
-with :math:`J_p` the translational Jacobian of the arm geom's body at :math:`p_A`
-(``mujoco.mj_jac``). A pair farther apart than ``distmax`` reports ``distmax`` with a zero
-gradient.
+for each hinge joint j that moves the arm geom (axis :math:`a_j` through :math:`o_j`,
+MuJoCo's ``xaxis`` and ``xanchor``; :math:`-n_k \cdot a_j` for a slide joint), computed by
+``ckernels.distance_gradients``. A pair farther apart than ``distmax`` reports ``distmax``
+with a zero gradient.
 
 Obstacles come three ways: simple shapes (:class:`Sphere`, :class:`Capsule`, :class:`Box`)
 or the primitive geoms of a MuJoCo model, placed in the arm's root frame and combined with
@@ -30,11 +36,12 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, NamedTuple
 
 import mujoco
 import numpy as np
 
+from .. import ckernels
 from ..exceptions import InvalidInput
 from ..kinematics.arm import Arm
 from ..mujoco_io.arm_in_model import ArmJoints
@@ -42,7 +49,6 @@ from ..mujoco_io.mjcf import arm_mjcf
 from ..validation import as_instance, as_joint_vector, as_pose, as_positive, as_vector
 
 DEFAULT_DISTMAX = 1.0  # m: pairs farther apart report this distance
-_NEXT, _PREVIOUS = [1, 2, 0], [2, 0, 1]  # (a x b)_i = a_{i+1} b_{i+2} - a_{i+2} b_{i+1}
 
 _PRIMITIVES = {
     mujoco.mjtGeom.mjGEOM_PLANE,
@@ -188,7 +194,9 @@ class Clearance:
         self.distmax = as_positive(distmax, "distmax")
         self._data = mujoco.MjData(model)
         joints = ArmJoints(arm, model, prefix)
-        self._qpos = joints.qpos_ids
+        ids = joints.qpos_ids
+        consecutive = np.array_equal(ids, np.arange(ids[0], ids[0] + len(ids)))
+        self._qpos = slice(int(ids[0]), int(ids[0]) + len(ids)) if consecutive else ids  # a slice sets faster
         self._dofs = joints.dof_ids
         moving = _subtree(model, model.jnt_bodyid[joints.joint_ids[0]])
         arm_geoms = [
@@ -205,13 +213,22 @@ class Clearance:
         self._pairs = np.array([(a, o) for a in arm_geoms for o in obstacles], dtype=np.int64).reshape(-1, 2)
         # bounding-sphere radii of each pair (MuJoCo's rbound; 0 means unbounded, a plane)
         rbound = np.where(model.geom_rbound > 0.0, model.geom_rbound, np.inf)
-        self._bounds = rbound[self._pairs[:, 0]] + rbound[self._pairs[:, 1]]
-        self._bodies = model.geom_bodyid[self._pairs[:, 0]]
-        self._arm_geoms, self._obstacle_geoms = self._pairs[:, 0].copy(), self._pairs[:, 1].copy()
-        arm_bodies, self._body_index = np.unique(self._bodies, return_inverse=True)
-        self._arm_bodies = arm_bodies.tolist()
+        self._geoms = _geom_cores(model, self._pairs, rbound, joints)
         self.pairs: tuple[tuple[str, str], ...] = tuple(
             (model.geom(a).name, model.geom(o).name) for a, o in self._pairs
+        )
+        #: A bound (m, at least 1) on every |dd_k/dq_i|: a point of an arm geom lies at most
+        #: this far from any joint's axis (the bodies' offsets, the joints' anchors, the
+        #: farthest geom point from its body's origin, summed), and a prismatic joint moves
+        #: it at unit speed.
+        geom_reach = np.linalg.norm(model.geom_pos[arm_geoms], axis=1) + rbound[arm_geoms]
+        self.lever = max(
+            1.0,
+            float(
+                np.linalg.norm(model.body_pos[moving], axis=1).sum()
+                + np.linalg.norm(model.jnt_pos[joints.joint_ids], axis=1).sum()
+                + geom_reach.max(initial=0.0)
+            ),
         )
 
     @classmethod
@@ -274,48 +291,123 @@ class Clearance:
         """
         return self._evaluate(q, gradient, min(as_positive(reach, "reach"), self.distmax))
 
+    def minima(self, q: np.ndarray) -> np.ndarray:
+        r"""The clearance D(q) of every row of q, as :meth:`minimum` gives it, computing few pairs.
+
+        Each geom contains its centre, so the centres' distance :math:`c_k` bounds a pair's
+        distance from above and :math:`c_k - r_k` (the bounding-sphere radii) from below: only
+        the pairs with :math:`c_k - r_k \le \min_j c_j` can be the smallest. The bounds of all
+        rows are one vectorised test on the geoms' centres.
+
+        Args:
+            q: (M, dof) joint vectors.
+
+        Returns:
+            (M,) clearances in metres (at most ``distmax``).
+        """
+        q = as_joint_vector(q, self._dof).reshape(-1, self._dof)
+        m, d = self.model, self._data
+        centres = np.empty((len(q), m.ngeom, 3))
+        for row, xpos in zip(q, centres, strict=True):
+            d.qpos[self._qpos] = row
+            mujoco.mj_kinematics(m, d)
+            xpos[:] = d.geom_xpos
+        apart = np.linalg.norm(centres[:, self._arm_geoms] - centres[:, self._obstacle_geoms], axis=2)
+        candidates = apart - self._bounds <= np.minimum(apart.min(axis=1), self.distmax)[:, None]
+        out = np.full(len(q), self.distmax)
+        for i in np.flatnonzero(candidates.any(axis=1)).tolist():
+            d.qpos[self._qpos] = q[i]
+            mujoco.mj_kinematics(m, d)
+            pairs = np.flatnonzero(candidates[i])
+            arm, obstacle = self._arm_geoms[pairs].tolist(), self._obstacle_geoms[pairs].tolist()
+            pairs = zip(arm, obstacle, strict=True)
+            out[i] = min(mujoco.mj_geomDistance(m, d, a, o, self.distmax, None) for a, o in pairs)
+        return out
+
     def _evaluate(
         self, q: np.ndarray, gradient: bool, reach: float | None = None
     ) -> tuple[np.ndarray, np.ndarray]:
-        r"""Distances capped at reach (default distmax), and their gradients if asked.
-
-        The gradient of pair k on arm body b, from the body's Jacobians at its origin x_b
-        (``mj_jacBody``, once per body), with :math:`r_k = p_A - x_b`:
-        :math:`J_p(p_A) = J_v - [r_k]_\times J_\omega`, so
-        :math:`\partial d_k/\partial q = -n_k^T J_v + (n_k \times r_k)^T J_\omega`.
-        """
+        """Distances capped at reach (default distmax), and their gradients if asked: one
+        ``mj_kinematics``, then ``ckernels.geom_distances`` (sphere and capsule arm geoms
+        against sphere, capsule and box obstacles, apart) with ``mj_geomDistance`` for the
+        pairs it leaves, and ``ckernels.distance_gradients`` (module docstring)."""
         q = as_joint_vector(q, self._dof, stack=False)
-        m, d = self.model, self._data
+        m, d, geoms = self.model, self._data, self._geoms
         reach = self.distmax if reach is None else reach
         d.qpos[self._qpos] = q
         mujoco.mj_kinematics(m, d)
         n_pairs = len(self._pairs)
-        dist = np.full(n_pairs, reach)
-        grad = np.zeros((n_pairs, self._dof))
-        apart = np.linalg.norm(d.geom_xpos[self._arm_geoms] - d.geom_xpos[self._obstacle_geoms], axis=1)
-        near = np.flatnonzero(apart - self._bounds < reach)
-        fromto = np.zeros((len(near), 6))
-        pairs = zip(self._arm_geoms[near].tolist(), self._obstacle_geoms[near].tolist(), fromto, strict=True)
-        dist[near] = [mujoco.mj_geomDistance(m, d, a, o, reach, row) for a, o, row in pairs]
-        if not gradient:
-            return dist, grad
-        moving = (dist[near] < reach) & (dist[near] != 0.0)
-        near, fromto = near[moving], fromto[moving]
-        if not len(near):
-            return dist, grad
-        mujoco.mj_comPos(m, d)
-        normal = (fromto[:, 3:] - fromto[:, :3]) / dist[near, None]
-        bodies = self._bodies[near]
-        r = fromto[:, :3] - d.xpos[bodies]
-        n_cross_r = (
-            normal[:, _NEXT] * r[:, _PREVIOUS] - normal[:, _PREVIOUS] * r[:, _NEXT]
-        )  # np.cross is slow
-        jac = np.zeros((len(self._arm_bodies), 6, m.nv))  # each body's (J_v; J_omega)
-        for b in np.unique(self._body_index[near]).tolist():
-            mujoco.mj_jacBody(m, d, jac[b, :3], jac[b, 3:], self._arm_bodies[b])
-        jac = jac[:, :, self._dofs][self._body_index[near]]
-        grad[near] = np.einsum("ki,kij->kj", np.hstack([-normal, n_cross_r]), jac)
+        dist, fromto = np.empty(n_pairs), np.empty((n_pairs, 6))
+        if ckernels.geom_distances(
+            geoms.kind,
+            geoms.radius,
+            geoms.half,
+            d.geom_xpos,
+            d.geom_xmat,
+            self._pairs,
+            geoms.bounds,
+            reach,
+            dist,
+            fromto,
+        ):
+            for k in np.flatnonzero(np.isnan(dist)).tolist():
+                a, o = self._pairs[k].tolist()
+                dist[k] = mujoco.mj_geomDistance(m, d, a, o, reach, fromto[k])
+        grad = np.empty((n_pairs, self._dof)) if gradient else np.zeros((n_pairs, self._dof))
+        if gradient:  # every row written
+            ckernels.distance_gradients(
+                dist, fromto, reach, d.xanchor, d.xaxis, geoms.joints, geoms.slide, geoms.moves, grad
+            )
         return dist, grad
+
+
+class GeomCores(NamedTuple):
+    """What ``ckernels.geom_distances`` and ``distance_gradients`` read of a model, set up
+    once per :class:`Clearance`.
+
+    Attributes:
+        kind: (G,) each geom's core: 1 a point (sphere), 2 a segment (capsule), 3 a box;
+            0 where MuJoCo computes its distances (other kinds, arm geoms other than
+            spheres and capsules).
+        radius: (G,) radius about the core (0 for a box).
+        half: (G, 3) half length of a segment along its z axis (0, 0, l); a box's half sizes.
+        bounds: (P,) sum of each pair's bounding-sphere radii (inf: a plane).
+        joints: (dof,) the arm's joint ids in the model.
+        slide: (dof,) which of them slide (else hinges).
+        moves: (P, dof) whether joint j moves pair k's arm geom.
+    """
+
+    kind: np.ndarray
+    radius: np.ndarray
+    half: np.ndarray
+    bounds: np.ndarray
+    joints: np.ndarray
+    slide: np.ndarray
+    moves: np.ndarray
+
+
+def _geom_cores(model: mujoco.MjModel, pairs: np.ndarray, rbound: np.ndarray, joints: ArmJoints) -> GeomCores:
+    kind = np.zeros(model.ngeom, dtype=np.int64)
+    radius, half = np.zeros(model.ngeom), np.zeros((model.ngeom, 3))
+    for g in range(model.ngeom):
+        size = model.geom_size[g]
+        if model.geom_type[g] == mujoco.mjtGeom.mjGEOM_SPHERE:
+            kind[g], radius[g] = 1, size[0]
+        elif model.geom_type[g] == mujoco.mjtGeom.mjGEOM_CAPSULE:
+            kind[g], radius[g], half[g, 2] = 2, size[0], size[1]
+        elif model.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX:
+            kind[g], half[g] = 3, size
+    inside = np.array([_subtree(model, model.jnt_bodyid[j]) for j in joints.joint_ids])  # (dof, nbody)
+    moves = np.ascontiguousarray(inside[:, model.geom_bodyid[pairs[:, 0]]].T)
+    return GeomCores(
+        kind,
+        radius,
+        half,
+        np.ascontiguousarray(rbound[pairs[:, 0]] + rbound[pairs[:, 1]]),
+        np.ascontiguousarray(joints.joint_ids, dtype=np.int64),
+        model.jnt_type[joints.joint_ids] == mujoco.mjtJoint.mjJNT_SLIDE,
+        moves,
+    )
 
 
 def _shape_geoms(obstacles: Sequence[Shape]) -> list[_Geom]:

@@ -237,6 +237,63 @@ class Objective:
         """f(q), M(q), D(q) and the feasibility slack."""
         return self.evaluation(self.groups(as_joint_vector(q, self._dof)))
 
+    def evaluations(self, q: np.ndarray) -> list[Evaluation]:
+        """:meth:`evaluate` at every row of q (M, dof), vectorised over the rows (the same
+        values: each group's minimum is the minimum of its pieces, D(q) by
+        :meth:`Clearance.minima <om_redundant.Clearance.minima>`)."""
+        q = as_joint_vector(q, self._dof).reshape(-1, self._dof)
+        inf = np.full(len(q), math.inf)
+        terms, slacks = [np.zeros(len(q))], [inf]
+        margin = clearance = singularity = inf
+        if len(self._limited):
+            lim = q[:, self._limited]
+            margin = np.minimum(*_limit_distances(lim, self._lower, self._upper, self._half)).min(axis=1)
+            terms.append(self.margin_weight * margin)
+            slacks.append(margin - 0.0)
+        if self.clearance is not None:
+            scaled = self.clearance.minima(q) / self.clearance_cap
+            terms.append(self.clearance_weight * np.minimum(1.0, scaled))
+            slacks.append(scaled - self.min_clearance / self.clearance_cap)
+            clearance = scaled * self.clearance_cap
+        if self.singularity is not None:
+            scaled = self.singularity.distances(q).min(axis=1) / SINGULARITY_CAP
+            terms.append(self.singularity_weight * np.minimum(1.0, scaled))
+            singularity = scaled * SINGULARITY_CAP
+        value = terms[0]
+        for term in terms[1:]:
+            value = value + term  # in the order of evaluation()'s sum
+        slack = np.min(slacks, axis=0)
+        return [
+            Evaluation(*(float(x) for x in row))
+            for row in zip(value, margin, clearance, slack, singularity, strict=True)
+        ]
+
+    def constraint_bounds(
+        self, q: np.ndarray, tangent: np.ndarray, evaluation: Evaluation
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        r"""The feasibility functions of :meth:`Group.constraints` at q, without the
+        clearances' gradients: bounds for a cheap test of a cell of a solution path.
+
+        Each limited joint's margin function :math:`1 - |q_i - c_i|/h_i` exactly, with its
+        rate's size :math:`|t_i|/h_i` (t = dq/dpsi, ``tangent`` (dof, 1)); then, with
+        obstacles, the smallest clearance function :math:`(D - d_{min})/d_{cap}` (every
+        clearance function is at least this) and a bound on every clearance function's rate,
+        :math:`\ell \sum_i |t_i| / d_{cap}` (:attr:`Clearance.lever <om_redundant.Clearance.lever>`).
+
+        Returns:
+            (values, rate bounds, exact): exact marks the entries that are one function each
+            (the margins), not a lower bound of several.
+        """
+        lim = self._limited
+        values = [np.minimum(*_limit_distances(q[lim], self._lower, self._upper, self._half))]
+        rates, exact = [np.abs(tangent[lim, 0]) / self._half], [np.ones(len(lim), dtype=bool)]
+        if self.clearance is not None:
+            cap = self.clearance_cap
+            values.append([(evaluation.clearance / cap) - self.min_clearance / cap])
+            rates.append([self.clearance.lever * float(np.abs(tangent).sum()) / cap])
+            exact.append([False])
+        return np.concatenate(values), np.concatenate(rates), np.concatenate(exact)
+
     def evaluation(self, groups: list[Group]) -> Evaluation:
         """f, M, D, the slack and S from the groups at one joint vector."""
         kinds = {g.kind: float(g.values.min()) for g in groups}

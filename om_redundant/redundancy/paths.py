@@ -41,7 +41,7 @@ import numpy as np
 from ..om.configuration import Configuration
 from ..om.solver import OMSolver, Solution
 from .objective import Evaluation, Group, Objective
-from .self_motion import self_motion_tangent
+from .self_motion import self_motion_tangent, self_motion_tangents
 
 JUMP = 1.0  # rad, max-norm joint step between neighbouring solutions of one path
 END_TOLERANCE = 1e-9  # rad: a path whose following step falls below this has ended
@@ -54,6 +54,31 @@ _HERMITE = np.array(
     [2 * _T**3 - 3 * _T**2 + 1, _T**3 - 2 * _T**2 + _T, -2 * _T**3 + 3 * _T**2, _T**3 - _T**2]
 )
 _TURN = 2.0 * math.pi
+_BOUND_SLACK = 1e-9  # covers the rounding of the Hermite models in the bounds of _quiet
+
+
+class _Terms:
+    """The objective at a point, computed when first asked for (a path's following steps
+    need only the joints and the tangent): the evaluation, then the groups with their rates.
+    Shared by the copies of a point at other representatives of psi."""
+
+    def __init__(
+        self, objective: Objective, q: np.ndarray, tangent: np.ndarray, evaluation: Evaluation | None
+    ):
+        self.objective, self.q, self.tangent = objective, q, tangent
+        self.evaluation, self.groups = evaluation, None
+
+    def get_evaluation(self) -> Evaluation:
+        if self.evaluation is None:
+            self.evaluation = self.objective.evaluation(self.objective.groups(self.q))
+        return self.evaluation
+
+    def get_groups(self) -> list[Group]:
+        if self.groups is None:
+            self.groups = [g.along(self.tangent) for g in self.objective.groups(self.q, jacobian=True)]
+            if self.evaluation is None:
+                self.evaluation = self.objective.evaluation(self.groups)
+        return self.groups
 
 
 @dataclass(frozen=True, eq=False)
@@ -63,19 +88,28 @@ class Point:
     Attributes:
         psi: The redundancy value (rad); an (r,) array for r > 1 redundancy variables.
         q: The joints.
-        evaluation: The objective at q.
-        groups: The objective's groups at q, their jacobians by psi (p_g, r).
         tangent: dq/dpsi (dof, r).
+        terms: The objective at q, evaluated when first asked for (:attr:`evaluation`,
+            :attr:`groups`).
         solution: The solver's Solution of it, when solved singly (its q may differ from
             ``q`` by turns of revolute joints); None for a batch sample.
     """
 
     psi: float | np.ndarray
     q: np.ndarray
-    evaluation: Evaluation
-    groups: list[Group]
     tangent: np.ndarray
+    terms: _Terms
     solution: Solution | None = None
+
+    @property
+    def evaluation(self) -> Evaluation:
+        """The objective at q."""
+        return self.terms.get_evaluation()
+
+    @property
+    def groups(self) -> list[Group]:
+        """The objective's groups at q, their jacobians by psi (p_g, r)."""
+        return self.terms.get_groups()
 
     def pieces(self) -> tuple[np.ndarray, np.ndarray]:
         """The feasibility functions g_j (all >= 0 iff feasible; see
@@ -141,8 +175,21 @@ class Probe:
 
     def _point(self, psi: float | np.ndarray, q: np.ndarray, solution: Solution | None) -> Point:
         tangent = self_motion_tangent(self.solver, q)
-        groups = [g.along(tangent) for g in self.objective.groups(q, jacobian=True)]
-        return Point(psi, q, self.objective.evaluation(groups), groups, tangent, solution)
+        return Point(psi, q, tangent, _Terms(self.objective, q, tangent, None), solution)
+
+    def points(self, psi: np.ndarray, q: np.ndarray) -> list[Point]:
+        """:meth:`point` for every psi and row of q (M, dof) of a 7-DOF arm, the tangents and
+        the evaluations computed for all rows at once."""
+        q = self._represent(q)
+        tangents = self_motion_tangents(self.solver, q)
+        bad = ~np.isfinite(tangents).all(axis=(1, 2))
+        if bad.any():
+            self_motion_tangent(self.solver, q[np.argmax(bad)])  # raises SingularSelfMotion
+        evaluations = self.objective.evaluations(q)
+        return [
+            Point(float(x), row, t, _Terms(self.objective, row, t, ev))
+            for x, row, t, ev in zip(psi, q, tangents, evaluations, strict=True)
+        ]
 
     def at(self, psi: float | np.ndarray, hint: np.ndarray) -> Point | None:
         """The solution at psi nearest ``hint``, if there is one."""
@@ -209,9 +256,11 @@ def sweep_circle(
     swept = []
     for b, signs in enumerate(branches):
         probe = Probe(solver, objective, T, signs)
+        rows = np.flatnonzero(batch.ok[b * n : (b + 1) * n])
+        samples = dict(zip(rows.tolist(), probe.points(psi[rows], batch.q[b * n + rows]), strict=True))
         roots = []
-        for k, row in enumerate(range(b * n, (b + 1) * n)):
-            found = [probe.point(psi[k], batch.q[row])] if batch.ok[row] else []
+        for k in range(n):
+            found = [samples[k]] if k in samples else []
             others = solver.solve_all(T, Configuration(signs, (psi[k],))) if found and several else []
             for sol in others:
                 if all(probe.step(sol.q, f.q) > _SAME for f in found):
@@ -352,6 +401,8 @@ def _surprise(a: Point, b: Point) -> float | None:
     """Where, as a fraction of the cell, the pieces' cubic models predict a feasibility that
     the ends do not explain: more changes between feasible and infeasible than the ends'
     (none if alike, one if not). Returns the middle of the first unexplained stretch."""
+    if _quiet(a, b):
+        return None
     (ga, da), (gb, db) = a.pieces(), b.pieces()
     if len(ga) == 0:
         return None
@@ -362,6 +413,25 @@ def _surprise(a: Point, b: Point) -> float | None:
     if len(changes) <= int(pattern[0] != pattern[-1]):
         return None
     return (changes[0] + 1 + changes[1]) / 2.0 / (len(pattern) - 1)
+
+
+def _quiet(a: Point, b: Point) -> bool:
+    """Whether the cell's cubic models cannot surprise, by bounds that need no clearance
+    gradients (:meth:`~om_redundant.redundancy.objective.Objective.constraint_bounds`): on
+    [0, 1] the Hermite basis functions of the values are >= 0 and sum to 1 and those of the
+    slopes stay within 4/27 in size, so a model lies within (4/27) span (|g'_a| + |g'_b|) of
+    the ends' range. Quiet: both ends feasible and every model stays >= 0, or both
+    infeasible and one exact function's model stays < 0."""
+    feasible = a.evaluation.feasible
+    if feasible != b.evaluation.feasible:
+        return False
+    objective = a.terms.objective
+    ga, ra, exact = objective.constraint_bounds(a.q, a.tangent, a.evaluation)
+    gb, rb, _ = objective.constraint_bounds(b.q, b.tangent, b.evaluation)
+    spread = 4.0 / 27.0 * abs(b.psi - a.psi) * (ra + rb) + _BOUND_SLACK
+    if feasible:
+        return bool((np.minimum(ga, gb) - spread > 0.0).all())
+    return bool((np.maximum(ga, gb) + spread < 0.0)[exact].any())
 
 
 def _wrap(x: np.ndarray) -> np.ndarray:

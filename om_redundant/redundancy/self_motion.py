@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import ckernels
 from ..exceptions import SingularSelfMotion
 from ..om.solver import OMSolver
 from ..validation import as_joint_vector
@@ -44,13 +45,11 @@ def self_motion_tangent(solver: OMSolver, q: np.ndarray) -> np.ndarray:
     """
     check_arm_angle(solver)
     q = as_joint_vector(q, solver.arm.dof, stack=False)
-    jacobian = solver.arm.jacobian(q)
-    gradient = arm_angle_and_gradient(solver, q)[1]
-    if jacobian.shape[1] == 7:  # one variable: the null vector of cofactors, n_i = (-1)^i det J_(i)
-        null = _COFACTOR_SIGNS * np.linalg.det(jacobian[:, _MINORS].transpose(1, 0, 2))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            tangent = (null / (gradient @ null))[:, None]
+    if solver.arm.dof == 7:  # one variable: the null vector of cofactors, n_i = (-1)^i det J_(i)
+        tangent = self_motion_tangents(solver, q[None])[0]
     else:
+        jacobian = solver.arm.jacobian(q)
+        gradient = arm_angle_and_gradient(solver, q)[1]
         null = np.linalg.svd(jacobian)[2][6:].T
         change = np.atleast_2d(gradient @ null)
         try:
@@ -63,3 +62,35 @@ def self_motion_tangent(solver: OMSolver, q: np.ndarray) -> np.ndarray:
             "(exactly at a fold of the solution path, or where the Jacobian lost rank)"
         )
     return tangent
+
+
+def self_motion_tangents(solver: OMSolver, q: np.ndarray) -> np.ndarray:
+    r"""dq/dpsi of a 7-DOF arm (one redundancy variable) at every row of q, as
+    :func:`self_motion_tangent` computes it (the same operations per row, the 6x6 minors of
+    all rows in one batch), NaN rows where psi does not move along the self-motion.
+
+    Args:
+        solver: The solver of a 7-DOF arm.
+        q: (M, 7) joint vectors.
+
+    Returns:
+        (M, 7, 1) tangents.
+
+    Raises:
+        InvalidInput: The arm has no arm angle, or q is malformed.
+    """
+    check_arm_angle(solver)
+    q = as_joint_vector(q, solver.arm.dof).reshape(-1, solver.arm.dof)
+    chain, model, flip = solver.arm.chain, solver.model.chain, solver.flip
+    jacobians = np.empty((len(q), 6, 7))
+    gradients = np.empty((len(q), 7))
+    for row, J, grad in zip(q, jacobians, gradients, strict=True):
+        ckernels.jacobian(chain.table, chain.T_root_base, chain.T_flange_tool, row, J)
+        ckernels.arm_angle_gradient(solver.om.params, model.table, flip * row, grad)
+    gradients *= flip
+    null = _COFACTOR_SIGNS * np.linalg.det(jacobians[:, :, _MINORS].transpose(0, 2, 1, 3))
+    change = np.array([g @ n for g, n in zip(gradients, null, strict=True)])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tangent = null / change[:, None]
+    tangent[~np.isfinite(tangent).all(axis=1)] = np.nan
+    return tangent[:, :, None]

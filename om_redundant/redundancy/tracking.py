@@ -125,6 +125,7 @@ class Tracker:
         # An arm near a family solves through om.near.NearKernel: no compiled tracking step.
         self._kernel = solver.kernel if isinstance(solver.kernel, ckernels.Solver) else None
         self._last: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # q, values, gradients
+        self._signs: dict[tuple[int, ...], np.ndarray] = {}  # each branch's signs as the kernel takes them
 
     def step(
         self, T: np.ndarray, signs: tuple[int, ...], psi: float, q: np.ndarray, curvature: float
@@ -142,12 +143,13 @@ class Tracker:
         work.setup[_CURVATURE] = curvature if math.isfinite(curvature) else INITIAL_CURVATURE
         if objective.clearance is not None:
             self._linearise_at(q)
-        status = ckernels.track_step(
-            self._kernel, T, np.asarray(signs, dtype=np.int64), q, *work[:-2], work.q, work.out
-        )
+        signs_array = self._signs.get(signs)
+        if signs_array is None:
+            signs_array = self._signs[signs] = np.array(signs, dtype=np.int64)
+        status = ckernels.track_step(self._kernel, T, signs_array, q, *work[:-2], work.q, work.out)
         if status != 0:
             return None
-        out, q_new = work.out, work.q.copy()
+        out, q_new = work.out.tolist(), work.q.copy()  # Python floats: cheaper arithmetic
         margin = out[_O_MARGIN]
         clearance = math.inf
         value = objective.margin_weight * margin if math.isfinite(margin) else 0.0
@@ -179,7 +181,7 @@ class Tracker:
         """The clearances and their gradients at q, over d_cap, into the work arrays (those
         of the last step's result when q is its joints)."""
         last = self._last
-        if last is None or not np.array_equal(last[0], q):
+        if last is None or (last[0] is not q and not np.array_equal(last[0], q)):
             d, grad = self.objective.clearance.distances_within(
                 q, self.objective.clearance_reach, gradient=True
             )

@@ -123,6 +123,7 @@ class ExactPoseTask(ArmTask):
         self.root = ArmRoot(self.joints, frame_name, frame_type)
         fixed = self.root.fixed_pose
         self._root_at_origin = fixed is not None and np.array_equal(fixed, np.eye(4))
+        self._world_to_fixed_root = None if fixed is None else _inverse(fixed)
         self.optimizer = optimizer
         self.arm_configuration = arm_configuration
         if arm_configuration is not None:
@@ -246,8 +247,8 @@ class ExactPoseTask(ArmTask):
         arm_configuration: Configuration | None,
     ) -> None:
         """Solve T_world for the root at root_pose and, only if that succeeds, take it."""
-        if root_pose is self.root.fixed_pose and self._root_at_origin:
-            T_root = T_world
+        if root_pose is self.root.fixed_pose:
+            T_root = T_world if self._root_at_origin else self._world_to_fixed_root @ T_world
         else:
             R, p = root_pose[:3, :3], root_pose[:3, 3]
             T_root = np.eye(4)
@@ -282,3 +283,11 @@ class ExactPoseTask(ArmTask):
                 f"ExactPoseTask: every solution for the target in configuration {c} breaks a joint limit"
             )
         return min(inside, key=lambda q: float(np.linalg.norm(q - solution.q)))
+
+
+def _inverse(pose: np.ndarray) -> np.ndarray:
+    """The inverse of a homogeneous transform, [[R^T, -R^T p], [0, 1]]."""
+    inverse = np.eye(4)
+    inverse[:3, :3] = pose[:3, :3].T
+    inverse[:3, 3] = -pose[:3, :3].T @ pose[:3, 3]
+    return inverse

@@ -50,4 +50,8 @@ SIGMA4, SIGMA5, THETA4, THETA5, THETA6 = 10, 11, 12, 13, 14
 WRIST_CENTRE = 15  # 3 entries: wrist centre in the flange frame
 E_ROT = 18  # 9 entries, row-major: rotation from the frame after Rz(phi6) to the flange
 WRIST_ROW = 27  # index in the table of joint 4's row
-N_PARAMS = 28
+# A wrist with a4 != 0 (zero otherwise; see om_redundant.om.model and csrc/wrist_offset.c):
+WRIST_OFFSET = 28  # 3 entries: the real arm's a4, d5, a5
+AXIS4 = 31  # 9 entries: joint 4's axis z3 = C0 + C1 cos q1 + C2 sin q1 in DH frame 0 (rows C0, C1, C2)
+AXIS6 = 40  # 3 entries: joint 6's axis z5 in the flange frame
+N_PARAMS = 43

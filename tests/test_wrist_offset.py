@@ -1,0 +1,97 @@
+"""6-DOF arms whose wrist has a4 != 0: dp turns with q1 (om.model._wrist_offset), solved exactly."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import om_redundant as om
+from benchmarks.near_family import bent, reversed_joint
+from tests.conftest import check_exact, random_q, well_conditioned
+
+
+def with_offsets(arm: om.Arm, **changes: dict[str, float]) -> om.Arm:
+    """The arm with fields of joint rows changed: ``joint3={"a": 0.07}`` sets a4 (0-based joints)."""
+    rows = list(arm.chain.rows)
+    for key, fields in changes.items():
+        r = arm.chain.joint_rows[int(key.removeprefix("joint"))]
+        rows[r] = dataclasses.replace(rows[r], **fields)
+    return arm.with_chain(arm.chain.replace_rows(rows), f"{arm.name}-offset")
+
+
+offsets = st.tuples(
+    st.sampled_from(["ur5e", "spherical"]),
+    st.floats(0.01, 0.15) | st.floats(-0.15, -0.01),
+    st.sampled_from([0.0, 0.03, -0.05]),
+)
+
+
+@settings(max_examples=20, deadline=None)
+@given(arm_a4_a5=offsets, q_seed=st.integers(0, 2**32 - 1))
+def test_dp_of_a_wrist_offset_turns_with_q1_and_is_bounded_by_dp_max(arm_a4_a5, q_seed):
+    """dp = -(a4 x4 + d5 z4 + a5 x5) with x4 perpendicular to z4: |dp| <= dp_max =
+    hypot(a4, d5) + |a5| everywhere, equal to it without a5 (the model's check at construction
+    compares the formula with the FK)."""
+    name, a4, a5 = arm_a4_a5
+    arm = with_offsets(om.load_arm(name), joint3={"a": a4}, joint4={"a": a5})
+    model = om.derive_model(arm)
+    assert model.dp_joint == 0 and "wrist offset a4" in model.family_name
+    d5 = arm.chain.rows[arm.chain.joint_rows[4]].d
+    assert model.dp_max == pytest.approx(np.hypot(a4, d5) + abs(a5), rel=1e-15)
+    norms = np.linalg.norm(model.dp(random_q(arm, 64, np.random.default_rng(q_seed))), axis=1)
+    assert norms.max() <= model.dp_max + 1e-15
+    if a5 == 0.0:
+        np.testing.assert_allclose(norms, model.dp_max, rtol=0, atol=1e-15)
+
+
+@settings(max_examples=20, deadline=None)
+@given(arm_a4_a5=offsets, q_seed=st.integers(0, 2**32 - 1))
+def test_arms_with_a_wrist_offset_are_solved_exactly(arm_a4_a5, q_seed):
+    """Accepted by OMSolver (its self-check passes); every root exact and in c, and away from
+    the singular boundaries q among solve_all's roots and the hinted solve's answer."""
+    name, a4, a5 = arm_a4_a5
+    solver = om.OMSolver(with_offsets(om.load_arm(name), joint3={"a": a4}, joint4={"a": a5}))
+    assert solver.nominal is None
+    for q in random_q(solver.arm, 6, np.random.default_rng(q_seed)):
+        check_exact(solver, q, well_conditioned(solver, q))
+
+
+@pytest.mark.parametrize("deviation", [0.0, 1e-6, 1e-4])
+def test_a_wrist_offset_near_a_family(deviation):
+    """Like Menagerie's ARX L5 and i2rt YAM: a4 = 0.074, joint 3's axis reversed (tilted
+    7e-6 rad), every twist moved by +-deviation: solved through the nominal arm, exactly."""
+    arm = reversed_joint(with_offsets(om.load_arm("ur5e"), joint3={"a": 0.074}), 2, 7e-6)
+    solver = om.OMSolver(bent(arm, deviation, np.random.default_rng(1)) if deviation else arm)
+    assert solver.nominal is not None and "wrist offset a4" in solver.om.family_name
+    for q in random_q(solver.arm, 30, np.random.default_rng(5)):
+        check_exact(solver, q, well_conditioned(solver, q))
+
+
+def test_an_inner_fold_of_a_near_arm_is_solved():
+    """A target where two roots in c meet (Jacobian's smallest singular value 4e-5) and the
+    nominal arm's pair begins just farther out: the nominal arm has no root there, nor at the
+    target pulled toward the base; pushed away from it, it has the seeds (near.PULL). Without
+    them the arm failed its own self-check at this q."""
+    arm = reversed_joint(with_offsets(om.load_arm("ur5e"), joint3={"a": 0.074}), 2, 7e-6)
+    solver = om.OMSolver(arm)
+    q = np.array([1.1850, -2.0369, -0.6810, 4.9043, -3.4286, 1.5480])
+    assert np.linalg.svd(arm.jacobian(q), compute_uv=False)[-1] < 1e-4
+    check_exact(solver, q, strict=True)
+
+
+def test_a_wrist_offset_whose_joint_4_turns_with_joint_2_is_refused():
+    """a4 != 0 with joint 4 perpendicular to joints 2 and 3 (a PUMA-like wrist, alpha_3 = 90
+    deg): dp turns with joints 5 and 6, which no bounded search here handles: a ModelError
+    naming a4, also at construction; the same arm without a4 is accepted."""
+    puma = with_offsets(om.load_arm("ur5e"), joint2={"alpha": np.pi / 2})
+    om.OMSolver(puma)
+    offset = with_offsets(puma, joint3={"a": 0.07})
+    cause = r"a4 = 0.07 != 0 makes dp depend on joints 5 and 6.*joint 4's axis turns with q1 alone"
+    with pytest.raises(om.ModelError, match=cause):
+        om.derive_model(offset)
+    with pytest.raises(om.ModelError, match=cause):
+        om.OMSolver(offset)
