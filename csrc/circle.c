@@ -4,7 +4,6 @@
 
 #define CELL_SAFETY 4.0  /* the curvature of g taken as this multiple of its sampled second differences */
 #define CELL_HALVINGS 6  /* halvings of a scan cell that may hide roots: 16 points as fine as 1024 */
-#define EDGE_HALVINGS 24 /* more of the half at an edge of reach (a square root there): to 1e-8 of a cell */
 
 /* out[n] = v if there is room; returns the new count (the candidates' capacity is a bound, checked). */
 static int _put(double *out, int n, int cap, double v)
@@ -61,26 +60,22 @@ static int _bracket(om_problem *pb, double a, double ga, double b, double gb, do
  * curvature * (b - a) / 2, and keeps its sign where min(|g(a)|, |g(b)|) exceeds curvature *
  * (b - a)^2 / 8 (g lies within that of its chord). Any other cell is halved, the curvature
  * raised to CELL_SAFETY times the second difference seen at the midpoint, down to
- * CELL_HALVINGS halvings (16 scan points: as fine as 1024); each leaf goes to _bracket. At an
- * edge of reach (edge -1: at a, +1: at b) g has a square root's unbounded curvature: the half
- * at the edge is always halved again, EDGE_HALVINGS times more. The curvature is an estimate from samples (second
- * differences times CELL_SAFETY), not a proof. */
-static int _cell_roots(om_problem *pb, double a, double ga, double b, double gb, double curvature, int edge,
-                       int halvings, double *q, double *out, int n, int cap)
+ * CELL_HALVINGS halvings (16 scan points: as fine as 1024); each leaf goes to _bracket. The
+ * curvature is an estimate from samples (second differences times CELL_SAFETY), not a proof. */
+static int _cell_roots(om_problem *pb, double a, double ga, double b, double gb, double curvature, int halvings,
+                       double *q, double *out, int n, int cap)
 {
-    double h = b - a, bound = edge ? INFINITY : curvature;
-    bool monotone = fabs(gb - ga) > 0.5 * bound * h * h;
-    bool clear = ga * gb > 0.0 && py_min(fabs(ga), fabs(gb)) > 0.125 * bound * h * h;
+    double h = b - a;
+    bool monotone = fabs(gb - ga) > 0.5 * curvature * h * h;
+    bool clear = ga * gb > 0.0 && py_min(fabs(ga), fabs(gb)) > 0.125 * curvature * h * h;
     if (halvings == 0 || monotone || clear || fabs(ga - gb) > OM_PI)
         return _bracket(pb, a, ga, b, gb, q, out, n, cap);
     double m = 0.5 * (a + b), gm = om_g(pb, m, q, false);
     if (isnan(gm) || fabs(gm - ga) > OM_PI || fabs(gb - gm) > OM_PI) /* a gap of reach or a wrap inside */
         return _bracket(pb, a, ga, b, gb, q, out, n, cap);
     curvature = py_max(curvature, CELL_SAFETY * fabs(ga - 2.0 * gm + gb) / (0.25 * h * h));
-    int inner = py_min(halvings - 1, CELL_HALVINGS); /* the edge's half keeps its extra halvings */
-    n = _cell_roots(pb, a, ga, m, gm, curvature, edge < 0 ? -1 : 0, edge < 0 ? halvings - 1 : inner, q, out, n, cap);
-    return _cell_roots(pb, m, gm, b, gb, curvature, edge > 0 ? 1 : 0, edge > 0 ? halvings - 1 : inner, q, out, n,
-                       cap);
+    n = _cell_roots(pb, a, ga, m, gm, curvature, halvings - 1, q, out, n, cap);
+    return _cell_roots(pb, m, gm, b, gb, curvature, halvings - 1, q, out, n, cap);
 }
 
 /* CELL_SAFETY times |g''| estimated at run point i from the wrapped slopes of its two cells
@@ -135,9 +130,7 @@ static int _run_roots(om_problem *pb, const double *pw, const double *pg, int L,
         for (int k = i - 1; k <= i + 2; k++)
             if (cyclic || (k >= 0 && k < L))
                 curvature = py_max(curvature, _curvature_at(pw, pg, L, cyclic, py_mod(k, L)));
-        int edge = cyclic ? 0 : (i == 0 ? -1 : (j == L - 1 ? 1 : 0)); /* a run's ends are edges of reach */
-        n = _cell_roots(pb, pw[i], pg[i], wj, pg[j], curvature, edge, CELL_HALVINGS + (edge ? EDGE_HALVINGS : 0), q,
-                        out, n, cap);
+        n = _cell_roots(pb, pw[i], pg[i], wj, pg[j], curvature, CELL_HALVINGS, q, out, n, cap);
     }
     for (int i = 0; i < L; i++) {
         double gi = pg[i];
