@@ -312,16 +312,11 @@ class Clearance:
             d.qpos[self._qpos] = row
             mujoco.mj_kinematics(m, d)
             xpos[:] = d.geom_xpos
-        apart = np.linalg.norm(centres[:, self._arm_geoms] - centres[:, self._obstacle_geoms], axis=2)
-        candidates = apart - self._bounds <= np.minimum(apart.min(axis=1), self.distmax)[:, None]
+        apart = np.linalg.norm(centres[:, self._pairs[:, 0]] - centres[:, self._pairs[:, 1]], axis=2)
+        candidates = apart - self._geoms.bounds <= np.minimum(apart.min(axis=1), self.distmax)[:, None]
         out = np.full(len(q), self.distmax)
         for i in np.flatnonzero(candidates.any(axis=1)).tolist():
-            d.qpos[self._qpos] = q[i]
-            mujoco.mj_kinematics(m, d)
-            pairs = np.flatnonzero(candidates[i])
-            arm, obstacle = self._arm_geoms[pairs].tolist(), self._obstacle_geoms[pairs].tolist()
-            pairs = zip(arm, obstacle, strict=True)
-            out[i] = min(mujoco.mj_geomDistance(m, d, a, o, self.distmax, None) for a, o in pairs)
+            out[i] = self._evaluate(q[i], gradient=False)[0].min()  # the compiled pairs, as minimum()
         return out
 
     def _evaluate(
