@@ -322,7 +322,7 @@ int om_band_roots(om_problem *pb, double *roots, bool *neighbour_reached)
     double redundancy[1], found[OM_MAX_ROOTS * OM_MAX_DOF];
     bool near[3];
     int count = touch_points(pb, near, roots);
-    if (s->family != OM_SRS && s->mode == OM_CIRCLE)
+    if (s->family != OM_SRS && s->mode == OM_CIRCLE && s->dp_joint == 5) /* q6 given: not for a4 != 0 */
         count = wrist_roots(pb, roots, count);
     if (s->mode == OM_CIRCLE && WRIST_SIGN < s->n_signs && !near[WRIST_SIGN])
         near[WRIST_SIGN] = q_j_swings(pb);

@@ -49,10 +49,12 @@ double om_model_ik_at(om_problem *pb, double w, double *q, bool all_joints)
 
 /* The wrist's consistency at p_m = p_d + R delta(w) with the wrist joint J = w given, for a
  * 6-DOF circle arm (om_six_dof_model_ik_q6): smooth where g is steep at a singular wrist.
- * Writes q (q_J = w); NaN out of the model's reach. */
+ * Writes q (q_J = w); NaN out of the model's reach, and where w is not q6 (a4 != 0). */
 double om_wrist_residual(om_problem *pb, double w, double *q)
 {
     const om_solver_data *data = pb->s;
+    if (data->dp_joint != 5) /* a wrist with a4 != 0: w is q1, not q6 (wrist_offset.c) */
+        return NAN;
     vec3 pm = circle_point(pb, w);
     double residual;
     double margin = om_six_dof_model_ik_q6(data->family, data->params, data->model_table, &pb->t, pm, pb->signs,

@@ -106,7 +106,9 @@ static void pieces_at(const tracking *tr, const double *q, const double *t, piec
     for (int k = 0; k < n_clear; k++) {
         const double *g = tr->clear_g + k * dof;
         double v = tr->clear_d[k], a = 0.0;
-        for (int i = 0; i < dof; i++) v += g[i] * (q[i] - tr->q_ref[i]), a += g[i] * t[i];
+        int moving = 0;
+        for (int i = 0; i < dof; i++) v += g[i] * (q[i] - tr->q_ref[i]), a += g[i] * t[i], moving |= g[i] != 0.0;
+        if (!moving && v >= tr->cap[1]) continue; /* a pair beyond the reach: constant above the cap, never active */
         P->v[n] = v, P->a[n] = a, P->group[n++] = 1;
     }
     for (int k = 0; k < n_sing; k++) {

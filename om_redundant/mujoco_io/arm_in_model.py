@@ -39,6 +39,8 @@ class ArmJoints:
         names: The arm's joint names in the model, prefix included.
         joint_ids: (dof,) joint ids in the model.
         qpos_ids: (dof,) addresses of the arm's joints in ``qpos``.
+        qpos_index: The same as a slice where they are consecutive (reads and writes
+            faster than the index array).
         dof_ids: (dof,) addresses of the arm's joints in the tangent space (columns of an
             ``(k, nv)`` task Jacobian).
         lower, upper: (dof,) joint limits, the tighter of the arm's and the model's.
@@ -71,6 +73,9 @@ class ArmJoints:
                     f"the arm needs a {mujoco.mjtJoint(kind).name}"
                 )
         self.qpos_ids = model.jnt_qposadr[self.joint_ids]
+        first, count = int(self.qpos_ids[0]), len(self.qpos_ids)
+        consecutive = np.array_equal(self.qpos_ids, np.arange(first, first + count))
+        self.qpos_index = slice(first, first + count) if consecutive else self.qpos_ids
         self.dof_ids = model.jnt_dofadr[self.joint_ids]
         limited = model.jnt_limited[self.joint_ids].astype(bool)
         ranges = model.jnt_range[self.joint_ids]
@@ -79,7 +84,7 @@ class ArmJoints:
 
     def q(self, qpos: np.ndarray) -> np.ndarray:
         """The arm's joint vector (dof,) out of a model's qpos."""
-        return qpos[self.qpos_ids]
+        return qpos[self.qpos_index].copy()
 
     def qpos_with(self, qpos: np.ndarray, q: np.ndarray) -> np.ndarray:
         """A copy of qpos with the arm's joints set to q."""

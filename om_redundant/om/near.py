@@ -38,14 +38,16 @@ FIXED_POINT_STEPS = 20
 #: Joint-space distance (rad) under which two roots are one (csrc's OM_SAME_ROOT).
 SAME_ROOT = 1e-9
 #: Fractions by which a target the seeds do not lead to is pulled toward the base (the real
-#: arm may reach a little farther than the nominal one), then pushed away from it (an inner
-#: fold, where two roots in c meet and the nominal arm's pair begins farther out).
+#: arm may reach a little farther than the nominal one).
 PULL = (1e-4, 1e-3, 1e-2)
-#: Distances (m) by which a target that none of those leads to is shifted along each axis of
+#: Distances (m) by which the target is also shifted along each axis of
 #: the root frame, both ways: a fold of the real arm's roots lies in any direction of the
 #: pose space (e.g. the shoulder's, where the wrist centre meets the cylinder of the lateral
 #: offset about joint 1's axis, and the real arm has a pair of roots the nominal arm lacks).
-SHIFT = (1e-3, 1e-2)
+SHIFT = (1e-3,)
+#: Fractions by which the target is pushed away from the base for the same purpose (an inner
+#: fold, where two roots in c meet and the nominal arm's pair begins farther out).
+PUSH = (1e-3,)
 #: |Branch quantity| of a nominal root in a neighbouring configuration within which it also
 #: seeds c's roots from the start (the real arm's branch boundary lies elsewhere).
 BOUNDARY = 0.05
@@ -137,15 +139,15 @@ class NearKernel:
         """Verified roots (real coordinates, position and orientation errors), evaluations.
 
         Seeds, stage by stage until one leads to a root: the nominal roots in c, and those of
-        the other configurations within :data:`BOUNDARY` of c's branches (there c may hold
-        two real roots, one of which the nominal arm has in the neighbouring configuration); in every
+        the neighbouring configurations (one branch flipped) within :data:`BOUNDARY` of it (c
+        may hold two real roots where the nominal arm has one in c and one there); in every
         other configuration (near a branch boundary the real arm's root may be the nominal
         arm's in the neighbouring one); of the target pulled toward the base by ``PULL`` in
         every configuration (the real arm may reach a little farther than the nominal one);
-        in c, of the target pushed away from the base by ``PULL`` or shifted by ``SHIFT``
-        along each axis (a fold of the roots in c in another direction). Every exact root, in
-        c or (reached from another configuration's seed) not, is searched for a fold partner
-        in c.
+        then, whatever the stages found, in c, of the target pushed away from the base by
+        ``PUSH`` or shifted by ``SHIFT`` along each axis (a fold of the roots in c in another
+        direction, which may lie beside roots already found). Every exact root, in c or
+        (reached from another configuration's seed) not, is searched for a fold partner in c.
         A seed that polish does not bring home takes the fixed point on T D(q). The hint, if
         any, is a seed too: at a fold of the psi-constrained map the nominal arm may lack the
         root next to the hint that the real arm has."""
@@ -156,11 +158,11 @@ class NearKernel:
         signs = tuple(int(s) for s in signs)
         others = [s for s in self._all_signs if s != signs]
         # (target, the seeds' configuration, only seeds within BOUNDARY of c's branches)
-        stages = [[(T, signs, False)] + [(T, s, True) for s in others], [(T, s, False) for s in others]]
+        neighbours = [s for s in others if sum(a != b for a, b in zip(s, signs, strict=True)) == 1]
+        stages = [[(T, signs, False)] + [(T, s, True) for s in neighbours], [(T, s, False) for s in others]]
         stages.append([(_pulled(T, f), s, False) for f in PULL for s in self._all_signs])
-        folds = [_pulled(T, -f) for f in PULL]
+        folds = [_pulled(T, -f) for f in PUSH]
         folds += [_shifted(T, axis, d) for d in SHIFT for axis in range(3) for d in (d, -d)]
-        stages.append([(target, signs, False) for target in folds])
         roots: list[tuple[np.ndarray, float, float]] = []
         anchors: list[np.ndarray] = []  # exact roots of T in other configurations
         evals = 0
@@ -178,6 +180,11 @@ class NearKernel:
                     _add_root(roots, found)
             if roots:
                 break
+        for target in folds:  # always: a pair in c may lie beside roots already found
+            seeds, n = self._nominal_roots(target, signs, redundancy)
+            evals += n + len(seeds) * POLISH_ITERATIONS
+            for seed in seeds:
+                _add_root(roots, self._refined(T, R, p, psi, seed, signs, redundancy, anchors))
         for q in [self._flip * q for q, _, _ in roots] + anchors:  # the other root of a close pair
             for seed in self._fold_partners(T, q, psi):
                 evals += POLISH_ITERATIONS

@@ -194,9 +194,7 @@ class Clearance:
         self.distmax = as_positive(distmax, "distmax")
         self._data = mujoco.MjData(model)
         joints = ArmJoints(arm, model, prefix)
-        ids = joints.qpos_ids
-        consecutive = np.array_equal(ids, np.arange(ids[0], ids[0] + len(ids)))
-        self._qpos = slice(int(ids[0]), int(ids[0]) + len(ids)) if consecutive else ids  # a slice sets faster
+        self._qpos = joints.qpos_index
         self._dofs = joints.dof_ids
         moving = _subtree(model, model.jnt_bodyid[joints.joint_ids[0]])
         arm_geoms = [

@@ -196,13 +196,12 @@ class ExactPoseTask(ArmTask):
 
     def seed(self, configuration: MinkConfiguration) -> None:
         """Put the arm's joints of ``configuration`` at :math:`q^*` (the other joints stay)."""
-        q_target = self._joint_target(configuration)
+        _, q_target = self._joint_target(configuration)
         configuration.update(self.joints.qpos_with(configuration.data.qpos, q_target))
 
     def compute_error(self, configuration: MinkConfiguration) -> np.ndarray:
         r"""The joint error :math:`e(q) = q_{arm} - \tilde q^*` (dof,)."""
-        q_target = self._joint_target(configuration)
-        q = self.joints.q(configuration.data.qpos)
+        q, q_target = self._joint_target(configuration)
         return q - self.joints.nearest_turn(q_target, q)
 
     def compute_jacobian(self, configuration: MinkConfiguration) -> np.ndarray:
@@ -212,9 +211,10 @@ class ExactPoseTask(ArmTask):
 
     # -----------------------------------------------------------------------------------
 
-    def _joint_target(self, configuration: MinkConfiguration) -> np.ndarray:
-        """:math:`q^*` for the configuration's root pose, solved again if the root moved."""
-        self._arm_q(configuration)
+    def _joint_target(self, configuration: MinkConfiguration) -> tuple[np.ndarray, np.ndarray]:
+        """The arm's joints q and :math:`q^*` for the configuration's root pose, solved again
+        if the root moved."""
+        q = self._arm_q(configuration)
         if self.transform_target_to_world is None:
             raise TargetNotSet(self.__class__.__name__)
         if self.root.fixed_pose is None:
@@ -231,7 +231,7 @@ class ExactPoseTask(ArmTask):
                     raise UnreachableTarget(f"{exc}; the target is dropped for the previous one") from None
                 self._unsolved_fallback = None
         assert self._q_target is not None
-        return self._q_target
+        return q, self._q_target
 
     def _arm_q(self, configuration: MinkConfiguration) -> np.ndarray:
         """The arm's joints (checked as :meth:`arm_q`); remembers where the root is."""
