@@ -47,7 +47,12 @@ bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori)
     om_polish(&t, POLISH_STEPS, q);
     if (om_verify(pb, q, pos, ori))
         return true;
-    if (branch == ELBOW_SIGN || !(nearest < SPLIT_NEAR))
+    /* The model's q1 is arbitrary all along its shoulder boundary where that boundary is the
+     * wrist centre on joint 1's axis (no lateral offset; a candidate there may be far off in
+     * q1 and in the ARM quantity); with a lateral offset, as at every other boundary, only
+     * within SPLIT_NEAR of it. */
+    bool on_axis = s->family == OM_SRS || s->params[SD_LATERAL] == 0.0;
+    if (branch == ELBOW_SIGN || ((branch != SHOULDER_SIGN || !on_axis) && !(nearest < SPLIT_NEAR)))
         return false;
     /* The wrist centre on joint 1's axis: the model's q1 is arbitrary there (atan2 of a
      * vanishing pair), the real arm's is not: starts around the circle of q1. The wrist

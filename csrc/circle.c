@@ -2,6 +2,9 @@
  * (the method: om_redundant/om/system.py). */
 #include "om_system.h"
 
+#define CELL_SAFETY 4.0  /* the curvature of g taken as this multiple of its sampled second differences */
+#define CELL_HALVINGS 6  /* halvings of a scan cell that may hide roots: 16 points as fine as 1024 */
+
 /* out[n] = v if there is room; returns the new count (the candidates' capacity is a bound, checked). */
 static int _put(double *out, int n, int cap, double v)
 {
@@ -51,6 +54,44 @@ static int _bracket(om_problem *pb, double a, double ga, double b, double gb, do
     return n;
 }
 
+/* The roots on one cell [a, b] of a run (both ends reachable). g can hold more roots there
+ * than its end signs show only where it is not monotone, and none where it stays away from
+ * zero: with |g''| <= curvature on the cell, g is monotone where the chord's slope exceeds
+ * curvature * (b - a) / 2, and keeps its sign where min(|g(a)|, |g(b)|) exceeds curvature *
+ * (b - a)^2 / 8 (g lies within that of its chord). Any other cell is halved, the curvature
+ * raised to CELL_SAFETY times the second difference seen at the midpoint, down to
+ * CELL_HALVINGS halvings (16 scan points: as fine as 1024); each leaf goes to _bracket. The
+ * curvature is an estimate from samples (second differences times CELL_SAFETY), not a proof. */
+static int _cell_roots(om_problem *pb, double a, double ga, double b, double gb, double curvature, int halvings,
+                       double *q, double *out, int n, int cap)
+{
+    double h = b - a;
+    bool monotone = fabs(gb - ga) > 0.5 * curvature * h * h;
+    bool clear = ga * gb > 0.0 && py_min(fabs(ga), fabs(gb)) > 0.125 * curvature * h * h;
+    if (halvings == 0 || monotone || clear || fabs(ga - gb) > OM_PI)
+        return _bracket(pb, a, ga, b, gb, q, out, n, cap);
+    double m = 0.5 * (a + b), gm = om_g(pb, m, q, false);
+    if (isnan(gm) || fabs(gm - ga) > OM_PI || fabs(gb - gm) > OM_PI) /* a gap of reach or a wrap inside */
+        return _bracket(pb, a, ga, b, gb, q, out, n, cap);
+    curvature = py_max(curvature, CELL_SAFETY * fabs(ga - 2.0 * gm + gb) / (0.25 * h * h));
+    n = _cell_roots(pb, a, ga, m, gm, curvature, halvings - 1, q, out, n, cap);
+    return _cell_roots(pb, m, gm, b, gb, curvature, halvings - 1, q, out, n, cap);
+}
+
+/* CELL_SAFETY times |g''| estimated at run point i from the wrapped slopes of its two cells
+ * (0 at the ends of a run that is not cyclic). */
+static double _curvature_at(const double *pw, const double *pg, int L, bool cyclic, int i)
+{
+    if (!cyclic && (i <= 0 || i >= L - 1))
+        return 0.0;
+    int before = py_mod(i - 1, L), after = py_mod(i + 1, L);
+    double h0 = om_wrap(pw[i] - pw[before]), h1 = om_wrap(pw[after] - pw[i]);
+    if (L < 3 || !(h0 > 0.0) || !(h1 > 0.0))
+        return 0.0;
+    double s0 = om_wrap(pg[i] - pg[before]) / h0, s1 = om_wrap(pg[after] - pg[i]) / h1;
+    return CELL_SAFETY * fabs(s1 - s0) / (0.5 * (h0 + h1));
+}
+
 /* Add a close pair of roots on [a, b] to out[n:]: g has one sign at a, x0 and b, and its
  * extremum between them may cross zero. Returns the new count. */
 static int _pair(om_problem *pb, double a, double ga, double x0, double b, double gb, double *q, double *out, int n,
@@ -85,7 +126,11 @@ static int _run_roots(om_problem *pb, const double *pw, const double *pg, int L,
     for (int i = 0; i < L - 1 + (int)cyclic; i++) {
         int j = (i + 1) % L;
         double wj = pw[j] + (j == 0 ? 2.0 * OM_PI : 0.0);
-        n = _bracket(pb, pw[i], pg[i], wj, pg[j], q, out, n, cap);
+        double curvature = 0.0; /* the largest estimate at the cell's ends and their neighbours */
+        for (int k = i - 1; k <= i + 2; k++)
+            if (cyclic || (k >= 0 && k < L))
+                curvature = py_max(curvature, _curvature_at(pw, pg, L, cyclic, py_mod(k, L)));
+        n = _cell_roots(pb, pw[i], pg[i], wj, pg[j], curvature, CELL_HALVINGS, q, out, n, cap);
     }
     for (int i = 0; i < L; i++) {
         double gi = pg[i];

@@ -3,7 +3,11 @@ that the model does not reach (``csrc/residual.c``, om_srs_reach_possible): the 
 is a trigonometric polynomial of degree 2, so its curvature bounds how far it can come
 between two samples. A coarse search, whose cells hide many islands, still finds every root
 that a dense one finds; with the islands left unsearched it would not (the Panda then fails
-its own self-check at 16 points)."""
+its own self-check at 16 points).
+
+Close roots inside one cell (``csrc/circle.c``, _cell_roots): a cell is halved where the
+curvature of g estimated from the samples allows g to turn back to zero inside it, so a
+search at 16 points holds q where close pairs and triples share its cells."""
 
 from __future__ import annotations
 
@@ -16,6 +20,19 @@ import om_redundant as om
 from tests.conftest import random_q
 
 COARSE, DENSE = 16, 1024
+
+#: random_q(arm, 1, default_rng(seed)) whose root shared a 16-point cell with one or two
+#: others (a pair 3e-3 rad apart next to a third root; a root 0.08 rad from another): the
+#: search at 16 points missed q before cells were halved by their curvature.
+CLOSE_ROOTS = [
+    ("xarm7", 68382241),
+    ("xarm7", 2703885895),
+    ("xarm7", 182082446),
+    ("panda", 3235945719),
+    ("fr3", 2557913823),
+    ("fr3", 3671483605),
+    ("fr3", 1851247954),
+]
 
 
 def _same_roots(a: list[om.Solution], b: list[om.Solution]) -> bool:
@@ -39,3 +56,21 @@ def test_a_coarse_search_finds_every_root_of_a_dense_one(solvers, seed):
     T = coarse.arm.fk(q)
     for c in coarse.configurations(coarse.configuration_of(q).redundancy):
         assert _same_roots(coarse.solve_all(T, c), dense.solve_all(T, c)), c
+
+
+def _holds(solver: om.OMSolver, seed: int) -> bool:
+    """Whether solve_all at q's pose and configuration holds q (to 1e-8 rad)."""
+    q = random_q(solver.arm, 1, np.random.default_rng(seed))[0]
+    roots = solver.solve_all(solver.arm.fk(q), solver.configuration_of(q))
+    return any(np.abs(np.remainder(r.q - q + np.pi, 2 * np.pi) - np.pi).max() < 1e-8 for r in roots)
+
+
+@pytest.mark.parametrize(("name", "seed"), CLOSE_ROOTS)
+def test_a_coarse_search_holds_q_among_close_roots(name, seed):
+    assert _holds(om.OMSolver(name, scan_points=COARSE), seed)
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1))
+def test_a_coarse_search_holds_q(solvers, seed):
+    assert _holds(solvers[0], seed)
