@@ -141,6 +141,7 @@ enum { OM_OK = 0, OM_UNREACHABLE = 1, OM_NO_SOLUTION_IN_CONFIGURATION = 2 };
 
 #define OM_ROOT_TOL 1e-13   /* a residual (rad) accepted as a root before verification */
 #define OM_SAME_ROOT 1e-9   /* joint-space distance under which two roots are one */
+#define OM_ONE_ROOT 1e-6    /* ... and under which the more accurate of two is kept */
 #define OM_BRANCH_BAND 1e-7 /* |branch quantity| within which q holds both neighbouring configurations */
 #define OM_TOUCH 1e-3      /* |g| (rad) of a touch of zero or an edge of reach tried as a candidate */
 #define OM_PAIR_SEARCH 1.0  /* |g| (rad) below which a local minimum is searched for a root pair */

@@ -44,10 +44,13 @@ bool om_verify(om_problem *pb, const double *q, double *pos, double *ori)
 }
 
 /* Append q to roots (OM_MAX_ROOTS x dof) if the real arm verifies it and it is new;
- * returns the count. */
+ * returns the count. Within OM_SAME_ROOT of a kept root q is that root; within OM_ONE_ROOT
+ * (a root found twice near a fold of the residual, where it is flat to second order) the
+ * copy with the smaller pose error is kept. */
 int om_add_root(om_problem *pb, const double *q, double *roots, int count)
 {
-    if (!om_verify(pb, q, NULL, NULL))
+    double pos, ori;
+    if (!om_verify(pb, q, &pos, &ori))
         return count;
     int dof = pb->s->dof;
     for (int r = 0; r < count; r++) {
@@ -56,6 +59,13 @@ int om_add_root(om_problem *pb, const double *q, double *roots, int count)
             diff = py_max(diff, fabs(om_wrap(q[j] - roots[r * dof + j])));
         if (diff < OM_SAME_ROOT)
             return count;
+        if (diff < OM_ONE_ROOT) {
+            double kept_pos, kept_ori;
+            om_verify(pb, roots + r * dof, &kept_pos, &kept_ori);
+            if (pos + ori < kept_pos + kept_ori)
+                memcpy(roots + r * dof, q, (size_t)dof * sizeof(double));
+            return count;
+        }
     }
     if (count < OM_MAX_ROOTS) {
         memcpy(roots + count * dof, q, (size_t)dof * sizeof(double));

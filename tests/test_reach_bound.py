@@ -74,3 +74,19 @@ def test_a_coarse_search_holds_q_among_close_roots(name, seed):
 @given(seed=st.integers(0, 2**32 - 1))
 def test_a_coarse_search_holds_q(solvers, seed):
     assert _holds(solvers[0], seed)
+
+
+#: xArm7 joints at a fold of the residual (benchmarks.seven_dof, seed 0, row 59153): two
+#: halved cells refined the root twice, 5e-9 rad apart, the second copy 7.6e-11 m off.
+FOLD_Q = [-5.601047109041344, -0.1676911858728567, -1.5299160010102657, 2.7418260873462583,
+          -4.235738466416173, 2.4179389976273047, -4.07003619128778]  # fmt: skip
+
+
+def test_a_root_found_twice_at_a_fold_is_returned_once_at_its_most_accurate():
+    solver, q = om.OMSolver("xarm7"), np.array(FOLD_Q)
+    roots = solver.solve_all(solver.arm.fk(q), solver.configuration_of(q))
+    for i, a in enumerate(roots):
+        for b in roots[:i]:
+            assert np.abs(np.remainder(a.q - b.q + np.pi, 2 * np.pi) - np.pi).max() > 1e-6
+    held = [r for r in roots if np.abs(np.remainder(r.q - q + np.pi, 2 * np.pi) - np.pi).max() < 1e-9]
+    assert len(held) == 1 and held[0].position_error < 1e-12
