@@ -215,10 +215,9 @@ class Clearance:
         self.pairs: tuple[tuple[str, str], ...] = tuple(
             (model.geom(a).name, model.geom(o).name) for a, o in self._pairs
         )
-        # for the batched bounds (minima, pair_bounds)
-        self._arm_geoms, self._obstacle_geoms = self._pairs[:, 0].copy(), self._pairs[:, 1].copy()
-        self._bounds, self._bodies = self._geoms.bounds, model.geom_bodyid[self._arm_geoms]
-        self._arm_rbound = rbound[self._arm_geoms]
+        # for pair_bounds: each arm geom's body, bounding radius and subtree root
+        self._bodies = model.geom_bodyid[self._pairs[:, 0]]
+        self._arm_rbound = rbound[self._pairs[:, 0]]
         self._roots = model.body_rootid[self._bodies]
 
     @classmethod
@@ -282,12 +281,7 @@ class Clearance:
         return self._evaluate(q, gradient, min(as_positive(reach, "reach"), self.distmax))
 
     def minima(self, q: np.ndarray) -> np.ndarray:
-        r"""The clearance D(q) of every row of q, as :meth:`minimum` gives it, computing few pairs.
-
-        Each geom contains its centre, so the centres' distance :math:`c_k` bounds a pair's
-        distance from above and :math:`c_k - r_k` (the bounding-sphere radii) from below: only
-        the pairs with :math:`c_k - r_k \le \min_j c_j` can be the smallest. The bounds of all
-        rows are one vectorised test on the geoms' centres.
+        """The clearance D(q) of every row of q, as :meth:`minimum` gives it.
 
         Args:
             q: (M, dof) joint vectors.
@@ -296,18 +290,7 @@ class Clearance:
             (M,) clearances in metres (at most ``distmax``).
         """
         q = as_joint_vector(q, self._dof).reshape(-1, self._dof)
-        m, d = self.model, self._data
-        centres = np.empty((len(q), m.ngeom, 3))
-        for row, xpos in zip(q, centres, strict=True):
-            d.qpos[self._qpos] = row
-            mujoco.mj_kinematics(m, d)
-            xpos[:] = d.geom_xpos
-        apart = np.linalg.norm(centres[:, self._pairs[:, 0]] - centres[:, self._pairs[:, 1]], axis=2)
-        candidates = apart - self._geoms.bounds <= np.minimum(apart.min(axis=1), self.distmax)[:, None]
-        out = np.full(len(q), self.distmax)
-        for i in np.flatnonzero(candidates.any(axis=1)).tolist():
-            out[i] = self._evaluate(q[i], gradient=False)[0].min()  # the compiled pairs, as minimum()
-        return out
+        return np.array([self._evaluate(row, gradient=False)[0].min() for row in q])
 
     def pair_bounds(self, q: np.ndarray, rate: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         r"""Bounds of every pair's distance and of its rate when the joints move at ``rate``.
@@ -335,8 +318,8 @@ class Clearance:
         mujoco.mj_kinematics(m, d)
         mujoco.mj_comPos(m, d)
         mujoco.mj_comVel(m, d)
-        centre = d.geom_xpos[self._arm_geoms]
-        lower = np.linalg.norm(centre - d.geom_xpos[self._obstacle_geoms], axis=1) - self._bounds
+        centre = d.geom_xpos[self._pairs[:, 0]]
+        lower = np.linalg.norm(centre - d.geom_xpos[self._pairs[:, 1]], axis=1) - self._geoms.bounds
         omega, linear = d.cvel[self._bodies, :3], d.cvel[self._bodies, 3:]
         r = centre - d.subtree_com[self._roots]
         velocity = linear + np.cross(omega, r)
