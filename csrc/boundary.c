@@ -187,16 +187,6 @@ static int wrist_bracket(om_problem *pb, double in, double r_in, double e, doubl
     return om_add_candidate(pb, q, roots, count);
 }
 
-/* Whether the model may reach some point between two samples it reaches at neither: where
- * the margin, which can peak between them by about its change across a cell (this one's or a
- * neighbour's, ms cyclic of n), could reach zero (as the circle search's island test). */
-static bool island_possible(const double *ms, int k, int n)
-{
-    double a = ms[k], b = ms[(k + 1) % n];
-    double change = py_max(fabs(b - a), py_max(fabs(a - ms[(k + n - 1) % n]), fabs(ms[(k + 2) % n] - b)));
-    return py_max(a, b) + change > 0.0;
-}
-
 /* A 6-DOF circle arm's roots from the wrist's consistency residual r(w) with q_J = w given
  * (om_wrist_residual): smooth where the model's wrist is singular, where g's q_J is the
  * arbitrary split of the aligned wrist (g may then miss zero by far over a whole run of
@@ -222,7 +212,7 @@ static int wrist_roots(om_problem *pb, double *roots, int count)
             count = wrist_bracket(pb, a, ra, b, rb, roots, count);
         else if (!isnan(rb))
             count = wrist_bracket(pb, b, rb, a, ra, roots, count);
-        else if (island_possible(ms, k, n)) {
+        else if (om_margin_may_reach(ms, k, n, true)) {
             double gc, c = om_extremum(pb, a, b, 0.5 * (a + b), 1.0, true, q, &gc, NULL);
             double rc = isnan(gc) ? NAN : om_wrist_residual(pb, c, q);
             if (!isnan(rc)) {

@@ -155,19 +155,28 @@ static int _run_roots(om_problem *pb, const double *pw, const double *pg, int L,
     return n;
 }
 
+/* Whether the reach margin, sampled as ms[0 .. count) (cyclic: ms[0] follows ms[count - 1]),
+ * may reach zero between samples i and i + 1, both out of reach: it can peak between them by
+ * about its change across a cell (this one's or a neighbour's). */
+bool om_margin_may_reach(const double *ms, int i, int count, bool cyclic)
+{
+    int next = cyclic ? (i + 1) % count : i + 1;
+    double change = fabs(ms[next] - ms[i]);
+    if (cyclic || i > 0)
+        change = py_max(change, fabs(ms[i] - ms[cyclic ? (i + count - 1) % count : i - 1]));
+    if (cyclic || i + 2 < count)
+        change = py_max(change, fabs(ms[cyclic ? (i + 2) % count : i + 2] - ms[next]));
+    return py_max(ms[i], ms[next]) + change > 0.0;
+}
+
 /* Whether the model may reach some point of the cell [ws[i], ws[i + 1]] (both ends out of
- * reach): on an S-R-S arm by a bound (om_srs_reach_possible); otherwise where the margin,
- * which can peak between the ends by about half its change across a cell, could reach zero. */
+ * reach): on an S-R-S arm by a bound (om_srs_reach_possible); otherwise where the margin
+ * may (om_margin_may_reach). */
 static bool _island_possible(om_problem *pb, const double *ws, const double *ms, int i, int count)
 {
     if (pb->s->family == OM_SRS)
         return om_srs_reach_possible(pb, ws[i], ws[i + 1]);
-    double change = fabs(ms[i + 1] - ms[i]);
-    if (i > 0)
-        change = py_max(change, fabs(ms[i] - ms[i - 1]));
-    if (i + 2 < count)
-        change = py_max(change, fabs(ms[i + 2] - ms[i + 1]));
-    return py_max(ms[i], ms[i + 1]) + change > 0.0;
+    return om_margin_may_reach(ms, i, count, false);
 }
 
 /* Candidate roots of g on [lo, hi] (the whole circle if full_circle) into cands (capacity

@@ -185,6 +185,7 @@ double om_g(om_problem *pb, double w, double *q, bool all_joints);
 double om_reach_margin(om_problem *pb, double w, double *q);
 /* S-R-S: whether the model may reach the circle's points somewhere in [a, b] (a bound; see residual.c). */
 bool om_srs_reach_possible(om_problem *pb, double a, double b);
+bool om_margin_may_reach(const double *ms, int i, int count, bool cyclic);
 vec3 om_lifted_residual(om_problem *pb, vec3 x, double *q);
 vec3 om_deflated_residual(om_problem *pb, vec3 x, double *q, const double *known, int n_known); /* known: n x 3 */
 double om_max_norm(vec3 F);
