@@ -18,7 +18,7 @@ checked against MuJoCo's own FK of the project's MJCF of the arm (``om.arm_model
   c = configuration_of(q); ``solve`` without a hint, with the hint q + N(0, 0.05),
   ``solve_batch`` of all, ``solve_all`` (which must hold q). A false "no" is ok False, or an
   empty ``solve_all``.
-* **singular**: q moved (1-D Newton on the joint that moves it most, kept within limits) so
+* **singular**: q moved along one joint, within its limits, to a randomly drawn crossing so
   that a branch quantity (``om.om.families.branch_values``, index 0, 1, 2) is +-10**u, u
   uniform in [-14, -3]; and joints at their limits +- 1e-12. Then ``solve``, hinted ``solve``
   and ``solve_all`` in c = configuration_of(q). Also "the other side": the flipped sign where
@@ -88,6 +88,7 @@ REDUNDANCY_TOLERANCE = 1e-9  # rad, modulo 2 pi
 ROOT_MATCH = 1e-6  # rad (or m): q among solve_all's roots
 HINT_NOISE = 0.05  # rad, standard deviation of the random class's hint
 DECADES = tuple(range(-14, -3))  # floor(log10 |branch quantity|) of the singular cases
+CROSSING_GRID = 64  # samples of a joint's range where the singular class looks for crossings
 TORUS_SOLVE_ALL_STRIDE = 20  # gen3, sawyer: solve_all on every 20th pose (5 ms a call)
 BATCH_CHUNK = 10_000
 THREADS = 4
@@ -521,31 +522,66 @@ class ArmRun:
     def random_q(self, n: int) -> np.ndarray:
         return random_joints(self.arm, n, self.rng)
 
-    def boundary_q(self, index: int, value: float) -> tuple[np.ndarray, int] | None:
-        """A random q moved so that branch quantity ``index`` is ``value`` (1-D Newton on the
-        joint that moves it most, within the limits); None if that fails."""
+    def boundary_q(self, index: int, value: float) -> np.ndarray | None:
+        """A random q moved along one joint so that branch quantity ``index`` is ``value``.
+
+        The joints are tried in order of the quantity's slope at q. On each, b_index - value is
+        sampled at :data:`CROSSING_GRID` points over the joint's range (its limits; one turn
+        around q_j for an unlimited joint), one of the sign changes is drawn at random and
+        bisected down to adjacent doubles, and the end whose branch quantity has value's sign
+        and is nearest it is kept. So every crossing within the limits can be drawn (also
+        those next to a limit), and the branch quantity is value to its last bits (at 1e-14 a
+        joint near pi resolves it to 4 %: the decade table reads the value made). None if no
+        joint crosses value within its limits (a new random q is drawn then).
+        """
         q = self.random_q(1)[0]
-        h = 1e-6
         slopes = np.empty(self.arm.dof)
         for j in range(self.arm.dof):
             e = np.zeros(self.arm.dof)
-            e[j] = h
-            slopes[j] = (self.checker.branch(q + e)[index] - self.checker.branch(q - e)[index]) / (2 * h)
-        j = int(np.argmax(np.abs(slopes)))
-        if slopes[j] == 0.0:
+            e[j] = 1e-6
+            slopes[j] = abs(self.checker.branch(q + e)[index] - self.checker.branch(q - e)[index])
+        for j in np.argsort(-slopes, kind="stable"):
+            if not slopes[j] > 0.0:
+                break
+            found = self._crossing(q, int(j), index, value)
+            if found is not None:
+                return found
+        return None
+
+    def _crossing(self, q: np.ndarray, j: int, index: int, value: float) -> np.ndarray | None:
+        """q with joint j at a random crossing of b_index = value within j's range, or None."""
+        lo = self.arm.lower[j] if math.isfinite(self.arm.lower[j]) else q[j] - math.pi
+        hi = self.arm.upper[j] if math.isfinite(self.arm.upper[j]) else q[j] + math.pi
+        x = q.copy()
+
+        def f(t: float) -> float:
+            x[j] = t
+            return float(self.checker.branch(x)[index]) - value
+
+        grid = np.linspace(lo, hi, CROSSING_GRID)
+        fs = np.array([f(t) for t in grid])
+        cells = np.flatnonzero(np.sign(fs[:-1]) * np.sign(fs[1:]) <= 0.0)
+        if not len(cells):
             return None
-        e = np.zeros(self.arm.dof)
-        e[j] = h
-        for _ in range(60):
-            r = self.checker.branch(q)[index] - value
-            if abs(r) <= 0.05 * abs(value):
-                return q, j
-            slope = (self.checker.branch(q + e)[index] - self.checker.branch(q - e)[index]) / (2 * h)
-            if slope == 0.0 or not math.isfinite(slope):
-                return None
-            q[j] -= r / slope
-            if not (self.arm.lower[j] <= q[j] <= self.arm.upper[j]) or not math.isfinite(q[j]):
-                return None
+        k = int(self.rng.choice(cells))
+        a, b, fa = float(grid[k]), float(grid[k + 1]), float(fs[k])
+        ends = [(abs(fa), a), (abs(float(fs[k + 1])), b)]
+        while True:
+            m = 0.5 * (a + b)
+            if not a < m < b:
+                break
+            fm = f(m)
+            ends.append((abs(fm), m))
+            if fm == 0.0:
+                break
+            if (fm < 0.0) == (fa < 0.0):
+                a, fa = m, fm
+            else:
+                b = m
+        for _, t in sorted(ends):
+            x[j] = t
+            if float(self.checker.branch(x)[index]) * value > 0.0:
+                return x
         return None
 
     def at_limits(self) -> np.ndarray | None:
@@ -622,12 +658,11 @@ def run_singular(run: ArmRun, n: int, n_limits: int) -> Tally:
         tries += 1
         index = made % k
         value = float(run.rng.choice([-1.0, 1.0]) * 10.0 ** run.rng.uniform(-14.0, -3.0))
-        found = run.boundary_q(index, value)
-        if found is None:
-            t.notes["Newton failed (skipped)"] += 1
+        q = run.boundary_q(index, value)
+        if q is None:
+            t.notes["no crossing within the limits (a new random q)"] += 1
             continue
         made += 1
-        q, _ = found
         b = run.checker.branch(q)[index]
         column = str(math.floor(math.log10(abs(b)))) if b != 0.0 else "0"
         context = f"branch {solver.sign_names[index]} = {b:.3e}"
@@ -636,6 +671,8 @@ def run_singular(run: ArmRun, n: int, n_limits: int) -> Tally:
         decades[column]["any"] += bad
         if abs(b) <= BRANCH_BAND:
             other_side(run, t, q, index, other, context)
+    if made < n:
+        t.notes["branch poses short of the size asked"] += n - made
     for _ in range(n_limits):
         q = run.at_limits()
         if q is None:
@@ -920,11 +957,9 @@ def questions(
     while len(out) < n:
         q = None
         if singular and rng.random() < 0.3:
-            found = run.boundary_q(
+            q = run.boundary_q(
                 int(rng.integers(k)), float(rng.choice([-1.0, 1.0]) * 10.0 ** rng.uniform(-14, -3))
             )
-            if found is not None:
-                q = found[0]
         if q is None:
             q = run.random_q(1)[0]
         T = run.arm.fk(q)
