@@ -32,8 +32,9 @@ checked against MuJoCo's own FK of the project's MJCF of the arm (``om.arm_model
   ``solve_batch`` equals per-row ``solve``.
 * **repeated**: the same questions (random, near-singular, other branches, hinted,
   ``solve_all``, batch rows) asked again in random order, each after another call.
-* **bad input**: items 7 and 9 of the issue; the exception raised, and whether it is an
-  ``om.OMError``.
+* **bad input** (:mod:`benchmarks.bad_input`): items 5 to 9 of the issue; the exception
+  raised and whether it is an ``om.OMError``; for the command, in a subprocess, the exit
+  status and the lines on stderr.
 
 An ok answer is **wrong** if MuJoCo's FK differs from T by more than 1e-10 m or 1e-10 rad,
 or q is not in the requested configuration (``OMSolver.holds``: signs equal, a branch quantity
@@ -51,7 +52,6 @@ import math
 import os
 import platform
 import sys
-import tempfile
 import threading
 import time
 import zlib
@@ -59,7 +59,6 @@ from collections import Counter
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import mujoco
@@ -70,6 +69,7 @@ from om_redundant.mujoco_io.mjcf import DEFAULT_SITE
 from om_redundant.om import system
 from om_redundant.om.families import branch_values, redundancy_values
 
+from .bad_input import BadInput, bad_input_table, run_bad_inputs
 from .report import RESULTS, cpu_model, write_page
 from .robots import random_joints
 
@@ -1103,128 +1103,6 @@ def run_repeated(run: ArmRun, n: int) -> Tally:
 
 
 # ------------------------------------------------------------------------------------------
-# Bad input (issue items 7 and 9)
-
-
-@dataclass
-class BadInput:
-    label: str
-    raised: str  # exception type, or "accepted"
-    library: bool  # an om.OMError subclass
-    message: str
-    seconds: float
-
-
-def bad_inputs() -> list[tuple[str, Callable[[], Any]]]:
-    """(label, call) for each bad input of the issue's items 7 and 9."""
-    import mink
-
-    ur5e, panda = om.OMSolver("ur5e"), om.OMSolver("panda")
-    q6 = np.array([0.4, -1.1, 1.3, -1.2, -1.4, 0.3])
-    T = ur5e.arm.fk(q6)
-    c = ur5e.configuration_of(q6)
-    q7 = np.array([0.2, 0.4, -0.3, -1.8, 0.5, 1.9, 0.6])
-    T7 = panda.arm.fk(q7)
-    c7 = panda.configuration_of(q7)
-    gen3 = om.OMSolver("gen3")
-    T7g, c7g = gen3.arm.fk(q7), gen3.configuration_of(q7)
-    deep = Path(tempfile.mkdtemp(prefix="om_adversarial_")) / "deep.toml"
-    deep.write_text("x = " + "[" * 100_000 + "]" * 100_000 + "\n")
-    from om_redundant.tasks import ExactPoseTask
-
-    return [
-        ("solve_batch: empty batch (0, 4, 4)", lambda: ur5e.solve_batch(np.zeros((0, 4, 4)), c.signs)),
-        ("solve_batch: 3 sign rows for 2 poses", lambda: ur5e.solve_batch(np.stack([T, T]), [c.signs] * 3)),
-        ("solve: pose as str", lambda: ur5e.solve("T", c)),
-        ("solve: pose as dict", lambda: ur5e.solve({"T": T.tolist()}, c)),
-        ("solve_batch: list of mink.SE3", lambda: ur5e.solve_batch([mink.SE3.from_matrix(T)] * 2, c.signs)),
-        ("Configuration(signs=1)", lambda: om.Configuration(signs=1)),
-        ("Configuration(redundancy=0.5)", lambda: om.Configuration(c7.signs, redundancy=0.5)),
-        ("Configuration(redundancy=None)", lambda: om.Configuration(c7.signs, redundancy=None)),
-        ("Configuration(redundancy=(0.5+1j,))", lambda: om.Configuration(c7.signs, redundancy=(0.5 + 1j,))),
-        ("Configuration(redundancy='0.5')", lambda: om.Configuration(c7.signs, redundancy="0.5")),
-        ("Configuration(redundancy=('0.5',))", lambda: om.Configuration(c7.signs, redundancy=("0.5",))),
-        ("panda solve_batch(redundancy='0.5')", lambda: panda.solve_batch(T7[None], c7.signs, "0.5")),
-        ("Configuration.isclose(None)", lambda: c.isclose(None)),
-        ("OMSolver(None)", lambda: om.OMSolver(None)),
-        ("OMSolver(123)", lambda: om.OMSolver(123)),
-        ("load_arm(None)", lambda: om.load_arm(None)),
-        ("load_arm(deeply nested TOML)", lambda: om.load_arm(str(deep))),
-        ("OMSolver(position_tolerance='1e-10')", lambda: om.OMSolver("ur5e", position_tolerance="1e-10")),
-        ("OMSolver(orientation_tolerance='1e-9')", lambda: om.OMSolver("ur5e", orientation_tolerance="1e-9")),
-        ("OMSolver(scan_points='x')", lambda: om.OMSolver("ur5e", scan_points="x")),
-        ("OMSolver(scan_points=8.9)", lambda: om.OMSolver("ur5e", scan_points=8.9)),
-        (
-            "OMSolver('ur5e', scan_points=100000).solve",
-            lambda: om.OMSolver("ur5e", scan_points=100_000).solve(T, c),
-        ),
-        (
-            "OMSolver('gen3', scan_points=100000).solve_all",
-            lambda: (
-                f"{len(om.OMSolver('gen3', scan_points=100_000).solve_all(T7g, c7g))} roots "
-                f"(default scan_points: {len(om.OMSolver('gen3').solve_all(T7g, c7g))})"
-            ),
-        ),
-        ("RedundancyOptimizer(max_step='x')", lambda: om.RedundancyOptimizer(panda, max_step="x")),
-        ("RedundancyOptimizer(margin_weight='1')", lambda: om.RedundancyOptimizer(panda, margin_weight="1")),
-        ("Sphere(center='abc')", lambda: om.Sphere(center="abc", radius=0.1)),
-        ("ExactPoseTask(model='model')", lambda: ExactPoseTask(ur5e, "model", arm_configuration=c)),
-        ("solve: complex T", lambda: ur5e.solve(T.astype(complex), c)),
-        ("solve: complex T, imaginary part 1e-3", lambda: ur5e.solve(T + 1e-3j, c)),
-        ("Configuration((np.True_, 1, 1))", lambda: om.Configuration((np.True_, 1, 1))),
-        (
-            "solve_batch: signs [[np.True_, 1, 1]]",
-            lambda: ur5e.solve_batch(T[None], np.array([[True, 1, 1]], dtype=object)),
-        ),
-        ("ur5e solve_batch: (M, 1) redundancy", lambda: ur5e.solve_batch(T[None], c.signs, np.zeros((1, 1)))),
-    ]
-
-
-def summary(value: Any) -> str:
-    """A short description of what a call that should have raised returned."""
-    if isinstance(value, str):
-        return value
-    if isinstance(value, om.Solution):
-        return f"a Solution, status '{value.status}'"
-    if isinstance(value, om.BatchSolution):
-        return f"a BatchSolution, status {value.status}"
-    if isinstance(value, list):
-        return f"a list of {len(value)}"
-    return type(value).__name__
-
-
-#: Inputs of the list that the library accepts on purpose, with the documented rule.
-ACCEPTED_BY_DESIGN = {
-    "solve_batch: empty batch (0, 4, 4)": "an empty batch gives an empty BatchSolution, as numpy would",
-    "solve_batch: list of mink.SE3": "a list of mink.SE3 is a batch of poses",
-    "Configuration(redundancy=0.5)": "one number is one redundancy value, (0.5,)",
-    "Configuration(redundancy=None)": "None is no redundancy values",
-}
-
-
-def run_bad_inputs() -> list[BadInput]:
-    import warnings
-
-    found = []
-    for label, fn in bad_inputs():
-        start = time.perf_counter()
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            try:
-                value = fn()
-                raised, library, message = "accepted", False, f"returned {summary(value)}"
-            except Exception as error:
-                raised, library = type(error).__name__, isinstance(error, om.OMError)
-                message = str(error).splitlines()[0][:140] if str(error) else ""
-        found.append(BadInput(label, raised, library, message, time.perf_counter() - start))
-        print(
-            f"bad input: {label}: {raised}{' (om.OMError)' if library else ''} {found[-1].seconds:.2f} s",
-            flush=True,
-        )
-    return found
-
-
-# ------------------------------------------------------------------------------------------
 # Running and reporting
 
 
@@ -1468,25 +1346,7 @@ def markdown(
                     ]
                 )
             )
-    if bad:
-        named = sum(b.library for b in bad)
-        by_design = sum(b.raised == "accepted" and b.label in ACCEPTED_BY_DESIGN for b in bad)
-        out += [
-            "",
-            "## Bad input (issue items 7 and 9)",
-            "",
-            f"{named} of {len(bad)} named by a library error (`om.OMError`); {by_design} accepted by a "
-            "documented rule (the message says which); the rest, if any, are failures.",
-            "",
-            _cells(["input", "raised", "om.OMError", "s", "message"]),
-            "|---|---|---|---|---|",
-        ]
-        for b in bad:
-            message = b.message.replace("|", "\\|")
-            verdict = "yes" if b.library else "**no**"
-            if b.raised == "accepted" and b.label in ACCEPTED_BY_DESIGN:
-                verdict, message = "by design", f"{ACCEPTED_BY_DESIGN[b.label]}; {message}"
-            out.append(_cells([b.label, b.raised, verdict, f"{b.seconds:.2f}", message]))
+    out += bad_input_table(bad)
     failures = [f for r in results for f in r.failures]
     counts = Counter()
     for r in results:
