@@ -359,3 +359,27 @@ def test_boundary_reproducers_are_solved(case):
     assert roots
     for root in roots:
         _assert_exact(solver, root.q, T, c)
+
+
+@pytest.mark.xfail(
+    strict=True, reason="open: the circle search near psi's singular half-line (issue 18, item 3)"
+)
+def test_the_wrist_centre_straight_below_the_shoulder_is_solved():
+    """xArm7 with the model's wrist centre 4.7e-5 rad from straight below the shoulder (where
+    psi's reference n(w_hat) = R(up -> w_hat) r is undefined), q within limits, T = FK(q): every
+    configuration answers "unreachable" (python -m benchmarks.adversarial, the arm angle's
+    singular half-line). Passes when the search handles it."""
+    xarm7 = _solver("xarm7")
+    q = np.array(
+        [
+            1.3722485557456992,
+            1.5276914922859586,
+            1.4734833117554082e-05,
+            0.30781086335256397,
+            0.004579983274622279,
+            2.6015994113708873,
+            -2.444255838945311,
+        ]
+    )
+    T, c = xarm7.arm.fk(q), xarm7.configuration_of(q)
+    assert xarm7.solve(T, c).ok
