@@ -50,6 +50,7 @@ import argparse
 import json
 import math
 import os
+import pickle
 import platform
 import sys
 import threading
@@ -747,7 +748,7 @@ def run_singular(run: ArmRun, n: int, n_limits: int, n_line: int = 0) -> Tally:
         counts["any"] += singular_case(
             run, t, q, counts, f"wrist centre {delta:.3e} rad from straight {column.split()[0]} the shoulder"
         )
-    if made < n_line:
+    if solver.redundancy_names and made < n_line:
         t.notes["arm angle line poses short of the size asked"] += n_line - made
     t.seconds = time.perf_counter() - start
     return t
@@ -1291,6 +1292,7 @@ def markdown(
     args: argparse.Namespace,
     seconds: float,
     load,
+    run_line: str | None = None,
 ) -> str:
     tallies = [t for r in results for t in r.tallies]
     out = [
@@ -1299,8 +1301,11 @@ def markdown(
         f"Machine: {cpu_model()}, {os.cpu_count()} cores, {platform.system()} {platform.machine()}, "
         f"Python {platform.python_version()}; load average {load[0]:.2f} at the start, {load[1]:.2f} "
         "at the end (the machine was shared).  ",
-        f"Run: `{' '.join(['python -m benchmarks.adversarial', *sys.argv[1:]])}`, seed {args.seed}, "
-        f"{args.jobs} process(es); **{seconds:.0f} s** wall time in all.  ",
+        run_line
+        or (
+            f"Run: `{' '.join(['python -m benchmarks.adversarial', *sys.argv[1:]])}`, seed {args.seed}, "
+            f"{args.jobs} process(es); **{seconds:.0f} s** wall time in all.  "
+        ),
         f"Sizes per arm: random {sizes.random} poses, singular {sizes.singular} branch poses and "
         f"{sizes.limits} poses at limits, huge/tiny {sizes.huge}, layouts {sizes.layouts}, "
         f"threads {sizes.threads} questions x {THREADS} threads, repeated {sizes.repeated} questions.",
@@ -1475,6 +1480,47 @@ def markdown(
     return "\n".join(out)
 
 
+def merge(parts: Sequence[ArmResult]) -> ArmResult:
+    """One arm's results from several runs (different classes of it) as one."""
+    out = ArmResult(parts[0].arm)
+    for r in parts:
+        out.tallies += r.tallies
+        for mine, theirs in ((out.decades, r.decades), (out.arm_angle_line, r.arm_angle_line)):
+            for key, counts in theirs.items():
+                mine.setdefault(key, Counter()).update(counts)
+        out.other_side.update(r.other_side)
+        out.failures += r.failures
+        out.failure_counts.update(r.failure_counts)
+        out.seconds += r.seconds
+    return out
+
+
+def combine(paths: Sequence[str]) -> str:
+    """The page of several ``--save-results`` pickles (runs of different arms or classes on the
+    same code), arms in :func:`om.arm_names` order; writes it as ``adversarial.md``."""
+    runs = []
+    for path in paths:
+        with open(path, "rb") as f:
+            runs.append(pickle.load(f))
+    by_arm: dict[str, list[ArmResult]] = {}
+    for run in runs:
+        for r in run["results"]:
+            by_arm.setdefault(r.arm, []).append(r)
+    results = [merge(by_arm[name]) for name in om.arm_names() if name in by_arm]
+    bad = [b for run in runs for b in run["bad"]]
+    run_line = "Runs, combined with `--combine`: " + "; ".join(
+        f"`python -m benchmarks.adversarial {' '.join(run['argv'])}` ({run['seconds']:.0f} s)" for run in runs
+    )
+    args = argparse.Namespace(seed=0, jobs=len(runs))
+    load = os.getloadavg()[0]
+    sizes = runs[0].get("sizes", Sizes.of(100_000, 10_000))
+    text = markdown(results, bad, sizes, args, 0.0, (load, load), run_line + ".  ")
+    write_page("adversarial.md", text)
+    failures = [f.__dict__ for r in results for f in r.failures]
+    (RESULTS / "adversarial.json").write_text(json.dumps(failures, indent=1) + "\n")
+    return text
+
+
 def main(argv: list[str] | None = None) -> list[ArmResult]:
     parser = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
@@ -1489,7 +1535,14 @@ def main(argv: list[str] | None = None) -> list[ArmResult]:
     parser.add_argument("--jobs", type=int, default=1, help="processes, one arm each at a time (default 1)")
     parser.add_argument("--classes", nargs="+", default=list(CLASSES), choices=CLASSES)
     parser.add_argument("--no-bad-input", action="store_true", help="skip the bad-input table")
+    parser.add_argument(
+        "--save-results", metavar="PATH", help="also pickle the per-arm results (for --combine)"
+    )
+    parser.add_argument("--combine", nargs="+", metavar="PATH", help="only write the page of these pickles")
     args = parser.parse_args(argv)
+    if args.combine:
+        combine(args.combine)
+        return []
     n_random, n_singular = args.n_random, args.n_singular
     if args.quick:
         n_random, n_singular = max(n_random // 100, 1), max(n_singular // 100, 1)
@@ -1509,6 +1562,11 @@ def main(argv: list[str] | None = None) -> list[ArmResult]:
     text = markdown(results, bad, sizes, args, seconds, (load_start, os.getloadavg()[0]))
     stem = "adversarial_quick" if args.quick else "adversarial"
     write_page(f"{stem}.md", text)
+    if args.save_results:
+        with open(args.save_results, "wb") as f:
+            pickle.dump(
+                {"results": results, "bad": bad, "seconds": seconds, "argv": sys.argv[1:], "sizes": sizes}, f
+            )
     failures = [f.__dict__ for r in results for f in r.failures]
     (RESULTS / f"{stem}.json").write_text(json.dumps(failures, indent=1) + "\n")
     print(f"total wall time {seconds:.1f} s")
