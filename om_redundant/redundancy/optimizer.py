@@ -55,7 +55,8 @@ from .objective import (
     Objective,
     check_weights,
 )
-from .paths import END_TOLERANCE, Path, Point, Probe, sweep_circle, sweep_window
+from .paths import Path, sweep_circle, sweep_window
+from .probe import END_TOLERANCE, Point, Probe
 from .singularity import Singularity
 from .tracking import Tracker
 
