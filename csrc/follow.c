@@ -7,14 +7,13 @@
  * by whole turns nearest mid-range c_i: c_i + wrap(q_i - c_i), for the feasible intervals)
  * and accepted when it continues the path (om_continues: no joint moved more than 1 rad,
  * |Delta q - t_k (x - psi_k)|_inf <= |Delta q|_inf / 2 + 1e-6, cyclic joints compared modulo
- * 2 pi); then h doubles, else it halves. Below END_TOLERANCE the path has ended there.
+ * 2 pi); then h doubles, else it halves. Below min_step (probe.py's END_TOLERANCE) the path
+ * has ended there; min_step = |psi* - psi_0| makes it one attempt (Probe.next).
  * Each accepted point's tangent is om_self_motion_tangent's; where it does not exist (a
  * fold met exactly) the call stops and says so: the caller's own loop then decides. */
 #include <string.h>
 
 #include "binding.h"
-
-#define END_TOLERANCE 1e-9 /* paths.py's END_TOLERANCE */
 
 enum { FOLLOW_ARRIVED = 0, FOLLOW_ENDED = 1, FOLLOW_SINGULAR = 2 };
 enum { F_PSI, F_STATUS, F_STEPS, F_N }; /* the out vector */
@@ -27,12 +26,12 @@ static void represent(int dof, const uint8_t *centred, const double *centre, dou
 /* Follow from (psi, q, t) towards target; q and t are updated in place to the point reached. */
 static int follow(const om_solver_data *s, const double *T, const int64_t *signs, const uint8_t *cyclic,
                   const uint8_t *centred, const double *centre, double *psi, double *q, double *t, double target,
-                  int *steps) {
+                  double min_step, int *steps) {
     int dof = s->dof;
     double step = target - *psi, x_q[OM_MAX_DOF], x_t[OM_MAX_DOF];
     *steps = 0;
     while (*psi != target) {
-        if (fabs(step) < END_TOLERANCE) return FOLLOW_ENDED;
+        if (fabs(step) < min_step) return FOLLOW_ENDED;
         double x = fabs(target - *psi) <= fabs(step) ? target : *psi + step;
         om_result r = om_solve_one(s, T, signs, &x, q, x_q);
         bool ok = r.status == OM_OK;
@@ -54,10 +53,10 @@ static int follow(const om_solver_data *s, const double *T, const int64_t *signs
     return FOLLOW_ARRIVED;
 }
 
-/* follow(solver, T, signs, cyclic, centred, centre, q, t, out, psi, target) -> None: q and t
- * (7, in place) become the point reached, out = (psi reached, status, accepted steps). */
+/* follow(solver, T, signs, cyclic, centred, centre, q, t, out, psi, target, min_step) -> None:
+ * q and t (7, in place) become the point reached, out = (psi reached, status, accepted steps). */
 static PyObject *om_follow(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
-    if (check_nargs(nargs, 11, "follow") < 0) return NULL;
+    if (check_nargs(nargs, 12, "follow") < 0) return NULL;
     if (!PyObject_TypeCheck(args[0], &om_SolverType)) {
         PyErr_SetString(PyExc_TypeError, "follow: solver must be a ckernels.Solver");
         return NULL;
@@ -67,7 +66,7 @@ static PyObject *om_follow(PyObject *mod, PyObject *const *args, Py_ssize_t narg
         PyErr_SetString(PyExc_ValueError, "follow: the solver must be a 7-DOF arm's (S-R-S model)");
         return NULL;
     }
-    double psi = PyFloat_AsDouble(args[9]), target = PyFloat_AsDouble(args[10]);
+    double psi = PyFloat_AsDouble(args[9]), target = PyFloat_AsDouble(args[10]), min_step = PyFloat_AsDouble(args[11]);
     if (PyErr_Occurred()) return NULL;
     Py_buffer v[8];
     const buffer_spec sp[8] = {{F64, 16, 0, "T"}, {I64, s->n_signs, 0, "signs"}, {U8, 7, 0, "cyclic"},
@@ -76,7 +75,7 @@ static PyObject *om_follow(PyObject *mod, PyObject *const *args, Py_ssize_t narg
     if (get_buffers(args + 1, v, sp, 8) < 0) return NULL;
     int steps = 0, status;
     Py_BEGIN_ALLOW_THREADS status = follow(s, v[0].buf, v[1].buf, v[2].buf, v[3].buf, v[4].buf, &psi, v[5].buf,
-                                           v[6].buf, target, &steps);
+                                           v[6].buf, target, min_step, &steps);
     Py_END_ALLOW_THREADS double *out = v[7].buf;
     out[F_PSI] = psi, out[F_STATUS] = status, out[F_STEPS] = steps;
     release_buffers(v, 8);
@@ -85,6 +84,6 @@ static PyObject *om_follow(PyObject *mod, PyObject *const *args, Py_ssize_t narg
 
 PyMethodDef om_follow_functions[] = {
     {"follow", (PyCFunction)(void (*)(void))om_follow, METH_FASTCALL,
-     "follow(solver, T, signs, cyclic, centred, centre, q, t, out, psi, target) -> None"},
+     "follow(solver, T, signs, cyclic, centred, centre, q, t, out, psi, target, min_step) -> None"},
     {NULL, NULL, 0, NULL},
 };

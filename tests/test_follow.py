@@ -45,3 +45,26 @@ def test_compiled_follow_reaches_what_the_python_loop_reaches(seed, name, step, 
     if fast is not starts[0]:  # the point reached is an exact solution on the branch
         assert np.abs(arm.fk(fast.q) - T).max() < 1e-9
         assert om.OMSolver(name).holds(fast.q, om.Configuration(configuration.signs, (fast.psi,)))
+
+
+@settings(max_examples=12, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), name=st.sampled_from(["panda", "iiwa14"]), step=st.floats(-0.5, 0.5))
+def test_compiled_next_is_the_python_next(seed, name, step):
+    """Probe.next (one attempt of the loop, the climb's trial step) compiled and in Python:
+    the same answer, the same point."""
+    optimizer = optimizer_of(name, 3)
+    solver = optimizer.solver
+    q = np.random.default_rng(seed).uniform(solver.arm.lower, solver.arm.upper)
+    configuration = solver.configuration_of(q)
+    (psi,) = configuration.redundancy
+    probes = [
+        Probe(solver, optimizer.objective, solver.arm.fk(q), configuration.signs, compiled=c)
+        for c in (True, False)
+    ]
+    fast, slow = (p.next(p.point(psi, q), psi + step) for p in probes)
+    assert (fast is None) == (slow is None)
+    if fast is not None:
+        assert fast.psi == slow.psi
+        np.testing.assert_allclose(fast.q, slow.q, atol=1e-9)
+        np.testing.assert_allclose(fast.tangent, slow.tangent, rtol=1e-9, atol=1e-9)
+        assert fast.evaluation.value == pytest.approx(slow.evaluation.value, abs=1e-9)

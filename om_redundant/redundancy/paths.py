@@ -202,9 +202,13 @@ def _with_hidden(probe: Probe, path: Path) -> Path:
     ends = list(path.points)
     if path.turns:  # the closing cell, to the first sample a loop later
         ends.append(replace(ends[0], psi=ends[0].psi + _TURN * path.turns))
+    # the cells that need no look inside, all at once: no joint moves more than FINE_STEP
+    # and the cheap bounds show the models quiet (_hidden's own first test, vectorised)
+    q = np.array([p.q for p in ends])
+    calm = (probe.steps(q[:-1], q[1:]) <= FINE_STEP) & _quiet(ends[:-1], ends[1:])
     filled = [ends[0]]
-    for a, b in itertools.pairwise(ends):
-        filled += [*_hidden(probe, a, b), b]
+    for (a, b), skip in zip(itertools.pairwise(ends), calm.tolist(), strict=True):
+        filled += [b] if skip else [*_hidden(probe, a, b), b]
     return Path(filled[:-1] if path.turns else filled, path.turns)
 
 
@@ -229,7 +233,7 @@ def _surprise(a: Point, b: Point) -> float | None:
     """Where, as a fraction of the cell, the pieces' cubic models predict a feasibility that
     the ends do not explain: more changes between feasible and infeasible than the ends'
     (none if alike, one if not). Returns the middle of the first unexplained stretch."""
-    if _quiet(a, b):
+    if _quiet([a], [b])[0]:
         return None
     (ga, da), (gb, db) = a.pieces(), b.pieces()
     if len(ga) == 0:
@@ -243,18 +247,26 @@ def _surprise(a: Point, b: Point) -> float | None:
     return (changes[0] + 1 + changes[1]) / 2.0 / (len(pattern) - 1)
 
 
-def _quiet(a: Point, b: Point) -> bool:
-    """Whether the cell's cubic models cannot surprise, by bounds that need no clearance
-    gradients (:meth:`~om_redundant.redundancy.objective.Objective.constraint_bounds`): on
-    [0, 1] the Hermite basis functions of the values are >= 0 and sum to 1 and those of the
-    slopes stay within 4/27 in size, so a model lies within (4/27) span (|g'_a| + |g'_b|) of
-    the ends' range. Quiet: both ends feasible and every model stays >= 0, or both
+def _quiet(a: list[Point], b: list[Point]) -> np.ndarray:
+    """Whether each cell (a_k, b_k)'s cubic models cannot surprise, by bounds that need no
+    clearance gradients (:meth:`~om_redundant.redundancy.objective.Objective.constraint_bounds`):
+    on [0, 1] the Hermite basis functions of the values are >= 0 and sum to 1 and those of
+    the slopes stay within 4/27 in size, so a model lies within (4/27) span (|g'_a| + |g'_b|)
+    of the ends' range. Quiet: both ends feasible and every model stays >= 0, or both
     infeasible and one exact function's model stays < 0."""
-    feasible = a.evaluation.feasible
-    if feasible != b.evaluation.feasible:
-        return False
-    (ga, ra, exact), (gb, rb, _) = a.terms.get_bounds(), b.terms.get_bounds()
-    spread = 4.0 / 27.0 * abs(b.psi - a.psi) * (ra + rb) + _BOUND_SLACK
-    if feasible:
-        return bool((np.minimum(ga, gb) - spread > 0.0).all())
-    return bool((np.maximum(ga, gb) + spread < 0.0)[exact].any())
+    if not a:
+        return np.zeros(0, dtype=bool)
+    feasible_a = np.array([p.evaluation.feasible for p in a])
+    feasible_b = np.array([p.evaluation.feasible for p in b])
+    (ga, ra, exact), (gb, rb) = _bounds(a), _bounds(b)[:2]
+    span = np.abs(np.array([y.psi - x.psi for x, y in zip(a, b, strict=True)], dtype=float))
+    spread = 4.0 / 27.0 * span[:, None] * (ra + rb) + _BOUND_SLACK
+    clear = (np.minimum(ga, gb) - spread > 0.0).all(axis=1)
+    blocked = (np.maximum(ga, gb) + spread < 0.0)[:, exact].any(axis=1)
+    return (feasible_a == feasible_b) & np.where(feasible_a, clear, blocked)
+
+
+def _bounds(points: list[Point]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The points' constraint bounds stacked: values (M, n), rate bounds (M, n), exact (n,)."""
+    bounds = [p.terms.get_bounds() for p in points]
+    return np.array([v for v, _, _ in bounds]), np.array([r for _, r, _ in bounds]), bounds[0][2]

@@ -51,7 +51,10 @@ class _Terms:
     def get_bounds(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """:meth:`~om_redundant.redundancy.objective.Objective.constraint_bounds` here."""
         if self.bounds is None:
-            self.bounds = self.objective.constraint_bounds(self.q, self.tangent, self.get_evaluation())
+            clearance = [self.get_evaluation().clearance]
+            q, tangent = self.q[None], self.tangent[None]
+            values, rates, exact = self.objective.constraint_bounds(q, tangent, clearance)
+            self.bounds = values[0], rates[0], exact
         return self.bounds
 
     def get_groups(self) -> list[Group]:
@@ -144,6 +147,10 @@ class Probe:
         """The largest joint step between joint vectors a and b."""
         return float(np.abs(self._delta(a, b)).max())
 
+    def steps(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """:meth:`step` between the rows of a and b (M, dof)."""
+        return np.abs(self._delta(a, b)).max(axis=1, initial=0.0)
+
     def _delta(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         d = b - a
         return np.where(self._cyclic, _wrap(d), d)
@@ -160,18 +167,22 @@ class Probe:
         return Point(psi, q, tangent, _Terms(self.objective, q, tangent, None), solution)
 
     def points(self, psi: np.ndarray, q: np.ndarray) -> list[Point]:
-        """:meth:`point` for every psi and row of q (M, dof) of a 7-DOF arm, the tangents and
-        the evaluations computed for all rows at once."""
+        """:meth:`point` for every psi and row of q (M, dof) of a 7-DOF arm, the tangents, the
+        evaluations and the constraint bounds computed for all rows at once."""
         q = self._represent(q)
         tangents = self_motion_tangents(self.solver, q)
         bad = ~np.isfinite(tangents).all(axis=(1, 2))
         if bad.any():
             self_motion_tangent(self.solver, q[np.argmax(bad)])  # raises SingularSelfMotion
         evaluations = self.objective.evaluations(q)
-        return [
-            Point(float(x), row, t, _Terms(self.objective, row, t, ev))
-            for x, row, t, ev in zip(psi, q, tangents, evaluations, strict=True)
-        ]
+        clearances = [ev.clearance for ev in evaluations]
+        values, rates, exact = self.objective.constraint_bounds(q, tangents, clearances)
+        points = []
+        for x, row, t, ev, v, r in zip(psi, q, tangents, evaluations, values, rates, strict=True):
+            terms = _Terms(self.objective, row, t, ev)
+            terms.bounds = v, r, exact
+            points.append(Point(float(x), row, t, terms))
+        return points
 
     def at(self, psi: float | np.ndarray, hint: np.ndarray) -> Point | None:
         """The solution at psi nearest ``hint``, if there is one."""
@@ -196,7 +207,11 @@ class Probe:
 
     def next(self, point: Point, psi: float | np.ndarray) -> Point | None:
         """The solution at psi nearest point, if it continues point's path (the objective
-        evaluated only then)."""
+        evaluated only then): one attempt of :meth:`follow`'s loop."""
+        if self._work is not None and psi != point.psi:
+            found = self._follow_compiled(point, psi, abs(psi - point.psi))
+            if found is not None:
+                return found[0] if found[1] else None
         sol = self._solve(psi, point.q)
         if not sol.ok:
             return None
@@ -226,13 +241,16 @@ class Probe:
                 point, step = nxt, 2.0 * step
         return point, True
 
-    def _follow_compiled(self, start: Point, psi: float) -> tuple[Point, bool] | None:
-        """:meth:`follow` in one ``ckernels.follow`` call; None where it met a point without
-        a tangent (a fold met exactly: :meth:`follow`'s own loop then decides)."""
+    def _follow_compiled(
+        self, start: Point, psi: float, min_step: float = END_TOLERANCE
+    ) -> tuple[Point, bool] | None:
+        """:meth:`follow` in one ``ckernels.follow`` call, ending where the step falls below
+        ``min_step``; None where it met a point without a tangent (a fold met exactly: the
+        Python loop then decides)."""
         work = self._work
         work.q[:] = start.q
         work.t[:] = start.tangent[:, 0]
-        ckernels.follow(*work, float(start.psi), float(psi))
+        ckernels.follow(*work, float(start.psi), float(psi), float(min_step))
         reached, status, steps = work.out.tolist()
         if status == _SINGULAR:
             return None
