@@ -269,33 +269,39 @@ class Objective:
         ]
 
     def constraint_bounds(
-        self, q: np.ndarray, tangent: np.ndarray, evaluation: Evaluation
+        self, q: np.ndarray, tangent: np.ndarray, clearance: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        r"""The feasibility functions of :meth:`Group.constraints` at q, without the
-        clearances' gradients: bounds for a cheap test of a cell of a solution path.
+        r"""The feasibility functions of :meth:`Group.constraints` at joint vectors q,
+        without the clearances' gradients: bounds for a cheap test of a cell of a solution
+        path.
 
         Each limited joint's margin function :math:`1 - |q_i - c_i|/h_i` exactly, with its
-        rate's size :math:`|t_i|/h_i` (t = dq/dpsi, ``tangent`` (dof, 1)); then, with
-        obstacles, per pair a lower bound of its clearance function,
+        rate's size :math:`|t_i|/h_i` (t = dq/dpsi); then, with obstacles, per pair a lower
+        bound of its clearance function,
         :math:`(\min(\max(D, \underline{d}_k), 2 d_{cap}) - d_{min})/d_{cap}` (the pieces
         beyond 2 d_cap report 2 d_cap), and a bound on its rate, from
         :meth:`Clearance.pair_bounds <om_redundant.Clearance.pair_bounds>`.
 
+        Args:
+            q: (M, dof) joint vectors.
+            tangent: (M, dof, 1) their dq/dpsi.
+            clearance: (M,) their clearances D(q) (m), as :meth:`evaluations` gives them.
+
         Returns:
-            (values, rate bounds, exact): exact marks the entries that are the functions
-            themselves (the margins), not lower bounds.
+            (values (M, n), rate bounds (M, n), exact (n,)): exact marks the entries that are
+            the functions themselves (the margins), not lower bounds.
         """
         lim = self._limited
-        values = [np.minimum(*_limit_distances(q[lim], self._lower, self._upper, self._half))]
-        rates, exact = [np.abs(tangent[lim, 0]) / self._half], [np.ones(len(lim), dtype=bool)]
+        values = [np.minimum(*_limit_distances(q[:, lim], self._lower, self._upper, self._half))]
+        rates, exact = [np.abs(tangent[:, lim, 0]) / self._half], [np.ones(len(lim), dtype=bool)]
         if self.clearance is not None:
             cap = self.clearance_cap
-            lower, speed = self.clearance.pair_bounds(q, tangent[:, 0])
-            near = np.minimum(np.maximum(lower, evaluation.clearance), self.clearance_reach)
+            lower, speed = self.clearance.pair_bounds(q, tangent[:, :, 0])
+            near = np.minimum(np.maximum(lower, np.asarray(clearance)[:, None]), self.clearance_reach)
             values.append((near - self.min_clearance) / cap)
             rates.append(speed / cap)
-            exact.append(np.zeros(len(lower), dtype=bool))
-        return np.concatenate(values), np.concatenate(rates), np.concatenate(exact)
+            exact.append(np.zeros(lower.shape[1], dtype=bool))
+        return np.concatenate(values, axis=1), np.concatenate(rates, axis=1), np.concatenate(exact)
 
     def evaluation(self, groups: list[Group]) -> Evaluation:
         """f, M, D, the slack and S from the groups at one joint vector."""
