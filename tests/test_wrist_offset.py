@@ -83,6 +83,61 @@ def test_an_inner_fold_of_a_near_arm_is_solved():
     check_exact(solver, q, strict=True)
 
 
+@pytest.mark.parametrize(
+    "q",
+    [
+        [
+            -5.4629771446174766,
+            4.2095890664587658,
+            -0.74255773747212173,
+            -2.1922600807444299,
+            -1.8530416858418177e-3,
+            3.5335467014825577,
+        ],
+        [
+            4.1455391977553235,
+            0.30029330676969046,
+            2.8671506651523146,
+            2.721976349656507,
+            3.1418255177434355,
+            5.558870545992829,
+        ],
+        [
+            0.75113424000742413,
+            -6.0127621125296624,
+            0.39370318309646457,
+            4.4836991459160638,
+            -1.3804595638713365e-3,
+            -1.4662528016092553,
+        ],
+        [
+            -1.9845450090520238,
+            4.0740510683838425,
+            -0.29833270002929213,
+            3.641329298322751,
+            3.1425235835183423,
+            5.060774448800198,
+        ],
+        [
+            5.3521282893960924,
+            2.7230052744771323,
+            -2.6590719889540089,
+            5.5347068569879339,
+            -3.6619624474883211e-3,
+            1.6118339416996541,
+        ],
+    ],
+)
+def test_a_wrist_offset_at_a_nearly_singular_wrist(q):
+    """q5 within 4e-3 rad of the wrist singularity (joints 4 and 6 parallel) with a4 = 0.074:
+    z4 turns through nearly pi over a few 1e-3 rad of q1, and the target's island of reach on
+    the circle is narrower than the scan's cells. Each was missed (no root, or only the other
+    one) before the bands around the singular w (wrist_offset.c, om_wrist_offset_candidates)."""
+    solver = om.OMSolver(with_offsets(om.load_arm("ur5e"), joint3={"a": 0.074}))
+    assert solver.nominal is None
+    check_exact(solver, np.array(q), strict=True)
+
+
 def test_a_wrist_offset_whose_joint_4_turns_with_joint_2_is_refused():
     """a4 != 0 with joint 4 perpendicular to joints 2 and 3 (a PUMA-like wrist, alpha_3 = 90
     deg): dp turns with joints 5 and 6, which no bounded search here handles: a ModelError
