@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import functools
 
 import numpy as np
 import pytest
@@ -136,6 +137,28 @@ def test_a_wrist_offset_at_a_nearly_singular_wrist(q):
     solver = om.OMSolver(with_offsets(om.load_arm("ur5e"), joint3={"a": 0.074}))
     assert solver.nominal is None
     check_exact(solver, np.array(q), strict=True)
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    a4=st.sampled_from([0.074, -0.05, 0.12]),
+    q5=st.floats(-6.0, -1.0).map(lambda e: 10.0**e),
+    side=st.sampled_from([1.0, -1.0]),
+    flip=st.sampled_from([0.0, np.pi]),
+    q_seed=st.integers(0, 2**32 - 1),
+)
+def test_every_root_is_found_at_a_nearly_singular_wrist(a4, q5, side, flip, q_seed):
+    """|q5 - 0 or pi| from 1e-6 to 0.1 rad (joints 4 and 6 nearly parallel) on an exact UR5e
+    with a wrist offset a4: q is among solve_all (the bands around the singular w)."""
+    solver = _offset_solver(a4)
+    q = random_q(solver.arm, 1, np.random.default_rng(q_seed))[0]
+    q[4] = flip + side * q5
+    check_exact(solver, q, strict=True)
+
+
+@functools.cache
+def _offset_solver(a4: float) -> om.OMSolver:
+    return om.OMSolver(with_offsets(om.load_arm("ur5e"), joint3={"a": a4}))
 
 
 def test_a_wrist_offset_whose_joint_4_turns_with_joint_2_is_refused():
