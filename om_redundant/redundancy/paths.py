@@ -255,16 +255,19 @@ def _quiet(a: list[Point], b: list[Point]) -> np.ndarray:
     of the ends' range. Quiet: both ends feasible and every model stays >= 0, or both
     infeasible and one function's model stays < 0 (the bounds below 0 are the functions
     themselves)."""
-    if not a:
-        return np.zeros(0, dtype=bool)
-    feasible_a = np.array([p.evaluation.feasible for p in a])
-    feasible_b = np.array([p.evaluation.feasible for p in b])
+    feasible = np.array([p.evaluation.feasible for p in a], dtype=bool)
+    quiet = np.zeros(len(a), dtype=bool)
+    alike = np.flatnonzero(feasible == np.array([p.evaluation.feasible for p in b], dtype=bool))
+    if len(alike) == 0:  # (only cells whose ends are alike need their bounds)
+        return quiet
+    a, b = [a[k] for k in alike], [b[k] for k in alike]
     (ga, ra), (gb, rb) = _bounds(a), _bounds(b)
     span = np.abs(np.array([y.psi - x.psi for x, y in zip(a, b, strict=True)], dtype=float))
     spread = 4.0 / 27.0 * span[:, None] * (ra + rb) + _BOUND_SLACK
     clear = (np.minimum(ga, gb) - spread > 0.0).all(axis=1)
     blocked = (np.maximum(ga, gb) + spread < 0.0).any(axis=1)
-    return (feasible_a == feasible_b) & np.where(feasible_a, clear, blocked)
+    quiet[alike] = np.where(feasible[alike], clear, blocked)
+    return quiet
 
 
 def _bounds(points: list[Point]) -> tuple[np.ndarray, np.ndarray]:
