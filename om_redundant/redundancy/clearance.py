@@ -148,7 +148,11 @@ class Clearance:
         return cls(spec.compile(), arm, [g.name for g in geoms], distmax=distmax)
 
     def distances(self, q: np.ndarray) -> np.ndarray:
-        """Signed distance d_k(q) of every pair (m), in the order of :attr:`pairs`."""
+        """Signed distance d_k(q) of every pair (m), in the order of :attr:`pairs`: (P,) for
+        a joint vector q (dof,), (M, P) for the rows of q (M, dof)."""
+        if np.ndim(q) == 2:
+            rows = [self._evaluate(row, gradient=False)[0] for row in q]
+            return np.array(rows).reshape(len(q), len(self._pairs))
         return self._evaluate(q, gradient=False)[0]
 
     def minimum(self, q: np.ndarray) -> float:
@@ -186,8 +190,7 @@ class Clearance:
         Returns:
             (M,) clearances in metres (at most ``distmax``).
         """
-        q = as_joint_vector(q, self._dof).reshape(-1, self._dof)
-        return np.array([self._evaluate(row, gradient=False)[0].min() for row in q])
+        return self.distances(as_joint_vector(q, self._dof).reshape(-1, self._dof)).min(axis=1)
 
     def pair_bounds(self, q: np.ndarray, rate: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         r"""Bounds of every pair's distance and of its rate when the joints move at ``rate``.

@@ -253,20 +253,21 @@ def _quiet(a: list[Point], b: list[Point]) -> np.ndarray:
     on [0, 1] the Hermite basis functions of the values are >= 0 and sum to 1 and those of
     the slopes stay within 4/27 in size, so a model lies within (4/27) span (|g'_a| + |g'_b|)
     of the ends' range. Quiet: both ends feasible and every model stays >= 0, or both
-    infeasible and one exact function's model stays < 0."""
+    infeasible and one function's model stays < 0 (the bounds below 0 are the functions
+    themselves)."""
     if not a:
         return np.zeros(0, dtype=bool)
     feasible_a = np.array([p.evaluation.feasible for p in a])
     feasible_b = np.array([p.evaluation.feasible for p in b])
-    (ga, ra, exact), (gb, rb) = _bounds(a), _bounds(b)[:2]
+    (ga, ra), (gb, rb) = _bounds(a), _bounds(b)
     span = np.abs(np.array([y.psi - x.psi for x, y in zip(a, b, strict=True)], dtype=float))
     spread = 4.0 / 27.0 * span[:, None] * (ra + rb) + _BOUND_SLACK
     clear = (np.minimum(ga, gb) - spread > 0.0).all(axis=1)
-    blocked = (np.maximum(ga, gb) + spread < 0.0)[:, exact].any(axis=1)
+    blocked = (np.maximum(ga, gb) + spread < 0.0).any(axis=1)
     return (feasible_a == feasible_b) & np.where(feasible_a, clear, blocked)
 
 
-def _bounds(points: list[Point]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The points' constraint bounds stacked: values (M, n), rate bounds (M, n), exact (n,)."""
+def _bounds(points: list[Point]) -> tuple[np.ndarray, np.ndarray]:
+    """The points' constraint bounds stacked: values (M, n), rate bounds (M, n)."""
     bounds = [p.terms.get_bounds() for p in points]
-    return np.array([v for v, _, _ in bounds]), np.array([r for _, r, _ in bounds]), bounds[0][2]
+    return np.array([v for v, _ in bounds]), np.array([r for _, r in bounds])

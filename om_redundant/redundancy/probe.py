@@ -48,13 +48,14 @@ class _Terms:
             self.evaluation = self.objective.evaluation(self.objective.groups(self.q))
         return self.evaluation
 
-    def get_bounds(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def get_bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`~om_redundant.redundancy.objective.Objective.constraint_bounds` here."""
         if self.bounds is None:
-            clearance = [self.get_evaluation().clearance]
+            clearance = self.objective.clearance
             q, tangent = self.q[None], self.tangent[None]
-            values, rates, exact = self.objective.constraint_bounds(q, tangent, clearance)
-            self.bounds = values[0], rates[0], exact
+            distances = None if clearance is None else clearance.distances(q)
+            values, rates = self.objective.constraint_bounds(q, tangent, distances)
+            self.bounds = values[0], rates[0]
         return self.bounds
 
     def get_groups(self) -> list[Group]:
@@ -174,13 +175,14 @@ class Probe:
         bad = ~np.isfinite(tangents).all(axis=(1, 2))
         if bad.any():
             self_motion_tangent(self.solver, q[np.argmax(bad)])  # raises SingularSelfMotion
-        evaluations = self.objective.evaluations(q)
-        clearances = [ev.clearance for ev in evaluations]
-        values, rates, exact = self.objective.constraint_bounds(q, tangents, clearances)
+        clearance = self.objective.clearance
+        distances = None if clearance is None else clearance.distances(q)
+        evaluations = self.objective.evaluations(q, distances)
+        values, rates = self.objective.constraint_bounds(q, tangents, distances)
         points = []
         for x, row, t, ev, v, r in zip(psi, q, tangents, evaluations, values, rates, strict=True):
             terms = _Terms(self.objective, row, t, ev)
-            terms.bounds = v, r, exact
+            terms.bounds = v, r
             points.append(Point(float(x), row, t, terms))
         return points
 
