@@ -65,6 +65,7 @@ import mujoco
 import numpy as np
 
 import om_redundant as om
+from om_redundant import ckernels
 from om_redundant.mujoco_io.mjcf import DEFAULT_SITE
 from om_redundant.om import system
 from om_redundant.om.families import branch_values, redundancy_values
@@ -167,6 +168,7 @@ class ArmResult:
     tallies: list[Tally] = field(default_factory=list)
     decades: dict[str, Counter] = field(default_factory=dict)  # column -> counts
     other_side: Counter = field(default_factory=Counter)
+    arm_angle_line: dict[str, Counter] = field(default_factory=dict)  # column -> counts
     failures: list[Failure] = field(default_factory=list)
     failure_counts: Counter = field(default_factory=Counter)
     seconds: float = 0.0
@@ -584,6 +586,52 @@ class ArmRun:
                 return x
         return None
 
+    def near_arm_angle_line(self, delta: float, side: float) -> np.ndarray | None:
+        """A random q (7-DOF) whose model's shoulder-wrist direction w_hat is at the angle delta
+        from the arm angle's singular half-line w_hat = -up (``side`` -1: the wrist centre
+        straight below the shoulder, where the reference n(w_hat) = R(up -> w_hat) r is
+        undefined) or from w_hat = +up (``side`` +1). Gauss-Newton on joints 2-7, within the
+        limits, for the part of w across up equal to delta |w| in a random direction; None if
+        it does not get within half of that.
+        """
+        up, across, w = self._arm_angle_frame()
+        q = self.random_q(1)[0]
+        angle = self.rng.uniform(0.0, TURN)
+        direction = np.array([math.cos(angle), math.sin(angle)])
+        steps = 1e-7 * np.eye(self.arm.dof)[1:]
+        for _ in range(40):
+            v = w(q)
+            length = float(np.linalg.norm(v))
+            miss = across @ v - delta * length * direction
+            if np.abs(miss).max() <= 0.5 * delta * length:
+                return q if side * float(v @ up) > 0.0 else None
+            J = (across @ (w(q + steps) - w(q - steps)).T) / 2e-7
+            q[1:] = np.clip(
+                q[1:] + np.linalg.lstsq(J, -miss, rcond=None)[0], self.arm.lower[1:], self.arm.upper[1:]
+            )
+        return None
+
+    def _arm_angle_frame(self) -> tuple[np.ndarray, np.ndarray, Callable[[np.ndarray], np.ndarray]]:
+        """The model's up axis, two unit vectors across it, and w(Q): W - S of the model at Q."""
+        model, P = self.solver.om.model, self.solver.om.params
+        up = P[ckernels.SRS_UP : ckernels.SRS_UP + 3]
+        e1 = np.cross(up, [1.0, 0.0, 0.0] if abs(up[0]) < 0.9 else [0.0, 1.0, 0.0])
+        e1 /= np.linalg.norm(e1)
+        wrist = P[ckernels.SRS_WRIST : ckernels.SRS_WRIST + 3]
+        shoulder = P[ckernels.SRS_SHOULDER : ckernels.SRS_SHOULDER + 3]
+
+        def w(Q: np.ndarray) -> np.ndarray:
+            T = model.fk(Q)
+            return T[..., :3, 3] + T[..., :3, :3] @ wrist - shoulder
+
+        return up, np.array([e1, np.cross(up, e1)]), w
+
+    def arm_angle_line_angle(self, q: np.ndarray, side: float) -> float:
+        """The angle of the model's w_hat at q from side * up."""
+        up, across, w = self._arm_angle_frame()
+        v = w(q)
+        return math.atan2(float(np.linalg.norm(across @ v)), side * float(v @ up))
+
     def at_limits(self) -> np.ndarray | None:
         """A random q with some limited joints at a limit +- 1e-12."""
         if not len(self.limited):
@@ -646,8 +694,9 @@ def run_random(run: ArmRun, n: int) -> Tally:
     return t
 
 
-def run_singular(run: ArmRun, n: int, n_limits: int) -> Tally:
-    """Poses at 1e-14 ... 1e-3 from a branch boundary, and joints at their limits +- 1e-12."""
+def run_singular(run: ArmRun, n: int, n_limits: int, n_line: int = 0) -> Tally:
+    """Poses at 1e-14 ... 1e-3 from a branch boundary, joints at their limits +- 1e-12, and
+    (7-DOF) the wrist centre 1e-14 ... 1e-3 rad from the arm angle's singular half-line."""
     t = run.tally("singular")
     solver, start = run.solver, time.perf_counter()
     decades = run.result.decades
@@ -683,6 +732,23 @@ def run_singular(run: ArmRun, n: int, n_limits: int) -> Tally:
         counts["any"] += singular_case(
             run, t, q, counts, f"joints {[int(j) + 1 for j in at]} at a limit +- 1e-12"
         )
+    made = tries = 0
+    while solver.redundancy_names and made < n_line and tries < 20 * n_line:
+        tries += 1
+        side = -1.0 if made % 4 else 1.0  # three of four below the shoulder
+        q = run.near_arm_angle_line(float(10.0 ** run.rng.uniform(-14.0, -3.0)), side)
+        if q is None:
+            continue
+        made += 1
+        delta = run.arm_angle_line_angle(q, side)
+        column = f"{'below' if side < 0 else 'above'} {math.floor(math.log10(delta)) if delta > 0 else '0'}"
+        counts = run.result.arm_angle_line.setdefault(column, Counter())
+        counts["cases"] += 1
+        counts["any"] += singular_case(
+            run, t, q, counts, f"wrist centre {delta:.3e} rad from straight {column.split()[0]} the shoulder"
+        )
+    if made < n_line:
+        t.notes["arm angle line poses short of the size asked"] += n_line - made
     t.seconds = time.perf_counter() - start
     return t
 
@@ -1111,6 +1177,7 @@ class Sizes:
     random: int
     singular: int
     limits: int
+    line: int
     huge: int
     layouts: int
     threads: int
@@ -1122,6 +1189,7 @@ class Sizes:
             random=n_random,
             singular=n_singular,
             limits=max(n_singular // 4, 1),
+            line=max(n_singular // 10, 1),
             huge=max(n_random // 50, 10),
             layouts=max(n_random // 1000, 5),
             threads=max(n_random // 50, 20),
@@ -1135,7 +1203,7 @@ def run_arm(name: str, sizes: Sizes, seed: int, classes: Sequence[str] = CLASSES
     run = ArmRun(name, seed)
     steps = {
         "random": lambda: run_random(run, sizes.random),
-        "singular": lambda: run_singular(run, sizes.singular, sizes.limits),
+        "singular": lambda: run_singular(run, sizes.singular, sizes.limits, sizes.line),
         "huge/tiny": lambda: run_huge_tiny(run, sizes.huge),
         "layouts": lambda: run_layouts(run, sizes.layouts),
         "threads": lambda: run_threads(run, sizes.threads),
@@ -1182,6 +1250,37 @@ def unlimited_prismatic_note(arms: Sequence[str]) -> list[str]:
         "translated poses are not unreachable, and at |p| = 1e120 m no float64 FK agrees with "
         "another to 1e-10 m (MuJoCo's rounding alone is about 1e-16 |p|): the position check there "
         f"is relative, {FK_ROUNDING:.1e} |p|.",
+    ]
+
+
+def arm_angle_line_table(results: list[ArmResult]) -> list[str]:
+    """The 7-DOF arms' poses next to the arm angle's singular half-line, per decade of delta."""
+    rows = [r for r in results if r.arm_angle_line]
+    if not rows:
+        return []
+    found = {k for r in rows for k in r.arm_angle_line}
+    columns = sorted(found, key=lambda k: (k.split()[0], int(k.split()[1])))
+    return [
+        "",
+        "## The arm angle's singular half-line",
+        "",
+        "7-DOF arms: the model's wrist centre at the angle delta from straight below the shoulder "
+        "(w_hat = -up, where psi's reference n(w_hat) = R(up -> w_hat) r is undefined) or straight above; "
+        "solve, hinted solve and solve_all in c = configuration_of(q) (counted in the singular class "
+        "above). Cell: poses with any false no, wrong ok or non-library exception / poses, by "
+        "floor(log10 delta).",
+        "",
+        _cells(["arm", *[f"{k.split()[0]} 1e{k.split()[1]}" for k in columns]]),
+        "|" + "---|" * (len(columns) + 1),
+        *(
+            _cells(
+                [
+                    r.arm,
+                    *[f"{d['any']}/{d['cases']}" if (d := r.arm_angle_line.get(k)) else "-" for k in columns],
+                ]
+            )
+            for r in rows
+        ),
     ]
 
 
@@ -1312,6 +1411,7 @@ def markdown(
             for d in r.decades.values():
                 total.update(d)
             out.append(_cells([r.arm, total["cases"], *[total[k] for k in kinds]]))
+        out += arm_angle_line_table(results)
         out += [
             "",
             "## The other side of the boundary",

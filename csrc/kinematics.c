@@ -4,15 +4,17 @@
 #include "om_kernels.h"
 
 /* Right-multiply the frame (R, p) in place by the standard DH row Rz(theta) Tz(d) Tx(a) Rx(alpha),
- * the variable qi added to theta (revolute, kind 0) or d (prismatic, kind 1). */
+ * the variable qi added to theta (revolute, kind 0) or d (prismatic, kind 1); cos and sin of
+ * theta into *ct_out, *st_out. */
 static inline void apply_row(double *R, double *p, const double *row, double qi, double *ct_out, double *st_out)
 {
     double kind = row[5];
     double theta = kind == 0.0 ? row[2] + qi : row[2];
     double d = kind == 1.0 ? row[1] + qi : row[1];
     double ct = cos(theta), st = sin(theta), ca = row[3], sa = row[4], a = row[0];
+    double Rl[9] = {R[0], R[1], R[2], R[3], R[4], R[5], R[6], R[7], R[8]}; /* in registers: R, p do not alias */
     for (int i = 0; i < 3; i++) {
-        double r0 = R[3 * i], r1 = R[3 * i + 1], r2 = R[3 * i + 2];
+        double r0 = Rl[3 * i], r1 = Rl[3 * i + 1], r2 = Rl[3 * i + 2];
         p[i] += r0 * a * ct + r1 * a * st + r2 * d;
         R[3 * i] = r0 * ct + r1 * st;
         R[3 * i + 1] = -r0 * st * ca + r1 * ct * ca + r2 * sa;

@@ -95,6 +95,7 @@ double om_polish(const om_polish_task *t, int iterations, double *q)
 {
     int dof = t->dof, rows = t->P ? 7 : 6;
     double e[POLISH_ROWS], e_try[POLISH_ROWS], J[POLISH_ROWS * OM_MAX_DOF], A[POLISH_ROWS * POLISH_ROWS];
+    double G[POLISH_ROWS * POLISH_ROWS];
     double y[POLISH_ROWS], q_try[OM_MAX_DOF];
     double cost = residual(t, q, e);
     jacobian(t, q, J);
@@ -107,21 +108,19 @@ double om_polish(const om_polish_task *t, int iterations, double *q)
             window_cost = cost;
         }
         double scale = 0.0;
-        for (int a = 0; a < rows; a++) {
-            double d = 0.0;
-            for (int j = 0; j < dof; j++)
-                d += J[a * dof + j] * J[a * dof + j];
-            scale = py_max(scale, d);
+        for (int a = 0; a < rows; a++) { /* J J^T (symmetric: each product sum once), its largest diagonal */
+            for (int b = 0; b <= a; b++) {
+                double d = 0.0;
+                for (int j = 0; j < dof; j++)
+                    d += J[a * dof + j] * J[b * dof + j];
+                G[a * rows + b] = G[b * rows + a] = d;
+            }
+            scale = py_max(scale, G[a * rows + a]);
         }
         bool improved = false;
         while (!improved && damping <= POLISH_DAMPING_MAX) {
+            memcpy(A, G, (size_t)(rows * rows) * sizeof(double));
             for (int a = 0; a < rows; a++) {
-                for (int b = 0; b < rows; b++) {
-                    double d = 0.0;
-                    for (int j = 0; j < dof; j++)
-                        d += J[a * dof + j] * J[b * dof + j];
-                    A[a * rows + b] = d;
-                }
                 A[a * rows + a] += damping * scale;
                 y[a] = e[a];
             }

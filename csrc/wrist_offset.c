@@ -29,6 +29,25 @@ vec3 om_wrist_offset_point(const double *P, const om_target *t, vec3 p, double w
 #define BAND_POINTS 5   /* samples of each band (4 cells) */
 #define MAX_BANDS 48    /* halvings of the band's distance to the singular w (0.3 / 2^48 < 1e-15) */
 
+/* The bands around the singular w0 (width |n_min| / rho) within [lo, hi], scanned into
+ * cands[n:]; returns the new count (see om_wrist_offset_candidates). */
+static int _bands(om_problem *pb, double w0, double width, double rho, double lo, double hi, double *q, double *cands,
+                  int n, int cap)
+{
+    double x = py_min(STEEP_WRIST / rho, OM_PI), inner = py_max(0.25 * width, 1e-15);
+    for (int band = 0; band < MAX_BANDS && x > inner; band++, x *= 0.5)
+        for (int side = -1; side <= 1; side += 2) {
+            double u = w0 + side * 0.5 * x, v = w0 + side * x;
+            double from = py_max(py_min(u, v), lo), to = py_min(py_max(u, v), hi);
+            if (to > from)
+                n += om_circle_candidates(pb, from, to, BAND_POINTS, false, q, cands + n, cap - n);
+        }
+    double from = py_max(w0 - x, lo), to = py_min(w0 + x, hi);
+    if (to > from)
+        n += om_circle_candidates(pb, from, to, BAND_POINTS, false, q, cands + n, cap - n);
+    return n;
+}
+
 /* Candidate roots of g near the wrist singularities of the circle, into cands (capacity cap);
  * returns the count. z3(w) . z5 = a + rho cos(w - phi) (z3 turns about joint 1's axis, z5 is
  * the target's), so |z3 x z5|^2 = 1 - (z3 . z5)^2 is smallest at w0 = phi or phi + pi. Near
@@ -39,7 +58,8 @@ vec3 om_wrist_offset_point(const double *P, const om_target *t, vec3 p, double w
  * [w0 - x, w0 + x], are scanned like the circle (om_circle_candidates on each): over a band
  * z4's angle, about atan((w - w0) rho / n_min), changes by at most atan(2u) - atan(u) <= 0.34
  * rad (0.12 rad per cell), whatever n_min's scale, and by at most 0.49 rad over the inner
- * window. Windowed solves (hi - lo < 2 pi) scan the bands' parts inside [lo, hi]. */
+ * window. Windowed solves (hi - lo < 2 pi) scan the parts inside [lo, hi] of the bands around
+ * w0 and its image w0 - 2 pi (w0 taken into [lo, lo + 2 pi)). */
 int om_wrist_offset_candidates(om_problem *pb, double lo, double hi, bool full_circle, double *q, double *cands,
                                int cap)
 {
@@ -56,20 +76,11 @@ int om_wrist_offset_candidates(om_problem *pb, double lo, double hi, bool full_c
         double n_min = sqrt(py_max(0.0, 1.0 - f * f));
         if (!(n_min < STEEP_WRIST))
             continue;
-        if (!full_circle) /* w0 into [lo, lo + 2 pi) */
+        if (!full_circle) /* w0 into [lo, lo + 2 pi); its image w0 - 2 pi may reach into [lo, hi] too */
             w0 = lo + (w0 - lo) - 2.0 * OM_PI * floor((w0 - lo) / (2.0 * OM_PI));
-        double x = py_min(STEEP_WRIST / rho, OM_PI), inner = py_max(n_min / (4.0 * rho), 1e-15);
-        for (int band = 0; band < MAX_BANDS && x > inner; band++, x *= 0.5)
-            for (int side = -1; side <= 1; side += 2) {
-                double u = w0 + side * 0.5 * x, v = w0 + side * x;
-                double from = py_max(py_min(u, v), full_circle ? -INFINITY : lo);
-                double to = py_min(py_max(u, v), full_circle ? INFINITY : hi);
-                if (to > from)
-                    n += om_circle_candidates(pb, from, to, BAND_POINTS, false, q, cands + n, cap - n);
-            }
-        double from = py_max(w0 - x, full_circle ? -INFINITY : lo), to = py_min(w0 + x, full_circle ? INFINITY : hi);
-        if (to > from)
-            n += om_circle_candidates(pb, from, to, BAND_POINTS, false, q, cands + n, cap - n);
+        for (int image = 0; image < (full_circle ? 1 : 2); image++)
+            n = _bands(pb, w0 - 2.0 * OM_PI * image, n_min / rho, rho, full_circle ? -INFINITY : lo,
+                       full_circle ? INFINITY : hi, q, cands, n, cap);
     }
     return n;
 }

@@ -37,6 +37,9 @@ POLISH_ITERATIONS = 30
 FIXED_POINT_STEPS = 20
 #: Joint-space distance (rad) under which two roots are one (csrc's OM_SAME_ROOT).
 SAME_ROOT = 1e-9
+#: Joint-space distance (rad) under which two verified roots are one root found twice near a
+#: fold (where the residual is flat to second order), the more accurate kept (csrc's OM_ONE_ROOT).
+ONE_ROOT = 1e-6
 #: Fractions by which a target the seeds do not lead to is pulled toward the base (the real
 #: arm may reach a little farther than the nominal one).
 PULL = (1e-4, 1e-3, 1e-2)
@@ -331,9 +334,16 @@ class NearKernel:
 
 
 def _add_root(roots: list, found: tuple[np.ndarray, float, float] | None) -> None:
-    """Append a verified root unless it is None or one already found (within SAME_ROOT)."""
-    if found is not None and all(_distance(found[0], q) >= SAME_ROOT for q, _, _ in roots):
-        roots.append(found)
+    """Append a verified root unless it is None or one already found: within ONE_ROOT of a
+    kept root it is that root, found twice, and the copy with the smaller pose error stays."""
+    if found is None:
+        return
+    for r, (q, pos, ori) in enumerate(roots):
+        if _distance(found[0], q) < ONE_ROOT:
+            if found[1] + found[2] < pos + ori:
+                roots[r] = found
+            return
+    roots.append(found)
 
 
 def _wrap(angle):
