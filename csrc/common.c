@@ -49,12 +49,12 @@ vec3 om_euler_zxzxz(mat3 M, double sigma_a, double sin_b, double cos_b, double s
 vec3 om_euler_zxzxz_given_first(mat3 M, double sin_a, double cos_a, double sigma_b, double phi_a)
 {
     double ca = cos(phi_a), sa = sin(phi_a);
-    /* Rz(-phi_a) M, rows 0-2; then Rx(alpha_a)^T mixes rows 1 and 2. */
+    /* Rz(-phi_a) M, rows 0-2; then Rx(alpha_a)^T mixes rows 1 and 2 (as om_euler_given_first_residual). */
     vec3 r0 = v_add(v_scale(ca, M.r0), v_scale(sa, M.r1));
     vec3 r1 = v_sub(v_scale(ca, M.r1), v_scale(sa, M.r0));
     vec3 n1 = v_add(v_scale(cos_a, r1), v_scale(sin_a, M.r2));
     vec3 n2 = v_sub(v_scale(cos_a, M.r2), v_scale(sin_a, r1));
     double phi_b = atan2(sigma_b * r0.z, -sigma_b * n1.z);
     double phi_c = atan2(sigma_b * n2.x, sigma_b * n2.y);
-    return v3(phi_b, phi_c, n2.z);
+    return v3(phi_b, phi_c, om_euler_given_first_residual(M, sin_a, cos_a, ca, sa));
 }

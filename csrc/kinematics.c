@@ -4,20 +4,30 @@
 #include "om_kernels.h"
 
 /* Right-multiply the frame (R, p) in place by the standard DH row Rz(theta) Tz(d) Tx(a) Rx(alpha),
- * the variable qi added to theta (revolute, kind 0) or d (prismatic, kind 1). */
-void om_apply_row(double *R, double *p, const double *row, double qi)
+ * the variable qi added to theta (revolute, kind 0) or d (prismatic, kind 1); cos and sin of
+ * theta into *ct_out, *st_out. */
+static inline void apply_row(double *R, double *p, const double *row, double qi, double *ct_out, double *st_out)
 {
     double kind = row[5];
     double theta = kind == 0.0 ? row[2] + qi : row[2];
     double d = kind == 1.0 ? row[1] + qi : row[1];
     double ct = cos(theta), st = sin(theta), ca = row[3], sa = row[4], a = row[0];
+    double Rl[9] = {R[0], R[1], R[2], R[3], R[4], R[5], R[6], R[7], R[8]}; /* in registers: R, p do not alias */
     for (int i = 0; i < 3; i++) {
-        double r0 = R[3 * i], r1 = R[3 * i + 1], r2 = R[3 * i + 2];
+        double r0 = Rl[3 * i], r1 = Rl[3 * i + 1], r2 = Rl[3 * i + 2];
         p[i] += r0 * a * ct + r1 * a * st + r2 * d;
         R[3 * i] = r0 * ct + r1 * st;
         R[3 * i + 1] = -r0 * st * ca + r1 * ct * ca + r2 * sa;
         R[3 * i + 2] = r0 * st * sa - r1 * ct * sa + r2 * ca;
     }
+    *ct_out = ct;
+    *st_out = st;
+}
+
+void om_apply_row(double *R, double *p, const double *row, double qi)
+{
+    double ct, st;
+    apply_row(R, p, row, qi, &ct, &st);
 }
 
 static void set_identity(double *R, double *p)
@@ -28,17 +38,19 @@ static void set_identity(double *R, double *p)
     p[0] = p[1] = p[2] = 0.0;
 }
 
-/* Axis and origin in DH frame 0 of joints 1..n (joint_axes_kernel): a standard row's joint acts
- * about the z-axis of the frame it starts from. (R, p) end as the frame before joint n+1's row. */
-void om_joint_axes(const double *table, int n_rows, const double *q, int n, double *axes, double *origins,
-                   double *R, double *p)
+/* The chain's rows applied up to joint n+1's (every row: n = n_rows) from the identity into
+ * (R, p); with axes not NULL, the axis and origin of joints 1..n; with trig not NULL, cos and
+ * sin of each joint row's angle as applied (2 per joint). */
+static void chain(const double *table, int n_rows, const double *q, int n, double *axes, double *origins, double *R,
+                  double *p, double *trig)
 {
     set_identity(R, p);
     int j = 0;
+    double cs[2];
     for (int k = 0; k < n_rows; k++) {
         const double *row = table + 6 * k;
         if (row[5] == 2.0) {
-            om_apply_row(R, p, row, 0.0);
+            apply_row(R, p, row, 0.0, &cs[0], &cs[1]);
             continue;
         }
         if (j == n)
@@ -48,16 +60,32 @@ void om_joint_axes(const double *table, int n_rows, const double *q, int n, doub
                 axes[3 * j + i] = R[3 * i + 2];
                 origins[3 * j + i] = p[i];
             }
-        om_apply_row(R, p, row, q[j]);
+        double *out = trig ? trig + 2 * j : cs;
+        apply_row(R, p, row, q[j], &out[0], &out[1]);
         j++;
     }
+}
+
+/* Axis and origin in DH frame 0 of joints 1..n (joint_axes_kernel): a standard row's joint acts
+ * about the z-axis of the frame it starts from. (R, p) end as the frame before joint n+1's row. */
+void om_joint_axes(const double *table, int n_rows, const double *q, int n, double *axes, double *origins,
+                   double *R, double *p)
+{
+    chain(table, n_rows, q, n, axes, origins, R, p, NULL);
 }
 
 /* The pose (R, p) of the last DH frame in DH frame 0: every row applied (no row has more
  * than n_rows joints before it). */
 void om_flange(const double *table, int n_rows, const double *q, double *R, double *p)
 {
-    om_joint_axes(table, n_rows, q, n_rows, NULL, NULL, R, p);
+    chain(table, n_rows, q, n_rows, NULL, NULL, R, p, NULL);
+}
+
+/* om_flange, also giving cos and sin of each joint row's angle theta + q_j as the product used
+ * them (trig: cos, sin per joint; a prismatic joint's are of its fixed theta). */
+void om_flange_trig(const double *table, int n_rows, const double *q, double *R, double *p, double *trig)
+{
+    chain(table, n_rows, q, n_rows, NULL, NULL, R, p, trig);
 }
 
 /* out = A @ B for 4x4 row-major matrices (_matmul4). */

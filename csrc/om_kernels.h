@@ -37,6 +37,14 @@ vec3 om_euler_zxzxz(mat3 M, double sigma_a, double sin_b, double cos_b, double s
 /* (phi_b, phi_c, residual N22) for phi_a given; see euler_zxzxz_given_first. */
 vec3 om_euler_zxzxz_given_first(mat3 M, double sin_a, double cos_a, double sigma_b, double phi_a);
 
+/* The residual N22 of om_euler_zxzxz_given_first alone, for ca = cos(phi_a), sa = sin(phi_a):
+ * row 2 of Rx(alpha_a)^T Rz(-phi_a) M, its z entry. */
+static inline double om_euler_given_first_residual(mat3 M, double sin_a, double cos_a, double ca, double sa)
+{
+    double r1z = ca * M.r1.z - sa * M.r0.z;
+    return cos_a * M.r2.z - sin_a * r1z;
+}
+
 /* ------------------------------------------------------------------------------------ */
 /* kinematics.c: DH chains.                                                               */
 
@@ -44,6 +52,7 @@ vec3 om_euler_zxzxz_given_first(mat3 M, double sin_a, double cos_a, double sigma
 void om_apply_row(double *R, double *p, const double *row, double qi);
 /* The pose of the last DH frame in DH frame 0. */
 void om_flange(const double *table, int n_rows, const double *q, double *R, double *p);
+void om_flange_trig(const double *table, int n_rows, const double *q, double *R, double *p, double *trig);
 /* Axis and origin (in DH frame 0) of joints 1..n into axes[n*3], origins[n*3] (both NULL:
  * not written); R, p end as the frame after every row before joint n+1's (the flange for
  * n >= dof). */
@@ -121,7 +130,9 @@ void om_srs_target(const double *P, om_target *t); /* fills RE, wrist, cos_psi, 
 void om_srs_reference(const double *P, vec3 w_hat, vec3 *n, vec3 *nw);
 double om_srs_arm_angle(const double *P, const double *q);
 double om_srs_arm_angle_in(const double *P, const double *q, double elbow);
+double om_srs_arm_angle_trig(const double *P, const double *trig, double elbow); /* trig: cos, sin of q_j + theta_j, j < 4 */
 void om_srs_branch_values(const double *P, const double *q, double *out);
+void om_srs_branch_values_trig(const double *P, const double *q, const double *trig, double *out);
 /* psi at q of the S-R-S model with parameters P and DH table; writes d psi / dq (7). */
 double om_arm_angle_gradient(const double *P, const double *table, int n_rows, const double *q, double *grad);
 
@@ -162,6 +173,7 @@ typedef struct {
     const double *lower, *upper;
     int scan_points;
     double tol_pos, tol_ori;
+    bool trig_shared; /* om_trig_shared: verify reuses the real FK's cos and sin in the configuration check */
 } om_solver_data;
 
 /* One target. */
@@ -207,6 +219,10 @@ double om_extremum(om_problem *pb, double a, double b, double x0, double sign, b
 /* circle.c: candidates into cands (capacity cap); returns the count. */
 int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool full_circle, double *q,
                          double *cands, int cap);
+/* wrist_offset.c: candidates in the bands around the singular wrist of an arm with a4 != 0. */
+#define OM_WRIST_BAND_CANDIDATES 256 /* room for them */
+int om_wrist_offset_candidates(om_problem *pb, double lo, double hi, bool full_circle, double *q, double *cands,
+                               int cap);
 
 /* torus.c */
 double om_newton(om_problem *pb, vec3 x, double *q, const double *known, int n_known, vec3 *x_end);
@@ -219,6 +235,7 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
  * configurations there), and the redundancy values, read in the requested branches, are
  * the requested ones. */
 bool om_in_configuration(const om_solver_data *s, const double *q, const int64_t *signs, const double *redundancy);
+bool om_trig_shared(const om_solver_data *s);
 bool om_verify(om_problem *pb, const double *q, double *pos, double *ori); /* returns accepted */
 int om_add_root(om_problem *pb, const double *q, double *roots, int count); /* roots: OM_MAX_ROOTS x dof */
 bool om_representative(double *q, int dof, const uint8_t *revolute, const double *lower, const double *upper,

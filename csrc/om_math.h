@@ -16,8 +16,13 @@ typedef struct {
 
 #define OM_PI 3.141592653589793 /* np.pi */
 
-/* x wrapped into [-pi, pi). */
-static inline double om_wrap(double x) { return x - 2.0 * OM_PI * floor((x + OM_PI) / (2.0 * OM_PI)); }
+/* x wrapped into [-pi, pi): x - 2 pi floor((x + pi) / (2 pi)), which is x itself where the
+ * floor is 0 (x - 0.0 == x, -0.0 included), so the floor is taken only otherwise. */
+static inline double om_wrap(double x)
+{
+    double turns = (x + OM_PI) / (2.0 * OM_PI);
+    return turns >= 0.0 && turns < 1.0 ? x : x - 2.0 * OM_PI * floor(turns);
+}
 
 /* np.sign of a float as numba computes it: +-1, and x itself for 0 (keeping -0) and NaN. */
 static inline double om_sign(double x)
@@ -100,9 +105,6 @@ static inline mat3 m_rz_cs_times(double c, double s, mat3 X)
     mat3 C = {v_sub(v_scale(c, X.r0), v_scale(s, X.r1)), v_add(v_scale(s, X.r0), v_scale(c, X.r1)), X.r2};
     return C;
 }
-
-/* Rz(phi) @ X. */
-static inline mat3 m_rz_times(double phi, mat3 X) { return m_rz_cs_times(cos(phi), sin(phi), X); }
 
 /* Python's max(a, b) on floats: b if b > a else a (so max(NaN, x) is NaN, max(x, NaN) is x). */
 static inline double py_max(double a, double b) { return b > a ? b : a; }

@@ -14,9 +14,9 @@
 
 static const double IDENTITY[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
 
-/* The residual e (rows: p - p(q); the rotation vector of R R(q)^T; psi - psi(q)) in DH frame 0,
- * its squared norm returned; with J not NULL, the Jacobian of the pose and psi (rows x dof). */
-static double residual(const om_polish_task *t, const double *q, double *e, double *J)
+/* The residual e (rows: p - p(q); the rotation vector of R R(q)^T; psi - psi(q)) in DH frame 0;
+ * returns its squared norm. */
+static double residual(const om_polish_task *t, const double *q, double *e)
 {
     double Rc[9], pc[3];
     om_flange(t->table, t->n_rows, q, Rc, pc);
@@ -32,22 +32,25 @@ static double residual(const om_polish_task *t, const double *q, double *e, doub
     e[4] = k * w.y;
     e[5] = k * w.z;
     int rows = t->P ? 7 : 6;
-    if (J)
-        om_jacobian(t->table, t->n_rows, IDENTITY, IDENTITY, q, t->dof, J);
     if (t->P) {
-        double grad[7];
-        double psi = om_arm_angle_gradient(t->P, t->model_table, t->n_model_rows, q, grad);
+        double psi = om_arm_angle_gradient(t->P, t->model_table, t->n_model_rows, q, NULL);
         /* psi's reference flips by pi with the ELBOW branch: read it in the requested one */
         double own = sin(q[3] + t->P[SRS_THETA + 3] - t->P[SRS_PHI_STAR]) < 0.0 ? -1.0 : 1.0;
         bool flipped = t->elbow != 0.0 && own != t->elbow;
         e[6] = om_wrap(t->psi + (flipped ? OM_PI : 0.0) - psi);
-        if (J)
-            memcpy(J + 6 * t->dof, grad, 7 * sizeof(double));
     }
     double cost = 0.0;
     for (int i = 0; i < rows; i++)
         cost += e[i] * e[i];
     return cost;
+}
+
+/* The Jacobian of the pose and of psi at q (rows x dof). */
+static void jacobian(const om_polish_task *t, const double *q, double *J)
+{
+    om_jacobian(t->table, t->n_rows, IDENTITY, IDENTITY, q, t->dof, J);
+    if (t->P)
+        om_arm_angle_gradient(t->P, t->model_table, t->n_model_rows, q, J + 6 * t->dof);
 }
 
 /* Solve the symmetric positive definite A y = b (n x n, A overwritten by its Cholesky
@@ -92,8 +95,10 @@ double om_polish(const om_polish_task *t, int iterations, double *q)
 {
     int dof = t->dof, rows = t->P ? 7 : 6;
     double e[POLISH_ROWS], e_try[POLISH_ROWS], J[POLISH_ROWS * OM_MAX_DOF], A[POLISH_ROWS * POLISH_ROWS];
+    double G[POLISH_ROWS * POLISH_ROWS];
     double y[POLISH_ROWS], q_try[OM_MAX_DOF];
-    double cost = residual(t, q, e, J);
+    double cost = residual(t, q, e);
+    jacobian(t, q, J);
     double damping = POLISH_DAMPING;
     double window_cost = cost; /* the cost POLISH_WINDOW Jacobians ago */
     for (int it = 0; it < iterations && cost > POLISH_DONE * POLISH_DONE && isfinite(cost); it++) {
@@ -103,21 +108,19 @@ double om_polish(const om_polish_task *t, int iterations, double *q)
             window_cost = cost;
         }
         double scale = 0.0;
-        for (int a = 0; a < rows; a++) {
-            double d = 0.0;
-            for (int j = 0; j < dof; j++)
-                d += J[a * dof + j] * J[a * dof + j];
-            scale = py_max(scale, d);
+        for (int a = 0; a < rows; a++) { /* J J^T (symmetric: each product sum once), its largest diagonal */
+            for (int b = 0; b <= a; b++) {
+                double d = 0.0;
+                for (int j = 0; j < dof; j++)
+                    d += J[a * dof + j] * J[b * dof + j];
+                G[a * rows + b] = G[b * rows + a] = d;
+            }
+            scale = py_max(scale, G[a * rows + a]);
         }
         bool improved = false;
         while (!improved && damping <= POLISH_DAMPING_MAX) {
+            memcpy(A, G, (size_t)(rows * rows) * sizeof(double));
             for (int a = 0; a < rows; a++) {
-                for (int b = 0; b < rows; b++) {
-                    double d = 0.0;
-                    for (int j = 0; j < dof; j++)
-                        d += J[a * dof + j] * J[b * dof + j];
-                    A[a * rows + b] = d;
-                }
                 A[a * rows + a] += damping * scale;
                 y[a] = e[a];
             }
@@ -128,11 +131,13 @@ double om_polish(const om_polish_task *t, int iterations, double *q)
                         dq += J[a * dof + j] * y[a];
                     q_try[j] = q[j] + dq;
                 }
-                double c = residual(t, q_try, e_try, NULL);
+                double c = residual(t, q_try, e_try);
                 improved = c < cost;
                 if (improved) {
                     memcpy(q, q_try, (size_t)dof * sizeof(double));
-                    cost = residual(t, q, e, J);
+                    memcpy(e, e_try, sizeof e);
+                    cost = c;
+                    jacobian(t, q, J);
                     damping = py_max(damping / 10.0, POLISH_DAMPING_MIN);
                     break;
                 }

@@ -126,7 +126,8 @@ double om_g(om_problem *pb, double w, double *q, bool all_joints)
 }
 
 /* The lifted residual (shoulder, wrist, elbow) at x = (w1, w7, phi4) for
- * p_m = p_d + a(w1) + R delta(w7) (see srs.model_ik_lifted); writes the model IK into q. */
+ * p_m = p_d + a(w1) + R delta(w7) (see srs.model_ik_lifted); writes the model IK into q
+ * unless q is NULL (the residual alone, cheaper: no joint angles). */
 vec3 om_lifted_residual(om_problem *pb, vec3 x, double *q)
 {
     const om_solver_data *data = pb->s;
@@ -143,7 +144,7 @@ vec3 om_lifted_residual(om_problem *pb, vec3 x, double *q)
 }
 
 /* The lifted residual times prod_k (1 + 1 / |x - x_k|^2) over the known roots x_k
- * (deflation: Newton's method is repelled from them). known: n_known x 3. */
+ * (deflation: Newton's method is repelled from them). known: n_known x 3; q as om_lifted_residual. */
 vec3 om_deflated_residual(om_problem *pb, vec3 x, double *q, const double *known, int n_known)
 {
     vec3 F = om_lifted_residual(pb, x, q);

@@ -106,6 +106,7 @@ static int Solver_init(Solver *self, PyObject *args, PyObject *kwds) {
     s->lower = lower;
     s->upper = upper;
     s->scan_points = (int)scan_points;
+    s->trig_shared = om_trig_shared(s);
     if (s->scan_points < 8 || (s->mode == OM_CIRCLE && (dp_joint < 0 || dp_joint >= dof))) {
         PyErr_SetString(PyExc_ValueError, "malformed solver data (scan points or dp joint)");
         return -1;

@@ -217,7 +217,8 @@ bool om_srs_model_ik_at_reach(const double *P, const om_target *t, vec3 p, const
 }
 
 /* The model IK with q1, q7 and the elbow angle phi4 given (phi4 NaN: the elbow root in the ELBOW
- * branch); writes q and returns the (shoulder, wrist, elbow) residuals (model_ik_lifted). */
+ * branch); writes q (unless NULL: the residuals alone) and returns the (shoulder, wrist, elbow)
+ * residuals (model_ik_lifted). */
 vec3 om_srs_model_ik_lifted(const double *P, const om_target *t, vec3 p, const int64_t *signs, double q1, double q7,
                             double phi4, double *q)
 {
@@ -237,13 +238,19 @@ vec3 om_srs_model_ik_lifted(const double *P, const om_target *t, vec3 p, const i
         s4 = sin(phi4);
     }
     mat3 R03 = rotation_03_at(P, t, w, L2, c4, s4, (double)signs[1]);
-    vec3 sh = om_euler_zxzxz_given_first(m_mmt(m_mtm(m_load(P, SRS_R_PRE), R03), m_load(P, SRS_X3)), P[SRS_SIGMA1],
-                                         0.0, P[SRS_SIGMA2], q1 + th[0]);
+    mat3 shoulder = m_mmt(m_mtm(m_load(P, SRS_R_PRE), R03), m_load(P, SRS_X3));
     mat3 R04 = m_mm(R03, m_rz_cs_times(c4, s4, m_load(P, SRS_X4)));
-    mat3 M = m_mtm(R04, t->RE);
     /* The wrist's M^T = Rz(-phi7) Rx(-beta) Rz(-phi6) Rx(-alpha5) Rz(-phi5): phi7 comes first. */
-    vec3 wr = om_euler_zxzxz_given_first(m_transpose(M), -P[SRS_SIN_BETA], P[SRS_COS_BETA], -P[SRS_SIGMA5],
-                                         -(q7 + th[6]));
+    mat3 wrist = m_transpose(m_mtm(R04, t->RE));
+    double elbow_residual = x - cos(phi4 - P[SRS_PHI_STAR]);
+    if (!q) { /* the residuals alone: no joint angle (atan2) */
+        double a1 = q1 + th[0], a7 = -(q7 + th[6]);
+        return v3(om_euler_given_first_residual(shoulder, P[SRS_SIGMA1], 0.0, cos(a1), sin(a1)),
+                  om_euler_given_first_residual(wrist, -P[SRS_SIN_BETA], P[SRS_COS_BETA], cos(a7), sin(a7)),
+                  elbow_residual);
+    }
+    vec3 sh = om_euler_zxzxz_given_first(shoulder, P[SRS_SIGMA1], 0.0, P[SRS_SIGMA2], q1 + th[0]);
+    vec3 wr = om_euler_zxzxz_given_first(wrist, -P[SRS_SIN_BETA], P[SRS_COS_BETA], -P[SRS_SIGMA5], -(q7 + th[6]));
     q[0] = q1;
     q[1] = om_wrap(sh.x - th[1]);
     q[2] = om_wrap(sh.y - th[2]);
@@ -251,16 +258,15 @@ vec3 om_srs_model_ik_lifted(const double *P, const om_target *t, vec3 p, const i
     q[4] = om_wrap(-wr.y - th[4]);
     q[5] = om_wrap(-wr.x - th[5]);
     q[6] = q7;
-    return v3(sh.z, wr.z, x - cos(phi4 - P[SRS_PHI_STAR]));
+    return v3(sh.z, wr.z, elbow_residual);
 }
 
-/* R03 at joint vector q (_rotation_03). */
-static mat3 rotation_03(const double *P, const double *q)
+/* R03 for trig: cos and sin of phi_j = q_j + theta_j, j = 1..3 (_rotation_03). */
+static mat3 rotation_03(const double *P, const double *trig)
 {
-    const double *th = P + SRS_THETA;
-    mat3 R = m_mm(m_load(P, SRS_R_PRE), m_rz_times(q[0] + th[0], rx(P[SRS_SIGMA1])));
-    R = m_mm(R, m_rz_times(q[1] + th[1], rx(P[SRS_SIGMA2])));
-    return m_mm(R, m_rz_times(q[2] + th[2], m_load(P, SRS_X3)));
+    mat3 R = m_mm(m_load(P, SRS_R_PRE), m_rz_cs_times(trig[0], trig[1], rx(P[SRS_SIGMA1])));
+    R = m_mm(R, m_rz_cs_times(trig[2], trig[3], rx(P[SRS_SIGMA2])));
+    return m_mm(R, m_rz_cs_times(trig[4], trig[5], m_load(P, SRS_X3)));
 }
 
 /* The model's arm angle psi at joint vector q (arm_angle). */
@@ -273,9 +279,20 @@ double om_srs_arm_angle(const double *P, const double *q)
  * branch, so at a straight elbow (both branches) psi is the requested branch's. */
 double om_srs_arm_angle_in(const double *P, const double *q, double elbow)
 {
-    mat3 R03 = rotation_03(P, q);
-    double phi4 = q[3] + P[SRS_THETA + 3];
-    vec3 w_hat = v_unit(m_mv(R03, elbow_vector(P, cos(phi4), sin(phi4))));
+    double trig[8];
+    for (int j = 0; j < 4; j++) {
+        double phi = q[j] + P[SRS_THETA + j];
+        trig[2 * j] = cos(phi);
+        trig[2 * j + 1] = sin(phi);
+    }
+    return om_srs_arm_angle_trig(P, trig, elbow);
+}
+
+/* om_srs_arm_angle_in from trig: cos and sin of phi_j = q_j + theta_j, j = 1..4 (8 values). */
+double om_srs_arm_angle_trig(const double *P, const double *trig, double elbow)
+{
+    mat3 R03 = rotation_03(P, trig);
+    vec3 w_hat = v_unit(m_mv(R03, elbow_vector(P, trig[6], trig[7])));
     vec3 n, nw;
     om_srs_reference(P, w_hat, &n, &nw);
     vec3 b = v_scale(elbow * P[SRS_BEND], v_cross(m_col(R03, 2), w_hat));
@@ -291,8 +308,17 @@ void om_srs_branch_values(const double *P, const double *q, double *out)
     out[2] = sin(q[5] + th[5]);
 }
 
+/* om_srs_branch_values from trig: cos and sin of q_j + theta_j for j = 1..6, as the real FK
+ * computed them where they are the model's (om_trig_shared). */
+void om_srs_branch_values_trig(const double *P, const double *q, const double *trig, double *out)
+{
+    out[0] = trig[3];
+    out[1] = sin(q[3] + P[SRS_THETA + 3] - P[SRS_PHI_STAR]);
+    out[2] = trig[11];
+}
+
 /* psi at q of the S-R-S model with parameters P and DH table, and d psi / dq into grad[0..6]
- * (arm_angle_gradient_kernel; psi depends on joints 1-4 only). */
+ * unless grad is NULL (arm_angle_gradient_kernel; psi depends on joints 1-4 only). */
 double om_arm_angle_gradient(const double *P, const double *table, int n_rows, const double *q, double *grad)
 {
     /* Axis and origin of joints 1-6 in DH frame 0; S is the origin after joint 1's row, W the one
@@ -312,9 +338,9 @@ double om_arm_angle_gradient(const double *P, const double *table, int n_rows, c
     vec3 wb = v_cross(w_hat, b);
     double bb = v_dot(b, b);
     double twist = 1.0 / (1.0 + v_dot(up, w_hat));
-    for (int j = 0; j < 7; j++)
+    for (int j = 0; grad && j < 7; j++)
         grad[j] = 0.0;
-    for (int j = 0; j < 4; j++) {
+    for (int j = 0; grad && j < 4; j++) {
         vec3 zj = v_load(axes, 3 * j), oj = v_load(origins, 3 * j);
         vec3 dW = v_cross(zj, v_sub(W, oj));
         vec3 dw_hat = v_scale(1.0 / length, v_sub(dW, v_scale(v_dot(w_hat, dW), w_hat)));

@@ -12,10 +12,11 @@
 
 /* Damped Newton on the lifted system from x = (w1, w7, phi4), forward-difference Jacobian,
  * deflated by the first n_known rows of known (n x 3). Returns the max norm of the
- * (undeflated) residual at the end (inf if not finite); the end point in *x_end, q the model IK there. */
+ * (undeflated) residual at the end (inf if not finite); the end point in *x_end, q the model IK
+ * there (solved once, at the end: the iterations need the residual alone). */
 double om_newton(om_problem *pb, vec3 x, double *q, const double *known, int n_known, vec3 *x_end)
 {
-    vec3 F = om_deflated_residual(pb, x, q, known, n_known);
+    vec3 F = om_deflated_residual(pb, x, NULL, known, n_known);
     double r = om_max_norm(F);
     double eps = 1e-7;
     int slow = 0;
@@ -24,9 +25,9 @@ double om_newton(om_problem *pb, vec3 x, double *q, const double *known, int n_k
         if (!(r < INFINITY) || r < 1e-15 || slow == STALL)
             break;
         /* Rows of the Jacobian, then the step -J^-1 F by cofactors. */
-        vec3 F0 = om_deflated_residual(pb, v3(x.x + eps, x.y, x.z), q, known, n_known);
-        vec3 F1 = om_deflated_residual(pb, v3(x.x, x.y + eps, x.z), q, known, n_known);
-        vec3 F2 = om_deflated_residual(pb, v3(x.x, x.y, x.z + eps), q, known, n_known);
+        vec3 F0 = om_deflated_residual(pb, v3(x.x + eps, x.y, x.z), NULL, known, n_known);
+        vec3 F1 = om_deflated_residual(pb, v3(x.x, x.y + eps, x.z), NULL, known, n_known);
+        vec3 F2 = om_deflated_residual(pb, v3(x.x, x.y, x.z + eps), NULL, known, n_known);
         vec3 rows[3];
         for (int i = 0; i < 3; i++) {
             double Fi = v_get(F, i);
@@ -40,7 +41,7 @@ double om_newton(om_problem *pb, vec3 x, double *q, const double *known, int n_k
         double size = py_max(py_max(fabs(step.x), fabs(step.y)), fabs(step.z));
         double t = size < 0.5 ? 1.0 : 0.5 / size;
         while (t > MIN_STEP) {
-            Fn = om_deflated_residual(pb, v_add(x, v_scale(t, step)), q, known, n_known);
+            Fn = om_deflated_residual(pb, v_add(x, v_scale(t, step)), NULL, known, n_known);
             if (om_max_norm(Fn) < r) /* false for NaN */
                 break;
             t *= 0.5;

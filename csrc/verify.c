@@ -7,28 +7,60 @@
 #define MAX_VALUES 16       /* branch values of a family (3 today) */
 #define HUGE_HINT 1e4       /* rad: a revolute joint's hint beyond it is reduced exactly (remainder) first */
 
-bool om_in_configuration(const om_solver_data *s, const double *q, const int64_t *signs, const double *redundancy)
+/* om_in_configuration for a requested psi already in [-pi, pi] (remainder leaves it as it is);
+ * trig not NULL (s->trig_shared): the real FK's cos and sin of q_j + theta_j, which are the
+ * model's for joints 1-6, bit for bit, so they are not computed again. */
+static bool in_configuration(const om_solver_data *s, const double *q, const double *trig, const int64_t *signs,
+                             double psi_requested)
 {
     double values[MAX_VALUES];
-    om_branch_values(s->family, s->params, q, values);
+    if (trig)
+        om_srs_branch_values_trig(s->params, q, trig, values);
+    else
+        om_branch_values(s->family, s->params, q, values);
     for (int i = 0; i < s->n_signs; i++)
         if (!(values[i] * (double)signs[i] >= 0.0 || fabs(values[i]) <= OM_BRANCH_BAND)) /* NaN: not in it */
             return false;
     if (s->family == OM_SRS) { /* psi: the only redundancy value; in the requested ELBOW branch */
-        double psi = om_srs_arm_angle_in(s->params, q, (double)signs[SRS_ELBOW_SIGN]);
-        /* reduced exactly first: a huge requested psi (1e16) is one well-defined angle */
-        return fabs(om_wrap(psi - remainder(redundancy[0], 2.0 * OM_PI))) <= REDUNDANCY_TOL;
+        double elbow = (double)signs[SRS_ELBOW_SIGN];
+        double psi = trig ? om_srs_arm_angle_trig(s->params, trig, elbow) : om_srs_arm_angle_in(s->params, q, elbow);
+        return fabs(om_wrap(psi - psi_requested)) <= REDUNDANCY_TOL;
     }
     return true;
 }
 
+bool om_in_configuration(const om_solver_data *s, const double *q, const int64_t *signs, const double *redundancy)
+{
+    /* reduced exactly first: a huge requested psi (1e16) is one well-defined angle */
+    return in_configuration(s, q, NULL, signs, s->family == OM_SRS ? remainder(redundancy[0], 2.0 * OM_PI) : 0.0);
+}
+
+/* Whether the real chain's joints 1-6 turn by the S-R-S model's angles q_j + theta_j, bit for
+ * bit (revolute rows whose theta is the model's): then om_verify reuses the FK's cos and sin. */
+bool om_trig_shared(const om_solver_data *s)
+{
+    if (s->family != OM_SRS || s->dof != 7)
+        return false;
+    int j = 0;
+    for (int k = 0; k < s->n_real_rows && j < 6; k++) {
+        const double *row = s->real_table + 6 * k;
+        if (row[5] == 2.0)
+            continue;
+        if (row[5] != 0.0 || memcmp(&row[2], &s->params[SRS_THETA + j], sizeof(double)) != 0)
+            return false;
+        j++;
+    }
+    return j == 6;
+}
+
 /* Position and orientation error of the REAL arm at q (into *pos, *ori), and the
- * configuration check; returns whether q is accepted. */
+ * configuration check; returns whether q is accepted. The problem's redundancy is reduced
+ * (solve.c; a neighbour's in boundary.c is wrapped). */
 bool om_verify(om_problem *pb, const double *q, double *pos, double *ori)
 {
     const om_solver_data *data = pb->s;
-    double Rr[9], pr[3];
-    om_flange(data->real_table, data->n_real_rows, q, Rr, pr);
+    double Rr[9], pr[3], trig[2 * OM_MAX_DOF];
+    om_flange_trig(data->real_table, data->n_real_rows, q, Rr, pr, trig);
     vec3 d = v3(pr[0] - pb->p.x, pr[1] - pb->p.y, pr[2] - pb->p.z);
     double position = sqrt(v_dot(d, d));
     mat3 E = m_mtm(pb->t.R, m_load(Rr, 0));
@@ -40,7 +72,8 @@ bool om_verify(om_problem *pb, const double *q, double *pos, double *ori)
     if (ori)
         *ori = orientation;
     return position <= data->tol_pos && orientation <= data->tol_ori &&
-           om_in_configuration(data, q, pb->signs, pb->redundancy);
+           in_configuration(data, q, data->trig_shared ? trig : NULL, pb->signs,
+                            data->family == OM_SRS ? pb->redundancy[0] : 0.0);
 }
 
 /* Append q to roots (OM_MAX_ROOTS x dof) if the real arm verifies it and it is new;

@@ -134,6 +134,7 @@ BATCH_CHUNK = 64
 
 _pool: ThreadPoolExecutor | None = None
 _pool_lock = threading.Lock()
+_CORES = os.cpu_count() or 1  # read once: os.cpu_count() reads a file (~30 us a call on Linux)
 
 
 def run_rows(solve_range: Callable[[int, int], None], rows: int, threads: int | None = None) -> None:
@@ -144,7 +145,7 @@ def run_rows(solve_range: Callable[[int, int], None], rows: int, threads: int | 
     per core (at most that many in any case); 1: every row on the calling thread, in one call.
     """
     global _pool
-    cores = os.cpu_count() or 1
+    cores = _CORES
     workers = cores if threads is None else min(cores, threads)
     if rows <= BATCH_CHUNK or workers == 1:
         solve_range(0, rows)
