@@ -18,7 +18,7 @@ checked against MuJoCo's own FK of the project's MJCF of the arm (``om.arm_model
   c = configuration_of(q); ``solve`` without a hint, with the hint q + N(0, 0.05),
   ``solve_batch`` of all, ``solve_all`` (which must hold q). A false "no" is ok False, or an
   empty ``solve_all``.
-* **singular**: q moved (1-D Newton on the joint that moves it most, kept within limits) so
+* **singular**: q moved along one joint, within its limits, to a randomly drawn crossing so
   that a branch quantity (``om.om.families.branch_values``, index 0, 1, 2) is +-10**u, u
   uniform in [-14, -3]; and joints at their limits +- 1e-12. Then ``solve``, hinted ``solve``
   and ``solve_all`` in c = configuration_of(q). Also "the other side": the flipped sign where
@@ -32,8 +32,9 @@ checked against MuJoCo's own FK of the project's MJCF of the arm (``om.arm_model
   ``solve_batch`` equals per-row ``solve``.
 * **repeated**: the same questions (random, near-singular, other branches, hinted,
   ``solve_all``, batch rows) asked again in random order, each after another call.
-* **bad input**: items 7 and 9 of the issue; the exception raised, and whether it is an
-  ``om.OMError``.
+* **bad input** (:mod:`benchmarks.bad_input`): items 5 to 9 of the issue; the exception
+  raised and whether it is an ``om.OMError``; for the command, in a subprocess, the exit
+  status and the lines on stderr.
 
 An ok answer is **wrong** if MuJoCo's FK differs from T by more than 1e-10 m or 1e-10 rad,
 or q is not in the requested configuration (``OMSolver.holds``: signs equal, a branch quantity
@@ -51,7 +52,6 @@ import math
 import os
 import platform
 import sys
-import tempfile
 import threading
 import time
 import zlib
@@ -59,17 +59,18 @@ from collections import Counter
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import mujoco
 import numpy as np
 
 import om_redundant as om
+from om_redundant import ckernels
 from om_redundant.mujoco_io.mjcf import DEFAULT_SITE
 from om_redundant.om import system
 from om_redundant.om.families import branch_values, redundancy_values
 
+from .bad_input import BadInput, bad_input_table, run_bad_inputs
 from .report import RESULTS, cpu_model, write_page
 from .robots import random_joints
 
@@ -88,6 +89,7 @@ REDUNDANCY_TOLERANCE = 1e-9  # rad, modulo 2 pi
 ROOT_MATCH = 1e-6  # rad (or m): q among solve_all's roots
 HINT_NOISE = 0.05  # rad, standard deviation of the random class's hint
 DECADES = tuple(range(-14, -3))  # floor(log10 |branch quantity|) of the singular cases
+CROSSING_GRID = 64  # samples of a joint's range where the singular class looks for crossings
 TORUS_SOLVE_ALL_STRIDE = 20  # gen3, sawyer: solve_all on every 20th pose (5 ms a call)
 BATCH_CHUNK = 10_000
 THREADS = 4
@@ -166,6 +168,7 @@ class ArmResult:
     tallies: list[Tally] = field(default_factory=list)
     decades: dict[str, Counter] = field(default_factory=dict)  # column -> counts
     other_side: Counter = field(default_factory=Counter)
+    arm_angle_line: dict[str, Counter] = field(default_factory=dict)  # column -> counts
     failures: list[Failure] = field(default_factory=list)
     failure_counts: Counter = field(default_factory=Counter)
     seconds: float = 0.0
@@ -521,32 +524,113 @@ class ArmRun:
     def random_q(self, n: int) -> np.ndarray:
         return random_joints(self.arm, n, self.rng)
 
-    def boundary_q(self, index: int, value: float) -> tuple[np.ndarray, int] | None:
-        """A random q moved so that branch quantity ``index`` is ``value`` (1-D Newton on the
-        joint that moves it most, within the limits); None if that fails."""
+    def boundary_q(self, index: int, value: float) -> np.ndarray | None:
+        """A random q moved along one joint so that branch quantity ``index`` is ``value``.
+
+        The joints are tried in order of the quantity's slope at q. On each, b_index - value is
+        sampled at :data:`CROSSING_GRID` points over the joint's range (its limits; one turn
+        around q_j for an unlimited joint), one of the sign changes is drawn at random and
+        bisected down to adjacent doubles, and the end whose branch quantity has value's sign
+        and is nearest it is kept. So every crossing within the limits can be drawn (also
+        those next to a limit), and the branch quantity is value to its last bits (at 1e-14 a
+        joint near pi resolves it to 4 %: the decade table reads the value made). None if no
+        joint crosses value within its limits (a new random q is drawn then).
+        """
         q = self.random_q(1)[0]
-        h = 1e-6
         slopes = np.empty(self.arm.dof)
         for j in range(self.arm.dof):
             e = np.zeros(self.arm.dof)
-            e[j] = h
-            slopes[j] = (self.checker.branch(q + e)[index] - self.checker.branch(q - e)[index]) / (2 * h)
-        j = int(np.argmax(np.abs(slopes)))
-        if slopes[j] == 0.0:
-            return None
-        e = np.zeros(self.arm.dof)
-        e[j] = h
-        for _ in range(60):
-            r = self.checker.branch(q)[index] - value
-            if abs(r) <= 0.05 * abs(value):
-                return q, j
-            slope = (self.checker.branch(q + e)[index] - self.checker.branch(q - e)[index]) / (2 * h)
-            if slope == 0.0 or not math.isfinite(slope):
-                return None
-            q[j] -= r / slope
-            if not (self.arm.lower[j] <= q[j] <= self.arm.upper[j]) or not math.isfinite(q[j]):
-                return None
+            e[j] = 1e-6
+            slopes[j] = abs(self.checker.branch(q + e)[index] - self.checker.branch(q - e)[index])
+        for j in np.argsort(-slopes, kind="stable"):
+            if not slopes[j] > 0.0:
+                break
+            found = self._crossing(q, int(j), index, value)
+            if found is not None:
+                return found
         return None
+
+    def _crossing(self, q: np.ndarray, j: int, index: int, value: float) -> np.ndarray | None:
+        """q with joint j at a random crossing of b_index = value within j's range, or None."""
+        lo = self.arm.lower[j] if math.isfinite(self.arm.lower[j]) else q[j] - math.pi
+        hi = self.arm.upper[j] if math.isfinite(self.arm.upper[j]) else q[j] + math.pi
+        x = q.copy()
+
+        def f(t: float) -> float:
+            x[j] = t
+            return float(self.checker.branch(x)[index]) - value
+
+        grid = np.linspace(lo, hi, CROSSING_GRID)
+        fs = np.array([f(t) for t in grid])
+        cells = np.flatnonzero(np.sign(fs[:-1]) * np.sign(fs[1:]) <= 0.0)
+        if not len(cells):
+            return None
+        k = int(self.rng.choice(cells))
+        a, b, fa = float(grid[k]), float(grid[k + 1]), float(fs[k])
+        ends = [(abs(fa), a), (abs(float(fs[k + 1])), b)]
+        while True:
+            m = 0.5 * (a + b)
+            if not a < m < b:
+                break
+            fm = f(m)
+            ends.append((abs(fm), m))
+            if fm == 0.0:
+                break
+            if (fm < 0.0) == (fa < 0.0):
+                a, fa = m, fm
+            else:
+                b = m
+        for _, t in sorted(ends):
+            x[j] = t
+            if float(self.checker.branch(x)[index]) * value > 0.0:
+                return x
+        return None
+
+    def near_arm_angle_line(self, delta: float, side: float) -> np.ndarray | None:
+        """A random q (7-DOF) whose model's shoulder-wrist direction w_hat is at the angle delta
+        from the arm angle's singular half-line w_hat = -up (``side`` -1: the wrist centre
+        straight below the shoulder, where the reference n(w_hat) = R(up -> w_hat) r is
+        undefined) or from w_hat = +up (``side`` +1). Gauss-Newton on joints 2-7, within the
+        limits, for the part of w across up equal to delta |w| in a random direction; None if
+        it does not get within half of that.
+        """
+        up, across, w = self._arm_angle_frame()
+        q = self.random_q(1)[0]
+        angle = self.rng.uniform(0.0, TURN)
+        direction = np.array([math.cos(angle), math.sin(angle)])
+        steps = 1e-7 * np.eye(self.arm.dof)[1:]
+        for _ in range(40):
+            v = w(q)
+            length = float(np.linalg.norm(v))
+            miss = across @ v - delta * length * direction
+            if np.abs(miss).max() <= 0.5 * delta * length:
+                return q if side * float(v @ up) > 0.0 else None
+            J = (across @ (w(q + steps) - w(q - steps)).T) / 2e-7
+            q[1:] = np.clip(
+                q[1:] + np.linalg.lstsq(J, -miss, rcond=None)[0], self.arm.lower[1:], self.arm.upper[1:]
+            )
+        return None
+
+    def _arm_angle_frame(self) -> tuple[np.ndarray, np.ndarray, Callable[[np.ndarray], np.ndarray]]:
+        """The model's up axis, two unit vectors across it, and w(Q): W - S of the model at Q."""
+        model, P = self.solver.om.model, self.solver.om.params
+        up = P[ckernels.SRS_UP : ckernels.SRS_UP + 3]
+        e1 = np.cross(up, [1.0, 0.0, 0.0] if abs(up[0]) < 0.9 else [0.0, 1.0, 0.0])
+        e1 /= np.linalg.norm(e1)
+        wrist = P[ckernels.SRS_WRIST : ckernels.SRS_WRIST + 3]
+        shoulder = P[ckernels.SRS_SHOULDER : ckernels.SRS_SHOULDER + 3]
+
+        def w(Q: np.ndarray) -> np.ndarray:
+            T = model.fk(Q)
+            return T[..., :3, 3] + T[..., :3, :3] @ wrist - shoulder
+
+        return up, np.array([e1, np.cross(up, e1)]), w
+
+    def arm_angle_line_angle(self, q: np.ndarray, side: float) -> float:
+        """The angle of the model's w_hat at q from side * up."""
+        up, across, w = self._arm_angle_frame()
+        v = w(q)
+        return math.atan2(float(np.linalg.norm(across @ v)), side * float(v @ up))
 
     def at_limits(self) -> np.ndarray | None:
         """A random q with some limited joints at a limit +- 1e-12."""
@@ -610,8 +694,9 @@ def run_random(run: ArmRun, n: int) -> Tally:
     return t
 
 
-def run_singular(run: ArmRun, n: int, n_limits: int) -> Tally:
-    """Poses at 1e-14 ... 1e-3 from a branch boundary, and joints at their limits +- 1e-12."""
+def run_singular(run: ArmRun, n: int, n_limits: int, n_line: int = 0) -> Tally:
+    """Poses at 1e-14 ... 1e-3 from a branch boundary, joints at their limits +- 1e-12, and
+    (7-DOF) the wrist centre 1e-14 ... 1e-3 rad from the arm angle's singular half-line."""
     t = run.tally("singular")
     solver, start = run.solver, time.perf_counter()
     decades = run.result.decades
@@ -622,12 +707,11 @@ def run_singular(run: ArmRun, n: int, n_limits: int) -> Tally:
         tries += 1
         index = made % k
         value = float(run.rng.choice([-1.0, 1.0]) * 10.0 ** run.rng.uniform(-14.0, -3.0))
-        found = run.boundary_q(index, value)
-        if found is None:
-            t.notes["Newton failed (skipped)"] += 1
+        q = run.boundary_q(index, value)
+        if q is None:
+            t.notes["no crossing within the limits (a new random q)"] += 1
             continue
         made += 1
-        q, _ = found
         b = run.checker.branch(q)[index]
         column = str(math.floor(math.log10(abs(b)))) if b != 0.0 else "0"
         context = f"branch {solver.sign_names[index]} = {b:.3e}"
@@ -636,6 +720,8 @@ def run_singular(run: ArmRun, n: int, n_limits: int) -> Tally:
         decades[column]["any"] += bad
         if abs(b) <= BRANCH_BAND:
             other_side(run, t, q, index, other, context)
+    if made < n:
+        t.notes["branch poses short of the size asked"] += n - made
     for _ in range(n_limits):
         q = run.at_limits()
         if q is None:
@@ -646,6 +732,23 @@ def run_singular(run: ArmRun, n: int, n_limits: int) -> Tally:
         counts["any"] += singular_case(
             run, t, q, counts, f"joints {[int(j) + 1 for j in at]} at a limit +- 1e-12"
         )
+    made = tries = 0
+    while solver.redundancy_names and made < n_line and tries < 20 * n_line:
+        tries += 1
+        side = -1.0 if made % 4 else 1.0  # three of four below the shoulder
+        q = run.near_arm_angle_line(float(10.0 ** run.rng.uniform(-14.0, -3.0)), side)
+        if q is None:
+            continue
+        made += 1
+        delta = run.arm_angle_line_angle(q, side)
+        column = f"{'below' if side < 0 else 'above'} {math.floor(math.log10(delta)) if delta > 0 else '0'}"
+        counts = run.result.arm_angle_line.setdefault(column, Counter())
+        counts["cases"] += 1
+        counts["any"] += singular_case(
+            run, t, q, counts, f"wrist centre {delta:.3e} rad from straight {column.split()[0]} the shoulder"
+        )
+    if made < n_line:
+        t.notes["arm angle line poses short of the size asked"] += n_line - made
     t.seconds = time.perf_counter() - start
     return t
 
@@ -920,11 +1023,9 @@ def questions(
     while len(out) < n:
         q = None
         if singular and rng.random() < 0.3:
-            found = run.boundary_q(
+            q = run.boundary_q(
                 int(rng.integers(k)), float(rng.choice([-1.0, 1.0]) * 10.0 ** rng.uniform(-14, -3))
             )
-            if found is not None:
-                q = found[0]
         if q is None:
             q = run.random_q(1)[0]
         T = run.arm.fk(q)
@@ -1068,128 +1169,6 @@ def run_repeated(run: ArmRun, n: int) -> Tally:
 
 
 # ------------------------------------------------------------------------------------------
-# Bad input (issue items 7 and 9)
-
-
-@dataclass
-class BadInput:
-    label: str
-    raised: str  # exception type, or "accepted"
-    library: bool  # an om.OMError subclass
-    message: str
-    seconds: float
-
-
-def bad_inputs() -> list[tuple[str, Callable[[], Any]]]:
-    """(label, call) for each bad input of the issue's items 7 and 9."""
-    import mink
-
-    ur5e, panda = om.OMSolver("ur5e"), om.OMSolver("panda")
-    q6 = np.array([0.4, -1.1, 1.3, -1.2, -1.4, 0.3])
-    T = ur5e.arm.fk(q6)
-    c = ur5e.configuration_of(q6)
-    q7 = np.array([0.2, 0.4, -0.3, -1.8, 0.5, 1.9, 0.6])
-    T7 = panda.arm.fk(q7)
-    c7 = panda.configuration_of(q7)
-    gen3 = om.OMSolver("gen3")
-    T7g, c7g = gen3.arm.fk(q7), gen3.configuration_of(q7)
-    deep = Path(tempfile.mkdtemp(prefix="om_adversarial_")) / "deep.toml"
-    deep.write_text("x = " + "[" * 100_000 + "]" * 100_000 + "\n")
-    from om_redundant.tasks import ExactPoseTask
-
-    return [
-        ("solve_batch: empty batch (0, 4, 4)", lambda: ur5e.solve_batch(np.zeros((0, 4, 4)), c.signs)),
-        ("solve_batch: 3 sign rows for 2 poses", lambda: ur5e.solve_batch(np.stack([T, T]), [c.signs] * 3)),
-        ("solve: pose as str", lambda: ur5e.solve("T", c)),
-        ("solve: pose as dict", lambda: ur5e.solve({"T": T.tolist()}, c)),
-        ("solve_batch: list of mink.SE3", lambda: ur5e.solve_batch([mink.SE3.from_matrix(T)] * 2, c.signs)),
-        ("Configuration(signs=1)", lambda: om.Configuration(signs=1)),
-        ("Configuration(redundancy=0.5)", lambda: om.Configuration(c7.signs, redundancy=0.5)),
-        ("Configuration(redundancy=None)", lambda: om.Configuration(c7.signs, redundancy=None)),
-        ("Configuration(redundancy=(0.5+1j,))", lambda: om.Configuration(c7.signs, redundancy=(0.5 + 1j,))),
-        ("Configuration(redundancy='0.5')", lambda: om.Configuration(c7.signs, redundancy="0.5")),
-        ("Configuration(redundancy=('0.5',))", lambda: om.Configuration(c7.signs, redundancy=("0.5",))),
-        ("panda solve_batch(redundancy='0.5')", lambda: panda.solve_batch(T7[None], c7.signs, "0.5")),
-        ("Configuration.isclose(None)", lambda: c.isclose(None)),
-        ("OMSolver(None)", lambda: om.OMSolver(None)),
-        ("OMSolver(123)", lambda: om.OMSolver(123)),
-        ("load_arm(None)", lambda: om.load_arm(None)),
-        ("load_arm(deeply nested TOML)", lambda: om.load_arm(str(deep))),
-        ("OMSolver(position_tolerance='1e-10')", lambda: om.OMSolver("ur5e", position_tolerance="1e-10")),
-        ("OMSolver(orientation_tolerance='1e-9')", lambda: om.OMSolver("ur5e", orientation_tolerance="1e-9")),
-        ("OMSolver(scan_points='x')", lambda: om.OMSolver("ur5e", scan_points="x")),
-        ("OMSolver(scan_points=8.9)", lambda: om.OMSolver("ur5e", scan_points=8.9)),
-        (
-            "OMSolver('ur5e', scan_points=100000).solve",
-            lambda: om.OMSolver("ur5e", scan_points=100_000).solve(T, c),
-        ),
-        (
-            "OMSolver('gen3', scan_points=100000).solve_all",
-            lambda: (
-                f"{len(om.OMSolver('gen3', scan_points=100_000).solve_all(T7g, c7g))} roots "
-                f"(default scan_points: {len(om.OMSolver('gen3').solve_all(T7g, c7g))})"
-            ),
-        ),
-        ("RedundancyOptimizer(max_step='x')", lambda: om.RedundancyOptimizer(panda, max_step="x")),
-        ("RedundancyOptimizer(margin_weight='1')", lambda: om.RedundancyOptimizer(panda, margin_weight="1")),
-        ("Sphere(center='abc')", lambda: om.Sphere(center="abc", radius=0.1)),
-        ("ExactPoseTask(model='model')", lambda: ExactPoseTask(ur5e, "model", arm_configuration=c)),
-        ("solve: complex T", lambda: ur5e.solve(T.astype(complex), c)),
-        ("solve: complex T, imaginary part 1e-3", lambda: ur5e.solve(T + 1e-3j, c)),
-        ("Configuration((np.True_, 1, 1))", lambda: om.Configuration((np.True_, 1, 1))),
-        (
-            "solve_batch: signs [[np.True_, 1, 1]]",
-            lambda: ur5e.solve_batch(T[None], np.array([[True, 1, 1]], dtype=object)),
-        ),
-        ("ur5e solve_batch: (M, 1) redundancy", lambda: ur5e.solve_batch(T[None], c.signs, np.zeros((1, 1)))),
-    ]
-
-
-def summary(value: Any) -> str:
-    """A short description of what a call that should have raised returned."""
-    if isinstance(value, str):
-        return value
-    if isinstance(value, om.Solution):
-        return f"a Solution, status '{value.status}'"
-    if isinstance(value, om.BatchSolution):
-        return f"a BatchSolution, status {value.status}"
-    if isinstance(value, list):
-        return f"a list of {len(value)}"
-    return type(value).__name__
-
-
-#: Inputs of the list that the library accepts on purpose, with the documented rule.
-ACCEPTED_BY_DESIGN = {
-    "solve_batch: empty batch (0, 4, 4)": "an empty batch gives an empty BatchSolution, as numpy would",
-    "solve_batch: list of mink.SE3": "a list of mink.SE3 is a batch of poses",
-    "Configuration(redundancy=0.5)": "one number is one redundancy value, (0.5,)",
-    "Configuration(redundancy=None)": "None is no redundancy values",
-}
-
-
-def run_bad_inputs() -> list[BadInput]:
-    import warnings
-
-    found = []
-    for label, fn in bad_inputs():
-        start = time.perf_counter()
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            try:
-                value = fn()
-                raised, library, message = "accepted", False, f"returned {summary(value)}"
-            except Exception as error:
-                raised, library = type(error).__name__, isinstance(error, om.OMError)
-                message = str(error).splitlines()[0][:140] if str(error) else ""
-        found.append(BadInput(label, raised, library, message, time.perf_counter() - start))
-        print(
-            f"bad input: {label}: {raised}{' (om.OMError)' if library else ''} {found[-1].seconds:.2f} s",
-            flush=True,
-        )
-    return found
-
-
-# ------------------------------------------------------------------------------------------
 # Running and reporting
 
 
@@ -1198,6 +1177,7 @@ class Sizes:
     random: int
     singular: int
     limits: int
+    line: int
     huge: int
     layouts: int
     threads: int
@@ -1209,6 +1189,7 @@ class Sizes:
             random=n_random,
             singular=n_singular,
             limits=max(n_singular // 4, 1),
+            line=max(n_singular // 10, 1),
             huge=max(n_random // 50, 10),
             layouts=max(n_random // 1000, 5),
             threads=max(n_random // 50, 20),
@@ -1222,7 +1203,7 @@ def run_arm(name: str, sizes: Sizes, seed: int, classes: Sequence[str] = CLASSES
     run = ArmRun(name, seed)
     steps = {
         "random": lambda: run_random(run, sizes.random),
-        "singular": lambda: run_singular(run, sizes.singular, sizes.limits),
+        "singular": lambda: run_singular(run, sizes.singular, sizes.limits, sizes.line),
         "huge/tiny": lambda: run_huge_tiny(run, sizes.huge),
         "layouts": lambda: run_layouts(run, sizes.layouts),
         "threads": lambda: run_threads(run, sizes.threads),
@@ -1269,6 +1250,37 @@ def unlimited_prismatic_note(arms: Sequence[str]) -> list[str]:
         "translated poses are not unreachable, and at |p| = 1e120 m no float64 FK agrees with "
         "another to 1e-10 m (MuJoCo's rounding alone is about 1e-16 |p|): the position check there "
         f"is relative, {FK_ROUNDING:.1e} |p|.",
+    ]
+
+
+def arm_angle_line_table(results: list[ArmResult]) -> list[str]:
+    """The 7-DOF arms' poses next to the arm angle's singular half-line, per decade of delta."""
+    rows = [r for r in results if r.arm_angle_line]
+    if not rows:
+        return []
+    found = {k for r in rows for k in r.arm_angle_line}
+    columns = sorted(found, key=lambda k: (k.split()[0], int(k.split()[1])))
+    return [
+        "",
+        "## The arm angle's singular half-line",
+        "",
+        "7-DOF arms: the model's wrist centre at the angle delta from straight below the shoulder "
+        "(w_hat = -up, where psi's reference n(w_hat) = R(up -> w_hat) r is undefined) or straight above; "
+        "solve, hinted solve and solve_all in c = configuration_of(q) (counted in the singular class "
+        "above). Cell: poses with any false no, wrong ok or non-library exception / poses, by "
+        "floor(log10 delta).",
+        "",
+        _cells(["arm", *[f"{k.split()[0]} 1e{k.split()[1]}" for k in columns]]),
+        "|" + "---|" * (len(columns) + 1),
+        *(
+            _cells(
+                [
+                    r.arm,
+                    *[f"{d['any']}/{d['cases']}" if (d := r.arm_angle_line.get(k)) else "-" for k in columns],
+                ]
+            )
+            for r in rows
+        ),
     ]
 
 
@@ -1399,6 +1411,7 @@ def markdown(
             for d in r.decades.values():
                 total.update(d)
             out.append(_cells([r.arm, total["cases"], *[total[k] for k in kinds]]))
+        out += arm_angle_line_table(results)
         out += [
             "",
             "## The other side of the boundary",
@@ -1433,25 +1446,7 @@ def markdown(
                     ]
                 )
             )
-    if bad:
-        named = sum(b.library for b in bad)
-        by_design = sum(b.raised == "accepted" and b.label in ACCEPTED_BY_DESIGN for b in bad)
-        out += [
-            "",
-            "## Bad input (issue items 7 and 9)",
-            "",
-            f"{named} of {len(bad)} named by a library error (`om.OMError`); {by_design} accepted by a "
-            "documented rule (the message says which); the rest, if any, are failures.",
-            "",
-            _cells(["input", "raised", "om.OMError", "s", "message"]),
-            "|---|---|---|---|---|",
-        ]
-        for b in bad:
-            message = b.message.replace("|", "\\|")
-            verdict = "yes" if b.library else "**no**"
-            if b.raised == "accepted" and b.label in ACCEPTED_BY_DESIGN:
-                verdict, message = "by design", f"{ACCEPTED_BY_DESIGN[b.label]}; {message}"
-            out.append(_cells([b.label, b.raised, verdict, f"{b.seconds:.2f}", message]))
+    out += bad_input_table(bad)
     failures = [f for r in results for f in r.failures]
     counts = Counter()
     for r in results:

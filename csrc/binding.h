@@ -61,9 +61,20 @@ int om_solver_set_types(om_Solver *self, PyObject *solution_type, PyObject *conf
 void om_solver_clear_types(om_Solver *self);
 PyObject *om_solver_solve_pose(om_Solver *self, PyObject *const *args, Py_ssize_t nargs);
 
+/* self_motion.c: dq/dpsi of a 7-DOF arm at q into t (see there); false where psi does not
+ * move along the self-motion, |Dpsi . n| <= tol |Dpsi| |n| (or t is not finite). */
+bool om_self_motion_tangent(const om_solver_data *s, const double *q, double *t, double tol);
+/* x - 2 pi k in [-pi, pi), as numpy's remainder(x + pi, 2 pi) - pi rounds it (paths.py's _wrap). */
+double om_wrap_angle(double x);
+/* Whether q1 (at psi + d) continues the self-motion from q0 with tangent t (paths.py's
+ * Probe.continues): no joint moved more than 1 rad, and |dq - t d|_inf <= |dq|_inf / 2 + 1e-6;
+ * t NULL: only that no joint jumped. cyclic (NULL: none): joints compared modulo 2 pi. */
+bool om_continues(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic);
+
 extern PyTypeObject om_SolverType;        /* solver_type.c: Solver(SolverData) */
 extern PyMethodDef om_kernel_functions[]; /* functions.c: kinematics and closed forms */
 extern PyMethodDef om_tracking_functions[]; /* tracking.c: the redundancy optimiser's tracking step */
-extern PyMethodDef om_clearance_functions[]; /* clearance.c: distances of arm and obstacle geoms */
+extern PyMethodDef om_clearance_functions[];
+extern PyMethodDef om_follow_functions[]; /* follow.c: a solution path followed along psi */ /* clearance.c: distances of arm and obstacle geoms */
 
 #endif

@@ -55,18 +55,27 @@ bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori)
     if (branch == ELBOW_SIGN || ((branch != SHOULDER_SIGN || !on_axis) && !(nearest < SPLIT_NEAR)))
         return false;
     /* The wrist centre on joint 1's axis: the model's q1 is arbitrary there (atan2 of a
-     * vanishing pair), the real arm's is not: starts around the circle of q1. The wrist
-     * aligned (its middle joint m = dof - 2 at zero): the model splits q_{m-1} +- q_{m+1}
-     * by the previous q, the real arm's offsets do not: starts that turn q_{m-1} by a and
-     * q_{m+1} by -+a (the model's pose kept for either alignment of the two axes). */
+     * vanishing pair), the real arm's is not: starts around the circle of q1, each with the
+     * wrist as it was and flipped (q_{m-1} + pi, -q_m, q_{m+1} + pi: the same rotation of a
+     * spherical wrist, the other WRIST sign), since turning q1 by a turns the hand, and the
+     * wrist must turn it back, which from the kept wrist may lead the refinement across its
+     * singularity into the other WRIST sign (the Spherical arm's ARM = -3e-14 reproducer).
+     * The wrist aligned (its middle joint m = dof - 2 at zero): the model splits q_{m-1} +-
+     * q_{m+1} by the previous q, the real arm's offsets do not: starts that turn q_{m-1} by a
+     * and q_{m+1} by -+a (the model's pose kept for either alignment of the two axes). */
     bool shoulder = branch == SHOULDER_SIGN;
     int m = s->dof - 2;
     for (int k = 1; k < SPLIT_STARTS; k++) {
         double a = 2.0 * OM_PI * (double)k / (double)SPLIT_STARTS;
-        for (int turn = shoulder ? 0 : -1; turn <= (shoulder ? 0 : 1); turn += 2) {
+        for (int turn = -1; turn <= 1; turn += 2) {
             memcpy(q, start, (size_t)s->dof * sizeof(double));
             if (shoulder) {
                 q[0] += a;
+                if (turn > 0) { /* the flipped wrist */
+                    q[m - 1] += OM_PI;
+                    q[m] = -q[m];
+                    q[m + 1] += OM_PI;
+                }
             } else {
                 q[m - 1] += a;
                 q[m + 1] += (double)turn * a;

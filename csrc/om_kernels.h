@@ -219,6 +219,10 @@ double om_extremum(om_problem *pb, double a, double b, double x0, double sign, b
 /* circle.c: candidates into cands (capacity cap); returns the count. */
 int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool full_circle, double *q,
                          double *cands, int cap);
+/* wrist_offset.c: candidates in the bands around the singular wrist of an arm with a4 != 0. */
+#define OM_WRIST_BAND_CANDIDATES 256 /* room for them */
+int om_wrist_offset_candidates(om_problem *pb, double lo, double hi, bool full_circle, double *q, double *cands,
+                               int cap);
 
 /* torus.c */
 double om_newton(om_problem *pb, vec3 x, double *q, const double *known, int n_known, vec3 *x_end);

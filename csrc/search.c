@@ -23,7 +23,7 @@ int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre
         return om_torus_roots(pb, side > 4 ? side : 4, roots, centre, radius);
     }
     int J = data->dp_joint;
-    int cap = 8 * n_scan + 8;
+    int cap = 8 * n_scan + 8 + OM_WRIST_BAND_CANDIDATES;
     double *cands = malloc((size_t)cap * sizeof(double));
     if (!cands)
         return 0;
@@ -31,6 +31,8 @@ int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre
     double lo = full_circle ? -OM_PI : centre[J] - radius;
     double hi = full_circle ? OM_PI : centre[J] + radius;
     int n = om_circle_candidates(pb, lo, hi, n_scan, full_circle, q, cands, cap);
+    if (data->family != OM_SRS && data->params[SD_WRIST_OFFSET] != 0.0) /* a4 != 0: the singular wrist's bands */
+        n += om_wrist_offset_candidates(pb, lo, hi, full_circle, q, cands + n, cap - n);
     int count = 0;
     bool lifted = data->family == OM_SRS; /* 7-DOF: the lifted system; 6-DOF: the wrist with q6 given */
     for (int i = 0; i < n; i++) {

@@ -30,6 +30,7 @@ enum { O_PSI, O_STEP, O_CURVATURE, O_MARGIN, O_SINGULARITY, O_CLEARANCE, O_POS, 
 #define HALVINGS 6
 #define MIN_CURVATURE 1e-3
 #define MAX_CURVATURE 1e3
+#define SINGULAR_TANGENT 1e-9 /* |Dpsi . n| below this of |Dpsi| |n|: a fold, no step */
 
 typedef struct {
     int n;
@@ -42,55 +43,6 @@ typedef struct {
     const double *setup, *lower, *upper, *sing_joint, *sing_offset, *q_ref, *clear_d, *clear_g;
     double weight[3], floor[3], cap[3];
 } tracking;
-
-/* det of the n x n matrix A (row-major, destroyed) by elimination with partial pivoting. */
-static double det(double *A, int n) {
-    double d = 1.0;
-    for (int k = 0; k < n; k++) {
-        int p = k;
-        for (int i = k + 1; i < n; i++)
-            if (fabs(A[i * n + k]) > fabs(A[p * n + k])) p = i;
-        if (A[p * n + k] == 0.0) return 0.0;
-        if (p != k) {
-            for (int j = 0; j < n; j++) {
-                double t = A[k * n + j];
-                A[k * n + j] = A[p * n + j];
-                A[p * n + j] = t;
-            }
-            d = -d;
-        }
-        d *= A[k * n + k];
-        for (int i = k + 1; i < n; i++) {
-            double f = A[i * n + k] / A[k * n + k];
-            for (int j = k; j < n; j++) A[i * n + j] -= f * A[k * n + j];
-        }
-    }
-    return d;
-}
-
-/* dq/dpsi at q into t (dof = 7); false where psi does not move along the self-motion. */
-static bool tangent(const om_solver_data *s, const double *q, double *t) {
-    static const double eye[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-    double J[6 * 7], M[36], grad[7], n[7], scale = 0.0;
-    om_jacobian(s->real_table, s->n_real_rows, eye, eye, q, 7, J);
-    for (int c = 0; c < 7; c++) {
-        for (int i = 0; i < 6; i++)
-            for (int j = 0, k = 0; j < 7; j++)
-                if (j != c) M[i * 6 + k++] = J[i * 7 + j];
-        n[c] = (c % 2 ? -1.0 : 1.0) * det(M, 6);
-    }
-    om_arm_angle_gradient(s->params, s->model_table, s->n_model_rows, q, grad);
-    double dot = 0.0, gn = 0.0, nn = 0.0;
-    for (int i = 0; i < 7; i++) {
-        dot += grad[i] * n[i];
-        gn += grad[i] * grad[i];
-        nn += n[i] * n[i];
-    }
-    scale = sqrt(gn * nn);
-    if (!(fabs(dot) > 1e-9 * scale) || !isfinite(dot)) return false;
-    for (int i = 0; i < 7; i++) t[i] = n[i] / dot;
-    return true;
-}
 
 /* The pieces and their rates at q with tangent t. */
 static void pieces_at(const tracking *tr, const double *q, const double *t, pieces *P) {
@@ -157,26 +109,14 @@ static bool box_step(const tracking *tr, const pieces *P, double b, double radiu
     return true;
 }
 
-/* Whether q1 (at psi + d) continues the self-motion from q0 with tangent t (paths.py's test);
- * t NULL: only that no joint jumped. */
-static bool continues(int dof, const double *q0, const double *q1, const double *t, double d) {
-    double moved = 0.0, error = 0.0;
-    for (int i = 0; i < dof; i++) {
-        double m = q1[i] - q0[i];
-        moved = fmax(moved, fabs(m));
-        error = fmax(error, t ? fabs(m - t[i] * d) : 0.0);
-    }
-    return moved <= 1.0 && error <= 0.5 * moved + 1e-6;
-}
-
 static int track(const tracking *tr, const double *T, const int64_t *signs, const double *q_prev, double *q1,
                  double *out) {
     const om_solver_data *s = tr->s;
     int dof = s->dof;
     double psi = tr->setup[S_PSI], q0[OM_MAX_DOF], t0[OM_MAX_DOF], t1[OM_MAX_DOF];
     om_result r = om_solve_one(s, T, signs, &psi, q_prev, q0);
-    if (r.status != OM_OK || !continues(dof, q_prev, q0, NULL, 0.0)) return TR_NO_SOLUTION;
-    if (!tangent(s, q0, t0)) return TR_SINGULAR;
+    if (r.status != OM_OK || !om_continues(dof, q_prev, q0, NULL, 0.0, NULL)) return TR_NO_SOLUTION;
+    if (!om_self_motion_tangent(s, q0, t0, SINGULAR_TANGENT)) return TR_SINGULAR;
     static pieces P0, P1; /* (the GIL is held: one call at a time) */
     pieces_at(tr, q0, t0, &P0);
     double b = fmin(fmax(tr->setup[S_CURVATURE], MIN_CURVATURE), MAX_CURVATURE), tmax = 0.0;
@@ -187,7 +127,7 @@ static int track(const tracking *tr, const double *T, const int64_t *signs, cons
     for (int k = 0;; k++) {
         psi1 = psi + d;
         r = om_solve_one(s, T, signs, &psi1, q0, q1);
-        if (r.status == OM_OK && continues(dof, q0, q1, t0, d) && tangent(s, q1, t1)) break;
+        if (r.status == OM_OK && om_continues(dof, q0, q1, t0, d, NULL) && om_self_motion_tangent(s, q1, t1, SINGULAR_TANGENT)) break;
         if (k == HALVINGS) return TR_LOST;
         d /= 2.0;
     }

@@ -64,3 +64,35 @@ def test_the_check_catches_a_wrong_answer(name):
         run.flush()
         assert tally.ok == len(cases)
         assert tally.wrong_ok == len(cases) - 1, _failures(run)
+
+
+@pytest.mark.parametrize("name", om.arm_names())
+def test_boundary_poses_are_made_within_the_limits_at_the_value_asked(name):
+    """The singular class's poses: a branch quantity at +-1e-3 ... 1e-14, q within the limits,
+    on the first random q (the old 1-D Newton left the limits or diverged for 40-55 % of them,
+    redrawing q, which kept out the crossings next to a limit)."""
+    run = adv.ArmRun(name, seed=3)
+    k = len(run.solver.sign_names)
+    for i in range(36):
+        value = (-1.0) ** i * 10.0 ** -(3 + i % 12)
+        q = run.boundary_q(i % k, value)
+        assert q is not None, (i % k, value)
+        assert ((run.arm.lower <= q) & (q <= run.arm.upper)).all()
+        assert abs(run.checker.branch(q)[i % k] - value) <= 0.05 * abs(value)
+
+
+@pytest.mark.parametrize("name", ["panda", "xarm7", "sawyer"])
+def test_arm_angle_line_poses_are_made_at_the_angle_asked(name):
+    """The singular class's 7-DOF poses next to psi's singular half-line: the model's wrist
+    centre at delta (1e-4 ... 1e-12) from straight below (or above) the shoulder, within limits."""
+    run = adv.ArmRun(name, seed=5)
+    made = 0
+    for i in range(60):
+        delta, side = 10.0 ** -(4 + i % 9), -1.0 if i % 3 else 1.0
+        q = run.near_arm_angle_line(delta, side)
+        if q is None:
+            continue
+        made += 1
+        assert ((run.arm.lower <= q) & (q <= run.arm.upper)).all()
+        assert 0.4 * delta <= run.arm_angle_line_angle(q, side) <= 1.6 * delta
+    assert made >= 6

@@ -211,6 +211,31 @@ def random_chain_mjcf(seed: int, kinds: str) -> str:
     return ET.tostring(root, encoding="unicode")
 
 
+def test_a_root_found_twice_at_a_fold_is_returned_once():
+    """Menagerie's Piper (near the family) at a random q (benchmarks.menagerie's draw, row 386
+    of 600) where two of the near kernel's seeds polish to the same root 1.9e-8 rad apart (the
+    residual is flat near the fold): solve_all returned both copies; now the more accurate one
+    (near.ONE_ROOT, as the compiled solver's OM_ONE_ROOT)."""
+    arm = imported("piper")
+    solver = om.OMSolver(arm)
+    q = np.array(
+        [
+            -0.22937982107726818,
+            2.0660538554928696,
+            -2.6959803050728404,
+            -1.6783798057344002,
+            0.05393236479461438,
+            -1.8900275012471828,
+        ]
+    )
+    T = arm.fk(q)
+    roots = solver.solve_all(T, solver.configuration_of(q))
+    assert any(np.abs(wrap(r.q - q)).max() < 1e-7 for r in roots)
+    for i, a in enumerate(roots):
+        for b in roots[i + 1 :]:
+            assert np.abs(wrap(a.q - b.q)).max() >= 1e-6
+
+
 @pytest.mark.parametrize(
     "seed, kinds",
     [(0, "rrrrrr"), (1, "rpprrr"), (2, "rooprr"), (3, "rcirrr"), (4, "rnrnrr"), (5, "srsrs"), (6, "rpnoci")],

@@ -12,7 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
-from benchmarks.near_family import bent, fixed_row_between, reversed_joint
+from benchmarks.near_family import bent, cases, fixed_row_between, reversed_joint
 from om_redundant import ckernels
 from om_redundant.om.nominal import NEAR_TWIST, nominal_arm
 from tests.conftest import EXACT, check_exact, random_q, well_conditioned, wrap
@@ -179,3 +179,75 @@ def test_targets_at_a_branch_boundary_of_a_near_arm(branch, q):
     ckernels.branch_values(solver.om.family, solver.om.params, solver.flip * q, values)
     assert abs(values[branch]) < 5e-3
     check_exact(solver, q, strict=True)
+
+
+@pytest.mark.parametrize(
+    ("name", "q"),
+    [
+        (
+            "ur5e-bent-1e-05",
+            [
+                -4.582842622328123,
+                -4.860425891087513,
+                0.13977119647540492,
+                0.8638580690895061,
+                0.2348096306534755,
+                1.4215676905502797,
+            ],
+        ),
+        (
+            "ur5e-bent-0.0001",
+            [
+                -3.8085543980652363,
+                -6.170986027399788,
+                3.137129346204689,
+                -2.938373093094823,
+                5.884473904863648,
+                -0.02431357390123523,
+            ],
+        ),
+        (
+            "ur5e-bent-0.001",
+            [
+                0.97625557877857627,
+                1.2847763412734015,
+                2.9054042941004865,
+                -5.3750772125506669,
+                -3.4150823280931775e-4,
+                3.0674216817078852,
+            ],
+        ),
+        (
+            "ur5e-bent-0.001",
+            [
+                5.190723627211129,
+                4.150721825171179,
+                1.4972916465879504,
+                2.646798314502308,
+                -6.1862165885094935,
+                -0.8073034706757785,
+            ],
+        ),
+        (
+            "ur5e-reversed-3",
+            [
+                6.181410753669776,
+                -5.461800289662156,
+                -1.8996899902268356,
+                1.180034261919607,
+                -3.0724521323575242,
+                5.896422989931524,
+            ],
+        ),
+    ],
+)
+def test_a_polish_that_stalls_beside_a_fold(name, q):
+    """benchmarks.near_family's arms (seed 0) at q it missed: no seed polishes to q, those
+    nearest it stall where the exact chain's Jacobian is nearly singular (a fold of the real
+    arm's roots that the nominal arm lacks, as on the Doosan M1013 at the shoulder's). The
+    roots of the fold's quadratic from the stalled point (NearKernel._fold_partners) seed both
+    roots of the pair; before, q was not among solve_all."""
+    arm = next(arm for arm in cases(0) if arm.name == name)
+    solver = om.OMSolver(arm)
+    assert solver.nominal is not None
+    check_exact(solver, np.array(q), strict=True)

@@ -64,31 +64,48 @@ def test_batched_tangents_equal_the_single_ones(seed, name):
 def test_constraint_bounds_bound_the_feasibility_functions_and_their_rates(seed, name, count):
     """Objective.constraint_bounds: the margin entries are the margin feasibility functions
     and their rates' sizes exactly; the clearance entries are at most the clearance
-    functions, and their rate bounds (Clearance.pair_bounds) at least their rates."""
+    functions and equal where below 0 (where the cell test takes them as the functions),
+    and their rate bounds (Clearance.pair_bounds) at least their rates' sizes; for all rows
+    at once the same as row by row."""
     optimizer = optimizer_of(name, count)
     objective, solver = optimizer.objective, optimizer.solver
-    for row in joints(optimizer, seed, 10):
-        t = om.self_motion_tangent(solver, row)
-        groups = [g.along(t) for g in objective.groups(row, jacobian=True)]
-        values, rates, exact = objective.constraint_bounds(row, t, objective.evaluation(groups))
+    q = joints(optimizer, seed, 10)
+    tangents = self_motion_tangents(solver, q)
+    distances = objective.clearance.distances(q)
+    batch = objective.constraint_bounds(q, tangents, distances)
+    for k, row in enumerate(q):
+        groups = [g.along(tangents[k]) for g in objective.groups(row, jacobian=True)]
+        values, rates = (
+            x[0] for x in objective.constraint_bounds(row[None], tangents[k][None], distances[[k]])
+        )
+        np.testing.assert_array_equal(values, batch[0][k])
+        np.testing.assert_array_equal(rates, batch[1][k])
         margin, clearance = (g.constraints() for g in groups[:2])
-        np.testing.assert_allclose(values[exact], margin[0], rtol=0, atol=1e-15)
-        np.testing.assert_allclose(rates[exact], np.abs(margin[1]), rtol=1e-15, atol=0)
-        assert (clearance[0] >= values[~exact] - 1e-12).all()
-        assert (np.abs(clearance[1]) <= rates[~exact] * (1 + 1e-9) + 1e-12).all()
+        limited = len(margin[0])
+        np.testing.assert_allclose(values[:limited], margin[0], rtol=0, atol=1e-15)
+        np.testing.assert_allclose(rates[:limited], np.abs(margin[1]), rtol=1e-15, atol=0)
+        assert (clearance[0] >= values[limited:] - 1e-12).all()
+        below = values[limited:] < 0.0
+        np.testing.assert_allclose(values[limited:][below], clearance[0][below], rtol=0, atol=1e-12)
+        assert (np.abs(clearance[1]) <= rates[limited:] * (1 + 1e-9) + 1e-12).all()
 
 
 @settings(max_examples=6, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1), name=st.sampled_from(list(HOMES)))
 def test_pair_bounds_bound_the_distances_and_their_rates(seed, name):
     """Clearance.pair_bounds: below every pair's exact distance, and above the size of its
-    derivative along any joint velocity (a random one and the self-motion)."""
+    derivative along any joint velocity (a random one and the self-motion); for all rows at
+    once exactly as row by row."""
     optimizer = optimizer_of(name, 3)
     clearance = optimizer.objective.clearance
     rng = np.random.default_rng(seed)
-    for row in joints(optimizer, seed, 10):
+    q = joints(optimizer, seed, 10)
+    rates = rng.normal(size=q.shape)
+    batch = clearance.pair_bounds(q, rates)
+    for k, row in enumerate(q):
         d, grad = clearance.distances_and_gradients(row)
-        for rate in (rng.normal(size=len(row)), om.self_motion_tangent(optimizer.solver, row)[:, 0]):
+        np.testing.assert_array_equal(clearance.pair_bounds(row, rates[k]), [b[k] for b in batch])
+        for rate in (rates[k], om.self_motion_tangent(optimizer.solver, row)[:, 0]):
             lower, speed = clearance.pair_bounds(row, rate)
             assert (np.minimum(lower, clearance.distmax) <= d + 1e-12).all()  # d: at most distmax
             assert (np.abs(grad @ rate) <= speed * (1 + 1e-9) + 1e-12).all()

@@ -359,3 +359,51 @@ def test_boundary_reproducers_are_solved(case):
     assert roots
     for root in roots:
         _assert_exact(solver, root.q, T, c)
+
+
+@pytest.mark.xfail(
+    strict=True, reason="open: the circle search near psi's singular half-line (issue 18, item 3)"
+)
+def test_the_wrist_centre_straight_below_the_shoulder_is_solved():
+    """xArm7 with the model's wrist centre 4.7e-5 rad from straight below the shoulder (where
+    psi's reference n(w_hat) = R(up -> w_hat) r is undefined), q within limits, T = FK(q): every
+    configuration answers "unreachable" (python -m benchmarks.adversarial, the arm angle's
+    singular half-line). Passes when the search handles it."""
+    xarm7 = _solver("xarm7")
+    q = np.array(
+        [
+            1.3722485557456992,
+            1.5276914922859586,
+            1.4734833117554082e-05,
+            0.30781086335256397,
+            0.004579983274622279,
+            2.6015994113708873,
+            -2.444255838945311,
+        ]
+    )
+    T, c = xarm7.arm.fk(q), xarm7.configuration_of(q)
+    assert xarm7.solve(T, c).ok
+
+
+def test_a_shoulder_start_may_need_the_flipped_wrist():
+    """Spherical arm, wrist centre 3.2e-14 from joint 1's axis (ARM = -3.238e-14), the wrist
+    at q5 = -3.08 (python -m benchmarks.adversarial, singular class, seed 0): solve said "no
+    solution in this configuration" and solve_all was empty, as every start of q1 kept the
+    model's wrist, from which the refinement crossed into the other WRIST sign. Each start
+    of q1 now also tries the flipped wrist."""
+    spherical = _solver("spherical")
+    q = np.array(
+        [
+            -2.931959233290574,
+            -0.9377734131111519,
+            -0.011006323352723703,
+            2.517356508937157,
+            -3.0817076239277292,
+            2.53662045303836,
+        ]
+    )
+    T, c = spherical.arm.fk(q), spherical.configuration_of(q)
+    sol = spherical.solve(T, c)
+    assert sol.ok and np.abs(spherical.arm.fk(sol.q) - T).max() < 1e-10 and spherical.holds(sol.q, c)
+    roots = spherical.solve_all(T, c)
+    assert roots and all(np.abs(spherical.arm.fk(r.q) - T).max() < 1e-10 for r in roots)

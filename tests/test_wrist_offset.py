@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import functools
 
 import numpy as np
 import pytest
@@ -81,6 +82,83 @@ def test_an_inner_fold_of_a_near_arm_is_solved():
     q = np.array([1.1850, -2.0369, -0.6810, 4.9043, -3.4286, 1.5480])
     assert np.linalg.svd(arm.jacobian(q), compute_uv=False)[-1] < 1e-4
     check_exact(solver, q, strict=True)
+
+
+@pytest.mark.parametrize(
+    "q",
+    [
+        [
+            -5.4629771446174766,
+            4.2095890664587658,
+            -0.74255773747212173,
+            -2.1922600807444299,
+            -1.8530416858418177e-3,
+            3.5335467014825577,
+        ],
+        [
+            4.1455391977553235,
+            0.30029330676969046,
+            2.8671506651523146,
+            2.721976349656507,
+            3.1418255177434355,
+            5.558870545992829,
+        ],
+        [
+            0.75113424000742413,
+            -6.0127621125296624,
+            0.39370318309646457,
+            4.4836991459160638,
+            -1.3804595638713365e-3,
+            -1.4662528016092553,
+        ],
+        [
+            -1.9845450090520238,
+            4.0740510683838425,
+            -0.29833270002929213,
+            3.641329298322751,
+            3.1425235835183423,
+            5.060774448800198,
+        ],
+        [
+            5.3521282893960924,
+            2.7230052744771323,
+            -2.6590719889540089,
+            5.5347068569879339,
+            -3.6619624474883211e-3,
+            1.6118339416996541,
+        ],
+    ],
+)
+def test_a_wrist_offset_at_a_nearly_singular_wrist(q):
+    """q5 within 4e-3 rad of the wrist singularity (joints 4 and 6 parallel) with a4 = 0.074:
+    z4 turns through nearly pi over a few 1e-3 rad of q1, and the target's island of reach on
+    the circle is narrower than the scan's cells. Each was missed (no root, or only the other
+    one) before the bands around the singular w (wrist_offset.c, om_wrist_offset_candidates)."""
+    solver = om.OMSolver(with_offsets(om.load_arm("ur5e"), joint3={"a": 0.074}))
+    assert solver.nominal is None
+    check_exact(solver, np.array(q), strict=True)
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    a4=st.sampled_from([0.074, -0.05, 0.12]),
+    q5=st.floats(-6.0, -1.0).map(lambda e: 10.0**e),
+    side=st.sampled_from([1.0, -1.0]),
+    flip=st.sampled_from([0.0, np.pi]),
+    q_seed=st.integers(0, 2**32 - 1),
+)
+def test_every_root_is_found_at_a_nearly_singular_wrist(a4, q5, side, flip, q_seed):
+    """|q5 - 0 or pi| from 1e-6 to 0.1 rad (joints 4 and 6 nearly parallel) on an exact UR5e
+    with a wrist offset a4: q is among solve_all (the bands around the singular w)."""
+    solver = _offset_solver(a4)
+    q = random_q(solver.arm, 1, np.random.default_rng(q_seed))[0]
+    q[4] = flip + side * q5
+    check_exact(solver, q, strict=True)
+
+
+@functools.cache
+def _offset_solver(a4: float) -> om.OMSolver:
+    return om.OMSolver(with_offsets(om.load_arm("ur5e"), joint3={"a": a4}))
 
 
 def test_a_wrist_offset_whose_joint_4_turns_with_joint_2_is_refused():

@@ -37,6 +37,9 @@ POLISH_ITERATIONS = 30
 FIXED_POINT_STEPS = 20
 #: Joint-space distance (rad) under which two roots are one (csrc's OM_SAME_ROOT).
 SAME_ROOT = 1e-9
+#: Joint-space distance (rad) under which two verified roots are one root found twice near a
+#: fold (where the residual is flat to second order), the more accurate kept (csrc's OM_ONE_ROOT).
+ONE_ROOT = 1e-6
 #: Fractions by which a target the seeds do not lead to is pulled toward the base (the real
 #: arm may reach a little farther than the nominal one).
 PULL = (1e-4, 1e-3, 1e-2)
@@ -58,6 +61,9 @@ FOLD = 1e-2
 PARTNER_STEPS = (1.0, 0.5, 2.0)
 #: Step (rad) of the second difference along the fold's null direction.
 FOLD_STEP = 1e-4
+#: Position error (m) of a stalled polish under which it is taken as beside a fold of the
+#: real arm's roots (:meth:`NearKernel._refined`).
+STALL = 1e-2
 
 
 class NearKernel:
@@ -209,10 +215,15 @@ class NearKernel:
         return [roots[r].copy() for r in range(n)], evals
 
     def _refined(
-        self, T, R, p, psi, seed, signs, redundancy, anchors: list | None = None
+        self, T, R, p, psi, seed, signs, redundancy, anchors: list | None = None, fold: bool = True
     ) -> tuple[np.ndarray, float, float] | None:
         """The seed (nominal coordinates) polished on the exact chain and verified; None if not
-        (an exact root in another configuration is appended to ``anchors``, if given)."""
+        (an exact root in another configuration is appended to ``anchors``, if given).
+
+        A polish that stalls short of T where the exact chain's Jacobian is nearly singular
+        stopped at a fold of the real arm's roots (the residual's valley along the fold): the
+        roots of the fold's quadratic (:meth:`_fold_partners`) seed the pair on both sides of
+        it, one in each neighbouring configuration."""
         if seed is None:
             return None
         q = np.ascontiguousarray(seed, dtype=np.float64).copy()
@@ -224,17 +235,27 @@ class NearKernel:
             return q_real, pos, ori
         if exact and anchors is not None:
             anchors.append(q)
+        if exact or not fold or pos > STALL:
+            return None
+        for start in self._fold_partners(T, q, psi):
+            found = self._refined(T, R, p, psi, start, signs, redundancy, anchors, fold=False)
+            if found is not None:
+                return found
         return None
 
     def _fold_partners(self, T, q, psi) -> list[np.ndarray]:
-        r"""Seeds for the fold partner of the exact root q (nominal coordinates).
+        r"""Seeds for the roots of T at a fold next to q (nominal coordinates): q an exact root
+        (its partner), or where a polish stalled beside the fold (both roots).
 
         Where the exact chain's Jacobian J (with the arm angle's gradient on a 7-DOF arm) is
         nearly singular, :math:`J v = \sigma u` with :math:`\sigma` < :data:`FOLD`, two roots of
-        (T, psi) meet along v: :math:`u \cdot e(q + t v) \approx \sigma t + c t^2 / 2`, e the
-        pose (and psi) error, so the partner lies near :math:`t = -2 \sigma / c`, c from a
-        second difference. The nominal arm may have neither root of the pair, or only one
-        (its fold lies elsewhere): the partner is the one no nominal seed leads to."""
+        (T, psi) meet along v: :math:`u \cdot e(q + t v) \approx r + \sigma t + c t^2 / 2`, e
+        the pose (and psi) error, :math:`r = u \cdot e(q)` (zero at a root), c from a second
+        difference; the roots t of the quadratic (at an exact root, 0 and its partner
+        :math:`-2 \sigma / c`) are tried at multiples :data:`PARTNER_STEPS`; where it has none
+        (a real minimum of the residual, or a curvature the second difference misjudges), its
+        vertex :math:`-\sigma / c`. The nominal arm may have neither root of the pair, or
+        only one (its fold lies elsewhere): these are the roots no nominal seed leads to."""
         J = self._exact.jacobian(q)
         if self._P is not None:
             grad = np.empty(self._real.dof)
@@ -245,11 +266,14 @@ class NearKernel:
         if sigma >= FOLD:
             return []
         h = FOLD_STEP
-        c = u @ (
-            self._error(T, q + h * v, psi) - 2.0 * self._error(T, q, psi) + self._error(T, q - h * v, psi)
-        )
-        t = -2.0 * sigma / (c / h**2) if c != 0.0 else np.nan
-        return [q + k * t * v for k in PARTNER_STEPS] if np.isfinite(t) else []
+        e = self._error(T, q, psi)
+        r = float(u @ e)
+        c = u @ (self._error(T, q + h * v, psi) - 2.0 * e + self._error(T, q - h * v, psi)) / h**2
+        if c == 0.0 or not np.isfinite(c):
+            return []
+        disc = sigma**2 - 2.0 * c * r
+        ts = [-sigma / c] if disc < 0.0 else [(-sigma + s * np.sqrt(disc)) / c for s in (1.0, -1.0)]
+        return [q + k * t * v for t in ts if abs(t) > SAME_ROOT for k in PARTNER_STEPS]
 
     def _error(self, T, q, psi) -> np.ndarray:
         """The exact chain's pose error at q (nominal coordinates) against T: position, the
@@ -310,9 +334,16 @@ class NearKernel:
 
 
 def _add_root(roots: list, found: tuple[np.ndarray, float, float] | None) -> None:
-    """Append a verified root unless it is None or one already found (within SAME_ROOT)."""
-    if found is not None and all(_distance(found[0], q) >= SAME_ROOT for q, _, _ in roots):
-        roots.append(found)
+    """Append a verified root unless it is None or one already found: within ONE_ROOT of a
+    kept root it is that root, found twice, and the copy with the smaller pose error stays."""
+    if found is None:
+        return
+    for r, (q, pos, ori) in enumerate(roots):
+        if _distance(found[0], q) < ONE_ROOT:
+            if found[1] + found[2] < pos + ori:
+                roots[r] = found
+            return
+    roots.append(found)
 
 
 def _wrap(angle):

@@ -6,11 +6,12 @@
 shows (:mod:`.sweep`)."""
 
 from .arm_angle import arm_angle_and_gradient
-from .clearance import Box, Capsule, Clearance, Sphere
+from .clearance import Clearance
 from .intervals import PsiInterval
 from .objective import Evaluation, Objective, joint_margins
 from .optimizer import RedundancyChoice, RedundancyOptimizer
 from .self_motion import self_motion_tangent
+from .shapes import Box, Capsule, Sphere
 from .singularity import Singularity
 from .sweep import (
     BranchSweep,

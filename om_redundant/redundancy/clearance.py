@@ -35,8 +35,7 @@ MuJoCo model that contains the arm, its joints found by name with an optional pr
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
-from typing import Any, NamedTuple
+from typing import NamedTuple
 
 import mujoco
 import numpy as np
@@ -46,112 +45,10 @@ from ..exceptions import InvalidInput
 from ..kinematics.arm import Arm
 from ..mujoco_io.arm_in_model import ArmJoints
 from ..mujoco_io.mjcf import arm_mjcf
-from ..validation import as_instance, as_joint_vector, as_pose, as_positive, as_vector
+from ..validation import as_instance, as_joint_vector, as_positive
+from .shapes import Shape, model_geoms, shape_geoms
 
 DEFAULT_DISTMAX = 1.0  # m: pairs farther apart report this distance
-
-_PRIMITIVES = {
-    mujoco.mjtGeom.mjGEOM_PLANE,
-    mujoco.mjtGeom.mjGEOM_SPHERE,
-    mujoco.mjtGeom.mjGEOM_CAPSULE,
-    mujoco.mjtGeom.mjGEOM_ELLIPSOID,
-    mujoco.mjtGeom.mjGEOM_CYLINDER,
-    mujoco.mjtGeom.mjGEOM_BOX,
-}
-
-
-@dataclass(frozen=True)
-class _Geom:
-    """A world geom to add to a MuJoCo spec: type, size, position, quaternion (w, x, y, z)."""
-
-    name: str
-    type: mujoco.mjtGeom
-    size: np.ndarray
-    pos: np.ndarray
-    quat: np.ndarray
-
-
-@dataclass(frozen=True, eq=False)
-class Sphere:
-    """A sphere obstacle, in the arm's root frame (metres).
-
-    Attributes:
-        center: (3,) centre.
-        radius: Radius, > 0.
-        name: Geom name; default ``"obstacle<k>"`` for the k-th obstacle.
-    """
-
-    center: Any
-    radius: float
-    name: str = ""
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "center", as_vector(self.center, 3, "Sphere center"))
-        object.__setattr__(self, "radius", as_positive(self.radius, "Sphere radius"))
-
-    def _geom(self, name: str) -> _Geom:
-        size = np.array([self.radius, 0.0, 0.0])
-        return _Geom(name, mujoco.mjtGeom.mjGEOM_SPHERE, size, self.center, np.array([1.0, 0, 0, 0]))
-
-
-@dataclass(frozen=True, eq=False)
-class Capsule:
-    """A capsule obstacle: the points within ``radius`` of the segment ``start``-``end``.
-
-    Attributes:
-        start, end: (3,) ends of the axis in the arm's root frame, distinct.
-        radius: Radius, > 0.
-        name: Geom name; default ``"obstacle<k>"``.
-    """
-
-    start: Any
-    end: Any
-    radius: float
-    name: str = ""
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "start", as_vector(self.start, 3, "Capsule start"))
-        object.__setattr__(self, "end", as_vector(self.end, 3, "Capsule end"))
-        object.__setattr__(self, "radius", as_positive(self.radius, "Capsule radius"))
-        if np.linalg.norm(self.end - self.start) == 0.0:
-            raise InvalidInput("Capsule start and end coincide; use a Sphere")
-
-    def _geom(self, name: str) -> _Geom:
-        axis = self.end - self.start
-        quat = np.empty(4)
-        mujoco.mju_quatZ2Vec(quat, axis)
-        size = np.array([self.radius, np.linalg.norm(axis) / 2.0, 0.0])
-        return _Geom(name, mujoco.mjtGeom.mjGEOM_CAPSULE, size, (self.start + self.end) / 2.0, quat)
-
-
-@dataclass(frozen=True, eq=False)
-class Box:
-    """A box obstacle.
-
-    Attributes:
-        half_sizes: (3,) half edge lengths along the box's own axes, each > 0.
-        pose: Pose of the box centre in the arm's root frame: 4x4 or ``mink.SE3``.
-        name: Geom name; default ``"obstacle<k>"``.
-    """
-
-    half_sizes: Any
-    pose: Any = field(default_factory=lambda: np.eye(4))
-    name: str = ""
-
-    def __post_init__(self) -> None:
-        half = as_vector(self.half_sizes, 3, "Box half_sizes")
-        if not (half > 0.0).all():
-            raise InvalidInput(f"Box half_sizes must be positive, got {half.tolist()}")
-        object.__setattr__(self, "half_sizes", half)
-        object.__setattr__(self, "pose", as_pose(self.pose, "Box pose"))
-
-    def _geom(self, name: str) -> _Geom:
-        quat = np.empty(4)
-        mujoco.mju_mat2Quat(quat, np.ascontiguousarray(self.pose[:3, :3]).ravel())
-        return _Geom(name, mujoco.mjtGeom.mjGEOM_BOX, self.half_sizes, self.pose[:3, 3], quat)
-
-
-Shape = Sphere | Capsule | Box
 
 
 class Clearance:
@@ -240,7 +137,7 @@ class Clearance:
             distmax: As in :class:`Clearance`.
         """
         as_instance(arm, Arm, "arm")
-        geoms = _model_geoms(obstacles) if isinstance(obstacles, mujoco.MjModel) else _shape_geoms(obstacles)
+        geoms = model_geoms(obstacles) if isinstance(obstacles, mujoco.MjModel) else shape_geoms(obstacles)
         spec = mujoco.MjSpec.from_string(arm_mjcf(arm, radius=radius))
         taken = {g.name for g in spec.geoms}
         for g in geoms:
@@ -251,7 +148,11 @@ class Clearance:
         return cls(spec.compile(), arm, [g.name for g in geoms], distmax=distmax)
 
     def distances(self, q: np.ndarray) -> np.ndarray:
-        """Signed distance d_k(q) of every pair (m), in the order of :attr:`pairs`."""
+        """Signed distance d_k(q) of every pair (m), in the order of :attr:`pairs`: (P,) for
+        a joint vector q (dof,), (M, P) for the rows of q (M, dof)."""
+        if np.ndim(q) == 2:
+            rows = [self._evaluate(row, gradient=False)[0] for row in q]
+            return np.array(rows).reshape(len(q), len(self._pairs))
         return self._evaluate(q, gradient=False)[0]
 
     def minimum(self, q: np.ndarray) -> float:
@@ -289,8 +190,7 @@ class Clearance:
         Returns:
             (M,) clearances in metres (at most ``distmax``).
         """
-        q = as_joint_vector(q, self._dof).reshape(-1, self._dof)
-        return np.array([self._evaluate(row, gradient=False)[0].min() for row in q])
+        return self.distances(as_joint_vector(q, self._dof).reshape(-1, self._dof)).min(axis=1)
 
     def pair_bounds(self, q: np.ndarray, rate: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         r"""Bounds of every pair's distance and of its rate when the joints move at ``rate``.
@@ -299,32 +199,39 @@ class Clearance:
         The rate :math:`|\dot d_k| = |n_k \cdot v(p_A)|` is at most the speed of the arm
         geom's fastest point, :math:`|v(x_g)| + |\omega_b|\, r_g` (x_g its centre, r_g its
         bounding radius, :math:`v, \omega` its body's velocity, MuJoCo's ``mj_comVel`` with
-        the joint velocities ``rate``).
+        the joint velocities ``rate``). Rows of q are placed one by one, the bounds computed
+        for all rows at once (the same values as row by row).
 
         Args:
-            q: (dof,) joint vector.
-            rate: (dof,) joint velocities, e.g. dq/dpsi.
+            q: (dof,) joint vector, or (M, dof) joint vectors.
+            rate: Joint velocities of q's shape, e.g. dq/dpsi.
 
         Returns:
-            (P,) lower bounds of d_k (m) and (P,) upper bounds of |dd_k/dt|, in the order of
-            :attr:`pairs`.
+            Lower bounds of d_k (m) and upper bounds of :math:`|\dot d_k|`, (P,) for one
+            joint vector, (M, P) for M, in the order of :attr:`pairs`.
         """
-        q = as_joint_vector(q, self._dof, stack=False)
-        rate = as_joint_vector(rate, self._dof, "rate", stack=False)
+        single = np.ndim(q) == 1
+        q = as_joint_vector(q, self._dof).reshape(-1, self._dof)
+        rate = as_joint_vector(rate, self._dof, "rate").reshape(-1, self._dof)
+        if rate.shape != q.shape:
+            raise InvalidInput(f"rate must have q's shape {q.shape}, got {rate.shape}")
         m, d = self.model, self._data
-        d.qpos[self._qpos] = q
+        xpos, cvel = np.empty((len(q), m.ngeom, 3)), np.empty((len(q), m.nbody, 6))
+        com = np.empty((len(q), m.nbody, 3))
         d.qvel[:] = 0.0
-        d.qvel[self._dofs] = rate
-        mujoco.mj_kinematics(m, d)
-        mujoco.mj_comPos(m, d)
-        mujoco.mj_comVel(m, d)
-        centre = d.geom_xpos[self._pairs[:, 0]]
-        lower = np.linalg.norm(centre - d.geom_xpos[self._pairs[:, 1]], axis=1) - self._geoms.bounds
-        omega, linear = d.cvel[self._bodies, :3], d.cvel[self._bodies, 3:]
-        r = centre - d.subtree_com[self._roots]
-        velocity = linear + np.cross(omega, r)
-        speed = np.linalg.norm(velocity, axis=1) + np.linalg.norm(omega, axis=1) * self._arm_rbound
-        return lower, speed
+        for row, rates, x, v, c in zip(q, rate, xpos, cvel, com, strict=True):
+            d.qpos[self._qpos] = row
+            d.qvel[self._dofs] = rates
+            mujoco.mj_kinematics(m, d)
+            mujoco.mj_comPos(m, d)
+            mujoco.mj_comVel(m, d)
+            x[:], v[:], c[:] = d.geom_xpos, d.cvel, d.subtree_com
+        centre = xpos[:, self._pairs[:, 0]]
+        lower = np.linalg.norm(centre - xpos[:, self._pairs[:, 1]], axis=-1) - self._geoms.bounds
+        omega, linear = cvel[:, self._bodies, :3], cvel[:, self._bodies, 3:]
+        velocity = linear + np.cross(omega, centre - com[:, self._roots])
+        speed = np.linalg.norm(velocity, axis=-1) + np.linalg.norm(omega, axis=-1) * self._arm_rbound
+        return (lower[0], speed[0]) if single else (lower, speed)
 
     def _evaluate(
         self, q: np.ndarray, gradient: bool, reach: float | None = None
@@ -410,42 +317,6 @@ def _geom_cores(model: mujoco.MjModel, pairs: np.ndarray, rbound: np.ndarray, jo
         model.jnt_type[joints.joint_ids] == mujoco.mjtJoint.mjJNT_SLIDE,
         moves,
     )
-
-
-def _shape_geoms(obstacles: Sequence[Shape]) -> list[_Geom]:
-    if isinstance(obstacles, Sphere | Capsule | Box):
-        obstacles = [obstacles]
-    as_instance(obstacles, Sequence, "obstacles", "shapes (Sphere, Capsule, Box) or a MuJoCo model")
-    geoms = []
-    for k, shape in enumerate(obstacles):
-        if isinstance(shape, mujoco.MjModel):
-            geoms += _model_geoms(shape)
-            continue
-        if not isinstance(shape, Sphere | Capsule | Box):
-            raise InvalidInput(
-                f"obstacle {k} must be a Sphere, Capsule or Box (or pass a MuJoCo model), "
-                f"got {type(shape).__name__}"
-            )
-        geoms.append(shape._geom(shape.name or f"obstacle{k}"))
-    return geoms
-
-
-def _model_geoms(model: mujoco.MjModel) -> list[_Geom]:
-    data = mujoco.MjData(model)
-    mujoco.mj_kinematics(model, data)
-    geoms = []
-    for g in range(model.ngeom):
-        kind = mujoco.mjtGeom(model.geom_type[g])
-        name = model.geom(g).name or f"obstacle{g}"
-        if kind not in _PRIMITIVES:
-            raise InvalidInput(
-                f"obstacle geom '{name}' is a {kind.name[7:].lower()}; only primitive geoms are copied "
-                "(for others, put the arm in your model and use Clearance(model, arm, names))"
-            )
-        quat = np.empty(4)
-        mujoco.mju_mat2Quat(quat, data.geom_xmat[g])
-        geoms.append(_Geom(name, kind, model.geom_size[g].copy(), data.geom_xpos[g].copy(), quat))
-    return geoms
 
 
 def _find(model: mujoco.MjModel, kind: mujoco.mjtObj, name: str, what: str) -> int:

@@ -34,7 +34,7 @@ import scipy.sparse as sp
 
 from .box_qp import maximise_1d
 from .objective import Group
-from .paths import Point, Probe
+from .probe import Point, Probe
 
 STEP_TOLERANCE = 1e-9  # rad: the climb stops when the step is this small
 GAIN_TOLERANCE = 1e-12  # the climb stops when the model promises no more

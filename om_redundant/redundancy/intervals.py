@@ -7,7 +7,7 @@ neighbouring samples of the path, extended at each end to the boundary. Where th
 next sample is infeasible, the boundary is the root of the continuous feasibility slack
 (:class:`~om_redundant.redundancy.objective.Evaluation`) along the path between the two, by the
 Illinois method (:func:`refine_end`); where the path itself ends, its end; both to
-:data:`~om_redundant.redundancy.paths.END_TOLERANCE`.
+:data:`~om_redundant.redundancy.probe.END_TOLERANCE`.
 
 So a psi can lie in two intervals of one branch (two solution paths), and a solution that
 no path reaches (a path shorter than the sweep's grid step that meets no other) is not
@@ -21,7 +21,8 @@ import math
 from dataclasses import dataclass, replace
 
 from .arm_angle import wrap_psi
-from .paths import END_TOLERANCE, Path, Point, Probe
+from .paths import Path
+from .probe import END_TOLERANCE, Point, Probe
 
 SLACK_TOLERANCE = 1e-12  # a refined end whose feasibility slack is this small is on the boundary
 _MAX_REFINE = 60  # Illinois steps per refined end
@@ -113,8 +114,8 @@ def refine_end(probe: Probe, inside: Point, outside: Point) -> Point:
 
     The feasibility slack changes sign between them; the Illinois method (regula falsi that
     halves the slack kept at a stale end) finds the root, each trial followed from the inner
-    end (:meth:`~om_redundant.redundancy.paths.Probe.follow`). It stops when the bracket is narrower
-    than :data:`~om_redundant.redundancy.paths.END_TOLERANCE` or the inner slack below
+    end (:meth:`~om_redundant.redundancy.probe.Probe.follow`). It stops when the bracket is narrower
+    than :data:`~om_redundant.redundancy.probe.END_TOLERANCE` or the inner slack below
     :data:`SLACK_TOLERANCE`.
     """
     a, fa, b, fb = inside, inside.evaluation.slack, outside.psi, outside.evaluation.slack

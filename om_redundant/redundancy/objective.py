@@ -237,10 +237,16 @@ class Objective:
         """f(q), M(q), D(q) and the feasibility slack."""
         return self.evaluation(self.groups(as_joint_vector(q, self._dof)))
 
-    def evaluations(self, q: np.ndarray) -> list[Evaluation]:
+    def evaluations(self, q: np.ndarray, distances: np.ndarray | None = None) -> list[Evaluation]:
         """:meth:`evaluate` at every row of q (M, dof), vectorised over the rows (the same
-        values: each group's minimum is the minimum of its pieces, D(q) by
-        :meth:`Clearance.minima <om_redundant.Clearance.minima>`)."""
+        values: each group's minimum is the minimum of its pieces, D(q) the smallest of
+        :meth:`Clearance.distances <om_redundant.Clearance.distances>`, as
+        :meth:`Clearance.minima <om_redundant.Clearance.minima>` gives it).
+
+        Args:
+            q: (M, dof) joint vectors.
+            distances: (M, P) the rows' pair distances if already computed (with obstacles).
+        """
         q = as_joint_vector(q, self._dof).reshape(-1, self._dof)
         inf = np.full(len(q), math.inf)
         terms, slacks = [np.zeros(len(q))], [inf]
@@ -251,7 +257,9 @@ class Objective:
             terms.append(self.margin_weight * margin)
             slacks.append(margin - 0.0)
         if self.clearance is not None:
-            scaled = self.clearance.minima(q) / self.clearance_cap
+            if distances is None:
+                distances = self.clearance.distances(q)
+            scaled = distances.min(axis=1) / self.clearance_cap
             terms.append(self.clearance_weight * np.minimum(1.0, scaled))
             slacks.append(scaled - self.min_clearance / self.clearance_cap)
             clearance = scaled * self.clearance_cap
@@ -269,33 +277,37 @@ class Objective:
         ]
 
     def constraint_bounds(
-        self, q: np.ndarray, tangent: np.ndarray, evaluation: Evaluation
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        r"""The feasibility functions of :meth:`Group.constraints` at q, without the
-        clearances' gradients: bounds for a cheap test of a cell of a solution path.
+        self, q: np.ndarray, tangent: np.ndarray, distances: np.ndarray | None
+    ) -> tuple[np.ndarray, np.ndarray]:
+        r"""The feasibility functions of :meth:`Group.constraints` at joint vectors q and
+        bounds of their rates, without the clearances' gradients: for a cheap test of a cell
+        of a solution path.
 
-        Each limited joint's margin function :math:`1 - |q_i - c_i|/h_i` exactly, with its
-        rate's size :math:`|t_i|/h_i` (t = dq/dpsi, ``tangent`` (dof, 1)); then, with
-        obstacles, per pair a lower bound of its clearance function,
-        :math:`(\min(\max(D, \underline{d}_k), 2 d_{cap}) - d_{min})/d_{cap}` (the pieces
-        beyond 2 d_cap report 2 d_cap), and a bound on its rate, from
+        Each limited joint's margin function :math:`1 - |q_i - c_i|/h_i`, with its rate's
+        size :math:`|t_i|/h_i` (t = dq/dpsi); then, with obstacles, per pair
+        :math:`(\min(d_k, 2 d_{cap}) - d_{min})/d_{cap}` (the clearance piece where it is
+        below 2 d_cap, a lower bound of it beyond: there the pieces report 2 d_cap, or
+        d_k when every pair is that far), and a bound on its rate's size from
         :meth:`Clearance.pair_bounds <om_redundant.Clearance.pair_bounds>`.
 
+        Args:
+            q: (M, dof) joint vectors.
+            tangent: (M, dof, 1) their dq/dpsi.
+            distances: (M, P) the pairs' distances d_k(q) (m), :meth:`Clearance.distances
+                <om_redundant.Clearance.distances>`; None without obstacles.
+
         Returns:
-            (values, rate bounds, exact): exact marks the entries that are the functions
-            themselves (the margins), not lower bounds.
+            (values (M, n), rate bounds (M, n)).
         """
         lim = self._limited
-        values = [np.minimum(*_limit_distances(q[lim], self._lower, self._upper, self._half))]
-        rates, exact = [np.abs(tangent[lim, 0]) / self._half], [np.ones(len(lim), dtype=bool)]
+        values = [np.minimum(*_limit_distances(q[:, lim], self._lower, self._upper, self._half))]
+        rates = [np.abs(tangent[:, lim, 0]) / self._half]
         if self.clearance is not None:
             cap = self.clearance_cap
-            lower, speed = self.clearance.pair_bounds(q, tangent[:, 0])
-            near = np.minimum(np.maximum(lower, evaluation.clearance), self.clearance_reach)
-            values.append((near - self.min_clearance) / cap)
+            speed = self.clearance.pair_bounds(q, tangent[:, :, 0])[1]
+            values.append((np.minimum(distances, self.clearance_reach) - self.min_clearance) / cap)
             rates.append(speed / cap)
-            exact.append(np.zeros(len(lower), dtype=bool))
-        return np.concatenate(values), np.concatenate(rates), np.concatenate(exact)
+        return np.concatenate(values, axis=1), np.concatenate(rates, axis=1)
 
     def evaluation(self, groups: list[Group]) -> Evaluation:
         """f, M, D, the slack and S from the groups at one joint vector."""

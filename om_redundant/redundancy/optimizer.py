@@ -45,7 +45,7 @@ from ..om.configuration import Configuration
 from ..om.solver import OMSolver, Solution
 from ..validation import as_count, as_instance, as_number, as_pose, as_signs
 from .arm_angle import wrap_psi
-from .clearance import DEFAULT_DISTMAX, Clearance, Shape
+from .clearance import DEFAULT_DISTMAX, Clearance
 from .climb import maximise
 from .intervals import PsiInterval, Run, feasible_runs
 from .objective import (
@@ -55,7 +55,9 @@ from .objective import (
     Objective,
     check_weights,
 )
-from .paths import END_TOLERANCE, Path, Point, Probe, sweep_circle, sweep_window
+from .paths import Path, sweep_circle, sweep_window
+from .probe import END_TOLERANCE, Point, Probe
+from .shapes import Shape
 from .singularity import Singularity
 from .tracking import Tracker
 

@@ -39,14 +39,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..om.configuration import Configuration
-from ..om.solver import OMSolver, Solution
-from .objective import Evaluation, Group, Objective
-from .self_motion import self_motion_tangent, self_motion_tangents
+from ..om.solver import OMSolver
+from .objective import Objective
+from .probe import END_TOLERANCE, JUMP, SAME, Point, Probe
 
-JUMP = 1.0  # rad, max-norm joint step between neighbouring solutions of one path
-END_TOLERANCE = 1e-9  # rad: a path whose following step falls below this has ended
 FINE_STEP = 0.25  # rad: cells in which a joint moves further get samples in between
-_SAME = 1e-6  # rad, max-norm: two solutions at one psi this close are one
 _MODEL_POINTS = 256  # points of a cell where the Hermite models are checked
 _MAX_INSERTED = 64  # exact samples inserted per cell
 _T = np.arange(1, _MODEL_POINTS + 1) / (_MODEL_POINTS + 1)
@@ -55,75 +52,6 @@ _HERMITE = np.array(
 )
 _TURN = 2.0 * math.pi
 _BOUND_SLACK = 1e-9  # covers the rounding of the Hermite models in the bounds of _quiet
-
-
-class _Terms:
-    """The objective at a point, computed when first asked for (a path's following steps
-    need only the joints and the tangent): the evaluation, then the groups with their rates.
-    Shared by the copies of a point at other representatives of psi."""
-
-    def __init__(
-        self, objective: Objective, q: np.ndarray, tangent: np.ndarray, evaluation: Evaluation | None
-    ):
-        self.objective, self.q, self.tangent = objective, q, tangent
-        self.evaluation, self.groups, self.bounds = evaluation, None, None
-
-    def get_evaluation(self) -> Evaluation:
-        if self.evaluation is None:
-            self.evaluation = self.objective.evaluation(self.objective.groups(self.q))
-        return self.evaluation
-
-    def get_bounds(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """:meth:`~om_redundant.redundancy.objective.Objective.constraint_bounds` here."""
-        if self.bounds is None:
-            self.bounds = self.objective.constraint_bounds(self.q, self.tangent, self.get_evaluation())
-        return self.bounds
-
-    def get_groups(self) -> list[Group]:
-        if self.groups is None:
-            self.groups = [g.along(self.tangent) for g in self.objective.groups(self.q, jacobian=True)]
-            if self.evaluation is None:
-                self.evaluation = self.objective.evaluation(self.groups)
-        return self.groups
-
-
-@dataclass(frozen=True, eq=False)
-class Point:
-    """An exact solution on a branch, its objective, and their rates along psi.
-
-    Attributes:
-        psi: The redundancy value (rad); an (r,) array for r > 1 redundancy variables.
-        q: The joints.
-        tangent: dq/dpsi (dof, r).
-        terms: The objective at q, evaluated when first asked for (:attr:`evaluation`,
-            :attr:`groups`).
-        solution: The solver's Solution of it, when solved singly (its q may differ from
-            ``q`` by turns of revolute joints); None for a batch sample.
-    """
-
-    psi: float | np.ndarray
-    q: np.ndarray
-    tangent: np.ndarray
-    terms: _Terms
-    solution: Solution | None = None
-
-    @property
-    def evaluation(self) -> Evaluation:
-        """The objective at q."""
-        return self.terms.get_evaluation()
-
-    @property
-    def groups(self) -> list[Group]:
-        """The objective's groups at q, their jacobians by psi (p_g, r)."""
-        return self.terms.get_groups()
-
-    def pieces(self) -> tuple[np.ndarray, np.ndarray]:
-        """The feasibility functions g_j (all >= 0 iff feasible; see
-        :meth:`~om_redundant.redundancy.objective.Group.constraints`) and dg_j/dpsi."""
-        if not self.groups:
-            return np.zeros(0), np.zeros(0)
-        g, dg = zip(*(group.constraints() for group in self.groups), strict=True)
-        return np.concatenate(g), np.concatenate(dg)
 
 
 @dataclass(eq=False)
@@ -139,112 +67,6 @@ class Path:
 
     points: list[Point]
     turns: int = 0
-
-
-class Probe:
-    """Exact solutions along one branch at one pose, and their objective.
-
-    Args:
-        solver, objective, T, signs: The solver, the objective, the pose and the branch.
-        wrapped: Revolute joints modulo 2 pi, at the representative nearest mid-range (for
-            the feasible intervals); False keeps them as solved (for tracking).
-    """
-
-    def __init__(
-        self,
-        solver: OMSolver,
-        objective: Objective,
-        T: np.ndarray,
-        signs: tuple[int, ...],
-        wrapped: bool = True,
-    ):
-        self.solver, self.objective, self.T, self.signs = solver, objective, T, signs
-        arm = solver.arm
-        self._cyclic = arm.revolute & wrapped
-        self._centred = self._cyclic & np.isfinite(arm.lower) & np.isfinite(arm.upper)
-        self._centre = np.where(self._centred, (arm.lower + arm.upper) / 2.0, 0.0)
-
-    def step(self, a: np.ndarray, b: np.ndarray) -> float:
-        """The largest joint step between joint vectors a and b."""
-        return float(np.abs(self._delta(a, b)).max())
-
-    def _delta(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        d = b - a
-        return np.where(self._cyclic, _wrap(d), d)
-
-    def point(self, psi: float | np.ndarray, q: np.ndarray, solution: Solution | None = None) -> Point:
-        """The point of solution q at psi, q at its representative (see the class)."""
-        return self._point(psi, self._represent(q), solution)
-
-    def _represent(self, q: np.ndarray) -> np.ndarray:
-        return np.where(self._centred, self._centre + _wrap(q - self._centre), q)
-
-    def _point(self, psi: float | np.ndarray, q: np.ndarray, solution: Solution | None) -> Point:
-        tangent = self_motion_tangent(self.solver, q)
-        return Point(psi, q, tangent, _Terms(self.objective, q, tangent, None), solution)
-
-    def points(self, psi: np.ndarray, q: np.ndarray) -> list[Point]:
-        """:meth:`point` for every psi and row of q (M, dof) of a 7-DOF arm, the tangents and
-        the evaluations computed for all rows at once."""
-        q = self._represent(q)
-        tangents = self_motion_tangents(self.solver, q)
-        bad = ~np.isfinite(tangents).all(axis=(1, 2))
-        if bad.any():
-            self_motion_tangent(self.solver, q[np.argmax(bad)])  # raises SingularSelfMotion
-        evaluations = self.objective.evaluations(q)
-        return [
-            Point(float(x), row, t, _Terms(self.objective, row, t, ev))
-            for x, row, t, ev in zip(psi, q, tangents, evaluations, strict=True)
-        ]
-
-    def at(self, psi: float | np.ndarray, hint: np.ndarray) -> Point | None:
-        """The solution at psi nearest ``hint``, if there is one."""
-        sol = self._solve(psi, hint)
-        return self.point(psi, sol.q, sol) if sol.ok else None
-
-    def _solve(self, psi: float | np.ndarray, hint: np.ndarray) -> Solution:
-        return self.solver.solve(self.T, Configuration(self.signs, tuple(np.atleast_1d(psi))), q_hint=hint)
-
-    def continues(self, point: Point, other: Point) -> bool:
-        r"""Whether ``other`` continues point's path: its joints moved at most :data:`JUMP` and
-        as the path's tangent predicts to first order,
-        :math:`|\Delta q - (dq/d\psi)\,\Delta\psi|_\infty \le \frac12 |\Delta q|_\infty`. (A
-        solution on another path, however near, is off by the paths' separation, which no
-        shorter step of psi shrinks.)"""
-        return self._continues(point, other.psi, other.q)
-
-    def _continues(self, point: Point, psi: float | np.ndarray, q: np.ndarray) -> bool:
-        moved = self._delta(point.q, q)
-        error = moved - point.tangent @ np.atleast_1d(psi - point.psi)
-        return np.abs(moved).max() <= JUMP and np.abs(error).max() <= 0.5 * np.abs(moved).max() + _SAME
-
-    def next(self, point: Point, psi: float | np.ndarray) -> Point | None:
-        """The solution at psi nearest point, if it continues point's path (the objective
-        evaluated only then)."""
-        sol = self._solve(psi, point.q)
-        if not sol.ok:
-            return None
-        q = self._represent(sol.q)
-        return self._point(psi, q, sol) if self._continues(point, psi, q) else None
-
-    def follow(self, start: Point, psi: float) -> tuple[Point, bool]:
-        """Continue start's path towards psi (module docstring).
-
-        Returns:
-            The point reached and whether it is at psi. When the path ends on the way the
-            point is its end, to :data:`END_TOLERANCE`.
-        """
-        point, step = start, psi - start.psi
-        while point.psi != psi:
-            if abs(step) < END_TOLERANCE:
-                return point, False
-            x = psi if abs(psi - point.psi) <= abs(step) else point.psi + step
-            nxt = self.next(point, x)
-            if nxt is None:
-                step /= 2.0
-            else:
-                point, step = nxt, 2.0 * step
-        return point, True
 
 
 def sweep_circle(
@@ -269,7 +91,7 @@ def sweep_circle(
             found = [samples[k]] if k in samples else []
             others = solver.solve_all(T, Configuration(signs, (psi[k],))) if found and several else []
             for sol in others:
-                if all(probe.step(sol.q, f.q) > _SAME for f in found):
+                if all(probe.step(sol.q, f.q) > SAME for f in found):
                     found.append(probe.point(psi[k], sol.q, sol))
             roots.append(found)
         swept.append([_with_hidden(probe, path) for path in _link(probe, psi, roots)])
@@ -372,7 +194,7 @@ def _back_to_end(probe: Probe, psi: np.ndarray, points: list[Point], k: int) -> 
 def _same(probe: Probe, point: Point, candidates: list[Point]) -> int | None:
     """The index of the candidate that is the same solution as point, if any."""
     steps = [probe.step(point.q, c.q) for c in candidates]
-    return int(np.argmin(steps)) if steps and min(steps) <= _SAME else None
+    return int(np.argmin(steps)) if steps and min(steps) <= SAME else None
 
 
 def _with_hidden(probe: Probe, path: Path) -> Path:
@@ -380,9 +202,13 @@ def _with_hidden(probe: Probe, path: Path) -> Path:
     ends = list(path.points)
     if path.turns:  # the closing cell, to the first sample a loop later
         ends.append(replace(ends[0], psi=ends[0].psi + _TURN * path.turns))
+    # the cells that need no look inside, all at once: no joint moves more than FINE_STEP
+    # and the cheap bounds show the models quiet (_hidden's own first test, vectorised)
+    q = np.array([p.q for p in ends])
+    calm = (probe.steps(q[:-1], q[1:]) <= FINE_STEP) & _quiet(ends[:-1], ends[1:])
     filled = [ends[0]]
-    for a, b in itertools.pairwise(ends):
-        filled += [*_hidden(probe, a, b), b]
+    for (a, b), skip in zip(itertools.pairwise(ends), calm.tolist(), strict=True):
+        filled += [b] if skip else [*_hidden(probe, a, b), b]
     return Path(filled[:-1] if path.turns else filled, path.turns)
 
 
@@ -407,7 +233,7 @@ def _surprise(a: Point, b: Point) -> float | None:
     """Where, as a fraction of the cell, the pieces' cubic models predict a feasibility that
     the ends do not explain: more changes between feasible and infeasible than the ends'
     (none if alike, one if not). Returns the middle of the first unexplained stretch."""
-    if _quiet(a, b):
+    if _quiet([a], [b])[0]:
         return None
     (ga, da), (gb, db) = a.pieces(), b.pieces()
     if len(ga) == 0:
@@ -421,22 +247,30 @@ def _surprise(a: Point, b: Point) -> float | None:
     return (changes[0] + 1 + changes[1]) / 2.0 / (len(pattern) - 1)
 
 
-def _quiet(a: Point, b: Point) -> bool:
-    """Whether the cell's cubic models cannot surprise, by bounds that need no clearance
-    gradients (:meth:`~om_redundant.redundancy.objective.Objective.constraint_bounds`): on
-    [0, 1] the Hermite basis functions of the values are >= 0 and sum to 1 and those of the
-    slopes stay within 4/27 in size, so a model lies within (4/27) span (|g'_a| + |g'_b|) of
-    the ends' range. Quiet: both ends feasible and every model stays >= 0, or both
-    infeasible and one exact function's model stays < 0."""
-    feasible = a.evaluation.feasible
-    if feasible != b.evaluation.feasible:
-        return False
-    (ga, ra, exact), (gb, rb, _) = a.terms.get_bounds(), b.terms.get_bounds()
-    spread = 4.0 / 27.0 * abs(b.psi - a.psi) * (ra + rb) + _BOUND_SLACK
-    if feasible:
-        return bool((np.minimum(ga, gb) - spread > 0.0).all())
-    return bool((np.maximum(ga, gb) + spread < 0.0)[exact].any())
+def _quiet(a: list[Point], b: list[Point]) -> np.ndarray:
+    """Whether each cell (a_k, b_k)'s cubic models cannot surprise, by bounds that need no
+    clearance gradients (:meth:`~om_redundant.redundancy.objective.Objective.constraint_bounds`):
+    on [0, 1] the Hermite basis functions of the values are >= 0 and sum to 1 and those of
+    the slopes stay within 4/27 in size, so a model lies within (4/27) span (|g'_a| + |g'_b|)
+    of the ends' range. Quiet: both ends feasible and every model stays >= 0, or both
+    infeasible and one function's model stays < 0 (the bounds below 0 are the functions
+    themselves)."""
+    feasible = np.array([p.evaluation.feasible for p in a], dtype=bool)
+    quiet = np.zeros(len(a), dtype=bool)
+    alike = np.flatnonzero(feasible == np.array([p.evaluation.feasible for p in b], dtype=bool))
+    if len(alike) == 0:  # (only cells whose ends are alike need their bounds)
+        return quiet
+    a, b = [a[k] for k in alike], [b[k] for k in alike]
+    (ga, ra), (gb, rb) = _bounds(a), _bounds(b)
+    span = np.abs(np.array([y.psi - x.psi for x, y in zip(a, b, strict=True)], dtype=float))
+    spread = 4.0 / 27.0 * span[:, None] * (ra + rb) + _BOUND_SLACK
+    clear = (np.minimum(ga, gb) - spread > 0.0).all(axis=1)
+    blocked = (np.maximum(ga, gb) + spread < 0.0).any(axis=1)
+    quiet[alike] = np.where(feasible[alike], clear, blocked)
+    return quiet
 
 
-def _wrap(x: np.ndarray) -> np.ndarray:
-    return np.remainder(x + math.pi, _TURN) - math.pi
+def _bounds(points: list[Point]) -> tuple[np.ndarray, np.ndarray]:
+    """The points' constraint bounds stacked: values (M, n), rate bounds (M, n)."""
+    bounds = [p.terms.get_bounds() for p in points]
+    return np.array([v for v, _ in bounds]), np.array([r for _, r in bounds])

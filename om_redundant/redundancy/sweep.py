@@ -19,9 +19,10 @@ import numpy as np
 
 from ..om.configuration import Configuration
 from ..om.solver import OMSolver
-from .clearance import Box, Capsule, Clearance, Shape, Sphere
+from .clearance import Clearance
 from .objective import DEFAULT_SINGULARITY_WEIGHT, joint_margins
 from .optimizer import RedundancyChoice, RedundancyOptimizer
+from .shapes import Box, Capsule, Shape, Sphere
 
 #: Obstacle shapes: the numbers each takes, in order (metres, in the arm's root frame).
 SHAPES = {

@@ -1,0 +1,89 @@
+/* A solution path of one branch followed along the arm angle in one call: the loop of
+ * Probe.follow (om_redundant/redundancy/paths.py) for a 7-DOF arm's compiled solver.
+ *
+ * From the point (psi_0, q_0) with tangent t_0 = dq/dpsi towards psi*: the step h starts at
+ * psi* - psi_0; at x = psi_k + h (psi* once within reach) the exact solution q nearest q_k
+ * (the solve's hint) is taken at its representative (revolute joints with both limits moved
+ * by whole turns nearest mid-range c_i: c_i + wrap(q_i - c_i), for the feasible intervals)
+ * and accepted when it continues the path (om_continues: no joint moved more than 1 rad,
+ * |Delta q - t_k (x - psi_k)|_inf <= |Delta q|_inf / 2 + 1e-6, cyclic joints compared modulo
+ * 2 pi); then h doubles, else it halves. Below min_step (probe.py's END_TOLERANCE) the path
+ * has ended there; min_step = |psi* - psi_0| makes it one attempt (Probe.next).
+ * Each accepted point's tangent is om_self_motion_tangent's; where it does not exist (a
+ * fold met exactly) the call stops and says so: the caller's own loop then decides. */
+#include <string.h>
+
+#include "binding.h"
+
+enum { FOLLOW_ARRIVED = 0, FOLLOW_ENDED = 1, FOLLOW_SINGULAR = 2 };
+enum { F_PSI, F_STATUS, F_STEPS, F_N }; /* the out vector */
+
+static void represent(int dof, const uint8_t *centred, const double *centre, double *q) {
+    for (int i = 0; i < dof; i++)
+        if (centred[i]) q[i] = centre[i] + om_wrap_angle(q[i] - centre[i]);
+}
+
+/* Follow from (psi, q, t) towards target; q and t are updated in place to the point reached. */
+static int follow(const om_solver_data *s, const double *T, const int64_t *signs, const uint8_t *cyclic,
+                  const uint8_t *centred, const double *centre, double *psi, double *q, double *t, double target,
+                  double min_step, int *steps) {
+    int dof = s->dof;
+    double step = target - *psi, x_q[OM_MAX_DOF], x_t[OM_MAX_DOF];
+    *steps = 0;
+    while (*psi != target) {
+        if (fabs(step) < min_step) return FOLLOW_ENDED;
+        double x = fabs(target - *psi) <= fabs(step) ? target : *psi + step;
+        om_result r = om_solve_one(s, T, signs, &x, q, x_q);
+        bool ok = r.status == OM_OK;
+        if (ok) {
+            represent(dof, centred, centre, x_q);
+            ok = om_continues(dof, q, x_q, t, x - *psi, cyclic);
+        }
+        if (!ok) {
+            step /= 2.0;
+            continue;
+        }
+        if (!om_self_motion_tangent(s, x_q, x_t, 0.0)) return FOLLOW_SINGULAR;
+        *psi = x;
+        memcpy(q, x_q, (size_t)dof * sizeof(double));
+        memcpy(t, x_t, (size_t)dof * sizeof(double));
+        (*steps)++;
+        step *= 2.0;
+    }
+    return FOLLOW_ARRIVED;
+}
+
+/* follow(solver, T, signs, cyclic, centred, centre, q, t, out, psi, target, min_step) -> None:
+ * q and t (7, in place) become the point reached, out = (psi reached, status, accepted steps). */
+static PyObject *om_follow(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 12, "follow") < 0) return NULL;
+    if (!PyObject_TypeCheck(args[0], &om_SolverType)) {
+        PyErr_SetString(PyExc_TypeError, "follow: solver must be a ckernels.Solver");
+        return NULL;
+    }
+    const om_solver_data *s = &((om_Solver *)args[0])->data;
+    if (s->family != OM_SRS || s->dof != 7) {
+        PyErr_SetString(PyExc_ValueError, "follow: the solver must be a 7-DOF arm's (S-R-S model)");
+        return NULL;
+    }
+    double psi = PyFloat_AsDouble(args[9]), target = PyFloat_AsDouble(args[10]), min_step = PyFloat_AsDouble(args[11]);
+    if (PyErr_Occurred()) return NULL;
+    Py_buffer v[8];
+    const buffer_spec sp[8] = {{F64, 16, 0, "T"}, {I64, s->n_signs, 0, "signs"}, {U8, 7, 0, "cyclic"},
+                               {U8, 7, 0, "centred"}, {F64, 7, 0, "centre"}, {F64, 7, 1, "q"},
+                               {F64, 7, 1, "t"}, {F64, F_N, 1, "out"}};
+    if (get_buffers(args + 1, v, sp, 8) < 0) return NULL;
+    int steps = 0, status;
+    Py_BEGIN_ALLOW_THREADS status = follow(s, v[0].buf, v[1].buf, v[2].buf, v[3].buf, v[4].buf, &psi, v[5].buf,
+                                           v[6].buf, target, min_step, &steps);
+    Py_END_ALLOW_THREADS double *out = v[7].buf;
+    out[F_PSI] = psi, out[F_STATUS] = status, out[F_STEPS] = steps;
+    release_buffers(v, 8);
+    Py_RETURN_NONE;
+}
+
+PyMethodDef om_follow_functions[] = {
+    {"follow", (PyCFunction)(void (*)(void))om_follow, METH_FASTCALL,
+     "follow(solver, T, signs, cyclic, centred, centre, q, t, out, psi, target, min_step) -> None"},
+    {NULL, NULL, 0, NULL},
+};

@@ -1,0 +1,76 @@
+/* The self-motion of a 7-DOF arm, shared by the tracking step (tracking.c) and the path
+ * following of the global choose (follow.c); om_redundant/redundancy/self_motion.py is the
+ * reference.
+ *
+ * The hand stays fixed along the self-motion, J(q) dq = 0, so dq is along the null vector n
+ * of the 6 x 7 Jacobian, here by cofactors, n_i = (-1)^i det J_{-i} (J without column i;
+ * smooth in q, no factorisation to pick a sign). The arm angle moves by
+ * dpsi = Dpsi(q) . n, so dq/dpsi = n / (Dpsi(q) . n). */
+#include "binding.h"
+
+/* det of the n x n matrix A (row-major, destroyed) by elimination with partial pivoting. */
+static double det(double *A, int n) {
+    double d = 1.0;
+    for (int k = 0; k < n; k++) {
+        int p = k;
+        for (int i = k + 1; i < n; i++)
+            if (fabs(A[i * n + k]) > fabs(A[p * n + k])) p = i;
+        if (A[p * n + k] == 0.0) return 0.0;
+        if (p != k) {
+            for (int j = 0; j < n; j++) {
+                double t = A[k * n + j];
+                A[k * n + j] = A[p * n + j];
+                A[p * n + j] = t;
+            }
+            d = -d;
+        }
+        d *= A[k * n + k];
+        for (int i = k + 1; i < n; i++) {
+            double f = A[i * n + k] / A[k * n + k];
+            for (int j = k; j < n; j++) A[i * n + j] -= f * A[k * n + j];
+        }
+    }
+    return d;
+}
+
+bool om_self_motion_tangent(const om_solver_data *s, const double *q, double *t, double tol) {
+    static const double eye[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    double J[6 * 7], M[36], grad[7], n[7];
+    om_jacobian(s->real_table, s->n_real_rows, eye, eye, q, 7, J);
+    for (int c = 0; c < 7; c++) {
+        for (int i = 0; i < 6; i++)
+            for (int j = 0, k = 0; j < 7; j++)
+                if (j != c) M[i * 6 + k++] = J[i * 7 + j];
+        n[c] = (c % 2 ? -1.0 : 1.0) * det(M, 6);
+    }
+    om_arm_angle_gradient(s->params, s->model_table, s->n_model_rows, q, grad);
+    double dot = 0.0, gn = 0.0, nn = 0.0;
+    for (int i = 0; i < 7; i++) {
+        dot += grad[i] * n[i];
+        gn += grad[i] * grad[i];
+        nn += n[i] * n[i];
+    }
+    if (!(fabs(dot) > tol * sqrt(gn * nn)) || !isfinite(dot)) return false;
+    for (int i = 0; i < 7; i++) {
+        t[i] = n[i] / dot;
+        if (!isfinite(t[i])) return false;
+    }
+    return true;
+}
+
+double om_wrap_angle(double x) {
+    double r = fmod(x + OM_PI, 2.0 * OM_PI);
+    if (r != 0.0 && r < 0.0) r += 2.0 * OM_PI; /* numpy.remainder: the sign of the divisor */
+    return r - OM_PI;
+}
+
+bool om_continues(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic) {
+    double moved = 0.0, error = 0.0;
+    for (int i = 0; i < dof; i++) {
+        double m = q1[i] - q0[i];
+        if (cyclic && cyclic[i]) m = om_wrap_angle(m);
+        moved = fmax(moved, fabs(m));
+        error = fmax(error, t ? fabs(m - t[i] * d) : 0.0);
+    }
+    return moved <= 1.0 && error <= 0.5 * moved + 1e-6;
+}

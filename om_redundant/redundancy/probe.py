@@ -1,0 +1,291 @@
+r"""Exact solutions along one branch of a 7-DOF arm at one pose: the points of its solution
+paths (:mod:`om_redundant.redundancy.paths`), and how a path is followed along psi.
+
+**Following.** From a solution, the next one is the solution nearest it (``q_hint``),
+accepted when it continues the path (:meth:`Probe.continues`: no joint moves more than
+:data:`JUMP`, and the joints move as the path's tangent predicts); a step that fails is
+halved (near a singular shoulder or wrist two joints turn fast), and doubled again after a
+success (:meth:`Probe.follow`). Below :data:`END_TOLERANCE` the path has *ended*: it folded
+back in psi, or left the branch or the reach. With a compiled solver the loop runs in one
+call (``ckernels.follow``, ``csrc/follow.c``: the same steps and tests, the tangents of
+``csrc/self_motion.c``); Python builds only the point reached.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numpy as np
+
+from .. import ckernels
+from ..om.configuration import Configuration
+from ..om.solver import OMSolver, Solution
+from .objective import Evaluation, Group, Objective
+from .self_motion import self_motion_tangent, self_motion_tangents
+
+JUMP = 1.0  # rad, max-norm joint step between neighbouring solutions of one path
+END_TOLERANCE = 1e-9  # rad: a path whose following step falls below this has ended (csrc/follow.c)
+SAME = 1e-6  # rad, max-norm: two solutions at one psi this close are one
+_TURN = 2.0 * math.pi
+_ARRIVED, _SINGULAR = 0, 2  # ckernels.follow's status
+
+
+class _Terms:
+    """The objective at a point, computed when first asked for (a path's following steps
+    need only the joints and the tangent): the evaluation, then the groups with their rates.
+    Shared by the copies of a point at other representatives of psi."""
+
+    def __init__(
+        self, objective: Objective, q: np.ndarray, tangent: np.ndarray, evaluation: Evaluation | None
+    ):
+        self.objective, self.q, self.tangent = objective, q, tangent
+        self.evaluation, self.groups, self.bounds = evaluation, None, None
+
+    def get_evaluation(self) -> Evaluation:
+        if self.evaluation is None:
+            self.evaluation = self.objective.evaluation(self.objective.groups(self.q))
+        return self.evaluation
+
+    def get_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`~om_redundant.redundancy.objective.Objective.constraint_bounds` here."""
+        if self.bounds is None:
+            clearance = self.objective.clearance
+            q, tangent = self.q[None], self.tangent[None]
+            distances = None if clearance is None else clearance.distances(q)
+            values, rates = self.objective.constraint_bounds(q, tangent, distances)
+            self.bounds = values[0], rates[0]
+        return self.bounds
+
+    def get_groups(self) -> list[Group]:
+        if self.groups is None:
+            self.groups = [g.along(self.tangent) for g in self.objective.groups(self.q, jacobian=True)]
+            if self.evaluation is None:
+                self.evaluation = self.objective.evaluation(self.groups)
+        return self.groups
+
+
+@dataclass(frozen=True, eq=False)
+class Point:
+    """An exact solution on a branch, its objective, and their rates along psi.
+
+    Attributes:
+        psi: The redundancy value (rad); an (r,) array for r > 1 redundancy variables.
+        q: The joints.
+        tangent: dq/dpsi (dof, r).
+        terms: The objective at q, evaluated when first asked for (:attr:`evaluation`,
+            :attr:`groups`).
+        solution: The solver's Solution of it, when solved singly (its q may differ from
+            ``q`` by turns of revolute joints); None for a batch sample.
+    """
+
+    psi: float | np.ndarray
+    q: np.ndarray
+    tangent: np.ndarray
+    terms: _Terms
+    solution: Solution | None = None
+
+    @property
+    def evaluation(self) -> Evaluation:
+        """The objective at q."""
+        return self.terms.get_evaluation()
+
+    @property
+    def groups(self) -> list[Group]:
+        """The objective's groups at q, their jacobians by psi (p_g, r)."""
+        return self.terms.get_groups()
+
+    def pieces(self) -> tuple[np.ndarray, np.ndarray]:
+        """The feasibility functions g_j (all >= 0 iff feasible; see
+        :meth:`~om_redundant.redundancy.objective.Group.constraints`) and dg_j/dpsi."""
+        if not self.groups:
+            return np.zeros(0), np.zeros(0)
+        g, dg = zip(*(group.constraints() for group in self.groups), strict=True)
+        return np.concatenate(g), np.concatenate(dg)
+
+
+class Probe:
+    """Exact solutions along one branch at one pose, and their objective.
+
+    Args:
+        solver, objective, T, signs: The solver, the objective, the pose and the branch.
+        wrapped: Revolute joints modulo 2 pi, at the representative nearest mid-range (for
+            the feasible intervals); False keeps them as solved (for tracking).
+        compiled: Follow paths with ``ckernels.follow`` where the solver is a 7-DOF arm's
+            compiled one; False: always the Python loop (the reference it is tested against).
+    """
+
+    def __init__(
+        self,
+        solver: OMSolver,
+        objective: Objective,
+        T: np.ndarray,
+        signs: tuple[int, ...],
+        wrapped: bool = True,
+        compiled: bool = True,
+    ):
+        self.solver, self.objective, self.T, self.signs = solver, objective, T, signs
+        arm = solver.arm
+        self._cyclic = arm.revolute & wrapped
+        self._centred = self._cyclic & np.isfinite(arm.lower) & np.isfinite(arm.upper)
+        self._centre = np.where(self._centred, (arm.lower + arm.upper) / 2.0, 0.0)
+        self._work = None  # the compiled follow's arrays: a 7-DOF arm's compiled solver only
+        if compiled and isinstance(solver.kernel, ckernels.Solver) and arm.dof == 7:
+            self._work = FollowWork(
+                solver.kernel,
+                np.ascontiguousarray(T, dtype=float),
+                np.array(signs, dtype=np.int64),
+                self._cyclic.astype(np.uint8),
+                self._centred.astype(np.uint8),
+                np.ascontiguousarray(self._centre, dtype=float),
+                np.empty(7),
+                np.empty(7),
+                np.empty(3),
+            )
+
+    def step(self, a: np.ndarray, b: np.ndarray) -> float:
+        """The largest joint step between joint vectors a and b."""
+        return float(np.abs(self._delta(a, b)).max())
+
+    def steps(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """:meth:`step` between the rows of a and b (M, dof)."""
+        return np.abs(self._delta(a, b)).max(axis=1, initial=0.0)
+
+    def _delta(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        d = b - a
+        return np.where(self._cyclic, _wrap(d), d)
+
+    def point(self, psi: float | np.ndarray, q: np.ndarray, solution: Solution | None = None) -> Point:
+        """The point of solution q at psi, q at its representative (see the class)."""
+        return self._point(psi, self._represent(q), solution)
+
+    def _represent(self, q: np.ndarray) -> np.ndarray:
+        return np.where(self._centred, self._centre + _wrap(q - self._centre), q)
+
+    def _point(self, psi: float | np.ndarray, q: np.ndarray, solution: Solution | None) -> Point:
+        tangent = self_motion_tangent(self.solver, q)
+        return Point(psi, q, tangent, _Terms(self.objective, q, tangent, None), solution)
+
+    def points(self, psi: np.ndarray, q: np.ndarray) -> list[Point]:
+        """:meth:`point` for every psi and row of q (M, dof) of a 7-DOF arm, the tangents, the
+        evaluations and the constraint bounds computed for all rows at once."""
+        q = self._represent(q)
+        tangents = self_motion_tangents(self.solver, q)
+        bad = ~np.isfinite(tangents).all(axis=(1, 2))
+        if bad.any():
+            self_motion_tangent(self.solver, q[np.argmax(bad)])  # raises SingularSelfMotion
+        clearance = self.objective.clearance
+        distances = None if clearance is None else clearance.distances(q)
+        evaluations = self.objective.evaluations(q, distances)
+        values, rates = self.objective.constraint_bounds(q, tangents, distances)
+        points = []
+        for x, row, t, ev, v, r in zip(psi, q, tangents, evaluations, values, rates, strict=True):
+            terms = _Terms(self.objective, row, t, ev)
+            terms.bounds = v, r
+            points.append(Point(float(x), row, t, terms))
+        return points
+
+    def at(self, psi: float | np.ndarray, hint: np.ndarray) -> Point | None:
+        """The solution at psi nearest ``hint``, if there is one."""
+        sol = self._solve(psi, hint)
+        return self.point(psi, sol.q, sol) if sol.ok else None
+
+    def _solve(self, psi: float | np.ndarray, hint: np.ndarray) -> Solution:
+        return self.solver.solve(self.T, Configuration(self.signs, tuple(np.atleast_1d(psi))), q_hint=hint)
+
+    def continues(self, point: Point, other: Point) -> bool:
+        r"""Whether ``other`` continues point's path: its joints moved at most :data:`JUMP` and
+        as the path's tangent predicts to first order,
+        :math:`|\Delta q - (dq/d\psi)\,\Delta\psi|_\infty \le \frac12 |\Delta q|_\infty`. (A
+        solution on another path, however near, is off by the paths' separation, which no
+        shorter step of psi shrinks.)"""
+        return self._continues(point, other.psi, other.q)
+
+    def _continues(self, point: Point, psi: float | np.ndarray, q: np.ndarray) -> bool:
+        moved = self._delta(point.q, q)
+        error = moved - point.tangent @ np.atleast_1d(psi - point.psi)
+        return np.abs(moved).max() <= JUMP and np.abs(error).max() <= 0.5 * np.abs(moved).max() + SAME
+
+    def next(self, point: Point, psi: float | np.ndarray) -> Point | None:
+        """The solution at psi nearest point, if it continues point's path (the objective
+        evaluated only then): one attempt of :meth:`follow`'s loop."""
+        if self._work is not None and psi != point.psi:
+            found = self._follow_compiled(point, psi, abs(psi - point.psi))
+            if found is not None:
+                return found[0] if found[1] else None
+        sol = self._solve(psi, point.q)
+        if not sol.ok:
+            return None
+        q = self._represent(sol.q)
+        return self._point(psi, q, sol) if self._continues(point, psi, q) else None
+
+    def follow(self, start: Point, psi: float) -> tuple[Point, bool]:
+        """Continue start's path towards psi (module docstring).
+
+        Returns:
+            The point reached and whether it is at psi. When the path ends on the way the
+            point is its end, to :data:`END_TOLERANCE`.
+        """
+        if self._work is not None:
+            reached = self._follow_compiled(start, psi)
+            if reached is not None:
+                return reached
+        point, step = start, psi - start.psi
+        while point.psi != psi:
+            if abs(step) < END_TOLERANCE:
+                return point, False
+            x = psi if abs(psi - point.psi) <= abs(step) else point.psi + step
+            nxt = self.next(point, x)
+            if nxt is None:
+                step /= 2.0
+            else:
+                point, step = nxt, 2.0 * step
+        return point, True
+
+    def _follow_compiled(
+        self, start: Point, psi: float, min_step: float = END_TOLERANCE
+    ) -> tuple[Point, bool] | None:
+        """:meth:`follow` in one ``ckernels.follow`` call, ending where the step falls below
+        ``min_step``; None where it met a point without a tangent (a fold met exactly: the
+        Python loop then decides)."""
+        work = self._work
+        work.q[:] = start.q
+        work.t[:] = start.tangent[:, 0]
+        ckernels.follow(*work, float(start.psi), float(psi), float(min_step))
+        reached, status, steps = work.out.tolist()
+        if status == _SINGULAR:
+            return None
+        if steps == 0:
+            return start, status == _ARRIVED
+        q, tangent = work.q.copy(), work.t.copy()[:, None]
+        return Point(reached, q, tangent, _Terms(self.objective, q, tangent, None)), status == _ARRIVED
+
+
+class FollowWork(NamedTuple):
+    """The arrays ``ckernels.follow`` reads and writes, set up once per :class:`Probe`.
+
+    Attributes:
+        kernel: The compiled solver.
+        T: (4, 4) the pose.
+        signs: The branch signs (int64).
+        cyclic: (7,) joints compared modulo 2 pi (uint8).
+        centred: (7,) joints taken at the turn nearest mid-range (uint8).
+        centre: (7,) the mid-ranges (0 where not centred).
+        q, t: (7,) the start's joints and tangent on entry, the point reached's on return.
+        out: (psi reached, status (0 arrived, 1 the path ended, 2 no tangent), steps taken).
+    """
+
+    kernel: ckernels.Solver
+    T: np.ndarray
+    signs: np.ndarray
+    cyclic: np.ndarray
+    centred: np.ndarray
+    centre: np.ndarray
+    q: np.ndarray
+    t: np.ndarray
+    out: np.ndarray
+
+
+def _wrap(x: np.ndarray) -> np.ndarray:
+    return np.remainder(x + math.pi, _TURN) - math.pi
