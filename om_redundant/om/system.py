@@ -141,8 +141,10 @@ def run_rows(solve_range: Callable[[int, int], None], rows: int, threads: int | 
     """Run ``solve_range(start, stop)`` over ``range(rows)`` in chunks, on ``threads`` threads.
 
     The kernels release the GIL, so threads run them in parallel; each thread takes the next
-    chunk as it comes free, which balances targets of unequal cost. ``threads`` None: one
-    per core (at most that many in any case); 1: every row on the calling thread, in one call.
+    chunk as it comes free, which balances targets of unequal cost. The calling thread is one
+    of them (it would only wait otherwise; on a busy machine a pool thread may be slow to
+    wake, and then the caller takes its chunks). ``threads`` None: one per core (at most that
+    many in any case); 1: every row on the calling thread, in one call.
     """
     global _pool
     cores = _CORES
@@ -164,5 +166,9 @@ def run_rows(solve_range: Callable[[int, int], None], rows: int, threads: int | 
                 return
             solve_range(start, min(start + chunk, rows))
 
-    for future in [_pool.submit(drain) for _ in range(workers)]:
-        future.result()
+    helpers = [_pool.submit(drain) for _ in range(workers - 1)]
+    try:
+        drain()
+    finally:
+        for future in helpers:
+            future.result()
