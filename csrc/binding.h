@@ -72,9 +72,11 @@ double om_wrap_angle(double x);
 bool om_continues(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic);
 
 extern PyTypeObject om_SolverType;        /* solver_type.c: Solver(SolverData) */
+/* solver_type.c: obj's data if it is a 7-DOF (S-R-S) Solver; NULL with an error naming what. */
+const om_solver_data *om_srs7_solver(PyObject *obj, const char *what);
 extern PyMethodDef om_kernel_functions[]; /* functions.c: kinematics and closed forms */
 extern PyMethodDef om_tracking_functions[]; /* tracking.c: the redundancy optimiser's tracking step */
-extern PyMethodDef om_clearance_functions[];
-extern PyMethodDef om_follow_functions[]; /* follow.c: a solution path followed along psi */ /* clearance.c: distances of arm and obstacle geoms */
+extern PyMethodDef om_clearance_functions[]; /* clearance.c: distances of arm and obstacle geoms */
+extern PyMethodDef om_follow_functions[];    /* follow.c: a solution path followed along psi */
 
 #endif

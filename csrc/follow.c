@@ -57,15 +57,8 @@ static int follow(const om_solver_data *s, const double *T, const int64_t *signs
  * q and t (7, in place) become the point reached, out = (psi reached, status, accepted steps). */
 static PyObject *om_follow(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
     if (check_nargs(nargs, 12, "follow") < 0) return NULL;
-    if (!PyObject_TypeCheck(args[0], &om_SolverType)) {
-        PyErr_SetString(PyExc_TypeError, "follow: solver must be a ckernels.Solver");
-        return NULL;
-    }
-    const om_solver_data *s = &((om_Solver *)args[0])->data;
-    if (s->family != OM_SRS || s->dof != 7) {
-        PyErr_SetString(PyExc_ValueError, "follow: the solver must be a 7-DOF arm's (S-R-S model)");
-        return NULL;
-    }
+    const om_solver_data *s = om_srs7_solver(args[0], "follow");
+    if (s == NULL) return NULL;
     double psi = PyFloat_AsDouble(args[9]), target = PyFloat_AsDouble(args[10]), min_step = PyFloat_AsDouble(args[11]);
     if (PyErr_Occurred()) return NULL;
     Py_buffer v[8];

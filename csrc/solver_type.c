@@ -249,6 +249,21 @@ static PyMethodDef Solver_methods[] = {
     {NULL, NULL, 0, NULL},
 };
 
+/* The Solver obj's data if it is a 7-DOF arm's (S-R-S model); NULL with a TypeError or
+ * ValueError naming `what` otherwise (follow and track_step walk its self-motion). */
+const om_solver_data *om_srs7_solver(PyObject *obj, const char *what) {
+    if (!PyObject_TypeCheck(obj, &om_SolverType)) {
+        PyErr_Format(PyExc_TypeError, "%s: solver must be a ckernels.Solver", what);
+        return NULL;
+    }
+    const om_solver_data *s = &((om_Solver *)obj)->data;
+    if (s->family != OM_SRS || s->dof != 7) {
+        PyErr_Format(PyExc_ValueError, "%s: the solver must be a 7-DOF arm's (S-R-S model)", what);
+        return NULL;
+    }
+    return s;
+}
+
 PyTypeObject om_SolverType = {
     PyVarObject_HEAD_INIT(NULL, 0).tp_name = "om_redundant.ckernels.Solver",
     .tp_doc = "The OM solver's fixed data, compiled: Solver(SolverData, solution_type=None, configuration_type=None).",

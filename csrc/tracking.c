@@ -152,15 +152,8 @@ static int track(const tracking *tr, const double *T, const int64_t *signs, cons
 PyObject *om_track_step(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
     if (check_nargs(nargs, 14, "track_step") < 0)
         return NULL;
-    if (!PyObject_TypeCheck(args[0], &om_SolverType)) {
-        PyErr_SetString(PyExc_TypeError, "track_step: solver must be a ckernels.Solver");
-        return NULL;
-    }
-    const om_solver_data *s = &((om_Solver *)args[0])->data;
-    if (s->family != OM_SRS || s->dof != 7) {
-        PyErr_SetString(PyExc_ValueError, "track_step: the solver must be a 7-DOF arm's (S-R-S model)");
-        return NULL;
-    }
+    const om_solver_data *s = om_srs7_solver(args[0], "track_step");
+    if (s == NULL) return NULL;
     Py_buffer v[13];
     const buffer_spec sp[13] = {{F64, 16, 0, "T"},           {I64, s->n_signs, 0, "signs"}, {F64, 7, 0, "q_prev"},
                 {F64, -1, 0, "setup"},       {F64, 7, 0, "lower"},          {F64, 7, 0, "upper"},
