@@ -231,15 +231,13 @@ def _where(bad: np.ndarray, T: np.ndarray) -> str:
 def as_joint_vector(q: Any, dof: int, name: str = "q", *, stack: bool = True) -> np.ndarray:
     """Return a validated joint vector of shape (dof,), or with ``stack`` also a stack (M, dof),
     as a C-contiguous float64 array."""
-    if type(q) is np.ndarray and q.dtype == np.float64 and q.shape == (dof,) and q.flags.c_contiguous:
-        if not ckernels.all_finite(q):  # the common case, fast: the array as given
-            raise InvalidInput(f"{name} contains NaN or inf")
-        return q
-    shapes = f"({dof},) or (M, {dof})" if stack else f"({dof},)"
-    q = as_array(q, name, f"a joint vector of shape {shapes}")
-    if q.ndim not in ((1, 2) if stack else (1,)) or q.shape[-1] != dof:
-        raise InvalidInput(f"{name} must have shape {shapes}, got {q.shape}")
-    q = np.ascontiguousarray(q)
+    # the common case, fast: a C-contiguous float64 (dof,) array is checked as given
+    if not (type(q) is np.ndarray and q.dtype == np.float64 and q.shape == (dof,) and q.flags.c_contiguous):
+        shapes = f"({dof},) or (M, {dof})" if stack else f"({dof},)"
+        q = as_array(q, name, f"a joint vector of shape {shapes}")
+        if q.ndim not in ((1, 2) if stack else (1,)) or q.shape[-1] != dof:
+            raise InvalidInput(f"{name} must have shape {shapes}, got {q.shape}")
+        q = np.ascontiguousarray(q)
     if not ckernels.all_finite(q):
         raise InvalidInput(f"{name} contains NaN or inf")
     return q
