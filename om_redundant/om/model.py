@@ -175,13 +175,13 @@ def _six_dof_model(arm: Arm) -> tuple[KinematicChain, int, str, np.ndarray]:
     R_fl, p_fl = _pose(model_chain.table, q0)
     params[six_dof.WRIST_CENTRE : six_dof.WRIST_CENTRE + 3] = R_fl.T @ (o4 - p_fl)
     if offsets[0] != 0.0:
-        _wrist_offset(arm, model_chain, offsets, params)
+        _wrist_offset(arm, model_chain, offsets, params, R_fl)
         family_name += ", wrist offset a4 (dp turns with q1)"
     return model_chain, family, family_name, params
 
 
 def _wrist_offset(
-    arm: Arm, model_chain: KinematicChain, offsets: tuple[float, ...], params: np.ndarray
+    arm: Arm, model_chain: KinematicChain, offsets: tuple[float, ...], params: np.ndarray, R_fl: np.ndarray
 ) -> None:
     r"""The dp circle of a 6-DOF wrist with :math:`a_4 \ne 0`, into ``params`` (``six_dof.WRIST_OFFSET``).
 
@@ -216,8 +216,7 @@ def _wrist_offset(
             "search handles a4 != 0 where joint 4's axis turns with q1 alone (parallel to joint 2's, as "
             "when joints 2, 3 and 4 are parallel): dp then turns with q1"
         ) from None
-    q0 = np.zeros(6)
-    axis6 = _pose(table, q0)[0].T @ _pose(table[: jr[5]], q0[:5])[0][:, 2]
+    axis6 = R_fl.T @ _pose(table[: jr[5]], np.zeros(5))[0][:, 2]  # R_fl: the flange's rotation at q = 0
     params[six_dof.WRIST_OFFSET : six_dof.WRIST_OFFSET + 3] = offsets
     params[six_dof.AXIS4 : six_dof.AXIS4 + 9] = axis4.ravel()
     params[six_dof.AXIS6 : six_dof.AXIS6 + 3] = axis6
