@@ -205,7 +205,9 @@ def _with_hidden(probe: Probe, path: Path) -> Path:
     # the cells that need no look inside, all at once: no joint moves more than FINE_STEP
     # and the cheap bounds show the models quiet (_hidden's own first test, vectorised)
     q = np.array([p.q for p in ends])
-    calm = (probe.steps(q[:-1], q[1:]) <= FINE_STEP) & _quiet(ends[:-1], ends[1:])
+    calm = probe.steps(q[:-1], q[1:]) <= FINE_STEP
+    small = np.flatnonzero(calm)  # (only these cells' ends need their bounds now)
+    calm[small] = _quiet([ends[k] for k in small], [ends[k + 1] for k in small])
     filled = [ends[0]]
     for (a, b), skip in zip(itertools.pairwise(ends), calm.tolist(), strict=True):
         filled += [b] if skip else [*_hidden(probe, a, b), b]
