@@ -21,20 +21,15 @@ import numpy as np
 import om_redundant as om
 
 from .report import cpu_model, write_page
-from .robots import random_joints
+from .robots import joint_distance, random_joints
 
 DENSE = 1024  # scan points of the reference search
 SAME = 1e-9  # rad: two roots are one (the same root refined from other samples differs in its last digits)
 
 
-def _same(x: np.ndarray, y: np.ndarray) -> bool:
-    """Whether joint vectors x and y are one root (within SAME rad joint-wise, modulo 2 pi)."""
-    return bool(np.abs(np.remainder(x - y + np.pi, 2 * np.pi) - np.pi).max() < SAME)
-
-
-def _matches(a: list[om.Solution], b: list[om.Solution]) -> int:
-    """How many roots of a have one of b."""
-    return sum(any(_same(x.q, y.q) for y in b) for x in a)
+def _matches(arm: om.Arm, a: list[om.Solution], b: list[om.Solution]) -> int:
+    """How many roots of a have one of b (within SAME, revolute joints modulo 2 pi)."""
+    return sum(any(joint_distance(arm, x.q, y.q) < SAME for y in b) for x in a)
 
 
 def measure(name: str, n: int, points: list[int], seed: int) -> dict[int, dict[str, int]]:
@@ -48,15 +43,15 @@ def measure(name: str, n: int, points: list[int], seed: int) -> dict[int, dict[s
             reference = dense.solve_all(T, c)
             for p, solver in coarse.items():
                 found = solver.solve_all(T, c)
-                missed = len(reference) - _matches(reference, found)
-                extra = len(found) - _matches(found, reference)
+                missed = len(reference) - _matches(dense.arm, reference, found)
+                extra = len(found) - _matches(dense.arm, found, reference)
                 row = counts[p]
                 row["configurations"] += 1
                 row["differ"] += int(missed > 0 or extra > 0)
                 row["missed"] += missed
                 row["extra"] += extra
                 if c == own:
-                    row["q missed"] += int(not any(_same(r.q, q) for r in found))
+                    row["q missed"] += int(not any(joint_distance(dense.arm, r.q, q) < SAME for r in found))
     return counts
 
 

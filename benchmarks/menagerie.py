@@ -26,6 +26,7 @@ import numpy as np
 import om_redundant as om
 
 from .report import write_page
+from .robots import joint_distance
 
 MENAGERIE = Path(__file__).resolve().parents[2] / "shared" / "reference" / "menagerie"
 
@@ -94,11 +95,6 @@ def _random_q(arm: om.Arm, n: int, rng: np.random.Generator) -> np.ndarray:
     return rng.uniform(lower, upper, (n, arm.dof))
 
 
-def _distance(arm: om.Arm, a: np.ndarray, b: np.ndarray) -> float:
-    d = a - b
-    return float(np.abs(np.where(arm.revolute, np.remainder(d + np.pi, 2 * np.pi) - np.pi, d)).max())
-
-
 def _angle(R: np.ndarray, S: np.ndarray) -> float:
     E = R.T @ S
     s = 0.5 * np.linalg.norm([E[2, 1] - E[1, 2], E[0, 2] - E[2, 0], E[1, 0] - E[0, 1]])
@@ -127,7 +123,7 @@ def measure(name: str, n: int, seed: int, entry: Entry | None = None, folder: Pa
         c = solver.configuration_of(q)
         roots = solver.solve_all(T, c)
         roots_total += len(roots)
-        among += any(_distance(arm, r.q, q) < 1e-7 for r in roots)
+        among += any(joint_distance(arm, r.q, q) < 1e-7 for r in roots)
         for root in roots:
             reached = frame_pose(model, data, arm, root.q)
             position = float(np.linalg.norm(reached[:3, 3] - T[:3, 3]))
@@ -138,7 +134,7 @@ def measure(name: str, n: int, seed: int, entry: Entry | None = None, folder: Pa
             )
             wrong += position > 1e-10 or orientation > 1e-10 or not solver.configuration_of(root.q).isclose(c)
         sol = solver.solve(T, c, q_hint=q)
-        if sol.ok and _distance(arm, sol.q, q) < 1e-7:
+        if sol.ok and joint_distance(arm, sol.q, q) < 1e-7:
             hinted += 1
         elif sol.ok:
             nearer += (

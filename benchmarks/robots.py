@@ -66,6 +66,12 @@ def random_joints(arm: om.Arm, n: int, rng: np.random.Generator) -> np.ndarray:
     return rng.uniform(lower, upper, (n, arm.dof))
 
 
+def joint_distance(arm: om.Arm, a: np.ndarray, b: np.ndarray) -> float:
+    """max |a - b| over the joints, revolute joints modulo 2 pi."""
+    d = a - b
+    return float(np.abs(np.where(arm.revolute, np.remainder(d + np.pi, 2 * np.pi) - np.pi, d)).max())
+
+
 def reference_spec(relative_path: str) -> mujoco.MjSpec:
     """A Menagerie MJCF under :data:`MENAGERIE` with its meshes stripped (the files ship
     without them), to edit before compiling."""
