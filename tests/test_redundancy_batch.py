@@ -65,18 +65,28 @@ def test_constraint_bounds_bound_the_feasibility_functions_and_their_rates(seed,
     """Objective.constraint_bounds: the margin entries are the margin feasibility functions
     and their rates' sizes exactly; the clearance entries are at most the clearance
     functions and equal where below 0 (where the cell test takes them as the functions),
-    and their rate bounds (Clearance.pair_bounds) at least their rates' sizes; for all rows
-    at once the same as row by row."""
+    and their rates at least the functions' rates' sizes, equal where the pair is within
+    2 d_cap; for all rows at once the same as row by row. Clearance.distances_and_gradients
+    of all rows gives exactly those of each row."""
     optimizer = optimizer_of(name, count)
     objective, solver = optimizer.objective, optimizer.solver
     q = joints(optimizer, seed, 10)
     tangents = self_motion_tangents(solver, q)
-    distances = objective.clearance.distances(q)
-    batch = objective.constraint_bounds(q, tangents, distances)
+    distances, gradients = objective.clearance.distances_and_gradients(q)
+    batch = objective.constraint_bounds(q, tangents, (distances, gradients))
     for k, row in enumerate(q):
+        d, grad = objective.clearance.distances_and_gradients(row)
+        np.testing.assert_array_equal(d, distances[k])
+        np.testing.assert_array_equal(grad, gradients[k])
         groups = [g.along(tangents[k]) for g in objective.groups(row, jacobian=True)]
+        for mine, theirs in zip(objective.groups(row, jacobian=True, pairs=(d, grad)), groups, strict=True):
+            np.testing.assert_array_equal(mine.values, theirs.values)
+            np.testing.assert_array_equal(mine.along(tangents[k]).jacobian, theirs.jacobian)
         values, rates = (
-            x[0] for x in objective.constraint_bounds(row[None], tangents[k][None], distances[[k]])
+            x[0]
+            for x in objective.constraint_bounds(
+                row[None], tangents[k][None], (distances[[k]], gradients[[k]])
+            )
         )
         np.testing.assert_array_equal(values, batch[0][k])
         np.testing.assert_array_equal(rates, batch[1][k])
@@ -88,27 +98,11 @@ def test_constraint_bounds_bound_the_feasibility_functions_and_their_rates(seed,
         below = values[limited:] < 0.0
         np.testing.assert_allclose(values[limited:][below], clearance[0][below], rtol=0, atol=1e-12)
         assert (np.abs(clearance[1]) <= rates[limited:] * (1 + 1e-9) + 1e-12).all()
-
-
-@settings(max_examples=6, deadline=None)
-@given(seed=st.integers(0, 2**32 - 1), name=st.sampled_from(list(HOMES)))
-def test_pair_bounds_bound_the_distances_and_their_rates(seed, name):
-    """Clearance.pair_bounds: below every pair's exact distance, and above the size of its
-    derivative along any joint velocity (a random one and the self-motion); for all rows at
-    once exactly as row by row."""
-    optimizer = optimizer_of(name, 3)
-    clearance = optimizer.objective.clearance
-    rng = np.random.default_rng(seed)
-    q = joints(optimizer, seed, 10)
-    rates = rng.normal(size=q.shape)
-    batch = clearance.pair_bounds(q, rates)
-    for k, row in enumerate(q):
-        d, grad = clearance.distances_and_gradients(row)
-        np.testing.assert_array_equal(clearance.pair_bounds(row, rates[k]), [b[k] for b in batch])
-        for rate in (rates[k], om.self_motion_tangent(optimizer.solver, row)[:, 0]):
-            lower, speed = clearance.pair_bounds(row, rate)
-            assert (np.minimum(lower, clearance.distmax) <= d + 1e-12).all()  # d: at most distmax
-            assert (np.abs(grad @ rate) <= speed * (1 + 1e-9) + 1e-12).all()
+        near = d < objective.clearance_reach
+        scale = 1.0 + np.abs(rates[limited:]).max()  # (the products' rounding: cancelling terms)
+        np.testing.assert_allclose(
+            rates[limited:][near], np.abs(clearance[1][near]), rtol=0, atol=1e-13 * scale
+        )
 
 
 @settings(max_examples=40, deadline=None)

@@ -226,11 +226,21 @@ class Objective:
         eye = np.eye(self._dof)[self._limited] / self._half[:, None]
         self._margin_jacobian = np.vstack([eye, -eye])  # pieces (q - l)/h, then (u - q)/h
 
-    def groups(self, q: np.ndarray, jacobian: bool = False) -> list[Group]:
+    def groups(
+        self, q: np.ndarray, jacobian: bool = False, pairs: tuple[np.ndarray, np.ndarray] | None = None
+    ) -> list[Group]:
         """The groups at q (module docstring): margin (if any joint is limited), clearance
-        (if there are obstacles), then singularity (if given); their jacobians by q if asked."""
+        (if there are obstacles), then singularity (if given); their jacobians by q if asked.
+
+        Args:
+            q: (dof,) joint vector.
+            jacobian: Also the jacobians.
+            pairs: The clearance's pair distances (P,) and gradients (P, dof) at q if
+                already computed (:meth:`Clearance.distances_and_gradients
+                <om_redundant.Clearance.distances_and_gradients>`): the same groups from them.
+        """
         groups = [self._margin(q, jacobian)] if len(self._limited) else []
-        groups += [self._clearance(q, jacobian)] if self.clearance is not None else []
+        groups += [self._clearance(q, jacobian, pairs)] if self.clearance is not None else []
         return groups + ([self._singularity(q, jacobian)] if self.singularity is not None else [])
 
     def evaluate(self, q: np.ndarray) -> Evaluation:
@@ -277,36 +287,37 @@ class Objective:
         ]
 
     def constraint_bounds(
-        self, q: np.ndarray, tangent: np.ndarray, distances: np.ndarray | None
+        self, q: np.ndarray, tangent: np.ndarray, pairs: tuple[np.ndarray, np.ndarray] | None
     ) -> tuple[np.ndarray, np.ndarray]:
         r"""The feasibility functions of :meth:`Group.constraints` at joint vectors q and
-        bounds of their rates, without the clearances' gradients: for a cheap test of a cell
-        of a solution path.
+        the sizes of their rates, for a cheap test of a cell of a solution path (its
+        Hermite models bounded without evaluating them).
 
         Each limited joint's margin function :math:`1 - |q_i - c_i|/h_i`, with its rate's
         size :math:`|t_i|/h_i` (t = dq/dpsi); then, with obstacles, per pair
         :math:`(\min(d_k, 2 d_{cap}) - d_{min})/d_{cap}` (the clearance piece where it is
         below 2 d_cap, a lower bound of it beyond: there the pieces report 2 d_cap, or
-        d_k when every pair is that far), and a bound on its rate's size from
-        :meth:`Clearance.pair_bounds <om_redundant.Clearance.pair_bounds>`.
+        d_k when every pair is that far) and :math:`|\nabla d_k \cdot t| / d_{cap}` (at least
+        the size of the piece's rate: the pieces capped at 2 d_cap have none).
 
         Args:
             q: (M, dof) joint vectors.
             tangent: (M, dof, 1) their dq/dpsi.
-            distances: (M, P) the pairs' distances d_k(q) (m), :meth:`Clearance.distances
-                <om_redundant.Clearance.distances>`; None without obstacles.
+            pairs: (M, P) the pairs' distances d_k(q) (m) and (M, P, dof) their gradients,
+                :meth:`Clearance.distances_and_gradients
+                <om_redundant.Clearance.distances_and_gradients>`; None without obstacles.
 
         Returns:
-            (values (M, n), rate bounds (M, n)).
+            (values (M, n), rate sizes (M, n)).
         """
         lim = self._limited
         values = [np.minimum(*_limit_distances(q[:, lim], self._lower, self._upper, self._half))]
         rates = [np.abs(tangent[:, lim, 0]) / self._half]
         if self.clearance is not None:
             cap = self.clearance_cap
-            speed = self.clearance.pair_bounds(q, tangent[:, :, 0])[1]
+            distances, gradients = pairs
             values.append((np.minimum(distances, self.clearance_reach) - self.min_clearance) / cap)
-            rates.append(speed / cap)
+            rates.append(np.abs(gradients @ tangent)[:, :, 0] / cap)
         return np.concatenate(values, axis=1), np.concatenate(rates, axis=1)
 
     def term_functions(self, q: np.ndarray, clearance: np.ndarray) -> list[tuple[float, float, np.ndarray]]:
@@ -355,14 +366,24 @@ class Objective:
             "margin", self.margin_weight, 0.0, math.inf, pieces, self._margin_jacobian if jacobian else None
         )
 
-    def _clearance(self, q: np.ndarray, jacobian: bool) -> Group:
+    def _clearance(self, q: np.ndarray, jacobian: bool, pairs: tuple[np.ndarray, np.ndarray] | None) -> Group:
         """The clearance pieces d_k / d_cap, computed only for the pairs within 2 d_cap (the
         others report 2 with zero gradient: beyond the cap they change neither the term,
         the slack's minimum nor, far above the floor, a feasibility model); all of them
-        exactly when no pair is that near, so that D(q) is exact."""
-        floor, cap = self.min_clearance / self.clearance_cap, self.clearance_cap
-        d, grad = self.clearance.distances_within(q, self.clearance_reach, gradient=jacobian)
-        if d.min() < self.clearance_reach:
+        exactly when no pair is that near, so that D(q) is exact. From ``pairs`` (every
+        pair's distance and gradient) the same pieces, capped here."""
+        floor, cap, reach = self.min_clearance / self.clearance_cap, self.clearance_cap, self.clearance_reach
+        if pairs is not None:
+            d, grad = pairs
+            if d.min() < reach:
+                near = d < reach
+                d = np.where(near, d, reach)
+                grad = np.where(near[:, None], grad, 0.0) if jacobian else None
+            return Group(
+                "clearance", self.clearance_weight, floor, 1.0, d / cap, grad / cap if jacobian else None
+            )
+        d, grad = self.clearance.distances_within(q, reach, gradient=jacobian)
+        if d.min() < reach:
             scaled = grad / cap if jacobian else None
             return Group("clearance", self.clearance_weight, floor, 1.0, d / cap, scaled)
         return _capped("clearance", self.clearance_weight, floor, self.clearance, cap, q, jacobian)
