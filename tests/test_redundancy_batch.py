@@ -40,6 +40,11 @@ def test_batched_evaluations_equal_the_single_ones(seed, name, count):
     q = joints(optimizer, seed)
     objective = optimizer.objective
     assert objective.evaluations(q) == [objective.evaluate(row) for row in q]
+    for row in q[:5]:  # f is the groups' terms summed in order
+        assert objective.evaluate(row).value == sum(g.term() for g in objective.groups(row))
+        if objective.clearance is not None:
+            distances = objective.clearance.distances_and_gradients(row)[0]
+            assert objective.evaluate(row, distances) == objective.evaluate(row)
     if objective.clearance is not None:
         assert objective.clearance.minima(q).tolist() == [objective.clearance.minimum(row) for row in q]
 

@@ -159,9 +159,12 @@ class Clearance:
         joint vector q (dof,), (M, P) and (M, P, dof) for the rows of q (M, dof), one
         ``mj_kinematics`` per row."""
         if np.ndim(q) == 2:
-            rows = [self._evaluate(row, gradient=True) for row in q]
-            distances = np.array([d for d, _ in rows]).reshape(len(q), len(self._pairs))
-            return distances, np.array([g for _, g in rows]).reshape(len(q), len(self._pairs), self._dof)
+            q = as_joint_vector(q, self._dof)
+            shape = (len(q), len(self._pairs))
+            dist, fromto, grad = np.empty(shape), np.empty((*shape, 6)), np.empty((*shape, self._dof))
+            for row, *out in zip(q, dist, fromto, grad, strict=True):
+                self._measure(row, self.distmax, *out)
+            return dist, grad
         return self._evaluate(q, gradient=True)
 
     def distances_within(
@@ -196,17 +199,26 @@ class Clearance:
     def _evaluate(
         self, q: np.ndarray, gradient: bool, reach: float | None = None
     ) -> tuple[np.ndarray, np.ndarray]:
-        """Distances capped at reach (default distmax), and their gradients if asked: one
-        ``mj_kinematics``, then ``ckernels.geom_distances`` (sphere and capsule arm geoms
-        against sphere, capsule and box obstacles, apart) with ``mj_geomDistance`` for the
-        pairs it leaves, and ``ckernels.distance_gradients`` (module docstring)."""
+        """Distances capped at reach (default distmax), and their gradients if asked (else
+        zero): :meth:`_measure` into new arrays."""
         q = as_joint_vector(q, self._dof, stack=False)
-        m, d, geoms = self.model, self._data, self._geoms
-        reach = self.distmax if reach is None else reach
-        d.qpos[self._qpos] = q
-        mujoco.mj_kinematics(m, d)
         n_pairs = len(self._pairs)
         dist, fromto = np.empty(n_pairs), np.empty((n_pairs, 6))
+        grad = np.empty((n_pairs, self._dof)) if gradient else np.zeros((n_pairs, self._dof))
+        self._measure(q, self.distmax if reach is None else reach, dist, fromto, grad if gradient else None)
+        return dist, grad
+
+    def _measure(
+        self, q: np.ndarray, reach: float, dist: np.ndarray, fromto: np.ndarray, grad: np.ndarray | None
+    ) -> None:
+        """Write the distances capped at reach, the nearest points and (unless ``grad`` is
+        None) the gradients at the joint vector q: one ``mj_kinematics``, then
+        ``ckernels.geom_distances`` (sphere and capsule arm geoms against sphere, capsule and
+        box obstacles, apart) with ``mj_geomDistance`` for the pairs it leaves, and
+        ``ckernels.distance_gradients`` (module docstring)."""
+        m, d, geoms = self.model, self._data, self._geoms
+        d.qpos[self._qpos] = q
+        mujoco.mj_kinematics(m, d)
         if ckernels.geom_distances(
             geoms.kind,
             geoms.radius,
@@ -222,12 +234,10 @@ class Clearance:
             for k in np.flatnonzero(np.isnan(dist)).tolist():
                 a, o = self._pairs[k].tolist()
                 dist[k] = mujoco.mj_geomDistance(m, d, a, o, reach, fromto[k])
-        grad = np.empty((n_pairs, self._dof)) if gradient else np.zeros((n_pairs, self._dof))
-        if gradient:  # every row written
+        if grad is not None:  # every row written
             ckernels.distance_gradients(
                 dist, fromto, reach, d.xanchor, d.xaxis, geoms.joints, geoms.slide, geoms.moves, grad
             )
-        return dist, grad
 
 
 class GeomCores(NamedTuple):

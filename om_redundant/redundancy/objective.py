@@ -239,13 +239,47 @@ class Objective:
                 already computed (:meth:`Clearance.distances_and_gradients
                 <om_redundant.Clearance.distances_and_gradients>`): the same groups from them.
         """
-        groups = [self._margin(q, jacobian)] if len(self._limited) else []
-        groups += [self._clearance(q, jacobian, pairs)] if self.clearance is not None else []
-        return groups + ([self._singularity(q, jacobian)] if self.singularity is not None else [])
+        singularity = [self._singularity(q, jacobian)] if self.singularity is not None else []
+        return self.constrained_groups(q, jacobian, pairs) + singularity
 
-    def evaluate(self, q: np.ndarray) -> Evaluation:
-        """f(q), M(q), D(q) and the feasibility slack."""
-        return self.evaluation(self.groups(as_joint_vector(q, self._dof)))
+    def constrained_groups(
+        self, q: np.ndarray, jacobian: bool = False, pairs: tuple[np.ndarray, np.ndarray] | None = None
+    ) -> list[Group]:
+        """The groups of :meth:`groups` that have a floor (margin, clearance): those whose
+        :meth:`Group.constraints` define feasibility."""
+        groups = [self._margin(q, jacobian)] if len(self._limited) else []
+        return groups + ([self._clearance(q, jacobian, pairs)] if self.clearance is not None else [])
+
+    def evaluate(self, q: np.ndarray, distances: np.ndarray | None = None) -> Evaluation:
+        """f(q), M(q), D(q), the feasibility slack and S(q): each group's minimum
+        (the smallest of its pieces, :meth:`groups`) capped and weighted, summed in the
+        groups' order.
+
+        Args:
+            q: (dof,) joint vector.
+            distances: (P,) the clearance's pair distances at q if already computed.
+        """
+        q = as_joint_vector(q, self._dof, stack=False)
+        value, slacks = 0.0, []
+        margin = clearance = singularity = math.inf
+        if len(self._limited):
+            lim = q[self._limited]
+            lower, upper = _limit_distances(lim, self._lower, self._upper, self._half)
+            margin = min(float(lower.min()), float(upper.min()))
+            value += self.margin_weight * margin
+            slacks.append(margin - 0.0)
+        if self.clearance is not None:
+            if distances is None:
+                distances = self.clearance.distances(q)
+            scaled = float(distances.min()) / self.clearance_cap  # (= the least piece d_k / d_cap)
+            value += self.clearance_weight * min(1.0, scaled)
+            slacks.append(scaled - self.min_clearance / self.clearance_cap)
+            clearance = scaled * self.clearance_cap
+        if self.singularity is not None:
+            scaled = float(self.singularity.distances(q).min()) / SINGULARITY_CAP
+            value += self.singularity_weight * min(1.0, scaled)
+            singularity = scaled * SINGULARITY_CAP
+        return Evaluation(value, margin, clearance, min(slacks, default=math.inf), singularity)
 
     def evaluations(self, q: np.ndarray, distances: np.ndarray | None = None) -> list[Evaluation]:
         """:meth:`evaluate` at every row of q (M, dof), vectorised over the rows (the same
@@ -279,7 +313,7 @@ class Objective:
             singularity = scaled * SINGULARITY_CAP
         value = terms[0]
         for term in terms[1:]:
-            value = value + term  # in the order of evaluation()'s sum
+            value = value + term  # in the order of evaluate()'s sum
         slack = np.min(slacks, axis=0)
         return [
             Evaluation(*(float(x) for x in row))
@@ -347,17 +381,6 @@ class Objective:
             singular = self.singularity.distances(q) / SINGULARITY_CAP
             groups.append((self.singularity_weight, 1.0, singular))
         return groups
-
-    def evaluation(self, groups: list[Group]) -> Evaluation:
-        """f, M, D, the slack and S from the groups at one joint vector."""
-        kinds = {g.kind: float(g.values.min()) for g in groups}
-        return Evaluation(
-            sum(g.term() for g in groups),
-            kinds.get("margin", math.inf),
-            kinds.get("clearance", math.inf) * self.clearance_cap,
-            min((g.slack() for g in groups), default=math.inf),
-            kinds.get("singularity", math.inf) * SINGULARITY_CAP,
-        )
 
     def _margin(self, q: np.ndarray, jacobian: bool) -> Group:
         lim = self._limited

@@ -243,25 +243,27 @@ def _with_hidden(probe: Probe, path: Path) -> Path:
 def _hidden(probe: Probe, a: Point, b: Point) -> list[Point]:
     """Exact samples inserted between neighbours a and b of a path, in order: halving until
     no joint moves more than :data:`FINE_STEP` in a sub-cell, then until the Hermite models
-    of every sub-cell agree with its ends (module docstring)."""
-    inserted, cells = [], [(a, b)]
+    of every sub-cell agree with its ends (module docstring). The cell (a, b) itself, if
+    no joint moves more than FINE_STEP in it, is known not quiet (:func:`_with_hidden`)."""
+    inserted, cells = [], [(a, b, True)]  # (left, right, known not quiet if fine)
     while cells and len(inserted) < _MAX_INSERTED:
-        left, right = cells.pop()
-        t = 0.5 if probe.step(left.q, right.q) > FINE_STEP else _surprise(left, right)
+        left, right, loud = cells.pop()
+        t = 0.5 if probe.step(left.q, right.q) > FINE_STEP else _surprise(left, right, loud)
         if t is None or right.psi - left.psi <= END_TOLERANCE:
             continue
         middle, arrived = probe.follow(left, left.psi + t * (right.psi - left.psi))
         if arrived:
             inserted.append(middle)
-            cells += [(left, middle), (middle, right)]
+            cells += [(left, middle, False), (middle, right, False)]
     return sorted(inserted, key=lambda p: p.psi)
 
 
-def _surprise(a: Point, b: Point) -> float | None:
+def _surprise(a: Point, b: Point, loud: bool = False) -> float | None:
     """Where, as a fraction of the cell, the pieces' cubic models predict a feasibility that
     the ends do not explain: more changes between feasible and infeasible than the ends'
-    (none if alike, one if not). Returns the middle of the first unexplained stretch."""
-    if _quiet([a], [b])[0]:
+    (none if alike, one if not). Returns the middle of the first unexplained stretch.
+    ``loud``: the cell is known not to be quiet (:func:`_quiet`), which is not tested again."""
+    if not loud and a.evaluation.feasible == b.evaluation.feasible and _quiet([a], [b])[0]:
         return None
     (ga, da), (gb, db) = a.pieces(), b.pieces()
     if len(ga) == 0:

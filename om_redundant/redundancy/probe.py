@@ -41,7 +41,7 @@ class _Terms:
 
     def __init__(self, objective: Objective, q: np.ndarray, tangent: np.ndarray):
         self.objective, self.q, self.tangent = objective, q, tangent
-        self.pairs, self.evaluation, self.groups, self.bounds = None, None, None, None
+        self.pairs, self.evaluation, self.groups, self.bounds, self.pieces = None, None, None, None, None
 
     def get_pairs(self) -> tuple[np.ndarray, np.ndarray] | None:
         """The clearance's pair distances and gradients at q; None without obstacles."""
@@ -51,7 +51,8 @@ class _Terms:
 
     def get_evaluation(self) -> Evaluation:
         if self.evaluation is None:
-            self.evaluation = self.objective.evaluation(self.get_groups())
+            pairs = self.get_pairs()
+            self.evaluation = self.objective.evaluate(self.q, None if pairs is None else pairs[0])
         return self.evaluation
 
     def get_bounds(self) -> tuple[np.ndarray, np.ndarray]:
@@ -62,6 +63,23 @@ class _Terms:
             values, rates = self.objective.constraint_bounds(self.q[None], self.tangent[None], pairs)
             self.bounds = values[0], rates[0]
         return self.bounds
+
+    def get_pieces(self) -> tuple[np.ndarray, np.ndarray]:
+        """The feasibility functions and their rates (:meth:`Point.pieces`), from the groups
+        if already computed, else from the groups with a floor only."""
+        if self.pieces is None:
+            if self.groups is None:
+                groups = self.objective.constrained_groups(self.q, jacobian=True, pairs=self.get_pairs())
+                groups = [g.along(self.tangent) for g in groups]
+            else:
+                groups = self.groups
+            pieces = [g.constraints() for g in groups]
+            if pieces:
+                g, dg = zip(*pieces, strict=True)
+                self.pieces = np.concatenate(g), np.concatenate(dg)
+            else:
+                self.pieces = np.zeros(0), np.zeros(0)
+        return self.pieces
 
     def get_groups(self) -> list[Group]:
         if self.groups is None:
@@ -108,10 +126,7 @@ class Point:
     def pieces(self) -> tuple[np.ndarray, np.ndarray]:
         """The feasibility functions g_j (all >= 0 iff feasible; see
         :meth:`~om_redundant.redundancy.objective.Group.constraints`) and dg_j/dpsi."""
-        if not self.groups:
-            return np.zeros(0), np.zeros(0)
-        g, dg = zip(*(group.constraints() for group in self.groups), strict=True)
-        return np.concatenate(g), np.concatenate(dg)
+        return self.terms.get_pieces()
 
 
 class Probe:
