@@ -315,10 +315,8 @@ class Objective:
         for term in terms[1:]:
             value = value + term  # in the order of evaluate()'s sum
         slack = np.min(slacks, axis=0)
-        return [
-            Evaluation(*(float(x) for x in row))
-            for row in zip(value, margin, clearance, slack, singularity, strict=True)
-        ]
+        columns = (x.tolist() for x in (value, margin, clearance, slack, singularity))
+        return [Evaluation(*row) for row in zip(*columns, strict=True)]
 
     def constraint_bounds(
         self, q: np.ndarray, tangent: np.ndarray, pairs: tuple[np.ndarray, np.ndarray] | None
