@@ -352,18 +352,18 @@ class Objective:
             rates.append(np.abs(gradients @ tangent)[:, :, 0] / cap)
         return np.concatenate(values, axis=1), np.concatenate(rates, axis=1)
 
-    def term_functions(self, q: np.ndarray, clearance: np.ndarray) -> list[tuple[float, float, np.ndarray]]:
+    def term_functions(
+        self, q: np.ndarray, distances: np.ndarray | None
+    ) -> list[tuple[float, float, np.ndarray]]:
         """The objective at the rows of q as ``f = sum_g w_g min(cap_g, min_j values_j)``:
         per group its weight, its cap and its functions at every row. The margin's are the
-        limited joints' margins m_i, the clearance's the one function D(q)/d_cap (its pairs
-        are not kept), the singularity's the distances s_k / s_cap. For bounds of f from
-        bounds of each function (the climbs' starts,
-        :meth:`~om_redundant.RedundancyOptimizer.choose`).
+        limited joints' margins m_i, the clearance's the pairs' distances d_k / d_cap, the
+        singularity's the distances s_k / s_cap. For bounds of f from bounds of each
+        function (the climbs' starts, :meth:`~om_redundant.RedundancyOptimizer.choose`).
 
         Args:
             q: (M, dof) joint vectors.
-            clearance: (M,) their clearances D(q) (m), as the evaluations give them (unused
-                without obstacles).
+            distances: (M, P) the pairs' distances d_k(q) (m) (None without obstacles).
 
         Returns:
             [(w_g, cap_g, (M, p_g) values)] in the order of :meth:`groups`.
@@ -374,7 +374,7 @@ class Objective:
             margins = np.minimum(*_limit_distances(lim, self._lower, self._upper, self._half))
             groups.append((self.margin_weight, math.inf, margins))
         if self.clearance is not None:
-            groups.append((self.clearance_weight, 1.0, clearance[:, None] / self.clearance_cap))
+            groups.append((self.clearance_weight, 1.0, distances / self.clearance_cap))
         if self.singularity is not None:
             singular = self.singularity.distances(q) / SINGULARITY_CAP
             groups.append((self.singularity_weight, 1.0, singular))

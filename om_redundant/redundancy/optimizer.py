@@ -14,10 +14,11 @@ the exact OM solution in it:
    distance to its farther neighbour and L the largest slope between neighbouring samples
    (over every interval, times 2), a start can only lead above the smaller of
    ``f_start + L_f h`` and ``sum_g w_g min(cap_g, min_j (v_j + L_j h))``, the second with
-   each function v_j of each group (a joint's margin, the clearance, a singularity
+   each function v_j of each group (a joint's margin, a pair's distance, a singularity
    distance; :meth:`~om_redundant.redundancy.objective.Objective.term_functions`) bounded by
-   its own slope: a joint that the self-motion does not move (the elbow of an S-R-S arm)
-   binding the margin, with the other terms at their caps, bounds f by its start value.
+   its own slope: where what binds every term does not move with the self-motion (the
+   elbow of an S-R-S arm binding the margin, the hand nearest an obstacle, or a term at its
+   cap), f cannot rise above its start value.
    Starts are climbed best first, and those whose bound is below the best value found (by
    more than :data:`PLATEAU` when tracking; not above it by :data:`_CLIMB_ROUNDING`
    otherwise, a climb that could at most tie) are skipped. This is what finds the global
@@ -284,10 +285,10 @@ class RedundancyOptimizer:
         slope, limits, starts = 0.0, None, []
         for run in runs:
             psi = np.array([p.psi for p in run.points])
-            evaluations = [p.evaluation for p in run.points]
-            f = np.array([e.value for e in evaluations])
-            clearance = np.array([e.clearance for e in evaluations])
-            terms = self.objective.term_functions(np.array([p.q for p in run.points]), clearance)
+            f = np.array([p.evaluation.value for p in run.points])
+            pairs = [p.terms.get_pairs() for p in run.points]  # (computed for the evaluations)
+            distances = None if pairs[0] is None else np.array([d for d, _ in pairs])
+            terms = self.objective.term_functions(np.array([p.q for p in run.points]), distances)
             if len(f) > 1:
                 step = np.maximum(np.diff(psi), 1e-12)
                 slope = max(slope, float(np.max(np.abs(np.diff(f)) / step)))
