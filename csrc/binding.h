@@ -79,5 +79,6 @@ extern PyMethodDef om_tracking_functions[]; /* tracking.c: the redundancy optimi
 extern PyMethodDef om_clearance_functions[]; /* clearance.c: distances of arm and obstacle geoms */
 extern PyMethodDef om_follow_functions[];    /* follow.c: a solution path followed along psi */
 extern PyMethodDef om_tangent_functions[];   /* tangents.c: self-motion tangents of many rows */
+extern PyMethodDef om_objective_functions[]; /* objective.c: the redundancy optimiser's objective */
 
 #endif

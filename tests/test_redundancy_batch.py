@@ -40,8 +40,17 @@ def test_batched_evaluations_equal_the_single_ones(seed, name, count):
     q = joints(optimizer, seed)
     objective = optimizer.objective
     assert objective.evaluations(q) == [objective.evaluate(row) for row in q]
-    for row in q[:5]:  # f is the groups' terms summed in order
-        assert objective.evaluate(row).value == sum(g.term() for g in objective.groups(row))
+    for row in q[:5]:  # the groups' minima, capped, weighted and summed (C's sin or numpy's)
+        evaluation, groups = objective.evaluate(row), {g.kind: g for g in objective.groups(row)}
+        assert evaluation.value == pytest.approx(sum(g.term() for g in groups.values()), rel=0, abs=1e-15)
+        assert evaluation.margin == groups["margin"].values.min()
+        assert evaluation.slack == min(g.slack() for g in groups.values())
+        if "clearance" in groups:
+            assert evaluation.clearance == groups["clearance"].values.min() * objective.clearance_cap
+        if "singularity" in groups:
+            assert evaluation.singularity == pytest.approx(
+                groups["singularity"].values.min() * 0.5, abs=1e-16
+            )
         if objective.clearance is not None:
             distances = objective.clearance.distances_and_gradients(row)[0]
             assert objective.evaluate(row, distances) == objective.evaluate(row)

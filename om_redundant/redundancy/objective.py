@@ -46,6 +46,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import ckernels
 from ..exceptions import InvalidInput
 from ..kinematics.arm import Arm
 from ..validation import as_instance, as_joint_vector, as_number
@@ -223,6 +224,11 @@ class Objective:
         self._limited = np.flatnonzero(np.isfinite(arm.lower) & np.isfinite(arm.upper))
         self._lower, self._upper = arm.lower[self._limited], arm.upper[self._limited]
         self._half = (self._upper - self._lower) / 2.0
+        singular = (np.zeros(0, dtype=np.int64), np.zeros(0)) if singularity is None else singularity.rows()
+        numbers = (self.margin_weight, self.clearance_weight, self.singularity_weight)
+        numbers += (self.clearance_cap, self.min_clearance, SINGULARITY_CAP)
+        # what ckernels.evaluate reads (csrc/objective.c)
+        self._terms = (self._limited, self._lower, self._upper, self._half, *singular, np.array(numbers))
         eye = np.eye(self._dof)[self._limited] / self._half[:, None]
         self._margin_jacobian = np.vstack([eye, -eye])  # pieces (q - l)/h, then (u - q)/h
 
@@ -253,70 +259,30 @@ class Objective:
     def evaluate(self, q: np.ndarray, distances: np.ndarray | None = None) -> Evaluation:
         """f(q), M(q), D(q), the feasibility slack and S(q): each group's minimum
         (the smallest of its pieces, :meth:`groups`) capped and weighted, summed in the
-        groups' order.
+        groups' order (``ckernels.evaluate``, ``csrc/objective.c``).
 
         Args:
             q: (dof,) joint vector.
             distances: (P,) the clearance's pair distances at q if already computed.
         """
         q = as_joint_vector(q, self._dof, stack=False)
-        value, slacks = 0.0, []
-        margin = clearance = singularity = math.inf
-        if len(self._limited):
-            lim = q[self._limited]
-            lower, upper = _limit_distances(lim, self._lower, self._upper, self._half)
-            margin = min(float(lower.min()), float(upper.min()))
-            value += self.margin_weight * margin
-            slacks.append(margin - 0.0)
-        if self.clearance is not None:
-            if distances is None:
-                distances = self.clearance.distances(q)
-            scaled = float(distances.min()) / self.clearance_cap  # (= the least piece d_k / d_cap)
-            value += self.clearance_weight * min(1.0, scaled)
-            slacks.append(scaled - self.min_clearance / self.clearance_cap)
-            clearance = scaled * self.clearance_cap
-        if self.singularity is not None:
-            scaled = float(self.singularity.distances(q).min()) / SINGULARITY_CAP
-            value += self.singularity_weight * min(1.0, scaled)
-            singularity = scaled * SINGULARITY_CAP
-        return Evaluation(value, margin, clearance, min(slacks, default=math.inf), singularity)
+        return self.evaluations(q[None], None if distances is None else distances[None])[0]
 
     def evaluations(self, q: np.ndarray, distances: np.ndarray | None = None) -> list[Evaluation]:
-        """:meth:`evaluate` at every row of q (M, dof), vectorised over the rows (the same
-        values: each group's minimum is the minimum of its pieces, D(q) the smallest of
-        :meth:`Clearance.distances <om_redundant.Clearance.distances>`, as
-        :meth:`Clearance.minima <om_redundant.Clearance.minima>` gives it).
+        """:meth:`evaluate` at every row of q (M, dof), in one call.
 
         Args:
             q: (M, dof) joint vectors.
             distances: (M, P) the rows' pair distances if already computed (with obstacles).
         """
         q = as_joint_vector(q, self._dof).reshape(-1, self._dof)
-        inf = np.full(len(q), math.inf)
-        terms, slacks = [np.zeros(len(q))], [inf]
-        margin = clearance = singularity = inf
-        if len(self._limited):
-            lim = q[:, self._limited]
-            margin = np.minimum(*_limit_distances(lim, self._lower, self._upper, self._half)).min(axis=1)
-            terms.append(self.margin_weight * margin)
-            slacks.append(margin - 0.0)
-        if self.clearance is not None:
-            if distances is None:
-                distances = self.clearance.distances(q)
-            scaled = distances.min(axis=1) / self.clearance_cap
-            terms.append(self.clearance_weight * np.minimum(1.0, scaled))
-            slacks.append(scaled - self.min_clearance / self.clearance_cap)
-            clearance = scaled * self.clearance_cap
-        if self.singularity is not None:
-            scaled = self.singularity.distances(q).min(axis=1) / SINGULARITY_CAP
-            terms.append(self.singularity_weight * np.minimum(1.0, scaled))
-            singularity = scaled * SINGULARITY_CAP
-        value = terms[0]
-        for term in terms[1:]:
-            value = value + term  # in the order of evaluate()'s sum
-        slack = np.min(slacks, axis=0)
-        columns = (x.tolist() for x in (value, margin, clearance, slack, singularity))
-        return [Evaluation(*row) for row in zip(*columns, strict=True)]
+        if self.clearance is None:
+            distances = np.empty((len(q), 0))
+        elif distances is None:
+            distances = self.clearance.distances(q)
+        out = np.empty((len(q), 5))
+        ckernels.evaluate(self._dof, q, np.ascontiguousarray(distances, dtype=float), *self._terms, out)
+        return [Evaluation(*row) for row in out.tolist()]
 
     def constraint_bounds(
         self, q: np.ndarray, tangent: np.ndarray, pairs: tuple[np.ndarray, np.ndarray] | None
