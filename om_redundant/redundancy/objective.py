@@ -227,6 +227,10 @@ class Objective:
         singular = (np.zeros(0, dtype=np.int64), np.zeros(0)) if singularity is None else singularity.rows()
         numbers = (self.margin_weight, self.clearance_weight, self.singularity_weight)
         numbers += (self.clearance_cap, self.min_clearance, SINGULARITY_CAP)
+        # what ckernels.pieces reads: 2 d_cap, d_cap, d_min / d_cap; no pairs
+        self._clearance_numbers = np.array([self.clearance_reach, self.clearance_cap, 0.0])
+        self._clearance_numbers[2] = self.min_clearance / self.clearance_cap
+        self._no_pairs = (np.zeros(0), np.zeros((0, self._dof)))
         # what ckernels.evaluate reads (csrc/objective.c)
         self._terms = (self._limited, self._lower, self._upper, self._half, *singular, np.array(numbers))
         eye = np.eye(self._dof)[self._limited] / self._half[:, None]
@@ -283,6 +287,28 @@ class Objective:
         out = np.empty((len(q), 5))
         ckernels.evaluate(self._dof, q, np.ascontiguousarray(distances, dtype=float), *self._terms, out)
         return [Evaluation(*row) for row in out.tolist()]
+
+    def pieces(
+        self, q: np.ndarray, tangent: np.ndarray, pairs: tuple[np.ndarray, np.ndarray] | None
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The feasibility functions g_j at q (>= 0 iff feasible) and dg_j/dpsi: the
+        :meth:`Group.constraints` of the margin and clearance groups chained through the
+        tangent (``ckernels.pieces``, ``csrc/cells.c``; the same numbers to rounding).
+
+        Args:
+            q: (dof,) joint vector.
+            tangent: (dof, 1) dq/dpsi at q.
+            pairs: The pairs' distances (P,) and gradients (P, dof) at q; None without
+                obstacles.
+
+        Returns:
+            (g, dg), each (limited + P,).
+        """
+        distances, gradients = self._no_pairs if pairs is None else pairs
+        g, dg = np.empty((2, len(self._limited) + len(distances)))
+        limits = (self._limited, self._lower, self._upper, self._half)
+        ckernels.pieces(q, tangent[:, 0], distances, gradients, *limits, self._clearance_numbers, g, dg)
+        return g, dg
 
     def constraint_bounds(
         self, q: np.ndarray, tangent: np.ndarray, pairs: tuple[np.ndarray, np.ndarray] | None
