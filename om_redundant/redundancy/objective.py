@@ -269,8 +269,7 @@ class Objective:
             q: (dof,) joint vector.
             distances: (P,) the clearance's pair distances at q if already computed.
         """
-        q = as_joint_vector(q, self._dof, stack=False)
-        return self.evaluations(q[None], None if distances is None else distances[None])[0]
+        return Evaluation(*self._evaluated(as_joint_vector(q, self._dof, stack=False), distances).tolist())
 
     def evaluations(self, q: np.ndarray, distances: np.ndarray | None = None) -> list[Evaluation]:
         """:meth:`evaluate` at every row of q (M, dof), in one call.
@@ -280,13 +279,18 @@ class Objective:
             distances: (M, P) the rows' pair distances if already computed (with obstacles).
         """
         q = as_joint_vector(q, self._dof).reshape(-1, self._dof)
+        return [Evaluation(*row) for row in self._evaluated(q, distances).tolist()]
+
+    def _evaluated(self, q: np.ndarray, distances: np.ndarray | None) -> np.ndarray:
+        """``ckernels.evaluate`` at q, (dof,) or (M, dof): (5,) or (M, 5) the fields of
+        :class:`Evaluation`."""
         if self.clearance is None:
-            distances = np.empty((len(q), 0))
+            distances = self._no_pairs[0]
         elif distances is None:
             distances = self.clearance.distances(q)
-        out = np.empty((len(q), 5))
+        out = np.empty((*q.shape[:-1], 5))
         ckernels.evaluate(self._dof, q, np.ascontiguousarray(distances, dtype=float), *self._terms, out)
-        return [Evaluation(*row) for row in out.tolist()]
+        return out
 
     def pieces(
         self, q: np.ndarray, tangent: np.ndarray, pairs: tuple[np.ndarray, np.ndarray] | None
