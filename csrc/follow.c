@@ -7,7 +7,10 @@
  * by whole turns nearest mid-range c_i: c_i + wrap(q_i - c_i), for the feasible intervals)
  * and accepted when it continues the path (om_continues: no joint moved more than 1 rad,
  * |Delta q - t_k (x - psi_k)|_inf <= |Delta q|_inf / 2 + 1e-6, cyclic joints compared modulo
- * 2 pi); then h doubles, else it halves. Below min_step (probe.py's END_TOLERANCE) the path
+ * 2 pi); then h doubles, else it halves. The solve is the hinted one's local part alone
+ * (om_solve_near): where the local solve from q_k fails, the step is halved without the
+ * bounded search, whose answer there is mostly a costly "no" (q_k is nearer the solution
+ * at a shorter step, where the local solve succeeds). Below min_step (probe.py's END_TOLERANCE) the path
  * has ended there; min_step = |psi* - psi_0| makes it one attempt (Probe.next).
  * Each accepted point's tangent is om_self_motion_tangent's; where it does not exist (a
  * fold met exactly) the call stops and says so: the caller's own loop then decides. */
@@ -33,8 +36,7 @@ static int follow(const om_solver_data *s, const double *T, const int64_t *signs
     while (*psi != target) {
         if (fabs(step) < min_step) return FOLLOW_ENDED;
         double x = fabs(target - *psi) <= fabs(step) ? target : *psi + step;
-        om_result r = om_solve_one(s, T, signs, &x, q, x_q);
-        bool ok = r.status == OM_OK;
+        bool ok = om_solve_near(s, T, signs, &x, q, x_q);
         if (ok) {
             represent(dof, centred, centre, x_q);
             ok = om_continues(dof, q, x_q, t, x - *psi, cyclic);
