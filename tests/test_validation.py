@@ -80,15 +80,19 @@ def test_bad_joint_vectors(solver, pose, q, message):
         solver.solve(pose, C, q_hint=q)
 
 
-def test_batch_input_is_checked(solver, pose):
+@pytest.mark.parametrize("method", ["solve_batch", "solve_all_batch"])
+def test_batch_input_is_checked(solver, pose, method):
+    batch = getattr(solver, method)
     with pytest.raises(om.InvalidInput, match=r"\(M, 4, 4\)"):
-        solver.solve_batch(pose, (1, 1, 1))
+        batch(pose, (1, 1, 1))
     poses = np.stack([pose, pose])
     poses[1, 2, 3] = np.nan
     with pytest.raises(om.InvalidInput, match=r"T\[1\] contains NaN"):
-        solver.solve_batch(poses, (1, 1, 1))
+        batch(poses, (1, 1, 1))
     with pytest.raises(om.InvalidInput, match="-1 or \\+1"):
-        solver.solve_batch(np.stack([pose]), (1, 0, 1))
+        batch(np.stack([pose]), (1, 0, 1))
+    with pytest.raises(om.InvalidInput, match=r"signs must be one row or one row per pose \(2\), got 3 rows"):
+        batch(np.stack([pose, pose]), [(1, 1, 1)] * 3)
 
 
 _DEFECTS = {
