@@ -35,35 +35,57 @@ _ARRIVED, _SINGULAR = 0, 2  # ckernels.follow's status
 
 class _Terms:
     """The objective at a point, computed when first asked for (a path's following steps
-    need only the joints and the tangent): the evaluation, then the groups with their rates.
-    Shared by the copies of a point at other representatives of psi."""
+    need only the joints and the tangent): the clearance's pair distances and gradients
+    (one ``mj_kinematics``), from which the groups with their rates, the evaluation and
+    the constraint bounds. Shared by the copies of a point at other representatives of psi.
+    """
 
-    def __init__(
-        self, objective: Objective, q: np.ndarray, tangent: np.ndarray, evaluation: Evaluation | None
-    ):
+    def __init__(self, objective: Objective, q: np.ndarray, tangent: np.ndarray):
         self.objective, self.q, self.tangent = objective, q, tangent
-        self.evaluation, self.groups, self.bounds = evaluation, None, None
+        self.pairs, self.evaluation, self.groups, self.bounds, self.pieces = None, None, None, None, None
+
+    def get_pairs(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """The clearance's pair distances and gradients at q; None without obstacles."""
+        if self.pairs is None and self.objective.clearance is not None:
+            self.pairs = self.objective.clearance.distances_and_gradients(self.q)
+        return self.pairs
 
     def get_evaluation(self) -> Evaluation:
         if self.evaluation is None:
-            self.evaluation = self.objective.evaluation(self.objective.groups(self.q))
+            pairs = self.get_pairs()
+            self.evaluation = self.objective.evaluate(self.q, None if pairs is None else pairs[0])
         return self.evaluation
 
     def get_bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`~om_redundant.redundancy.objective.Objective.constraint_bounds` here."""
         if self.bounds is None:
-            clearance = self.objective.clearance
-            q, tangent = self.q[None], self.tangent[None]
-            distances = None if clearance is None else clearance.distances(q)
-            values, rates = self.objective.constraint_bounds(q, tangent, distances)
+            pairs = self.get_pairs()
+            pairs = None if pairs is None else (pairs[0][None], pairs[1][None])
+            values, rates = self.objective.constraint_bounds(self.q[None], self.tangent[None], pairs)
             self.bounds = values[0], rates[0]
         return self.bounds
 
+    def get_pieces(self) -> tuple[np.ndarray, np.ndarray]:
+        """The feasibility functions and their rates (:meth:`Point.pieces`), from the groups
+        if already computed, else from the groups with a floor only."""
+        if self.pieces is None:
+            if self.groups is None:
+                groups = self.objective.constrained_groups(self.q, jacobian=True, pairs=self.get_pairs())
+                groups = [g.along(self.tangent) for g in groups]
+            else:
+                groups = self.groups
+            pieces = [g.constraints() for g in groups]
+            if pieces:
+                g, dg = zip(*pieces, strict=True)
+                self.pieces = np.concatenate(g), np.concatenate(dg)
+            else:
+                self.pieces = np.zeros(0), np.zeros(0)
+        return self.pieces
+
     def get_groups(self) -> list[Group]:
         if self.groups is None:
-            self.groups = [g.along(self.tangent) for g in self.objective.groups(self.q, jacobian=True)]
-            if self.evaluation is None:
-                self.evaluation = self.objective.evaluation(self.groups)
+            groups = self.objective.groups(self.q, jacobian=True, pairs=self.get_pairs())
+            self.groups = [g.along(self.tangent) for g in groups]
         return self.groups
 
 
@@ -87,6 +109,11 @@ class Point:
     terms: _Terms
     solution: Solution | None = None
 
+    def at(self, psi: float | np.ndarray) -> Point:
+        """The same solution at another representative of psi (itself at the same psi)."""
+        same = isinstance(psi, float) and psi == self.psi
+        return self if same else Point(psi, self.q, self.tangent, self.terms, self.solution)
+
     @property
     def evaluation(self) -> Evaluation:
         """The objective at q."""
@@ -100,10 +127,7 @@ class Point:
     def pieces(self) -> tuple[np.ndarray, np.ndarray]:
         """The feasibility functions g_j (all >= 0 iff feasible; see
         :meth:`~om_redundant.redundancy.objective.Group.constraints`) and dg_j/dpsi."""
-        if not self.groups:
-            return np.zeros(0), np.zeros(0)
-        g, dg = zip(*(group.constraints() for group in self.groups), strict=True)
-        return np.concatenate(g), np.concatenate(dg)
+        return self.terms.get_pieces()
 
 
 class Probe:
@@ -166,24 +190,26 @@ class Probe:
 
     def _point(self, psi: float | np.ndarray, q: np.ndarray, solution: Solution | None) -> Point:
         tangent = self_motion_tangent(self.solver, q)
-        return Point(psi, q, tangent, _Terms(self.objective, q, tangent, None), solution)
+        return Point(psi, q, tangent, _Terms(self.objective, q, tangent), solution)
 
     def points(self, psi: np.ndarray, q: np.ndarray) -> list[Point]:
         """:meth:`point` for every psi and row of q (M, dof) of a 7-DOF arm, the tangents, the
-        evaluations and the constraint bounds computed for all rows at once."""
+        clearance's distances and gradients, the evaluations and the constraint bounds
+        computed for all rows at once."""
         q = self._represent(q)
         tangents = self_motion_tangents(self.solver, q)
         bad = ~np.isfinite(tangents).all(axis=(1, 2))
         if bad.any():
             self_motion_tangent(self.solver, q[np.argmax(bad)])  # raises SingularSelfMotion
         clearance = self.objective.clearance
-        distances = None if clearance is None else clearance.distances(q)
-        evaluations = self.objective.evaluations(q, distances)
-        values, rates = self.objective.constraint_bounds(q, tangents, distances)
+        pairs = None if clearance is None else clearance.distances_and_gradients(q)
+        evaluations = self.objective.evaluations(q, None if pairs is None else pairs[0])
+        values, rates = self.objective.constraint_bounds(q, tangents, pairs)
         points = []
-        for x, row, t, ev, v, r in zip(psi, q, tangents, evaluations, values, rates, strict=True):
-            terms = _Terms(self.objective, row, t, ev)
-            terms.bounds = v, r
+        for k, (x, row, t, ev) in enumerate(zip(psi, q, tangents, evaluations, strict=True)):
+            terms = _Terms(self.objective, row, t)
+            terms.pairs = None if pairs is None else (pairs[0][k], pairs[1][k])
+            terms.evaluation, terms.bounds = ev, (values[k], rates[k])
             points.append(Point(float(x), row, t, terms))
         return points
 
@@ -207,6 +233,17 @@ class Probe:
         moved = self._delta(point.q, q)
         error = moved - point.tangent @ np.atleast_1d(psi - point.psi)
         return np.abs(moved).max() <= JUMP and np.abs(error).max() <= 0.5 * np.abs(moved).max() + SAME
+
+    def continue_rows(
+        self, psi_a: np.ndarray, psi_b: np.ndarray, q_a: np.ndarray, tangent_a: np.ndarray, q_b: np.ndarray
+    ) -> np.ndarray:
+        """:meth:`continues` for M pairs at once (the same operations row by row): whether
+        the solutions (psi_b, q_b) continue the paths of (psi_a, q_a) with tangents
+        ``tangent_a`` (M, dof) (r = 1)."""
+        moved = self._delta(q_a, q_b)
+        error = moved - tangent_a * (psi_b - psi_a)[:, None]
+        jump = np.abs(moved).max(axis=1)
+        return (jump <= JUMP) & (np.abs(error).max(axis=1) <= 0.5 * jump + SAME)
 
     def next(self, point: Point, psi: float | np.ndarray) -> Point | None:
         """The solution at psi nearest point, if it continues point's path (the objective
@@ -286,7 +323,7 @@ class Probe:
         if steps == 0:
             return start, status == _ARRIVED
         q, tangent = work.q.copy(), work.t.copy()[:, None]
-        return Point(reached, q, tangent, _Terms(self.objective, q, tangent, None)), status == _ARRIVED
+        return Point(reached, q, tangent, _Terms(self.objective, q, tangent)), status == _ARRIVED
 
 
 class FollowWork(NamedTuple):
