@@ -321,7 +321,7 @@ class OMSolver:
                 answers do not depend on it.
 
         Returns:
-            A :class:`BatchSolution` with M rows. An empty batch (M = 0) gives empty rows.
+            A :class:`BatchSolution` with M rows.
 
         Raises:
             InvalidInput: A malformed argument, or one whose rows do not match the M poses.
@@ -340,8 +340,7 @@ class OMSolver:
         def solve_range(start: int, stop: int) -> None:
             kernel.solve_rows(T, signs, redundancy, hints, start, stop, q, info)
 
-        if m:
-            system.run_rows(solve_range, m, threads)
+        system.run_rows(solve_range, m, threads)
         status = info[:, 0].astype(np.int64)
         return BatchSolution(
             q,
@@ -378,8 +377,7 @@ class OMSolver:
         def solve_range(start: int, stop: int) -> None:
             kernel.solve_all_rows(T, signs, redundancy, start, stop, roots, info, counts)
 
-        if m:
-            system.run_rows(solve_range, m, threads)
+        system.run_rows(solve_range, m, threads)
         return BatchRoots(roots, counts[:, 0], info[..., 0], info[..., 1], counts[:, 1], info[..., 2] > 0.0)
 
     def check_configuration(self, configuration: Configuration) -> None:
