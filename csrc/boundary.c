@@ -36,9 +36,12 @@ bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori)
     const om_solver_data *s = pb->s;
     int branch = -1;
     double nearest = nearest_branch(s, q, &branch);
-    if (!(nearest < NEAR_BOUNDARY))
-        return false;
     bool srs = s->family == OM_SRS;
+    /* Next to psi's singular half-line the circle's root holds q to a few digits only: g turns
+     * by 2 pi within 1e-16 / rho of w there, the model's reference n by 1e-16 / rho rad */
+    bool half_line = srs && om_srs_half_line_angle(s->params, q) < NEAR_BOUNDARY;
+    if (!(nearest < NEAR_BOUNDARY) && !half_line)
+        return false;
     om_polish_task t = {s->real_table, s->n_real_rows, s->dof, srs ? s->params : NULL,
                         srs ? s->model_table : NULL, s->n_model_rows, pb->t.R, pb->p,
                         srs ? pb->redundancy[0] : 0.0, srs ? (double)pb->signs[ELBOW_SIGN] : 0.0, true};
@@ -52,7 +55,7 @@ bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori)
      * q1 and in the ARM quantity); with a lateral offset, as at every other boundary, only
      * within SPLIT_NEAR of it. */
     bool on_axis = s->family == OM_SRS || s->params[SD_LATERAL] == 0.0;
-    if (branch == ELBOW_SIGN || ((branch != SHOULDER_SIGN || !on_axis) && !(nearest < SPLIT_NEAR)))
+    if (!(nearest < NEAR_BOUNDARY) || branch == ELBOW_SIGN || ((branch != SHOULDER_SIGN || !on_axis) && !(nearest < SPLIT_NEAR)))
         return false;
     /* The wrist centre on joint 1's axis: the model's q1 is arbitrary there (atan2 of a
      * vanishing pair), the real arm's is not: starts around the circle of q1, each with the

@@ -4,6 +4,11 @@
 
 #define CELL_SAFETY 4.0  /* the curvature of g taken as this multiple of its sampled second differences */
 #define CELL_HALVINGS 6  /* halvings of a scan cell that may hide roots: 16 points as fine as 1024 */
+#define POLE_TURN (0.25 * OM_PI) /* rad: the most w_hat's azimuth about up turns in one cell below the shoulder */
+#define POLE_SPLITS 3            /* split points on either side of a close pass: azimuth steps of pi / 8 */
+#define POLE_DEPTH 64            /* nested splits of a cell at psi's half-line: to the last bit */
+#define POLE_NEWTON 8            /* Newton steps to the closest pass of h to zero in a cell */
+#define POLE_ROUNDING 1e-15      /* relative rounding of W - S: of |e| + |u1| + |u2| (DBL_EPSILON 2.2e-16) */
 
 /* out[n] = v if there is room; returns the new count (the candidates' capacity is a bound, checked). */
 static int _put(double *out, int n, int cap, double v)
@@ -78,6 +83,138 @@ static int _cell_roots(om_problem *pb, double a, double ga, double b, double gb,
     return _cell_roots(pb, m, gm, b, gb, curvature, halvings - 1, q, out, n, cap);
 }
 
+/* psi's singular half-line on the circle. The model's shoulder-wrist vector is x(w) = W(w) -
+ * S = e + u1 cos w + u2 sin w (om_srs_wrist_circle), an ellipse: its part across up, h(w), and
+ * its height z(w) = up . x(w). Where x passes close by -up (the wrist centre straight below the
+ * shoulder), psi's reference n(w_hat) = R(up -> w_hat) r turns by about twice the azimuth of h,
+ * a full turn within a fraction of a scan cell when h passes close by zero, and with it q_J
+ * and g: a root there is not bracketed by the samples. Such a cell is split until the azimuth
+ * turns by at most POLE_TURN in each part, by a bound: on a cell [a, b] of width L, h stays
+ * within sigma L^2 t (1 - t) / 2 of its chord h(a) + t (h(b) - h(a)) (|h''| <= sigma, the
+ * largest singular value of u1, u2 across up), so where the chord keeps farther than that
+ * from zero, the azimuth of h turns across the cell as the chord's ends show. */
+typedef struct {
+    bool active; /* some cell may be one to split (a bound over the whole ellipse) */
+    vec3 up, e, u1, u2;
+    double sigma;   /* bounds |h'| and |h''| */
+    double sigma_z; /* bounds |z''| */
+    double slack;   /* rounding of x(w) (m) */
+} pole_guard;
+
+/* The part of x across up. */
+static vec3 _across(const pole_guard *pole, vec3 x)
+{
+    return v_sub(x, v_scale(v_dot(pole->up, x), pole->up));
+}
+
+/* The guard of the circle for scan cells of width L: active unless every cell keeps the
+ * azimuth's turn below POLE_TURN (the whole ellipse above the shoulder, or h everywhere at
+ * least M = |e across| - sigma from zero: its turn across a cell is at most sigma L / M, and
+ * its chords keep 3 sigma L^2 / 8 clear of zero where M exceeds that). */
+static pole_guard _pole_guard(om_problem *pb, double L)
+{
+    pole_guard pole = {false};
+    if (pb->s->family != OM_SRS)
+        return pole;
+    pole.up = v_load(pb->s->params, SRS_UP);
+    om_srs_wrist_circle(pb, &pole.e, &pole.u1, &pole.u2);
+    vec3 a1 = _across(&pole, pole.u1), a2 = _across(&pole, pole.u2);
+    double p = 0.5 * (v_dot(a1, a1) + v_dot(a2, a2)), d = 0.5 * (v_dot(a1, a1) - v_dot(a2, a2));
+    pole.sigma = sqrt(p + sqrt(d * d + v_dot(a1, a2) * v_dot(a1, a2)));
+    double z1 = v_dot(pole.up, pole.u1), z2 = v_dot(pole.up, pole.u2);
+    pole.sigma_z = sqrt(z1 * z1 + z2 * z2);
+    pole.slack = POLE_ROUNDING * (v_norm(pole.e) + v_norm(pole.u1) + v_norm(pole.u2));
+    double nearest = v_norm(_across(&pole, pole.e)) - pole.sigma;
+    double needed = py_max(0.375 * pole.sigma * L * L, pole.sigma * L / POLE_TURN) + pole.slack;
+    pole.active = v_dot(pole.up, pole.e) - pole.sigma_z < pole.slack && nearest <= needed;
+    return pole;
+}
+
+/* x(w) on the ellipse. */
+static vec3 _shoulder_wrist(const pole_guard *pole, double w)
+{
+    return v_add(pole->e, v_add(v_scale(cos(w), pole->u1), v_scale(sin(w), pole->u2)));
+}
+
+/* Whether |h0 + t d| > K t + slack for t in [0, 1/2]: the squares' difference is a quadratic
+ * A t^2 + B t + C, positive at both ends and at its vertex if that lies inside. */
+static bool _clear_of_zero(vec3 h0, vec3 d, double K, double slack)
+{
+    double A = v_dot(d, d) - K * K, B = 2.0 * (v_dot(h0, d) - K * slack), C = v_dot(h0, h0) - slack * slack;
+    double f = A * 0.25 + B * 0.5 + C, t = A > 0.0 ? -B / (2.0 * A) : 0.0;
+    return C > 0.0 && f > 0.0 && !(0.0 < t && t < 0.5 && C - B * B / (4.0 * A) <= 0.0);
+}
+
+/* Where the cell [a, b] is to be split at psi's half-line: 0 if it is calm (above the
+ * shoulder all along, or the azimuth of h turns by at most POLE_TURN across it, by the bound
+ * above: the deviation sigma L^2 t (1 - t) / 2 is at most K min(t, 1 - t), K = sigma L^2 / 2);
+ * else the split points in (a, b), ascending, into split (2 POLE_SPLITS + 1): around h's
+ * closest pass w* to zero (Newton on h . h' = 0 from the chord's), at distance rho with speed
+ * v there, w* + (rho / v) tan(k pi / 8), k = -3 ... 3, between which a straight pass turns the
+ * azimuth by pi / 8 (the midpoint if none of them lies inside, as at a pass through zero to
+ * the last bit). A part that is still not calm is split again (_run_roots' depth). Returns
+ * the count. */
+static int _pole_splits(const pole_guard *pole, double a, double b, double *split)
+{
+    vec3 xa = _shoulder_wrist(pole, a), xb = _shoulder_wrist(pole, b);
+    double width = b - a, sag_z = 0.125 * pole->sigma_z * width * width + pole->slack;
+    if (v_dot(pole->up, xa) > sag_z && v_dot(pole->up, xb) > sag_z) /* above the shoulder all along */
+        return 0;
+    vec3 ha = _across(pole, xa), hb = _across(pole, xb), d = v_sub(hb, ha);
+    double K = 0.5 * pole->sigma * width * width;
+    if (atan2(v_norm(v_cross(ha, hb)), v_dot(ha, hb)) <= POLE_TURN && _clear_of_zero(ha, d, K, pole->slack) &&
+        _clear_of_zero(hb, v_scale(-1.0, d), K, pole->slack))
+        return 0;
+    double dd = v_dot(d, d), centre = a + (dd > 0.0 ? py_min(py_max(-v_dot(ha, d) / dd, 0.0), 1.0) : 0.0) * width;
+    vec3 h, speed; /* h and h' at the pass */
+    for (int it = 0; it < POLE_NEWTON; it++) { /* Newton on (|h|^2)' / 2 = h . h' from the chord's pass */
+        double c = cos(centre), s = sin(centre);
+        h = _across(pole, _shoulder_wrist(pole, centre));
+        speed = _across(pole, v_sub(v_scale(c, pole->u2), v_scale(s, pole->u1)));
+        vec3 bend = v_sub(_across(pole, pole->e), h); /* h'' = -(h - e across) */
+        double slope = v_dot(speed, speed) + v_dot(h, bend);
+        double next = py_min(py_max(centre - v_dot(h, speed) / slope, a), b);
+        if (!(slope > 0.0) || next == centre)
+            break;
+        centre = next;
+    }
+    double v = v_norm(speed), scale = v > 0.0 ? v_norm(h) / v : 0.0;
+    int n = 0;
+    for (int k = -POLE_SPLITS; k <= POLE_SPLITS; k++) {
+        double w = centre + scale * tan((double)k * OM_PI / (2.0 * (double)POLE_SPLITS + 2.0));
+        if (a < w && w < b && (n == 0 || w > split[n - 1]))
+            split[n++] = w;
+    }
+    double middle = 0.5 * (a + b);
+    if (n == 0 && a < middle && middle < b)
+        split[n++] = middle;
+    return n;
+}
+
+static int _run_roots(om_problem *pb, const pole_guard *pole, int depth, const double *pw, const double *pg, int L,
+                      bool cyclic, double *q, double *out, int n, int cap);
+
+/* The roots on the cell [a, b] of a run (both ends reachable) split at the points split[0 ..
+ * k): a run of its own (_run_roots, depth splits more at most), so that its parts get the
+ * curvature estimates and the close-pair search of the run's samples. A split point out of
+ * reach is left out. */
+static int _split_roots(om_problem *pb, const pole_guard *pole, int depth, double a, double ga, const double *split,
+                        int k, double b, double gb, double *q, double *out, int n, int cap)
+{
+    double sw[2 * POLE_SPLITS + 3], sg[2 * POLE_SPLITS + 3];
+    int m = 1;
+    sw[0] = a;
+    sg[0] = ga;
+    for (int i = 0; i < k; i++) {
+        sw[m] = split[i];
+        sg[m] = om_g(pb, split[i], q, false);
+        m += !isnan(sg[m]);
+    }
+    sw[m] = b;
+    sg[m] = gb;
+    return _run_roots(pb, pole, depth, sw, sg, m + 1, false, q, out, n, cap);
+}
+
 /* CELL_SAFETY times |g''| estimated at run point i from the wrapped slopes of its two cells
  * (0 at the ends of a run that is not cyclic). */
 static double _curvature_at(const double *pw, const double *pg, int L, bool cyclic, int i)
@@ -112,10 +249,11 @@ static int _pair(om_problem *pb, double a, double ga, double x0, double b, doubl
 /* Add the roots on a run of reachable points (w ascending) to out[n:]; returns the count.
  * Sign changes bracket roots; local minima of |g| are searched for close pairs; a touch of
  * zero (|g| < OM_TOUCH without a crossing, also at an edge of reach) is a candidate for the
- * singular boundary, where the closed form's last digits are lost. A cyclic run covers the
- * whole circle. */
-static int _run_roots(om_problem *pb, const double *pw, const double *pg, int L, bool cyclic, double *q,
-                      double *out, int n, int cap)
+ * singular boundary, where the closed form's last digits are lost. A cell where w_hat passes
+ * close by psi's half-line is split first (_pole_splits, at most depth times nested). A
+ * cyclic run covers the whole circle. */
+static int _run_roots(om_problem *pb, const pole_guard *pole, int depth, const double *pw, const double *pg, int L,
+                      bool cyclic, double *q, double *out, int n, int cap)
 {
     if (!cyclic) { /* g near zero at an edge of reach: a root at the singular boundary there */
         if (fabs(pg[0]) < OM_TOUCH)
@@ -130,7 +268,12 @@ static int _run_roots(om_problem *pb, const double *pw, const double *pg, int L,
         for (int k = i - 1; k <= i + 2; k++)
             if (cyclic || (k >= 0 && k < L))
                 curvature = py_max(curvature, _curvature_at(pw, pg, L, cyclic, py_mod(k, L)));
-        n = _cell_roots(pb, pw[i], pg[i], wj, pg[j], curvature, CELL_HALVINGS, q, out, n, cap);
+        double split[2 * POLE_SPLITS + 1];
+        int k = pole->active && depth > 0 ? _pole_splits(pole, pw[i], wj, split) : 0;
+        if (k)
+            n = _split_roots(pb, pole, depth - 1, pw[i], pg[i], split, k, wj, pg[j], q, out, n, cap);
+        else
+            n = _cell_roots(pb, pw[i], pg[i], wj, pg[j], curvature, CELL_HALVINGS, q, out, n, cap);
     }
     for (int i = 0; i < L; i++) {
         double gi = pg[i];
@@ -199,6 +342,7 @@ int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool f
     double *ws = buffer, *gs = ws + (n_pts + 1), *ms = gs + (n_pts + 1);
     double *rws = ms + (n_pts + 1), *rgs = rws + count, *rms = rgs + count;
     double *pw = rms + count, *pg = pw + (count + 2);
+    pole_guard pole = _pole_guard(pb, h);
     int start = -1;
     for (int k = 0; k < n_pts; k++) {
         ws[k] = lo + h * (double)k;
@@ -208,7 +352,7 @@ int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool f
     }
     int n = 0;
     if (full_circle && start < 0) { /* reachable everywhere: one cyclic run */
-        n = _run_roots(pb, ws, gs, n_pts, true, q, cands, n, cap);
+        n = _run_roots(pb, &pole, POLE_DEPTH, ws, gs, n_pts, true, q, cands, n, cap);
         free(buffer);
         free(order);
         return n;
@@ -243,7 +387,7 @@ int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool f
         if (L > 0) { /* leaving reach */
             pw[L] = om_reach_edge(pb, pw[L - 1], w, q);
             pg[L] = om_g(pb, pw[L], q, false);
-            n = _run_roots(pb, pw, pg, L + 1, false, q, cands, n, cap);
+            n = _run_roots(pb, &pole, POLE_DEPTH, pw, pg, L + 1, false, q, cands, n, cap);
             L = 0;
         }
         if (i + 1 < count && isnan(gs[i + 1])) {
@@ -259,13 +403,13 @@ int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool f
                     pw[2] = om_reach_edge(pb, c, ws[i + 1], q);
                     pg[0] = om_g(pb, pw[0], q, false);
                     pg[2] = om_g(pb, pw[2], q, false);
-                    n = _run_roots(pb, pw, pg, 3, false, q, cands, n, cap);
+                    n = _run_roots(pb, &pole, POLE_DEPTH, pw, pg, 3, false, q, cands, n, cap);
                 }
             }
         }
     }
     if (L > 0) /* a run that reaches the end of the window */
-        n = _run_roots(pb, pw, pg, L, false, q, cands, n, cap);
+        n = _run_roots(pb, &pole, POLE_DEPTH, pw, pg, L, false, q, cands, n, cap);
     free(buffer);
     free(order);
     return n;

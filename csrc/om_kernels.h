@@ -134,6 +134,7 @@ double om_srs_arm_angle_trig(const double *P, const double *trig, double elbow);
 void om_srs_branch_values(const double *P, const double *q, double *out);
 void om_srs_branch_values_trig(const double *P, const double *q, const double *trig, double *out);
 /* psi at q of the S-R-S model with parameters P and DH table; writes d psi / dq (7). */
+double om_srs_half_line_angle(const double *P, const double *q); /* w_hat's angle from -up at q */
 double om_arm_angle_gradient(const double *P, const double *table, int n_rows, const double *q, double *grad);
 
 /* Dispatch on the family (families.c). */
@@ -197,6 +198,8 @@ double om_g(om_problem *pb, double w, double *q, bool all_joints);
 double om_reach_margin(om_problem *pb, double w, double *q);
 /* S-R-S: whether the model may reach the circle's points somewhere in [a, b] (a bound; see residual.c). */
 bool om_srs_reach_possible(om_problem *pb, double a, double b);
+/* S-R-S: W(w) - S = e + u1 cos w + u2 sin w on the circle. */
+void om_srs_wrist_circle(const om_problem *pb, vec3 *e, vec3 *u1, vec3 *u2);
 bool om_margin_may_reach(const double *ms, int i, int count, bool cyclic);
 vec3 om_lifted_residual(om_problem *pb, vec3 x, double *q);
 vec3 om_deflated_residual(om_problem *pb, vec3 x, double *q, const double *known, int n_known); /* known: n x 3 */
@@ -304,6 +307,13 @@ void om_flange_target(const double *T, const double *T_base_root, const double *
 /* hint NULL: no hint. */
 om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
                        const double *hint, double *q_out);
+/* om_solve_one's local part alone, for a hint: the root the local solve from the hint
+ * reaches, replaced by any root nearer the hint, into q_out (revolute joints at the turn
+ * nearest the hint). Returns false where the local solve fails, without the bounded search
+ * that would follow in om_solve_one: a solution may still exist (the path following halves
+ * such a step, where that search's costly "no" would be wasted). */
+bool om_solve_near(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
+                   const double *hint, double *q_out);
 /* Every root (OM_MAX_ROOTS x dof) with per root (position error, orientation error, within limits)
  * in info (OM_MAX_ROOTS x 3). Returns the count; *evaluations the residual evaluations. */
 int om_solve_all(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,

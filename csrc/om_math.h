@@ -54,6 +54,8 @@ static inline vec3 v_scale(double k, vec3 a) { return v3(k * a.x, k * a.y, k * a
 
 static inline double v_dot(vec3 a, vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 
+static inline double v_norm(vec3 a) { return sqrt(v_dot(a, a)); }
+
 static inline vec3 v_cross(vec3 a, vec3 b)
 {
     return v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);

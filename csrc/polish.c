@@ -11,8 +11,21 @@
 #define POLISH_DONE 1e-15      /* residual (m, rad) below which the refinement stops */
 #define POLISH_WINDOW 10       /* Jacobians over which |e| must at least halve while above POLISH_FAR */
 #define POLISH_FAR 1e-6        /* residual (m, rad) above which a crawl is given up */
+/* |grad psi| beyond which the arm-angle row is divided by |grad psi| / PSI_ROW_SCALE: next to
+ * psi's singular half-line |grad psi| grows as 1 / rho, and that row would swamp the pose rows
+ * (the damping is relative to the largest row) while its residual is psi's rounding there */
+#define PSI_ROW_SCALE 1e3
 
 static const double IDENTITY[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+
+/* The divisor of the arm-angle row at q with d psi / dq = grad: max(1, |grad| / PSI_ROW_SCALE). */
+static double psi_row_scale(const double *grad, int dof)
+{
+    double g2 = 0.0;
+    for (int j = 0; j < dof; j++)
+        g2 += grad[j] * grad[j];
+    return py_max(1.0, sqrt(g2) / PSI_ROW_SCALE);
+}
 
 /* The residual e (rows: p - p(q); the rotation vector of R R(q)^T; psi - psi(q)) in DH frame 0;
  * returns its squared norm. */
@@ -33,11 +46,12 @@ static double residual(const om_polish_task *t, const double *q, double *e)
     e[5] = k * w.z;
     int rows = t->P ? 7 : 6;
     if (t->P) {
-        double psi = om_arm_angle_gradient(t->P, t->model_table, t->n_model_rows, q, NULL);
+        double grad[OM_MAX_DOF];
+        double psi = om_arm_angle_gradient(t->P, t->model_table, t->n_model_rows, q, grad);
         /* psi's reference flips by pi with the ELBOW branch: read it in the requested one */
         double own = sin(q[3] + t->P[SRS_THETA + 3] - t->P[SRS_PHI_STAR]) < 0.0 ? -1.0 : 1.0;
         bool flipped = t->elbow != 0.0 && own != t->elbow;
-        e[6] = om_wrap(t->psi + (flipped ? OM_PI : 0.0) - psi);
+        e[6] = om_wrap(t->psi + (flipped ? OM_PI : 0.0) - psi) / psi_row_scale(grad, t->dof);
     }
     double cost = 0.0;
     for (int i = 0; i < rows; i++)
@@ -49,8 +63,13 @@ static double residual(const om_polish_task *t, const double *q, double *e)
 static void jacobian(const om_polish_task *t, const double *q, double *J)
 {
     om_jacobian(t->table, t->n_rows, IDENTITY, IDENTITY, q, t->dof, J);
-    if (t->P)
-        om_arm_angle_gradient(t->P, t->model_table, t->n_model_rows, q, J + 6 * t->dof);
+    if (t->P) {
+        double *row = J + 6 * t->dof, scale;
+        om_arm_angle_gradient(t->P, t->model_table, t->n_model_rows, q, row);
+        scale = psi_row_scale(row, t->dof);
+        for (int j = 0; j < t->dof; j++)
+            row[j] /= scale;
+    }
 }
 
 /* Solve the symmetric positive definite A y = b (n x n, A overwritten by its Cholesky

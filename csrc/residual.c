@@ -89,6 +89,17 @@ double om_reach_margin(om_problem *pb, double w, double *q)
     return margin;
 }
 
+/* The S-R-S model's shoulder-wrist vector on the circle, W(w) - S = e + u1 cos w + u2 sin w:
+ * e = p_d + R D0 + R w_F - S, u1 = R D1, u2 = R D2. */
+void om_srs_wrist_circle(const om_problem *pb, vec3 *e, vec3 *u1, vec3 *u2)
+{
+    const double(*D)[3] = pb->s->D;
+    const mat3 *R = &pb->t.R;
+    *e = v_add(v_add(pb->p, pb->t.wrist), m_mv(*R, v_load(D[0], 0)));
+    *u1 = m_mv(*R, v_load(D[1], 0));
+    *u2 = m_mv(*R, v_load(D[2], 0));
+}
+
 /* Whether an S-R-S model may reach p_d + R delta(w) for some w in [a, b], where it reaches
  * neither end: the elbow's x(w) = (L2(w) - k0) / K must come within [-1, 1]. With e = p_d +
  * R D0 + R w_F - S, u1 = R D1, u2 = R D2, L2(w) = |e + u1 cos w + u2 sin w|^2 = c0 + a1 cos w
@@ -99,15 +110,13 @@ double om_reach_margin(om_problem *pb, double w, double *q)
 bool om_srs_reach_possible(om_problem *pb, double a, double b)
 {
     const double *P = pb->s->params;
-    const double(*D)[3] = pb->s->D;
-    const mat3 *R = &pb->t.R;
     double xa = NAN, xb = NAN;
     om_srs_reach(P, &pb->t, on_circle(pb, a), &xa);
     om_srs_reach(P, &pb->t, on_circle(pb, b), &xb);
     if (isnan(xa) || isnan(xb)) /* W = S at an end */
         return true;
-    vec3 e = v_add(v_add(pb->p, pb->t.wrist), m_mv(*R, v_load(D[0], 0)));
-    vec3 u1 = m_mv(*R, v_load(D[1], 0)), u2 = m_mv(*R, v_load(D[2], 0));
+    vec3 e, u1, u2;
+    om_srs_wrist_circle(pb, &e, &u1, &u2);
     double a1 = 2.0 * v_dot(e, u1), b1 = 2.0 * v_dot(e, u2);
     double a2 = 0.5 * (v_dot(u1, u1) - v_dot(u2, u2)), b2 = v_dot(u1, u2);
     double curvature = (sqrt(a1 * a1 + b1 * b1) + 4.0 * sqrt(a2 * a2 + b2 * b2)) / P[SRS_K];

@@ -16,13 +16,22 @@ static mat3 rx(double sigma)
     return A;
 }
 
+/* 1 + up . w_hat for unit vectors, v = up x w_hat: to its last digits also near w_hat = -up,
+ * where 1 + up . w_hat = |v|^2 / (1 - up . w_hat) has no cancellation (1 + up . w_hat
+ * itself keeps only 1e-16 of it: relative error 1e-16 / angle^2 from the half-line). */
+static double one_plus_cos(vec3 up, vec3 w_hat, vec3 v)
+{
+    double c = v_dot(up, w_hat);
+    return c < 0.0 ? v_dot(v, v) / (1.0 - c) : 1.0 + c;
+}
+
 /* The arm angle's reference direction n(w_hat) = R(up -> w_hat) r, and w_hat x n (_reference). */
 void om_srs_reference(const double *P, vec3 w_hat, vec3 *n, vec3 *nw)
 {
     vec3 up = v_load(P, SRS_UP), r = v_load(P, SRS_REF);
     vec3 v = v_cross(up, w_hat);
     vec3 vr = v_cross(v, r);
-    *n = v_unit(v_add(v_add(r, vr), v_scale(1.0 / py_max(1.0 + v_dot(up, w_hat), 1e-300), v_cross(v, vr))));
+    *n = v_unit(v_add(v_add(r, vr), v_scale(1.0 / py_max(one_plus_cos(up, w_hat, v), 1e-300), v_cross(v, vr))));
     *nw = v_cross(w_hat, *n);
 }
 
@@ -299,6 +308,21 @@ double om_srs_arm_angle_trig(const double *P, const double *trig, double elbow)
     return atan2(v_dot(nw, b), v_dot(n, b));
 }
 
+/* The angle of the model's shoulder-wrist direction w_hat at q from psi's singular half-line
+ * w_hat = -up (the wrist centre straight below the shoulder). */
+double om_srs_half_line_angle(const double *P, const double *q)
+{
+    double trig[8];
+    for (int j = 0; j < 4; j++) {
+        double phi = q[j] + P[SRS_THETA + j];
+        trig[2 * j] = cos(phi);
+        trig[2 * j + 1] = sin(phi);
+    }
+    vec3 w = m_mv(rotation_03(P, trig), elbow_vector(P, trig[6], trig[7])), up = v_load(P, SRS_UP);
+    vec3 across = v_cross(up, w);
+    return atan2(sqrt(v_dot(across, across)), -v_dot(up, w));
+}
+
 /* The quantities whose signs are (SHOULDER, ELBOW, WRIST) at joint vector q, into out[0..2]. */
 void om_srs_branch_values(const double *P, const double *q, double *out)
 {
@@ -337,7 +361,7 @@ double om_arm_angle_gradient(const double *P, const double *table, int n_rows, c
     vec3 up = v_load(P, SRS_UP);
     vec3 wb = v_cross(w_hat, b);
     double bb = v_dot(b, b);
-    double twist = 1.0 / (1.0 + v_dot(up, w_hat));
+    double twist = 1.0 / one_plus_cos(up, w_hat, v_cross(up, w_hat));
     for (int j = 0; grad && j < 7; j++)
         grad[j] = 0.0;
     for (int j = 0; grad && j < 4; j++) {

@@ -3,9 +3,26 @@
 #include "om_system.h"
 
 #define REDUNDANCY_TOL 1e-9 /* a solution's redundancy values (rad) must equal the requested ones */
+/* rad per joint: psi's own rounding at q is at most its change when each joint moves by this
+ * (an ulp of pi, 2^-51), which exceeds REDUNDANCY_TOL only next to psi's singular half-line */
+#define PSI_ROUNDING 4.440892098500626e-16
 #define SRS_ELBOW_SIGN 1    /* (SHOULDER, ELBOW, WRIST) */
 #define MAX_VALUES 16       /* branch values of a family (3 today) */
 #define HUGE_HINT 1e4       /* rad: a revolute joint's hint beyond it is reduced exactly (remainder) first */
+
+/* How far psi computed at q can be from psi at the exact joint values (NaN: not finite):
+ * |grad psi|_1 PSI_ROUNDING. Next to psi's singular half-line (the wrist centre straight
+ * below the shoulder, at the angle rho from it) |grad psi| grows as 1 / rho, and the last bits
+ * of q, and of any pose's solution, leave psi uncertain by 1e-16 / rho: beyond REDUNDANCY_TOL
+ * below rho = 1e-7, where no floating-point q can meet psi to 1e-9. */
+static double psi_rounding(const om_solver_data *s, const double *q)
+{
+    double grad[OM_MAX_DOF], sum = 0.0;
+    om_arm_angle_gradient(s->params, s->model_table, s->n_model_rows, q, grad);
+    for (int j = 0; j < s->dof; j++)
+        sum += fabs(grad[j]);
+    return sum * PSI_ROUNDING;
+}
 
 /* om_in_configuration for a requested psi already in [-pi, pi] (remainder leaves it as it is);
  * trig not NULL (s->trig_shared): the real FK's cos and sin of q_j + theta_j, which are the
@@ -24,7 +41,8 @@ static bool in_configuration(const om_solver_data *s, const double *q, const dou
     if (s->family == OM_SRS) { /* psi: the only redundancy value; in the requested ELBOW branch */
         double elbow = (double)signs[SRS_ELBOW_SIGN];
         double psi = trig ? om_srs_arm_angle_trig(s->params, trig, elbow) : om_srs_arm_angle_in(s->params, q, elbow);
-        return fabs(om_wrap(psi - psi_requested)) <= REDUNDANCY_TOL;
+        double miss = fabs(om_wrap(psi - psi_requested));
+        return miss <= REDUNDANCY_TOL || miss <= psi_rounding(s, q);
     }
     return true;
 }

@@ -6,10 +6,11 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
+from benchmarks import adversarial as adv
 from tests.conftest import random_q
 
 _SOLVERS: dict[str, om.OMSolver] = {}
@@ -361,14 +362,12 @@ def test_boundary_reproducers_are_solved(case):
         _assert_exact(solver, root.q, T, c)
 
 
-@pytest.mark.xfail(
-    strict=True, reason="open: the circle search near psi's singular half-line (issue 18, item 3)"
-)
 def test_the_wrist_centre_straight_below_the_shoulder_is_solved():
     """xArm7 with the model's wrist centre 4.7e-5 rad from straight below the shoulder (where
-    psi's reference n(w_hat) = R(up -> w_hat) r is undefined), q within limits, T = FK(q): every
-    configuration answers "unreachable" (python -m benchmarks.adversarial, the arm angle's
-    singular half-line). Passes when the search handles it."""
+    psi's reference n(w_hat) = R(up -> w_hat) r is undefined), q within limits, T = FK(q):
+    every configuration answered "unreachable" (python -m benchmarks.adversarial, the arm
+    angle's singular half-line), as g turned by 2 pi between two scan samples. The circle
+    search now splits such cells where the azimuth of w_hat about up turns fast."""
     xarm7 = _solver("xarm7")
     q = np.array(
         [
@@ -382,7 +381,46 @@ def test_the_wrist_centre_straight_below_the_shoulder_is_solved():
         ]
     )
     T, c = xarm7.arm.fk(q), xarm7.configuration_of(q)
-    assert xarm7.solve(T, c).ok
+    sol = xarm7.solve(T, c)
+    assert sol.ok, sol.status
+    _assert_exact(xarm7, sol.q, T, c)
+    roots = xarm7.solve_all(T, c)
+    assert roots
+    for root in roots:
+        _assert_exact(xarm7, root.q, T, c)
+
+
+_LINE_RUNS: dict[str, adv.ArmRun] = {}
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    name=st.sampled_from(["xarm7"]),
+    seed=st.integers(0, 2**32 - 1),
+    exponent=st.floats(-14.0, -3.0),
+    below=st.booleans(),
+)
+def test_a_pose_next_to_the_arm_angles_singular_half_line_is_solved(name, seed, exponent, below):
+    """T = FK(q), q within limits with the model's wrist centre 10**exponent rad from straight
+    below (or above) the shoulder, where psi's reference is undefined (the generator of
+    ``python -m benchmarks.adversarial``): solve in configuration_of(q) is ok, exact by the
+    real FK and holds the configuration (psi within its own rounding there, see
+    OMSolver.holds), and solve_all holds a solution."""
+    if name not in _LINE_RUNS:
+        _LINE_RUNS[name] = adv.ArmRun(name, seed=0)
+    run = _LINE_RUNS[name]
+    run.rng = np.random.default_rng(seed)
+    q = run.near_arm_angle_line(10.0**exponent, -1.0 if below else 1.0)
+    assume(q is not None)
+    solver = run.solver
+    T, c = solver.arm.fk(q), solver.configuration_of(q)
+    sol = solver.solve(T, c)
+    assert sol.ok, sol.status
+    _assert_exact(solver, sol.q, T, c)
+    roots = solver.solve_all(T, c)
+    assert roots
+    for root in roots:
+        _assert_exact(solver, root.q, T, c)
 
 
 def test_a_shoulder_start_may_need_the_flipped_wrist():

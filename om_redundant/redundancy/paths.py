@@ -14,10 +14,10 @@ elbow), so the solutions of a branch are organised as *paths*:
   taken at the representative nearest mid-range (the solver's within-limits one, if any):
   feasibility is that of the arm's pose, not of one unwrapped joint vector. Tracking
   compares the joints as they are (the path the joints can move along).
-* **Sweep** (:func:`sweep_circle`). The branch is solved on a psi grid in one parallel
-  batch without hints; where the model can have several solutions per psi (an offset
-  model, ``dp_max > 0``) :meth:`~om_redundant.OMSolver.solve_all` adds the others at every
-  grid psi that has one. Each solution is followed to the next grid psi and linked to the
+* **Sweep** (:func:`sweep_circle`). Every solution of the branch at each psi of a grid
+  (:meth:`~om_redundant.OMSolver.solve_all`; an offset model, ``dp_max > 0``, can have
+  several per psi) comes from one parallel batch (:meth:`~om_redundant.OMSolver.solve_all_batch`).
+  Each solution is followed to the next grid psi and linked to the
   solution it arrives at; solutions not arrived at start new paths, followed backwards to
   where they end; paths are joined across +-pi, and close into loops.
 * **Cells.** Between neighbouring samples of a path where a joint moves more than
@@ -39,7 +39,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import ckernels
-from ..om.configuration import Configuration
 from ..om.solver import OMSolver
 from .objective import Objective
 from .probe import END_TOLERANCE, JUMP, SAME, Point, Probe
@@ -76,25 +75,26 @@ def sweep_circle(
     """The solution paths of every branch over the whole circle, from the grid
     psi_k = -pi + 2 pi k / n (module docstring)."""
     psi = -math.pi + _TURN * np.arange(n) / n
-    batch = solver.solve_batch(
+    batch = solver.solve_all_batch(
         np.repeat(T[None], n * len(branches), axis=0),
         np.repeat(branches, n, axis=0),
         np.tile(psi, len(branches)),
     )
-    several = solver.dp_max > 0.0  # an exact S-R-S model has one solution per psi
     swept = []
     for b, signs in enumerate(branches):
         probe = Probe(solver, objective, T, signs)
-        rows = np.flatnonzero(batch.ok[b * n : (b + 1) * n])
-        samples = dict(zip(rows.tolist(), probe.points(psi[rows], batch.q[b * n + rows]), strict=True))
-        roots = []
+        grid, distinct = [], []  # the grid index of each distinct solution, its joints
         for k in range(n):
-            found = [samples[k]] if k in samples else []
-            others = solver.solve_all(T, Configuration(signs, (psi[k],))) if found and several else []
-            for sol in others:
-                if all(probe.step(sol.q, f.q) > SAME for f in found):
-                    found.append(probe.point(psi[k], sol.q, sol))
-            roots.append(found)
+            found = []
+            for q in batch.q[b * n + k, : batch.count[b * n + k]]:
+                if all(probe.step(q, f) > SAME for f in found):
+                    found.append(q)
+            grid += [k] * len(found)
+            distinct += found
+        roots: list[list[Point]] = [[] for _ in range(n)]
+        if grid:
+            for k, point in zip(grid, probe.points(psi[grid], np.array(distinct)), strict=True):
+                roots[k].append(point)
         swept.append([_with_hidden(probe, path) for path in _link(probe, psi, roots)])
     return swept
 

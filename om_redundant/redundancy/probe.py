@@ -21,13 +21,14 @@ import numpy as np
 
 from .. import ckernels
 from ..om.configuration import Configuration
-from ..om.solver import OMSolver, Solution
+from ..om.solver import BRANCH_BAND, OMSolver, Solution
 from .objective import Evaluation, Group, Objective
 from .self_motion import self_motion_tangent, self_motion_tangents
 
 JUMP = 1.0  # rad, max-norm joint step between neighbouring solutions of one path
 END_TOLERANCE = 1e-9  # rad: a path whose following step falls below this has ended (csrc/follow.c)
 SAME = 1e-6  # rad, max-norm: two solutions at one psi this close are one
+_AIM = 63.0 / 64.0  # of the distance to a path's predicted end, a step aimed there goes (csrc/follow.c)
 _TURN = 2.0 * math.pi
 _ARRIVED, _SINGULAR = 0, 2  # ckernels.follow's status
 
@@ -247,7 +248,11 @@ class Probe:
         return self._point(psi, q, sol) if self._continues(point, psi, q) else None
 
     def follow(self, start: Point, psi: float) -> tuple[Point, bool]:
-        """Continue start's path towards psi (module docstring).
+        """Continue start's path towards psi (module docstring). Where the secant of an end
+        measure (:meth:`_end_measures`) through the last two points predicts the path's end
+        short of the next step, the step aims :data:`_AIM` of the way there instead (at
+        least 1.5 :data:`END_TOLERANCE`): the end is approached in a few successful steps
+        rather than by halving, whose failing attempts beyond the end are the costliest.
 
         Returns:
             The point reached and whether it is at psi. When the path ends on the way the
@@ -258,16 +263,38 @@ class Probe:
             if reached is not None:
                 return reached
         point, step = start, psi - start.psi
+        ends, behind = self._end_measures(point), None  # behind: (psi, end measures) of the point before
         while point.psi != psi:
             if abs(step) < END_TOLERANCE:
                 return point, False
             x = psi if abs(psi - point.psi) <= abs(step) else point.psi + step
+            aim = math.inf
+            if behind is not None:
+                ahead = _predicted_end(behind[1], ends, abs(point.psi - behind[0]))
+                aim = max(_AIM * ahead, 1.5 * END_TOLERANCE)
+            if aim < abs(x - point.psi):
+                x = point.psi + math.copysign(aim, step)
             nxt = self.next(point, x)
-            if nxt is None:
-                step /= 2.0
+            if nxt is None:  # (halved from x, not from step: psi nearer than step is not tried again)
+                step = 0.5 * (x - point.psi)
             else:
-                point, step = nxt, 2.0 * step
+                step = 2.0 * (x - point.psi)
+                behind, point = (point.psi, ends), nxt
+                ends = self._end_measures(point)
         return point, True
+
+    def _end_measures(self, point: Point) -> list[float]:
+        """What ends a path, as functions of its point that fall to zero there linearly in
+        psi: 1 / |dq/dpsi|^2 at a fold (q - q_f ~ (psi_f - psi)^(1/2)), and s_i b_i +
+        BRANCH_BAND where branch quantity b_i leaves its sign s_i beyond the band."""
+        branch, redundancy = np.empty(len(self.signs)), np.empty(1)
+        self.solver.kernel.configuration_values(np.ascontiguousarray(point.q), branch, redundancy)
+        tt = 0.0
+        for v in point.tangent[:, 0].tolist():  # (summed in order, as csrc/follow.c does)
+            tt += v * v
+        return [1.0 / tt] + [
+            float(s) * b + BRANCH_BAND for s, b in zip(self.signs, branch.tolist(), strict=True)
+        ]
 
     def _follow_compiled(
         self, start: Point, psi: float, min_step: float = END_TOLERANCE
@@ -311,6 +338,14 @@ class FollowWork(NamedTuple):
     q: np.ndarray
     t: np.ndarray
     out: np.ndarray
+
+
+def _predicted_end(before: list[float], now: list[float], moved: float) -> float:
+    """The distance in psi ahead of a point (end measures ``now``) to the nearest end that
+    the secant of a measure falling towards zero predicts, from the point ``moved`` behind
+    (measures ``before``); inf where none falls."""
+    ahead = [moved * f / (b - f) for b, f in zip(before, now, strict=True) if 0.0 < f < b]
+    return min(ahead, default=math.inf)
 
 
 def _wrap(x: np.ndarray) -> np.ndarray:
