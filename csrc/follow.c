@@ -5,8 +5,8 @@
  * psi* - psi_0; at x = psi_k + h (psi* once within reach) the exact solution q nearest q_k
  * (the solve's hint; where the local solve's root lies on the path beyond doubt, see
  * on_path, it is taken without the scan for a nearer one) is taken at its representative
- * (revolute joints with both limits moved
- * by whole turns nearest mid-range c_i: c_i + wrap(q_i - c_i), for the feasible intervals)
+ * (revolute joints with both limits moved by whole turns nearest mid-range c_i:
+ * c_i + wrap(q_i - c_i), for the feasible intervals)
  * and accepted when it continues the path (om_continues: no joint moved more than 1 rad,
  * |Delta q - t_k (x - psi_k)|_inf <= |Delta q|_inf / 2 + 1e-6, cyclic joints compared modulo
  * 2 pi); then h doubles, else it halves; where the path's last two points predict its end
@@ -25,7 +25,7 @@
 enum { FOLLOW_ARRIVED = 0, FOLLOW_ENDED = 1, FOLLOW_SINGULAR = 2 };
 enum { F_PSI, F_STATUS, F_STEPS, F_N }; /* the out vector */
 #define AIM (63.0 / 64.0) /* of the distance to a predicted end, a step aimed there goes */
-#define TIGHT 0.25          /* a root's error from the first-order prediction, per joint step, on the path beyond doubt */
+#define TIGHT 0.25 /* a root's error from the first-order prediction per joint step: on the path beyond doubt */
 
 static void represent(int dof, const uint8_t *centred, const double *centre, double *q) {
     for (int i = 0; i < dof; i++)
