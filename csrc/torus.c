@@ -245,15 +245,30 @@ static int _half_line_points(om_problem *pb, double lo1, double lo7, double step
     vec3 up = v_load(pb->s->params, SRS_UP), d1, d7;
     vec3 b1 = v_unit(v_cross(up, fabs(up.x) < 0.9 ? v3(1.0, 0.0, 0.0) : v3(0.0, 1.0, 0.0))), b2 = v_cross(up, b1);
     const double(*D)[3] = pb->s->D;
-    double bend = (v_norm(v_load(D[4], 0)) + v_norm(v_load(D[5], 0)) + v_norm(v_load(D[1], 0)) +
-                   v_norm(v_load(D[2], 0))) * step * step;
-    double *H = malloc(2 * (size_t)m * (size_t)m * sizeof(double));
-    if (!H)
+    double r1 = v_norm(v_load(D[4], 0)) + v_norm(v_load(D[5], 0)), r7 = v_norm(v_load(D[1], 0)) + v_norm(v_load(D[2], 0));
+    /* x = centre + (D4 cos w1 + D5 sin w1) + R (D1 cos w7 + D2 sin w7), the last two at most
+     * r1 and r7 long: no point where the centre's part across up, or its height, exceeds that */
+    vec3 centre = v_add(v_add(pb->p, pb->t.wrist), v_add(v_load(D[3], 0), m_mv(pb->t.R, v_load(D[0], 0))));
+    double h0[2];
+    _across(centre, b1, b2, h0);
+    if (hypot(h0[0], h0[1]) > r1 + r7 || v_dot(up, centre) > r1 + r7)
         return 0;
+    double bend = (r1 + r7) * step * step;
+    double *H = malloc(2 * (size_t)m * (size_t)m * sizeof(double));
+    vec3 *rows = malloc(2 * (size_t)m * sizeof(vec3)), *cols = rows + m;
+    if (!H || !rows) {
+        free(H);
+        free(rows);
+        return 0;
+    }
+    for (int i = 0; i < m; i++) { /* x = rows[i] + cols[j] at node (i, j) */
+        rows[i] = _shoulder_wrist(pb, lo1 + (double)i * step, lo7, &d1, &d7);
+        cols[i] = v_sub(_shoulder_wrist(pb, lo1, lo7 + (double)i * step, &d1, &d7), _shoulder_wrist(pb, lo1, lo7, &d1, &d7));
+    }
     for (int i = 0; i < m; i++)
         for (int j = 0; j < m; j++)
-            _across(_shoulder_wrist(pb, lo1 + (double)i * step, lo7 + (double)j * step, &d1, &d7), b1, b2,
-                    H + 2 * (i * m + j));
+            _across(v_add(rows[i], cols[j]), b1, b2, H + 2 * (i * m + j));
+    free(rows);
     int count = 0;
     for (int i = 0; i + 1 < m && count < LINE_POINTS; i++) {
         for (int j = 0; j + 1 < m && count < LINE_POINTS; j++) {
