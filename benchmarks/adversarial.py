@@ -40,7 +40,8 @@ checked against MuJoCo's own FK of the project's MJCF of the arm (``om.arm_model
 An ok answer is **wrong** if MuJoCo's FK differs from T by more than 1e-10 m or 1e-10 rad,
 or q is not in the requested configuration (``OMSolver.holds``: signs equal, a branch quantity
 within ``om.BRANCH_BAND`` of zero counting for both; psi, read in the requested ELBOW branch,
-within 1e-9 modulo 2 pi), or ``within_limits`` is not
+within 1e-9 modulo 2 pi or within its own rounding next to its singular half-line), or
+``within_limits`` is not
 ``lower <= q <= upper``. A **non-library exception** is anything raised that is not an
 ``om.OMError``.
 """
@@ -1319,7 +1320,8 @@ def markdown(
         f"more than {POSITION_TOLERANCE:g} m (or {FK_ROUNDING:.1e} |p| where that is more: two FKs' "
         f"rounding far away) or {ORIENTATION_TOLERANCE:g} rad, or q is not in the "
         f"requested configuration (a branch quantity within {BRANCH_BAND:g} of zero counts for both "
-        f"signs; psi within {REDUNDANCY_TOLERANCE:g} rad modulo 2 pi), or `within_limits` is not "
+        f"signs; psi within {REDUNDANCY_TOLERANCE:g} rad modulo 2 pi, or within its own rounding "
+        "next to its singular half-line: `OMSolver.holds`), or `within_limits` is not "
         "`lower <= q <= upper`. **false no**: ok False (or an empty `solve_all`) for T = FK(q) in "
         "c = configuration_of(q) (for huge psi: only where the reduced psi is within 1e-9 of q's). "
         "**non-library**: an exception that is not an `om.OMError`. **differ**: an answer (status, q, "

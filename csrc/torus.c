@@ -11,7 +11,7 @@
 #define PARTNER_SAMPLES 8      /* samples each way along the fold direction */
 #define LINE_SEEDS 16          /* directions phi around a point of psi's half-line from which Newton starts */
 #define LINE_START 1e-6        /* m: the seeds' r (the lifted residual is about linear in r there) */
-#define LINE_ROOT 1e-6         /* lifted residual under which a chart's end is a candidate (its rounding is 1e-16 / rho) */
+#define LINE_ROOT 1e-6         /* lifted residual under which a chart's end is a candidate (rounding: 1e-16 / rho) */
 #define LINE_POINTS 8          /* points of the half-line kept per search */
 #define LINE_NEWTON 30         /* Newton steps to a point of the half-line (h = 0) */
 
@@ -245,7 +245,8 @@ static int _half_line_points(om_problem *pb, double lo1, double lo7, double step
     vec3 up = v_load(pb->s->params, SRS_UP), d1, d7;
     vec3 b1 = v_unit(v_cross(up, fabs(up.x) < 0.9 ? v3(1.0, 0.0, 0.0) : v3(0.0, 1.0, 0.0))), b2 = v_cross(up, b1);
     const double(*D)[3] = pb->s->D;
-    double r1 = v_norm(v_load(D[4], 0)) + v_norm(v_load(D[5], 0)), r7 = v_norm(v_load(D[1], 0)) + v_norm(v_load(D[2], 0));
+    double r1 = v_norm(v_load(D[4], 0)) + v_norm(v_load(D[5], 0));
+    double r7 = v_norm(v_load(D[1], 0)) + v_norm(v_load(D[2], 0));
     /* x = centre + (D4 cos w1 + D5 sin w1) + R (D1 cos w7 + D2 sin w7), the last two at most
      * r1 and r7 long: no point where the centre's part across up, or its height, exceeds that */
     vec3 centre = v_add(v_add(pb->p, pb->t.wrist), v_add(v_load(D[3], 0), m_mv(pb->t.R, v_load(D[0], 0))));
@@ -261,9 +262,10 @@ static int _half_line_points(om_problem *pb, double lo1, double lo7, double step
         free(rows);
         return 0;
     }
+    vec3 corner = _shoulder_wrist(pb, lo1, lo7, &d1, &d7);
     for (int i = 0; i < m; i++) { /* x = rows[i] + cols[j] at node (i, j) */
         rows[i] = _shoulder_wrist(pb, lo1 + (double)i * step, lo7, &d1, &d7);
-        cols[i] = v_sub(_shoulder_wrist(pb, lo1, lo7 + (double)i * step, &d1, &d7), _shoulder_wrist(pb, lo1, lo7, &d1, &d7));
+        cols[i] = v_sub(_shoulder_wrist(pb, lo1, lo7 + (double)i * step, &d1, &d7), corner);
     }
     for (int i = 0; i < m; i++)
         for (int j = 0; j < m; j++)
@@ -299,12 +301,14 @@ static int _half_line_points(om_problem *pb, double lo1, double lo7, double step
                 w1 -= s1;
                 w7 -= s7;
             }
-            bool inside = fabs(w1 - lo1 - ((double)i + 0.5) * step) <= step && fabs(w7 - lo7 - ((double)j + 0.5) * step) <= step;
+            bool inside = fabs(w1 - lo1 - ((double)i + 0.5) * step) <= step &&
+                          fabs(w7 - lo7 - ((double)j + 0.5) * step) <= step;
             if (!(fabs(det) > 0.0) || !inside || !(v_dot(up, x) < 0.0) || hypot(h[0], h[1]) > 1e-12 * v_norm(x))
                 continue;
             bool seen = false;
             for (int k = 0; k < count; k++)
-                seen = seen || (fabs(om_wrap(w1 - charts[k].w1)) < OM_SAME_ROOT && fabs(om_wrap(w7 - charts[k].w7)) < OM_SAME_ROOT);
+                seen = seen || (fabs(om_wrap(w1 - charts[k].w1)) < OM_SAME_ROOT &&
+                                fabs(om_wrap(w7 - charts[k].w7)) < OM_SAME_ROOT);
             if (seen)
                 continue;
             half_line_chart chart = {w1, w7, {{J[1][1] / det, -J[0][1] / det}, {-J[1][0] / det, J[0][0] / det}}};
