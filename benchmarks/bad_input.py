@@ -178,10 +178,6 @@ def summary(value: Any) -> str:
 
 #: Inputs of the list that the library accepts on purpose, with the documented rule.
 ACCEPTED_BY_DESIGN = {
-    "solve_batch: empty batch (0, 4, 4)": "an empty batch gives an empty BatchSolution, as numpy would",
-    "solve_batch: list of mink.SE3": "a list of mink.SE3 is a batch of poses",
-    "Configuration(redundancy=0.5)": "one number is one redundancy value, (0.5,)",
-    "Configuration(redundancy=None)": "None is no redundancy values",
     "arm file: tool quat times 1e300": SCALED_QUATERNION,
     "CLI: solve --quat 1e300 1e300 1e300 1e300": SCALED_QUATERNION,
 }

@@ -252,14 +252,21 @@ def quality(name: str, n: int, seed: int) -> tuple[int, int, float, float]:
     return checked, bad, worst_gap, worst_gain
 
 
+GLOBAL_HEADER = ["| arm | poses | wall | CPU |", "|---|---|---|---|"]
+
+
+def global_row(name: str, poses: int, ticks: int) -> str:
+    """One arm's row of the global choose's table (:func:`global_times`), printed as well."""
+    walls, cpus = global_times(name, poses, ticks)
+    row = f"| {name} | {len(walls)} | {_stats(walls)} | {_stats(cpus)} |"
+    print(row, flush=True)
+    return row
+
+
 def global_page(poses: int, ticks: int) -> str:
     """The global choose alone (``--global-only``): its table, with the load."""
     load = os.getloadavg()
-    rows = []
-    for name in HOMES:
-        walls, cpus = global_times(name, poses, ticks)
-        rows.append(f"| {name} | {len(walls)} | {_stats(walls)} | {_stats(cpus)} |")
-        print(rows[-1], flush=True)
+    rows = [global_row(name, poses, ticks) for name in HOMES]
     return "\n".join(
         [
             "# Redundancy resolution at control rate: the global choose",
@@ -268,8 +275,7 @@ def global_page(poses: int, ticks: int) -> str:
             f"{os.getloadavg()[0]:.1f} at the end. Global `choose(T)`, 3 obstacles, "
             f"min_clearance {MIN_CLEARANCE} m, poses of the path (ms, median / p99):",
             "",
-            "| arm | poses | wall | CPU |",
-            "|---|---|---|---|",
+            *GLOBAL_HEADER,
             *rows,
             "",
         ]
@@ -309,9 +315,7 @@ def main() -> None:
             rows.append("| " + " | ".join(str(c) for c in cells) + " |")
             print(rows[-1], flush=True)
         if not args.quality_only:
-            walls, cpus = global_times(name, args.globals, args.ticks)
-            global_rows.append(f"| {name} | {len(walls)} | {_stats(walls)} | {_stats(cpus)} |")
-            print(global_rows[-1], flush=True)
+            global_rows.append(global_row(name, args.globals, args.ticks))
         if args.quality:
             checked, bad, gap, gain = quality(name, args.quality, args.seed)
             quality_rows.append(f"| {name} | {args.quality} | {checked} | {bad} | {gap:.2e} | {gain:.2e} |")
@@ -334,8 +338,7 @@ def main() -> None:
             "",
             "Global `choose(T)`, 3 obstacles, poses of the path (ms, median / p99):",
             "",
-            "| arm | poses | wall | CPU |",
-            "|---|---|---|---|",
+            *GLOBAL_HEADER,
             *global_rows,
             "",
             f"Convergence (3 obstacles): tracking from q at fk(q) until psi moves < {CONVERGED} rad, "

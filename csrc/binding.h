@@ -78,5 +78,6 @@ extern PyMethodDef om_kernel_functions[]; /* functions.c: kinematics and closed 
 extern PyMethodDef om_tracking_functions[]; /* tracking.c: the redundancy optimiser's tracking step */
 extern PyMethodDef om_clearance_functions[]; /* clearance.c: distances of arm and obstacle geoms */
 extern PyMethodDef om_follow_functions[];    /* follow.c: a solution path followed along psi */
+extern PyMethodDef om_tangent_functions[];   /* tangents.c: self-motion tangents of many rows */
 
 #endif

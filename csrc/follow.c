@@ -7,8 +7,13 @@
  * by whole turns nearest mid-range c_i: c_i + wrap(q_i - c_i), for the feasible intervals)
  * and accepted when it continues the path (om_continues: no joint moved more than 1 rad,
  * |Delta q - t_k (x - psi_k)|_inf <= |Delta q|_inf / 2 + 1e-6, cyclic joints compared modulo
- * 2 pi); then h doubles, else it halves. Below min_step (probe.py's END_TOLERANCE) the path
- * has ended there; min_step = |psi* - psi_0| makes it one attempt (Probe.next).
+ * 2 pi); then h doubles, else it halves; where the path's last two points predict its end
+ * short of the next step, h aims just short of it (see follow). The solve is the hinted
+ * one's local part alone (om_solve_near): where the local solve from q_k fails, the step is
+ * halved without the bounded search, whose answer there is mostly a costly "no" (q_k is
+ * nearer the solution at a shorter step, where the local solve succeeds). Below min_step
+ * (probe.py's END_TOLERANCE) the path has ended there; min_step = |psi* - psi_0| makes it
+ * one attempt (Probe.next).
  * Each accepted point's tangent is om_self_motion_tangent's; where it does not exist (a
  * fold met exactly) the call stops and says so: the caller's own loop then decides. */
 #include <string.h>
@@ -17,38 +22,74 @@
 
 enum { FOLLOW_ARRIVED = 0, FOLLOW_ENDED = 1, FOLLOW_SINGULAR = 2 };
 enum { F_PSI, F_STATUS, F_STEPS, F_N }; /* the out vector */
+#define AIM (63.0 / 64.0) /* of the distance to a predicted end, a step aimed there goes */
 
 static void represent(int dof, const uint8_t *centred, const double *centre, double *q) {
     for (int i = 0; i < dof; i++)
         if (centred[i]) q[i] = centre[i] + om_wrap_angle(q[i] - centre[i]);
 }
 
-/* Follow from (psi, q, t) towards target; q and t are updated in place to the point reached. */
+/* What ends a path, as functions of its point (q, t) that fall to zero there linearly in psi
+ * (into f, 1 + n_signs): 1 / |t|^2 at a fold (q - q_f ~ (psi_f - psi)^(1/2), so |t|^2 ~
+ * 1 / (psi_f - psi)), and s_i b_i + OM_BRANCH_BAND where a branch quantity b_i leaves its
+ * sign s_i beyond the band that verify allows (verify.c). */
+static void end_measures(const om_solver_data *s, const int64_t *signs, const double *q, const double *t,
+                         double *f) {
+    double tt = 0.0, b[3];
+    for (int i = 0; i < s->dof; i++) tt += t[i] * t[i];
+    f[0] = 1.0 / tt;
+    om_branch_values(s->family, s->params, q, b);
+    for (int i = 0; i < s->n_signs; i++) f[1 + i] = (double)signs[i] * b[i] + OM_BRANCH_BAND;
+}
+
+/* The distance in psi ahead of the last point (measures f) to the nearest end that the
+ * secant of a measure falling towards zero predicts, from the point before (f_prev, a
+ * distance d behind); INFINITY where none falls. */
+static double predicted_end(int n, const double *f_prev, const double *f, double d) {
+    double r = INFINITY;
+    for (int i = 0; i < n; i++)
+        if (f[i] > 0.0 && f[i] < f_prev[i]) r = fmin(r, d * f[i] / (f_prev[i] - f[i]));
+    return r;
+}
+
+/* Follow from (psi, q, t) towards target; q and t are updated in place to the point reached.
+ * Where the secant of an end measure predicts the path's end short of the next step, the step
+ * aims just short of it instead (AIM of the way, at least 1.5 min_step): the end is then
+ * approached in a few successful steps rather than by halving, each halving costing about
+ * two attempts, most of them failing beyond the end, where a failed local solve is the
+ * costliest. A step of 1.5 min_step that fails ends the path as the halving would (below
+ * min_step); an aimed step that fails is halved, one that succeeds doubled, as any other. */
 static int follow(const om_solver_data *s, const double *T, const int64_t *signs, const uint8_t *cyclic,
                   const uint8_t *centred, const double *centre, double *psi, double *q, double *t, double target,
                   double min_step, int *steps) {
-    int dof = s->dof;
+    int dof = s->dof, n_ends = 1 + s->n_signs;
     double step = target - *psi, x_q[OM_MAX_DOF], x_t[OM_MAX_DOF];
+    double ends[4], ends_prev[4], moved = 0.0; /* moved: psi from the point before (0: none yet) */
+    end_measures(s, signs, q, t, ends);
     *steps = 0;
     while (*psi != target) {
         if (fabs(step) < min_step) return FOLLOW_ENDED;
         double x = fabs(target - *psi) <= fabs(step) ? target : *psi + step;
-        om_result r = om_solve_one(s, T, signs, &x, q, x_q);
-        bool ok = r.status == OM_OK;
+        double aim = moved > 0.0 ? fmax(AIM * predicted_end(n_ends, ends_prev, ends, moved), 1.5 * min_step) : INFINITY;
+        if (aim < fabs(x - *psi)) x = *psi + copysign(aim, step);
+        bool ok = om_solve_near(s, T, signs, &x, q, x_q);
         if (ok) {
             represent(dof, centred, centre, x_q);
             ok = om_continues(dof, q, x_q, t, x - *psi, cyclic);
         }
-        if (!ok) {
-            step /= 2.0;
+        if (!ok) { /* (halved from x, not from step: psi* nearer than step is not tried again) */
+            step = 0.5 * (x - *psi);
             continue;
         }
         if (!om_self_motion_tangent(s, x_q, x_t, 0.0)) return FOLLOW_SINGULAR;
+        moved = fabs(x - *psi);
+        step = 2.0 * (x - *psi);
         *psi = x;
         memcpy(q, x_q, (size_t)dof * sizeof(double));
         memcpy(t, x_t, (size_t)dof * sizeof(double));
+        memcpy(ends_prev, ends, sizeof ends);
+        end_measures(s, signs, q, t, ends);
         (*steps)++;
-        step *= 2.0;
     }
     return FOLLOW_ARRIVED;
 }

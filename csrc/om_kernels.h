@@ -308,6 +308,13 @@ void om_flange_target(const double *T, const double *T_base_root, const double *
 /* hint NULL: no hint. */
 om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
                        const double *hint, double *q_out);
+/* om_solve_one's local part alone, for a hint: the root the local solve from the hint
+ * reaches, replaced by any root nearer the hint, into q_out (revolute joints at the turn
+ * nearest the hint). Returns false where the local solve fails, without the bounded search
+ * that would follow in om_solve_one: a solution may still exist (the path following halves
+ * such a step, where that search's costly "no" would be wasted). */
+bool om_solve_near(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
+                   const double *hint, double *q_out);
 /* Every root (OM_MAX_ROOTS x dof) with per root (position error, orientation error, within limits)
  * in info (OM_MAX_ROOTS x 3). Returns the count; *evaluations the residual evaluations. */
 int om_solve_all(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,

@@ -104,6 +104,37 @@ static om_result _result(int status, double pos, double ori, int64_t evaluations
     return result;
 }
 
+/* The problem of one solve: the target T, the branch signs, the redundancy values reduced
+ * into reduced (n_redundancy; it must outlive the problem), joints kept at singularities
+ * from q_prev. */
+static void _problem(om_problem *pb, const om_solver_data *s, const double *T, const int64_t *signs,
+                     const double *redundancy, double *reduced, const double *q_prev)
+{
+    pb->s = s;
+    _reduce(s, redundancy, reduced);
+    _set_target(pb, T, reduced);
+    pb->signs = signs;
+    pb->redundancy = reduced;
+    pb->q_prev = q_prev;
+    pb->counter = 0;
+}
+
+/* A hinted solve's local part (the hint is pb->q_prev, copied into start): the local solve
+ * from the hint, its root replaced by any root nearer the hint (the windowed scan), written
+ * into q_out at the representative nearest the hint. Returns false where the local solve
+ * fails (q_out not written); else *pos, *ori are q_out's errors and *inside whether it is
+ * within the limits. q: scratch (dof). */
+static bool _near_hint(om_problem *pb, double *start, bool *start_complete, double *q, double *q_out, double *pos,
+                       double *ori, bool *inside)
+{
+    if (!om_local_solve(pb, start, start_complete, q, pos, ori))
+        return false;
+    if (pb->s->mode != OM_FIXED && om_nearest_in_window(pb, pb->q_prev, q))
+        om_verify(pb, q, pos, ori);
+    *inside = _finish(pb, q, pb->q_prev, true, q_out, pos, ori);
+    return true;
+}
+
 /* One OM solve: the local solve (secant, or lifted Newton), then the bounded search.
  * hint NULL: no hint. Writes q_out (dof; NaN when no solution). */
 om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
@@ -119,15 +150,8 @@ om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *
         om_usable_hint(s, hint, usable);
     hint = has_hint ? usable : zeros; /* zeros: what the Python side passes without a hint */
     om_problem problem;
-    problem.s = s;
     double psi[1];
-    _reduce(s, redundancy, psi);
-    redundancy = psi;
-    _set_target(&problem, T, redundancy);
-    problem.signs = signs;
-    problem.redundancy = redundancy;
-    problem.q_prev = hint; /* the hint, or zeros */
-    problem.counter = 0;
+    _problem(&problem, s, T, signs, redundancy, psi, hint);
     om_problem *pb = &problem;
     double q[OM_MAX_DOF], start[OM_MAX_DOF];
     /* local_solve verifies q even where the secant's first point is out of reach and q was
@@ -146,17 +170,16 @@ om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *
     } else if (!has_hint) { /* the paper's fixed-point start, p_m = p_d */
         found = om_fixed_point_start(pb, q, start);
     }
-    if (found) {
-        bool verified = om_local_solve(pb, start, &start_complete, q, &pos, &ori);
-        if (verified) {
-            if (has_hint && mode != OM_FIXED && om_nearest_in_window(pb, hint, q))
-                om_verify(pb, q, &pos, &ori);
-            bool inside = _finish(pb, q, hint, has_hint, q_out, &pos, &ori);
-            if (inside || has_hint || mode == OM_FIXED)
-                return _result(OM_OK, pos, ori, problem.counter, inside);
-            /* Without a hint, a root within the limits is preferred: search for one. */
-            outside_w = q[s->dp_joint];
-        }
+    if (has_hint) {
+        bool inside;
+        if (_near_hint(pb, start, &start_complete, q, q_out, &pos, &ori, &inside))
+            return _result(OM_OK, pos, ori, problem.counter, inside);
+    } else if (found && om_local_solve(pb, start, &start_complete, q, &pos, &ori)) {
+        bool inside = _finish(pb, q, hint, false, q_out, &pos, &ori);
+        if (inside || mode == OM_FIXED)
+            return _result(OM_OK, pos, ori, problem.counter, inside);
+        /* Without a hint, a root within the limits is preferred: search for one. */
+        outside_w = q[s->dp_joint];
     }
     if (!has_hint && mode == OM_CIRCLE) {
         /* Other starts on the circle first: cheaper than the bounded search, and a root
@@ -212,6 +235,20 @@ om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *
     return _result(OM_OK, pos, ori, problem.counter, inside);
 }
 
+/* The hinted solve's local part alone (see om_solve_near in om_kernels.h). */
+bool om_solve_near(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
+                   const double *hint, double *q_out)
+{
+    double usable[OM_MAX_DOF], psi[1], q[OM_MAX_DOF], start[OM_MAX_DOF], pos, ori;
+    om_usable_hint(s, hint, usable);
+    om_problem problem;
+    _problem(&problem, s, T, signs, redundancy, psi, usable);
+    nan_fill(q, OM_MAX_DOF); /* as in om_solve_one */
+    memcpy(start, usable, (size_t)s->dof * sizeof(double));
+    bool complete = true, inside;
+    return _near_hint(&problem, start, &complete, q, q_out, &pos, &ori, &inside);
+}
+
 /* Every solution in one configuration (the bounded search): roots (OM_MAX_ROOTS x dof,
  * revolute joints shifted into the limits where possible) and per root (position error,
  * orientation error, within limits) in info (OM_MAX_ROOTS x 3). Returns the count. */
@@ -221,14 +258,8 @@ int om_solve_all(const om_solver_data *s, const double *T, const int64_t *signs,
     double zeros[OM_MAX_DOF] = {0.0};
     int dof = s->dof;
     double psi[1];
-    _reduce(s, redundancy, psi);
     om_problem problem;
-    problem.s = s;
-    _set_target(&problem, T, psi);
-    problem.signs = signs;
-    problem.redundancy = psi;
-    problem.q_prev = zeros;
-    problem.counter = 0;
+    _problem(&problem, s, T, signs, redundancy, psi, zeros);
     int n = om_all_roots(&problem, s->scan_points, roots, zeros, INFINITY);
     bool neighbour_reached, complete = true;
     if (n == 0) { /* the band's roots, and what solve finds: its local solve from the fixed-point start */

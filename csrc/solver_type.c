@@ -151,6 +151,35 @@ static PyObject *Solver_solve(Solver *self, PyObject *const *args, Py_ssize_t na
     return result_tuple(r);
 }
 
+/* A batch call's rows start:stop (args[3], args[4]) and inputs: Ts (M, 4, 4) from args[0] into
+ * v[0], signs (M, k) int64 and redundancy (M, r) from args[1], args[2] into v[1], v[2], and
+ * the outputs outs[i] by specs[i] (n_out of them; entries given per row, times M here) into
+ * v[3 + i]. Returns M, or -1 with a TypeError or ValueError (nothing acquired). */
+static Py_ssize_t get_rows(const om_solver_data *s, PyObject *const *args, PyObject *const *outs,
+                           const buffer_spec *specs, int n_out, Py_buffer *v, Py_ssize_t *start, Py_ssize_t *stop) {
+    *start = PyLong_AsSsize_t(args[3]), *stop = PyLong_AsSsize_t(args[4]);
+    if (PyErr_Occurred()) return -1;
+    if (get_buffer(args[0], &v[0], F64, -1, 0, "Ts") < 0) return -1;
+    Py_ssize_t m = v[0].len / (16 * 8);
+    if (v[0].len != m * 16 * 8 || *start < 0 || *stop > m || *start > *stop) {
+        PyErr_SetString(PyExc_ValueError, "Ts must be (M, 4, 4) and 0 <= start <= stop <= M");
+        release_buffers(v, 1);
+        return -1;
+    }
+    PyObject *objs[8] = {args[1], args[2]};
+    buffer_spec all[8] = {{I64, m * s->n_signs, 0, "signs"}, {F64, m * s->n_redundancy, 0, "redundancy"}};
+    for (int i = 0; i < n_out; i++) {
+        objs[2 + i] = outs[i];
+        all[2 + i] = specs[i];
+        all[2 + i].n *= m;
+    }
+    if (get_buffers(objs, v + 1, all, 2 + n_out) < 0) {
+        release_buffers(v, 1);
+        return -1;
+    }
+    return m;
+}
+
 /* solve_rows(Ts, signs, redundancy, hints, start, stop, q_out, info): rows start:stop of a
  * batch; Ts (M, 4, 4), signs (M, k) int64, redundancy (M, r), hints (M, dof) or None,
  * q_out (M, dof), info (M, 5) gets (status, position error, orientation error,
@@ -159,25 +188,14 @@ static PyObject *Solver_solve_rows(Solver *self, PyObject *const *args, Py_ssize
     if (check_nargs(nargs, 8, "solve_rows") < 0)
         return NULL;
     const om_solver_data *s = &self->data;
-    Py_ssize_t start = PyLong_AsSsize_t(args[4]), stop = PyLong_AsSsize_t(args[5]);
-    if (PyErr_Occurred()) return NULL;
-    Py_buffer v[6]; /* Ts, then signs, redundancy, q_out, info and the hints last */
-    if (get_buffer(args[0], &v[0], F64, -1, 0, "Ts") < 0) return NULL;
-    Py_ssize_t m = v[0].len / (16 * 8);
-    if (v[0].len != m * 16 * 8 || start < 0 || stop > m || start > stop) {
-        PyErr_SetString(PyExc_ValueError, "Ts must be (M, 4, 4) and 0 <= start <= stop <= M");
-        release_buffers(v, 1);
-        return NULL;
-    }
-    int dof = s->dof, k = s->n_signs, nr = s->n_redundancy, n = args[3] != Py_None ? 5 : 4;
-    PyObject *objs[5] = {args[1], args[2], args[6], args[7], args[3]};
-    buffer_spec specs[5] = {{I64, m * k, 0, "signs"}, {F64, m * nr, 0, "redundancy"}, {F64, m * dof, 1, "q_out"},
-                            {F64, m * 5, 1, "info"}, {F64, m * dof, 0, "q_hint"}};
-    if (get_buffers(objs, v + 1, specs, n) < 0) {
-        release_buffers(v, 1);
-        return NULL;
-    }
-    const double *Tb = v[0].buf, *rb = v[2].buf, *hb = n == 5 ? v[5].buf : NULL;
+    int dof = s->dof, k = s->n_signs, nr = s->n_redundancy, n_out = args[3] != Py_None ? 3 : 2;
+    PyObject *rows[5] = {args[0], args[1], args[2], args[4], args[5]};
+    PyObject *outs[3] = {args[6], args[7], args[3]};
+    const buffer_spec specs[3] = {{F64, dof, 1, "q_out"}, {F64, 5, 1, "info"}, {F64, dof, 0, "q_hint"}};
+    Py_buffer v[6]; /* Ts, signs, redundancy, q_out, info and the hints last */
+    Py_ssize_t start, stop;
+    if (get_rows(s, rows, outs, specs, n_out, v, &start, &stop) < 0) return NULL;
+    const double *Tb = v[0].buf, *rb = v[2].buf, *hb = n_out == 3 ? v[5].buf : NULL;
     const int64_t *sb = v[1].buf;
     double *qb = v[3].buf, *ib = v[4].buf;
     Py_BEGIN_ALLOW_THREADS for (Py_ssize_t i = start; i < stop; i++) {
@@ -189,7 +207,35 @@ static PyObject *Solver_solve_rows(Solver *self, PyObject *const *args, Py_ssize
         row[3] = (double)r.evaluations;
         row[4] = r.within_limits;
     }
-    Py_END_ALLOW_THREADS release_buffers(v, n + 1);
+    Py_END_ALLOW_THREADS release_buffers(v, 3 + n_out);
+    Py_RETURN_NONE;
+}
+
+/* solve_all_rows(Ts, signs, redundancy, start, stop, roots, info, counts): om_solve_all of
+ * rows start:stop of a batch; Ts (M, 4, 4), signs (M, k) int64, redundancy (M, r); roots
+ * (M, MAX_ROOTS, dof) and info (M, MAX_ROOTS, 3) get each row's as solve_all's, counts
+ * (M, 2) int64 its (count, evaluations). */
+static PyObject *Solver_solve_all_rows(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 8, "solve_all_rows") < 0)
+        return NULL;
+    const om_solver_data *s = &self->data;
+    int dof = s->dof, k = s->n_signs, nr = s->n_redundancy;
+    const buffer_spec specs[3] = {
+        {F64, OM_MAX_ROOTS * dof, 1, "roots"}, {F64, OM_MAX_ROOTS * 3, 1, "info"}, {I64, 2, 1, "counts"}};
+    Py_buffer v[6];
+    Py_ssize_t start, stop;
+    if (get_rows(s, args, args + 5, specs, 3, v, &start, &stop) < 0) return NULL;
+    const double *Tb = v[0].buf, *rb = v[2].buf;
+    const int64_t *sb = v[1].buf;
+    double *roots = v[3].buf, *info = v[4].buf;
+    int64_t *counts = v[5].buf;
+    Py_BEGIN_ALLOW_THREADS for (Py_ssize_t i = start; i < stop; i++) {
+        int64_t evaluations;
+        counts[2 * i] = om_solve_all(s, Tb + 16 * i, sb + k * i, rb + nr * i, roots + OM_MAX_ROOTS * dof * i,
+                                     info + OM_MAX_ROOTS * 3 * i, &evaluations);
+        counts[2 * i + 1] = evaluations;
+    }
+    Py_END_ALLOW_THREADS release_buffers(v, 6);
     Py_RETURN_NONE;
 }
 
@@ -242,6 +288,8 @@ static PyMethodDef Solver_methods[] = {
     {"solve_pose", (PyCFunction)(void (*)(void))om_solver_solve_pose, METH_FASTCALL,
      "solve_pose(T, configuration) -> Solution, or None: the whole unhinted solve in one call."},
     {"solve_rows", (PyCFunction)(void (*)(void))Solver_solve_rows, METH_FASTCALL, "Rows of a batch."},
+    {"solve_all_rows", (PyCFunction)(void (*)(void))Solver_solve_all_rows, METH_FASTCALL,
+     "Every root in each configuration of rows of a batch."},
     {"solve_all", (PyCFunction)(void (*)(void))Solver_solve_all, METH_FASTCALL, "Every root in a configuration."},
     {"configuration_values", (PyCFunction)(void (*)(void))Solver_configuration_values, METH_FASTCALL,
      "Branch quantities and redundancy values at q."},

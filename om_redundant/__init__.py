@@ -35,6 +35,7 @@ from .mujoco_io import (
 from .om import (
     BRANCH_BAND,
     NEAR_TWIST,
+    BatchRoots,
     BatchSolution,
     Configuration,
     ModelArm,
@@ -71,6 +72,7 @@ __all__ = [
     "ArmFileError",
     "ArmJoints",
     "ArmRoot",
+    "BatchRoots",
     "BatchSolution",
     "Box",
     "Capsule",

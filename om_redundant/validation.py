@@ -54,6 +54,7 @@ _NOT_ARRAYS = (str, bytes, bytearray, Mapping, set, frozenset)
 _SEQUENCES = (tuple, list)
 _INTEGERS = (int, np.int64, np.int32)
 _REALS = (float, int, np.float64, np.int64)
+_SCALARS = (int, float, complex, np.number, np.bool_)  # one number where a sequence is wanted
 
 
 # ---------------------------------------------------------------------------------------
@@ -163,19 +164,22 @@ def as_pose(T: Any, name: str = "T") -> np.ndarray:
 
 
 def as_poses(T: Any, name: str = "T") -> np.ndarray:
-    """Return a validated (M, 4, 4) stack of homogeneous transforms.
+    """Return a validated (M, 4, 4) stack of homogeneous transforms, M >= 1.
 
-    Takes an (M, 4, 4) array or a sequence of (4, 4) arrays and ``mink.SE3``. M may be 0 (an
-    empty sequence too): an empty stack.
+    Takes an (M, 4, 4) array or a sequence of M (4, 4) arrays. An empty batch and
+    ``mink.SE3`` (one, or a sequence of them) are refused with the fix in the message:
+    ``solve`` takes one SE3, and the stack of matrices is one ``np.stack`` away.
     """
-    expected = "(M, 4, 4) poses or a sequence of mink.SE3"
-    if _is_se3(T):
-        raise InvalidInput(f"{name} must be {expected}, got one {type(T).__name__} (give [{name}])")
-    if isinstance(T, list | tuple) and any(_is_se3(x) for x in T):
-        T = [x.as_matrix() if _is_se3(x) else x for x in T]
+    expected = "(M, 4, 4) poses"
+    if _is_se3(T) or (isinstance(T, list | tuple) and any(_is_se3(x) for x in T)):
+        what = f"one {type(T).__name__}" if _is_se3(T) else "a sequence holding mink.SE3"
+        raise InvalidInput(
+            f"{name} must be {expected}, got {what}: solve takes one SE3; for a batch give "
+            f"np.stack([p.as_matrix() for p in poses])"
+        )
     T = as_array(T, name, expected)
-    if T.shape == (0,):
-        T = T.reshape(0, 4, 4)
+    if T.size == 0:
+        raise InvalidInput(f"{name} holds no poses (shape {T.shape}): a batch needs at least one")
     if T.ndim != 3 or T.shape[1:] != (4, 4):
         raise InvalidInput(f"{name} must have shape (M, 4, 4), got {T.shape}")
     T = np.ascontiguousarray(T)
@@ -291,36 +295,43 @@ def _holds_bool(values: Any) -> bool:
 def as_redundancy(
     values: Any, name: str = "redundancy", names: tuple[str, ...] | None = None, rows: int | None = None
 ) -> np.ndarray:
-    """Redundancy values (a 7-DOF arm's arm angle psi), finite real numbers.
+    """Redundancy values (a 7-DOF arm's arm angle psi), finite real numbers, always given as
+    a sequence or array: a bare number or None is refused (one way to write them).
 
-    For one configuration (``rows`` None): None is no values, one number is one value, else
-    a sequence; returns shape (r,). For a batch (``rows`` = M, ``names`` the arm's r
-    redundancy names): None for an arm without any; (r,) or one number (r = 1) for every row,
-    (M,) when r = 1, or (M, r); returns (M, r).
+    For one configuration (``rows`` None): a sequence; returns shape (r,). For a batch
+    (``rows`` = M, ``names`` the arm's r redundancy names): None for an arm without any;
+    (r,) for every row, (M,) when r = 1, or (M, r); returns (M, r).
     """
-    if values is None:
-        if rows is None or not names:
-            return np.zeros((0,) if rows is None else (rows, 0))
-        raise InvalidInput(f"{name}: the arm needs redundancy values {names}")
+    if values is None and rows is not None and not names:
+        return np.zeros((rows, 0))
     if rows is None and _plain(values, _REALS) and all(math.isfinite(x) for x in values):
         return np.array(values, dtype=np.float64)  # the common case, fast: a tuple of finite floats
-    array = as_array(values, name, "real numbers")
     if rows is None:
-        if array.ndim > 1:
+        expected = "a sequence of real numbers"
+        rule = f"be {expected} (() for none)"
+    else:
+        r = len(names or ())
+        expected = f"an array of shape ({rows}, {r})"
+        rule = f"have shape ({rows}, {r}) " + (
+            f"for {names}" if names else "(the arm has no redundancy values: give None)"
+        )
+    if values is None or isinstance(values, _SCALARS):
+        example = "; e.g. (0.5,) for psi = 0.5" if rows is None or names else ""
+        raise InvalidInput(f"{name} must {rule}, got {_describe(values)}{example}")
+    array = as_array(values, name, expected)
+    if rows is None:
+        if array.ndim != 1:
             raise InvalidInput(f"{name} must be a sequence of numbers, got shape {array.shape}")
-        array = array.reshape(-1)
         if not np.isfinite(array).all():
             raise InvalidInput(f"{name} values must be finite, got {tuple(array.tolist())}")
         return array
     assert names is not None, "a batch needs the arm's redundancy names"
-    r = len(names)
-    if array.ndim == 0 or (array.ndim == 1 and len(array) == r):
+    if array.ndim == 1 and len(array) == r:
         array = array.reshape(1, -1)
     elif array.ndim == 1 and r == 1 and len(array) == rows:
         array = array[:, None]
     if array.ndim != 2 or array.shape[1] != r or len(array) not in (1, rows):
-        what = f"for {names}" if names else "(the arm has no redundancy values: give None)"
-        raise InvalidInput(f"{name} must have shape ({rows}, {r}) {what}, got {np.shape(values)}")
+        raise InvalidInput(f"{name} must {rule}, got {np.shape(values)}")
     array = np.ascontiguousarray(np.broadcast_to(array, (rows, r)))
     bad = ~np.isfinite(array)
     if bad.any():

@@ -83,6 +83,47 @@ def test_batch_equals_one_solve_per_row_across_threads(panda):
         assert batch.status[m] == sol.status and batch.iterations[m] == sol.iterations
 
 
+def _assert_rows_are_solve_all(solver: om.OMSolver, T, signs, redundancy, batch: om.BatchRoots) -> None:
+    """Row i of a solve_all_batch is solve_all of row i: the same roots in the same order."""
+    for i in range(len(T)):
+        single = solver.solve_all(
+            T[i], om.Configuration(tuple(signs[i]), tuple(np.atleast_1d(redundancy[i])))
+        )
+        assert batch.count[i] == len(single)
+        assert np.isnan(batch.q[i, len(single) :]).all()
+        for r, sol in enumerate(single):
+            np.testing.assert_array_equal(batch.q[i, r], sol.q)
+            assert batch.position_error[i, r] == sol.position_error
+            assert batch.orientation_error[i, r] == sol.orientation_error
+            assert batch.within_limits[i, r] == sol.within_limits
+            assert batch.iterations[i] == sol.iterations
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_solve_all_batch_equals_solve_all_per_row(panda, threads):
+    """Every configuration of random poses on a psi grid (rows with 0, 1 and several roots)."""
+    T = panda.arm.fk(random_q(panda.arm, 3, np.random.default_rng(6)))
+    branches = [c.signs for c in panda.configurations()]
+    psi = np.linspace(-np.pi, np.pi, 8, endpoint=False)
+    rows = [(t, s, x) for t in T for s in branches for x in psi]
+    Ts, signs, redundancy = (np.array(column) for column in zip(*rows, strict=True))
+    batch = panda.solve_all_batch(Ts, signs, redundancy, threads=threads)
+    assert (batch.count == 0).any() and (batch.count > 1).any()
+    _assert_rows_are_solve_all(panda, Ts, signs, redundancy, batch)
+
+
+def test_solve_all_batch_of_a_6dof_arm_and_an_empty_batch_refused():
+    ur5e = om.OMSolver("ur5e")
+    Q = random_q(ur5e.arm, 6, np.random.default_rng(7))
+    T = ur5e.arm.fk(Q)
+    signs = np.array([ur5e.configuration_of(q).signs for q in Q])
+    batch = ur5e.solve_all_batch(T, signs)
+    assert (batch.count >= 1).all()
+    _assert_rows_are_solve_all(ur5e, T, signs, np.zeros((6, 0)), batch)
+    with pytest.raises(om.InvalidInput, match="T holds no poses"):
+        ur5e.solve_all_batch(np.zeros((0, 4, 4)), np.zeros((0, 3)))
+
+
 @pytest.mark.parametrize("threads", [1, 2, 3, 64.0])
 def test_batch_answers_do_not_depend_on_the_threads(panda, threads):
     """threads=1 solves on the calling thread; more take chunks from a shared queue: same rows."""

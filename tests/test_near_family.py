@@ -93,6 +93,21 @@ def test_batch_and_single_solves_agree_on_a_near_arm():
             assert np.array_equal(single.q, batch.q[i])
 
 
+def test_solve_all_batch_equals_solve_all_on_a_near_arm():
+    solver = bent_solver("panda", -4.0, 0)
+    q = random_q(solver.arm, 6, np.random.default_rng(9))
+    T = solver.arm.fk(q)
+    configurations = [solver.configuration_of(x) for x in q]
+    batch = solver.solve_all_batch(
+        T, np.array([c.signs for c in configurations]), np.array([c.redundancy for c in configurations])
+    )
+    for i, c in enumerate(configurations):
+        single = solver.solve_all(T[i], c)
+        assert batch.count[i] == len(single) >= 1
+        for r, sol in enumerate(single):
+            np.testing.assert_array_equal(batch.q[i, r], sol.q)
+
+
 @pytest.mark.parametrize(
     ("name", "row", "field", "value", "cause"),
     [

@@ -80,15 +80,19 @@ def test_bad_joint_vectors(solver, pose, q, message):
         solver.solve(pose, C, q_hint=q)
 
 
-def test_batch_input_is_checked(solver, pose):
+@pytest.mark.parametrize("method", ["solve_batch", "solve_all_batch"])
+def test_batch_input_is_checked(solver, pose, method):
+    batch = getattr(solver, method)
     with pytest.raises(om.InvalidInput, match=r"\(M, 4, 4\)"):
-        solver.solve_batch(pose, (1, 1, 1))
+        batch(pose, (1, 1, 1))
     poses = np.stack([pose, pose])
     poses[1, 2, 3] = np.nan
     with pytest.raises(om.InvalidInput, match=r"T\[1\] contains NaN"):
-        solver.solve_batch(poses, (1, 1, 1))
+        batch(poses, (1, 1, 1))
     with pytest.raises(om.InvalidInput, match="-1 or \\+1"):
-        solver.solve_batch(np.stack([pose]), (1, 0, 1))
+        batch(np.stack([pose]), (1, 0, 1))
+    with pytest.raises(om.InvalidInput, match=r"signs must be one row or one row per pose \(2\), got 3 rows"):
+        batch(np.stack([pose, pose]), [(1, 1, 1)] * 3)
 
 
 _DEFECTS = {
@@ -175,14 +179,12 @@ def test_complex_poses_are_refused_not_truncated(solver, pose):
         solver.arm.fk([0.1, True, 0.0, 0.0, 0.0, 0.0])
 
 
-def test_an_empty_batch_gives_empty_results(solver, panda):
-    """M = 0 is a batch like any other: rows of length 0, no error (numpy's convention)."""
-    for T in (np.zeros((0, 4, 4)), []):
-        batch = solver.solve_batch(T, C.signs)
-        assert batch.q.shape == (0, 6) and batch.ok.shape == (0,) and batch.status == []
-    batch = panda.solve_batch(np.zeros((0, 4, 4)), (1, -1, 1), [], q_hint=np.zeros((0, 7)))
-    assert batch.q.shape == (0, 7) and batch.within_limits.shape == (0,)
-    assert panda.solve_batch(np.zeros((0, 4, 4)), np.zeros((0, 3)), 0.3).q.shape == (0, 7)
+def test_an_empty_batch_is_refused(solver, panda):
+    for T in (np.zeros((0, 4, 4)), [], np.zeros((0,))):
+        with pytest.raises(om.InvalidInput, match=r"T holds no poses \(shape \(0,"):
+            solver.solve_batch(T, C.signs)
+    with pytest.raises(om.InvalidInput, match="T holds no poses"):
+        panda.solve_batch(np.zeros((0, 4, 4)), (1, -1, 1), [0.3], q_hint=np.zeros((0, 7)))
 
 
 def test_batch_rows_must_match_the_poses(solver, panda, pose):
@@ -198,13 +200,17 @@ def test_batch_rows_must_match_the_poses(solver, panda, pose):
     np.testing.assert_array_equal(one_row.q, solver.solve_batch(poses, (1, 1, 1)).q)
 
 
-def test_a_list_of_mink_se3_is_a_batch(solver, pose):
-    poses = [mink.SE3.from_matrix(pose), pose, mink.SE3.from_matrix(pose)]
-    batch = solver.solve_batch(poses, C.signs)
-    matrices = np.stack([p.as_matrix() if isinstance(p, mink.SE3) else p for p in poses])
-    np.testing.assert_array_equal(batch.q, solver.solve_batch(matrices, C.signs).q)
-    with pytest.raises(om.InvalidInput, match=r"got one SE3 \(give \[T\]\)"):
-        solver.solve_batch(mink.SE3.from_matrix(pose), C.signs)
+def test_mink_se3_in_a_batch_is_refused_with_the_fix(solver, pose):
+    """solve takes one SE3; a batch is an array, one np.stack away (the message says so)."""
+    for poses in (
+        [mink.SE3.from_matrix(pose), pose],
+        (mink.SE3.from_matrix(pose),),
+        mink.SE3.from_matrix(pose),
+    ):
+        with pytest.raises(om.InvalidInput, match=r"T must be \(M, 4, 4\) poses, got .*np\.stack"):
+            solver.solve_batch(poses, C.signs)
+    batch = solver.solve_batch([pose, pose], C.signs)  # a sequence of arrays is a batch
+    np.testing.assert_array_equal(batch.q, solver.solve_batch(np.stack([pose, pose]), C.signs).q)
 
 
 def test_a_6dof_batch_refuses_redundancy_values_like_solve(solver, pose):
@@ -244,17 +250,22 @@ def test_np_true_is_refused_as_a_sign_everywhere(solver, pose, panda):
         om.RedundancyOptimizer(panda, branches=[(1, np.True_, 1)])
 
 
-def test_redundancy_values_are_numbers_one_number_is_one_value():
-    """The rule: a sequence of finite real numbers; one number is one value; None is none."""
-    assert om.Configuration((1, 1, 1), 0.5).redundancy == (0.5,)
-    assert om.Configuration((1, 1, 1), np.float64(0.5)).redundancy == (0.5,)
-    assert om.Configuration((1, 1, 1), None).redundancy == ()
+def test_redundancy_values_are_a_sequence_of_numbers():
+    """The rule: a sequence of finite real numbers; a bare number and None are refused."""
+    assert om.Configuration((1, 1, 1), (0.5,)).redundancy == (0.5,)
+    assert om.Configuration((1, 1, 1), [np.float64(0.5)]).redundancy == (0.5,)
+    assert om.Configuration((1, 1, 1), ()).redundancy == ()
     assert om.Configuration((1, 1, 1), np.array([0.5])).redundancy == (0.5,)
     for bad, message in [
+        (0.5, "a sequence of real numbers \\(\\(\\) for none\\), got float 0.5; e.g. \\(0.5,\\)"),
+        (np.float64(0.5), "got float64"),
+        (None, "got None"),
+        (True, "got True"),
+        (np.array(0.5), "a sequence of numbers, got shape \\(\\)"),
         ("0.5", "got str '0.5'"),
         (("0.5",), "got text"),
         ((1j,), "got complex numbers"),
-        (1j, "got complex numbers"),
+        (1j, "got complex"),
         ((True,), "got booleans"),
         ((0.5, True), "got a boolean among the numbers"),
         (((0.1,), (0.2,)), "a sequence of numbers, got shape \\(2, 1\\)"),
@@ -264,11 +275,20 @@ def test_redundancy_values_are_numbers_one_number_is_one_value():
             om.Configuration((1, 1, 1), bad)
 
 
-def test_batch_redundancy_is_numbers_only(panda):
+def test_batch_redundancy_is_an_array_of_numbers(panda):
     T = panda.arm.fk(np.full(7, 0.3))
-    for bad, message in [("0.5", "got str '0.5'"), (["0.5"], "got text"), ([1j], "got complex numbers")]:
-        with pytest.raises(om.InvalidInput, match="redundancy must be real numbers, " + message):
+    for bad, message in [
+        ("0.5", "got str '0.5'"),
+        (["0.5"], "got text"),
+        ([1j], "got complex numbers"),
+        (0.5, "got float 0.5; e.g. \\(0.5,\\)"),
+        (np.float64(0.5), "got float64"),
+    ]:
+        with pytest.raises(om.InvalidInput, match="redundancy must .*" + message):
             panda.solve_batch(T[None], (1, 1, 1), bad)
+    one = panda.solve(T, om.Configuration((1, 1, 1), (0.5,))).q
+    for good in ([0.5], (0.5,), np.array([0.5]), np.array([[0.5]])):
+        np.testing.assert_array_equal(panda.solve_batch(T[None], (1, 1, 1), good).q[0], one)
 
 
 def test_isclose_takes_a_configuration():

@@ -6,11 +6,12 @@ that fronts them (:mod:`.solver`)."""
 from .configuration import Configuration
 from .model import ModelArm, derive_model
 from .nominal import NEAR_TWIST, NominalArm, nominal_arm
-from .solver import BRANCH_BAND, BatchSolution, OMSolver, Solution
+from .solver import BRANCH_BAND, BatchRoots, BatchSolution, OMSolver, Solution
 
 __all__ = [
     "BRANCH_BAND",
     "NEAR_TWIST",
+    "BatchRoots",
     "BatchSolution",
     "Configuration",
     "ModelArm",

@@ -19,13 +19,12 @@ class Configuration:
         signs: Branch signs of the model arm's closed form, each -1 or +1; for 6-DOF
             arms ``(ARM, ELBOW, WRIST)``. A sequence of numbers; ``True`` is refused.
         redundancy: Redundancy variables appended to c (the arm angle psi of a 7-DOF
-            arm); empty for 6-DOF arms. Finite real numbers, never text; one number is
-            taken as one value (``Configuration(signs, 0.3)`` is ``Configuration(signs,
-            (0.3,))``) and None as none.
+            arm); empty for 6-DOF arms. A sequence of finite real numbers, e.g. ``(0.3,)``;
+            a bare number, None or text is refused.
 
     Raises:
-        InvalidInput: Signs that are not a sequence of -1 and +1; redundancy values that are
-            not finite real numbers.
+        InvalidInput: Signs that are not a sequence of -1 and +1; redundancy that is not a
+            sequence of finite real numbers.
     """
 
     signs: tuple[int, ...]

@@ -131,6 +131,11 @@ class NearKernel:
             info[r] = (pos, ori, float(within))
         return len(roots), evals
 
+    def solve_all_rows(self, T, signs, redundancy, start, stop, roots_out, info, counts) -> None:
+        """:meth:`solve_all` of rows start:stop of a batch (counts: count, evaluations)."""
+        for i in range(start, stop):
+            counts[i] = self.solve_all(T[i], signs[i], redundancy[i], roots_out[i], info[i])
+
     def configuration_values(self, q, values, redundancy) -> None:
         """The nominal model's branch quantities and arm angle at q."""
         self._nominal.configuration_values(np.ascontiguousarray(self._flip * q), values, redundancy)

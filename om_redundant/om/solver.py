@@ -104,6 +104,29 @@ class BatchSolution:
         return [system.STATUS_NAMES[c] for c in self.status_code]
 
 
+@dataclass(frozen=True, eq=False, slots=True)
+class BatchRoots:
+    """Outcomes of :meth:`OMSolver.solve_all_batch`: every solution of each row's
+    configuration, as :meth:`OMSolver.solve_all` finds them.
+
+    Attributes:
+        q: (M, MAX_ROOTS, dof): row i's solutions are ``q[i, :count[i]]``, in solve_all's
+            order (NaN beyond).
+        count: (M,) how many (0: none).
+        position_error: (M, MAX_ROOTS) metres.
+        orientation_error: (M, MAX_ROOTS) radians.
+        iterations: (M,) residual evaluations.
+        within_limits: (M, MAX_ROOTS) bool.
+    """
+
+    q: np.ndarray
+    count: np.ndarray
+    position_error: np.ndarray
+    orientation_error: np.ndarray
+    iterations: np.ndarray
+    within_limits: np.ndarray
+
+
 class OMSolver:
     """Exact IK of a real arm by the offset modification method.
 
@@ -302,17 +325,13 @@ class OMSolver:
                 answers do not depend on it.
 
         Returns:
-            A :class:`BatchSolution` with M rows. An empty batch (M = 0) gives empty rows.
+            A :class:`BatchSolution` with M rows.
 
         Raises:
             InvalidInput: A malformed argument, or one whose rows do not match the M poses.
         """
-        T = as_poses(T)
+        T, signs, redundancy, threads = self._batch_rows(T, signs, redundancy, threads)
         m = len(T)
-        k = len(self.sign_names)
-        signs = np.ascontiguousarray(np.broadcast_to(as_signs(signs, k, stack=True, rows=m), (m, k)))
-        redundancy = self._redundancy_rows(redundancy, m)
-        threads = None if threads is None else as_count(threads, "threads", 1, MAX_THREADS)
         hints = None
         if q_hint is not None:
             hints = as_joint_vector(q_hint, self.arm.dof, "q_hint").reshape(-1, self.arm.dof)
@@ -325,8 +344,7 @@ class OMSolver:
         def solve_range(start: int, stop: int) -> None:
             kernel.solve_rows(T, signs, redundancy, hints, start, stop, q, info)
 
-        if m:
-            system.run_rows(solve_range, m, threads)
+        system.run_rows(solve_range, m, threads)
         status = info[:, 0].astype(np.int64)
         return BatchSolution(
             q,
@@ -337,6 +355,34 @@ class OMSolver:
             info[:, 3].astype(np.int64),
             info[:, 4] > 0.0,
         )
+
+    def solve_all_batch(
+        self, T: Any, signs: Any, redundancy: Any = None, threads: int | None = None
+    ) -> BatchRoots:
+        """:meth:`solve_all` for many targets at once, in parallel.
+
+        Args:
+            T, signs, redundancy, threads: As :meth:`solve_batch` takes them (no hints).
+
+        Returns:
+            A :class:`BatchRoots` with M rows, each row's solutions those of
+            ``solve_all(T[i], Configuration(signs[i], redundancy[i]))``.
+
+        Raises:
+            InvalidInput: A malformed argument, or one whose rows do not match the M poses.
+        """
+        T, signs, redundancy, threads = self._batch_rows(T, signs, redundancy, threads)
+        m, dof = len(T), self.arm.dof
+        roots = np.full((m, system.MAX_ROOTS, dof), np.nan)
+        info = np.full((m, system.MAX_ROOTS, 3), np.nan)
+        counts = np.zeros((m, 2), dtype=np.int64)
+        kernel = self._kernel
+
+        def solve_range(start: int, stop: int) -> None:
+            kernel.solve_all_rows(T, signs, redundancy, start, stop, roots, info, counts)
+
+        system.run_rows(solve_range, m, threads)
+        return BatchRoots(roots, counts[:, 0], info[..., 0], info[..., 1], counts[:, 1], info[..., 2] > 0.0)
 
     def check_configuration(self, configuration: Configuration) -> None:
         """Check that a configuration fits this arm.
@@ -392,6 +438,18 @@ class OMSolver:
                     f"model ({self.om.family_name}) does not fit this arm"
                 )
         _SELF_CHECKED.setdefault(arm, set()).add(key)
+
+    def _batch_rows(
+        self, T: Any, signs: Any, redundancy: Any, threads: int | None
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, int | None]:
+        """A batch's poses (M, 4, 4), signs (M, k) and redundancy rows (M, r), and threads, checked."""
+        T = as_poses(T)
+        m = len(T)
+        k = len(self.sign_names)
+        signs = np.ascontiguousarray(np.broadcast_to(as_signs(signs, k, stack=True, rows=m), (m, k)))
+        redundancy = self._redundancy_rows(redundancy, m)
+        threads = None if threads is None else as_count(threads, "threads", 1, MAX_THREADS)
+        return T, signs, redundancy, threads
 
     def _redundancy_rows(self, redundancy: Any, m: int) -> np.ndarray:
         """(M, r) redundancy values for a batch, checked: shape and finiteness, named."""

@@ -92,7 +92,6 @@ class Clearance:
         self._data = mujoco.MjData(model)
         joints = ArmJoints(arm, model, prefix)
         self._qpos = joints.qpos_index
-        self._dofs = joints.dof_ids
         moving = _subtree(model, model.jnt_bodyid[joints.joint_ids[0]])
         arm_geoms = [
             g
@@ -112,10 +111,6 @@ class Clearance:
         self.pairs: tuple[tuple[str, str], ...] = tuple(
             (model.geom(a).name, model.geom(o).name) for a, o in self._pairs
         )
-        # for pair_bounds: each arm geom's body, bounding radius and subtree root
-        self._bodies = model.geom_bodyid[self._pairs[:, 0]]
-        self._arm_rbound = rbound[self._pairs[:, 0]]
-        self._roots = model.body_rootid[self._bodies]
 
     @classmethod
     def for_arm(
@@ -160,7 +155,16 @@ class Clearance:
         return float(self.distances(q).min())
 
     def distances_and_gradients(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """d_k(q) (P,) and their gradients dd_k/dq (P, dof) (module docstring)."""
+        """d_k(q) and their gradients dd_k/dq (module docstring): (P,) and (P, dof) for a
+        joint vector q (dof,), (M, P) and (M, P, dof) for the rows of q (M, dof), one
+        ``mj_kinematics`` per row."""
+        if np.ndim(q) == 2:
+            q = as_joint_vector(q, self._dof)
+            shape = (len(q), len(self._pairs))
+            dist, fromto, grad = np.empty(shape), np.empty((*shape, 6)), np.empty((*shape, self._dof))
+            for row, *out in zip(q, dist, fromto, grad, strict=True):
+                self._measure(row, self.distmax, *out)
+            return dist, grad
         return self._evaluate(q, gradient=True)
 
     def distances_within(
@@ -192,61 +196,29 @@ class Clearance:
         """
         return self.distances(as_joint_vector(q, self._dof).reshape(-1, self._dof)).min(axis=1)
 
-    def pair_bounds(self, q: np.ndarray, rate: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        r"""Bounds of every pair's distance and of its rate when the joints move at ``rate``.
-
-        The lower bound is the geoms' centres' distance less their bounding-sphere radii.
-        The rate :math:`|\dot d_k| = |n_k \cdot v(p_A)|` is at most the speed of the arm
-        geom's fastest point, :math:`|v(x_g)| + |\omega_b|\, r_g` (x_g its centre, r_g its
-        bounding radius, :math:`v, \omega` its body's velocity, MuJoCo's ``mj_comVel`` with
-        the joint velocities ``rate``). Rows of q are placed one by one, the bounds computed
-        for all rows at once (the same values as row by row).
-
-        Args:
-            q: (dof,) joint vector, or (M, dof) joint vectors.
-            rate: Joint velocities of q's shape, e.g. dq/dpsi.
-
-        Returns:
-            Lower bounds of d_k (m) and upper bounds of :math:`|\dot d_k|`, (P,) for one
-            joint vector, (M, P) for M, in the order of :attr:`pairs`.
-        """
-        single = np.ndim(q) == 1
-        q = as_joint_vector(q, self._dof).reshape(-1, self._dof)
-        rate = as_joint_vector(rate, self._dof, "rate").reshape(-1, self._dof)
-        if rate.shape != q.shape:
-            raise InvalidInput(f"rate must have q's shape {q.shape}, got {rate.shape}")
-        m, d = self.model, self._data
-        xpos, cvel = np.empty((len(q), m.ngeom, 3)), np.empty((len(q), m.nbody, 6))
-        com = np.empty((len(q), m.nbody, 3))
-        d.qvel[:] = 0.0
-        for row, rates, x, v, c in zip(q, rate, xpos, cvel, com, strict=True):
-            d.qpos[self._qpos] = row
-            d.qvel[self._dofs] = rates
-            mujoco.mj_kinematics(m, d)
-            mujoco.mj_comPos(m, d)
-            mujoco.mj_comVel(m, d)
-            x[:], v[:], c[:] = d.geom_xpos, d.cvel, d.subtree_com
-        centre = xpos[:, self._pairs[:, 0]]
-        lower = np.linalg.norm(centre - xpos[:, self._pairs[:, 1]], axis=-1) - self._geoms.bounds
-        omega, linear = cvel[:, self._bodies, :3], cvel[:, self._bodies, 3:]
-        velocity = linear + np.cross(omega, centre - com[:, self._roots])
-        speed = np.linalg.norm(velocity, axis=-1) + np.linalg.norm(omega, axis=-1) * self._arm_rbound
-        return (lower[0], speed[0]) if single else (lower, speed)
-
     def _evaluate(
         self, q: np.ndarray, gradient: bool, reach: float | None = None
     ) -> tuple[np.ndarray, np.ndarray]:
-        """Distances capped at reach (default distmax), and their gradients if asked: one
-        ``mj_kinematics``, then ``ckernels.geom_distances`` (sphere and capsule arm geoms
-        against sphere, capsule and box obstacles, apart) with ``mj_geomDistance`` for the
-        pairs it leaves, and ``ckernels.distance_gradients`` (module docstring)."""
+        """Distances capped at reach (default distmax), and their gradients if asked (else
+        zero): :meth:`_measure` into new arrays."""
         q = as_joint_vector(q, self._dof, stack=False)
-        m, d, geoms = self.model, self._data, self._geoms
-        reach = self.distmax if reach is None else reach
-        d.qpos[self._qpos] = q
-        mujoco.mj_kinematics(m, d)
         n_pairs = len(self._pairs)
         dist, fromto = np.empty(n_pairs), np.empty((n_pairs, 6))
+        grad = np.empty((n_pairs, self._dof)) if gradient else np.zeros((n_pairs, self._dof))
+        self._measure(q, self.distmax if reach is None else reach, dist, fromto, grad if gradient else None)
+        return dist, grad
+
+    def _measure(
+        self, q: np.ndarray, reach: float, dist: np.ndarray, fromto: np.ndarray, grad: np.ndarray | None
+    ) -> None:
+        """Write the distances capped at reach, the nearest points and (unless ``grad`` is
+        None) the gradients at the joint vector q: one ``mj_kinematics``, then
+        ``ckernels.geom_distances`` (sphere and capsule arm geoms against sphere, capsule and
+        box obstacles, apart) with ``mj_geomDistance`` for the pairs it leaves, and
+        ``ckernels.distance_gradients`` (module docstring)."""
+        m, d, geoms = self.model, self._data, self._geoms
+        d.qpos[self._qpos] = q
+        mujoco.mj_kinematics(m, d)
         if ckernels.geom_distances(
             geoms.kind,
             geoms.radius,
@@ -262,12 +234,10 @@ class Clearance:
             for k in np.flatnonzero(np.isnan(dist)).tolist():
                 a, o = self._pairs[k].tolist()
                 dist[k] = mujoco.mj_geomDistance(m, d, a, o, reach, fromto[k])
-        grad = np.empty((n_pairs, self._dof)) if gradient else np.zeros((n_pairs, self._dof))
-        if gradient:  # every row written
+        if grad is not None:  # every row written
             ckernels.distance_gradients(
                 dist, fromto, reach, d.xanchor, d.xaxis, geoms.joints, geoms.slide, geoms.moves, grad
             )
-        return dist, grad
 
 
 class GeomCores(NamedTuple):

@@ -18,7 +18,7 @@ when the arc crosses +-pi.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 from .arm_angle import wrap_psi
 from .paths import Path
@@ -74,7 +74,7 @@ def feasible_runs(probe: Probe, path: Path) -> list[Run]:
     for k in [*range(start, n), *range(start)]:  # a loop is scanned from after an infeasible sample
         if feasible[k]:
             wrapped = bool(current) and k < current[0][0]  # (a run of a loop past its last sample)
-            current.append((k, replace(points[k], psi=points[k].psi + period) if wrapped else points[k]))
+            current.append((k, points[k].at(points[k].psi + period) if wrapped else points[k]))
         elif current:
             runs.append(current)
             current = []
@@ -88,23 +88,15 @@ def _run(probe: Probe, path: Path, points: list[Point], k_first: int, k_last: in
     n, period = len(path.points), 2.0 * math.pi * path.turns
     if k_first > 0 or path.turns:
         before = path.points[k_first - 1]
-        before = (
-            replace(before, psi=points[0].psi - (points[0].psi - before.psi) % period)
-            if path.turns
-            else before
-        )
+        before = before.at(points[0].psi - (points[0].psi - before.psi) % period) if path.turns else before
         points = [refine_end(probe, points[0], before), *points]
     if k_last < n - 1 or path.turns:
         after = path.points[(k_last + 1) % n]
-        after = (
-            replace(after, psi=points[-1].psi + (after.psi - points[-1].psi) % period)
-            if path.turns
-            else after
-        )
+        after = after.at(points[-1].psi + (after.psi - points[-1].psi) % period) if path.turns else after
         points = [*points, refine_end(probe, points[-1], after)]
     lo = wrap_psi(points[0].psi)
     shift = lo - points[0].psi
-    points = [replace(p, psi=p.psi + shift) for p in points]
+    points = [p.at(p.psi + shift) for p in points]
     return Run(PsiInterval(probe.signs, lo, points[-1].psi), points)
 
 

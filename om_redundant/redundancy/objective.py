@@ -226,16 +226,60 @@ class Objective:
         eye = np.eye(self._dof)[self._limited] / self._half[:, None]
         self._margin_jacobian = np.vstack([eye, -eye])  # pieces (q - l)/h, then (u - q)/h
 
-    def groups(self, q: np.ndarray, jacobian: bool = False) -> list[Group]:
+    def groups(
+        self, q: np.ndarray, jacobian: bool = False, pairs: tuple[np.ndarray, np.ndarray] | None = None
+    ) -> list[Group]:
         """The groups at q (module docstring): margin (if any joint is limited), clearance
-        (if there are obstacles), then singularity (if given); their jacobians by q if asked."""
-        groups = [self._margin(q, jacobian)] if len(self._limited) else []
-        groups += [self._clearance(q, jacobian)] if self.clearance is not None else []
-        return groups + ([self._singularity(q, jacobian)] if self.singularity is not None else [])
+        (if there are obstacles), then singularity (if given); their jacobians by q if asked.
 
-    def evaluate(self, q: np.ndarray) -> Evaluation:
-        """f(q), M(q), D(q) and the feasibility slack."""
-        return self.evaluation(self.groups(as_joint_vector(q, self._dof)))
+        Args:
+            q: (dof,) joint vector.
+            jacobian: Also the jacobians.
+            pairs: The clearance's pair distances (P,) and gradients (P, dof) at q if
+                already computed (:meth:`Clearance.distances_and_gradients
+                <om_redundant.Clearance.distances_and_gradients>`): the same groups from them.
+        """
+        singularity = [self._singularity(q, jacobian)] if self.singularity is not None else []
+        return self.constrained_groups(q, jacobian, pairs) + singularity
+
+    def constrained_groups(
+        self, q: np.ndarray, jacobian: bool = False, pairs: tuple[np.ndarray, np.ndarray] | None = None
+    ) -> list[Group]:
+        """The groups of :meth:`groups` that have a floor (margin, clearance): those whose
+        :meth:`Group.constraints` define feasibility."""
+        groups = [self._margin(q, jacobian)] if len(self._limited) else []
+        return groups + ([self._clearance(q, jacobian, pairs)] if self.clearance is not None else [])
+
+    def evaluate(self, q: np.ndarray, distances: np.ndarray | None = None) -> Evaluation:
+        """f(q), M(q), D(q), the feasibility slack and S(q): each group's minimum
+        (the smallest of its pieces, :meth:`groups`) capped and weighted, summed in the
+        groups' order.
+
+        Args:
+            q: (dof,) joint vector.
+            distances: (P,) the clearance's pair distances at q if already computed.
+        """
+        q = as_joint_vector(q, self._dof, stack=False)
+        value, slacks = 0.0, []
+        margin = clearance = singularity = math.inf
+        if len(self._limited):
+            lim = q[self._limited]
+            lower, upper = _limit_distances(lim, self._lower, self._upper, self._half)
+            margin = min(float(lower.min()), float(upper.min()))
+            value += self.margin_weight * margin
+            slacks.append(margin - 0.0)
+        if self.clearance is not None:
+            if distances is None:
+                distances = self.clearance.distances(q)
+            scaled = float(distances.min()) / self.clearance_cap  # (= the least piece d_k / d_cap)
+            value += self.clearance_weight * min(1.0, scaled)
+            slacks.append(scaled - self.min_clearance / self.clearance_cap)
+            clearance = scaled * self.clearance_cap
+        if self.singularity is not None:
+            scaled = float(self.singularity.distances(q).min()) / SINGULARITY_CAP
+            value += self.singularity_weight * min(1.0, scaled)
+            singularity = scaled * SINGULARITY_CAP
+        return Evaluation(value, margin, clearance, min(slacks, default=math.inf), singularity)
 
     def evaluations(self, q: np.ndarray, distances: np.ndarray | None = None) -> list[Evaluation]:
         """:meth:`evaluate` at every row of q (M, dof), vectorised over the rows (the same
@@ -269,56 +313,72 @@ class Objective:
             singularity = scaled * SINGULARITY_CAP
         value = terms[0]
         for term in terms[1:]:
-            value = value + term  # in the order of evaluation()'s sum
+            value = value + term  # in the order of evaluate()'s sum
         slack = np.min(slacks, axis=0)
-        return [
-            Evaluation(*(float(x) for x in row))
-            for row in zip(value, margin, clearance, slack, singularity, strict=True)
-        ]
+        columns = (x.tolist() for x in (value, margin, clearance, slack, singularity))
+        return [Evaluation(*row) for row in zip(*columns, strict=True)]
 
     def constraint_bounds(
-        self, q: np.ndarray, tangent: np.ndarray, distances: np.ndarray | None
+        self, q: np.ndarray, tangent: np.ndarray, pairs: tuple[np.ndarray, np.ndarray] | None
     ) -> tuple[np.ndarray, np.ndarray]:
         r"""The feasibility functions of :meth:`Group.constraints` at joint vectors q and
-        bounds of their rates, without the clearances' gradients: for a cheap test of a cell
-        of a solution path.
+        the sizes of their rates, for a cheap test of a cell of a solution path (its
+        Hermite models bounded without evaluating them).
 
         Each limited joint's margin function :math:`1 - |q_i - c_i|/h_i`, with its rate's
         size :math:`|t_i|/h_i` (t = dq/dpsi); then, with obstacles, per pair
         :math:`(\min(d_k, 2 d_{cap}) - d_{min})/d_{cap}` (the clearance piece where it is
         below 2 d_cap, a lower bound of it beyond: there the pieces report 2 d_cap, or
-        d_k when every pair is that far), and a bound on its rate's size from
-        :meth:`Clearance.pair_bounds <om_redundant.Clearance.pair_bounds>`.
+        d_k when every pair is that far) and :math:`|\nabla d_k \cdot t| / d_{cap}` (at least
+        the size of the piece's rate: the pieces capped at 2 d_cap have none).
 
         Args:
             q: (M, dof) joint vectors.
             tangent: (M, dof, 1) their dq/dpsi.
-            distances: (M, P) the pairs' distances d_k(q) (m), :meth:`Clearance.distances
-                <om_redundant.Clearance.distances>`; None without obstacles.
+            pairs: (M, P) the pairs' distances d_k(q) (m) and (M, P, dof) their gradients,
+                :meth:`Clearance.distances_and_gradients
+                <om_redundant.Clearance.distances_and_gradients>`; None without obstacles.
 
         Returns:
-            (values (M, n), rate bounds (M, n)).
+            (values (M, n), rate sizes (M, n)).
         """
         lim = self._limited
         values = [np.minimum(*_limit_distances(q[:, lim], self._lower, self._upper, self._half))]
         rates = [np.abs(tangent[:, lim, 0]) / self._half]
         if self.clearance is not None:
             cap = self.clearance_cap
-            speed = self.clearance.pair_bounds(q, tangent[:, :, 0])[1]
+            distances, gradients = pairs
             values.append((np.minimum(distances, self.clearance_reach) - self.min_clearance) / cap)
-            rates.append(speed / cap)
+            rates.append(np.abs(gradients @ tangent)[:, :, 0] / cap)
         return np.concatenate(values, axis=1), np.concatenate(rates, axis=1)
 
-    def evaluation(self, groups: list[Group]) -> Evaluation:
-        """f, M, D, the slack and S from the groups at one joint vector."""
-        kinds = {g.kind: float(g.values.min()) for g in groups}
-        return Evaluation(
-            sum(g.term() for g in groups),
-            kinds.get("margin", math.inf),
-            kinds.get("clearance", math.inf) * self.clearance_cap,
-            min((g.slack() for g in groups), default=math.inf),
-            kinds.get("singularity", math.inf) * SINGULARITY_CAP,
-        )
+    def term_functions(self, q: np.ndarray, clearance: np.ndarray) -> list[tuple[float, float, np.ndarray]]:
+        """The objective at the rows of q as ``f = sum_g w_g min(cap_g, min_j values_j)``:
+        per group its weight, its cap and its functions at every row. The margin's are the
+        limited joints' margins m_i, the clearance's the one function D(q)/d_cap (its pairs
+        are not kept), the singularity's the distances s_k / s_cap. For bounds of f from
+        bounds of each function (the climbs' starts,
+        :meth:`~om_redundant.RedundancyOptimizer.choose`).
+
+        Args:
+            q: (M, dof) joint vectors.
+            clearance: (M,) their clearances D(q) (m), as the evaluations give them (unused
+                without obstacles).
+
+        Returns:
+            [(w_g, cap_g, (M, p_g) values)] in the order of :meth:`groups`.
+        """
+        groups = []
+        if len(self._limited):
+            lim = q[:, self._limited]
+            margins = np.minimum(*_limit_distances(lim, self._lower, self._upper, self._half))
+            groups.append((self.margin_weight, math.inf, margins))
+        if self.clearance is not None:
+            groups.append((self.clearance_weight, 1.0, clearance[:, None] / self.clearance_cap))
+        if self.singularity is not None:
+            singular = self.singularity.distances(q) / SINGULARITY_CAP
+            groups.append((self.singularity_weight, 1.0, singular))
+        return groups
 
     def _margin(self, q: np.ndarray, jacobian: bool) -> Group:
         lim = self._limited
@@ -327,14 +387,24 @@ class Objective:
             "margin", self.margin_weight, 0.0, math.inf, pieces, self._margin_jacobian if jacobian else None
         )
 
-    def _clearance(self, q: np.ndarray, jacobian: bool) -> Group:
+    def _clearance(self, q: np.ndarray, jacobian: bool, pairs: tuple[np.ndarray, np.ndarray] | None) -> Group:
         """The clearance pieces d_k / d_cap, computed only for the pairs within 2 d_cap (the
         others report 2 with zero gradient: beyond the cap they change neither the term,
         the slack's minimum nor, far above the floor, a feasibility model); all of them
-        exactly when no pair is that near, so that D(q) is exact."""
-        floor, cap = self.min_clearance / self.clearance_cap, self.clearance_cap
-        d, grad = self.clearance.distances_within(q, self.clearance_reach, gradient=jacobian)
-        if d.min() < self.clearance_reach:
+        exactly when no pair is that near, so that D(q) is exact. From ``pairs`` (every
+        pair's distance and gradient) the same pieces, capped here."""
+        floor, cap, reach = self.min_clearance / self.clearance_cap, self.clearance_cap, self.clearance_reach
+        if pairs is not None:
+            d, grad = pairs
+            if d.min() < reach:
+                near = d < reach
+                d = np.where(near, d, reach)
+                grad = np.where(near[:, None], grad, 0.0) if jacobian else None
+            return Group(
+                "clearance", self.clearance_weight, floor, 1.0, d / cap, grad / cap if jacobian else None
+            )
+        d, grad = self.clearance.distances_within(q, reach, gradient=jacobian)
+        if d.min() < reach:
             scaled = grad / cap if jacobian else None
             return Group("clearance", self.clearance_weight, floor, 1.0, d / cap, scaled)
         return _capped("clearance", self.clearance_weight, floor, self.clearance, cap, q, jacobian)

@@ -10,11 +10,18 @@ the exact OM solution in it:
 1. **Sweep.** Every allowed branch's exact solutions are sampled on a psi grid and linked
    into solution paths (:mod:`om_redundant.redundancy.paths`), which are cut into feasible intervals
    with refined ends (:mod:`om_redundant.redundancy.intervals`).
-2. **Starts.** In each interval, the samples that are local maxima of f. With L the largest
-   slope of f between neighbouring samples (times 2) and h a start's distance to its
-   neighbours, a start can only lead above ``f_start + L h``; starts are climbed best
-   first, and those whose bound is below the best value found are skipped. This is what
-   finds the global optimum rather than the nearest local one.
+2. **Starts.** In each interval, the samples that are local maxima of f. With h a start's
+   distance to its farther neighbour and L the largest slope between neighbouring samples
+   (over every interval, times 2), a start can only lead above the smaller of
+   ``f_start + L_f h`` and ``sum_g w_g min(cap_g, min_j (v_j + L_j h))``, the second with
+   each function v_j of each group (a joint's margin, the clearance, a singularity
+   distance; :meth:`~om_redundant.redundancy.objective.Objective.term_functions`) bounded by
+   its own slope: a joint that the self-motion does not move (the elbow of an S-R-S arm)
+   binding the margin, with the other terms at their caps, bounds f by its start value.
+   Starts are climbed best first, and those whose bound is below the best value found (by
+   more than :data:`PLATEAU` when tracking; not above it by :data:`_CLIMB_ROUNDING`
+   otherwise, a climb that could at most tie) are skipped. This is what finds the global
+   optimum rather than the nearest local one.
 3. **Climb** from each start (:func:`~om_redundant.redundancy.climb.maximise`): a trust-region SQP
    whose QP, solved by OSQP, linearises margins and clearances around the current exact
    solution, within the interval. The result is the best point's own exact solve.
@@ -64,6 +71,9 @@ from .tracking import Tracker
 _WINDOW_POINTS = 4  # tracking samples on each side of the previous psi
 #: Tracking: optima within this of the best objective value are equal; the nearest wins.
 PLATEAU = 1e-6
+#: Global choose: a start whose bound is within this of the best found is not climbed (it can
+#: at most tie).
+_CLIMB_ROUNDING = 1e-12
 #: Bounds of ``grid_points`` (psi samples per branch; the sweep's cost grows with it).
 MIN_GRID_POINTS, MAX_GRID_POINTS = 16, 100_000
 
@@ -271,28 +281,52 @@ class RedundancyOptimizer:
         where it was instead of jumping to whichever sample rounding favours, farther than
         the joints can follow in one tick.
         """
-        slope = 0.0
-        starts = []
+        slope, limits, starts = 0.0, None, []
         for run in runs:
             psi = np.array([p.psi for p in run.points])
-            f = np.array([p.evaluation.value for p in run.points])
+            evaluations = [p.evaluation for p in run.points]
+            f = np.array([e.value for e in evaluations])
+            clearance = np.array([e.clearance for e in evaluations])
+            terms = self.objective.term_functions(np.array([p.q for p in run.points]), clearance)
             if len(f) > 1:
-                slope = max(slope, float(np.max(np.abs(np.diff(f)) / np.maximum(np.diff(psi), 1e-12))))
+                step = np.maximum(np.diff(psi), 1e-12)
+                slope = max(slope, float(np.max(np.abs(np.diff(f)) / step)))
+                rates = [np.max(np.abs(np.diff(v, axis=0)) / step[:, None], axis=0) for _, _, v in terms]
+                limits = (
+                    rates
+                    if limits is None
+                    else [np.maximum(a, b) for a, b in zip(limits, rates, strict=True)]
+                )
             for k in range(len(f)):
                 at_near = near is not None and _distance(psi[k], near) <= END_TOLERANCE
                 if at_near or ((k == 0 or f[k] >= f[k - 1]) and (k == len(f) - 1 or f[k] >= f[k + 1])):
                     gap = max(psi[min(k + 1, len(f) - 1)] - psi[k], psi[k] - psi[max(k - 1, 0)])
-                    starts.append((f[k], gap, run, run.points[k]))
+                    here = [(w, cap, v[k]) for w, cap, v in terms]
+                    starts.append((f[k], gap, run, run.points[k], here))
+        if limits is None:  # (single samples: no slopes, and no gaps)
+            limits = [np.zeros(len(v)) for _, _, v in starts[0][4]]
         starts.sort(key=lambda s: -s[0])
-        tolerance = 0.0 if near is None else PLATEAU
         found = [(starts[0][2], starts[0][3])]
-        for value, gap, run, start in starts:
-            best = max(point.evaluation.value for _, point in found)
-            if value + 2.0 * slope * gap < best - tolerance:
+        best = found[0][1].evaluation.value
+        probes = {}
+        for value, gap, run, start, here in starts:
+            reach = 2.0 * gap
+            bound = min(
+                value + slope * reach,
+                sum(
+                    w * min(cap, float((v + rate * reach).min()))
+                    for (w, cap, v), rate in zip(here, limits, strict=True)
+                ),
+            )
+            if (bound < best + _CLIMB_ROUNDING) if near is None else (bound < best - PLATEAU):
                 continue
             lo, hi = (-math.inf, math.inf) if run.interval.closed else (run.interval.lo, run.interval.hi)
-            probe = self._probe(T, run.interval.signs, wrapped=near is None)
-            found.append((run, maximise(probe, start, lo, hi, max(gap, 1e-6))))
+            signs = run.interval.signs
+            if signs not in probes:
+                probes[signs] = self._probe(T, signs, wrapped=near is None)
+            point = maximise(probes[signs], start, lo, hi, max(gap, 1e-6))
+            found.append((run, point))
+            best = max(best, point.evaluation.value)
         best = max(point.evaluation.value for _, point in found)
         if near is None:
             return next((run, point) for run, point in found if point.evaluation.value == best)

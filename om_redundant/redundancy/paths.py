@@ -14,10 +14,10 @@ elbow), so the solutions of a branch are organised as *paths*:
   taken at the representative nearest mid-range (the solver's within-limits one, if any):
   feasibility is that of the arm's pose, not of one unwrapped joint vector. Tracking
   compares the joints as they are (the path the joints can move along).
-* **Sweep** (:func:`sweep_circle`). The branch is solved on a psi grid in one parallel
-  batch without hints; where the model can have several solutions per psi (an offset
-  model, ``dp_max > 0``) :meth:`~om_redundant.OMSolver.solve_all` adds the others at every
-  grid psi that has one. Each solution is followed to the next grid psi and linked to the
+* **Sweep** (:func:`sweep_circle`). Every solution of the branch at each psi of a grid
+  (:meth:`~om_redundant.OMSolver.solve_all`; an offset model, ``dp_max > 0``, can have
+  several per psi) comes from one parallel batch (:meth:`~om_redundant.OMSolver.solve_all_batch`).
+  Each solution is followed to the next grid psi and linked to the
   solution it arrives at; solutions not arrived at start new paths, followed backwards to
   where they end; paths are joined across +-pi, and close into loops.
 * **Cells.** Between neighbouring samples of a path where a joint moves more than
@@ -34,11 +34,10 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
-from ..om.configuration import Configuration
 from ..om.solver import OMSolver
 from .objective import Objective
 from .probe import END_TOLERANCE, JUMP, SAME, Point, Probe
@@ -75,25 +74,26 @@ def sweep_circle(
     """The solution paths of every branch over the whole circle, from the grid
     psi_k = -pi + 2 pi k / n (module docstring)."""
     psi = -math.pi + _TURN * np.arange(n) / n
-    batch = solver.solve_batch(
+    batch = solver.solve_all_batch(
         np.repeat(T[None], n * len(branches), axis=0),
         np.repeat(branches, n, axis=0),
         np.tile(psi, len(branches)),
     )
-    several = solver.dp_max > 0.0  # an exact S-R-S model has one solution per psi
     swept = []
     for b, signs in enumerate(branches):
         probe = Probe(solver, objective, T, signs)
-        rows = np.flatnonzero(batch.ok[b * n : (b + 1) * n])
-        samples = dict(zip(rows.tolist(), probe.points(psi[rows], batch.q[b * n + rows]), strict=True))
-        roots = []
+        grid, distinct = [], []  # the grid index of each distinct solution, its joints
         for k in range(n):
-            found = [samples[k]] if k in samples else []
-            others = solver.solve_all(T, Configuration(signs, (psi[k],))) if found and several else []
-            for sol in others:
-                if all(probe.step(sol.q, f.q) > SAME for f in found):
-                    found.append(probe.point(psi[k], sol.q, sol))
-            roots.append(found)
+            found = []
+            for q in batch.q[b * n + k, : batch.count[b * n + k]]:
+                if all(probe.step(q, f) > SAME for f in found):
+                    found.append(q)
+            grid += [k] * len(found)
+            distinct += found
+        roots: list[list[Point]] = [[] for _ in range(n)]
+        if grid:
+            for k, point in zip(grid, probe.points(psi[grid], np.array(distinct)), strict=True):
+                roots[k].append(point)
         swept.append([_with_hidden(probe, path) for path in _link(probe, psi, roots)])
     return swept
 
@@ -124,11 +124,15 @@ def _link(probe: Probe, psi: np.ndarray, roots: list[list[Point]]) -> list[Path]
     paths: list[list[Point]] = []
     first: list[int] = []  # grid index of each path's first sample
     ongoing: list[int] = []  # paths that reached the previous grid psi
+    continuing = _continuing(probe, roots)
     for k in range(n):
         taken = [False] * len(roots[k])
         reaching = []
         for i in ongoing:
-            if len(roots[k]) == 1 and probe.continues(paths[i][-1], roots[k][0]):
+            last = paths[i][-1]
+            if len(roots[k]) == 1 and (
+                continuing[last] if last in continuing else probe.continues(last, roots[k][0])
+            ):
                 reached, arrived = roots[k][0], True  # the only solution, and it continues the path
             else:
                 reached, arrived = probe.follow(paths[i][-1], psi[k])
@@ -151,6 +155,25 @@ def _link(probe: Probe, psi: np.ndarray, roots: list[list[Point]]) -> list[Path]
                 reaching.append(len(paths) - 1)
         ongoing = reaching
     return _joined(probe, psi, paths, first, ongoing)
+
+
+def _continuing(probe: Probe, roots: list[list[Point]]) -> dict[Point, bool]:
+    """For each solution at a grid psi followed by a single one at the next: whether that one
+    continues its path (:meth:`Probe.continues`), all tested at once."""
+    pairs = [(a, roots[k][0]) for k in range(1, len(roots)) if len(roots[k]) == 1 for a in roots[k - 1]]
+    if not pairs:
+        return {}
+    flags = probe.continue_rows(*(np.array([[p.psi for p in pair] for pair in pairs]).T), *_stacked(pairs))
+    return dict(zip([a for a, _ in pairs], flags.tolist(), strict=True))
+
+
+def _stacked(pairs: list[tuple[Point, Point]]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The first points' joints and tangents and the second points' joints, stacked."""
+    return (
+        np.array([a.q for a, _ in pairs]),
+        np.array([a.tangent[:, 0] for a, _ in pairs]),
+        np.array([b.q for _, b in pairs]),
+    )
 
 
 def _joined(
@@ -176,7 +199,7 @@ def _joined(
         while chain[-1] in following and following[chain[-1]] not in chain:
             chain.append(following[chain[-1]])
         seen.update(chain)
-        points = [replace(p, psi=p.psi + _TURN * turn) for turn, i in enumerate(chain) for p in paths[i]]
+        points = [p.at(p.psi + _TURN * turn) for turn, i in enumerate(chain) for p in paths[i]]
         if following.get(chain[-1]) == chain[0]:
             result.append(Path(points, turns=len(chain)))
         else:
@@ -193,6 +216,9 @@ def _back_to_end(probe: Probe, psi: np.ndarray, points: list[Point], k: int) -> 
 
 def _same(probe: Probe, point: Point, candidates: list[Point]) -> int | None:
     """The index of the candidate that is the same solution as point, if any."""
+    for j, candidate in enumerate(candidates):
+        if candidate is point:  # (the candidates are more than SAME apart)
+            return j
     steps = [probe.step(point.q, c.q) for c in candidates]
     return int(np.argmin(steps)) if steps and min(steps) <= SAME else None
 
@@ -201,7 +227,7 @@ def _with_hidden(probe: Probe, path: Path) -> Path:
     """The path with exact samples inserted where a cell hides a feature (module docstring)."""
     ends = list(path.points)
     if path.turns:  # the closing cell, to the first sample a loop later
-        ends.append(replace(ends[0], psi=ends[0].psi + _TURN * path.turns))
+        ends.append(ends[0].at(ends[0].psi + _TURN * path.turns))
     # the cells that need no look inside, all at once: no joint moves more than FINE_STEP
     # and the cheap bounds show the models quiet (_hidden's own first test, vectorised)
     q = np.array([p.q for p in ends])
@@ -217,25 +243,27 @@ def _with_hidden(probe: Probe, path: Path) -> Path:
 def _hidden(probe: Probe, a: Point, b: Point) -> list[Point]:
     """Exact samples inserted between neighbours a and b of a path, in order: halving until
     no joint moves more than :data:`FINE_STEP` in a sub-cell, then until the Hermite models
-    of every sub-cell agree with its ends (module docstring)."""
-    inserted, cells = [], [(a, b)]
+    of every sub-cell agree with its ends (module docstring). The cell (a, b) itself, if
+    no joint moves more than FINE_STEP in it, is known not quiet (:func:`_with_hidden`)."""
+    inserted, cells = [], [(a, b, True)]  # (left, right, known not quiet if fine)
     while cells and len(inserted) < _MAX_INSERTED:
-        left, right = cells.pop()
-        t = 0.5 if probe.step(left.q, right.q) > FINE_STEP else _surprise(left, right)
+        left, right, loud = cells.pop()
+        t = 0.5 if probe.step(left.q, right.q) > FINE_STEP else _surprise(left, right, loud)
         if t is None or right.psi - left.psi <= END_TOLERANCE:
             continue
         middle, arrived = probe.follow(left, left.psi + t * (right.psi - left.psi))
         if arrived:
             inserted.append(middle)
-            cells += [(left, middle), (middle, right)]
+            cells += [(left, middle, False), (middle, right, False)]
     return sorted(inserted, key=lambda p: p.psi)
 
 
-def _surprise(a: Point, b: Point) -> float | None:
+def _surprise(a: Point, b: Point, loud: bool = False) -> float | None:
     """Where, as a fraction of the cell, the pieces' cubic models predict a feasibility that
     the ends do not explain: more changes between feasible and infeasible than the ends'
-    (none if alike, one if not). Returns the middle of the first unexplained stretch."""
-    if _quiet([a], [b])[0]:
+    (none if alike, one if not). Returns the middle of the first unexplained stretch.
+    ``loud``: the cell is known not to be quiet (:func:`_quiet`), which is not tested again."""
+    if not loud and a.evaluation.feasible == b.evaluation.feasible and _quiet([a], [b])[0]:
         return None
     (ga, da), (gb, db) = a.pieces(), b.pieces()
     if len(ga) == 0:

@@ -21,48 +21,71 @@ import numpy as np
 
 from .. import ckernels
 from ..om.configuration import Configuration
-from ..om.solver import OMSolver, Solution
+from ..om.solver import BRANCH_BAND, OMSolver, Solution
 from .objective import Evaluation, Group, Objective
 from .self_motion import self_motion_tangent, self_motion_tangents
 
 JUMP = 1.0  # rad, max-norm joint step between neighbouring solutions of one path
 END_TOLERANCE = 1e-9  # rad: a path whose following step falls below this has ended (csrc/follow.c)
 SAME = 1e-6  # rad, max-norm: two solutions at one psi this close are one
+_AIM = 63.0 / 64.0  # of the distance to a path's predicted end, a step aimed there goes (csrc/follow.c)
 _TURN = 2.0 * math.pi
 _ARRIVED, _SINGULAR = 0, 2  # ckernels.follow's status
 
 
 class _Terms:
     """The objective at a point, computed when first asked for (a path's following steps
-    need only the joints and the tangent): the evaluation, then the groups with their rates.
-    Shared by the copies of a point at other representatives of psi."""
+    need only the joints and the tangent): the clearance's pair distances and gradients
+    (one ``mj_kinematics``), from which the groups with their rates, the evaluation and
+    the constraint bounds. Shared by the copies of a point at other representatives of psi.
+    """
 
-    def __init__(
-        self, objective: Objective, q: np.ndarray, tangent: np.ndarray, evaluation: Evaluation | None
-    ):
+    def __init__(self, objective: Objective, q: np.ndarray, tangent: np.ndarray):
         self.objective, self.q, self.tangent = objective, q, tangent
-        self.evaluation, self.groups, self.bounds = evaluation, None, None
+        self.pairs, self.evaluation, self.groups, self.bounds, self.pieces = None, None, None, None, None
+
+    def get_pairs(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """The clearance's pair distances and gradients at q; None without obstacles."""
+        if self.pairs is None and self.objective.clearance is not None:
+            self.pairs = self.objective.clearance.distances_and_gradients(self.q)
+        return self.pairs
 
     def get_evaluation(self) -> Evaluation:
         if self.evaluation is None:
-            self.evaluation = self.objective.evaluation(self.objective.groups(self.q))
+            pairs = self.get_pairs()
+            self.evaluation = self.objective.evaluate(self.q, None if pairs is None else pairs[0])
         return self.evaluation
 
     def get_bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`~om_redundant.redundancy.objective.Objective.constraint_bounds` here."""
         if self.bounds is None:
-            clearance = self.objective.clearance
-            q, tangent = self.q[None], self.tangent[None]
-            distances = None if clearance is None else clearance.distances(q)
-            values, rates = self.objective.constraint_bounds(q, tangent, distances)
+            pairs = self.get_pairs()
+            pairs = None if pairs is None else (pairs[0][None], pairs[1][None])
+            values, rates = self.objective.constraint_bounds(self.q[None], self.tangent[None], pairs)
             self.bounds = values[0], rates[0]
         return self.bounds
 
+    def get_pieces(self) -> tuple[np.ndarray, np.ndarray]:
+        """The feasibility functions and their rates (:meth:`Point.pieces`), from the groups
+        if already computed, else from the groups with a floor only."""
+        if self.pieces is None:
+            if self.groups is None:
+                groups = self.objective.constrained_groups(self.q, jacobian=True, pairs=self.get_pairs())
+                groups = [g.along(self.tangent) for g in groups]
+            else:
+                groups = self.groups
+            pieces = [g.constraints() for g in groups]
+            if pieces:
+                g, dg = zip(*pieces, strict=True)
+                self.pieces = np.concatenate(g), np.concatenate(dg)
+            else:
+                self.pieces = np.zeros(0), np.zeros(0)
+        return self.pieces
+
     def get_groups(self) -> list[Group]:
         if self.groups is None:
-            self.groups = [g.along(self.tangent) for g in self.objective.groups(self.q, jacobian=True)]
-            if self.evaluation is None:
-                self.evaluation = self.objective.evaluation(self.groups)
+            groups = self.objective.groups(self.q, jacobian=True, pairs=self.get_pairs())
+            self.groups = [g.along(self.tangent) for g in groups]
         return self.groups
 
 
@@ -86,6 +109,11 @@ class Point:
     terms: _Terms
     solution: Solution | None = None
 
+    def at(self, psi: float | np.ndarray) -> Point:
+        """The same solution at another representative of psi (itself at the same psi)."""
+        same = isinstance(psi, float) and psi == self.psi
+        return self if same else Point(psi, self.q, self.tangent, self.terms, self.solution)
+
     @property
     def evaluation(self) -> Evaluation:
         """The objective at q."""
@@ -99,10 +127,7 @@ class Point:
     def pieces(self) -> tuple[np.ndarray, np.ndarray]:
         """The feasibility functions g_j (all >= 0 iff feasible; see
         :meth:`~om_redundant.redundancy.objective.Group.constraints`) and dg_j/dpsi."""
-        if not self.groups:
-            return np.zeros(0), np.zeros(0)
-        g, dg = zip(*(group.constraints() for group in self.groups), strict=True)
-        return np.concatenate(g), np.concatenate(dg)
+        return self.terms.get_pieces()
 
 
 class Probe:
@@ -165,24 +190,26 @@ class Probe:
 
     def _point(self, psi: float | np.ndarray, q: np.ndarray, solution: Solution | None) -> Point:
         tangent = self_motion_tangent(self.solver, q)
-        return Point(psi, q, tangent, _Terms(self.objective, q, tangent, None), solution)
+        return Point(psi, q, tangent, _Terms(self.objective, q, tangent), solution)
 
     def points(self, psi: np.ndarray, q: np.ndarray) -> list[Point]:
         """:meth:`point` for every psi and row of q (M, dof) of a 7-DOF arm, the tangents, the
-        evaluations and the constraint bounds computed for all rows at once."""
+        clearance's distances and gradients, the evaluations and the constraint bounds
+        computed for all rows at once."""
         q = self._represent(q)
         tangents = self_motion_tangents(self.solver, q)
         bad = ~np.isfinite(tangents).all(axis=(1, 2))
         if bad.any():
             self_motion_tangent(self.solver, q[np.argmax(bad)])  # raises SingularSelfMotion
         clearance = self.objective.clearance
-        distances = None if clearance is None else clearance.distances(q)
-        evaluations = self.objective.evaluations(q, distances)
-        values, rates = self.objective.constraint_bounds(q, tangents, distances)
+        pairs = None if clearance is None else clearance.distances_and_gradients(q)
+        evaluations = self.objective.evaluations(q, None if pairs is None else pairs[0])
+        values, rates = self.objective.constraint_bounds(q, tangents, pairs)
         points = []
-        for x, row, t, ev, v, r in zip(psi, q, tangents, evaluations, values, rates, strict=True):
-            terms = _Terms(self.objective, row, t, ev)
-            terms.bounds = v, r
+        for k, (x, row, t, ev) in enumerate(zip(psi, q, tangents, evaluations, strict=True)):
+            terms = _Terms(self.objective, row, t)
+            terms.pairs = None if pairs is None else (pairs[0][k], pairs[1][k])
+            terms.evaluation, terms.bounds = ev, (values[k], rates[k])
             points.append(Point(float(x), row, t, terms))
         return points
 
@@ -207,6 +234,17 @@ class Probe:
         error = moved - point.tangent @ np.atleast_1d(psi - point.psi)
         return np.abs(moved).max() <= JUMP and np.abs(error).max() <= 0.5 * np.abs(moved).max() + SAME
 
+    def continue_rows(
+        self, psi_a: np.ndarray, psi_b: np.ndarray, q_a: np.ndarray, tangent_a: np.ndarray, q_b: np.ndarray
+    ) -> np.ndarray:
+        """:meth:`continues` for M pairs at once (the same operations row by row): whether
+        the solutions (psi_b, q_b) continue the paths of (psi_a, q_a) with tangents
+        ``tangent_a`` (M, dof) (r = 1)."""
+        moved = self._delta(q_a, q_b)
+        error = moved - tangent_a * (psi_b - psi_a)[:, None]
+        jump = np.abs(moved).max(axis=1)
+        return (jump <= JUMP) & (np.abs(error).max(axis=1) <= 0.5 * jump + SAME)
+
     def next(self, point: Point, psi: float | np.ndarray) -> Point | None:
         """The solution at psi nearest point, if it continues point's path (the objective
         evaluated only then): one attempt of :meth:`follow`'s loop."""
@@ -221,7 +259,11 @@ class Probe:
         return self._point(psi, q, sol) if self._continues(point, psi, q) else None
 
     def follow(self, start: Point, psi: float) -> tuple[Point, bool]:
-        """Continue start's path towards psi (module docstring).
+        """Continue start's path towards psi (module docstring). Where the secant of an end
+        measure (:meth:`_end_measures`) through the last two points predicts the path's end
+        short of the next step, the step aims :data:`_AIM` of the way there instead (at
+        least 1.5 :data:`END_TOLERANCE`): the end is approached in a few successful steps
+        rather than by halving, whose failing attempts beyond the end are the costliest.
 
         Returns:
             The point reached and whether it is at psi. When the path ends on the way the
@@ -232,16 +274,38 @@ class Probe:
             if reached is not None:
                 return reached
         point, step = start, psi - start.psi
+        ends, behind = self._end_measures(point), None  # behind: (psi, end measures) of the point before
         while point.psi != psi:
             if abs(step) < END_TOLERANCE:
                 return point, False
             x = psi if abs(psi - point.psi) <= abs(step) else point.psi + step
+            aim = math.inf
+            if behind is not None:
+                ahead = _predicted_end(behind[1], ends, abs(point.psi - behind[0]))
+                aim = max(_AIM * ahead, 1.5 * END_TOLERANCE)
+            if aim < abs(x - point.psi):
+                x = point.psi + math.copysign(aim, step)
             nxt = self.next(point, x)
-            if nxt is None:
-                step /= 2.0
+            if nxt is None:  # (halved from x, not from step: psi nearer than step is not tried again)
+                step = 0.5 * (x - point.psi)
             else:
-                point, step = nxt, 2.0 * step
+                step = 2.0 * (x - point.psi)
+                behind, point = (point.psi, ends), nxt
+                ends = self._end_measures(point)
         return point, True
+
+    def _end_measures(self, point: Point) -> list[float]:
+        """What ends a path, as functions of its point that fall to zero there linearly in
+        psi: 1 / |dq/dpsi|^2 at a fold (q - q_f ~ (psi_f - psi)^(1/2)), and s_i b_i +
+        BRANCH_BAND where branch quantity b_i leaves its sign s_i beyond the band."""
+        branch, redundancy = np.empty(len(self.signs)), np.empty(1)
+        self.solver.kernel.configuration_values(np.ascontiguousarray(point.q), branch, redundancy)
+        tt = 0.0
+        for v in point.tangent[:, 0].tolist():  # (summed in order, as csrc/follow.c does)
+            tt += v * v
+        return [1.0 / tt] + [
+            float(s) * b + BRANCH_BAND for s, b in zip(self.signs, branch.tolist(), strict=True)
+        ]
 
     def _follow_compiled(
         self, start: Point, psi: float, min_step: float = END_TOLERANCE
@@ -259,7 +323,7 @@ class Probe:
         if steps == 0:
             return start, status == _ARRIVED
         q, tangent = work.q.copy(), work.t.copy()[:, None]
-        return Point(reached, q, tangent, _Terms(self.objective, q, tangent, None)), status == _ARRIVED
+        return Point(reached, q, tangent, _Terms(self.objective, q, tangent)), status == _ARRIVED
 
 
 class FollowWork(NamedTuple):
@@ -285,6 +349,14 @@ class FollowWork(NamedTuple):
     q: np.ndarray
     t: np.ndarray
     out: np.ndarray
+
+
+def _predicted_end(before: list[float], now: list[float], moved: float) -> float:
+    """The distance in psi ahead of a point (end measures ``now``) to the nearest end that
+    the secant of a measure falling towards zero predicts, from the point ``moved`` behind
+    (measures ``before``); inf where none falls."""
+    ahead = [moved * f / (b - f) for b, f in zip(before, now, strict=True) if 0.0 < f < b]
+    return min(ahead, default=math.inf)
 
 
 def _wrap(x: np.ndarray) -> np.ndarray:

@@ -64,14 +64,17 @@ def self_motion_tangent(solver: OMSolver, q: np.ndarray) -> np.ndarray:
     return tangent
 
 
-def self_motion_tangents(solver: OMSolver, q: np.ndarray) -> np.ndarray:
+def self_motion_tangents(solver: OMSolver, q: np.ndarray, compiled: bool = True) -> np.ndarray:
     r"""dq/dpsi of a 7-DOF arm (one redundancy variable) at every row of q, as
     :func:`self_motion_tangent` computes it (the same operations per row, the 6x6 minors of
-    all rows in one batch), NaN rows where psi does not move along the self-motion.
+    all rows in one batch; with a compiled solver by :func:`compiled_tangents`), NaN rows
+    where psi does not move along the self-motion.
 
     Args:
         solver: The solver of a 7-DOF arm.
         q: (M, 7) joint vectors.
+        compiled: With a compiled solver, its kernel; False: always numpy (the reference
+            it is tested against).
 
     Returns:
         (M, 7, 1) tangents.
@@ -81,6 +84,8 @@ def self_motion_tangents(solver: OMSolver, q: np.ndarray) -> np.ndarray:
     """
     check_arm_angle(solver)
     q = as_joint_vector(q, solver.arm.dof).reshape(-1, solver.arm.dof)
+    if compiled and isinstance(solver.kernel, ckernels.Solver) and solver.arm.dof == 7:
+        return compiled_tangents(solver.kernel, q)
     chain, model, flip = solver.arm.chain, solver.model.chain, solver.flip
     jacobians = np.empty((len(q), 6, 7))
     gradients = np.empty((len(q), 7))
@@ -93,4 +98,21 @@ def self_motion_tangents(solver: OMSolver, q: np.ndarray) -> np.ndarray:
     with np.errstate(divide="ignore", invalid="ignore"):
         tangent = null / change[:, None]
     tangent[~np.isfinite(tangent).all(axis=1)] = np.nan
+    return tangent[:, :, None]
+
+
+def compiled_tangents(kernel: ckernels.Solver, q: np.ndarray) -> np.ndarray:
+    """:func:`self_motion_tangents` by a 7-DOF arm's compiled solver
+    (``ckernels.self_motion_tangents``, ``csrc/tangents.c``: the cofactors of the real arm's
+    Jacobian in its base frame, the same null vector, and the tangents of ``ckernels.follow``).
+
+    Args:
+        kernel: The compiled solver.
+        q: (M, 7) joint vectors.
+
+    Returns:
+        (M, 7, 1) tangents, NaN rows where psi does not move along the self-motion.
+    """
+    tangent = np.empty((len(q), 7))
+    ckernels.self_motion_tangents(kernel, q, tangent)
     return tangent[:, :, None]
