@@ -269,7 +269,8 @@ double om_polish(const om_polish_task *t, int iterations, double *q);
 
 /* boundary.c */
 /* A candidate q that failed verification, refined on the real arm where a branch quantity is
- * within 1e-2 of zero (else left as it is); returns whether it now verifies. */
+ * within 1e-2 of zero, or (S-R-S) w_hat within 1e-2 rad of psi's singular half-line (else left
+ * as it is); returns whether it now verifies. */
 bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori);
 /* om_add_root of q, polished first where it fails verification near the boundary. */
 int om_add_candidate(om_problem *pb, double *q, double *roots, int count);
