@@ -83,5 +83,8 @@ extern PyMethodDef om_tracking_functions[]; /* tracking.c: the redundancy optimi
 extern PyMethodDef om_clearance_functions[]; /* clearance.c: distances of arm and obstacle geoms */
 extern PyMethodDef om_follow_functions[];    /* follow.c: a solution path followed along psi */
 extern PyMethodDef om_tangent_functions[];   /* tangents.c: self-motion tangents of many rows */
+extern PyMethodDef om_objective_functions[]; /* objective.c: the redundancy optimiser's objective */
+extern PyMethodDef om_cell_functions[];      /* cells.c: the cell test of the solution paths */
+extern PyMethodDef om_box_qp_functions[];    /* box_qp.c: the climb's QP in one variable */
 
 #endif

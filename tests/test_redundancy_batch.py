@@ -40,8 +40,17 @@ def test_batched_evaluations_equal_the_single_ones(seed, name, count):
     q = joints(optimizer, seed)
     objective = optimizer.objective
     assert objective.evaluations(q) == [objective.evaluate(row) for row in q]
-    for row in q[:5]:  # f is the groups' terms summed in order
-        assert objective.evaluate(row).value == sum(g.term() for g in objective.groups(row))
+    for row in q[:5]:  # the groups' minima, capped, weighted and summed (C's sin or numpy's)
+        evaluation, groups = objective.evaluate(row), {g.kind: g for g in objective.groups(row)}
+        assert evaluation.value == pytest.approx(sum(g.term() for g in groups.values()), rel=0, abs=1e-15)
+        assert evaluation.margin == groups["margin"].values.min()
+        assert evaluation.slack == min(g.slack() for g in groups.values())
+        if "clearance" in groups:
+            assert evaluation.clearance == groups["clearance"].values.min() * objective.clearance_cap
+        if "singularity" in groups:
+            assert evaluation.singularity == pytest.approx(
+                groups["singularity"].values.min() * 0.5, abs=1e-16
+            )
         if objective.clearance is not None:
             distances = objective.clearance.distances_and_gradients(row)[0]
             assert objective.evaluate(row, distances) == objective.evaluate(row)
@@ -123,7 +132,8 @@ def test_constraint_bounds_bound_the_feasibility_functions_and_their_rates(seed,
 def test_the_one_variable_qp_step_is_the_models_maximiser(seed, pieces, curvature, reach):
     """box_qp.maximise_1d, from a point within the floors as the climb's: a delta within the
     box and the floors whose model value no point of a dense grid of the feasible interval
-    beats, and multipliers in [0, w_g] per group."""
+    beats, and multipliers in [0, w_g] per group; compiled exactly as numpy computes it,
+    also from points below the floors (where they may leave no delta)."""
     rng = np.random.default_rng(seed)
     groups = [
         Group(
@@ -144,6 +154,17 @@ def test_the_one_variable_qp_step_is_the_models_maximiser(seed, pieces, curvatur
         start=-0.5 * curvature * grid**2,
     )
     delta, multipliers = maximise_1d(groups, curvature, lower, upper)
+    reference = maximise_1d(groups, curvature, lower, upper, compiled=False)  # numpy's
+    assert delta == reference[0]
+    for z, want in zip(multipliers, reference[1], strict=True):
+        np.testing.assert_array_equal(z, want)
+    below = [Group(g.kind, g.weight, g.floor, g.cap, g.values - 0.5, g.jacobian) for g in groups]
+    found, want = (maximise_1d(below, curvature, lower, upper, compiled=c) for c in (True, False))
+    assert (found is None) == (want is None)  # (the floors may leave no delta)
+    if found is not None:
+        assert found[0] == want[0]
+        for z, w in zip(found[1], want[1], strict=True):
+            np.testing.assert_array_equal(z, w)
     assert lower <= delta <= upper
     at = [g.values + g.jacobian[:, 0] * delta for g in groups]
     assert all(v.min() >= g.floor - 1e-12 for g, v in zip(groups, at, strict=True))

@@ -20,24 +20,36 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import ckernels
 from .objective import Group
 
 _TIE = 1e-12  # pieces within this of their group's minimum meet there
 
 
 def maximise_1d(
-    groups: list[Group], curvature: float, lower: float, upper: float
+    groups: list[Group], curvature: float, lower: float, upper: float, compiled: bool = True
 ) -> tuple[float, list[np.ndarray]] | None:
     """The maximiser delta of phi (module docstring) and each group's multipliers.
 
     Args:
-        groups: Groups with jacobians (p_g, 1) by the redundancy variable.
+        groups: Groups with jacobians (p_g, 1) by the redundancy variable, each with a piece.
         curvature: b > 0.
         lower, upper: Bounds of delta, lower <= 0 <= upper.
+        compiled: By ``ckernels.maximise_1d`` (``csrc/box_qp.c``, the same operations);
+            False: numpy, the reference it is tested against.
 
     Returns:
         (delta, multipliers per group), or None when the floors leave no delta.
     """
+    if compiled:
+        sizes = [len(g.values) for g in groups]
+        ends = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+        v = np.concatenate([g.values for g in groups])
+        a = np.concatenate([g.jacobian[:, 0] for g in groups])
+        weights, floors, caps = np.array([(g.weight, g.floor, g.cap) for g in groups], dtype=float).T.copy()
+        z = np.empty(len(v))
+        delta = ckernels.maximise_1d(v, a, ends, weights, floors, caps, curvature, lower, upper, z)
+        return None if delta is None else (delta, np.split(z, ends[1:-1]))
     v = [g.values for g in groups]
     a = [g.jacobian[:, 0] for g in groups]
     lo, hi = lower, upper

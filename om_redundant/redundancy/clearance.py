@@ -90,6 +90,9 @@ class Clearance:
         self.model, self.arm, self._dof = model, arm, arm.dof
         self.distmax = as_positive(distmax, "distmax")
         self._data = mujoco.MjData(model)
+        # the data's arrays that each evaluation writes or reads (views of its buffers)
+        d = self._data
+        self._views = (d.qpos, d.geom_xpos, d.geom_xmat, d.xanchor, d.xaxis)
         joints = ArmJoints(arm, model, prefix)
         self._qpos = joints.qpos_index
         moving = _subtree(model, model.jnt_bodyid[joints.joint_ids[0]])
@@ -216,15 +219,15 @@ class Clearance:
         ``ckernels.geom_distances`` (sphere and capsule arm geoms against sphere, capsule and
         box obstacles, apart) with ``mj_geomDistance`` for the pairs it leaves, and
         ``ckernels.distance_gradients`` (module docstring)."""
-        m, d, geoms = self.model, self._data, self._geoms
-        d.qpos[self._qpos] = q
+        m, d, geoms, (qpos, xpos, xmat, xanchor, xaxis) = self.model, self._data, self._geoms, self._views
+        qpos[self._qpos] = q
         mujoco.mj_kinematics(m, d)
         if ckernels.geom_distances(
             geoms.kind,
             geoms.radius,
             geoms.half,
-            d.geom_xpos,
-            d.geom_xmat,
+            xpos,
+            xmat,
             self._pairs,
             geoms.bounds,
             reach,
@@ -236,7 +239,7 @@ class Clearance:
                 dist[k] = mujoco.mj_geomDistance(m, d, a, o, reach, fromto[k])
         if grad is not None:  # every row written
             ckernels.distance_gradients(
-                dist, fromto, reach, d.xanchor, d.xaxis, geoms.joints, geoms.slide, geoms.moves, grad
+                dist, fromto, reach, xanchor, xaxis, geoms.joints, geoms.slide, geoms.moves, grad
             )
 
 

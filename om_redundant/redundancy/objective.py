@@ -46,6 +46,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import ckernels
 from ..exceptions import InvalidInput
 from ..kinematics.arm import Arm
 from ..validation import as_instance, as_joint_vector, as_number
@@ -223,6 +224,15 @@ class Objective:
         self._limited = np.flatnonzero(np.isfinite(arm.lower) & np.isfinite(arm.upper))
         self._lower, self._upper = arm.lower[self._limited], arm.upper[self._limited]
         self._half = (self._upper - self._lower) / 2.0
+        singular = (np.zeros(0, dtype=np.int64), np.zeros(0)) if singularity is None else singularity.rows()
+        numbers = (self.margin_weight, self.clearance_weight, self.singularity_weight)
+        numbers += (self.clearance_cap, self.min_clearance, SINGULARITY_CAP)
+        # what ckernels.pieces reads: 2 d_cap, d_cap, d_min / d_cap; no pairs
+        self._clearance_numbers = np.array([self.clearance_reach, self.clearance_cap, 0.0])
+        self._clearance_numbers[2] = self.min_clearance / self.clearance_cap
+        self._no_pairs = (np.zeros(0), np.zeros((0, self._dof)))
+        # what ckernels.evaluate reads (csrc/objective.c)
+        self._terms = (self._limited, self._lower, self._upper, self._half, *singular, np.array(numbers))
         eye = np.eye(self._dof)[self._limited] / self._half[:, None]
         self._margin_jacobian = np.vstack([eye, -eye])  # pieces (q - l)/h, then (u - q)/h
 
@@ -253,70 +263,56 @@ class Objective:
     def evaluate(self, q: np.ndarray, distances: np.ndarray | None = None) -> Evaluation:
         """f(q), M(q), D(q), the feasibility slack and S(q): each group's minimum
         (the smallest of its pieces, :meth:`groups`) capped and weighted, summed in the
-        groups' order.
+        groups' order (``ckernels.evaluate``, ``csrc/objective.c``).
 
         Args:
             q: (dof,) joint vector.
             distances: (P,) the clearance's pair distances at q if already computed.
         """
-        q = as_joint_vector(q, self._dof, stack=False)
-        value, slacks = 0.0, []
-        margin = clearance = singularity = math.inf
-        if len(self._limited):
-            lim = q[self._limited]
-            lower, upper = _limit_distances(lim, self._lower, self._upper, self._half)
-            margin = min(float(lower.min()), float(upper.min()))
-            value += self.margin_weight * margin
-            slacks.append(margin - 0.0)
-        if self.clearance is not None:
-            if distances is None:
-                distances = self.clearance.distances(q)
-            scaled = float(distances.min()) / self.clearance_cap  # (= the least piece d_k / d_cap)
-            value += self.clearance_weight * min(1.0, scaled)
-            slacks.append(scaled - self.min_clearance / self.clearance_cap)
-            clearance = scaled * self.clearance_cap
-        if self.singularity is not None:
-            scaled = float(self.singularity.distances(q).min()) / SINGULARITY_CAP
-            value += self.singularity_weight * min(1.0, scaled)
-            singularity = scaled * SINGULARITY_CAP
-        return Evaluation(value, margin, clearance, min(slacks, default=math.inf), singularity)
+        return Evaluation(*self._evaluated(as_joint_vector(q, self._dof, stack=False), distances).tolist())
 
     def evaluations(self, q: np.ndarray, distances: np.ndarray | None = None) -> list[Evaluation]:
-        """:meth:`evaluate` at every row of q (M, dof), vectorised over the rows (the same
-        values: each group's minimum is the minimum of its pieces, D(q) the smallest of
-        :meth:`Clearance.distances <om_redundant.Clearance.distances>`, as
-        :meth:`Clearance.minima <om_redundant.Clearance.minima>` gives it).
+        """:meth:`evaluate` at every row of q (M, dof), in one call.
 
         Args:
             q: (M, dof) joint vectors.
             distances: (M, P) the rows' pair distances if already computed (with obstacles).
         """
         q = as_joint_vector(q, self._dof).reshape(-1, self._dof)
-        inf = np.full(len(q), math.inf)
-        terms, slacks = [np.zeros(len(q))], [inf]
-        margin = clearance = singularity = inf
-        if len(self._limited):
-            lim = q[:, self._limited]
-            margin = np.minimum(*_limit_distances(lim, self._lower, self._upper, self._half)).min(axis=1)
-            terms.append(self.margin_weight * margin)
-            slacks.append(margin - 0.0)
-        if self.clearance is not None:
-            if distances is None:
-                distances = self.clearance.distances(q)
-            scaled = distances.min(axis=1) / self.clearance_cap
-            terms.append(self.clearance_weight * np.minimum(1.0, scaled))
-            slacks.append(scaled - self.min_clearance / self.clearance_cap)
-            clearance = scaled * self.clearance_cap
-        if self.singularity is not None:
-            scaled = self.singularity.distances(q).min(axis=1) / SINGULARITY_CAP
-            terms.append(self.singularity_weight * np.minimum(1.0, scaled))
-            singularity = scaled * SINGULARITY_CAP
-        value = terms[0]
-        for term in terms[1:]:
-            value = value + term  # in the order of evaluate()'s sum
-        slack = np.min(slacks, axis=0)
-        columns = (x.tolist() for x in (value, margin, clearance, slack, singularity))
-        return [Evaluation(*row) for row in zip(*columns, strict=True)]
+        return [Evaluation(*row) for row in self._evaluated(q, distances).tolist()]
+
+    def _evaluated(self, q: np.ndarray, distances: np.ndarray | None) -> np.ndarray:
+        """``ckernels.evaluate`` at q, (dof,) or (M, dof): (5,) or (M, 5) the fields of
+        :class:`Evaluation`."""
+        if self.clearance is None:
+            distances = self._no_pairs[0]
+        elif distances is None:
+            distances = self.clearance.distances(q)
+        out = np.empty((*q.shape[:-1], 5))
+        ckernels.evaluate(self._dof, q, np.ascontiguousarray(distances, dtype=float), *self._terms, out)
+        return out
+
+    def pieces(
+        self, q: np.ndarray, tangent: np.ndarray, pairs: tuple[np.ndarray, np.ndarray] | None
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The feasibility functions g_j at q (>= 0 iff feasible) and dg_j/dpsi: the
+        :meth:`Group.constraints` of the margin and clearance groups chained through the
+        tangent (``ckernels.pieces``, ``csrc/cells.c``; the same numbers to rounding).
+
+        Args:
+            q: (dof,) joint vector.
+            tangent: (dof, 1) dq/dpsi at q.
+            pairs: The pairs' distances (P,) and gradients (P, dof) at q; None without
+                obstacles.
+
+        Returns:
+            (g, dg), each (limited + P,).
+        """
+        distances, gradients = self._no_pairs if pairs is None else pairs
+        g, dg = np.empty((2, len(self._limited) + len(distances)))
+        limits = (self._limited, self._lower, self._upper, self._half)
+        ckernels.pieces(q, tangent[:, 0], distances, gradients, *limits, self._clearance_numbers, g, dg)
+        return g, dg
 
     def constraint_bounds(
         self, q: np.ndarray, tangent: np.ndarray, pairs: tuple[np.ndarray, np.ndarray] | None
@@ -352,18 +348,18 @@ class Objective:
             rates.append(np.abs(gradients @ tangent)[:, :, 0] / cap)
         return np.concatenate(values, axis=1), np.concatenate(rates, axis=1)
 
-    def term_functions(self, q: np.ndarray, clearance: np.ndarray) -> list[tuple[float, float, np.ndarray]]:
+    def term_functions(
+        self, q: np.ndarray, distances: np.ndarray | None
+    ) -> list[tuple[float, float, np.ndarray]]:
         """The objective at the rows of q as ``f = sum_g w_g min(cap_g, min_j values_j)``:
         per group its weight, its cap and its functions at every row. The margin's are the
-        limited joints' margins m_i, the clearance's the one function D(q)/d_cap (its pairs
-        are not kept), the singularity's the distances s_k / s_cap. For bounds of f from
-        bounds of each function (the climbs' starts,
-        :meth:`~om_redundant.RedundancyOptimizer.choose`).
+        limited joints' margins m_i, the clearance's the pairs' distances d_k / d_cap, the
+        singularity's the distances s_k / s_cap. For bounds of f from bounds of each
+        function (the climbs' starts, :meth:`~om_redundant.RedundancyOptimizer.choose`).
 
         Args:
             q: (M, dof) joint vectors.
-            clearance: (M,) their clearances D(q) (m), as the evaluations give them (unused
-                without obstacles).
+            distances: (M, P) the pairs' distances d_k(q) (m) (None without obstacles).
 
         Returns:
             [(w_g, cap_g, (M, p_g) values)] in the order of :meth:`groups`.
@@ -374,7 +370,7 @@ class Objective:
             margins = np.minimum(*_limit_distances(lim, self._lower, self._upper, self._half))
             groups.append((self.margin_weight, math.inf, margins))
         if self.clearance is not None:
-            groups.append((self.clearance_weight, 1.0, clearance[:, None] / self.clearance_cap))
+            groups.append((self.clearance_weight, 1.0, distances / self.clearance_cap))
         if self.singularity is not None:
             singular = self.singularity.distances(q) / SINGULARITY_CAP
             groups.append((self.singularity_weight, 1.0, singular))

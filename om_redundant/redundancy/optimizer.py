@@ -14,10 +14,11 @@ the exact OM solution in it:
    distance to its farther neighbour and L the largest slope between neighbouring samples
    (over every interval, times 2), a start can only lead above the smaller of
    ``f_start + L_f h`` and ``sum_g w_g min(cap_g, min_j (v_j + L_j h))``, the second with
-   each function v_j of each group (a joint's margin, the clearance, a singularity
+   each function v_j of each group (a joint's margin, a pair's distance, a singularity
    distance; :meth:`~om_redundant.redundancy.objective.Objective.term_functions`) bounded by
-   its own slope: a joint that the self-motion does not move (the elbow of an S-R-S arm)
-   binding the margin, with the other terms at their caps, bounds f by its start value.
+   its own slope: where what binds every term does not move with the self-motion (the
+   elbow of an S-R-S arm binding the margin, the hand nearest an obstacle, or a term at its
+   cap), f cannot rise above its start value.
    Starts are climbed best first, and those whose bound is below the best value found (by
    more than :data:`PLATEAU` when tracking; not above it by :data:`_CLIMB_ROUNDING`
    otherwise, a climb that could at most tie) are skipped. This is what finds the global
@@ -281,13 +282,13 @@ class RedundancyOptimizer:
         where it was instead of jumping to whichever sample rounding favours, farther than
         the joints can follow in one tick.
         """
-        slope, limits, starts = 0.0, None, []
+        slope, limits, sampled = 0.0, None, []
         for run in runs:
             psi = np.array([p.psi for p in run.points])
-            evaluations = [p.evaluation for p in run.points]
-            f = np.array([e.value for e in evaluations])
-            clearance = np.array([e.clearance for e in evaluations])
-            terms = self.objective.term_functions(np.array([p.q for p in run.points]), clearance)
+            f = np.array([p.evaluation.value for p in run.points])
+            pairs = [p.terms.get_pairs() for p in run.points]  # (computed for the evaluations)
+            distances = None if pairs[0] is None else np.array([d for d, _ in pairs])
+            terms = self.objective.term_functions(np.array([p.q for p in run.points]), distances)
             if len(f) > 1:
                 step = np.maximum(np.diff(psi), 1e-12)
                 slope = max(slope, float(np.max(np.abs(np.diff(f)) / step)))
@@ -297,27 +298,32 @@ class RedundancyOptimizer:
                     if limits is None
                     else [np.maximum(a, b) for a, b in zip(limits, rates, strict=True)]
                 )
-            for k in range(len(f)):
-                at_near = near is not None and _distance(psi[k], near) <= END_TOLERANCE
-                if at_near or ((k == 0 or f[k] >= f[k - 1]) and (k == len(f) - 1 or f[k] >= f[k + 1])):
-                    gap = max(psi[min(k + 1, len(f) - 1)] - psi[k], psi[k] - psi[max(k - 1, 0)])
-                    here = [(w, cap, v[k]) for w, cap, v in terms]
-                    starts.append((f[k], gap, run, run.points[k], here))
+            # local maxima among the samples (the ends against their one neighbour), and near
+            rising = np.concatenate([[True], f[1:] >= f[:-1]])
+            falling = np.concatenate([f[:-1] >= f[1:], [True]])
+            chosen = rising & falling
+            if near is not None:
+                chosen |= np.array([_distance(x, near) <= END_TOLERANCE for x in psi.tolist()])
+            k = np.flatnonzero(chosen)
+            last = len(f) - 1
+            gap = np.maximum(psi[np.minimum(k + 1, last)] - psi[k], psi[k] - psi[np.maximum(k - 1, 0)])
+            sampled.append((run, k, f[k], gap, [(w, cap, v[k]) for w, cap, v in terms]))
         if limits is None:  # (single samples: no slopes, and no gaps)
-            limits = [np.zeros(len(v)) for _, _, v in starts[0][4]]
+            limits = [np.zeros(v.shape[1]) for _, _, v in sampled[0][4]]
+        starts = []
+        for run, k, value, gap, terms in sampled:
+            reach = 2.0 * gap
+            bound = 0.0
+            for (w, cap, v), rate in zip(terms, limits, strict=True):
+                bound = bound + w * np.minimum(cap, (v + rate * reach[:, None]).min(axis=1))
+            bound = np.minimum(value + slope * reach, bound)
+            rows = zip(value.tolist(), gap.tolist(), bound.tolist(), k.tolist(), strict=True)
+            starts += [(f_k, gap_k, bound_k, run, run.points[j]) for f_k, gap_k, bound_k, j in rows]
         starts.sort(key=lambda s: -s[0])
-        found = [(starts[0][2], starts[0][3])]
+        found = [(starts[0][3], starts[0][4])]
         best = found[0][1].evaluation.value
         probes = {}
-        for value, gap, run, start, here in starts:
-            reach = 2.0 * gap
-            bound = min(
-                value + slope * reach,
-                sum(
-                    w * min(cap, float((v + rate * reach).min()))
-                    for (w, cap, v), rate in zip(here, limits, strict=True)
-                ),
-            )
+        for _, gap, bound, run, start in starts:
             if (bound < best + _CLIMB_ROUNDING) if near is None else (bound < best - PLATEAU):
                 continue
             lo, hi = (-math.inf, math.inf) if run.interval.closed else (run.interval.lo, run.interval.hi)

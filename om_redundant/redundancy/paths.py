@@ -38,6 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import ckernels
 from ..om.solver import OMSolver
 from .objective import Objective
 from .probe import END_TOLERANCE, JUMP, SAME, Point, Probe
@@ -243,38 +244,31 @@ def _with_hidden(probe: Probe, path: Path) -> Path:
 def _hidden(probe: Probe, a: Point, b: Point) -> list[Point]:
     """Exact samples inserted between neighbours a and b of a path, in order: halving until
     no joint moves more than :data:`FINE_STEP` in a sub-cell, then until the Hermite models
-    of every sub-cell agree with its ends (module docstring). The cell (a, b) itself, if
-    no joint moves more than FINE_STEP in it, is known not quiet (:func:`_with_hidden`)."""
-    inserted, cells = [], [(a, b, True)]  # (left, right, known not quiet if fine)
+    of every sub-cell agree with its ends (module docstring)."""
+    inserted, cells = [], [(a, b)]
     while cells and len(inserted) < _MAX_INSERTED:
-        left, right, loud = cells.pop()
-        t = 0.5 if probe.step(left.q, right.q) > FINE_STEP else _surprise(left, right, loud)
+        left, right = cells.pop()
+        t = 0.5 if probe.step(left.q, right.q) > FINE_STEP else _surprise(left, right)
         if t is None or right.psi - left.psi <= END_TOLERANCE:
             continue
         middle, arrived = probe.follow(left, left.psi + t * (right.psi - left.psi))
         if arrived:
             inserted.append(middle)
-            cells += [(left, middle, False), (middle, right, False)]
+            cells += [(left, middle), (middle, right)]
     return sorted(inserted, key=lambda p: p.psi)
 
 
-def _surprise(a: Point, b: Point, loud: bool = False) -> float | None:
+def _surprise(a: Point, b: Point) -> float | None:
     """Where, as a fraction of the cell, the pieces' cubic models predict a feasibility that
     the ends do not explain: more changes between feasible and infeasible than the ends'
-    (none if alike, one if not). Returns the middle of the first unexplained stretch.
-    ``loud``: the cell is known not to be quiet (:func:`_quiet`), which is not tested again."""
-    if not loud and a.evaluation.feasible == b.evaluation.feasible and _quiet([a], [b])[0]:
-        return None
+    (none if alike, one if not), at the _MODEL_POINTS points of the cell. Returns the middle
+    of the first unexplained stretch. (``ckernels.surprise``, ``csrc/cells.c``; a piece
+    that :func:`_quiet`'s bound keeps positive cannot change the pattern and is skipped.)"""
     (ga, da), (gb, db) = a.pieces(), b.pieces()
     if len(ga) == 0:
         return None
-    span = b.psi - a.psi
-    models = np.column_stack([ga, da * span, gb, db * span]) @ _HERMITE  # (pieces, points)
-    pattern = np.concatenate([[a.evaluation.feasible], (models >= 0.0).all(axis=0), [b.evaluation.feasible]])
-    changes = np.flatnonzero(pattern[1:] != pattern[:-1])
-    if len(changes) <= int(pattern[0] != pattern[-1]):
-        return None
-    return (changes[0] + 1 + changes[1]) / 2.0 / (len(pattern) - 1)
+    feasible = a.evaluation.feasible, b.evaluation.feasible
+    return ckernels.surprise(ga, da, gb, db, b.psi - a.psi, _HERMITE, *feasible, _BOUND_SLACK)
 
 
 def _quiet(a: list[Point], b: list[Point]) -> np.ndarray:

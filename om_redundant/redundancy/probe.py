@@ -70,20 +70,9 @@ class _Terms:
         return self.bounds
 
     def get_pieces(self) -> tuple[np.ndarray, np.ndarray]:
-        """The feasibility functions and their rates (:meth:`Point.pieces`), from the groups
-        if already computed, else from the groups with a floor only."""
+        """The feasibility functions and their rates (:meth:`Point.pieces`)."""
         if self.pieces is None:
-            if self.groups is None:
-                groups = self.objective.constrained_groups(self.q, jacobian=True, pairs=self.get_pairs())
-                groups = [g.along(self.tangent) for g in groups]
-            else:
-                groups = self.groups
-            pieces = [g.constraints() for g in groups]
-            if pieces:
-                g, dg = zip(*pieces, strict=True)
-                self.pieces = np.concatenate(g), np.concatenate(dg)
-            else:
-                self.pieces = np.zeros(0), np.zeros(0)
+            self.pieces = self.objective.pieces(self.q, self.tangent, self.get_pairs())
         return self.pieces
 
     def get_groups(self) -> list[Group]:

@@ -75,6 +75,12 @@ class Singularity:
             offsets *= np.asarray(flip, dtype=float)[joints]
         return cls(names, joints, offsets, model.real.dof)
 
+    def rows(self) -> tuple[np.ndarray, np.ndarray]:
+        """The joints (int64) and offsets as compiled kernels take them (C-contiguous)."""
+        return np.ascontiguousarray(self.joints, dtype=np.int64), np.ascontiguousarray(
+            self.offsets, dtype=float
+        )
+
     def distances(self, q: np.ndarray) -> np.ndarray:
         r"""The distances :math:`s_k(q) = |\sin(q_{j_k} + c_k)|`.
 

@@ -1,0 +1,185 @@
+/* The climb's QP in one redundancy variable, solved exactly (om_redundant/redundancy/box_qp.py's
+ * maximise_1d, whose numpy version is the reference): maximise the concave, piecewise
+ * quadratic phi(delta) = sum_g w_g min(cap_g, min_{j in g} v_j + a_j delta) - b delta^2 / 2 over
+ * [lower, upper] where every group with a floor keeps its minimum >= floor. The maximiser is a
+ * breakpoint (two pieces of a group crossing, a piece crossing its cap), an end, or a
+ * segment's stationary point D_k / b (D_k the weighted rates of the uncapped groups' least
+ * pieces in the segment); all are evaluated and the first best taken. The multipliers are
+ * those of the epigraph's KKT conditions (box_qp.py). Each sum and quotient in box_qp.py's
+ * order. */
+#include <stdlib.h>
+
+#include "binding.h"
+
+#define TIE 1e-12 /* pieces within this of their group's minimum meet there (box_qp.py) */
+
+typedef struct {
+    const double *v, *a, *w, *floor, *cap;
+    const int64_t *ends; /* group g's pieces are ends[g] .. ends[g + 1] - 1 */
+    Py_ssize_t G;
+} qp_groups;
+
+static int compare_doubles(const void *x, const void *y) {
+    double a = *(const double *)x, b = *(const double *)y;
+    return (a > b) - (a < b);
+}
+
+/* The weighted rate of the groups' least pieces at x (0 for a capped group). */
+static double rate_at(const qp_groups *q, double x) {
+    double slope = 0.0;
+    for (Py_ssize_t g = 0; g < q->G; g++) {
+        int64_t least = q->ends[g];
+        double value = q->v[least] + q->a[least] * x;
+        for (int64_t j = least + 1; j < q->ends[g + 1]; j++) {
+            double y = q->v[j] + q->a[j] * x;
+            if (y < value) value = y, least = j;
+        }
+        slope += q->w[g] * (value < q->cap[g] ? q->a[least] : 0.0);
+    }
+    return slope;
+}
+
+/* phi(x). */
+static double phi(const qp_groups *q, double b, double x) {
+    double value = -0.5 * b * (x * x);
+    for (Py_ssize_t g = 0; g < q->G; g++) {
+        double least = INFINITY;
+        for (int64_t j = q->ends[g]; j < q->ends[g + 1]; j++) least = fmin(least, q->v[j] + q->a[j] * x);
+        value += q->w[g] * fmin(q->cap[g], least);
+    }
+    return value;
+}
+
+/* The multipliers z at delta (box_qp.py's _multipliers). */
+static void multipliers(const qp_groups *q, double b, double delta, double *z, Py_ssize_t n) {
+    for (Py_ssize_t j = 0; j < n; j++) z[j] = 0.0;
+    double balance = b * delta;
+    Py_ssize_t kinks = 0;
+    int64_t *falling = PyMem_Malloc((q->G ? q->G : 1) * 2 * sizeof(int64_t)), *rising;
+    Py_ssize_t *kink_group = PyMem_Malloc((q->G ? q->G : 1) * sizeof(Py_ssize_t));
+    if (!falling || !kink_group) { /* (tiny: cannot fail in practice; leave z at 0) */
+        PyMem_Free(falling), PyMem_Free(kink_group);
+        return;
+    }
+    rising = falling + (q->G ? q->G : 1);
+    for (Py_ssize_t g = 0; g < q->G; g++) {
+        double least = INFINITY;
+        for (int64_t j = q->ends[g]; j < q->ends[g + 1]; j++) least = fmin(least, q->v[j] + q->a[j] * delta);
+        if (least > q->cap[g] + TIE || q->w[g] == 0.0) continue;
+        int64_t first = -1, low = -1, high = -1, count = 0;
+        for (int64_t j = q->ends[g]; j < q->ends[g + 1]; j++) {
+            if (!(q->v[j] + q->a[j] * delta <= least + TIE)) continue;
+            if (first < 0) first = j, low = j, high = j;
+            if (q->a[j] < q->a[low]) low = j; /* (argmin, argmax: the first extreme) */
+            if (q->a[j] > q->a[high]) high = j;
+            count++;
+        }
+        if (count == 1) {
+            z[first] = q->w[g];
+            balance -= q->w[g] * q->a[first];
+        } else
+            falling[kinks] = low, rising[kinks] = high, kink_group[kinks++] = g;
+    }
+    for (Py_ssize_t k = 0; k < kinks; k++) {
+        double w = q->w[kink_group[k]], spread = q->a[rising[k]] - q->a[falling[k]];
+        double share = balance / (double)kinks;
+        z[rising[k]] = spread > 0.0 ? fmin(fmax((share - w * q->a[falling[k]]) / spread, 0.0), w) : w;
+        z[falling[k]] = w - z[rising[k]];
+    }
+    PyMem_Free(falling), PyMem_Free(kink_group);
+}
+
+/* maximise_1d(v, a, ends, weights, floors, caps, curvature, lower, upper, z) -> delta or None:
+ * the pieces of G groups concatenated (v, a; group g's are ends[g] .. ends[g + 1] - 1; a floor
+ * of -inf: none), z (in place) their multipliers; None when the floors leave no delta. */
+static PyObject *om_maximise_1d(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 10, "maximise_1d") < 0) return NULL;
+    double b = PyFloat_AsDouble(args[6]), lo = PyFloat_AsDouble(args[7]), hi = PyFloat_AsDouble(args[8]);
+    if (PyErr_Occurred()) return NULL;
+    Py_buffer v[7];
+    const buffer_spec sp[7] = {{F64, -1, 0, "v"},      {F64, -1, 0, "a"},    {I64, -1, 0, "ends"},
+                               {F64, -1, 0, "weights"}, {F64, -1, 0, "floors"}, {F64, -1, 0, "caps"},
+                               {F64, -1, 1, "z"}};
+    PyObject *const objs[7] = {args[0], args[1], args[2], args[3], args[4], args[5], args[9]};
+    if (get_buffers(objs, v, sp, 7) < 0) return NULL;
+    Py_ssize_t n = v[0].len / 8, G = v[3].len / 8;
+    qp_groups q = {v[0].buf, v[1].buf, v[3].buf, v[4].buf, v[5].buf, v[2].buf, G};
+    int bad = v[1].len != n * 8 || v[2].len != (G + 1) * 8 || v[4].len != G * 8 || v[5].len != G * 8 ||
+              v[6].len != n * 8 || (G > 0 && (q.ends[0] != 0 || q.ends[G] != n));
+    for (Py_ssize_t g = 0; g < G && !bad; g++) bad = q.ends[g + 1] <= q.ends[g];
+    if (bad) {
+        release_buffers(v, 7);
+        PyErr_SetString(PyExc_ValueError, "maximise_1d: sizes of the pieces, the groups and z disagree");
+        return NULL;
+    }
+    PyObject *result = NULL;
+    double *points = NULL;
+    /* the floors: lo <= delta <= hi */
+    for (Py_ssize_t g = 0; g < G; g++) {
+        if (isinf(q.floor[g]) && q.floor[g] < 0.0) continue;
+        for (int64_t j = q.ends[g]; j < q.ends[g + 1]; j++) {
+            double gap = q.floor[g] - q.v[j];
+            if (q.a[j] == 0.0) {
+                if (gap > 0.0) goto none;
+            } else if (q.a[j] > 0.0)
+                lo = fmax(lo, gap / q.a[j]);
+            else
+                hi = fmin(hi, gap / q.a[j]);
+        }
+    }
+    if (!(lo <= hi)) goto none;
+    /* the breakpoints within [lo, hi], sorted, each once */
+    Py_ssize_t size = 2;
+    for (Py_ssize_t g = 0; g < G; g++) {
+        Py_ssize_t p = q.ends[g + 1] - q.ends[g];
+        size += p * p + p;
+    }
+    points = PyMem_Malloc(2 * size * sizeof(double));
+    if (!points) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    Py_ssize_t m = 0;
+    points[m++] = lo, points[m++] = hi;
+    for (Py_ssize_t g = 0; g < G; g++) {
+        for (int64_t i = q.ends[g]; i < q.ends[g + 1]; i++) {
+            for (int64_t j = q.ends[g]; j < q.ends[g + 1]; j++) {
+                double x = (q.v[j] - q.v[i]) / (q.a[i] - q.a[j]);
+                if (isfinite(x) && x >= lo && x <= hi) points[m++] = x;
+            }
+            double x = (q.cap[g] - q.v[i]) / q.a[i];
+            if (isfinite(x) && x >= lo && x <= hi) points[m++] = x;
+        }
+    }
+    qsort(points, m, sizeof(double), compare_doubles);
+    Py_ssize_t unique = 0;
+    for (Py_ssize_t k = 0; k < m; k++)
+        if (unique == 0 || points[k] != points[unique - 1]) points[unique++] = points[k];
+    /* the candidates: the breakpoints, then each segment's stationary point */
+    double *candidates = points, best = -INFINITY, delta = points[0];
+    Py_ssize_t count = unique;
+    for (Py_ssize_t k = 0; k + 1 < unique; k++) {
+        double middle = (points[k] + points[k + 1]) / 2.0;
+        candidates[count++] = fmin(fmax(rate_at(&q, middle) / b, points[k]), points[k + 1]);
+    }
+    for (Py_ssize_t k = 0; k < count; k++) {
+        double value = phi(&q, b, candidates[k]);
+        if (value > best || k == 0) best = value, delta = candidates[k];
+    }
+    multipliers(&q, b, delta, v[6].buf, n);
+    result = PyFloat_FromDouble(delta);
+    goto done;
+none:
+    result = Py_None;
+    Py_INCREF(result);
+done:
+    PyMem_Free(points);
+    release_buffers(v, 7);
+    return result;
+}
+
+PyMethodDef om_box_qp_functions[] = {
+    {"maximise_1d", (PyCFunction)(void (*)(void))om_maximise_1d, METH_FASTCALL,
+     "maximise_1d(v, a, ends, weights, floors, caps, curvature, lower, upper, z) -> delta or None"},
+    {NULL, NULL, 0, NULL},
+};

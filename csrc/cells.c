@@ -1,0 +1,118 @@
+/* The cell test of the global choose's solution paths (om_redundant/redundancy/paths.py's
+ * _surprise, whose numpy version is the reference): the feasibility functions g_j of a point
+ * and their rates along psi, and where their cubic Hermite models between two neighbouring
+ * points predict a feasibility that the ends do not explain. */
+#include "binding.h"
+
+enum { P_REACH, P_CAP, P_FLOOR, P_N }; /* clearance: 2 d_cap, d_cap, d_min / d_cap */
+
+/* pieces(q, t, distances, gradients, limited, lower, upper, half, numbers, g, dg) -> None:
+ * objective.py's Group.constraints of the margin and clearance groups at q with dq/dpsi = t:
+ * per limited joint the smaller of (q_i - l_i)/h_i and (u_i - q_i)/h_i with its rate; then per
+ * pair d_k/d_cap - d_min/d_cap with its rate grad d_k . t / d_cap, a pair at 2 d_cap or more
+ * taken as 2 d_cap with rate 0 when some pair is nearer (objective.py's _clearance). */
+static PyObject *om_pieces(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 11, "pieces") < 0) return NULL;
+    Py_buffer v[11];
+    const buffer_spec sp[11] = {{F64, -1, 0, "q"},     {F64, -1, 0, "t"},      {F64, -1, 0, "distances"},
+                                {F64, -1, 0, "gradients"}, {I64, -1, 0, "limited"}, {F64, -1, 0, "lower"},
+                                {F64, -1, 0, "upper"}, {F64, -1, 0, "half"},   {F64, P_N, 0, "numbers"},
+                                {F64, -1, 1, "g"},     {F64, -1, 1, "dg"}};
+    if (get_buffers(args, v, sp, 11) < 0) return NULL;
+    Py_ssize_t dof = v[0].len / 8, P = v[2].len / 8, L = v[4].len / 8;
+    const int64_t *limited = v[4].buf;
+    int bad = v[1].len != dof * 8 || v[3].len != P * dof * 8 || v[5].len != L * 8 || v[6].len != L * 8 ||
+              v[7].len != L * 8 || v[9].len != (L + P) * 8 || v[10].len != (L + P) * 8;
+    for (Py_ssize_t i = 0; i < L && !bad; i++) bad = limited[i] < 0 || limited[i] >= dof;
+    if (bad) {
+        release_buffers(v, 11);
+        PyErr_SetString(PyExc_ValueError, "pieces: sizes of q, t, the pairs, the joints and g disagree");
+        return NULL;
+    }
+    const double *q = v[0].buf, *t = v[1].buf, *d = v[2].buf, *grad = v[3].buf, *lower = v[5].buf;
+    const double *upper = v[6].buf, *half = v[7].buf, *num = v[8].buf;
+    double *g = v[9].buf, *dg = v[10].buf;
+    for (Py_ssize_t i = 0; i < L; i++) {
+        int64_t j = limited[i];
+        double a = (q[j] - lower[i]) / half[i], b = (upper[i] - q[j]) / half[i], s = 1.0 / half[i];
+        if (a <= b)
+            g[i] = a - 0.0, dg[i] = s * t[j];
+        else
+            g[i] = b - 0.0, dg[i] = -s * t[j];
+    }
+    double least = INFINITY;
+    for (Py_ssize_t k = 0; k < P; k++) least = fmin(least, d[k]);
+    int capped = least < num[P_REACH]; /* then pairs from 2 d_cap on count as 2 d_cap, flat */
+    for (Py_ssize_t k = 0; k < P; k++) {
+        double *gk = g + L + k, *dgk = dg + L + k;
+        if (capped && !(d[k] < num[P_REACH])) {
+            *gk = num[P_REACH] / num[P_CAP] - num[P_FLOOR], *dgk = 0.0;
+            continue;
+        }
+        double rate = 0.0;
+        for (Py_ssize_t j = 0; j < dof; j++) rate += grad[k * dof + j] / num[P_CAP] * t[j];
+        *gk = d[k] / num[P_CAP] - num[P_FLOOR], *dgk = rate;
+    }
+    release_buffers(v, 11);
+    Py_RETURN_NONE;
+}
+
+/* surprise(ga, da, gb, db, span, hermite, feasible_a, feasible_b, slack) -> fraction or None:
+ * the models m_j(s) = ga_j H0(s) + span da_j H1(s) + gb_j H2(s) + span db_j H3(s) at the N
+ * points s of hermite (4 x N, the basis there); the pattern (feasible_a, all_j m_j >= 0 at
+ * each point, feasible_b); None if it changes no more often than its ends (0 times if
+ * alike, once if not), else the middle of the first stretch between changes as a fraction
+ * of the pattern. A piece whose model stays above `slack` by the bound of paths.py's _quiet
+ * (min(ga, gb) - 4/27 span (|da| + |db|)) cannot change it and is not evaluated. */
+static PyObject *om_surprise(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 9, "surprise") < 0) return NULL;
+    double span = PyFloat_AsDouble(args[4]), slack = PyFloat_AsDouble(args[8]);
+    int fa = PyObject_IsTrue(args[6]), fb = PyObject_IsTrue(args[7]);
+    if (PyErr_Occurred() || fa < 0 || fb < 0) return NULL;
+    Py_buffer v[5];
+    const buffer_spec sp[5] = {{F64, -1, 0, "ga"}, {F64, -1, 0, "da"}, {F64, -1, 0, "gb"}, {F64, -1, 0, "db"},
+                               {F64, -1, 0, "hermite"}};
+    PyObject *const objs[5] = {args[0], args[1], args[2], args[3], args[5]};
+    if (get_buffers(objs, v, sp, 5) < 0) return NULL;
+    Py_ssize_t n = v[0].len / 8, N = v[4].len / 32;
+    if (v[1].len != n * 8 || v[2].len != n * 8 || v[3].len != n * 8 || v[4].len != N * 32) {
+        release_buffers(v, 5);
+        PyErr_SetString(PyExc_ValueError, "surprise: sizes of the pieces or the basis disagree");
+        return NULL;
+    }
+    const double *ga = v[0].buf, *da = v[1].buf, *gb = v[2].buf, *db = v[3].buf, *H = v[4].buf;
+    Py_ssize_t *live = PyMem_Malloc((n ? n : 1) * sizeof(Py_ssize_t)), m = 0;
+    if (!live) {
+        release_buffers(v, 5);
+        return PyErr_NoMemory();
+    }
+    for (Py_ssize_t j = 0; j < n; j++)
+        if (!(fmin(ga[j], gb[j]) - 4.0 / 27.0 * fabs(span) * (fabs(da[j]) + fabs(db[j])) > slack)) live[m++] = j;
+    Py_ssize_t changes[2], count = 0, allowed = fa != fb;
+    int previous = fa;
+    for (Py_ssize_t k = 0; k <= N && count < 2; k++) { /* (the first two changes tell) */
+        int feasible = fb;
+        if (k < N) {
+            feasible = 1;
+            for (Py_ssize_t i = 0; i < m && feasible; i++) {
+                Py_ssize_t j = live[i];
+                double model = ga[j] * H[k] + da[j] * span * H[N + k] + gb[j] * H[2 * N + k] + db[j] * span * H[3 * N + k];
+                feasible = model >= 0.0;
+            }
+        }
+        if (feasible != previous) changes[count++] = k;
+        previous = feasible;
+    }
+    PyMem_Free(live);
+    release_buffers(v, 5);
+    if (count <= allowed) Py_RETURN_NONE;
+    return PyFloat_FromDouble((double)(changes[0] + 1 + changes[1]) / 2.0 / (double)(N + 1));
+}
+
+PyMethodDef om_cell_functions[] = {
+    {"pieces", (PyCFunction)(void (*)(void))om_pieces, METH_FASTCALL,
+     "pieces(q, t, distances, gradients, limited, lower, upper, half, numbers, g, dg) -> None"},
+    {"surprise", (PyCFunction)(void (*)(void))om_surprise, METH_FASTCALL,
+     "surprise(ga, da, gb, db, span, hermite, feasible_a, feasible_b, slack) -> fraction or None"},
+    {NULL, NULL, 0, NULL},
+};
