@@ -7,8 +7,9 @@ sizes: ``results/adversarial_quick.md``) and the reproducers of every failure fo
 at a time in separate processes; ``--classes`` and ``--no-bad-input`` select what runs. The full
 run takes about 12 minutes in one process on a 2-core AMD EPYC (sawyer and gen3 are half of
 it); ``--quick`` about 10 s. Sizes per arm: ``--n-random`` random poses, ``--n-singular``
-branch-boundary poses plus a quarter as many at joint limits, and 1/50 of ``--n-random`` for
-huge/tiny, threads and repeated (1/1000 for layouts, each in about 12 layouts).
+branch-boundary poses plus a quarter as many at joint limits and (7-DOF, ``--n-line``) a tenth
+as many next to psi's singular half-line, and 1/50 of ``--n-random`` for huge/tiny, threads
+and repeated (1/1000 for layouts, each in about 12 layouts).
 
 Every shipped arm (``om.arm_names()``) gets these attack classes; every answer marked ok is
 checked against MuJoCo's own FK of the project's MJCF of the arm (``om.arm_model(arm)``,
@@ -39,7 +40,8 @@ checked against MuJoCo's own FK of the project's MJCF of the arm (``om.arm_model
 An ok answer is **wrong** if MuJoCo's FK differs from T by more than 1e-10 m or 1e-10 rad,
 or q is not in the requested configuration (``OMSolver.holds``: signs equal, a branch quantity
 within ``om.BRANCH_BAND`` of zero counting for both; psi, read in the requested ELBOW branch,
-within 1e-9 modulo 2 pi), or ``within_limits`` is not
+within 1e-9 modulo 2 pi or within its own rounding next to its singular half-line), or
+``within_limits`` is not
 ``lower <= q <= upper``. A **non-library exception** is anything raised that is not an
 ``om.OMError``.
 """
@@ -613,8 +615,10 @@ class ArmRun:
         return None
 
     def _arm_angle_frame(self) -> tuple[np.ndarray, np.ndarray, Callable[[np.ndarray], np.ndarray]]:
-        """The model's up axis, two unit vectors across it, and w(Q): W - S of the model at Q."""
-        model, P = self.solver.om.model, self.solver.om.params
+        """The model's up axis, two unit vectors across it, and w(Q): W - S of the model at Q,
+        all in DH frame 0 (where the kernels' up, shoulder and flange-frame wrist offset are;
+        the model's FK is in the root frame, turned on the Gen3: z down)."""
+        model, P, data = self.solver.om.model, self.solver.om.params, self.solver.solver_data()
         up = P[ckernels.SRS_UP : ckernels.SRS_UP + 3]
         e1 = np.cross(up, [1.0, 0.0, 0.0] if abs(up[0]) < 0.9 else [0.0, 1.0, 0.0])
         e1 /= np.linalg.norm(e1)
@@ -622,7 +626,7 @@ class ArmRun:
         shoulder = P[ckernels.SRS_SHOULDER : ckernels.SRS_SHOULDER + 3]
 
         def w(Q: np.ndarray) -> np.ndarray:
-            T = model.fk(Q)
+            T = data.T_base_root @ model.fk(Q) @ data.T_tool_flange  # the flange in DH frame 0
             return T[..., :3, 3] + T[..., :3, :3] @ wrist - shoulder
 
         return up, np.array([e1, np.cross(up, e1)]), w
@@ -1185,12 +1189,12 @@ class Sizes:
     repeated: int
 
     @staticmethod
-    def of(n_random: int, n_singular: int) -> Sizes:
+    def of(n_random: int, n_singular: int, n_line: int | None = None) -> Sizes:
         return Sizes(
             random=n_random,
             singular=n_singular,
             limits=max(n_singular // 4, 1),
-            line=max(n_singular // 10, 1),
+            line=max(n_singular // 10, 1) if n_line is None else n_line,
             huge=max(n_random // 50, 10),
             layouts=max(n_random // 1000, 5),
             threads=max(n_random // 50, 20),
@@ -1307,7 +1311,8 @@ def markdown(
             f"{args.jobs} process(es); **{seconds:.0f} s** wall time in all.  "
         ),
         f"Sizes per arm: random {sizes.random} poses, singular {sizes.singular} branch poses and "
-        f"{sizes.limits} poses at limits, huge/tiny {sizes.huge}, layouts {sizes.layouts}, "
+        f"{sizes.limits} poses at limits, {sizes.line} next to psi's half-line (7-DOF), "
+        f"huge/tiny {sizes.huge}, layouts {sizes.layouts}, "
         f"threads {sizes.threads} questions x {THREADS} threads, repeated {sizes.repeated} questions.",
         "",
         "Every answer marked ok is checked against MuJoCo's FK of the project's MJCF of the arm "
@@ -1315,7 +1320,8 @@ def markdown(
         f"more than {POSITION_TOLERANCE:g} m (or {FK_ROUNDING:.1e} |p| where that is more: two FKs' "
         f"rounding far away) or {ORIENTATION_TOLERANCE:g} rad, or q is not in the "
         f"requested configuration (a branch quantity within {BRANCH_BAND:g} of zero counts for both "
-        f"signs; psi within {REDUNDANCY_TOLERANCE:g} rad modulo 2 pi), or `within_limits` is not "
+        f"signs; psi within {REDUNDANCY_TOLERANCE:g} rad modulo 2 pi, or within its own rounding "
+        "next to its singular half-line: `OMSolver.holds`), or `within_limits` is not "
         "`lower <= q <= upper`. **false no**: ok False (or an empty `solve_all`) for T = FK(q) in "
         "c = configuration_of(q) (for huge psi: only where the reduced psi is within 1e-9 of q's). "
         "**non-library**: an exception that is not an `om.OMError`. **differ**: an answer (status, q, "
@@ -1532,6 +1538,11 @@ def main(argv: list[str] | None = None) -> list[ArmResult]:
     parser.add_argument(
         "--quick", action="store_true", help="1/100 of the sizes; writes adversarial_quick.md"
     )
+    parser.add_argument(
+        "--n-line",
+        type=int,
+        help="poses next to psi's half-line per 7-DOF arm, in the singular class (--n-singular / 10)",
+    )
     parser.add_argument("--jobs", type=int, default=1, help="processes, one arm each at a time (default 1)")
     parser.add_argument("--classes", nargs="+", default=list(CLASSES), choices=CLASSES)
     parser.add_argument("--no-bad-input", action="store_true", help="skip the bad-input table")
@@ -1546,7 +1557,7 @@ def main(argv: list[str] | None = None) -> list[ArmResult]:
     n_random, n_singular = args.n_random, args.n_singular
     if args.quick:
         n_random, n_singular = max(n_random // 100, 1), max(n_singular // 100, 1)
-    sizes = Sizes.of(n_random, n_singular)
+    sizes = Sizes.of(n_random, n_singular, args.n_line)
     load_start = os.getloadavg()[0]
     start = time.perf_counter()
     bad = [] if args.no_bad_input else run_bad_inputs()

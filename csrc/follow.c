@@ -3,8 +3,10 @@
  *
  * From the point (psi_0, q_0) with tangent t_0 = dq/dpsi towards psi*: the step h starts at
  * psi* - psi_0; at x = psi_k + h (psi* once within reach) the exact solution q nearest q_k
- * (the solve's hint) is taken at its representative (revolute joints with both limits moved
- * by whole turns nearest mid-range c_i: c_i + wrap(q_i - c_i), for the feasible intervals)
+ * (the solve's hint; where the local solve's root lies on the path beyond doubt, see
+ * on_path, it is taken without the scan for a nearer one) is taken at its representative
+ * (revolute joints with both limits moved by whole turns nearest mid-range c_i:
+ * c_i + wrap(q_i - c_i), for the feasible intervals)
  * and accepted when it continues the path (om_continues: no joint moved more than 1 rad,
  * |Delta q - t_k (x - psi_k)|_inf <= |Delta q|_inf / 2 + 1e-6, cyclic joints compared modulo
  * 2 pi); then h doubles, else it halves; where the path's last two points predict its end
@@ -23,10 +25,33 @@
 enum { FOLLOW_ARRIVED = 0, FOLLOW_ENDED = 1, FOLLOW_SINGULAR = 2 };
 enum { F_PSI, F_STATUS, F_STEPS, F_N }; /* the out vector */
 #define AIM (63.0 / 64.0) /* of the distance to a predicted end, a step aimed there goes */
+#define TIGHT 0.25 /* a root's error from the first-order prediction per joint step: on the path beyond doubt */
 
 static void represent(int dof, const uint8_t *centred, const double *centre, double *q) {
     for (int i = 0; i < dof; i++)
         if (centred[i]) q[i] = centre[i] + om_wrap_angle(q[i] - centre[i]);
+}
+
+/* A step's prediction from the path's last point: (q, t) at psi, d ahead. */
+typedef struct {
+    int dof;
+    const uint8_t *cyclic, *centred;
+    const double *centre, *q, *t;
+    double d;
+} prediction;
+
+/* Whether root x (at its representative) lies on the prediction's path beyond doubt: within
+ * TIGHT of its joint step from the first-order prediction (om_solve_near's as_is test; the
+ * windowed scan for a nearer root is skipped then). A root of another path would be off by
+ * the paths' separation; one that merely continues (om_continues: within 1/2) may be the
+ * partner at a fold, or another path's, where the root nearest q is the path's. */
+static bool on_path(const double *x, void *context) {
+    const prediction *p = context;
+    double r[OM_MAX_DOF], moved, error;
+    memcpy(r, x, (size_t)p->dof * sizeof(double));
+    represent(p->dof, p->centred, p->centre, r);
+    om_continuation(p->dof, p->q, r, p->t, p->d, p->cyclic, &moved, &error);
+    return moved <= 1.0 && error <= TIGHT * moved;
 }
 
 /* What ends a path, as functions of its point (q, t) that fall to zero there linearly in psi
@@ -72,7 +97,8 @@ static int follow(const om_solver_data *s, const double *T, const int64_t *signs
         double x = fabs(target - *psi) <= fabs(step) ? target : *psi + step;
         double aim = moved > 0.0 ? fmax(AIM * predicted_end(n_ends, ends_prev, ends, moved), 1.5 * min_step) : INFINITY;
         if (aim < fabs(x - *psi)) x = *psi + copysign(aim, step);
-        bool ok = om_solve_near(s, T, signs, &x, q, x_q);
+        prediction p = {dof, cyclic, centred, centre, q, t, x - *psi};
+        bool ok = om_solve_near(s, T, signs, &x, q, x_q, on_path, &p);
         if (ok) {
             represent(dof, centred, centre, x_q);
             ok = om_continues(dof, q, x_q, t, x - *psi, cyclic);

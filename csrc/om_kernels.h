@@ -269,7 +269,8 @@ double om_polish(const om_polish_task *t, int iterations, double *q);
 
 /* boundary.c */
 /* A candidate q that failed verification, refined on the real arm where a branch quantity is
- * within 1e-2 of zero (else left as it is); returns whether it now verifies. */
+ * within 1e-2 of zero, or (S-R-S) w_hat within 1e-2 rad of psi's singular half-line (else left
+ * as it is); returns whether it now verifies. */
 bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori);
 /* om_add_root of q, polished first where it fails verification near the boundary. */
 int om_add_candidate(om_problem *pb, double *q, double *roots, int count);
@@ -307,13 +308,16 @@ void om_flange_target(const double *T, const double *T_base_root, const double *
 /* hint NULL: no hint. */
 om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
                        const double *hint, double *q_out);
+/* A test of a root (a joint vector) with its caller's context. */
+typedef bool (*om_root_test)(const double *q, void *context);
 /* om_solve_one's local part alone, for a hint: the root the local solve from the hint
- * reaches, replaced by any root nearer the hint, into q_out (revolute joints at the turn
- * nearest the hint). Returns false where the local solve fails, without the bounded search
- * that would follow in om_solve_one: a solution may still exist (the path following halves
- * such a step, where that search's costly "no" would be wasted). */
+ * reaches, replaced by any root nearer the hint (a windowed scan), into q_out (revolute
+ * joints at the turn nearest the hint). as_is (NULL: none) may take the local root as it is
+ * (in q_out when called), without the scan. Returns false where the local solve fails,
+ * without the bounded search that would follow in om_solve_one: a solution may still exist
+ * (the path following halves such a step, where that search's costly "no" would be wasted). */
 bool om_solve_near(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
-                   const double *hint, double *q_out);
+                   const double *hint, double *q_out, om_root_test as_is, void *context);
 /* Every root (OM_MAX_ROOTS x dof) with per root (position error, orientation error, within limits)
  * in info (OM_MAX_ROOTS x 3). Returns the count; *evaluations the residual evaluations. */
 int om_solve_all(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,

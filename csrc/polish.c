@@ -27,8 +27,8 @@ static double psi_row_scale(const double *grad, int dof)
     return py_max(1.0, sqrt(g2) / PSI_ROW_SCALE);
 }
 
-/* The residual e (rows: p - p(q); the rotation vector of R R(q)^T; psi - psi(q)) in DH frame 0;
- * returns its squared norm. */
+/* The residual e (rows: p - p(q); the rotation vector of R R(q)^T; psi - psi(q), divided by
+ * psi_row_scale) in DH frame 0; returns its squared norm. */
 static double residual(const om_polish_task *t, const double *q, double *e)
 {
     double Rc[9], pc[3];

@@ -64,13 +64,19 @@ double om_wrap_angle(double x) {
     return r - OM_PI;
 }
 
-bool om_continues(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic) {
-    double moved = 0.0, error = 0.0;
+void om_continuation(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic,
+                     double *moved, double *error) {
+    *moved = 0.0, *error = 0.0;
     for (int i = 0; i < dof; i++) {
         double m = q1[i] - q0[i];
         if (cyclic && cyclic[i]) m = om_wrap_angle(m);
-        moved = fmax(moved, fabs(m));
-        error = fmax(error, t ? fabs(m - t[i] * d) : 0.0);
+        *moved = fmax(*moved, fabs(m));
+        *error = fmax(*error, t ? fabs(m - t[i] * d) : 0.0);
     }
+}
+
+bool om_continues(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic) {
+    double moved, error;
+    om_continuation(dof, q0, q1, t, d, cyclic, &moved, &error);
     return moved <= 1.0 && error <= 0.5 * moved + 1e-6;
 }

@@ -121,14 +121,23 @@ static void _problem(om_problem *pb, const om_solver_data *s, const double *T, c
 
 /* A hinted solve's local part (the hint is pb->q_prev, copied into start): the local solve
  * from the hint, its root replaced by any root nearer the hint (the windowed scan), written
- * into q_out at the representative nearest the hint. Returns false where the local solve
+ * into q_out at the representative nearest the hint. as_is (NULL: none) may take the local
+ * root as it is, without the scan: it sees it in q_out. Returns false where the local solve
  * fails (q_out not written); else *pos, *ori are q_out's errors and *inside whether it is
  * within the limits. q: scratch (dof). */
 static bool _near_hint(om_problem *pb, double *start, bool *start_complete, double *q, double *q_out, double *pos,
-                       double *ori, bool *inside)
+                       double *ori, bool *inside, om_root_test as_is, void *context)
 {
     if (!om_local_solve(pb, start, start_complete, q, pos, ori))
         return false;
+    if (as_is) {
+        double local_pos = *pos, local_ori = *ori;
+        *inside = _finish(pb, q, pb->q_prev, true, q_out, pos, ori);
+        if (as_is(q_out, context))
+            return true;
+        *pos = local_pos;
+        *ori = local_ori;
+    }
     if (pb->s->mode != OM_FIXED && om_nearest_in_window(pb, pb->q_prev, q))
         om_verify(pb, q, pos, ori);
     *inside = _finish(pb, q, pb->q_prev, true, q_out, pos, ori);
@@ -172,7 +181,7 @@ om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *
     }
     if (has_hint) {
         bool inside;
-        if (_near_hint(pb, start, &start_complete, q, q_out, &pos, &ori, &inside))
+        if (_near_hint(pb, start, &start_complete, q, q_out, &pos, &ori, &inside, NULL, NULL))
             return _result(OM_OK, pos, ori, problem.counter, inside);
     } else if (found && om_local_solve(pb, start, &start_complete, q, &pos, &ori)) {
         bool inside = _finish(pb, q, hint, false, q_out, &pos, &ori);
@@ -237,7 +246,7 @@ om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *
 
 /* The hinted solve's local part alone (see om_solve_near in om_kernels.h). */
 bool om_solve_near(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
-                   const double *hint, double *q_out)
+                   const double *hint, double *q_out, om_root_test as_is, void *context)
 {
     double usable[OM_MAX_DOF], psi[1], q[OM_MAX_DOF], start[OM_MAX_DOF], pos, ori;
     om_usable_hint(s, hint, usable);
@@ -246,7 +255,7 @@ bool om_solve_near(const om_solver_data *s, const double *T, const int64_t *sign
     nan_fill(q, OM_MAX_DOF); /* as in om_solve_one */
     memcpy(start, usable, (size_t)s->dof * sizeof(double));
     bool complete = true, inside;
-    return _near_hint(&problem, start, &complete, q, q_out, &pos, &ori, &inside);
+    return _near_hint(&problem, start, &complete, q, q_out, &pos, &ori, &inside, as_is, context);
 }
 
 /* Every solution in one configuration (the bounded search): roots (OM_MAX_ROOTS x dof,

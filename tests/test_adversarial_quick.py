@@ -87,7 +87,7 @@ def test_arm_angle_line_poses_are_made_at_the_angle_asked(name):
     centre at delta (1e-4 ... 1e-12) from straight below (or above) the shoulder, within limits."""
     run = adv.ArmRun(name, seed=5)
     made = 0
-    for i in range(60):
+    for i in range(120):
         delta, side = 10.0 ** -(4 + i % 9), -1.0 if i % 3 else 1.0
         q = run.near_arm_angle_line(delta, side)
         if q is None:

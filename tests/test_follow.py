@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
-from om_redundant.redundancy.probe import Probe
+from om_redundant.redundancy.probe import END_TOLERANCE, Probe
 from tests.test_redundancy_batch import optimizer_of
 
 
@@ -68,3 +68,22 @@ def test_compiled_next_is_the_python_next(seed, name, step):
         np.testing.assert_allclose(fast.q, slow.q, atol=1e-9)
         np.testing.assert_allclose(fast.tangent, slow.tangent, rtol=1e-9, atol=1e-9)
         assert fast.evaluation.value == pytest.approx(slow.evaluation.value, abs=1e-9)
+
+
+@settings(max_examples=12, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), name=st.sampled_from(["panda", "iiwa14"]), compiled=st.booleans())
+def test_a_path_ends_where_follow_says(seed, name, compiled):
+    """A path that ends on the way (a fold, or a branch quantity leaving its sign beyond the
+    band) ends at the point reached, to END_TOLERANCE: no step of 2 END_TOLERANCE beyond it
+    continues the path. The end is aimed at from the end measures of the last points, not
+    halved towards: this checks that the aim does not stop short."""
+    optimizer = optimizer_of(name, 0)
+    solver = optimizer.solver
+    q = np.random.default_rng(seed).uniform(solver.arm.lower, solver.arm.upper)
+    configuration = solver.configuration_of(q)
+    (psi,) = configuration.redundancy
+    probe = Probe(solver, optimizer.objective, solver.arm.fk(q), configuration.signs, compiled=compiled)
+    for side in (1.0, -1.0):
+        end, arrived = probe.follow(probe.point(psi, q), psi + side * np.pi)
+        if not arrived:
+            assert probe.next(end, end.psi + side * 2.0 * END_TOLERANCE) is None

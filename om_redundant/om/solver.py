@@ -246,8 +246,12 @@ class OMSolver:
         must have the requested sign s_i, or lie in the band |b_i(q)| <= :data:`BRANCH_BAND`,
         where q belongs to both neighbouring configurations: s_i b_i(q) >= 0 or
         |b_i(q)| <= 1e-7. A 7-DOF arm's arm angle psi(q) must equal the requested one within
-        1e-9 rad modulo 2 pi, psi read in the requested ELBOW branch (the elbow plane's
-        normal flips with the branch, so at a straight elbow psi is the requested branch's).
+        1e-9 rad modulo 2 pi, or within its own rounding at q, |d psi / dq|_1 2^-51 (psi's
+        change when each joint moves by an ulp of pi: larger than 1e-9 only within about
+        1e-7 rad of psi's singular half-line, the wrist centre straight below the shoulder,
+        where |d psi / dq| grows as 1 / rho), psi read in the requested ELBOW branch (the
+        elbow plane's normal flips with the branch, so at a straight elbow psi is the
+        requested branch's).
         Every ``ok`` answer of :meth:`solve`, :meth:`solve_all` and :meth:`solve_batch`
         holds its configuration.
 

@@ -5,10 +5,14 @@ paths (:mod:`om_redundant.redundancy.paths`), and how a path is followed along p
 accepted when it continues the path (:meth:`Probe.continues`: no joint moves more than
 :data:`JUMP`, and the joints move as the path's tangent predicts); a step that fails is
 halved (near a singular shoulder or wrist two joints turn fast), and doubled again after a
-success (:meth:`Probe.follow`). Below :data:`END_TOLERANCE` the path has *ended*: it folded
+success; where the last two points predict the path's end short of the next step, the step
+aims just short of it (:meth:`Probe.follow`). Below :data:`END_TOLERANCE` the path has *ended*: it folded
 back in psi, or left the branch or the reach. With a compiled solver the loop runs in one
 call (``ckernels.follow``, ``csrc/follow.c``: the same steps and tests, the tangents of
-``csrc/self_motion.c``); Python builds only the point reached.
+``csrc/self_motion.c``; its solves are the hinted solve's local part, so a failed local solve
+is a failed step without the bounded search, and a root within a quarter of its step of the
+first-order prediction is taken without the scan for a nearer one); Python builds only the
+point reached.
 """
 
 from __future__ import annotations
