@@ -282,43 +282,38 @@ class RedundancyOptimizer:
         where it was instead of jumping to whichever sample rounding favours, farther than
         the joints can follow in one tick.
         """
-        slope, limits, sampled = 0.0, None, []
-        for run in runs:
-            psi = np.array([p.psi for p in run.points])
-            f = np.array([p.evaluation.value for p in run.points])
-            pairs = [p.terms.get_pairs() for p in run.points]  # (computed for the evaluations)
-            distances = None if pairs[0] is None else np.array([d for d, _ in pairs])
-            terms = self.objective.term_functions(np.array([p.q for p in run.points]), distances)
-            if len(f) > 1:
-                step = np.maximum(np.diff(psi), 1e-12)
-                slope = max(slope, float(np.max(np.abs(np.diff(f)) / step)))
-                rates = [np.max(np.abs(np.diff(v, axis=0)) / step[:, None], axis=0) for _, _, v in terms]
-                limits = (
-                    rates
-                    if limits is None
-                    else [np.maximum(a, b) for a, b in zip(limits, rates, strict=True)]
-                )
-            # local maxima among the samples (the ends against their one neighbour), and near
-            rising = np.concatenate([[True], f[1:] >= f[:-1]])
-            falling = np.concatenate([f[:-1] >= f[1:], [True]])
-            chosen = rising & falling
-            if near is not None:
-                chosen |= np.array([_distance(x, near) <= END_TOLERANCE for x in psi.tolist()])
-            k = np.flatnonzero(chosen)
-            last = len(f) - 1
-            gap = np.maximum(psi[np.minimum(k + 1, last)] - psi[k], psi[k] - psi[np.maximum(k - 1, 0)])
-            sampled.append((run, k, f[k], gap, [(w, cap, v[k]) for w, cap, v in terms]))
-        if limits is None:  # (single samples: no slopes, and no gaps)
-            limits = [np.zeros(v.shape[1]) for _, _, v in sampled[0][4]]
-        starts = []
-        for run, k, value, gap, terms in sampled:
-            reach = 2.0 * gap
-            bound = 0.0
-            for (w, cap, v), rate in zip(terms, limits, strict=True):
-                bound = bound + w * np.minimum(cap, (v + rate * reach[:, None]).min(axis=1))
-            bound = np.minimum(value + slope * reach, bound)
-            rows = zip(value.tolist(), gap.tolist(), bound.tolist(), k.tolist(), strict=True)
-            starts += [(f_k, gap_k, bound_k, run, run.points[j]) for f_k, gap_k, bound_k, j in rows]
+        # every run's samples at once; the slopes between neighbours of one run only
+        points = [p for run in runs for p in run.points]
+        owner = np.repeat(np.arange(len(runs)), [len(run.points) for run in runs])
+        first = np.flatnonzero(np.diff(owner, prepend=-1))  # each run's first sample
+        first, last = first[owner], np.append(first[1:], len(points))[owner] - 1
+        psi = np.array([p.psi for p in points])
+        f = np.array([p.evaluation.value for p in points])
+        pairs = [p.terms.get_pairs() for p in points]  # (computed for the evaluations)
+        distances = None if pairs[0] is None else np.array([d for d, _ in pairs])
+        terms = self.objective.term_functions(np.array([p.q for p in points]), distances)
+        inner = owner[1:] == owner[:-1]  # neighbours on one run
+        step = np.maximum(np.diff(psi), 1e-12)[inner]
+        slope = float(np.max(np.abs(np.diff(f)[inner]) / step, initial=0.0))
+        limits = [
+            np.max(np.abs(np.diff(v, axis=0)[inner]) / step[:, None], axis=0, initial=0.0)
+            for _, _, v in terms
+        ]
+        # local maxima among a run's samples (its ends against their one neighbour), and near
+        rising = np.concatenate([[True], f[1:] >= f[:-1]]) | (first == np.arange(len(f)))
+        falling = np.concatenate([f[:-1] >= f[1:], [True]]) | (last == np.arange(len(f)))
+        chosen = rising & falling
+        if near is not None:
+            chosen |= np.array([_distance(x, near) <= END_TOLERANCE for x in psi.tolist()])
+        k = np.flatnonzero(chosen)
+        gap = np.maximum(psi[np.minimum(k + 1, last[k])] - psi[k], psi[k] - psi[np.maximum(k - 1, first[k])])
+        reach = 2.0 * gap
+        bound = 0.0
+        for (w, cap, v), rate in zip(terms, limits, strict=True):
+            bound = bound + w * np.minimum(cap, (v[k] + rate * reach[:, None]).min(axis=1))
+        bound = np.minimum(f[k] + slope * reach, bound)
+        rows = zip(f[k].tolist(), gap.tolist(), bound.tolist(), k.tolist(), strict=True)
+        starts = [(f_k, gap_k, bound_k, runs[owner[j]], points[j]) for f_k, gap_k, bound_k, j in rows]
         starts.sort(key=lambda s: -s[0])
         found = [(starts[0][3], starts[0][4])]
         best = found[0][1].evaluation.value
