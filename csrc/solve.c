@@ -260,18 +260,21 @@ bool om_solve_near(const om_solver_data *s, const double *T, const int64_t *sign
 
 /* Every solution in one configuration (the bounded search): roots (OM_MAX_ROOTS x dof,
  * revolute joints shifted into the limits where possible) and per root (position error,
- * orientation error, within limits) in info (OM_MAX_ROOTS x 3). Returns the count. */
+ * orientation error, within limits) in info (OM_MAX_ROOTS x 3). Returns the count. band:
+ * where the bounded search finds none, the band's roots and the local solve's. cache (NULL:
+ * none): the circle search's candidates shared with the previous problem where they are
+ * the same (om_scan_cache). */
 int om_solve_all(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
-                 double *roots, double *info, int64_t *evaluations)
+                 double *roots, double *info, int64_t *evaluations, bool band, om_scan_cache *cache)
 {
     double zeros[OM_MAX_DOF] = {0.0};
     int dof = s->dof;
     double psi[1];
     om_problem problem;
     _problem(&problem, s, T, signs, redundancy, psi, zeros);
-    int n = om_all_roots(&problem, s->scan_points, roots, zeros, INFINITY);
+    int n = om_all_roots_cached(&problem, s->scan_points, roots, cache);
     bool neighbour_reached, complete = true;
-    if (n == 0) { /* the band's roots, and what solve finds: its local solve from the fixed-point start */
+    if (n == 0 && band) { /* the band's roots, and what solve finds: its local solve from the fixed-point start */
         n = om_band_roots(&problem, roots, &neighbour_reached);
         double q[OM_MAX_DOF], start[OM_MAX_DOF], pos, ori;
         nan_fill(q, OM_MAX_DOF);
