@@ -311,7 +311,8 @@ class Objective:
         distances, gradients = self._no_pairs if pairs is None else pairs
         g, dg = np.empty((2, len(self._limited) + len(distances)))
         limits = (self._limited, self._lower, self._upper, self._half)
-        ckernels.pieces(q, tangent[:, 0], distances, gradients, *limits, self._clearance_numbers, g, dg)
+        q, rate = (np.ascontiguousarray(x, dtype=float) for x in (q, tangent[:, 0]))
+        ckernels.pieces(q, rate, distances, gradients, *limits, self._clearance_numbers, g, dg)
         return g, dg
 
     def constraint_bounds(
