@@ -327,14 +327,18 @@ void om_flange_target(const double *T, const double *T_base_root, const double *
 /* hint NULL: no hint. */
 om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
                        const double *hint, double *q_out);
+/* What a caller makes of a root: scan for a nearer one, take it as it is, or reject it and
+ * every root at most as near the hint. */
+typedef enum { OM_ROOT_SCAN = 0, OM_ROOT_TAKE = 1, OM_ROOT_REJECT = 2 } om_root_verdict;
 /* A test of a root (a joint vector) with its caller's context. */
-typedef bool (*om_root_test)(const double *q, void *context);
+typedef om_root_verdict (*om_root_test)(const double *q, void *context);
 /* om_solve_one's local part alone, for a hint: the root the local solve from the hint
  * reaches, replaced by any root nearer the hint (a windowed scan), into q_out (revolute
- * joints at the turn nearest the hint). as_is (NULL: none) may take the local root as it is
- * (in q_out when called), without the scan. Returns false where the local solve fails,
- * without the bounded search that would follow in om_solve_one: a solution may still exist
- * (the path following halves such a step, where that search's costly "no" would be wasted). */
+ * joints at the turn nearest the hint). as_is (NULL: none) judges the local root (in q_out
+ * when called): taken as it is, or rejected, without the scan. Returns false where the local
+ * solve fails, without the bounded search that would follow in om_solve_one: a solution may
+ * still exist (the path following halves such a step, where that search's costly "no" would
+ * be wasted); and where as_is rejects. */
 bool om_solve_near(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
                    const double *hint, double *q_out, om_root_test as_is, void *context);
 /* Every root (OM_MAX_ROOTS x dof) with per root (position error, orientation error, within limits)

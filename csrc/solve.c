@@ -122,9 +122,9 @@ static void _problem(om_problem *pb, const om_solver_data *s, const double *T, c
 /* A hinted solve's local part (the hint is pb->q_prev, copied into start): the local solve
  * from the hint, its root replaced by any root nearer the hint (the windowed scan), written
  * into q_out at the representative nearest the hint. as_is (NULL: none) may take the local
- * root as it is, without the scan: it sees it in q_out. Returns false where the local solve
- * fails (q_out not written); else *pos, *ori are q_out's errors and *inside whether it is
- * within the limits. q: scratch (dof). */
+ * root as it is, or reject it, without the scan: it sees it in q_out. Returns false where the
+ * local solve fails (q_out not written) or as_is rejects; else *pos, *ori are q_out's errors
+ * and *inside whether it is within the limits. q: scratch (dof). */
 static bool _near_hint(om_problem *pb, double *start, bool *start_complete, double *q, double *q_out, double *pos,
                        double *ori, bool *inside, om_root_test as_is, void *context)
 {
@@ -133,8 +133,9 @@ static bool _near_hint(om_problem *pb, double *start, bool *start_complete, doub
     if (as_is) {
         double local_pos = *pos, local_ori = *ori;
         *inside = _finish(pb, q, pb->q_prev, true, q_out, pos, ori);
-        if (as_is(q_out, context))
-            return true;
+        om_root_verdict verdict = as_is(q_out, context);
+        if (verdict != OM_ROOT_SCAN)
+            return verdict == OM_ROOT_TAKE;
         *pos = local_pos;
         *ori = local_ori;
     }
