@@ -4,7 +4,8 @@
  * From the point (psi_0, q_0) with tangent t_0 = dq/dpsi towards psi*: the step h starts at
  * psi* - psi_0; at x = psi_k + h (psi* once within reach) the exact solution q nearest q_k
  * (the solve's hint; where the local solve's root lies on the path beyond doubt, see
- * on_path, it is taken without the scan for a nearer one) is taken at its representative
+ * on_path, it is taken without the scan for a nearer one, and where no root as near can
+ * continue the path, the attempt fails without it) is taken at its representative
  * (revolute joints with both limits moved by whole turns nearest mid-range c_i:
  * c_i + wrap(q_i - c_i), for the feasible intervals)
  * and accepted when it continues the path (om_continues: no joint moved more than 1 rad,
@@ -40,18 +41,31 @@ typedef struct {
     double d;
 } prediction;
 
-/* Whether root x (at its representative) lies on the prediction's path beyond doubt: within
- * TIGHT of its joint step from the first-order prediction (om_solve_near's as_is test; the
- * windowed scan for a nearer root is skipped then). A root of another path would be off by
- * the paths' separation; one that merely continues (om_continues: within 1/2) may be the
- * partner at a fold, or another path's, where the root nearest q is the path's. */
-static bool on_path(const double *x, void *context) {
+/* What the attempt makes of the local solve's root x (at its representative; om_solve_near's
+ * as_is test). Taken without the windowed scan for a nearer root where it lies on the
+ * prediction's path beyond doubt: within TIGHT of its joint step from the first-order
+ * prediction. A root of another path would be off by the paths' separation; one that merely
+ * continues (om_continues: within 1/2) may be the partner at a fold, or another path's, where
+ * the root nearest q is the path's. Rejected, without the scan, where no root at most as far
+ * from q as x can continue the path, the attempt's answer whatever the scan finds: such a
+ * root is within d = |x - q| of q (every joint wrapped, the scan's distance), so it moves each
+ * joint by m_i with |m_i| <= moved <= min(d, 1) and |m_i - t_i h| <= moved / 2 + 1e-6
+ * (om_continues), whence |t_i h| <= 1.5 min(d, 1) + 1e-6; a prediction that moves some joint
+ * farther (h the step, the prediction's d; 1e-6 more for the representatives' rounding) leaves
+ * none. Else the scan decides. */
+static om_root_verdict on_path(const double *x, void *context) {
     const prediction *p = context;
-    double r[OM_MAX_DOF], moved, error;
+    double r[OM_MAX_DOF], moved, error, d2 = 0.0, farthest = 0.0;
     memcpy(r, x, (size_t)p->dof * sizeof(double));
     represent(p->dof, p->centred, p->centre, r);
     om_continuation(p->dof, p->q, r, p->t, p->d, p->cyclic, &moved, &error);
-    return moved <= 1.0 && error <= TIGHT * moved;
+    if (moved <= 1.0 && error <= TIGHT * moved) return OM_ROOT_TAKE;
+    for (int i = 0; i < p->dof; i++) {
+        double e = om_wrap_angle(r[i] - p->q[i]);
+        d2 += e * e;
+        farthest = fmax(farthest, fabs(p->t[i] * p->d));
+    }
+    return farthest > 1.5 * fmin(sqrt(d2), 1.0) + 2e-6 ? OM_ROOT_REJECT : OM_ROOT_SCAN;
 }
 
 /* What ends a path, as functions of its point (q, t) that fall to zero there linearly in psi

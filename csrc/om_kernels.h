@@ -22,6 +22,7 @@
 
 #define OM_MAX_DOF 16  /* joints of an arm the kernels take (the binding checks) */
 #define OM_MAX_ROOTS 16 /* roots kept per configuration */
+#define OM_SCAN_KEY (3 + 9 + 1 + 2 + OM_MAX_DOF + 1) /* om_scan_cache's key */
 
 /* ------------------------------------------------------------------------------------ */
 /* om_math.h: tuple math, angle wrapping; common.c: the Euler decomposition of a revolute triple. */
@@ -284,6 +285,24 @@ int om_band_roots(om_problem *pb, double *roots, bool *neighbour_reached);
 
 /* search.c */
 int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre, double radius);
+/* The circle search's candidates of one problem, kept for a next problem that differs from it
+ * in the SHOULDER sign alone. On an S-R-S arm whose dp turns with q7 the circle residual g(w)
+ * is the model's q7 less w, and q7 does not depend on the SHOULDER sign (srs.c,
+ * q7_with_elbow): the scan, its brackets and refinements are the same, only the joints that
+ * each candidate becomes differ. */
+typedef struct {
+    bool valid;
+    double key[OM_SCAN_KEY];  /* the target, psi, the other signs, q_prev, the scan points */
+    int count;                /* candidates */
+    int64_t evaluations;      /* the residual evaluations they took */
+    double q[OM_MAX_DOF];     /* the scratch joints as the search left them */
+    double *candidates;       /* capacity of them */
+    int capacity;
+} om_scan_cache;
+#define OM_SCAN_CAPACITY(n_scan) (8 * (n_scan) + 8 + OM_WRIST_BAND_CANDIDATES)
+/* om_all_roots on the whole circle with the candidates taken from cache where it holds this
+ * problem's, else searched and kept there (cache NULL: om_all_roots). */
+int om_all_roots_cached(om_problem *pb, int n_scan, double *roots, om_scan_cache *cache);
 /* The fixed-point start: where only q_J of it is known (*complete false), every joint of the
  * model IK at p_m = p_d (S-R-S: at the edge of reach beyond it) into start. */
 void om_complete_start(om_problem *pb, double *start, bool *complete);
@@ -308,19 +327,23 @@ void om_flange_target(const double *T, const double *T_base_root, const double *
 /* hint NULL: no hint. */
 om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
                        const double *hint, double *q_out);
+/* What a caller makes of a root: scan for a nearer one, take it as it is, or reject it and
+ * every root at most as near the hint. */
+typedef enum { OM_ROOT_SCAN = 0, OM_ROOT_TAKE = 1, OM_ROOT_REJECT = 2 } om_root_verdict;
 /* A test of a root (a joint vector) with its caller's context. */
-typedef bool (*om_root_test)(const double *q, void *context);
+typedef om_root_verdict (*om_root_test)(const double *q, void *context);
 /* om_solve_one's local part alone, for a hint: the root the local solve from the hint
  * reaches, replaced by any root nearer the hint (a windowed scan), into q_out (revolute
- * joints at the turn nearest the hint). as_is (NULL: none) may take the local root as it is
- * (in q_out when called), without the scan. Returns false where the local solve fails,
- * without the bounded search that would follow in om_solve_one: a solution may still exist
- * (the path following halves such a step, where that search's costly "no" would be wasted). */
+ * joints at the turn nearest the hint). as_is (NULL: none) judges the local root (in q_out
+ * when called): taken as it is, or rejected, without the scan. Returns false where the local
+ * solve fails, without the bounded search that would follow in om_solve_one: a solution may
+ * still exist (the path following halves such a step, where that search's costly "no" would
+ * be wasted); and where as_is rejects. */
 bool om_solve_near(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
                    const double *hint, double *q_out, om_root_test as_is, void *context);
 /* Every root (OM_MAX_ROOTS x dof) with per root (position error, orientation error, within limits)
  * in info (OM_MAX_ROOTS x 3). Returns the count; *evaluations the residual evaluations. */
 int om_solve_all(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
-                 double *roots, double *info, int64_t *evaluations);
+                 double *roots, double *info, int64_t *evaluations, bool band, om_scan_cache *cache);
 
 #endif

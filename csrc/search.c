@@ -6,33 +6,11 @@
 #define WINDOW_POINTS 8  /* samples of the window searched around a hint */
 #define START_POINTS 8   /* points of the dp circle tried when p_d is out of the model's reach */
 
-/* Bounded search: every verified solution in this configuration into roots (OM_MAX_ROOTS x
- * dof); returns the count. With radius < pi, only roots whose scanned joints lie within
- * radius of the centre's are sought. */
-int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre, double radius)
+/* The roots from the circle's candidates cands[0 .. n), each polished and verified into roots
+ * (OM_MAX_ROOTS x dof); returns the count. q: scratch, as the candidates' search left it. */
+static int _circle_roots(om_problem *pb, const double *cands, int n, double *q, double *roots)
 {
     const om_solver_data *data = pb->s;
-    double q[OM_MAX_DOF];
-    nan_fill(q, OM_MAX_DOF); /* unwritten joints read as NaN, which verify rejects */
-    if (data->mode == OM_FIXED) {
-        double gw = om_g(pb, 0.0, q, true);
-        return isnan(gw) ? 0 : om_add_candidate(pb, q, roots, 0);
-    }
-    if (data->mode == OM_TORUS) {
-        int side = (int)(TORUS_SIDE * (double)n_scan);
-        return om_torus_roots(pb, side > 4 ? side : 4, roots, centre, radius);
-    }
-    int J = data->dp_joint;
-    int cap = 8 * n_scan + 8 + OM_WRIST_BAND_CANDIDATES;
-    double *cands = malloc((size_t)cap * sizeof(double));
-    if (!cands)
-        return 0;
-    bool full_circle = radius >= OM_PI;
-    double lo = full_circle ? -OM_PI : centre[J] - radius;
-    double hi = full_circle ? OM_PI : centre[J] + radius;
-    int n = om_circle_candidates(pb, lo, hi, n_scan, full_circle, q, cands, cap);
-    if (data->family != OM_SRS && data->params[SD_WRIST_OFFSET] != 0.0) /* a4 != 0: the singular wrist's bands */
-        n += om_wrist_offset_candidates(pb, lo, hi, full_circle, q, cands + n, cap - n);
     int count = 0;
     bool lifted = data->family == OM_SRS; /* 7-DOF: the lifted system; 6-DOF: the wrist with q6 given */
     for (int i = 0; i < n; i++) {
@@ -56,8 +34,78 @@ int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre
                 count = om_add_candidate(pb, at_candidate, roots, count);
         }
     }
+    return count;
+}
+
+/* What the circle's candidates of the problem depend on, but for its SHOULDER sign (om_scan_cache). */
+static void _scan_key(const om_problem *pb, int n_scan, double *key)
+{
+    const mat3 *R = &pb->t.R;
+    const vec3 rows[3] = {R->r0, R->r1, R->r2};
+    double *k = key;
+    *k++ = pb->p.x, *k++ = pb->p.y, *k++ = pb->p.z;
+    for (int i = 0; i < 3; i++)
+        *k++ = rows[i].x, *k++ = rows[i].y, *k++ = rows[i].z;
+    *k++ = pb->t.psi;
+    *k++ = (double)pb->signs[1], *k++ = (double)pb->signs[2];
+    for (int j = 0; j < OM_MAX_DOF; j++)
+        *k++ = j < pb->s->dof ? pb->q_prev[j] : 0.0;
+    *k = (double)n_scan;
+}
+
+/* Bounded search: every verified solution in this configuration into roots (OM_MAX_ROOTS x
+ * dof); returns the count. With radius < pi, only roots whose scanned joints lie within
+ * radius of the centre's are sought. */
+int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre, double radius)
+{
+    const om_solver_data *data = pb->s;
+    double q[OM_MAX_DOF];
+    nan_fill(q, OM_MAX_DOF); /* unwritten joints read as NaN, which verify rejects */
+    if (data->mode == OM_FIXED) {
+        double gw = om_g(pb, 0.0, q, true);
+        return isnan(gw) ? 0 : om_add_candidate(pb, q, roots, 0);
+    }
+    if (data->mode == OM_TORUS) {
+        int side = (int)(TORUS_SIDE * (double)n_scan);
+        return om_torus_roots(pb, side > 4 ? side : 4, roots, centre, radius);
+    }
+    int J = data->dp_joint, cap = OM_SCAN_CAPACITY(n_scan);
+    double *cands = malloc((size_t)cap * sizeof(double));
+    if (!cands)
+        return 0;
+    bool full_circle = radius >= OM_PI;
+    double lo = full_circle ? -OM_PI : centre[J] - radius;
+    double hi = full_circle ? OM_PI : centre[J] + radius;
+    int n = om_circle_candidates(pb, lo, hi, n_scan, full_circle, q, cands, cap);
+    if (data->family != OM_SRS && data->params[SD_WRIST_OFFSET] != 0.0) /* a4 != 0: the singular wrist's bands */
+        n += om_wrist_offset_candidates(pb, lo, hi, full_circle, q, cands + n, cap - n);
+    int count = _circle_roots(pb, cands, n, q, roots);
     free(cands);
     return count;
+}
+
+int om_all_roots_cached(om_problem *pb, int n_scan, double *roots, om_scan_cache *cache)
+{
+    const om_solver_data *data = pb->s;
+    double zeros[OM_MAX_DOF] = {0.0};
+    if (!cache || data->mode != OM_CIRCLE || data->family != OM_SRS || data->dp_joint != 6 ||
+        OM_SCAN_CAPACITY(n_scan) > cache->capacity)
+        return om_all_roots(pb, n_scan, roots, zeros, INFINITY);
+    double key[OM_SCAN_KEY], q[OM_MAX_DOF];
+    _scan_key(pb, n_scan, key);
+    if (cache->valid && memcmp(key, cache->key, sizeof key) == 0) {
+        pb->counter += cache->evaluations;
+        memcpy(q, cache->q, sizeof q);
+    } else {
+        nan_fill(q, OM_MAX_DOF); /* as om_all_roots */
+        int64_t before = pb->counter;
+        cache->count = om_circle_candidates(pb, -OM_PI, OM_PI, n_scan, true, q, cache->candidates, cache->capacity);
+        cache->evaluations = pb->counter - before;
+        memcpy(cache->q, q, sizeof q);
+        memcpy(cache->key, key, sizeof key);
+        cache->valid = true;
+    }
+    return _circle_roots(pb, cache->candidates, cache->count, q, roots);
 }
 
 void om_complete_start(om_problem *pb, double *start, bool *complete)

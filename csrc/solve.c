@@ -122,9 +122,9 @@ static void _problem(om_problem *pb, const om_solver_data *s, const double *T, c
 /* A hinted solve's local part (the hint is pb->q_prev, copied into start): the local solve
  * from the hint, its root replaced by any root nearer the hint (the windowed scan), written
  * into q_out at the representative nearest the hint. as_is (NULL: none) may take the local
- * root as it is, without the scan: it sees it in q_out. Returns false where the local solve
- * fails (q_out not written); else *pos, *ori are q_out's errors and *inside whether it is
- * within the limits. q: scratch (dof). */
+ * root as it is, or reject it, without the scan: it sees it in q_out. Returns false where the
+ * local solve fails (q_out not written) or as_is rejects; else *pos, *ori are q_out's errors
+ * and *inside whether it is within the limits. q: scratch (dof). */
 static bool _near_hint(om_problem *pb, double *start, bool *start_complete, double *q, double *q_out, double *pos,
                        double *ori, bool *inside, om_root_test as_is, void *context)
 {
@@ -133,8 +133,9 @@ static bool _near_hint(om_problem *pb, double *start, bool *start_complete, doub
     if (as_is) {
         double local_pos = *pos, local_ori = *ori;
         *inside = _finish(pb, q, pb->q_prev, true, q_out, pos, ori);
-        if (as_is(q_out, context))
-            return true;
+        om_root_verdict verdict = as_is(q_out, context);
+        if (verdict != OM_ROOT_SCAN)
+            return verdict == OM_ROOT_TAKE;
         *pos = local_pos;
         *ori = local_ori;
     }
@@ -260,18 +261,21 @@ bool om_solve_near(const om_solver_data *s, const double *T, const int64_t *sign
 
 /* Every solution in one configuration (the bounded search): roots (OM_MAX_ROOTS x dof,
  * revolute joints shifted into the limits where possible) and per root (position error,
- * orientation error, within limits) in info (OM_MAX_ROOTS x 3). Returns the count. */
+ * orientation error, within limits) in info (OM_MAX_ROOTS x 3). Returns the count. band:
+ * where the bounded search finds none, the band's roots and the local solve's. cache (NULL:
+ * none): the circle search's candidates shared with the previous problem where they are
+ * the same (om_scan_cache). */
 int om_solve_all(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
-                 double *roots, double *info, int64_t *evaluations)
+                 double *roots, double *info, int64_t *evaluations, bool band, om_scan_cache *cache)
 {
     double zeros[OM_MAX_DOF] = {0.0};
     int dof = s->dof;
     double psi[1];
     om_problem problem;
     _problem(&problem, s, T, signs, redundancy, psi, zeros);
-    int n = om_all_roots(&problem, s->scan_points, roots, zeros, INFINITY);
+    int n = om_all_roots_cached(&problem, s->scan_points, roots, cache);
     bool neighbour_reached, complete = true;
-    if (n == 0) { /* the band's roots, and what solve finds: its local solve from the fixed-point start */
+    if (n == 0 && band) { /* the band's roots, and what solve finds: its local solve from the fixed-point start */
         n = om_band_roots(&problem, roots, &neighbour_reached);
         double q[OM_MAX_DOF], start[OM_MAX_DOF], pos, ori;
         nan_fill(q, OM_MAX_DOF);

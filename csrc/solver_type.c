@@ -211,31 +211,41 @@ static PyObject *Solver_solve_rows(Solver *self, PyObject *const *args, Py_ssize
     Py_RETURN_NONE;
 }
 
-/* solve_all_rows(Ts, signs, redundancy, start, stop, roots, info, counts): om_solve_all of
- * rows start:stop of a batch; Ts (M, 4, 4), signs (M, k) int64, redundancy (M, r); roots
- * (M, MAX_ROOTS, dof) and info (M, MAX_ROOTS, 3) get each row's as solve_all's, counts
- * (M, 2) int64 its (count, evaluations). */
+/* solve_all_rows(Ts, signs, redundancy, start, stop, roots, info, counts, band): om_solve_all
+ * of rows start:stop of a batch; Ts (M, 4, 4), signs (M, k) int64, redundancy (M, r), band
+ * (M,) bool (whether a row without a root of its own searches the band); roots (M,
+ * MAX_ROOTS, dof) and info (M, MAX_ROOTS, 3) get each row's as solve_all's, counts (M, 2)
+ * int64 its (count, evaluations). */
 static PyObject *Solver_solve_all_rows(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
-    if (check_nargs(nargs, 8, "solve_all_rows") < 0)
+    if (check_nargs(nargs, 9, "solve_all_rows") < 0)
         return NULL;
     const om_solver_data *s = &self->data;
     int dof = s->dof, k = s->n_signs, nr = s->n_redundancy;
-    const buffer_spec specs[3] = {
-        {F64, OM_MAX_ROOTS * dof, 1, "roots"}, {F64, OM_MAX_ROOTS * 3, 1, "info"}, {I64, 2, 1, "counts"}};
-    Py_buffer v[6];
+    PyObject *outs[4] = {args[5], args[6], args[7], args[8]};
+    const buffer_spec specs[4] = {{F64, OM_MAX_ROOTS * dof, 1, "roots"},
+                                  {F64, OM_MAX_ROOTS * 3, 1, "info"},
+                                  {I64, 2, 1, "counts"},
+                                  {U8, 1, 0, "band"}};
+    Py_buffer v[7];
     Py_ssize_t start, stop;
-    if (get_rows(s, args, args + 5, specs, 3, v, &start, &stop) < 0) return NULL;
+    if (get_rows(s, args, outs, specs, 4, v, &start, &stop) < 0) return NULL;
     const double *Tb = v[0].buf, *rb = v[2].buf;
     const int64_t *sb = v[1].buf;
     double *roots = v[3].buf, *info = v[4].buf;
     int64_t *counts = v[5].buf;
-    Py_BEGIN_ALLOW_THREADS for (Py_ssize_t i = start; i < stop; i++) {
+    const uint8_t *band = v[6].buf;
+    /* Neighbouring rows that differ in the SHOULDER sign alone share the circle's candidates. */
+    om_scan_cache cache = {.valid = false, .capacity = OM_SCAN_CAPACITY(s->scan_points)};
+    Py_BEGIN_ALLOW_THREADS cache.candidates = malloc((size_t)cache.capacity * sizeof(double));
+    for (Py_ssize_t i = start; i < stop; i++) {
         int64_t evaluations;
         counts[2 * i] = om_solve_all(s, Tb + 16 * i, sb + k * i, rb + nr * i, roots + OM_MAX_ROOTS * dof * i,
-                                     info + OM_MAX_ROOTS * 3 * i, &evaluations);
+                                     info + OM_MAX_ROOTS * 3 * i, &evaluations, band[i],
+                                     cache.candidates ? &cache : NULL);
         counts[2 * i + 1] = evaluations;
     }
-    Py_END_ALLOW_THREADS release_buffers(v, 6);
+    free(cache.candidates);
+    Py_END_ALLOW_THREADS release_buffers(v, 7);
     Py_RETURN_NONE;
 }
 
@@ -252,7 +262,7 @@ static PyObject *Solver_solve_all(Solver *self, PyObject *const *args, Py_ssize_
     if (get_buffers(objs, v, specs, 3) < 0) return NULL;
     int n;
     int64_t evaluations;
-    Py_BEGIN_ALLOW_THREADS n = om_solve_all(s, v[0].buf, c.signs, c.redundancy, v[1].buf, v[2].buf, &evaluations);
+    Py_BEGIN_ALLOW_THREADS n = om_solve_all(s, v[0].buf, c.signs, c.redundancy, v[1].buf, v[2].buf, &evaluations, true, NULL);
     Py_END_ALLOW_THREADS release_buffers(v, 3);
     return Py_BuildValue("(iL)", n, (long long)evaluations);
 }

@@ -12,6 +12,7 @@ from om_redundant import ckernels
 from om_redundant.om.families import six_dof, srs
 from om_redundant.om.system import MAX_ROOTS, SolverData
 from tests.conftest import random_q
+from tests.test_reliability import BOUNDARY_CASES
 
 
 @pytest.fixture(scope="module")
@@ -100,16 +101,52 @@ def _assert_rows_are_solve_all(solver: om.OMSolver, T, signs, redundancy, batch:
 
 
 @pytest.mark.parametrize("threads", [1, 2])
-def test_solve_all_batch_equals_solve_all_per_row(panda, threads):
-    """Every configuration of random poses on a psi grid (rows with 0, 1 and several roots)."""
+@pytest.mark.parametrize("shoulder_pairs", [False, True])
+def test_solve_all_batch_equals_solve_all_per_row(panda, threads, shoulder_pairs):
+    """Every configuration of random poses on a psi grid (rows with 0, 1 and several roots);
+    also with the rows that differ in the SHOULDER sign alone next to each other, where the
+    second takes the first's circle search (om_scan_cache)."""
+    T = panda.arm.fk(random_q(panda.arm, 3, np.random.default_rng(6)))
+    branches = [c.signs for c in panda.configurations()]
+    psi = np.linspace(-np.pi, np.pi, 8, endpoint=False)
+    rows = [(t, s, x) for t in T for s in branches for x in psi]
+    if shoulder_pairs:
+        paired = sorted(branches, key=lambda s: (s[1:], s[0]))
+        rows = [(t, s, x) for t in T for x in psi for s in paired]
+    Ts, signs, redundancy = (np.array(column) for column in zip(*rows, strict=True))
+    batch = panda.solve_all_batch(Ts, signs, redundancy, threads=threads)
+    assert (batch.count == 0).any() and (batch.count > 1).any()
+    _assert_rows_are_solve_all(panda, Ts, signs, redundancy, batch)
+
+
+def test_solve_grid_searches_the_band_only_where_asked(panda):
+    """solve_grid's rows marked for the band are solve_all's; the others are solve_all's
+    wherever the bounded search finds a root (solve_all searches further only where it finds
+    none), and empty elsewhere. The FR3's close pair inside one scan cell, a reproducer that
+    only the band's dip search solves, is found only where the band is searched."""
     T = panda.arm.fk(random_q(panda.arm, 3, np.random.default_rng(6)))
     branches = [c.signs for c in panda.configurations()]
     psi = np.linspace(-np.pi, np.pi, 8, endpoint=False)
     rows = [(t, s, x) for t in T for s in branches for x in psi]
     Ts, signs, redundancy = (np.array(column) for column in zip(*rows, strict=True))
-    batch = panda.solve_all_batch(Ts, signs, redundancy, threads=threads)
-    assert (batch.count == 0).any() and (batch.count > 1).any()
-    _assert_rows_are_solve_all(panda, Ts, signs, redundancy, batch)
+    band = np.random.default_rng(0).random(len(Ts)) < 0.5
+    grid = panda.solve_grid(Ts, signs, redundancy, band)
+    every = panda.solve_all_batch(Ts, signs, redundancy)
+    same = band | (grid.count > 0)
+    assert (every.count[~band] == 0).any() and (every.count[~band] > 0).any()
+    assert (grid.count[~same] == 0).all()
+    for field in ("q", "count", "position_error", "orientation_error", "iterations", "within_limits"):
+        np.testing.assert_array_equal(getattr(grid, field)[same], getattr(every, field)[same])
+    with pytest.raises(om.InvalidInput, match="band must have one entry per row"):
+        panda.solve_grid(Ts, signs, redundancy, band[1:])
+    fr3 = om.OMSolver("fr3")
+    q = np.array(BOUNDARY_CASES["dip inside a cell"][1])
+    c = fr3.configuration_of(q)
+    T, c_signs, c_psi = fr3.arm.fk(q)[None], np.array([c.signs]), np.array([c.redundancy])
+    assert fr3.solve_grid(T, c_signs, c_psi, np.array([False])).count[0] == 0
+    found = fr3.solve_grid(T, c_signs, c_psi, np.array([True]))
+    assert found.count[0] == 1
+    np.testing.assert_allclose(found.q[0, 0], q, atol=1e-8)
 
 
 def test_solve_all_batch_of_a_6dof_arm_and_an_empty_batch_refused():

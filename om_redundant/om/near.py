@@ -131,8 +131,9 @@ class NearKernel:
             info[r] = (pos, ori, float(within))
         return len(roots), evals
 
-    def solve_all_rows(self, T, signs, redundancy, start, stop, roots_out, info, counts) -> None:
-        """:meth:`solve_all` of rows start:stop of a batch (counts: count, evaluations)."""
+    def solve_all_rows(self, T, signs, redundancy, start, stop, roots_out, info, counts, band) -> None:
+        """:meth:`solve_all` of rows start:stop of a batch (counts: count, evaluations);
+        band is ignored: the nominal arm's seeds always include its band's roots."""
         for i in range(start, stop):
             counts[i] = self.solve_all(T[i], signs[i], redundancy[i], roots_out[i], info[i])
 

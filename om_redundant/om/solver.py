@@ -371,15 +371,42 @@ class OMSolver:
         Raises:
             InvalidInput: A malformed argument, or one whose rows do not match the M poses.
         """
+        return self.solve_grid(T, signs, redundancy, None, threads)
+
+    def solve_grid(
+        self, T: Any, signs: Any, redundancy: Any, band: np.ndarray | None, threads: int | None = None
+    ) -> BatchRoots:
+        """:meth:`solve_all_batch`, where a row whose ``band`` is False returns its
+        configuration's own roots (the bounded search's) and nothing else: where it has none,
+        it is not searched further for the roots that :meth:`solve_all` adds then (those of
+        the neighbouring configurations within :data:`BRANCH_BAND` of the boundary, the
+        singular boundary's touch points, the local solve from the fixed-point start). For a
+        caller that solves each such row's neighbouring configurations too, as the
+        redundancy optimiser's sweep does.
+
+        Args:
+            T, signs, redundancy, threads: As :meth:`solve_all_batch` takes them.
+            band: (M,) bool, or None: every row searches as :meth:`solve_all` does. (An arm
+                near a closed-form family always does: its roots are its nominal arm's.)
+
+        Returns:
+            A :class:`BatchRoots` with M rows.
+
+        Raises:
+            InvalidInput: A malformed argument, or one whose rows do not match the M poses.
+        """
         T, signs, redundancy, threads = self._batch_rows(T, signs, redundancy, threads)
         m, dof = len(T), self.arm.dof
+        band = np.ones(m, dtype=bool) if band is None else np.ascontiguousarray(band, dtype=bool)
+        if band.shape != (m,):
+            raise InvalidInput(f"band must have one entry per row ({m}), got shape {band.shape}")
         roots = np.full((m, system.MAX_ROOTS, dof), np.nan)
         info = np.full((m, system.MAX_ROOTS, 3), np.nan)
         counts = np.zeros((m, 2), dtype=np.int64)
         kernel = self._kernel
 
         def solve_range(start: int, stop: int) -> None:
-            kernel.solve_all_rows(T, signs, redundancy, start, stop, roots, info, counts)
+            kernel.solve_all_rows(T, signs, redundancy, start, stop, roots, info, counts, band)
 
         system.run_rows(solve_range, m, threads)
         return BatchRoots(roots, counts[:, 0], info[..., 0], info[..., 1], counts[:, 1], info[..., 2] > 0.0)

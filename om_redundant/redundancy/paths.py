@@ -75,10 +75,16 @@ def sweep_circle(
     """The solution paths of every branch over the whole circle, from the grid
     psi_k = -pi + 2 pi k / n (module docstring)."""
     psi = -math.pi + _TURN * np.arange(n) / n
-    batch = solver.solve_all_batch(
+    # Rows psi by psi, the branches that differ in the first sign alone next to each other:
+    # the solver shares their circle search where it is the same (S-R-S: the SHOULDER sign).
+    order = sorted(range(len(branches)), key=lambda b: (branches[b][1:], branches[b][0]))
+    rows = np.empty((len(branches), n), dtype=int)  # the batch row of each branch and grid psi
+    rows[order] = np.arange(n * len(branches)).reshape(n, len(branches)).T
+    batch = solver.solve_grid(
         np.repeat(T[None], n * len(branches), axis=0),
-        np.repeat(branches, n, axis=0),
-        np.tile(psi, len(branches)),
+        np.tile([branches[b] for b in order], (n, 1)),
+        np.repeat(psi, len(branches)),
+        np.tile([not _neighbours_swept(branches[b], branches, n) for b in order], n),
     )
     swept = []
     for b, signs in enumerate(branches):
@@ -86,7 +92,7 @@ def sweep_circle(
         grid, distinct = [], []  # the grid index of each distinct solution, its joints
         for k in range(n):
             found = []
-            for q in batch.q[b * n + k, : batch.count[b * n + k]]:
+            for q in batch.q[rows[b, k], : batch.count[rows[b, k]]]:
                 if all(probe.step(q, f) > SAME for f in found):
                     found.append(q)
             grid += [k] * len(found)
@@ -97,6 +103,17 @@ def sweep_circle(
                 roots[k].append(point)
         swept.append([_with_hidden(probe, path) for path in _link(probe, psi, roots)])
     return swept
+
+
+def _neighbours_swept(signs: tuple[int, ...], branches: list[tuple[int, ...]], n: int) -> bool:
+    """Whether the grid holds, at each of its psi, every configuration one branch away from
+    ``signs`` (each sign flipped in turn) at the psi where the solutions within BRANCH_BAND
+    of their common boundary are its own: the same psi, and psi + pi across the S-R-S elbow,
+    whose flip turns psi's reference (a grid psi when n is even). Then a grid row of
+    ``signs`` need not search the band (:meth:`~om_redundant.OMSolver.solve_grid`): a
+    neighbour's roots there are that neighbour's row's, the same joints and objective."""
+    flips = (tuple(-s if j == i else s for j, s in enumerate(signs)) for i in range(len(signs)))
+    return n % 2 == 0 and all(f in branches for f in flips)
 
 
 def sweep_window(probe: Probe, center: float, hint: np.ndarray, half_width: float, n: int) -> list[Path]:

@@ -10,9 +10,10 @@ aims just short of it (:meth:`Probe.follow`). Below :data:`END_TOLERANCE` the pa
 back in psi, or left the branch or the reach. With a compiled solver the loop runs in one
 call (``ckernels.follow``, ``csrc/follow.c``: the same steps and tests, the tangents of
 ``csrc/self_motion.c``; its solves are the hinted solve's local part, so a failed local solve
-is a failed step without the bounded search, and a root within a quarter of its step of the
-first-order prediction is taken without the scan for a nearer one); Python builds only the
-point reached.
+is a failed step without the bounded search, a root within a quarter of its step of the
+first-order prediction is taken without the scan for a nearer one, and a step whose
+prediction moves a joint farther than any root as near as the local one could continue
+fails without it, as it would with it); Python builds only the point reached.
 """
 
 from __future__ import annotations
