@@ -77,8 +77,11 @@ static int _cell_roots(om_problem *pb, double a, double ga, double b, double gb,
     if (halvings == 0 || monotone || clear || fabs(ga - gb) > OM_PI)
         return _bracket(pb, a, ga, b, gb, q, out, n, cap);
     double m = 0.5 * (a + b), gm = om_g(pb, m, q, false);
-    if (isnan(gm) || fabs(gm - ga) > OM_PI || fabs(gb - gm) > OM_PI) /* a gap of reach or a wrap inside */
+    if (isnan(gm)) /* a gap of reach inside */
         return _bracket(pb, a, ga, b, gb, q, out, n, cap);
+    /* A wrap in one half goes to _bracket as that half (the check above): the other half may
+     * hold a root that the whole cell's ends hide (g turning by more than pi across the cell,
+     * next to psi's half-line: a root and a wrap whose ends differ by less than pi). */
     curvature = py_max(curvature, CELL_SAFETY * fabs(ga - 2.0 * gm + gb) / (0.25 * h * h));
     n = _cell_roots(pb, a, ga, m, gm, curvature, halvings - 1, q, out, n, cap);
     return _cell_roots(pb, m, gm, b, gb, curvature, halvings - 1, q, out, n, cap);

@@ -438,6 +438,18 @@ def test_a_pose_next_to_the_arm_angles_singular_half_line_is_solved(name, seed, 
                 -1.6647416489432354,
             ],
         ),
+        (  # 5.2e-11 rad (seed 5): a scan cell 7e-11 wide next to the pass held a root and a wrap
+            "xarm7",
+            [
+                0.9476753339042272,
+                1.0131117008836665,
+                -6.283185307122622,
+                -0.11547719716815809,
+                1.6882915320043015,
+                0.4185215822150059,
+                1.9828976510300498,
+            ],
+        ),
         (  # 6.7e-14 rad: the torus chart's ends missed psi by 2.3-2.7 rad
             "sawyer",
             [
@@ -479,10 +491,13 @@ def test_a_pose_next_to_the_arm_angles_singular_half_line_is_solved(name, seed, 
 def test_a_pose_within_1e_11_rad_of_the_half_line_is_solved(name, q):
     """T = FK(q), q within limits, the model's wrist centre 1e-14 ... 1e-11 rad from straight
     below the shoulder (python -m benchmarks.adversarial, seed 0, 1,000 poses next to psi's
-    half-line): "no solution in this configuration" and solve_all empty. On the xArm7's circle
-    the pass's split points covered only the azimuth's turn (offsets rho / v tan(k pi / 8)),
-    and the cell beyond them, 1e11 times wider, held both the root and g's wrap, so its ends
-    looked like a wrap: the split now goes on by doubling offsets out to the cell's ends. On
+    half-line; the second xArm7 pose: seed 5): "no solution in this configuration" and
+    solve_all empty. On the xArm7's circle the pass's split points covered only the azimuth's
+    turn (offsets rho / v tan(k pi / 8)), and the cell beyond them, 1e11 times wider, held
+    both the root and g's wrap, so its ends looked like a wrap: the split now goes on by
+    doubling offsets out to the cell's ends; and a cell whose halving showed a wrap in one
+    half went to the bracket whole (ends 3.11 and 0.06 rad: neither a root nor a wrap), now
+    each half on its own. On
     the Sawyer's torus the chart's ends missed psi by 2-3 rad, out of the refinement's reach:
     psi is now searched along the real arm's self-motion (the closest pass, a scan in the
     azimuth, bisection to the last bit)."""
