@@ -6,6 +6,7 @@
 #define CELL_HALVINGS 6  /* halvings of a scan cell that may hide roots: 16 points as fine as 1024 */
 #define POLE_TURN (0.25 * OM_PI) /* rad: the most w_hat's azimuth about up turns in one cell below the shoulder */
 #define POLE_SPLITS 3            /* split points on either side of a close pass: azimuth steps of pi / 8 */
+#define POLE_SPREAD 60           /* then offsets doubling out to the cell's ends (g's own slope beside the turn) */
 #define POLE_DEPTH 64            /* nested splits of a cell at psi's half-line: to the last bit */
 #define POLE_NEWTON 8            /* Newton steps to the closest pass of h to zero in a cell */
 #define POLE_ROUNDING 1e-15      /* relative rounding of W - S: of |e| + |u1| + |u2| (DBL_EPSILON 2.2e-16) */
@@ -76,8 +77,11 @@ static int _cell_roots(om_problem *pb, double a, double ga, double b, double gb,
     if (halvings == 0 || monotone || clear || fabs(ga - gb) > OM_PI)
         return _bracket(pb, a, ga, b, gb, q, out, n, cap);
     double m = 0.5 * (a + b), gm = om_g(pb, m, q, false);
-    if (isnan(gm) || fabs(gm - ga) > OM_PI || fabs(gb - gm) > OM_PI) /* a gap of reach or a wrap inside */
+    if (isnan(gm)) /* a gap of reach inside */
         return _bracket(pb, a, ga, b, gb, q, out, n, cap);
+    /* A wrap in one half goes to _bracket as that half (the check above): the other half may
+     * hold a root that the whole cell's ends hide (g turning by more than pi across the cell,
+     * next to psi's half-line: a root and a wrap whose ends differ by less than pi). */
     curvature = py_max(curvature, CELL_SAFETY * fabs(ga - 2.0 * gm + gb) / (0.25 * h * h));
     n = _cell_roots(pb, a, ga, m, gm, curvature, halvings - 1, q, out, n, cap);
     return _cell_roots(pb, m, gm, b, gb, curvature, halvings - 1, q, out, n, cap);
@@ -179,9 +183,12 @@ static int _pole_splits(const pole_guard *pole, double a, double b, double *spli
         centre = next;
     }
     double v = v_norm(speed), scale = v > 0.0 ? v_norm(h) / v : 0.0;
+    double outer = scale * tan((double)POLE_SPLITS * OM_PI / (2.0 * (double)POLE_SPLITS + 2.0));
     int n = 0;
-    for (int k = -POLE_SPLITS; k <= POLE_SPLITS; k++) {
-        double w = centre + scale * tan((double)k * OM_PI / (2.0 * (double)POLE_SPLITS + 2.0));
+    for (int k = -POLE_SPLITS - POLE_SPREAD; k <= POLE_SPLITS + POLE_SPREAD; k++) {
+        int far = abs(k) - POLE_SPLITS; /* beyond the pass: doublings of the outermost offset */
+        double w = far > 0 ? centre + (double)(k > 0 ? 1 : -1) * ldexp(outer, far)
+                           : centre + scale * tan((double)k * OM_PI / (2.0 * (double)POLE_SPLITS + 2.0));
         if (a < w && w < b && (n == 0 || w > split[n - 1]))
             split[n++] = w;
     }
@@ -201,7 +208,7 @@ static int _run_roots(om_problem *pb, const pole_guard *pole, int depth, const d
 static int _split_roots(om_problem *pb, const pole_guard *pole, int depth, double a, double ga, const double *split,
                         int k, double b, double gb, double *q, double *out, int n, int cap)
 {
-    double sw[2 * POLE_SPLITS + 3], sg[2 * POLE_SPLITS + 3];
+    double sw[2 * (POLE_SPLITS + POLE_SPREAD) + 3], sg[2 * (POLE_SPLITS + POLE_SPREAD) + 3];
     int m = 1;
     sw[0] = a;
     sg[0] = ga;
@@ -268,7 +275,7 @@ static int _run_roots(om_problem *pb, const pole_guard *pole, int depth, const d
         for (int k = i - 1; k <= i + 2; k++)
             if (cyclic || (k >= 0 && k < L))
                 curvature = py_max(curvature, _curvature_at(pw, pg, L, cyclic, py_mod(k, L)));
-        double split[2 * POLE_SPLITS + 1];
+        double split[2 * (POLE_SPLITS + POLE_SPREAD) + 1];
         int k = pole->active && depth > 0 ? _pole_splits(pole, pw[i], wj, split) : 0;
         if (k)
             n = _split_roots(pb, pole, depth - 1, pw[i], pg[i], split, k, wj, pg[j], q, out, n, cap);

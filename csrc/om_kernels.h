@@ -136,6 +136,7 @@ void om_srs_branch_values(const double *P, const double *q, double *out);
 void om_srs_branch_values_trig(const double *P, const double *q, const double *trig, double *out);
 /* psi at q of the S-R-S model with parameters P and DH table; writes d psi / dq (7). */
 double om_srs_half_line_angle(const double *P, const double *q); /* w_hat's angle from -up at q */
+vec3 om_srs_half_line_across(const double *P, const double *q);  /* up x (W - S) of the model at q */
 double om_arm_angle_gradient(const double *P, const double *table, int n_rows, const double *q, double *grad);
 
 /* Dispatch on the family (families.c). */
@@ -273,6 +274,8 @@ double om_polish(const om_polish_task *t, int iterations, double *q);
  * within 1e-2 of zero, or (S-R-S) w_hat within 1e-2 rad of psi's singular half-line (else left
  * as it is); returns whether it now verifies. */
 bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori);
+/* self_motion.c: the null vector of the real 6 x 7 Jacobian at q by cofactors (not normalised) */
+void om_self_motion_null(const om_solver_data *s, const double *q, double *n);
 /* om_add_root of q, polished first where it fails verification near the boundary. */
 int om_add_candidate(om_problem *pb, double *q, double *roots, int count);
 

@@ -33,9 +33,9 @@ static double det(double *A, int n) {
     return d;
 }
 
-bool om_self_motion_tangent(const om_solver_data *s, const double *q, double *t, double tol) {
+void om_self_motion_null(const om_solver_data *s, const double *q, double *n) {
     static const double eye[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-    double J[6 * 7], M[36], grad[7], n[7];
+    double J[6 * 7], M[36];
     om_jacobian(s->real_table, s->n_real_rows, eye, eye, q, 7, J);
     for (int c = 0; c < 7; c++) {
         for (int i = 0; i < 6; i++)
@@ -43,6 +43,11 @@ bool om_self_motion_tangent(const om_solver_data *s, const double *q, double *t,
                 if (j != c) M[i * 6 + k++] = J[i * 7 + j];
         n[c] = (c % 2 ? -1.0 : 1.0) * det(M, 6);
     }
+}
+
+bool om_self_motion_tangent(const om_solver_data *s, const double *q, double *t, double tol) {
+    double grad[7], n[7];
+    om_self_motion_null(s, q, n);
     om_arm_angle_gradient(s->params, s->model_table, s->n_model_rows, q, grad);
     double dot = 0.0, gn = 0.0, nn = 0.0;
     for (int i = 0; i < 7; i++) {

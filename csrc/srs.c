@@ -310,7 +310,9 @@ double om_srs_arm_angle_trig(const double *P, const double *trig, double elbow)
 
 /* The angle of the model's shoulder-wrist direction w_hat at q from psi's singular half-line
  * w_hat = -up (the wrist centre straight below the shoulder). */
-double om_srs_half_line_angle(const double *P, const double *q)
+/* The model's shoulder-wrist vector w = W - S at q (into *w) and up x w, its part across up
+ * turned by pi / 2 (zero on psi's singular half-line and on its continuation above). */
+static vec3 shoulder_wrist_across(const double *P, const double *q, vec3 *w)
 {
     double trig[8];
     for (int j = 0; j < 4; j++) {
@@ -318,9 +320,20 @@ double om_srs_half_line_angle(const double *P, const double *q)
         trig[2 * j] = cos(phi);
         trig[2 * j + 1] = sin(phi);
     }
-    vec3 w = m_mv(rotation_03(P, trig), elbow_vector(P, trig[6], trig[7])), up = v_load(P, SRS_UP);
-    vec3 across = v_cross(up, w);
-    return atan2(sqrt(v_dot(across, across)), -v_dot(up, w));
+    *w = m_mv(rotation_03(P, trig), elbow_vector(P, trig[6], trig[7]));
+    return v_cross(v_load(P, SRS_UP), *w);
+}
+
+vec3 om_srs_half_line_across(const double *P, const double *q)
+{
+    vec3 w;
+    return shoulder_wrist_across(P, q, &w);
+}
+
+double om_srs_half_line_angle(const double *P, const double *q)
+{
+    vec3 w, across = shoulder_wrist_across(P, q, &w);
+    return atan2(sqrt(v_dot(across, across)), -v_dot(v_load(P, SRS_UP), w));
 }
 
 /* The quantities whose signs are (SHOULDER, ELBOW, WRIST) at joint vector q, into out[0..2]. */

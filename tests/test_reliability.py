@@ -423,6 +423,99 @@ def test_a_pose_next_to_the_arm_angles_singular_half_line_is_solved(name, seed, 
         _assert_exact(solver, root.q, T, c)
 
 
+@pytest.mark.parametrize(
+    ("name", "q"),
+    [
+        (  # 1.0e-11 rad from the line: the circle's root lay in the split pass's wide outer cell
+            "xarm7",
+            [
+                0.7726982207265092,
+                1.2524356149198066,
+                4.0265196822346827e-13,
+                0.03400481199607115,
+                -1.4805740759432284,
+                3.014254660235763,
+                -1.6647416489432354,
+            ],
+        ),
+        (  # 5.2e-11 rad (seed 5): a scan cell 7e-11 wide next to the pass held a root and a wrap
+            "xarm7",
+            [
+                0.9476753339042272,
+                1.0131117008836665,
+                -6.283185307122622,
+                -0.11547719716815809,
+                1.6882915320043015,
+                0.4185215822150059,
+                1.9828976510300498,
+            ],
+        ),
+        (  # 6.7e-14 rad: the torus chart's ends missed psi by 2.3-2.7 rad
+            "sawyer",
+            [
+                1.2615779100692732,
+                1.8741937259176593,
+                -0.7836548171058206,
+                -0.4364460456437585,
+                1.0394722802208896,
+                -2.0046151449996263,
+                2.5900651816138875,
+            ],
+        ),
+        (  # 9.7e-12 rad
+            "sawyer",
+            [
+                -1.6440081759849647,
+                1.8741083086082735,
+                -0.7839024386647164,
+                -0.43621510983980627,
+                2.7842944172186286,
+                0.9171589294783161,
+                -0.6554943708260135,
+            ],
+        ),
+        (  # 5.0e-13 rad
+            "sawyer",
+            [
+                1.6749776632765085,
+                -3.1589802113293373,
+                -1.85557997279084,
+                3.0179609294544916,
+                1.1636204680862394,
+                2.088779909413381,
+                -2.008096640944234,
+            ],
+        ),
+    ],
+)
+def test_a_pose_within_1e_11_rad_of_the_half_line_is_solved(name, q):
+    """T = FK(q), q within limits, the model's wrist centre 1e-14 ... 1e-11 rad from straight
+    below the shoulder (python -m benchmarks.adversarial, seed 0, 1,000 poses next to psi's
+    half-line; the second xArm7 pose: seed 5): "no solution in this configuration" and
+    solve_all empty. On the xArm7's circle the pass's split points covered only the azimuth's
+    turn (offsets rho / v tan(k pi / 8)), and the cell beyond them, 1e11 times wider, held
+    both the root and g's wrap, so its ends looked like a wrap: the split now goes on by
+    doubling offsets out to the cell's ends; and a cell whose halving showed a wrap in one
+    half went to the bracket whole (ends 3.11 and 0.06 rad: neither a root nor a wrap), now
+    each half on its own. On
+    the Sawyer's torus the chart's ends missed psi by 2-3 rad, out of the refinement's reach:
+    psi is now searched along the real arm's self-motion (the closest pass, a scan in the
+    azimuth, bisection to the last bit)."""
+    solver = _solver(name)
+    q = np.array(q)
+    T, c = solver.arm.fk(q), solver.configuration_of(q)
+    sol = solver.solve(T, c)
+    assert sol.ok, sol.status
+    _assert_exact(solver, sol.q, T, c)
+    hinted = solver.solve(T, c, q_hint=q)
+    assert hinted.ok, hinted.status
+    _assert_exact(solver, hinted.q, T, c)
+    roots = solver.solve_all(T, c)
+    assert roots
+    for root in roots:
+        _assert_exact(solver, root.q, T, c)
+
+
 def test_a_shoulder_start_may_need_the_flipped_wrist():
     """Spherical arm, wrist centre 3.2e-14 from joint 1's axis (ARM = -3.238e-14), the wrist
     at q5 = -3.08 (python -m benchmarks.adversarial, singular class, seed 0): solve said "no
