@@ -121,6 +121,9 @@ class ExactPoseTask(ArmTask):
             )
         super().__init__(solver, model, solver.arm.dof, prefix, cost, gain, lm_damping)
         self.root = ArmRoot(self.joints, frame_name, frame_type)
+        fixed = self.root.fixed_pose
+        self._root_at_origin = fixed is not None and np.array_equal(fixed, np.eye(4))
+        self._world_to_fixed_root = None if fixed is None else _inverse(fixed)
         self.optimizer = optimizer
         self.arm_configuration = arm_configuration
         if arm_configuration is not None:
@@ -244,7 +247,13 @@ class ExactPoseTask(ArmTask):
         arm_configuration: Configuration | None,
     ) -> None:
         """Solve T_world for the root at root_pose and, only if that succeeds, take it."""
-        T_root = _transform_target_to_root(root_pose, T_world)
+        if root_pose is self.root.fixed_pose:
+            T_root = T_world if self._root_at_origin else self._world_to_fixed_root @ T_world
+        else:
+            R, p = root_pose[:3, :3], root_pose[:3, 3]
+            T_root = np.eye(4)
+            T_root[:3, :3] = R.T @ T_world[:3, :3]
+            T_root[:3, 3] = R.T @ (T_world[:3, 3] - p)
         if arm_configuration is None:
             choice = self.optimizer.choose(T_root, previous=self.choice)
             if not choice.ok:
@@ -276,11 +285,9 @@ class ExactPoseTask(ArmTask):
         return min(inside, key=lambda q: float(np.linalg.norm(q - solution.q)))
 
 
-def _transform_target_to_root(T_world_root: np.ndarray, T_world_target: np.ndarray) -> np.ndarray:
-    """The target in the root frame, :math:`T_{root,target} = T_{world,root}^{-1} T_{world,target}`,
-    as :math:`[R^T R_t, R^T (p_t - p)]` (a root at the origin gives the target itself, exactly)."""
-    R, p = T_world_root[:3, :3], T_world_root[:3, 3]
-    T_root_target = np.eye(4)
-    T_root_target[:3, :3] = R.T @ T_world_target[:3, :3]
-    T_root_target[:3, 3] = R.T @ (T_world_target[:3, 3] - p)
-    return T_root_target
+def _inverse(pose: np.ndarray) -> np.ndarray:
+    """The inverse of a homogeneous transform, [[R^T, -R^T p], [0, 1]]."""
+    inverse = np.eye(4)
+    inverse[:3, :3] = pose[:3, :3].T
+    inverse[:3, 3] = -pose[:3, :3].T @ pose[:3, 3]
+    return inverse
