@@ -538,3 +538,57 @@ def test_a_shoulder_start_may_need_the_flipped_wrist():
     assert sol.ok and np.abs(spherical.arm.fk(sol.q) - T).max() < 1e-10 and spherical.holds(sol.q, c)
     roots = spherical.solve_all(T, c)
     assert roots and all(np.abs(spherical.arm.fk(r.q) - T).max() < 1e-10 for r in roots)
+
+
+@pytest.mark.xfail(strict=True, reason="open: psi's singular half-line (issue 18; README, Reliability)")
+@pytest.mark.parametrize(
+    "name, q",
+    [
+        (  # the model's wrist centre 1.4e-11 rad straight below the shoulder
+            "panda",
+            [
+                2.5322766795321816,
+                1.2918364845492474,
+                -1.3925042270764227e-11,
+                -3.0428150134486214,
+                1.5710014579302713,
+                0.20106223384117075,
+                -1.0528010010011744,
+            ],
+        ),
+        (  # 2.0e-5 rad below
+            "sawyer",
+            [
+                2.5235809388599737,
+                1.260947568218835,
+                2.375996532511514,
+                -0.4537392172704337,
+                -0.06513001537355505,
+                1.8770479999918128,
+                2.6019643612305865,
+            ],
+        ),
+        (  # 6.0e-7 rad below; the hinted solve fails too
+            "sawyer",
+            [
+                1.5892063303101063,
+                1.8986574592233114,
+                -0.7204169771390664,
+                -0.5005292450411228,
+                -1.6144795568825436,
+                2.1767149092763836,
+                -1.7232618128951618,
+            ],
+        ),
+    ],
+)
+def test_the_last_false_no_next_to_the_half_line(name, q):
+    """The full adversarial run of session 11 (seed 0): 1 of 1,000 Panda and 5 of 1,000 Sawyer
+    poses next to psi's singular half-line still answered "no solution in this configuration"
+    in configuration_of(q). Passes when the search finds them."""
+    solver = _solver(name)
+    q = np.array(q)
+    T, c = solver.arm.fk(q), solver.configuration_of(q)
+    sol = solver.solve(T, c)
+    assert sol.ok, sol.status
+    _assert_exact(solver, sol.q, T, c)
