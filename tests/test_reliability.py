@@ -36,6 +36,21 @@ def _assert_exact(solver: om.OMSolver, q: np.ndarray, T: np.ndarray, c: om.Confi
     assert solver.holds(q, c)
 
 
+def _assert_solved(
+    solver: om.OMSolver, T: np.ndarray, c: om.Configuration, q_hint: np.ndarray | None = None
+) -> None:
+    """solve (and, given q_hint, the hinted solve) is ok and exact in c, and solve_all holds
+    roots, each exact in c."""
+    for hint in (None,) if q_hint is None else (None, q_hint):
+        sol = solver.solve(T, c, q_hint=hint)
+        assert sol.ok, sol.status
+        _assert_exact(solver, sol.q, T, c)
+    roots = solver.solve_all(T, c)
+    assert roots
+    for root in roots:
+        _assert_exact(solver, root.q, T, c)
+
+
 def _branch_joint(solver: om.OMSolver, name: str) -> tuple[int, float] | None:
     """The joint j and offset theta with the branch quantity ``name`` = sin(q_j + theta)
     (None: the branch is not an angle, as the Spherical arm's prismatic elbow)."""
@@ -353,13 +368,7 @@ def test_boundary_reproducers_are_solved(case):
     T, c = solver.arm.fk(q), solver.configuration_of(q)
     if flip is not None:
         c = _flipped(solver, c, solver.sign_names.index(flip))
-    sol = solver.solve(T, c)
-    assert sol.ok, sol.status
-    _assert_exact(solver, sol.q, T, c)
-    roots = solver.solve_all(T, c)
-    assert roots
-    for root in roots:
-        _assert_exact(solver, root.q, T, c)
+    _assert_solved(solver, T, c)
 
 
 def test_the_wrist_centre_straight_below_the_shoulder_is_solved():
@@ -381,13 +390,7 @@ def test_the_wrist_centre_straight_below_the_shoulder_is_solved():
         ]
     )
     T, c = xarm7.arm.fk(q), xarm7.configuration_of(q)
-    sol = xarm7.solve(T, c)
-    assert sol.ok, sol.status
-    _assert_exact(xarm7, sol.q, T, c)
-    roots = xarm7.solve_all(T, c)
-    assert roots
-    for root in roots:
-        _assert_exact(xarm7, root.q, T, c)
+    _assert_solved(xarm7, T, c)
 
 
 _LINE_RUNS: dict[str, adv.ArmRun] = {}
@@ -414,13 +417,7 @@ def test_a_pose_next_to_the_arm_angles_singular_half_line_is_solved(name, seed, 
     assume(q is not None)
     solver = run.solver
     T, c = solver.arm.fk(q), solver.configuration_of(q)
-    sol = solver.solve(T, c)
-    assert sol.ok, sol.status
-    _assert_exact(solver, sol.q, T, c)
-    roots = solver.solve_all(T, c)
-    assert roots
-    for root in roots:
-        _assert_exact(solver, root.q, T, c)
+    _assert_solved(solver, T, c)
 
 
 @pytest.mark.parametrize(
@@ -504,16 +501,7 @@ def test_a_pose_within_1e_11_rad_of_the_half_line_is_solved(name, q):
     solver = _solver(name)
     q = np.array(q)
     T, c = solver.arm.fk(q), solver.configuration_of(q)
-    sol = solver.solve(T, c)
-    assert sol.ok, sol.status
-    _assert_exact(solver, sol.q, T, c)
-    hinted = solver.solve(T, c, q_hint=q)
-    assert hinted.ok, hinted.status
-    _assert_exact(solver, hinted.q, T, c)
-    roots = solver.solve_all(T, c)
-    assert roots
-    for root in roots:
-        _assert_exact(solver, root.q, T, c)
+    _assert_solved(solver, T, c, q_hint=q)
 
 
 def test_a_shoulder_start_may_need_the_flipped_wrist():
@@ -534,10 +522,7 @@ def test_a_shoulder_start_may_need_the_flipped_wrist():
         ]
     )
     T, c = spherical.arm.fk(q), spherical.configuration_of(q)
-    sol = spherical.solve(T, c)
-    assert sol.ok and np.abs(spherical.arm.fk(sol.q) - T).max() < 1e-10 and spherical.holds(sol.q, c)
-    roots = spherical.solve_all(T, c)
-    assert roots and all(np.abs(spherical.arm.fk(r.q) - T).max() < 1e-10 for r in roots)
+    _assert_solved(spherical, T, c)
 
 
 @pytest.mark.xfail(strict=True, reason="open: psi's singular half-line (issue 18; README, Reliability)")
