@@ -112,7 +112,7 @@ static int follow(const om_solver_data *s, const double *T, const int64_t *signs
         double aim = moved > 0.0 ? fmax(AIM * predicted_end(n_ends, ends_prev, ends, moved), 1.5 * min_step) : INFINITY;
         if (aim < fabs(x - *psi)) x = *psi + copysign(aim, step);
         prediction p = {dof, cyclic, centred, centre, q, t, x - *psi};
-        bool ok = om_solve_near(s, T, signs, &x, q, x_q, on_path, &p);
+        bool ok = om_solve_near(s, T, signs, &x, q, x_q, on_path, &p, NULL);
         if (ok) {
             represent(dof, centred, centre, x_q);
             ok = om_continues(dof, q, x_q, t, x - *psi, cyclic);

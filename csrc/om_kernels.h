@@ -341,9 +341,9 @@ typedef om_root_verdict (*om_root_test)(const double *q, void *context);
  * when called): taken as it is, or rejected, without the scan. Returns false where the local
  * solve fails, without the bounded search that would follow in om_solve_one: a solution may
  * still exist (the path following halves such a step, where that search's costly "no" would
- * be wasted); and where as_is rejects. */
+ * be wasted); and where as_is rejects. result (NULL: not wanted): om_solve_one's for the root. */
 bool om_solve_near(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
-                   const double *hint, double *q_out, om_root_test as_is, void *context);
+                   const double *hint, double *q_out, om_root_test as_is, void *context, om_result *result);
 /* Every root (OM_MAX_ROOTS x dof) with per root (position error, orientation error, within limits)
  * in info (OM_MAX_ROOTS x 3). Returns the count; *evaluations the residual evaluations. */
 int om_solve_all(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,

@@ -247,7 +247,7 @@ om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *
 
 /* The hinted solve's local part alone (see om_solve_near in om_kernels.h). */
 bool om_solve_near(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
-                   const double *hint, double *q_out, om_root_test as_is, void *context)
+                   const double *hint, double *q_out, om_root_test as_is, void *context, om_result *result)
 {
     double usable[OM_MAX_DOF], psi[1], q[OM_MAX_DOF], start[OM_MAX_DOF], pos, ori;
     om_usable_hint(s, hint, usable);
@@ -256,7 +256,10 @@ bool om_solve_near(const om_solver_data *s, const double *T, const int64_t *sign
     nan_fill(q, OM_MAX_DOF); /* as in om_solve_one */
     memcpy(start, usable, (size_t)s->dof * sizeof(double));
     bool complete = true, inside;
-    return _near_hint(&problem, start, &complete, q, q_out, &pos, &ori, &inside, as_is, context);
+    bool found = _near_hint(&problem, start, &complete, q, q_out, &pos, &ori, &inside, as_is, context);
+    if (found && result)
+        *result = _result(OM_OK, pos, ori, problem.counter, inside);
+    return found;
 }
 
 /* Every solution in one configuration (the bounded search): roots (OM_MAX_ROOTS x dof,
