@@ -74,6 +74,11 @@ bool om_continues(int dof, const double *q0, const double *q1, const double *t, 
  * |q1 - q0 - t d|_inf into *error (t NULL: 0), cyclic joints modulo 2 pi (om_continues' terms). */
 void om_continuation(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic,
                      double *moved, double *error);
+/* Whether q1 continues the path from (q0, t) d ahead beyond doubt: no joint moved more than
+ * 1 rad and the first-order prediction's error is within 1/4 of the joint step. A root of
+ * another path is off by the paths' separation, which no shorter step shrinks; one that
+ * merely continues (om_continues: within 1/2) may be the partner at a fold. */
+bool om_beyond_doubt(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic);
 
 extern PyTypeObject om_SolverType;        /* solver_type.c: Solver(SolverData) */
 /* solver_type.c: obj's data if it is a 7-DOF (S-R-S) Solver; NULL with an error naming what. */

@@ -26,7 +26,6 @@
 enum { FOLLOW_ARRIVED = 0, FOLLOW_ENDED = 1, FOLLOW_SINGULAR = 2 };
 enum { F_PSI, F_STATUS, F_STEPS, F_N }; /* the out vector */
 #define AIM (63.0 / 64.0) /* of the distance to a predicted end, a step aimed there goes */
-#define TIGHT 0.25 /* a root's error from the first-order prediction per joint step: on the path beyond doubt */
 
 static void represent(int dof, const uint8_t *centred, const double *centre, double *q) {
     for (int i = 0; i < dof; i++)
@@ -43,10 +42,7 @@ typedef struct {
 
 /* What the attempt makes of the local solve's root x (at its representative; om_solve_near's
  * as_is test). Taken without the windowed scan for a nearer root where it lies on the
- * prediction's path beyond doubt: within TIGHT of its joint step from the first-order
- * prediction. A root of another path would be off by the paths' separation; one that merely
- * continues (om_continues: within 1/2) may be the partner at a fold, or another path's, where
- * the root nearest q is the path's. Rejected, without the scan, where no root at most as far
+ * prediction's path beyond doubt (om_beyond_doubt). Rejected, without the scan, where no root at most as far
  * from q as x can continue the path, the attempt's answer whatever the scan finds: such a
  * root is within d = |x - q| of q (every joint wrapped, the scan's distance), so it moves each
  * joint by m_i with |m_i| <= moved <= min(d, 1) and |m_i - t_i h| <= moved / 2 + 1e-6
@@ -55,11 +51,10 @@ typedef struct {
  * none. Else the scan decides. */
 static om_root_verdict on_path(const double *x, void *context) {
     const prediction *p = context;
-    double r[OM_MAX_DOF], moved, error, d2 = 0.0, farthest = 0.0;
+    double r[OM_MAX_DOF], d2 = 0.0, farthest = 0.0;
     memcpy(r, x, (size_t)p->dof * sizeof(double));
     represent(p->dof, p->centred, p->centre, r);
-    om_continuation(p->dof, p->q, r, p->t, p->d, p->cyclic, &moved, &error);
-    if (moved <= 1.0 && error <= TIGHT * moved) return OM_ROOT_TAKE;
+    if (om_beyond_doubt(p->dof, p->q, r, p->t, p->d, p->cyclic)) return OM_ROOT_TAKE;
     for (int i = 0; i < p->dof; i++) {
         double e = om_wrap_angle(r[i] - p->q[i]);
         d2 += e * e;

@@ -85,3 +85,9 @@ bool om_continues(int dof, const double *q0, const double *q1, const double *t, 
     om_continuation(dof, q0, q1, t, d, cyclic, &moved, &error);
     return moved <= 1.0 && error <= 0.5 * moved + 1e-6;
 }
+
+bool om_beyond_doubt(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic) {
+    double moved, error;
+    om_continuation(dof, q0, q1, t, d, cyclic, &moved, &error);
+    return moved <= 1.0 && error <= 0.25 * moved;
+}

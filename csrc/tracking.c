@@ -110,11 +110,9 @@ static bool box_step(const tracking *tr, const pieces *P, double b, double radiu
 }
 
 /* The second solve's root (at psi + d, hinted by q0) is taken without the windowed scan for
- * a nearer one where it lies on the step's path beyond doubt: within TIGHT of its joint step
- * from the first-order prediction q0 + t0 d (as follow.c's on_path: a root of another path is
- * off by the paths' separation); else the scan decides, and where the local solve fails,
- * om_solve_one's bounded search, as before. (About 12 us of the Panda's step.) */
-#define TIGHT 0.25
+ * a nearer one where it continues the step's path beyond doubt (om_beyond_doubt, as follow.c
+ * takes its roots); else the scan decides, and where the local solve fails, om_solve_one's
+ * bounded search, as before. (About 15 us of the Panda's step.) */
 typedef struct {
     int dof;
     const double *q, *t;
@@ -123,9 +121,7 @@ typedef struct {
 
 static om_root_verdict on_step(const double *x, void *context) {
     const step_prediction *p = context;
-    double moved, error;
-    om_continuation(p->dof, p->q, x, p->t, p->d, NULL, &moved, &error);
-    return moved <= 1.0 && error <= TIGHT * moved ? OM_ROOT_TAKE : OM_ROOT_SCAN;
+    return om_beyond_doubt(p->dof, p->q, x, p->t, p->d, NULL) ? OM_ROOT_TAKE : OM_ROOT_SCAN;
 }
 
 static int track(const tracking *tr, const double *T, const int64_t *signs, const double *q_prev, double *q1,
