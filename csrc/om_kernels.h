@@ -327,14 +327,16 @@ typedef struct {
 } om_result;
 
 void om_flange_target(const double *T, const double *T_base_root, const double *T_tool_flange, mat3 *R, vec3 *p);
-/* hint NULL: no hint. */
-om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
-                       const double *hint, double *q_out);
 /* What a caller makes of a root: scan for a nearer one, take it as it is, or reject it and
  * every root at most as near the hint. */
 typedef enum { OM_ROOT_SCAN = 0, OM_ROOT_TAKE = 1, OM_ROOT_REJECT = 2 } om_root_verdict;
 /* A test of a root (a joint vector) with its caller's context. */
 typedef om_root_verdict (*om_root_test)(const double *q, void *context);
+/* One solve. hint NULL: no hint. as_is (NULL: none) judges a hinted solve's local root as
+ * om_solve_near's does; where the local part fails, or as_is rejects, the bounded search
+ * decides. */
+om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
+                       const double *hint, double *q_out, om_root_test as_is, void *context);
 /* om_solve_one's local part alone, for a hint: the root the local solve from the hint
  * reaches, replaced by any root nearer the hint (a windowed scan), into q_out (revolute
  * joints at the turn nearest the hint). as_is (NULL: none) judges the local root (in q_out

@@ -145,10 +145,11 @@ static bool _near_hint(om_problem *pb, double *start, bool *start_complete, doub
     return true;
 }
 
-/* One OM solve: the local solve (secant, or lifted Newton), then the bounded search.
- * hint NULL: no hint. Writes q_out (dof; NaN when no solution). */
-om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
-                       const double *hint, double *q_out)
+/* One OM solve: the local solve (secant, or lifted Newton), then, with search, the bounded
+ * search; without it a hinted solve ends where its local part fails (om_solve_near). hint
+ * NULL: no hint. Writes q_out (dof; NaN when no solution). */
+static om_result _solve(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
+                        const double *hint, double *q_out, om_root_test as_is, void *context, bool search)
 {
     int family = s->family, mode = s->mode, dof = s->dof;
     const double *P = s->params;
@@ -182,8 +183,10 @@ om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *
     }
     if (has_hint) {
         bool inside;
-        if (_near_hint(pb, start, &start_complete, q, q_out, &pos, &ori, &inside, NULL, NULL))
+        if (_near_hint(pb, start, &start_complete, q, q_out, &pos, &ori, &inside, as_is, context))
             return _result(OM_OK, pos, ori, problem.counter, inside);
+        if (!search) /* not a verdict: a solution may still exist */
+            return _result(OM_NO_SOLUTION_IN_CONFIGURATION, NAN, NAN, problem.counter, false);
     } else if (found && om_local_solve(pb, start, &start_complete, q, &pos, &ori)) {
         bool inside = _finish(pb, q, hint, false, q_out, &pos, &ori);
         if (inside || mode == OM_FIXED)
@@ -245,21 +248,20 @@ om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *
     return _result(OM_OK, pos, ori, problem.counter, inside);
 }
 
+om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
+                       const double *hint, double *q_out, om_root_test as_is, void *context)
+{
+    return _solve(s, T, signs, redundancy, hint, q_out, as_is, context, true);
+}
+
 /* The hinted solve's local part alone (see om_solve_near in om_kernels.h). */
 bool om_solve_near(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
                    const double *hint, double *q_out, om_root_test as_is, void *context, om_result *result)
 {
-    double usable[OM_MAX_DOF], psi[1], q[OM_MAX_DOF], start[OM_MAX_DOF], pos, ori;
-    om_usable_hint(s, hint, usable);
-    om_problem problem;
-    _problem(&problem, s, T, signs, redundancy, psi, usable);
-    nan_fill(q, OM_MAX_DOF); /* as in om_solve_one */
-    memcpy(start, usable, (size_t)s->dof * sizeof(double));
-    bool complete = true, inside;
-    bool found = _near_hint(&problem, start, &complete, q, q_out, &pos, &ori, &inside, as_is, context);
-    if (found && result)
-        *result = _result(OM_OK, pos, ori, problem.counter, inside);
-    return found;
+    om_result r = _solve(s, T, signs, redundancy, hint, q_out, as_is, context, false);
+    if (r.status == OM_OK && result)
+        *result = r;
+    return r.status == OM_OK;
 }
 
 /* Every solution in one configuration (the bounded search): roots (OM_MAX_ROOTS x dof,

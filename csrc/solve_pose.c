@@ -133,7 +133,7 @@ PyObject *om_solver_solve_pose(om_Solver *self, PyObject *const *args, Py_ssize_
     if (!self->solution_type || !read_configuration(self, args[1], signs, redundancy) || !read_pose(args[0], &T))
         Py_RETURN_NONE;
     om_result r;
-    Py_BEGIN_ALLOW_THREADS r = om_solve_one(&self->data, T.buf, signs, redundancy, NULL, q);
+    Py_BEGIN_ALLOW_THREADS r = om_solve_one(&self->data, T.buf, signs, redundancy, NULL, q, NULL, NULL);
     Py_END_ALLOW_THREADS PyBuffer_Release(&T);
     PyObject *values[OM_N_SOLUTION_FIELDS] = {
         new_vector(self, q),

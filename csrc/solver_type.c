@@ -146,7 +146,7 @@ static PyObject *Solver_solve(Solver *self, PyObject *const *args, Py_ssize_t na
     Py_buffer v[3];
     if (get_buffers(objs, v, specs, n) < 0) return NULL;
     om_result r;
-    Py_BEGIN_ALLOW_THREADS r = om_solve_one(s, v[0].buf, c.signs, c.redundancy, n == 3 ? v[2].buf : NULL, v[1].buf);
+    Py_BEGIN_ALLOW_THREADS r = om_solve_one(s, v[0].buf, c.signs, c.redundancy, n == 3 ? v[2].buf : NULL, v[1].buf, NULL, NULL);
     Py_END_ALLOW_THREADS release_buffers(v, n);
     return result_tuple(r);
 }
@@ -199,7 +199,7 @@ static PyObject *Solver_solve_rows(Solver *self, PyObject *const *args, Py_ssize
     const int64_t *sb = v[1].buf;
     double *qb = v[3].buf, *ib = v[4].buf;
     Py_BEGIN_ALLOW_THREADS for (Py_ssize_t i = start; i < stop; i++) {
-        om_result r = om_solve_one(s, Tb + 16 * i, sb + k * i, rb + nr * i, hb ? hb + dof * i : NULL, qb + dof * i);
+        om_result r = om_solve_one(s, Tb + 16 * i, sb + k * i, rb + nr * i, hb ? hb + dof * i : NULL, qb + dof * i, NULL, NULL);
         double *row = ib + 5 * i;
         row[0] = r.status;
         row[1] = r.position_error;

@@ -111,8 +111,8 @@ static bool box_step(const tracking *tr, const pieces *P, double b, double radiu
 
 /* The second solve's root (at psi + d, hinted by q0) is taken without the windowed scan for
  * a nearer one where it continues the step's path beyond doubt (om_beyond_doubt, as follow.c
- * takes its roots); else the scan decides, and where the local solve fails, om_solve_one's
- * bounded search, as before. (About 15 us of the Panda's step.) */
+ * takes its roots); else the scan decides, and where the local solve fails, the bounded
+ * search, as before. (About 15 us of the Panda's step.) */
 typedef struct {
     int dof;
     const double *q, *t;
@@ -129,7 +129,7 @@ static int track(const tracking *tr, const double *T, const int64_t *signs, cons
     const om_solver_data *s = tr->s;
     int dof = s->dof;
     double psi = tr->setup[S_PSI], q0[OM_MAX_DOF], t0[OM_MAX_DOF], t1[OM_MAX_DOF];
-    om_result r = om_solve_one(s, T, signs, &psi, q_prev, q0);
+    om_result r = om_solve_one(s, T, signs, &psi, q_prev, q0, NULL, NULL);
     if (r.status != OM_OK || !om_continues(dof, q_prev, q0, NULL, 0.0, NULL)) return TR_NO_SOLUTION;
     if (!om_self_motion_tangent(s, q0, t0, SINGULAR_TANGENT)) return TR_SINGULAR;
     static pieces P0, P1; /* (the GIL is held: one call at a time) */
@@ -142,8 +142,7 @@ static int track(const tracking *tr, const double *T, const int64_t *signs, cons
     for (int k = 0;; k++) {
         psi1 = psi + d;
         step_prediction p = {dof, q0, t0, d};
-        if (!om_solve_near(s, T, signs, &psi1, q0, q1, on_step, &p, &r))
-            r = om_solve_one(s, T, signs, &psi1, q0, q1);
+        r = om_solve_one(s, T, signs, &psi1, q0, q1, on_step, &p);
         if (r.status == OM_OK && om_continues(dof, q0, q1, t0, d, NULL) && om_self_motion_tangent(s, q1, t1, SINGULAR_TANGENT)) break;
         if (k == HALVINGS) return TR_LOST;
         d /= 2.0;
