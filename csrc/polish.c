@@ -28,8 +28,9 @@ static double psi_row_scale(const double *grad, int dof)
 }
 
 /* The residual e (rows: p - p(q); the rotation vector of R R(q)^T; psi - psi(q), divided by
- * psi_row_scale) in DH frame 0; returns its squared norm. */
-static double residual(const om_polish_task *t, const double *q, double *e)
+ * psi_row_scale) in DH frame 0; returns its squared norm. With the arm angle, its Jacobian row
+ * (d psi / dq over the same scale) into psi_row (dof): computed here, with psi. */
+static double residual(const om_polish_task *t, const double *q, double *e, double *psi_row)
 {
     double Rc[9], pc[3];
     om_flange(t->table, t->n_rows, q, Rc, pc);
@@ -46,12 +47,14 @@ static double residual(const om_polish_task *t, const double *q, double *e)
     e[5] = k * w.z;
     int rows = t->P ? 7 : 6;
     if (t->P) {
-        double grad[OM_MAX_DOF];
-        double psi = om_arm_angle_gradient(t->P, t->model_table, t->n_model_rows, q, grad);
+        double psi = om_arm_angle_gradient(t->P, t->model_table, t->n_model_rows, q, psi_row);
+        double scale = psi_row_scale(psi_row, t->dof);
+        for (int j = 0; j < t->dof; j++)
+            psi_row[j] /= scale;
         /* psi's reference flips by pi with the ELBOW branch: read it in the requested one */
         double own = sin(q[3] + t->P[SRS_THETA + 3] - t->P[SRS_PHI_STAR]) < 0.0 ? -1.0 : 1.0;
         bool flipped = t->elbow != 0.0 && own != t->elbow;
-        e[6] = om_wrap(t->psi + (flipped ? OM_PI : 0.0) - psi) / psi_row_scale(grad, t->dof);
+        e[6] = om_wrap(t->psi + (flipped ? OM_PI : 0.0) - psi) / scale;
     }
     double cost = 0.0;
     for (int i = 0; i < rows; i++)
@@ -59,17 +62,12 @@ static double residual(const om_polish_task *t, const double *q, double *e)
     return cost;
 }
 
-/* The Jacobian of the pose and of psi at q (rows x dof). */
-static void jacobian(const om_polish_task *t, const double *q, double *J)
+/* The Jacobian of the pose and of psi at q (rows x dof), psi's row residual's at q. */
+static void jacobian(const om_polish_task *t, const double *q, const double *psi_row, double *J)
 {
     om_jacobian(t->table, t->n_rows, IDENTITY, IDENTITY, q, t->dof, J);
-    if (t->P) {
-        double *row = J + 6 * t->dof, scale;
-        om_arm_angle_gradient(t->P, t->model_table, t->n_model_rows, q, row);
-        scale = psi_row_scale(row, t->dof);
-        for (int j = 0; j < t->dof; j++)
-            row[j] /= scale;
-    }
+    if (t->P)
+        memcpy(J + 6 * t->dof, psi_row, (size_t)t->dof * sizeof(double));
 }
 
 /* Solve the symmetric positive definite A y = b (n x n, A overwritten by its Cholesky
@@ -115,9 +113,9 @@ double om_polish(const om_polish_task *t, int iterations, double *q)
     int dof = t->dof, rows = t->P ? 7 : 6;
     double e[POLISH_ROWS], e_try[POLISH_ROWS], J[POLISH_ROWS * OM_MAX_DOF], A[POLISH_ROWS * POLISH_ROWS];
     double G[POLISH_ROWS * POLISH_ROWS];
-    double y[POLISH_ROWS], q_try[OM_MAX_DOF];
-    double cost = residual(t, q, e);
-    jacobian(t, q, J);
+    double y[POLISH_ROWS], q_try[OM_MAX_DOF], psi_row[OM_MAX_DOF], psi_row_try[OM_MAX_DOF];
+    double cost = residual(t, q, e, psi_row);
+    jacobian(t, q, psi_row, J);
     double damping = POLISH_DAMPING;
     double window_cost = cost; /* the cost POLISH_WINDOW Jacobians ago */
     for (int it = 0; it < iterations && cost > POLISH_DONE * POLISH_DONE && isfinite(cost); it++) {
@@ -150,13 +148,13 @@ double om_polish(const om_polish_task *t, int iterations, double *q)
                         dq += J[a * dof + j] * y[a];
                     q_try[j] = q[j] + dq;
                 }
-                double c = residual(t, q_try, e_try);
+                double c = residual(t, q_try, e_try, psi_row_try);
                 improved = c < cost;
                 if (improved) {
                     memcpy(q, q_try, (size_t)dof * sizeof(double));
                     memcpy(e, e_try, sizeof e);
                     cost = c;
-                    jacobian(t, q, J);
+                    jacobian(t, q, psi_row_try, J);
                     damping = py_max(damping / 10.0, POLISH_DAMPING_MIN);
                     break;
                 }
