@@ -208,7 +208,7 @@ def _se3_matrix(T: Any) -> np.ndarray:
 
 
 def _check_poses(T: np.ndarray, name: str) -> None:
-    if len(T) == 0 or ckernels.pose_is_valid(T, ORTHONORMALITY_TOLERANCE):  # fast path
+    if ckernels.pose_is_valid(T, ORTHONORMALITY_TOLERANCE):  # fast path
         return
     bad = ~np.isfinite(T).all(axis=(1, 2))
     if bad.any():

@@ -164,9 +164,10 @@ class Clearance:
         if np.ndim(q) == 2:
             q = as_joint_vector(q, self._dof)
             shape = (len(q), len(self._pairs))
-            dist, fromto, grad = np.empty(shape), np.empty((*shape, 6)), np.empty((*shape, self._dof))
-            for row, *out in zip(q, dist, fromto, grad, strict=True):
-                self._measure(row, self.distmax, *out)
+            dist, grad = np.empty(shape), np.empty((*shape, self._dof))
+            fromto = np.empty((len(self._pairs), 6))  # scratch: each pair's slot is written afresh
+            for row, row_dist, row_grad in zip(q, dist, grad, strict=True):
+                self._measure(row, self.distmax, row_dist, fromto, row_grad)
             return dist, grad
         return self._evaluate(q, gradient=True)
 

@@ -339,9 +339,8 @@ class Objective:
         Returns:
             (values (M, n), rate sizes (M, n)).
         """
-        lim = self._limited
-        values = [np.minimum(*_limit_distances(q[:, lim], self._lower, self._upper, self._half))]
-        rates = [np.abs(tangent[:, lim, 0]) / self._half]
+        values = [self._margins(q)]
+        rates = [np.abs(tangent[:, self._limited, 0]) / self._half]
         if self.clearance is not None:
             cap = self.clearance_cap
             distances, gradients = pairs
@@ -367,15 +366,17 @@ class Objective:
         """
         groups = []
         if len(self._limited):
-            lim = q[:, self._limited]
-            margins = np.minimum(*_limit_distances(lim, self._lower, self._upper, self._half))
-            groups.append((self.margin_weight, math.inf, margins))
+            groups.append((self.margin_weight, math.inf, self._margins(q)))
         if self.clearance is not None:
             groups.append((self.clearance_weight, 1.0, distances / self.clearance_cap))
         if self.singularity is not None:
             singular = self.singularity.distances(q) / SINGULARITY_CAP
             groups.append((self.singularity_weight, 1.0, singular))
         return groups
+
+    def _margins(self, q: np.ndarray) -> np.ndarray:
+        """The limited joints' margins m_i at the rows of q (M, dof): (M, limited)."""
+        return np.minimum(*_limit_distances(q[:, self._limited], self._lower, self._upper, self._half))
 
     def _margin(self, q: np.ndarray, jacobian: bool) -> Group:
         lim = self._limited

@@ -328,7 +328,6 @@ class RedundancyOptimizer:
             point = maximise(probes[signs], start, lo, hi, max(gap, 1e-6))
             found.append((run, point))
             best = max(best, point.evaluation.value)
-        best = max(point.evaluation.value for _, point in found)
         if near is None:
             return next((run, point) for run, point in found if point.evaluation.value == best)
         optima = [(run, point) for run, point in found if point.evaluation.value >= best - PLATEAU]

@@ -289,8 +289,8 @@ def _surprise(a: Point, b: Point) -> float | None:
 
 
 def _quiet(a: list[Point], b: list[Point]) -> np.ndarray:
-    """Whether each cell (a_k, b_k)'s cubic models cannot surprise, by bounds that need no
-    clearance gradients (:meth:`~om_redundant.redundancy.objective.Objective.constraint_bounds`):
+    """Whether each cell (a_k, b_k)'s cubic models cannot surprise, by bounds from the ends'
+    values and rates (:meth:`~om_redundant.redundancy.objective.Objective.constraint_bounds`):
     on [0, 1] the Hermite basis functions of the values are >= 0 and sum to 1 and those of
     the slopes stay within 4/27 in size, so a model lies within (4/27) span (|g'_a| + |g'_b|)
     of the ends' range. Quiet: both ends feasible and every model stays >= 0, or both
