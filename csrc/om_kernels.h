@@ -134,9 +134,9 @@ double om_srs_arm_angle_in(const double *P, const double *q, double elbow);
 double om_srs_arm_angle_trig(const double *P, const double *trig, double elbow); /* trig: cos, sin of q_j + theta_j, j < 4 */
 void om_srs_branch_values(const double *P, const double *q, double *out);
 void om_srs_branch_values_trig(const double *P, const double *q, const double *trig, double *out);
-/* psi at q of the S-R-S model with parameters P and DH table; writes d psi / dq (7). */
 double om_srs_half_line_angle(const double *P, const double *q); /* w_hat's angle from -up at q */
 vec3 om_srs_half_line_across(const double *P, const double *q);  /* up x (W - S) of the model at q */
+/* psi at q of the S-R-S model with parameters P and DH table; writes d psi / dq (7). */
 double om_arm_angle_gradient(const double *P, const double *table, int n_rows, const double *q, double *grad);
 
 /* Dispatch on the family (families.c). */

@@ -284,16 +284,22 @@ double om_srs_arm_angle(const double *P, const double *q)
     return om_srs_arm_angle_in(P, q, sin(q[3] + P[SRS_THETA + 3] - P[SRS_PHI_STAR]) < 0.0 ? -1.0 : 1.0);
 }
 
-/* psi at q read in the ELBOW branch `elbow` (+-1): the elbow plane's normal flips with the
- * branch, so at a straight elbow (both branches) psi is the requested branch's. */
-double om_srs_arm_angle_in(const double *P, const double *q, double elbow)
+/* cos and sin of phi_j = q_j + theta_j, j = 1..4, into trig (8 values). */
+static void joint_trig(const double *P, const double *q, double *trig)
 {
-    double trig[8];
     for (int j = 0; j < 4; j++) {
         double phi = q[j] + P[SRS_THETA + j];
         trig[2 * j] = cos(phi);
         trig[2 * j + 1] = sin(phi);
     }
+}
+
+/* psi at q read in the ELBOW branch `elbow` (+-1): the elbow plane's normal flips with the
+ * branch, so at a straight elbow (both branches) psi is the requested branch's. */
+double om_srs_arm_angle_in(const double *P, const double *q, double elbow)
+{
+    double trig[8];
+    joint_trig(P, q, trig);
     return om_srs_arm_angle_trig(P, trig, elbow);
 }
 
@@ -308,18 +314,12 @@ double om_srs_arm_angle_trig(const double *P, const double *trig, double elbow)
     return atan2(v_dot(nw, b), v_dot(n, b));
 }
 
-/* The angle of the model's shoulder-wrist direction w_hat at q from psi's singular half-line
- * w_hat = -up (the wrist centre straight below the shoulder). */
 /* The model's shoulder-wrist vector w = W - S at q (into *w) and up x w, its part across up
  * turned by pi / 2 (zero on psi's singular half-line and on its continuation above). */
 static vec3 shoulder_wrist_across(const double *P, const double *q, vec3 *w)
 {
     double trig[8];
-    for (int j = 0; j < 4; j++) {
-        double phi = q[j] + P[SRS_THETA + j];
-        trig[2 * j] = cos(phi);
-        trig[2 * j + 1] = sin(phi);
-    }
+    joint_trig(P, q, trig);
     *w = m_mv(rotation_03(P, trig), elbow_vector(P, trig[6], trig[7]));
     return v_cross(v_load(P, SRS_UP), *w);
 }
@@ -330,6 +330,8 @@ vec3 om_srs_half_line_across(const double *P, const double *q)
     return shoulder_wrist_across(P, q, &w);
 }
 
+/* The angle of the model's shoulder-wrist direction w_hat at q from psi's singular half-line
+ * w_hat = -up (the wrist centre straight below the shoulder). */
 double om_srs_half_line_angle(const double *P, const double *q)
 {
     vec3 w, across = shoulder_wrist_across(P, q, &w);

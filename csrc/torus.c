@@ -122,6 +122,12 @@ typedef struct {
     int cap;
 } known_roots;
 
+/* Whether two points (w1, w7, phi4) are one: each coordinate within OM_SAME_ROOT, modulo 2 pi. */
+static bool _same_point(vec3 a, vec3 b)
+{
+    return py_max(py_max(fabs(om_wrap(a.x - b.x)), fabs(om_wrap(a.y - b.y))), fabs(om_wrap(a.z - b.z))) < OM_SAME_ROOT;
+}
+
 /* Newton's method from x, deflated by the known roots if deflate; a new root is appended
  * to known, with its model IK in q. Returns the number of known roots. */
 static int _new_root(om_problem *pb, vec3 x, bool deflate, known_roots *known, int n_known, double *q)
@@ -130,12 +136,9 @@ static int _new_root(om_problem *pb, vec3 x, bool deflate, known_roots *known, i
     double r = om_newton(pb, x, q, known->x, deflate ? n_known : 0, &x_root);
     if (r > OM_ROOT_TOL)
         return n_known;
-    for (int k = 0; k < n_known; k++) {
-        const double *kr = known->x + 3 * k;
-        if (py_max(py_max(fabs(om_wrap(x_root.x - kr[0])), fabs(om_wrap(x_root.y - kr[1]))),
-                   fabs(om_wrap(x_root.z - kr[2]))) < OM_SAME_ROOT)
+    for (int k = 0; k < n_known; k++)
+        if (_same_point(x_root, v_load(known->x, 3 * k)))
             return n_known;
-    }
     if (n_known >= known->cap) {
         int cap = 2 * known->cap;
         double *grown = realloc(known->x, (size_t)cap * 3 * sizeof(double));
@@ -307,8 +310,7 @@ static int _half_line_points(om_problem *pb, double lo1, double lo7, double step
                 continue;
             bool seen = false;
             for (int k = 0; k < count; k++)
-                seen = seen || (fabs(om_wrap(w1 - charts[k].w1)) < OM_SAME_ROOT &&
-                                fabs(om_wrap(w7 - charts[k].w7)) < OM_SAME_ROOT);
+                seen = seen || _same_point(v3(w1, w7, 0.0), v3(charts[k].w1, charts[k].w7, 0.0));
             if (seen)
                 continue;
             half_line_chart chart = {w1, w7, {{J[1][1] / det, -J[0][1] / det}, {-J[1][0] / det, J[0][0] / det}}};
@@ -339,8 +341,7 @@ static int _half_line_roots(om_problem *pb, double lo1, double lo7, double step,
                 continue;
             bool seen = false;
             for (int e = 0; e < n_ends; e++)
-                seen = seen || py_max(py_max(fabs(om_wrap(end.x - ends[e].x)), fabs(om_wrap(end.y - ends[e].y))),
-                                      fabs(om_wrap(end.z - ends[e].z))) < OM_SAME_ROOT;
+                seen = seen || _same_point(end, ends[e]);
             if (seen)
                 continue;
             ends[n_ends++] = end;
