@@ -89,17 +89,45 @@ static double slope(const tracking *tr, const pieces *P, double b, double d) {
     return D;
 }
 
-/* The maximiser of the model over the box and the floors; false if they leave nothing. */
-static bool box_step(const tracking *tr, const pieces *P, double b, double radius, double *step) {
-    double lo = -radius, hi = radius;
+/* The pieces of P that can be their group's smallest somewhere in [lo, hi], into Q. A piece is
+ * left out where its least value there exceeds the least of the group's greatest values (each
+ * at an end: the pieces are linear) by more than the rounding of v + a d can make up (at most
+ * 2^-52 (|v| + |a d|) each, so 1e-12 of both pieces' magnitudes is ample): the computed v_j(d)
+ * then exceeds that other piece's at every d of [lo, hi], and slope's minima, its tie-breaks
+ * and so its every value are P's. */
+static void contenders(const pieces *P, double lo, double hi, pieces *Q) {
+    double reach = fmax(fabs(lo), fabs(hi)), least_top[3] = {INFINITY, INFINITY, INFINITY}, size[3] = {0.0, 0.0, 0.0};
     for (int j = 0; j < P->n; j++) {
-        double floor = tr->floor[P->group[j]], a = P->a[j], gap = floor - P->v[j];
+        int g = P->group[j];
+        double top = fmax(P->v[j] + P->a[j] * lo, P->v[j] + P->a[j] * hi);
+        if (top < least_top[g]) least_top[g] = top, size[g] = fabs(P->v[j]) + fabs(P->a[j]) * reach;
+    }
+    int n = 0;
+    for (int j = 0; j < P->n; j++) {
+        int g = P->group[j];
+        double bottom = fmin(P->v[j] + P->a[j] * lo, P->v[j] + P->a[j] * hi);
+        double slack = 1e-12 * (1.0 + fabs(P->v[j]) + fabs(P->a[j]) * reach + size[g]);
+        if (bottom - least_top[g] > slack) continue; /* (NaN: kept) */
+        Q->v[n] = P->v[j], Q->a[n] = P->a[j], Q->group[n++] = g;
+    }
+    Q->n = n;
+}
+
+/* The maximiser of the model over the box and the floors; false if they leave nothing. The
+ * bisection reads only the pieces that can bind (contenders). */
+static bool box_step(const tracking *tr, const pieces *all, double b, double radius, double *step) {
+    double lo = -radius, hi = radius;
+    for (int j = 0; j < all->n; j++) {
+        double floor = tr->floor[all->group[j]], a = all->a[j], gap = floor - all->v[j];
         if (floor == -INFINITY) continue;
         if (a > 0.0) lo = fmax(lo, gap / a);
         else if (a < 0.0) hi = fmin(hi, gap / a);
         else if (gap > 0.0) return false;
     }
     if (!(lo <= hi)) return false;
+    static pieces contending; /* (the GIL is held: one call at a time) */
+    const pieces *P = &contending;
+    contenders(all, lo, hi, &contending);
     if (slope(tr, P, b, lo) <= 0.0) return *step = lo, true;
     double left = lo, right = hi;
     if (slope(tr, P, b, hi) >= 0.0) return *step = hi, true;
