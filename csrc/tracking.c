@@ -145,8 +145,8 @@ static bool box_step(const tracking *tr, const pieces *all, double b, double rad
  * continues its path from the hint beyond doubt (om_beyond_doubt, as follow.c takes its
  * roots): the second solve's (at psi + d, hinted by q0) along the self-motion, the first
  * solve's (at psi, hinted by q_prev) along the hand's motion at fixed psi (pose_motion). Else
- * the scan decides, and where the local solve fails, the bounded search, as before. (The scans
- * cost about 15 us of the Panda's step each.) The prediction: q d ahead of q along t. */
+ * the scan decides, and where the local solve fails, the bounded search, as before. (Each scan
+ * cost 12-15 us of the Panda's step.) The prediction: q d ahead of q along t. */
 typedef struct {
     int dof;
     const double *q, *t;
@@ -217,7 +217,7 @@ static int track(const tracking *tr, const double *T, const int64_t *signs, cons
     int dof = s->dof;
     double psi = tr->setup[S_PSI], q0[OM_MAX_DOF], t0[OM_MAX_DOF], t1[OM_MAX_DOF], dq[OM_MAX_DOF];
     step_prediction moved = {dof, q_prev, dq, 1.0};
-    bool predicted = pose_motion(s, T, q_prev, dq);
+    bool predicted = s->mode != OM_FIXED && pose_motion(s, T, q_prev, dq); /* (a fixed dp: no scan to spare) */
     om_result r = om_solve_one(s, T, signs, &psi, q_prev, q0, predicted ? on_step : NULL, &moved);
     if (r.status != OM_OK || !om_continues(dof, q_prev, q0, NULL, 0.0, NULL)) return TR_NO_SOLUTION;
     if (!om_self_motion_tangent(s, q0, t0, SINGULAR_TANGENT)) return TR_SINGULAR;
