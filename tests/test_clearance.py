@@ -72,7 +72,7 @@ def test_compiled_distances_are_mujocos(panda, kind, size, position, quat, joint
     assert not grad[d >= reach].any()
 
 
-SEVEN_DOF = [name for name in om.arm_names() if om.load_arm(name).dof == 7]
+SHIPPED = om.arm_names()  # every 7-DOF arm, and a 6-DOF one with a prismatic joint
 
 
 def within_limits(arm: om.Arm, rng: np.random.Generator, rows: int) -> np.ndarray:
@@ -82,28 +82,38 @@ def within_limits(arm: om.Arm, rng: np.random.Generator, rows: int) -> np.ndarra
     return rng.uniform(lower, upper, (rows, arm.dof))
 
 
-def mounted(arm: om.Arm, obstacles: list[str]) -> om.Clearance:
+def mounted(arm: om.Arm) -> om.Clearance:
     """The project's MJCF of the arm with its base moved and turned in the world, a sphere on
-    its last link and a capsule, a sphere and a box about it, as a user's scene."""
+    its last link and a box on link 5, and about it a capsule, a sphere, a box and a sphere that
+    overlaps link 3 near q = 0, as a user's scene."""
     spec = mujoco.MjSpec.from_string(om.arm_mjcf(arm, prefix="l_"))
     base = spec.body("l_base")
     base.pos, base.quat = [0.3, -0.2, 0.1], [0.9, 0.1, -0.3, 0.2]
     last = spec.body(f"l_link{arm.dof}")
     last.add_geom(name="knob", type=KINDS["sphere"], size=[0.04, 0, 0], pos=[0.02, 0.03, 0.05])
+    # an arm geom the kernel leaves to MuJoCo (it gives the gradients of its pairs)
+    spec.body("l_link5").add_geom(
+        name="plate", type=KINDS["box"], size=[0.03, 0.05, 0.01], pos=[0.0, 0.05, 0.0]
+    )
+    model = spec.compile()
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
     world = spec.worldbody
     world.add_geom(name="pole", type=KINDS["capsule"], size=[0.05, 0.3, 0], pos=[0.7, -0.1, 0.5])
     world.add_geom(name="ball", type=KINDS["sphere"], size=[0.1, 0, 0], pos=[0.4, 0.3, 0.7])
     world.add_geom(name="crate", type=KINDS["box"], size=[0.1, 0.2, 0.1], pos=[0.6, -0.6, 0.2])
-    return om.Clearance(spec.compile(), arm, obstacles, prefix="l_")
+    near = data.body("l_link3").xpos + np.array([0.03, 0.04, 0.05])
+    world.add_geom(name="touch", type=KINDS["sphere"], size=[0.1, 0, 0], pos=near)
+    return om.Clearance(spec.compile(), arm, ["pole", "ball", "crate", "touch"], prefix="l_")
 
 
-@pytest.mark.parametrize("name", SEVEN_DOF)
+@pytest.mark.parametrize("name", SHIPPED)
 def test_geoms_are_placed_as_mujoco_places_them(name):
     """Every arm geom's pose from the arm's DH chain (Clearance.geom_poses) is MuJoCo's
     mj_kinematics of the model to 1e-12, the arm's base moved and turned in the world and a
     geom added to the last link, on random joint vectors; and the distances are MuJoCo's."""
     arm = om.load_arm(name)
-    clearance = mounted(arm, ["pole", "ball", "crate"])
+    clearance = mounted(arm)
     model, data = clearance.model, mujoco.MjData(clearance.model)
     ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, g) for g in clearance.arm_geoms]
     assert "knob" in clearance.arm_geoms and len(ids) == len(set(ids)) > arm.dof
@@ -121,18 +131,19 @@ def test_geoms_are_placed_as_mujoco_places_them(name):
             assert dist[k] == pytest.approx(expected, abs=1e-12), (a, o)
 
 
-@pytest.mark.parametrize("name", SEVEN_DOF)
+@pytest.mark.parametrize("name", SHIPPED)
 def test_gradients_are_finite_differences_on_every_arm(name):
-    """The gradients of all rows in one call match central differences of the distances
-    (apart, and overlapping but for the box: MuJoCo's depth of a capsule in a box is not
-    smooth), and equal the row-by-row ones."""
+    """The gradients of all rows in one call (random joint vectors, and some near q = 0 where
+    a sphere overlaps link 3) match central differences of the distances (apart, and
+    overlapping but for the box: MuJoCo's depth of a capsule in a box is not smooth), and
+    equal the row-by-row ones."""
     arm = om.load_arm(name)
-    clearance = mounted(arm, ["pole", "ball", "crate"])
+    clearance = mounted(arm)
     rng = np.random.default_rng(2)
-    Q = within_limits(arm, rng, 30)
+    Q = np.vstack([within_limits(arm, rng, 25), rng.uniform(-0.1, 0.1, (5, arm.dof))])
     D, grad = clearance.distances_and_gradients(Q)
     in_box = np.array([o == "crate" for _, o in clearance.pairs])
-    h = 1e-7
+    h, checked = 1e-7, 0
     for q, d, g in zip(Q, D, grad, strict=True):
         single = clearance.distances_and_gradients(q)
         np.testing.assert_array_equal(single[0], d)
@@ -140,8 +151,9 @@ def test_gradients_are_finite_differences_on_every_arm(name):
         direction = rng.normal(size=arm.dof)
         ahead, behind = clearance.distances(q + h * direction), clearance.distances(q - h * direction)
         smooth = (np.abs(d) > 1e-4) & (d < clearance.distmax - 1e-4) & ((d > 0.0) | ~in_box)
-        assert smooth.sum() > len(d) // 2
+        checked += smooth.sum()
         np.testing.assert_allclose(g[smooth] @ direction, ((ahead - behind) / (2 * h))[smooth], atol=1e-6)
+    assert checked > D.size // 2
     assert (D < 0.0).any() and (D > 0.0).any()  # overlapping pairs and pairs apart both checked
 
 
