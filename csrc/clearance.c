@@ -254,15 +254,16 @@ static PyObject *om_arm_geom_poses(PyObject *mod, PyObject *const *args, Py_ssiz
     Py_RETURN_NONE;
 }
 
-/* arm_clearance(table, start, link, offset, slide, q, xpos, xmat, kind, radius, half, pairs,
- * bounds, reach, dist, fromto, grad, given) -> left: for each row m of q (M, dof), the arm's
- * A geoms placed into rows 0..A-1 of the scratch xpos (G, 3) and xmat (G, 9) (rows A..G-1: the
- * obstacles, set by the caller), each pair's distance (M, P) capped at reach and nearest points
- * (M, P, 6) (nan: the `left` pairs MuJoCo must compute), and unless grad is None their
- * gradients (M, P, dof). given true: dist and fromto are read, not written, for the gradients
- * of pairs MuJoCo computed. Pairs (P, 2) index the geoms, an arm geom first. */
+/* arm_clearance(table, start, link, offset, slide, q, obstacle_pos, obstacle_mat, kind, radius,
+ * half, pairs, bounds, reach, dist, fromto, grad, given) -> left: the geoms are the arm's A and
+ * the O obstacles (poses (O, 3) and (O, 9)), G = A + O; for each row m of q (M, dof), the arm's
+ * geoms placed (in this call's own work array: calls may run in parallel), each pair's
+ * distance (M, P) capped at reach and nearest points (M, P, 6) (nan: the `left` pairs MuJoCo
+ * must compute), and unless grad is None their gradients (M, P, dof). given true: dist and
+ * fromto are read, not written, for the gradients of pairs MuJoCo computed. Pairs (P, 2) index
+ * the geoms, an arm geom first. */
 static PyObject *om_arm_clearance(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
-    enum { N = N_ARM + 9 }; /* buffers: the arm's, xmat ... bounds, dist, fromto, grad */
+    enum { N = N_ARM + 9 }; /* buffers: the arm's, obstacle_mat ... bounds, dist, fromto, grad */
     if (check_nargs(nargs, 18, "arm_clearance") < 0) return NULL;
     double reach = PyFloat_AsDouble(args[13]);
     if (reach == -1.0 && PyErr_Occurred()) return NULL;
@@ -275,8 +276,9 @@ static PyObject *om_arm_clearance(PyObject *mod, PyObject *const *args, Py_ssize
     Py_buffer v[N];
     buffer_spec sp[N];
     memcpy(sp, arm_spec, sizeof arm_spec);
+    sp[N_ARM - 1] = (buffer_spec){F64, -1, 0, "obstacle_pos"};
     const buffer_spec rest[N - N_ARM] = {
-        {F64, -1, 1, "xmat"},  {I64, -1, 0, "kind"},       {F64, -1, 0, "radius"},
+        {F64, -1, 0, "obstacle_mat"},  {I64, -1, 0, "kind"},       {F64, -1, 0, "radius"},
         {F64, -1, 0, "half"},  {I64, -1, 0, "pairs"},      {F64, -1, 0, "bounds"},
         {F64, -1, !given, "dist"}, {F64, -1, !given, "fromto"}, {F64, -1, 1, "grad"}};
     memcpy(sp + N_ARM, rest, sizeof rest);
@@ -291,8 +293,8 @@ static PyObject *om_arm_clearance(PyObject *mod, PyObject *const *args, Py_ssize
         return NULL;
     }
     const int64_t *pairs = v[11].buf;
-    int bad = A > G || v[6].len != G * 24 || v[7].len != G * 72 || v[9].len != G * 8 || v[10].len != G * 24 ||
-              v[11].len != P * 16 || v[13].len != M * P * 8 || v[14].len != M * P * 48 ||
+    int bad = A > G || v[6].len != (G - A) * 24 || v[7].len != (G - A) * 72 || v[9].len != G * 8 ||
+              v[10].len != G * 24 || v[11].len != P * 16 || v[13].len != M * P * 8 || v[14].len != M * P * 48 ||
               (with_grad && v[15].len != M * P * dof * 8);
     for (Py_ssize_t k = 0; k < P && !bad; k++)
         bad = pairs[2 * k] < 0 || pairs[2 * k] >= A || pairs[2 * k + 1] < A || pairs[2 * k + 1] >= G;
@@ -305,8 +307,14 @@ static PyObject *om_arm_clearance(PyObject *mod, PyObject *const *args, Py_ssize
     const int64_t *link = v[2].buf, *kind = v[8].buf;
     const uint8_t *slide = v[4].buf;
     const double *radius = v[9].buf, *half = v[10].buf, *bounds = v[12].buf;
-    double *xpos = v[6].buf, *xmat = v[7].buf, *dist = v[13].buf, *fromto = v[14].buf;
-    double *grad = with_grad ? v[15].buf : NULL;
+    double *dist = v[13].buf, *fromto = v[14].buf, *grad = with_grad ? v[15].buf : NULL;
+    double *xpos = PyMem_RawMalloc((size_t)G * 12 * sizeof(double)), *xmat = xpos + 3 * G; /* poses, all geoms */
+    if (!xpos) {
+        release_buffers(v, n_views);
+        return PyErr_NoMemory();
+    }
+    memcpy(xpos + 3 * A, v[6].buf, (size_t)(G - A) * 3 * sizeof(double));
+    memcpy(xmat + 9 * A, v[7].buf, (size_t)(G - A) * 9 * sizeof(double));
     int n_rows = (int)(v[0].len / 48);
     long left = 0;
     Py_BEGIN_ALLOW_THREADS for (Py_ssize_t m = 0; m < M; m++) {
@@ -318,7 +326,8 @@ static PyObject *om_arm_clearance(PyObject *mod, PyObject *const *args, Py_ssize
         }
         if (grad) gradients(d, ft, pairs, link, frames, slide, P, dof, reach, grad + m * P * dof);
     }
-    Py_END_ALLOW_THREADS release_buffers(v, n_views);
+    Py_END_ALLOW_THREADS PyMem_RawFree(xpos);
+    release_buffers(v, n_views);
     return PyLong_FromLong(left);
 }
 
@@ -326,7 +335,7 @@ PyMethodDef om_clearance_functions[] = {
     {"arm_geom_poses", (PyCFunction)(void (*)(void))om_arm_geom_poses, METH_FASTCALL,
      "arm_geom_poses(table, start, link, offset, slide, q, xpos, xmat)"},
     {"arm_clearance", (PyCFunction)(void (*)(void))om_arm_clearance, METH_FASTCALL,
-     "arm_clearance(table, start, link, offset, slide, q, xpos, xmat, kind, radius, half, pairs, bounds, reach, "
-     "dist, fromto, grad, given) -> pairs left to MuJoCo"},
+     "arm_clearance(table, start, link, offset, slide, q, obstacle_pos, obstacle_mat, kind, radius, half, pairs, "
+     "bounds, reach, dist, fromto, grad, given) -> pairs left to MuJoCo"},
     {NULL, NULL, 0, NULL},
 };

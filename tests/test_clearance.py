@@ -12,6 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
+from om_redundant import ckernels
 from om_redundant.exceptions import ModelMismatch
 
 KINDS = {
@@ -164,3 +165,23 @@ def test_a_model_whose_links_are_not_the_arms_is_refused(panda):
     spec.worldbody.add_geom(name="ball", type=KINDS["sphere"], size=[0.1, 0, 0], pos=[0.4, 0.3, 0.7])
     with pytest.raises(ModelMismatch, match="do not move like its kinematic chain"):
         om.Clearance(spec.compile(), panda.arm, ["ball"])
+
+
+def test_the_kernel_refuses_arrays_of_other_sizes(panda):
+    """ckernels.arm_clearance checks every array's size against the others: a ValueError, never
+    a read past an end."""
+    clearance = om.Clearance.for_arm(panda.arm, [om.Sphere([0.4, 0.1, 0.5], 0.05)])
+    arm, geoms = clearance._arguments
+    q, n_pairs = np.zeros(7), len(clearance.pairs)
+    dist, fromto, grad = np.empty(n_pairs), np.empty((n_pairs, 6)), np.empty((n_pairs, 7))
+    assert ckernels.arm_clearance(*arm, q, *geoms, 1.0, dist, fromto, grad, False) == 0
+    short = [
+        (arm, q[:6], geoms),
+        (arm, q, (geoms[0][:0], *geoms[1:])),
+        ((*arm[:3], arm[3][:-1], arm[4]), q, geoms),
+    ]
+    for a, x, g in short:
+        with pytest.raises(ValueError, match="disagree"):
+            ckernels.arm_clearance(*a, x, *g, 1.0, dist, fromto, grad, False)
+    with pytest.raises(ValueError, match="disagree"):
+        ckernels.arm_clearance(*arm, q, *geoms, 1.0, dist[:-1], fromto, grad, False)

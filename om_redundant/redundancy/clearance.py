@@ -233,8 +233,8 @@ class Clearance:
     def _by_mujoco(
         self, q: np.ndarray, reach: float, dist: np.ndarray, fromto: np.ndarray, grad: np.ndarray | None
     ) -> None:
-        """The pairs ``ckernels.arm_clearance`` left (nan: kinds it does not compute, geoms
-        touching or overlapping) by ``mj_geomDistance``, the arm geoms placed as it places
+        """The pairs ``ckernels.arm_clearance`` left (nan: kinds it does not compute, cores
+        touching, boxes touched) by ``mj_geomDistance``, the arm geoms placed as it places
         them, and those rows' gradients."""
         m, d, n_pairs = self.model, self._data, self._n_pairs
         fromto = fromto.reshape(-1, n_pairs, 6)
@@ -253,7 +253,7 @@ class Clearance:
 class ArmCores(NamedTuple):
     """What ``ckernels.arm_clearance`` reads, in its order, set up once per :class:`Clearance`:
     the arm's links (its DH chain placed in the world) with the arm geoms' offsets in them,
-    and the geoms as cores, the arm's A geoms first, then the obstacles.
+    and the geoms as cores, the arm's A geoms first, then the O obstacles (G = A + O).
 
     Attributes:
         table: The arm's DH table (``KinematicChain.table``).
@@ -261,8 +261,7 @@ class ArmCores(NamedTuple):
         link: (A,) each arm geom's link: the number of the arm's joints that move it.
         offset: (A, 12) each arm geom's pose in its link's frame, as ``start``.
         slide: (dof,) which joints slide (else turn).
-        xpos, xmat: (G, 3), (G, 9) the geoms' world poses: the arm's rows scratch, the
-            obstacles' fixed.
+        obstacle_pos, obstacle_mat: (O, 3), (O, 9) the obstacles' world poses.
         kind: (G,) each geom's core: 1 a point (sphere), 2 a segment (capsule), 3 a box;
             0 where MuJoCo computes its distances (other kinds, arm geoms other than
             spheres and capsules).
@@ -277,8 +276,8 @@ class ArmCores(NamedTuple):
     link: np.ndarray
     offset: np.ndarray
     slide: np.ndarray
-    xpos: np.ndarray
-    xmat: np.ndarray
+    obstacle_pos: np.ndarray
+    obstacle_mat: np.ndarray
     kind: np.ndarray
     radius: np.ndarray
     half: np.ndarray
@@ -332,8 +331,8 @@ def _arm_cores(
         np.ascontiguousarray(link, dtype=np.int64),
         offset,
         slide,
-        np.ascontiguousarray(data.geom_xpos[geoms]),
-        np.ascontiguousarray(data.geom_xmat[geoms]),
+        np.ascontiguousarray(data.geom_xpos[obstacles]),
+        np.ascontiguousarray(data.geom_xmat[obstacles]),
         kind,
         radius,
         half,
