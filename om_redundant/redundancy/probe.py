@@ -200,12 +200,13 @@ class Probe:
         pairs = None if clearance is None else clearance.distances_and_gradients(q)
         evaluations = self.objective.evaluations(q, None if pairs is None else pairs[0])
         values, rates = self.objective.constraint_bounds(q, tangents, pairs)
+        pair_rows = [None] * len(q) if pairs is None else zip(*pairs, strict=True)  # (distances, gradients)
+        rows = zip(psi.tolist(), q, tangents, evaluations, pair_rows, values, rates, strict=True)
         points = []
-        for k, (x, row, t, ev) in enumerate(zip(psi, q, tangents, evaluations, strict=True)):
+        for x, row, t, ev, pair, v, r in rows:
             terms = _Terms(self.objective, row, t)
-            terms.pairs = None if pairs is None else (pairs[0][k], pairs[1][k])
-            terms.evaluation, terms.bounds = ev, (values[k], rates[k])
-            points.append(Point(float(x), row, t, terms))
+            terms.pairs, terms.evaluation, terms.bounds = pair, ev, (v, r)
+            points.append(Point(x, row, t, terms))
         return points
 
     def at(self, psi: float | np.ndarray, hint: np.ndarray) -> Point | None:
