@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 from typing import NamedTuple
 
 import numpy as np
@@ -41,13 +42,13 @@ _ARRIVED, _SINGULAR = 0, 2  # ckernels.follow's status
 class _Terms:
     """The objective at a point, computed when first asked for (a path's following steps
     need only the joints and the tangent): the clearance's pair distances and gradients
-    (one ``mj_kinematics``), from which the groups with their rates, the evaluation and
-    the constraint bounds. Shared by the copies of a point at other representatives of psi.
+    (one ``ckernels.arm_clearance`` call), from which the groups with their rates, the
+    evaluation and the constraint bounds. Shared by the copies of a point at other representatives of psi.
     """
 
     def __init__(self, objective: Objective, q: np.ndarray, tangent: np.ndarray):
         self.objective, self.q, self.tangent = objective, q, tangent
-        self.pairs, self.evaluation, self.groups, self.bounds, self.pieces = None, None, None, None, None
+        self.pairs, self.groups, self.bounds, self.pieces = None, None, None, None
 
     def get_pairs(self) -> tuple[np.ndarray, np.ndarray] | None:
         """The clearance's pair distances and gradients at q; None without obstacles."""
@@ -55,11 +56,11 @@ class _Terms:
             self.pairs = self.objective.clearance.distances_and_gradients(self.q)
         return self.pairs
 
-    def get_evaluation(self) -> Evaluation:
-        if self.evaluation is None:
-            pairs = self.get_pairs()
-            self.evaluation = self.objective.evaluate(self.q, None if pairs is None else pairs[0])
-        return self.evaluation
+    @cached_property
+    def evaluation(self) -> Evaluation:
+        """The objective at q (an attribute once computed: points are asked for it often)."""
+        pairs = self.get_pairs()
+        return self.objective.evaluate(self.q, None if pairs is None else pairs[0])
 
     def get_bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`~om_redundant.redundancy.objective.Objective.constraint_bounds` here."""
@@ -111,7 +112,7 @@ class Point:
     @property
     def evaluation(self) -> Evaluation:
         """The objective at q."""
-        return self.terms.get_evaluation()
+        return self.terms.evaluation
 
     @property
     def groups(self) -> list[Group]:
@@ -199,12 +200,13 @@ class Probe:
         pairs = None if clearance is None else clearance.distances_and_gradients(q)
         evaluations = self.objective.evaluations(q, None if pairs is None else pairs[0])
         values, rates = self.objective.constraint_bounds(q, tangents, pairs)
+        pair_rows = [None] * len(q) if pairs is None else zip(*pairs, strict=True)  # (distances, gradients)
+        rows = zip(psi.tolist(), q, tangents, evaluations, pair_rows, values, rates, strict=True)
         points = []
-        for k, (x, row, t, ev) in enumerate(zip(psi, q, tangents, evaluations, strict=True)):
+        for x, row, t, ev, pair, v, r in rows:
             terms = _Terms(self.objective, row, t)
-            terms.pairs = None if pairs is None else (pairs[0][k], pairs[1][k])
-            terms.evaluation, terms.bounds = ev, (values[k], rates[k])
-            points.append(Point(float(x), row, t, terms))
+            terms.pairs, terms.evaluation, terms.bounds = pair, ev, (v, r)
+            points.append(Point(x, row, t, terms))
         return points
 
     def at(self, psi: float | np.ndarray, hint: np.ndarray) -> Point | None:
