@@ -18,12 +18,69 @@ that the slope balances :math:`b\delta`.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from .. import ckernels
 from .objective import Group
 
 _TIE = 1e-12  # pieces within this of their group's minimum meet there
+
+
+class Pieces(NamedTuple):
+    """Groups of one variable concatenated, as ``ckernels.maximise_1d`` reads them: group g's
+    pieces are ``ends[g]`` to ``ends[g + 1] - 1``, each group has at least one.
+
+    Attributes:
+        values: (n,) the pieces v_j.
+        rates: (n,) their rates a_j.
+        ends: (G + 1,) int64, from 0 to n.
+        weights, floors, caps: (G,) per group.
+    """
+
+    values: np.ndarray
+    rates: np.ndarray
+    ends: np.ndarray
+    weights: np.ndarray
+    floors: np.ndarray
+    caps: np.ndarray
+
+    @classmethod
+    def of(cls, groups: list[Group]) -> Pieces:
+        """The pieces of groups with jacobians (p_g, 1)."""
+        ends = np.cumsum([0] + [len(g.values) for g in groups], dtype=np.int64)
+        numbers = np.array([(g.weight, g.floor, g.cap) for g in groups], dtype=float).T.copy()
+        values = np.concatenate([g.values for g in groups])
+        rates = np.concatenate([g.jacobian[:, 0] for g in groups])
+        return cls(values, rates, ends, *numbers)
+
+    def least(self, values: np.ndarray) -> np.ndarray:
+        """(G,) each group's smallest of ``values`` (n,), one per piece."""
+        return np.minimum.reduceat(values, self.ends[:-1])
+
+    def model(self, delta: float) -> float:
+        """The linearised objective sum_g w_g min(cap_g, min_j (v_j + a_j delta)), summed
+        in the groups' order."""
+        terms = self.weights * np.minimum(self.caps, self.least(self.values + self.rates * delta))
+        return sum(terms.tolist())
+
+    def kept(self, keep: np.ndarray) -> Pieces:
+        """The pieces where ``keep`` (n,) holds, at least one per group."""
+        ends = np.concatenate([[0], np.cumsum(keep)[self.ends[1:] - 1]]).astype(np.int64)
+        return self._replace(values=self.values[keep], rates=self.rates[keep], ends=ends)
+
+    def split(self, z: np.ndarray) -> list[np.ndarray]:
+        """(n,) per piece into one array per group."""
+        return np.split(z, self.ends[1:-1])
+
+
+def solve_1d(pieces: Pieces, curvature: float, lower: float, upper: float) -> tuple[float, np.ndarray] | None:
+    """:func:`maximise_1d` of the pieces by ``ckernels.maximise_1d``: (delta, the pieces'
+    multipliers (n,)), or None when the floors leave no delta."""
+    z = np.empty(len(pieces.values))
+    delta = ckernels.maximise_1d(*pieces, curvature, lower, upper, z)
+    return None if delta is None else (delta, z)
 
 
 def maximise_1d(
@@ -35,21 +92,16 @@ def maximise_1d(
         groups: Groups with jacobians (p_g, 1) by the redundancy variable, each with a piece.
         curvature: b > 0.
         lower, upper: Bounds of delta, lower <= 0 <= upper.
-        compiled: By ``ckernels.maximise_1d`` (``csrc/box_qp.c``, the same operations);
-            False: numpy, the reference it is tested against.
+        compiled: By ``ckernels.maximise_1d`` (``csrc/box_qp.c``, the same operations;
+            :func:`solve_1d`); False: numpy, the reference it is tested against.
 
     Returns:
         (delta, multipliers per group), or None when the floors leave no delta.
     """
     if compiled:
-        sizes = [len(g.values) for g in groups]
-        ends = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
-        v = np.concatenate([g.values for g in groups])
-        a = np.concatenate([g.jacobian[:, 0] for g in groups])
-        weights, floors, caps = np.array([(g.weight, g.floor, g.cap) for g in groups], dtype=float).T.copy()
-        z = np.empty(len(v))
-        delta = ckernels.maximise_1d(v, a, ends, weights, floors, caps, curvature, lower, upper, z)
-        return None if delta is None else (delta, np.split(z, ends[1:-1]))
+        pieces = Pieces.of(groups)
+        found = solve_1d(pieces, curvature, lower, upper)
+        return None if found is None else (found[0], pieces.split(found[1]))
     v = [g.values for g in groups]
     a = [g.jacobian[:, 0] for g in groups]
     lo, hi = lower, upper

@@ -32,7 +32,7 @@ import numpy as np
 import qpsolvers
 import scipy.sparse as sp
 
-from .box_qp import maximise_1d
+from .box_qp import Pieces, solve_1d
 from .objective import Group
 from .probe import Point, Probe
 
@@ -81,25 +81,36 @@ def qp_step(groups: list[Group], curvature: np.ndarray, lower: np.ndarray, upper
         checks every step exactly.
     """
     r = len(lower)
+    if r == 1:
+        return _step_1d(Pieces.of(groups), float(curvature[0, 0]), float(lower[0]), float(upper[0]))
     reach = np.maximum(-lower, upper)
     keep = [_may_be_least(g, reach) for g in groups]
-    if r == 1:
-        pairs = zip(groups, keep, strict=True)
-        kept = [replace(g, values=g.values[k], jacobian=g.jacobian[k]) for g, k in pairs]
-        found = maximise_1d(kept, float(curvature[0, 0]), float(lower[0]), float(upper[0]))
-        if found is None:
-            return None
-        delta, duals = np.array([found[0]]), found[1]
-    else:
-        found = _osqp_step(groups, keep, curvature, lower, upper, reach)
-        if found is None:
-            return None
-        delta, duals = found
+    found = _osqp_step(groups, keep, curvature, lower, upper, reach)
+    if found is None:
+        return None
+    delta, duals = found
     gain = _model(groups, delta) - 0.5 * delta @ curvature @ delta - _model(groups, np.zeros(r))
     multipliers = [np.zeros(len(g.values)) for g in groups]
     for full, k, z in zip(multipliers, keep, duals, strict=True):
         full[k] = z
     return _Step(delta, gain, multipliers)
+
+
+def _step_1d(pieces: Pieces, curvature: float, lower: float, upper: float) -> _Step | None:
+    """:func:`qp_step` with one variable, on the groups' pieces concatenated (the same
+    operations as the general case's, on one array instead of one per group)."""
+    reach = max(-lower, upper)
+    change = np.abs(pieces.rates) * reach
+    least = pieces.least(pieces.values + change)
+    keep = pieces.values - change <= np.repeat(least, np.diff(pieces.ends))
+    found = solve_1d(pieces.kept(keep), curvature, lower, upper)
+    if found is None:
+        return None
+    delta, z = found
+    gain = pieces.model(delta) - 0.5 * delta * curvature * delta - pieces.model(0.0)
+    multipliers = np.zeros(len(keep))
+    multipliers[keep] = z
+    return _Step(np.array([delta]), gain, pieces.split(multipliers))
 
 
 def _osqp_step(
