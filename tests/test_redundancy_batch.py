@@ -15,6 +15,7 @@ import om_redundant as om
 from benchmarks.control_rate import HOMES, MIN_CLEARANCE, obstacles
 from om_redundant.redundancy.box_qp import maximise_1d
 from om_redundant.redundancy.objective import Group
+from om_redundant.redundancy.optimizer import _start_bounds
 from om_redundant.redundancy.self_motion import self_motion_tangents
 
 
@@ -175,3 +176,39 @@ def test_the_one_variable_qp_step_is_the_models_maximiser(seed, pieces, curvatur
     assert all(
         (z >= 0.0).all() and z.sum() <= g.weight + 1e-12 for g, z in zip(groups, multipliers, strict=True)
     )
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), runs=st.integers(1, 3), scale=st.floats(0.0, 4.0))
+def test_the_climbs_start_bounds_hold_for_functions_within_their_slopes(seed, runs, scale):
+    """optimizer._start_bounds, for term functions c + A sin(omega psi + phi) (slope bound
+    A omega; f's the weighted sum of its groups' largest) sampled on runs of uneven spacing:
+    every start's bound is at least f anywhere within its reach (a dense grid), at least f at
+    the start and at most the start's own cone f_k + L R (the bound before)."""
+    rng = np.random.default_rng(seed)
+    groups = [(rng.uniform(0, 2), np.inf, rng.integers(1, 5)), (rng.uniform(0, 2), 1.0, rng.integers(1, 5))]
+    waves = [rng.uniform([0.2, 0.0, 0.5, -3.0], [1.5, scale, 8.0, 3.0], (p, 4)) for _, _, p in groups]
+
+    def functions(x):  # (N,) -> per group (N, p)
+        return [c + a * np.sin(omega * x[:, None] + phi) for c, a, omega, phi in (w.T for w in waves)]
+
+    def objective(x):
+        return sum(
+            w * np.minimum(cap, v.min(axis=1)) for (w, cap, _), v in zip(groups, functions(x), strict=True)
+        )
+
+    slopes = [a * omega for _, a, omega, _ in (w.T for w in waves)]
+    slope = sum(w * s.max() for (w, _, _), s in zip(groups, slopes, strict=True))
+    psi = np.concatenate([np.sort(rng.uniform(-3, 3, rng.integers(1, 12))) for _ in range(runs)])
+    starts = np.flatnonzero(np.concatenate([[True], np.diff(psi) < 0]))  # each run's first sample
+    owner = np.cumsum(np.isin(np.arange(len(psi)), starts)) - 1
+    first = starts[owner]
+    last = np.append(starts[1:], len(psi))[owner] - 1
+    terms = [(w, cap, v) for (w, cap, _), v in zip(groups, functions(psi), strict=True)]
+    f = objective(psi)
+    k = np.arange(len(psi))
+    reach = rng.uniform(0.0, 1.0, len(psi))
+    bound = _start_bounds(psi, f, terms, slope, slopes, k, first, last, reach)
+    for x, r, b, f_k in zip(psi, reach, bound, f, strict=True):
+        assert b >= objective(np.linspace(x - r, x + r, 2001)).max() - 1e-12
+        assert f_k <= b <= f_k + slope * r + 1e-12

@@ -10,15 +10,19 @@ the exact OM solution in it:
 1. **Sweep.** Every allowed branch's exact solutions are sampled on a psi grid and linked
    into solution paths (:mod:`om_redundant.redundancy.paths`), which are cut into feasible intervals
    with refined ends (:mod:`om_redundant.redundancy.intervals`).
-2. **Starts.** In each interval, the samples that are local maxima of f. With h a start's
-   distance to its farther neighbour and L the largest slope between neighbouring samples
-   (over every interval, times 2), a start can only lead above the smaller of
-   ``f_start + L_f h`` and ``sum_g w_g min(cap_g, min_j (v_j + L_j h))``, the second with
-   each function v_j of each group (a joint's margin, a pair's distance, a singularity
-   distance; :meth:`~om_redundant.redundancy.objective.Objective.term_functions`) bounded by
-   its own slope: where what binds every term does not move with the self-motion (the
-   elbow of an S-R-S arm binding the margin, the hand nearest an obstacle, or a term at its
-   cap), f cannot rise above its start value.
+2. **Starts.** In each interval, the samples that are local maxima of f. A climb from a
+   start is taken to end within R, twice the start's distance to its farther neighbour, and
+   each function to change at most by L, its largest slope between neighbouring samples
+   (over every interval). On each side of the start, such a function is below the cones of
+   slope L from the start's value u_0 and the neighbour's u_h (h away): below
+   ``max((u_0 + u_h + L h) / 2, u_h + L (R - h))`` (:func:`_cone_bound`; at most
+   ``u_0 + L R``). A start can only lead above the larger side's smaller of that bound of f
+   and ``sum_g w_g min(cap_g, min_j bound_j)``, the second with each function v_j of each
+   group (a joint's margin, a pair's distance, a singularity distance;
+   :meth:`~om_redundant.redundancy.objective.Objective.term_functions`) bounded by its own
+   slope: where what binds every term does not move with the self-motion (the elbow of an
+   S-R-S arm binding the margin, the hand nearest an obstacle, or a term at its cap), f
+   cannot rise above its start value.
    Starts are climbed best first, and those whose bound is below the best value found (by
    more than :data:`PLATEAU` when tracking; not above it by :data:`_CLIMB_ROUNDING`
    otherwise, a climb that could at most tie) are skipped. This is what finds the global
@@ -40,6 +44,7 @@ result is not ok and names where.
 
 from __future__ import annotations
 
+import bisect
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
@@ -307,11 +312,7 @@ class RedundancyOptimizer:
             chosen |= np.array([_distance(x, near) <= END_TOLERANCE for x in psi.tolist()])
         k = np.flatnonzero(chosen)
         gap = np.maximum(psi[np.minimum(k + 1, last[k])] - psi[k], psi[k] - psi[np.maximum(k - 1, first[k])])
-        reach = 2.0 * gap
-        bound = 0.0
-        for (w, cap, v), rate in zip(terms, limits, strict=True):
-            bound = bound + w * np.minimum(cap, (v[k] + rate * reach[:, None]).min(axis=1))
-        bound = np.minimum(f[k] + slope * reach, bound)
+        bound = _start_bounds(psi, f, terms, slope, limits, k, first[k], last[k], 2.0 * gap)
         rows = zip(f[k].tolist(), gap.tolist(), bound.tolist(), k.tolist(), strict=True)
         starts = [(f_k, gap_k, bound_k, runs[owner[j]], points[j]) for f_k, gap_k, bound_k, j in rows]
         starts.sort(key=lambda s: -s[0])
@@ -375,6 +376,76 @@ class RedundancyOptimizer:
             f"branch {signs}: clearance below {self.objective.min_clearance} m wherever within the limits "
             f"(best {best:.4f} m)"
         )
+
+
+def _start_bounds(
+    psi: np.ndarray,
+    f: np.ndarray,
+    terms: list[tuple[float, float, np.ndarray]],
+    slope: float,
+    slopes: list[np.ndarray],
+    k: np.ndarray,
+    first: np.ndarray,
+    last: np.ndarray,
+    reach: np.ndarray,
+) -> np.ndarray:
+    r"""Bounds of what climbs from the starts k can reach (module docstring, Starts): f
+    within ``reach`` R of each start, a function u of slope bound L being below the cones
+    :math:`u_i + L |x - \psi_i|` of the samples of its run.
+
+    Between neighbouring samples i, i + 1 (h apart) the cones of the two meet at most at
+    :math:`(u_i + u_{i+1} + L h)/2`; in a cell that R cuts, or beyond the run's end, the
+    last sample's cone reaches :math:`u_i + L r` (r the reach left). Per cell or cut cell
+    the smaller of f's bound and :math:`\sum_g w_g \min(cap_g, \min_j \text{bound}_j)`
+    (each term function with its own slope), per start the largest over its cells within
+    reach; at least f at the start. Never above the start's own cone :math:`f_k + L R`.
+
+    Args:
+        psi, f: (M,) the runs' samples, a run's in increasing psi, and f there.
+        terms: :meth:`~om_redundant.redundancy.objective.Objective.term_functions` at them.
+        slope, slopes: L of f and of each group's functions (p_g,).
+        k, first, last: (K,) the starts and their runs' first and last samples.
+        reach: (K,) R per start.
+    """
+    h = np.diff(psi)  # (cells across two runs are never looked at)
+    peak = lambda u, rate, width: np.maximum(0.5 * (u[:-1] + u[1:] + rate * width), np.maximum(u[:-1], u[1:]))  # noqa: E731
+    cells = np.minimum(
+        peak(f, slope, h),
+        _capped_sum(
+            terms, [peak(v, rate, h[:, None]) for (_, _, v), rate in zip(terms, slopes, strict=True)]
+        ),
+    )
+    whole, cut, ends, left = (
+        [],
+        [],
+        [],
+        [],
+    )  # per start: the cells within reach; the cut cells, their ends, reach left
+    at, bounded = psi.tolist(), cells.tolist()
+    for x, r, a, b in zip(psi[k].tolist(), reach.tolist(), first.tolist(), last.tolist(), strict=True):
+        lo = bisect.bisect_left(at, x - r, a, b + 1)  # the samples within reach: lo..hi
+        hi = bisect.bisect_right(at, x + r, a, b + 1) - 1
+        whole.append(max(bounded[lo:hi], default=-math.inf))
+        cut += [bounded[lo - 1] if lo > a else math.inf, bounded[hi] if hi < b else math.inf]
+        ends += [lo, hi]
+        left += [max(r - (x - at[lo]), 0.0), max(r - (at[hi] - x), 0.0)]
+    ends, left = np.array(ends, dtype=np.int64), np.array(left)
+    cones = np.minimum(
+        f[ends] + slope * left,
+        _capped_sum(
+            terms, [v[ends] + rate * left[:, None] for (_, _, v), rate in zip(terms, slopes, strict=True)]
+        ),
+    )
+    cut = np.minimum(np.array(cut), cones).reshape(-1, 2).max(axis=1)
+    return np.maximum(np.maximum(np.array(whole), cut), f[k])
+
+
+def _capped_sum(terms: list[tuple[float, float, np.ndarray]], bounds: list[np.ndarray]) -> np.ndarray:
+    """sum_g w_g min(cap_g, min_j bounds_gj): f from bounds (N, p_g) of each group's functions."""
+    total = 0.0
+    for (w, cap, _), b in zip(terms, bounds, strict=True):
+        total = total + w * np.minimum(cap, b.min(axis=1))
+    return total
 
 
 def _distance(a: float, b: float) -> float:
