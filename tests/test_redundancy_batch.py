@@ -15,7 +15,7 @@ import om_redundant as om
 from benchmarks.control_rate import HOMES, MIN_CLEARANCE, obstacles
 from om_redundant.redundancy.box_qp import maximise_1d
 from om_redundant.redundancy.objective import Group
-from om_redundant.redundancy.optimizer import _start_bounds
+from om_redundant.redundancy.optimizer import _StartBounds
 from om_redundant.redundancy.self_motion import self_motion_tangents
 
 
@@ -181,10 +181,10 @@ def test_the_one_variable_qp_step_is_the_models_maximiser(seed, pieces, curvatur
 @settings(max_examples=40, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1), runs=st.integers(1, 3), scale=st.floats(0.0, 4.0))
 def test_the_climbs_start_bounds_hold_for_functions_within_their_slopes(seed, runs, scale):
-    """optimizer._start_bounds, for term functions c + A sin(omega psi + phi) (slope bound
-    A omega; f's the weighted sum of its groups' largest) sampled on runs of uneven spacing:
-    every start's bound is at least f anywhere within its reach (a dense grid), at least f at
-    the start and at most the start's own cone f_k + L R (the bound before)."""
+    """optimizer._StartBounds.within, for term functions c + A sin(omega psi + phi) (slope
+    bound A omega; f's the weighted sum of its groups' largest) sampled on runs of uneven
+    spacing: every start's bound is at least f anywhere within its reach (a dense grid), at
+    least f at the start and at most the bound from its own cones (``cone``, the bound before)."""
     rng = np.random.default_rng(seed)
     groups = [(rng.uniform(0, 2), np.inf, rng.integers(1, 5)), (rng.uniform(0, 2), 1.0, rng.integers(1, 5))]
     waves = [rng.uniform([0.2, 0.0, 0.5, -3.0], [1.5, scale, 8.0, 3.0], (p, 4)) for _, _, p in groups]
@@ -206,9 +206,10 @@ def test_the_climbs_start_bounds_hold_for_functions_within_their_slopes(seed, ru
     last = np.append(starts[1:], len(psi))[owner] - 1
     terms = [(w, cap, v) for (w, cap, _), v in zip(groups, functions(psi), strict=True)]
     f = objective(psi)
-    k = np.arange(len(psi))
+    bounds = _StartBounds(psi, f, terms, slope, slopes, first, last)
     reach = rng.uniform(0.0, 1.0, len(psi))
-    bound = _start_bounds(psi, f, terms, slope, slopes, k, first, last, reach)
-    for x, r, b, f_k in zip(psi, reach, bound, f, strict=True):
-        assert b >= objective(np.linspace(x - r, x + r, 2001)).max() - 1e-12
-        assert f_k <= b <= f_k + slope * r + 1e-12
+    cones = bounds.cone(np.arange(len(psi)), reach)
+    for k, (x, r, f_k) in enumerate(zip(psi, reach, f, strict=True)):
+        bound = bounds.within(k, r)
+        assert bound >= objective(np.linspace(x - r, x + r, 2001)).max() - 1e-12
+        assert f_k <= bound <= min(cones[k], f_k + slope * r) + 1e-12

@@ -312,16 +312,19 @@ class RedundancyOptimizer:
             chosen |= np.array([_distance(x, near) <= END_TOLERANCE for x in psi.tolist()])
         k = np.flatnonzero(chosen)
         gap = np.maximum(psi[np.minimum(k + 1, last[k])] - psi[k], psi[k] - psi[np.maximum(k - 1, first[k])])
-        bound = _start_bounds(psi, f, terms, slope, limits, k, first[k], last[k], 2.0 * gap)
+        bounds = _StartBounds(psi, f, terms, slope, limits, first, last)
+        bound = bounds.cone(k, 2.0 * gap)
         rows = zip(f[k].tolist(), gap.tolist(), bound.tolist(), k.tolist(), strict=True)
-        starts = [(f_k, gap_k, bound_k, runs[owner[j]], points[j]) for f_k, gap_k, bound_k, j in rows]
+        starts = [(f_k, gap_k, bound_k, j) for f_k, gap_k, bound_k, j in rows]
         starts.sort(key=lambda s: -s[0])
-        found = [(starts[0][3], starts[0][4])]
+        found = [(runs[owner[starts[0][3]]], points[starts[0][3]])]
         best = found[0][1].evaluation.value
         probes = {}
-        for _, gap, bound, run, start in starts:
-            if (bound < best + _CLIMB_ROUNDING) if near is None else (bound < best - PLATEAU):
+        for _, gap, bound, j in starts:
+            least = best + _CLIMB_ROUNDING if near is None else best - PLATEAU  # what a climb must reach
+            if bound < least or bounds.within(j, 2.0 * gap) < least:  # (the cheap bound first)
                 continue
+            run, start = runs[owner[j]], points[j]
             lo, hi = (-math.inf, math.inf) if run.interval.closed else (run.interval.lo, run.interval.hi)
             signs = run.interval.signs
             if signs not in probes:
@@ -378,66 +381,74 @@ class RedundancyOptimizer:
         )
 
 
-def _start_bounds(
-    psi: np.ndarray,
-    f: np.ndarray,
-    terms: list[tuple[float, float, np.ndarray]],
-    slope: float,
-    slopes: list[np.ndarray],
-    k: np.ndarray,
-    first: np.ndarray,
-    last: np.ndarray,
-    reach: np.ndarray,
-) -> np.ndarray:
-    r"""Bounds of what climbs from the starts k can reach (module docstring, Starts): f
-    within ``reach`` R of each start, a function u of slope bound L being below the cones
+class _StartBounds:
+    r"""Bounds of what climbs from the samples of runs can reach (module docstring, Starts):
+    f within a reach R of a start, a function u of slope bound L being below the cones
     :math:`u_i + L |x - \psi_i|` of the samples of its run.
-
-    Between neighbouring samples i, i + 1 (h apart) the cones of the two meet at most at
-    :math:`(u_i + u_{i+1} + L h)/2`; in a cell that R cuts, or beyond the run's end, the
-    last sample's cone reaches :math:`u_i + L r` (r the reach left). Per cell or cut cell
-    the smaller of f's bound and :math:`\sum_g w_g \min(cap_g, \min_j \text{bound}_j)`
-    (each term function with its own slope), per start the largest over its cells within
-    reach; at least f at the start. Never above the start's own cone :math:`f_k + L R`.
 
     Args:
         psi, f: (M,) the runs' samples, a run's in increasing psi, and f there.
         terms: :meth:`~om_redundant.redundancy.objective.Objective.term_functions` at them.
         slope, slopes: L of f and of each group's functions (p_g,).
-        k, first, last: (K,) the starts and their runs' first and last samples.
-        reach: (K,) R per start.
+        first, last: (M,) each sample's run's first and last sample.
     """
-    h = np.diff(psi)  # (cells across two runs are never looked at)
-    peak = lambda u, rate, width: np.maximum(0.5 * (u[:-1] + u[1:] + rate * width), np.maximum(u[:-1], u[1:]))  # noqa: E731
-    cells = np.minimum(
-        peak(f, slope, h),
-        _capped_sum(
-            terms, [peak(v, rate, h[:, None]) for (_, _, v), rate in zip(terms, slopes, strict=True)]
-        ),
-    )
-    whole, cut, ends, left = (
-        [],
-        [],
-        [],
-        [],
-    )  # per start: the cells within reach; the cut cells, their ends, reach left
-    at, bounded = psi.tolist(), cells.tolist()
-    for x, r, a, b in zip(psi[k].tolist(), reach.tolist(), first.tolist(), last.tolist(), strict=True):
-        lo = bisect.bisect_left(at, x - r, a, b + 1)  # the samples within reach: lo..hi
-        hi = bisect.bisect_right(at, x + r, a, b + 1) - 1
-        whole.append(max(bounded[lo:hi], default=-math.inf))
-        cut += [bounded[lo - 1] if lo > a else math.inf, bounded[hi] if hi < b else math.inf]
-        ends += [lo, hi]
-        left += [max(r - (x - at[lo]), 0.0), max(r - (at[hi] - x), 0.0)]
-    ends, left = np.array(ends, dtype=np.int64), np.array(left)
-    cones = np.minimum(
-        f[ends] + slope * left,
-        _capped_sum(
-            terms, [v[ends] + rate * left[:, None] for (_, _, v), rate in zip(terms, slopes, strict=True)]
-        ),
-    )
-    cut = np.minimum(np.array(cut), cones).reshape(-1, 2).max(axis=1)
-    return np.maximum(np.maximum(np.array(whole), cut), f[k])
+
+    def __init__(
+        self,
+        psi: np.ndarray,
+        f: np.ndarray,
+        terms: list[tuple[float, float, np.ndarray]],
+        slope: float,
+        slopes: list[np.ndarray],
+        first: np.ndarray,
+        last: np.ndarray,
+    ):
+        self.psi, self.f, self.terms, self.slope, self.slopes = psi, f, terms, slope, slopes
+        self.first, self.last, self._at = first, last, psi.tolist()
+
+    def cone(self, k: np.ndarray, reach: np.ndarray) -> np.ndarray:
+        r"""(K,) the bounds from the starts' own cones: the smaller of :math:`f_k + L R` and
+        :math:`\sum_g w_g \min(cap_g, \min_j (v_{jk} + L_j R))`."""
+        return self._least(k, reach)
+
+    def within(self, k: int, reach: float) -> float:
+        r"""The bound of start k from every sample of its run within its reach R (never
+        above :meth:`cone`'s for consistent slopes). Between neighbouring samples i, i + 1
+        (h apart) the cones of the two meet at most at :math:`(u_i + u_{i+1} + L h)/2`; in
+        a cell that R cuts, or beyond the run's end, the last sample's cone reaches
+        :math:`u_i + L r` (r the reach left). Per cell or cut cell the smaller of f's bound
+        and the terms' (:meth:`cone`'s sum), the largest over the cells; at least f_k."""
+        at, a, b, x = self._at, int(self.first[k]), int(self.last[k]), self._at[k]
+        lo = bisect.bisect_left(at, x - reach, a, b + 1)  # the samples within reach: lo..hi
+        hi = bisect.bisect_right(at, x + reach, a, b + 1) - 1
+        cells = np.arange(lo - 1 if lo > a else lo, hi + 1 if hi < b else hi)  # whole and cut
+        bounded = np.full(hi - lo + 2, math.inf)  # the cut cells', then the whole ones
+        bounded[int(lo == a) : len(cells) + int(lo == a)] = self._peaks(cells)
+        ends = np.array([lo, hi])
+        cones = self._least(ends, np.maximum(reach - np.abs(self.psi[ends] - x), 0.0))
+        cut = np.minimum(bounded[[0, -1]], cones)
+        return max(float(bounded[1:-1].max(initial=-math.inf)), float(cut.max()), float(self.f[k]))
+
+    def _peaks(self, cells: np.ndarray) -> np.ndarray:
+        """The bounds of f between samples i and i + 1 for the cells i."""
+        h = self.psi[cells + 1] - self.psi[cells]
+
+        def peak(u: np.ndarray, rate: np.ndarray | float, width: np.ndarray) -> np.ndarray:
+            return np.maximum(
+                0.5 * (u[cells] + u[cells + 1] + rate * width), np.maximum(u[cells], u[cells + 1])
+            )
+
+        pairs = zip(self.terms, self.slopes, strict=True)
+        return np.minimum(
+            peak(self.f, self.slope, h),
+            _capped_sum(self.terms, [peak(v, L, h[:, None]) for (_, _, v), L in pairs]),
+        )
+
+    def _least(self, samples: np.ndarray, reach: np.ndarray) -> np.ndarray:
+        """The cones of the samples reaching ``reach`` further: f's and the terms' smaller."""
+        pairs = zip(self.terms, self.slopes, strict=True)
+        terms = _capped_sum(self.terms, [v[samples] + L * reach[:, None] for (_, _, v), L in pairs])
+        return np.minimum(self.f[samples] + self.slope * reach, terms)
 
 
 def _capped_sum(terms: list[tuple[float, float, np.ndarray]], bounds: list[np.ndarray]) -> np.ndarray:
