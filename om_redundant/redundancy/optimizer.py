@@ -403,13 +403,18 @@ class _StartBounds:
         first: np.ndarray,
         last: np.ndarray,
     ):
-        self.psi, self.f, self.terms, self.slope, self.slopes = psi, f, terms, slope, slopes
-        self.first, self.last, self._at = first, last, psi.tolist()
+        # f and every group's functions as the columns of one array, their slope bounds L
+        self.psi, self.first, self.last, self._at = psi, first, last, psi.tolist()
+        self._values = np.hstack([f[:, None]] + [v for _, _, v in terms])
+        self._slopes = np.concatenate([[slope], *slopes])
+        self._groups = np.cumsum([1] + [v.shape[1] for _, _, v in terms[:-1]])  # each group's first column
+        self._weights = np.array([w for w, _, _ in terms])
+        self._caps = np.array([cap for _, cap, _ in terms])
 
     def cone(self, k: np.ndarray, reach: np.ndarray) -> np.ndarray:
         r"""(K,) the bounds from the starts' own cones: the smaller of :math:`f_k + L R` and
         :math:`\sum_g w_g \min(cap_g, \min_j (v_{jk} + L_j R))`."""
-        return self._least(k, reach)
+        return self._bound(self._values[k] + self._slopes * reach[:, None])
 
     def within(self, k: int, reach: float) -> float:
         r"""The bound of start k from every sample of its run within its reach R (never
@@ -422,41 +427,26 @@ class _StartBounds:
         lo = bisect.bisect_left(at, x - reach, a, b + 1)  # the samples within reach: lo..hi
         hi = bisect.bisect_right(at, x + reach, a, b + 1) - 1
         cells = np.arange(lo - 1 if lo > a else lo, hi + 1 if hi < b else hi)  # whole and cut
-        bounded = np.full(hi - lo + 2, math.inf)  # the cut cells', then the whole ones
-        bounded[int(lo == a) : len(cells) + int(lo == a)] = self._peaks(cells)
+        u, v, h = self._values[cells], self._values[cells + 1], self.psi[cells + 1] - self.psi[cells]
+        peaks = np.maximum(0.5 * (u + v + self._slopes * h[:, None]), np.maximum(u, v))
         ends = np.array([lo, hi])
-        cones = self._least(ends, np.maximum(reach - np.abs(self.psi[ends] - x), 0.0))
-        cut = np.minimum(bounded[[0, -1]], cones)
-        return max(float(bounded[1:-1].max(initial=-math.inf)), float(cut.max()), float(self.f[k]))
+        left = np.maximum(reach - np.abs(self.psi[ends] - x), 0.0)
+        bounds = self._bound(np.vstack([peaks, self._values[ends] + self._slopes * left[:, None]]))
+        bounded = np.full(hi - lo + 2, math.inf)  # the cut cells', then the whole ones
+        bounded[int(lo == a) : len(cells) + int(lo == a)] = bounds[: len(cells)]
+        cut = np.minimum(bounded[[0, -1]], bounds[len(cells) :])
+        return max(float(bounded[1:-1].max(initial=-math.inf)), float(cut.max()), float(self._values[k, 0]))
 
-    def _peaks(self, cells: np.ndarray) -> np.ndarray:
-        """The bounds of f between samples i and i + 1 for the cells i."""
-        h = self.psi[cells + 1] - self.psi[cells]
-
-        def peak(u: np.ndarray, rate: np.ndarray | float, width: np.ndarray) -> np.ndarray:
-            return np.maximum(
-                0.5 * (u[cells] + u[cells + 1] + rate * width), np.maximum(u[cells], u[cells + 1])
-            )
-
-        pairs = zip(self.terms, self.slopes, strict=True)
-        return np.minimum(
-            peak(self.f, self.slope, h),
-            _capped_sum(self.terms, [peak(v, L, h[:, None]) for (_, _, v), L in pairs]),
-        )
-
-    def _least(self, samples: np.ndarray, reach: np.ndarray) -> np.ndarray:
-        """The cones of the samples reaching ``reach`` further: f's and the terms' smaller."""
-        pairs = zip(self.terms, self.slopes, strict=True)
-        terms = _capped_sum(self.terms, [v[samples] + L * reach[:, None] for (_, _, v), L in pairs])
-        return np.minimum(self.f[samples] + self.slope * reach, terms)
-
-
-def _capped_sum(terms: list[tuple[float, float, np.ndarray]], bounds: list[np.ndarray]) -> np.ndarray:
-    """sum_g w_g min(cap_g, min_j bounds_gj): f from bounds (N, p_g) of each group's functions."""
-    total = 0.0
-    for (w, cap, _), b in zip(terms, bounds, strict=True):
-        total = total + w * np.minimum(cap, b.min(axis=1))
-    return total
+    def _bound(self, values: np.ndarray) -> np.ndarray:
+        """(N,) the smaller of f's bound and sum_g w_g min(cap_g, min_j bound_j), from bounds
+        (N, 1 + n) of f and of each group's functions, the groups summed in their order."""
+        if not len(self._weights):  # no terms: f = 0
+            return np.minimum(values[:, 0], 0.0)
+        terms = self._weights * np.minimum(self._caps, np.minimum.reduceat(values, self._groups, axis=1))
+        total = 0.0
+        for column in terms.T:
+            total = total + column
+        return np.minimum(values[:, 0], total)
 
 
 def _distance(a: float, b: float) -> float:
