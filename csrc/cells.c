@@ -109,10 +109,59 @@ static PyObject *om_surprise(PyObject *mod, PyObject *const *args, Py_ssize_t na
     return PyFloat_FromDouble((double)(changes[0] + 1 + changes[1]) / 2.0 / (double)(N + 1));
 }
 
+/* crossing(ga, da, gb, db, span, hermite) -> fraction or None: where the first of surprise's
+ * models m_j reaches zero from a feasible end a (s = 0): the first of the N points s_k =
+ * (k + 1) / (N + 1) where one is negative, refined by the secant of the most negative one
+ * from the point before (from s = 0, where that model is ga_j, at the first point); None
+ * where none is negative there. A piece that surprise's bound keeps positive is skipped. */
+static PyObject *om_crossing(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 6, "crossing") < 0) return NULL;
+    double span = PyFloat_AsDouble(args[4]);
+    if (PyErr_Occurred()) return NULL;
+    Py_buffer v[5];
+    const buffer_spec sp[5] = {{F64, -1, 0, "ga"}, {F64, -1, 0, "da"}, {F64, -1, 0, "gb"}, {F64, -1, 0, "db"},
+                               {F64, -1, 0, "hermite"}};
+    PyObject *const objs[5] = {args[0], args[1], args[2], args[3], args[5]};
+    if (get_buffers(objs, v, sp, 5) < 0) return NULL;
+    Py_ssize_t n = v[0].len / 8, N = v[4].len / 32;
+    if (v[1].len != n * 8 || v[2].len != n * 8 || v[3].len != n * 8 || v[4].len != N * 32) {
+        release_buffers(v, 5);
+        PyErr_SetString(PyExc_ValueError, "crossing: sizes of the pieces or the basis disagree");
+        return NULL;
+    }
+    const double *ga = v[0].buf, *da = v[1].buf, *gb = v[2].buf, *db = v[3].buf, *H = v[4].buf;
+    double found = -1.0;
+    Py_ssize_t first = N; /* the first point where a model is negative */
+    int j_first = -1;
+    double m_first = 0.0;
+    for (Py_ssize_t j = 0; j < n; j++) {
+        if (fmin(ga[j], gb[j]) - 4.0 / 27.0 * fabs(span) * (fabs(da[j]) + fabs(db[j])) > 0.0) continue;
+        for (Py_ssize_t k = 0; k < N && k <= first; k++) { /* (up to the first found so far) */
+            double model = ga[j] * H[k] + da[j] * span * H[N + k] + gb[j] * H[2 * N + k] + db[j] * span * H[3 * N + k];
+            if (model < 0.0) {
+                if (k < first || model < m_first) first = k, j_first = (int)j, m_first = model;
+                break;
+            }
+        }
+    }
+    if (j_first >= 0) {
+        Py_ssize_t j = j_first, k = first;
+        double s1 = (double)(k + 1) / (double)(N + 1), s0 = (double)k / (double)(N + 1), m0 = ga[j];
+        if (k > 0)
+            m0 = ga[j] * H[k - 1] + da[j] * span * H[N + k - 1] + gb[j] * H[2 * N + k - 1] + db[j] * span * H[3 * N + k - 1];
+        found = s0 + (s1 - s0) * m0 / (m0 - m_first);
+    }
+    release_buffers(v, 5);
+    if (found < 0.0) Py_RETURN_NONE;
+    return PyFloat_FromDouble(found);
+}
+
 PyMethodDef om_cell_functions[] = {
     {"pieces", (PyCFunction)(void (*)(void))om_pieces, METH_FASTCALL,
      "pieces(q, t, distances, gradients, limited, lower, upper, half, numbers, g, dg) -> None"},
     {"surprise", (PyCFunction)(void (*)(void))om_surprise, METH_FASTCALL,
      "surprise(ga, da, gb, db, span, hermite, feasible_a, feasible_b, slack) -> fraction or None"},
+    {"crossing", (PyCFunction)(void (*)(void))om_crossing, METH_FASTCALL,
+     "crossing(ga, da, gb, db, span, hermite) -> fraction or None"},
     {NULL, NULL, 0, NULL},
 };

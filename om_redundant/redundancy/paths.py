@@ -34,14 +34,16 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Generator
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from .. import ckernels
 from ..om.solver import OMSolver
 from .objective import Objective
-from .probe import END_TOLERANCE, JUMP, SAME, Point, Probe
+from .probe import END_TOLERANCE, JUMP, SAME, Point, Probe, evaluate_points
 
 FINE_STEP = 0.25  # rad: cells in which a joint moves further get samples in between
 _MODEL_POINTS = 256  # points of a cell where the Hermite models are checked
@@ -52,6 +54,10 @@ _HERMITE = np.array(
 )
 _TURN = 2.0 * math.pi
 _BOUND_SLACK = 1e-9  # covers the rounding of the Hermite models in the bounds of _quiet
+
+#: What a process of :func:`lockstep` asks for: follow from the point towards psi on the
+#: probe's branch (:meth:`Probe.follow`).
+Follow = tuple[Probe, Point, float]
 
 
 @dataclass(eq=False)
@@ -114,6 +120,39 @@ def _neighbours_swept(signs: tuple[int, ...], branches: list[tuple[int, ...]], n
     neighbour's roots there are that neighbour's row's, the same joints and objective."""
     flips = (tuple(-s if j == i else s for j, s in enumerate(signs)) for i in range(len(signs)))
     return n % 2 == 0 and all(f in branches for f in flips)
+
+
+def lockstep(processes: list[Generator[Follow, tuple[Point, bool], Any]]) -> list[Any]:
+    """Run processes that each follow their paths one step after another (the refinement
+    of an interval's end, the look inside a cell), all at once: each round follows every
+    process's request (:data:`Follow`), evaluates the objective at all the points reached
+    in one batch (:func:`~om_redundant.redundancy.probe.evaluate_points`) and sends each
+    process its answer, ``probe.follow``'s (point reached, arrived). Each process makes the
+    same follows as it would alone; the objective is evaluated in batches instead of point
+    by point.
+
+    Returns:
+        Each process's return value, in order.
+    """
+    results: list[Any] = [None] * len(processes)
+    requests: dict[int, Follow] = {}
+
+    def advance(i: int, answer: tuple[Point, bool] | None) -> None:
+        try:
+            requests[i] = processes[i].send(answer)
+        except StopIteration as done:
+            results[i] = done.value
+
+    for i in range(len(processes)):
+        advance(i, None)
+    while requests:
+        asked = list(requests.items())
+        requests.clear()
+        answers = [probe.follow(start, psi) for _, (probe, start, psi) in asked]
+        evaluate_points(asked[0][1][0].objective, [point for point, _ in answers])
+        for (i, _), answer in zip(asked, answers, strict=True):
+            advance(i, answer)
+    return results
 
 
 def sweep_window(probe: Probe, center: float, hint: np.ndarray, half_width: float, n: int) -> list[Path]:

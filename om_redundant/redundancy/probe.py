@@ -83,6 +83,21 @@ class _Terms:
         return self.groups
 
 
+def evaluate_points(objective: Objective, points: list[Point]) -> None:
+    """The objective at those of the points not yet evaluated (their clearance's pair
+    distances and gradients, their evaluations), in one batch: what :attr:`Point.evaluation`
+    would compute point by point."""
+    terms = list({id(p.terms): p.terms for p in points if p.terms.evaluation is None}.values())
+    if not terms:
+        return
+    q = np.array([t.q for t in terms])
+    clearance = objective.clearance
+    pairs = None if clearance is None else clearance.distances_and_gradients(q)
+    evaluations = objective.evaluations(q, None if pairs is None else pairs[0])
+    for k, (t, ev) in enumerate(zip(terms, evaluations, strict=True)):
+        t.pairs, t.evaluation = None if pairs is None else (pairs[0][k], pairs[1][k]), ev
+
+
 @dataclass(frozen=True, eq=False)
 class Point:
     """An exact solution on a branch, its objective, and their rates along psi.
