@@ -32,7 +32,6 @@ elbow), so the solutions of a branch are organised as *paths*:
 
 from __future__ import annotations
 
-import itertools
 import math
 from collections.abc import Generator
 from dataclasses import dataclass
@@ -95,20 +94,34 @@ def sweep_circle(
     swept = []
     for b, signs in enumerate(branches):
         probe = Probe(solver, objective, T, signs)
-        grid, distinct = [], []  # the grid index of each distinct solution, its joints
-        for k in range(n):
-            found = []
-            for q in batch.q[rows[b, k], : batch.count[rows[b, k]]]:
-                if all(probe.step(q, f) > SAME for f in found):
-                    found.append(q)
-            grid += [k] * len(found)
-            distinct += found
+        grid, distinct = _distinct(probe, batch.q[rows[b]], batch.count[rows[b]])
         roots: list[list[Point]] = [[] for _ in range(n)]
-        if grid:
-            for k, point in zip(grid, probe.points(psi[grid], np.array(distinct)), strict=True):
+        if len(grid):
+            for k, point in zip(grid.tolist(), probe.points(psi[grid], distinct), strict=True):
                 roots[k].append(point)
-        swept.append([_with_hidden(probe, path) for path in _link(probe, psi, roots)])
-    return swept
+        swept.append([(probe, path) for path in _link(probe, psi, roots)])
+    filled = iter(_with_hidden([path for paths in swept for path in paths]))  # (every branch's at once)
+    return [[next(filled) for _ in paths] for paths in swept]
+
+
+def _distinct(probe: Probe, q: np.ndarray, count: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The distinct solutions of the grid rows q (n, roots, dof), count[k] of them in row k:
+    their grid indices, in order, and their joints. Solutions within SAME of an earlier one
+    of the row are that one; only rows with several solutions need the test."""
+    sizes = np.minimum(count, 1)
+    found = {}
+    for k in np.flatnonzero(count > 1).tolist():
+        found[k] = []
+        for row in q[k, : count[k]]:
+            if all(probe.step(row, f) > SAME for f in found[k]):
+                found[k].append(row)
+        sizes[k] = len(found[k])
+    grid = np.repeat(np.arange(len(count)), sizes)
+    distinct = q[grid, 0]
+    starts = np.cumsum(sizes) - sizes
+    for k, rows in found.items():
+        distinct[starts[k] : starts[k] + sizes[k]] = rows
+    return grid, distinct
 
 
 def _neighbours_swept(signs: tuple[int, ...], branches: list[tuple[int, ...]], n: int) -> bool:
@@ -171,8 +184,7 @@ def sweep_window(probe: Probe, center: float, hint: np.ndarray, half_width: floa
             if not arrived:
                 break
         halves.append(points[1:])
-    path = Path(halves[0][::-1] + [start] + halves[1])
-    return [_with_hidden(probe, path)]
+    return _with_hidden([(probe, Path(halves[0][::-1] + [start] + halves[1]))])
 
 
 def _link(probe: Probe, psi: np.ndarray, roots: list[list[Point]]) -> list[Path]:
@@ -280,34 +292,45 @@ def _same(probe: Probe, point: Point, candidates: list[Point]) -> int | None:
     return int(np.argmin(steps)) if steps and min(steps) <= SAME else None
 
 
-def _with_hidden(probe: Probe, path: Path) -> Path:
-    """The path with exact samples inserted where a cell hides a feature (module docstring)."""
-    ends = list(path.points)
-    if path.turns:  # the closing cell, to the first sample a loop later
-        ends.append(ends[0].at(ends[0].psi + _TURN * path.turns))
-    # the cells that need no look inside, all at once: no joint moves more than FINE_STEP
-    # and the cheap bounds show the models quiet (_hidden's own first test, vectorised)
-    q = np.array([p.q for p in ends])
-    calm = probe.steps(q[:-1], q[1:]) <= FINE_STEP
-    small = np.flatnonzero(calm)  # (only these cells' ends need their bounds now)
-    calm[small] = _quiet([ends[k] for k in small], [ends[k + 1] for k in small])
-    filled = [ends[0]]
-    for (a, b), skip in zip(itertools.pairwise(ends), calm.tolist(), strict=True):
-        filled += [b] if skip else [*_hidden(probe, a, b), b]
-    return Path(filled[:-1] if path.turns else filled, path.turns)
+def _with_hidden(paths: list[tuple[Probe, Path]]) -> list[Path]:
+    """The paths with exact samples inserted where a cell hides a feature (module
+    docstring): the look inside every cell of every (probe, path) at once (:func:`lockstep`)."""
+    cells = []  # (probe, a, b) of the cells that need a look, path by path in order
+    calms = []
+    for probe, path in paths:
+        ends = list(path.points)
+        if path.turns:  # the closing cell, to the first sample a loop later
+            ends.append(ends[0].at(ends[0].psi + _TURN * path.turns))
+        # the cells that need no look inside, all at once: no joint moves more than FINE_STEP
+        # and the cheap bounds show the models quiet (_hidden's own first test, vectorised)
+        q = np.array([p.q for p in ends])
+        calm = probe.steps(q[:-1], q[1:]) <= FINE_STEP
+        small = np.flatnonzero(calm)  # (only these cells' ends need their bounds now)
+        calm[small] = _quiet([ends[k] for k in small], [ends[k + 1] for k in small])
+        calms.append((ends, calm.tolist()))
+        cells += [(probe, ends[k], ends[k + 1]) for k in np.flatnonzero(~calm).tolist()]
+    inserted = iter(lockstep([_hidden(*cell) for cell in cells]))
+    result = []
+    for (_, path), (ends, calm) in zip(paths, calms, strict=True):
+        filled = [ends[0]]
+        for b, skip in zip(ends[1:], calm, strict=True):
+            filled += [b] if skip else [*next(inserted), b]
+        result.append(Path(filled[:-1] if path.turns else filled, path.turns))
+    return result
 
 
-def _hidden(probe: Probe, a: Point, b: Point) -> list[Point]:
+def _hidden(probe: Probe, a: Point, b: Point) -> Generator[Follow, tuple[Point, bool], list[Point]]:
     """Exact samples inserted between neighbours a and b of a path, in order: halving until
     no joint moves more than :data:`FINE_STEP` in a sub-cell, then until the Hermite models
-    of every sub-cell agree with its ends (module docstring)."""
+    of every sub-cell agree with its ends (module docstring). A process of :func:`lockstep`,
+    which asks for each inserted sample's follow."""
     inserted, cells = [], [(a, b)]
     while cells and len(inserted) < _MAX_INSERTED:
         left, right = cells.pop()
         t = 0.5 if probe.step(left.q, right.q) > FINE_STEP else _surprise(left, right)
         if t is None or right.psi - left.psi <= END_TOLERANCE:
             continue
-        middle, arrived = probe.follow(left, left.psi + t * (right.psi - left.psi))
+        middle, arrived = yield probe, left, left.psi + t * (right.psi - left.psi)
         if arrived:
             inserted.append(middle)
             cells += [(left, middle), (middle, right)]
