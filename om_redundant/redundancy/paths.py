@@ -295,7 +295,7 @@ def _same(probe: Probe, point: Point, candidates: list[Point]) -> int | None:
 def _with_hidden(paths: list[tuple[Probe, Path]]) -> list[Path]:
     """The paths with exact samples inserted where a cell hides a feature (module
     docstring): the look inside every cell of every (probe, path) at once (:func:`lockstep`)."""
-    cells = []  # (probe, a, b) of the cells that need a look, path by path in order
+    cells = []  # (probe, a, b, step) of the cells that need a look, path by path in order
     calms = []
     for probe, path in paths:
         ends = list(path.points)
@@ -304,11 +304,13 @@ def _with_hidden(paths: list[tuple[Probe, Path]]) -> list[Path]:
         # the cells that need no look inside, all at once: no joint moves more than FINE_STEP
         # and the cheap bounds show the models quiet (_hidden's own first test, vectorised)
         q = np.array([p.q for p in ends])
-        calm = probe.steps(q[:-1], q[1:]) <= FINE_STEP
+        steps = probe.steps(q[:-1], q[1:])
+        calm = steps <= FINE_STEP
         small = np.flatnonzero(calm)  # (only these cells' ends need their bounds now)
         calm[small] = _quiet([ends[k] for k in small], [ends[k + 1] for k in small])
         calms.append((ends, calm.tolist()))
-        cells += [(probe, ends[k], ends[k + 1]) for k in np.flatnonzero(~calm).tolist()]
+        looked = np.flatnonzero(~calm).tolist()
+        cells += [(probe, ends[k], ends[k + 1], float(steps[k])) for k in looked]
     inserted = iter(lockstep([_hidden(*cell) for cell in cells]))
     result = []
     for (_, path), (ends, calm) in zip(paths, calms, strict=True):
@@ -319,21 +321,25 @@ def _with_hidden(paths: list[tuple[Probe, Path]]) -> list[Path]:
     return result
 
 
-def _hidden(probe: Probe, a: Point, b: Point) -> Generator[Follow, tuple[Point, bool], list[Point]]:
-    """Exact samples inserted between neighbours a and b of a path, in order: halving until
-    no joint moves more than :data:`FINE_STEP` in a sub-cell, then until the Hermite models
-    of every sub-cell agree with its ends (module docstring). A process of :func:`lockstep`,
-    which asks for each inserted sample's follow."""
-    inserted, cells = [], [(a, b)]
+def _hidden(
+    probe: Probe, a: Point, b: Point, step: float
+) -> Generator[Follow, tuple[Point, bool], list[Point]]:
+    """Exact samples inserted between neighbours a and b of a path (``step``: the largest
+    joint step between them), in order: halving until no joint moves more than
+    :data:`FINE_STEP` in a sub-cell, then until the Hermite models of every sub-cell agree
+    with its ends (module docstring). A process of :func:`lockstep`, which asks for each
+    inserted sample's follow."""
+    inserted, cells = [], [(a, b, step)]
     while cells and len(inserted) < _MAX_INSERTED:
-        left, right = cells.pop()
-        t = 0.5 if probe.step(left.q, right.q) > FINE_STEP else _surprise(left, right)
+        left, right, step = cells.pop()
+        t = 0.5 if step > FINE_STEP else _surprise(left, right)
         if t is None or right.psi - left.psi <= END_TOLERANCE:
             continue
         middle, arrived = yield probe, left, left.psi + t * (right.psi - left.psi)
         if arrived:
             inserted.append(middle)
-            cells += [(left, middle), (middle, right)]
+            before, after = probe.steps(np.array([left.q, middle.q]), np.array([middle.q, right.q])).tolist()
+            cells += [(left, middle, before), (middle, right, after)]
     return sorted(inserted, key=lambda p: p.psi)
 
 
