@@ -357,29 +357,29 @@ def _surprise(a: Point, b: Point) -> float | None:
 
 
 def _quiet(a: list[Point], b: list[Point]) -> np.ndarray:
-    """Whether each cell (a_k, b_k)'s cubic models cannot surprise, by bounds from the ends'
-    values and rates (:meth:`~om_redundant.redundancy.objective.Objective.constraint_bounds`):
-    on [0, 1] the Hermite basis functions of the values are >= 0 and sum to 1 and those of
-    the slopes stay within 4/27 in size, so a model lies within (4/27) span (|g'_a| + |g'_b|)
-    of the ends' range. Quiet: both ends feasible and every model stays >= 0, or both
-    infeasible and one function's model stays < 0 (the bounds below 0 are the functions
-    themselves)."""
+    """Whether each cell (a_k, b_k)'s cubic models (:func:`_surprise`'s, of the ends'
+    feasibility functions and rates, :meth:`Point.pieces`) cannot surprise, by bounds: on
+    [0, 1] the Hermite basis functions of the values are >= 0 and sum to 1 and those of the
+    slopes stay within 4/27 in size, so a model lies within (4/27) span (|g'_a| + |g'_b|) of
+    the ends' range. Quiet: both ends feasible and every model stays >= 0, or both
+    infeasible and one function's model stays < 0; then :func:`_surprise` finds no change
+    (it skips the pieces that this bound keeps positive)."""
     feasible = np.array([p.evaluation.feasible for p in a], dtype=bool)
     quiet = np.zeros(len(a), dtype=bool)
     alike = np.flatnonzero(feasible == np.array([p.evaluation.feasible for p in b], dtype=bool))
     if len(alike) == 0:  # (only cells whose ends are alike need their bounds)
         return quiet
     a, b = [a[k] for k in alike], [b[k] for k in alike]
-    (ga, ra), (gb, rb) = _bounds(a), _bounds(b)
+    (ga, da), (gb, db) = _pieces(a), _pieces(b)
     span = np.abs(np.array([y.psi - x.psi for x, y in zip(a, b, strict=True)], dtype=float))
-    spread = 4.0 / 27.0 * span[:, None] * (ra + rb) + _BOUND_SLACK
+    spread = 4.0 / 27.0 * span[:, None] * (np.abs(da) + np.abs(db)) + _BOUND_SLACK
     clear = (np.minimum(ga, gb) - spread > 0.0).all(axis=1)
     blocked = (np.maximum(ga, gb) + spread < 0.0).any(axis=1)
     quiet[alike] = np.where(feasible[alike], clear, blocked)
     return quiet
 
 
-def _bounds(points: list[Point]) -> tuple[np.ndarray, np.ndarray]:
-    """The points' constraint bounds stacked: values (M, n), rate bounds (M, n)."""
-    bounds = [p.terms.get_bounds() for p in points]
-    return np.array([v for v, _ in bounds]), np.array([r for _, r in bounds])
+def _pieces(points: list[Point]) -> tuple[np.ndarray, np.ndarray]:
+    """The points' feasibility functions and rates stacked: (M, n) each."""
+    pieces = [p.pieces() for p in points]
+    return np.array([g for g, _ in pieces]), np.array([dg for _, dg in pieces])
