@@ -229,20 +229,17 @@ def _link(probe: Probe, psi: np.ndarray, roots: list[list[Point]]) -> list[Path]
 def _continuing(probe: Probe, roots: list[list[Point]]) -> dict[Point, bool]:
     """For each solution at a grid psi followed by a single one at the next: whether that one
     continues its path (:meth:`Probe.continues`), all tested at once."""
-    pairs = [(a, roots[k][0]) for k in range(1, len(roots)) if len(roots[k]) == 1 for a in roots[k - 1]]
+    flat = [p for points in roots for p in points]
+    start = np.cumsum([0] + [len(points) for points in roots]).tolist()  # each psi's first in flat
+    single = [k for k in range(1, len(roots)) if len(roots[k]) == 1]
+    pairs = [(i, start[k]) for k in single for i in range(start[k - 1], start[k])]
     if not pairs:
         return {}
-    flags = probe.continue_rows(*(np.array([[p.psi for p in pair] for pair in pairs]).T), *_stacked(pairs))
-    return dict(zip([a for a, _ in pairs], flags.tolist(), strict=True))
-
-
-def _stacked(pairs: list[tuple[Point, Point]]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The first points' joints and tangents and the second points' joints, stacked."""
-    return (
-        np.array([a.q for a, _ in pairs]),
-        np.array([a.tangent[:, 0] for a, _ in pairs]),
-        np.array([b.q for _, b in pairs]),
-    )
+    a, b = (np.array(x) for x in zip(*pairs, strict=True))
+    psi = np.array([p.psi for p in flat])
+    q, tangents = np.array([p.q for p in flat]), np.array([p.tangent[:, 0] for p in flat])
+    flags = probe.continue_rows(psi[a], psi[b], q[a], tangents[a], q[b])
+    return dict(zip([flat[i] for i in a.tolist()], flags.tolist(), strict=True))
 
 
 def _joined(
