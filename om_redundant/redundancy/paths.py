@@ -32,6 +32,7 @@ elbow), so the solutions of a branch are organised as *paths*:
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Generator
 from dataclasses import dataclass
@@ -291,29 +292,42 @@ def _same(probe: Probe, point: Point, candidates: list[Point]) -> int | None:
 
 def _with_hidden(paths: list[tuple[Probe, Path]]) -> list[Path]:
     """The paths with exact samples inserted where a cell hides a feature (module
-    docstring): the look inside every cell of every (probe, path) at once (:func:`lockstep`)."""
-    cells = []  # (probe, a, b, step) of the cells that need a look, path by path in order
-    calms = []
-    for probe, path in paths:
-        ends = list(path.points)
-        if path.turns:  # the closing cell, to the first sample a loop later
-            ends.append(ends[0].at(ends[0].psi + _TURN * path.turns))
-        # the cells that need no look inside, all at once: no joint moves more than FINE_STEP
-        # and the cheap bounds show the models quiet (_hidden's own first test, vectorised)
-        q = np.array([p.q for p in ends])
-        steps = probe.steps(q[:-1], q[1:])
-        calm = steps <= FINE_STEP
-        small = np.flatnonzero(calm)  # (only these cells' ends need their bounds now)
-        calm[small] = _quiet([ends[k] for k in small], [ends[k + 1] for k in small])
-        calms.append((ends, calm.tolist()))
-        looked = np.flatnonzero(~calm).tolist()
-        cells += [(probe, ends[k], ends[k + 1], float(steps[k])) for k in looked]
-    inserted = iter(lockstep([_hidden(*cell) for cell in cells]))
-    result = []
-    for (_, path), (ends, calm) in zip(paths, calms, strict=True):
+    docstring): the look inside every cell of every (probe, path) at once (:func:`lockstep`).
+    The probes share one objective."""
+    if not paths:
+        return []
+    ends_of = []  # each path's samples, then a loop's closing cell's end (its first, a loop later)
+    for _, path in paths:
+        closing = [path.points[0].at(path.points[0].psi + _TURN * path.turns)] if path.turns else []
+        ends_of.append(list(path.points) + closing)
+    flat = [p for ends in ends_of for p in ends]
+    evaluate_points(paths[0][0].objective, flat)  # (the path ends that the following found)
+    # every cell's first tests at once: no joint moves more than FINE_STEP and the bounds of
+    # the cubic models show them quiet (else _hidden looks inside)
+    first = np.cumsum([0] + [len(ends) for ends in ends_of]).tolist()  # each path's first in flat
+    bounds = list(itertools.pairwise(first))
+    a = np.concatenate([np.arange(i, j - 1) for i, j in bounds])  # each cell's first end in flat
+    q = np.array([p.q for p in flat])
+    steps = np.concatenate(
+        [probe.steps(q[i : j - 1], q[i + 1 : j]) for (probe, _), (i, j) in zip(paths, bounds, strict=True)]
+    )
+    psi = np.array([p.psi for p in flat])
+    feasible = np.array([p.evaluation.feasible for p in flat], dtype=bool)
+    pieces = [p.pieces() for p in flat]
+    g, dg = np.array([x for x, _ in pieces]), np.array([x for _, x in pieces])
+    calm = (steps <= FINE_STEP) & _quiet(
+        psi[a + 1] - psi[a], g[a], dg[a], g[a + 1], dg[a + 1], feasible[a], feasible[a + 1]
+    )
+    probes = [probe for (probe, _), ends in zip(paths, ends_of, strict=True) for _ in ends[1:]]
+    looked, a = np.flatnonzero(~calm).tolist(), a.tolist()
+    cells = [_hidden(probes[c], flat[a[c]], flat[a[c] + 1], float(steps[c])) for c in looked]
+    inserted = dict(zip(looked, lockstep(cells), strict=True))
+    result, c = [], 0
+    for (_, path), ends in zip(paths, ends_of, strict=True):
         filled = [ends[0]]
-        for b, skip in zip(ends[1:], calm, strict=True):
-            filled += [b] if skip else [*next(inserted), b]
+        for b in ends[1:]:
+            filled += [*inserted.get(c, ()), b]
+            c += 1
         result.append(Path(filled[:-1] if path.turns else filled, path.turns))
     return result
 
@@ -353,30 +367,24 @@ def _surprise(a: Point, b: Point) -> float | None:
     return ckernels.surprise(ga, da, gb, db, b.psi - a.psi, _HERMITE, *feasible, _BOUND_SLACK)
 
 
-def _quiet(a: list[Point], b: list[Point]) -> np.ndarray:
-    """Whether each cell (a_k, b_k)'s cubic models (:func:`_surprise`'s, of the ends'
-    feasibility functions and rates, :meth:`Point.pieces`) cannot surprise, by bounds: on
-    [0, 1] the Hermite basis functions of the values are >= 0 and sum to 1 and those of the
-    slopes stay within 4/27 in size, so a model lies within (4/27) span (|g'_a| + |g'_b|) of
-    the ends' range. Quiet: both ends feasible and every model stays >= 0, or both
-    infeasible and one function's model stays < 0; then :func:`_surprise` finds no change
-    (it skips the pieces that this bound keeps positive)."""
-    feasible = np.array([p.evaluation.feasible for p in a], dtype=bool)
-    quiet = np.zeros(len(a), dtype=bool)
-    alike = np.flatnonzero(feasible == np.array([p.evaluation.feasible for p in b], dtype=bool))
-    if len(alike) == 0:  # (only cells whose ends are alike need their bounds)
-        return quiet
-    a, b = [a[k] for k in alike], [b[k] for k in alike]
-    (ga, da), (gb, db) = _pieces(a), _pieces(b)
-    span = np.abs(np.array([y.psi - x.psi for x, y in zip(a, b, strict=True)], dtype=float))
-    spread = 4.0 / 27.0 * span[:, None] * (np.abs(da) + np.abs(db)) + _BOUND_SLACK
+def _quiet(
+    span: np.ndarray,
+    ga: np.ndarray,
+    da: np.ndarray,
+    gb: np.ndarray,
+    db: np.ndarray,
+    feasible_a: np.ndarray,
+    feasible_b: np.ndarray,
+) -> np.ndarray:
+    """Whether each cell's cubic models (:func:`_surprise`'s, of its ends' feasibility
+    functions ga, gb (cells, n) and their rates da, db, :meth:`Point.pieces`; span: the
+    cell's psi) cannot surprise, by bounds: on [0, 1] the Hermite basis functions of the
+    values are >= 0 and sum to 1 and those of the slopes stay within 4/27 in size, so a
+    model lies within (4/27) |span| (|g'_a| + |g'_b|) of the ends' range. Quiet: both ends
+    feasible and every model stays >= 0, or both infeasible and one function's model stays
+    < 0; then :func:`_surprise` finds no change (it skips the pieces that this bound keeps
+    positive)."""
+    spread = 4.0 / 27.0 * np.abs(span)[:, None] * (np.abs(da) + np.abs(db)) + _BOUND_SLACK
     clear = (np.minimum(ga, gb) - spread > 0.0).all(axis=1)
     blocked = (np.maximum(ga, gb) + spread < 0.0).any(axis=1)
-    quiet[alike] = np.where(feasible[alike], clear, blocked)
-    return quiet
-
-
-def _pieces(points: list[Point]) -> tuple[np.ndarray, np.ndarray]:
-    """The points' feasibility functions and rates stacked: (M, n) each."""
-    pieces = [p.pieces() for p in points]
-    return np.array([g for g, _ in pieces]), np.array([dg for _, dg in pieces])
+    return (feasible_a == feasible_b) & np.where(feasible_a, clear, blocked)
