@@ -149,7 +149,7 @@ def _run(probe: Probe, span: _Span, lo: Point | None, hi: Point | None) -> Run:
     points = [*([] if lo is None else [lo]), *span.points, *([] if hi is None else [hi])]
     lo_psi = wrap_psi(points[0].psi)
     shift = lo_psi - points[0].psi
-    points = [p.at(p.psi + shift) for p in points]
+    points = [p.at(p.psi + shift) for p in points] if shift else points
     return Run(PsiInterval(probe.signs, lo_psi, points[-1].psi), points)
 
 

@@ -266,7 +266,7 @@ def _joined(
         while chain[-1] in following and following[chain[-1]] not in chain:
             chain.append(following[chain[-1]])
         seen.update(chain)
-        points = [p.at(p.psi + _TURN * turn) for turn, i in enumerate(chain) for p in paths[i]]
+        points = [p.at(p.psi + _TURN * turn) if turn else p for turn, i in enumerate(chain) for p in paths[i]]
         if following.get(chain[-1]) == chain[0]:
             result.append(Path(points, turns=len(chain)))
         else:
