@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 import om_redundant as om
 from benchmarks.control_rate import HOMES, MIN_CLEARANCE, obstacles
 from om_redundant import ckernels
-from om_redundant.redundancy.paths import _BOUND_SLACK, _HERMITE
+from om_redundant.redundancy.paths import _BOUND_SLACK, _HERMITE, _quiet
 from om_redundant.redundancy.self_motion import self_motion_tangents
 
 
@@ -98,3 +98,18 @@ def test_crossing_is_numpys(seed, pieces, span):
     assert (got is None) == (want is None)
     if want is not None:
         assert 0.0 <= got <= 1.0 and abs(got - want) <= 1e-12
+
+
+@settings(max_examples=300, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), pieces=st.integers(1, 12), span=st.floats(-1.0, 1.0))
+def test_a_quiet_cell_has_no_surprise(seed, pieces, span):
+    """paths._quiet's bounds: where they call a cell quiet, ckernels.surprise finds no change
+    that its ends do not explain (so skipping its look changes no sample); cells drawn near
+    the bounds' edge (values small against the slopes), ends feasible or not as they say."""
+    rng = np.random.default_rng(seed)
+    ga, gb = rng.normal(0.05, 0.3, (2, pieces))
+    da, db = rng.normal(0.0, 0.5 / max(abs(span), 1e-6), (2, pieces))
+    fa, fb = bool((ga >= 0).all()), bool((gb >= 0).all())
+    quiet = _quiet(np.array([span]), ga[None], da[None], gb[None], db[None], np.array([fa]), np.array([fb]))
+    if quiet[0]:
+        assert ckernels.surprise(ga, da, gb, db, span, _HERMITE, fa, fb, _BOUND_SLACK) is None

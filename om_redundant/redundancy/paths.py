@@ -143,7 +143,7 @@ def lockstep(processes: list[Generator[Follow, tuple[Point, bool], Any]]) -> lis
     in one batch (:func:`~om_redundant.redundancy.probe.evaluate_points`) and sends each
     process its answer, ``probe.follow``'s (point reached, arrived). Each process makes the
     same follows as it would alone; the objective is evaluated in batches instead of point
-    by point.
+    by point. The processes' probes share one objective.
 
     Returns:
         Each process's return value, in order.
