@@ -16,11 +16,6 @@
 #define DIP_STEPS 24       /* golden-section steps to a dip's bottom: 0.618^24 of two cells, 1e-5 rad */
 #define SWING 1.5          /* rad: a change of g across one scan cell that is a swing of q_J (pi), not its slope */
 #define WRIST_BISECTIONS 64 /* halvings of a cell of the wrist residual's sign change: to the last bit */
-#define LINE_PASSES 3       /* self-motion searches at psi's half-line, each from the last one's pose-polished end */
-#define LINE_NEWTON 6       /* Newton steps to the self-motion's closest pass by the half-line */
-#define LINE_DIFFERENCE 1e-6 /* step (in |n|) of the central difference of h along the self-motion */
-#define LINE_SCAN 7         /* scan points on either side of the closest pass: azimuth steps of pi / 16 */
-#define LINE_BISECTIONS 80  /* halvings of the scan's bracket of psi: to the last bit */
 
 /* The smallest |branch quantity| of q and its index (NaN-safe: INFINITY for NaN). */
 static double nearest_branch(const om_solver_data *s, const double *q, int *index)
@@ -34,110 +29,6 @@ static double nearest_branch(const om_solver_data *s, const double *q, int *inde
         }
     }
     return nearest;
-}
-
-/* q = q0 + s n (7 joints). */
-static void _line_point(const double *q0, const double *n, double s, double *q)
-{
-    for (int j = 0; j < 7; j++)
-        q[j] = q0[j] + s * n[j];
-}
-
-/* The wrapped miss of psi at q0 + s n from the requested one, in the requested ELBOW branch
- * (om_verify's); q gets the point. */
-static double _line_miss(const om_problem *pb, const double *q0, const double *n, double s, double *q)
-{
-    _line_point(q0, n, s, q);
-    return om_wrap(om_srs_arm_angle_in(pb->s->params, q, (double)pb->signs[ELBOW_SIGN]) - pb->redundancy[0]);
-}
-
-/* h = up x (W - S) of the model at q0 + s n (q: scratch). */
-static vec3 _line_across(const om_problem *pb, const double *q0, const double *n, double s, double *q)
-{
-    _line_point(q0, n, s, q);
-    return om_srs_half_line_across(pb->s->params, q);
-}
-
-/* psi's singular half-line along the real arm's self-motion: where the model's shoulder-wrist
- * vector passes by the half-line at rho, psi turns by 2 pi within a few rho / v of the
- * closest pass (v: the speed of h = up x (W - S) there), so every requested psi is met there,
- * within its own rounding by a floating-point q (verify.c), though not within reach of the
- * refinement, whose psi row is flat to rounding on that scale. From q (refined first on the
- * pose rows alone), along the self-motion's unit null vector n: the closest pass s* (Newton
- * on h . h' = 0, h' by central differences: h is smooth there, unlike psi), the scan s* +
- * (rho / v) tan(k pi / 16), k = -7 ... 7, between whose points a straight pass turns the
- * azimuth of h by pi / 16, psi's miss bisected to the last bit in the scan's first bracket (a
- * change of sign, not a wrap), both ends verified. The line q + s n leaves the self-motion by
- * O(s^2): where an end misses the pose, the next pass starts from it. Returns whether q (then
- * the accepted end) holds. */
-static bool _line_search(om_problem *pb, const om_polish_task *t, double *q, double *pos, double *ori)
-{
-    om_polish_task pose = *t;
-    pose.P = NULL;
-    double q0[7], n[7], qa[7], qb[7];
-    memcpy(q0, q, sizeof q0);
-    for (int pass = 0; pass < LINE_PASSES; pass++) {
-        om_polish(&pose, POLISH_STEPS, q0);
-        om_self_motion_null(pb->s, q0, n);
-        double norm = 0.0;
-        for (int j = 0; j < 7; j++)
-            norm += n[j] * n[j];
-        norm = sqrt(norm);
-        if (!(norm > 0.0) || !isfinite(norm))
-            return false;
-        for (int j = 0; j < 7; j++)
-            n[j] /= norm;
-        double centre = 0.0, speed = 0.0;
-        for (int it = 0; it < LINE_NEWTON; it++) {
-            vec3 h = _line_across(pb, q0, n, centre, qa);
-            vec3 dh = v_scale(0.5 / LINE_DIFFERENCE, v_sub(_line_across(pb, q0, n, centre + LINE_DIFFERENCE, qa),
-                                                           _line_across(pb, q0, n, centre - LINE_DIFFERENCE, qa)));
-            double dd = v_dot(dh, dh), next = centre - v_dot(h, dh) / dd;
-            speed = sqrt(dd);
-            if (!isfinite(next) || next == centre)
-                break;
-            centre = next;
-        }
-        double scale = v_norm(_line_across(pb, q0, n, centre, qa)) / speed;
-        if (!isfinite(scale))
-            return false;
-        double sa = 0.0, ma = NAN, sb = 0.0, mb = NAN;
-        bool bracket = false;
-        for (int k = -LINE_SCAN; k <= LINE_SCAN && !bracket; k++) {
-            sa = sb;
-            ma = mb;
-            sb = centre + scale * tan((double)k * OM_PI / (2.0 * (double)LINE_SCAN + 2.0));
-            mb = _line_miss(pb, q0, n, sb, qb);
-            bracket = ma * mb <= 0.0 && fabs(ma - mb) < OM_PI; /* false with the first point's NaN */
-        }
-        if (!bracket)
-            return false;
-        for (int it = 0; it < LINE_BISECTIONS; it++) {
-            double sc = 0.5 * (sa + sb);
-            if (sc == sa || sc == sb)
-                break;
-            double mc = _line_miss(pb, q0, n, sc, qa);
-            if (mc * ma > 0.0) {
-                sa = sc;
-                ma = mc;
-            } else {
-                sb = sc;
-                mb = mc;
-            }
-        }
-        _line_point(q0, n, sa, qa);
-        _line_point(q0, n, sb, qb);
-        double *near = fabs(ma) <= fabs(mb) ? qa : qb, *far = near == qa ? qb : qa;
-        for (int e = 0; e < 2; e++) {
-            double *end = e == 0 ? near : far;
-            if (om_verify(pb, end, pos, ori)) {
-                memcpy(q, end, sizeof q0);
-                return true;
-            }
-        }
-        memcpy(q0, near, sizeof q0);
-    }
-    return false;
 }
 
 bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori)
@@ -159,8 +50,17 @@ bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori)
     om_polish(&t, POLISH_STEPS, q);
     if (om_verify(pb, q, pos, ori))
         return true;
-    if (half_line && s->dof == 7 && _line_search(pb, &t, q, pos, ori))
-        return true;
+    if (half_line && s->dof == 7) { /* the pose met, psi not: psi turns along the loop next to the half-line */
+        double on_pose[7];
+        om_polish_task pose = t;
+        pose.P = NULL;
+        memcpy(on_pose, q, sizeof on_pose);
+        om_polish(&pose, POLISH_STEPS, on_pose);
+        if (om_loop_pass(pb, on_pose, pos, ori)) {
+            memcpy(q, on_pose, sizeof on_pose);
+            return true;
+        }
+    }
     /* The model's q1 is arbitrary all along its shoulder boundary where that boundary is the
      * wrist centre on joint 1's axis (no lateral offset; a candidate there may be far off in
      * q1 and in the ARM quantity); with a lateral offset, as at every other boundary, only
@@ -451,5 +351,7 @@ int om_band_roots(om_problem *pb, double *roots, bool *neighbour_reached)
         for (int r = 0; r < n; r++) /* verified again in the problem's own configuration */
             count = om_add_root(pb, found + r * s->dof, roots, count);
     }
+    if (count == 0) /* next to psi's half-line the model's search may miss what the real arm's loop meets */
+        count = om_loop_roots(pb, roots, count);
     return count;
 }

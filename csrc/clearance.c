@@ -1,5 +1,11 @@
-/* Distances between an arm's geoms and obstacle geoms, and their gradients, in one call each
- * (om_redundant/redundancy/clearance.py).
+/* Distances between an arm's geoms and obstacle geoms, and their gradients, for many joint
+ * vectors in one call (om_redundant/redundancy/clearance.py).
+ *
+ * Placement: the arm's links are the frames of its DH chain (csrc/kinematics.c's rows) started
+ * from the world pose of DH frame 0; link l (l = 0..dof) is the frame just before joint l+1's
+ * row (the chain's end for l = dof), which joints 1..l move, and joint l+1 turns about its z
+ * axis through its origin. A geom on link l sits at the fixed offset G in it, X = F_l(q) G,
+ * both taken once from the model (clearance.py). Obstacles do not move.
  *
  * Each geom is a core and a radius: a sphere is its centre and radius, a capsule the segment
  * of its axis and radius, a box itself and 0. The distance of two geoms that do not touch is
@@ -8,12 +14,12 @@
  * Segment to segment: the minimiser of the convex quadratic |c1(s) - c2(t)|^2 over the unit
  * square (Ericson, Real-Time Collision Detection, 5.1.9). Segment to box, in the box's frame:
  * |p(t) - clamp(p(t))|^2 is a quadratic between the parameters where p(t) crosses a face's
- * plane, minimised on each piece in closed form. Pairs of other kinds, and pairs whose
- * geoms touch or overlap, are left to MuJoCo (marked nan).
+ * plane, minimised on each piece in closed form. Pairs of other kinds, pairs whose cores
+ * touch and boxes touched are left to MuJoCo (marked nan).
  *
- * Gradient of pair k, its arm point p moving with the body of the arm geom: the distance
- * changes by -n . dp, with dp/dq_j = a_j x (p - o_j) for a hinge joint j (axis a_j through
- * o_j, MuJoCo's xaxis and xanchor) and a_j for a slide joint, for the joints that move it. */
+ * Gradient of pair k, its arm point p moving with link l: the distance changes by -n . dp,
+ * with dp/dq_j = a_j x (p - o_j) for a revolute joint j <= l (axis a_j through o_j) and a_j
+ * for a prismatic one. */
 #include <string.h>
 
 #include "binding.h"
@@ -92,7 +98,9 @@ static void core(const double *xpos, const double *xmat, const double *half, int
 }
 
 /* The signed distance of geoms g1 (point or segment core) and g2 (any core but MuJoCo's),
- * their nearest points into fromto; nan where they touch. */
+ * their nearest points into fromto: negative where a sphere or capsule overlaps one whose
+ * core it does not touch (the depth MuJoCo gives); nan where the cores touch, or a box is
+ * touched (MuJoCo's depth in a box is not the cores' distance). */
 static double pair_distance(const int64_t *kind, const double *radius, const double *half, const double *xpos,
                             const double *xmat, int g1, int g2, double *fromto) {
     double a1[3], b1[3], c1[3], c2[3];
@@ -113,7 +121,7 @@ static double pair_distance(const int64_t *kind, const double *radius, const dou
     }
     double v[3] = {c2[0] - c1[0], c2[1] - c1[1], c2[2] - c1[2]}, length = sqrt(dot3(v, v));
     double dist = length - radius[g1] - radius[g2];
-    if (!(dist > 0.0)) return NAN;
+    if (!(length > 0.0) || (kind[g2] == CORE_BOX && !(dist > 0.0))) return NAN;
     for (int i = 0; i < 3; i++) {
         double n = v[i] / length;
         fromto[i] = c1[i] + radius[g1] * n;
@@ -122,34 +130,46 @@ static double pair_distance(const int64_t *kind, const double *radius, const dou
     return dist;
 }
 
-/* geom_distances(kind, radius, half, xpos, xmat, pairs, bounds, reach, dist, fromto) -> left:
- * each pair's distance capped at reach (reach without computing it where the bounding spheres
- * are that far apart) and nearest points; nan for the `left` pairs MuJoCo must compute. */
-static PyObject *om_geom_distances(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
-    if (check_nargs(nargs, 10, "geom_distances") < 0) return NULL;
-    double reach = PyFloat_AsDouble(args[7]);
-    if (reach == -1.0 && PyErr_Occurred()) return NULL;
-    Py_buffer v[9];
-    const buffer_spec sp[9] = {{I64, -1, 0, "kind"},  {F64, -1, 0, "radius"},     {F64, -1, 0, "half"},
-                               {F64, -1, 0, "xpos"},  {F64, -1, 0, "xmat"},       {I64, -1, 0, "pairs"},
-                               {F64, -1, 0, "bounds"}, {F64, -1, 1, "dist"},      {F64, -1, 1, "fromto"}};
-    PyObject *const objs[9] = {args[0], args[1], args[2], args[3], args[4], args[5], args[6], args[8], args[9]};
-    if (get_buffers(objs, v, sp, 9) < 0) return NULL;
-    Py_ssize_t G = v[0].len / 8, P = v[6].len / 8;
-    const int64_t *kind = v[0].buf, *pairs = v[5].buf;
-    int bad = v[1].len != G * 8 || v[2].len != G * 24 || v[3].len != G * 24 || v[4].len != G * 72 ||
-              v[5].len != P * 16 || v[7].len != P * 8 || v[8].len != P * 48;
-    for (Py_ssize_t k = 0; k < P && !bad; k++)
-        bad = pairs[2 * k] < 0 || pairs[2 * k] >= G || pairs[2 * k + 1] < 0 || pairs[2 * k + 1] >= G;
-    if (bad) {
-        release_buffers(v, 9);
-        PyErr_SetString(PyExc_ValueError, "geom_distances: sizes of the geoms, pairs and outputs disagree");
-        return NULL;
+/* The world poses of links 0..dof at q (rows of R (9) and p (3) in frames, (dof + 1) x 12):
+ * the chain's rows applied from start, the pose of DH frame 0. */
+static void link_frames(const double *table, int n_rows, const double *start, const double *q, double *frames) {
+    double R[9], p[3];
+    memcpy(R, start, sizeof R);
+    memcpy(p, start + 9, sizeof p);
+    int j = 0;
+    for (int k = 0; k < n_rows; k++) {
+        const double *row = table + 6 * k;
+        int joint = row[5] != 2.0;
+        if (joint) memcpy(frames + 12 * j, R, sizeof R), memcpy(frames + 12 * j + 9, p, sizeof p);
+        om_apply_row(R, p, row, joint ? q[j] : 0.0);
+        j += joint;
     }
-    const double *radius = v[1].buf, *half = v[2].buf, *xpos = v[3].buf, *xmat = v[4].buf, *bounds = v[6].buf;
-    double *dist = v[7].buf, *fromto = v[8].buf;
+    memcpy(frames + 12 * j, R, sizeof R);
+    memcpy(frames + 12 * j + 9, p, sizeof p);
+}
+
+/* The world pose of each arm geom a (xpos 3, xmat 9 per geom), on link link[a] at offset[a]
+ * (R 9, p 3): X = F G. */
+static void place(const double *frames, const int64_t *link, const double *offset, Py_ssize_t A, double *xpos,
+                  double *xmat) {
+    for (Py_ssize_t a = 0; a < A; a++) {
+        const double *F = frames + 12 * link[a], *G = offset + 12 * a;
+        for (int i = 0; i < 3; i++) {
+            xpos[3 * a + i] = F[9 + i] + F[3 * i] * G[9] + F[3 * i + 1] * G[10] + F[3 * i + 2] * G[11];
+            for (int j = 0; j < 3; j++)
+                xmat[9 * a + 3 * i + j] = F[3 * i] * G[j] + F[3 * i + 1] * G[3 + j] + F[3 * i + 2] * G[6 + j];
+        }
+    }
+}
+
+/* Each pair's distance capped at reach (reach without computing it where the bounding
+ * spheres are that far apart) and nearest points; nan for the pairs MuJoCo must compute,
+ * counted in the return value. */
+static long distances(const int64_t *kind, const double *radius, const double *half, const double *xpos,
+                      const double *xmat, const int64_t *pairs, const double *bounds, Py_ssize_t P, double reach,
+                      double *dist, double *fromto) {
     long left = 0;
-    Py_BEGIN_ALLOW_THREADS for (Py_ssize_t k = 0; k < P; k++) {
+    for (Py_ssize_t k = 0; k < P; k++) {
         int g1 = (int)pairs[2 * k], g2 = (int)pairs[2 * k + 1];
         double *ft = fromto + 6 * k, w[3];
         for (int i = 0; i < 3; i++) w[i] = xpos[3 * g1 + i] - xpos[3 * g2 + i];
@@ -163,56 +183,159 @@ static PyObject *om_geom_distances(PyObject *mod, PyObject *const *args, Py_ssiz
             dist[k] = NAN;
         left += isnan(dist[k]);
     }
-    Py_END_ALLOW_THREADS release_buffers(v, 9);
-    return PyLong_FromLong(left);
+    return left;
 }
 
-/* distance_gradients(dist, fromto, reach, xanchor, xaxis, joints, slide, moves, grad): the
- * gradient of each pair's distance over the arm's joints (zero where capped at reach or 0). */
-static PyObject *om_distance_gradients(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
-    if (check_nargs(nargs, 9, "distance_gradients") < 0) return NULL;
-    double reach = PyFloat_AsDouble(args[2]);
-    if (reach == -1.0 && PyErr_Occurred()) return NULL;
-    Py_buffer v[8];
-    const buffer_spec sp[8] = {{F64, -1, 0, "dist"},  {F64, -1, 0, "fromto"}, {F64, -1, 0, "xanchor"},
-                               {F64, -1, 0, "xaxis"}, {I64, -1, 0, "joints"}, {U8, -1, 0, "slide"},
-                               {U8, -1, 0, "moves"},  {F64, -1, 1, "grad"}};
-    PyObject *const objs[8] = {args[0], args[1], args[3], args[4], args[5], args[6], args[7], args[8]};
-    if (get_buffers(objs, v, sp, 8) < 0) return NULL;
-    Py_ssize_t P = v[0].len / 8, n = v[4].len / 8, J = v[2].len / 24;
-    const int64_t *joints = v[4].buf;
-    int bad = v[1].len != P * 48 || v[3].len != J * 24 || v[5].len != n || v[6].len != P * n || v[7].len != P * n * 8;
-    for (Py_ssize_t j = 0; j < n && !bad; j++) bad = joints[j] < 0 || joints[j] >= J;
-    if (bad) {
-        release_buffers(v, 8);
-        PyErr_SetString(PyExc_ValueError, "distance_gradients: sizes of the pairs, joints and outputs disagree");
-        return NULL;
-    }
-    const double *dist = v[0].buf, *fromto = v[1].buf, *anchor = v[2].buf, *axis = v[3].buf;
-    const uint8_t *slide = v[5].buf, *moves = v[6].buf;
-    double *grad = v[7].buf;
-    Py_BEGIN_ALLOW_THREADS for (Py_ssize_t k = 0; k < P; k++) {
-        double *row = grad + k * n;
+/* The gradient over the dof joints of each pair's distance (zero where capped at reach, 0 or
+ * left to MuJoCo); the first link[a] joints move arm geom a, the first of the pair. */
+static void gradients(const double *dist, const double *fromto, const int64_t *pairs, const int64_t *link,
+                      const double *frames, const uint8_t *slide, Py_ssize_t P, int dof, double reach, double *grad) {
+    for (Py_ssize_t k = 0; k < P; k++) {
+        double *row = grad + k * dof;
         const double *p = fromto + 6 * k;
-        memset(row, 0, n * sizeof(double));
+        memset(row, 0, dof * sizeof(double));
         if (!(dist[k] < reach && dist[k] != 0.0)) continue;
         double nk[3] = {(p[3] - p[0]) / dist[k], (p[4] - p[1]) / dist[k], (p[5] - p[2]) / dist[k]};
-        for (Py_ssize_t j = 0; j < n; j++) {
-            if (!moves[k * n + j]) continue;
-            const double *a = axis + 3 * joints[j], *o = anchor + 3 * joints[j];
-            double r[3] = {p[0] - o[0], p[1] - o[1], p[2] - o[2]};
+        for (int j = 0; j < link[pairs[2 * k]]; j++) {
+            const double *F = frames + 12 * j;
+            double a[3] = {F[2], F[5], F[8]}, r[3] = {p[0] - F[9], p[1] - F[10], p[2] - F[11]};
             double dp[3] = {a[1] * r[2] - a[2] * r[1], a[2] * r[0] - a[0] * r[2], a[0] * r[1] - a[1] * r[0]};
             row[j] = -dot3(nk, slide[j] ? a : dp);
         }
     }
-    Py_END_ALLOW_THREADS release_buffers(v, 8);
+}
+
+/* The arm's fixed data, as both entry points read it: the first 7 arguments. */
+enum { N_ARM = 7 };
+static const buffer_spec arm_spec[N_ARM] = {
+    {F64, -1, 0, "table"}, {F64, 12, 0, "start"}, {I64, -1, 0, "link"}, {F64, -1, 0, "offset"},
+    {U8, -1, 0, "slide"},  {F64, -1, 0, "q"},     {F64, -1, 1, "xpos"},
+};
+
+/* Check the arm's arguments (table rows of 6, offsets of 12 per geom, links within 0..dof,
+ * q rows of dof); the number of rows of q into *M, dof into *dof. */
+static int check_arm(Py_buffer *v, Py_ssize_t A, Py_ssize_t *M, int *dof, const char *what) {
+    Py_ssize_t n_rows = v[0].len / 48, joints = 0;
+    const double *table = v[0].buf;
+    for (Py_ssize_t k = 0; k < n_rows; k++) joints += table[6 * k + 5] != 2.0;
+    const int64_t *link = v[2].buf;
+    int bad = v[0].len != n_rows * 48 || joints < 1 || joints > OM_MAX_DOF || v[2].len != A * 8 ||
+              v[3].len != A * 96 || v[4].len != joints || v[5].len % (joints * 8) != 0;
+    for (Py_ssize_t a = 0; a < A && !bad; a++) bad = link[a] < 0 || link[a] > joints;
+    if (bad) {
+        PyErr_Format(PyExc_ValueError, "%s: sizes of the chain, geoms and joint vectors disagree", what);
+        return -1;
+    }
+    *M = v[5].len / (joints * 8);
+    *dof = (int)joints;
+    return 0;
+}
+
+/* arm_geom_poses(table, start, link, offset, slide, q, xpos, xmat): the world poses (A, 3) and
+ * (A, 3, 3) of the arm's A geoms at the joint vector q. */
+static PyObject *om_arm_geom_poses(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, N_ARM + 1, "arm_geom_poses") < 0) return NULL;
+    Py_buffer v[N_ARM + 1];
+    buffer_spec sp[N_ARM + 1];
+    memcpy(sp, arm_spec, sizeof arm_spec);
+    sp[N_ARM] = (buffer_spec){F64, -1, 1, "xmat"};
+    if (get_buffers(args, v, sp, N_ARM + 1) < 0) return NULL;
+    Py_ssize_t A = v[2].len / 8, M;
+    int dof;
+    if (check_arm(v, A, &M, &dof, "arm_geom_poses") < 0 || M != 1 || v[6].len != A * 24 || v[7].len != A * 72) {
+        if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "arm_geom_poses: one joint vector, A poses");
+        release_buffers(v, N_ARM + 1);
+        return NULL;
+    }
+    double frames[12 * (OM_MAX_DOF + 1)];
+    link_frames(v[0].buf, (int)(v[0].len / 48), v[1].buf, v[5].buf, frames);
+    place(frames, v[2].buf, v[3].buf, A, v[6].buf, v[7].buf);
+    release_buffers(v, N_ARM + 1);
     Py_RETURN_NONE;
 }
 
+/* arm_clearance(table, start, link, offset, slide, q, obstacle_pos, obstacle_mat, kind, radius,
+ * half, pairs, bounds, reach, dist, fromto, grad, given) -> left: the geoms are the arm's A and
+ * the O obstacles (poses (O, 3) and (O, 9)), G = A + O; for each row m of q (M, dof), the arm's
+ * geoms placed (in this call's own work array: calls may run in parallel), each pair's
+ * distance (M, P) capped at reach and nearest points (M, P, 6) (nan: the `left` pairs MuJoCo
+ * must compute), and unless grad is None their gradients (M, P, dof). given true: dist and
+ * fromto are read, not written, for the gradients of pairs MuJoCo computed. Pairs (P, 2) index
+ * the geoms, an arm geom first. */
+static PyObject *om_arm_clearance(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    enum { N = N_ARM + 9 }; /* buffers: the arm's, obstacle_mat ... bounds, dist, fromto, grad */
+    if (check_nargs(nargs, 18, "arm_clearance") < 0) return NULL;
+    double reach = PyFloat_AsDouble(args[13]);
+    if (reach == -1.0 && PyErr_Occurred()) return NULL;
+    int given = PyObject_IsTrue(args[17]), with_grad = args[16] != Py_None;
+    if (given < 0) return NULL;
+    if (given && !with_grad) {
+        PyErr_SetString(PyExc_ValueError, "arm_clearance: given distances need grad");
+        return NULL;
+    }
+    Py_buffer v[N];
+    buffer_spec sp[N];
+    memcpy(sp, arm_spec, sizeof arm_spec);
+    sp[N_ARM - 1] = (buffer_spec){F64, -1, 0, "obstacle_pos"};
+    const buffer_spec rest[N - N_ARM] = {
+        {F64, -1, 0, "obstacle_mat"},  {I64, -1, 0, "kind"},       {F64, -1, 0, "radius"},
+        {F64, -1, 0, "half"},  {I64, -1, 0, "pairs"},      {F64, -1, 0, "bounds"},
+        {F64, -1, !given, "dist"}, {F64, -1, !given, "fromto"}, {F64, -1, 1, "grad"}};
+    memcpy(sp + N_ARM, rest, sizeof rest);
+    PyObject *const objs[N] = {args[0],  args[1],  args[2],  args[3],  args[4],  args[5],  args[6], args[7],
+                               args[8],  args[9],  args[10], args[11], args[12], args[14], args[15], args[16]};
+    int n_views = with_grad ? N : N - 1;
+    if (get_buffers(objs, v, sp, n_views) < 0) return NULL;
+    Py_ssize_t A = v[2].len / 8, G = v[8].len / 8, P = v[12].len / 8, M;
+    int dof;
+    if (check_arm(v, A, &M, &dof, "arm_clearance") < 0) {
+        release_buffers(v, n_views);
+        return NULL;
+    }
+    const int64_t *pairs = v[11].buf;
+    int bad = A > G || v[6].len != (G - A) * 24 || v[7].len != (G - A) * 72 || v[9].len != G * 8 ||
+              v[10].len != G * 24 || v[11].len != P * 16 || v[13].len != M * P * 8 || v[14].len != M * P * 48 ||
+              (with_grad && v[15].len != M * P * dof * 8);
+    for (Py_ssize_t k = 0; k < P && !bad; k++)
+        bad = pairs[2 * k] < 0 || pairs[2 * k] >= A || pairs[2 * k + 1] < A || pairs[2 * k + 1] >= G;
+    if (bad) {
+        release_buffers(v, n_views);
+        PyErr_SetString(PyExc_ValueError, "arm_clearance: sizes of the geoms, pairs and outputs disagree");
+        return NULL;
+    }
+    const double *table = v[0].buf, *start = v[1].buf, *offset = v[3].buf, *q = v[5].buf;
+    const int64_t *link = v[2].buf, *kind = v[8].buf;
+    const uint8_t *slide = v[4].buf;
+    const double *radius = v[9].buf, *half = v[10].buf, *bounds = v[12].buf;
+    double *dist = v[13].buf, *fromto = v[14].buf, *grad = with_grad ? v[15].buf : NULL;
+    double *xpos = PyMem_RawMalloc((size_t)G * 12 * sizeof(double)), *xmat = xpos + 3 * G; /* poses, all geoms */
+    if (!xpos) {
+        release_buffers(v, n_views);
+        return PyErr_NoMemory();
+    }
+    memcpy(xpos + 3 * A, v[6].buf, (size_t)(G - A) * 3 * sizeof(double));
+    memcpy(xmat + 9 * A, v[7].buf, (size_t)(G - A) * 9 * sizeof(double));
+    int n_rows = (int)(v[0].len / 48);
+    long left = 0;
+    Py_BEGIN_ALLOW_THREADS for (Py_ssize_t m = 0; m < M; m++) {
+        double frames[12 * (OM_MAX_DOF + 1)], *d = dist + m * P, *ft = fromto + 6 * m * P;
+        link_frames(table, n_rows, start, q + m * dof, frames);
+        if (!given) {
+            place(frames, link, offset, A, xpos, xmat);
+            left += distances(kind, radius, half, xpos, xmat, pairs, bounds, P, reach, d, ft);
+        }
+        if (grad) gradients(d, ft, pairs, link, frames, slide, P, dof, reach, grad + m * P * dof);
+    }
+    Py_END_ALLOW_THREADS PyMem_RawFree(xpos);
+    release_buffers(v, n_views);
+    return PyLong_FromLong(left);
+}
+
 PyMethodDef om_clearance_functions[] = {
-    {"geom_distances", (PyCFunction)(void (*)(void))om_geom_distances, METH_FASTCALL,
-     "geom_distances(kind, radius, half, xpos, xmat, pairs, bounds, reach, dist, fromto) -> pairs left to MuJoCo"},
-    {"distance_gradients", (PyCFunction)(void (*)(void))om_distance_gradients, METH_FASTCALL,
-     "distance_gradients(dist, fromto, reach, xanchor, xaxis, joints, slide, moves, grad)"},
+    {"arm_geom_poses", (PyCFunction)(void (*)(void))om_arm_geom_poses, METH_FASTCALL,
+     "arm_geom_poses(table, start, link, offset, slide, q, xpos, xmat)"},
+    {"arm_clearance", (PyCFunction)(void (*)(void))om_arm_clearance, METH_FASTCALL,
+     "arm_clearance(table, start, link, offset, slide, q, obstacle_pos, obstacle_mat, kind, radius, half, pairs, "
+     "bounds, reach, dist, fromto, grad, given) -> pairs left to MuJoCo"},
     {NULL, NULL, 0, NULL},
 };

@@ -285,6 +285,15 @@ int om_add_candidate(om_problem *pb, double *q, double *roots, int count);
  * (their flipped branch quantity within OM_BRANCH_BAND of zero), verified, into roots
  * (OM_MAX_ROOTS x dof); returns the count. *neighbour_reached: some neighbour had a root. */
 int om_band_roots(om_problem *pb, double *roots, bool *neighbour_reached);
+/* loop_search.c: for a 7-DOF S-R-S configuration without a root whose pose's wrist centre may
+ * come within 1e-2 rad of psi's singular half-line, the roots met where psi crosses the
+ * requested value along the real arm's self-motion loops through the pose's solutions in the
+ * same signs at other arm angles, into roots from count on; returns the count. */
+int om_loop_roots(om_problem *pb, double *roots, int count);
+/* For q on the pose (within 1e-12) next to psi's half-line: psi's crossings of the requested
+ * value where the self-motion loop through q passes by the line; the first root into q (*pos,
+ * *ori its errors). Returns whether there was one. */
+bool om_loop_pass(om_problem *pb, double *q, double *pos, double *ori);
 
 /* search.c */
 int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre, double radius);

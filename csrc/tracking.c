@@ -4,7 +4,7 @@
  *
  * Pieces v_j (normalised, see objective.py) in three groups g: the joint-limit margins
  * (q_i - l_i)/h_i and (u_i - q_i)/h_i (floor 0, no cap), the clearances d_k/d_cap linearised
- * about the joints where Python last evaluated them (floor d_min/d_cap, cap 1), the
+ * about the joints where Python last evaluated them (given in metres; floor d_min/d_cap, cap 1), the
  * singularity distances |sin(q_j + c_j)|/s_cap (no floor, cap 1). Their rates
  * a_j = dv_j/dq . dq/dpsi use the self-motion tangent dq/dpsi = n / (dpsi/dq . n), n the
  * null vector of the 6 x 7 Jacobian J by cofactors, n_i = (-1)^i det J_{-i} (smooth in q, no
@@ -19,8 +19,8 @@
 enum { TR_OK = 0, TR_NO_SOLUTION = 1, TR_SINGULAR = 2, TR_INFEASIBLE = 3, TR_LOST = 4 };
 /* layout of the setup vector */
 enum {
-    S_PSI, S_WM, S_WC, S_WS, S_FLOOR_C, S_SING_CAP, S_MAX_STEP, S_CURVATURE, S_JOINT_STEP, S_N_SING, S_N_CLEAR,
-    S_HEAD
+    S_PSI, S_WM, S_WC, S_WS, S_FLOOR_C, S_SING_CAP, S_MAX_STEP, S_CURVATURE, S_JOINT_STEP, S_CLEAR_CAP, S_N_SING,
+    S_N_CLEAR, S_HEAD
 };
 /* layout of the output vector after q (dof) */
 enum { O_PSI, O_STEP, O_CURVATURE, O_MARGIN, O_SINGULARITY, O_CLEARANCE, O_POS, O_ORI, O_EVALS, O_WITHIN, O_N };
@@ -55,11 +55,15 @@ static void pieces_at(const tracking *tr, const double *q, const double *t, piec
         P->v[n] = (tr->upper[i] - q[i]) / h, P->a[n] = -t[i] / h, P->group[n++] = 0;
     }
     int n_clear = (int)tr->setup[S_N_CLEAR], n_sing = (int)tr->setup[S_N_SING];
+    double d_cap = tr->setup[S_CLEAR_CAP];
     for (int k = 0; k < n_clear; k++) {
         const double *g = tr->clear_g + k * dof;
-        double v = tr->clear_d[k], a = 0.0;
+        double v = tr->clear_d[k] / d_cap, a = 0.0;
         int moving = 0;
-        for (int i = 0; i < dof; i++) v += g[i] * (q[i] - tr->q_ref[i]), a += g[i] * t[i], moving |= g[i] != 0.0;
+        for (int i = 0; i < dof; i++) {
+            double gi = g[i] / d_cap;
+            v += gi * (q[i] - tr->q_ref[i]), a += gi * t[i], moving |= gi != 0.0;
+        }
         if (!moving && v >= tr->cap[1]) continue; /* a pair beyond the reach: constant above the cap, never active */
         P->v[n] = v, P->a[n] = a, P->group[n++] = 1;
     }
@@ -85,17 +89,45 @@ static double slope(const tracking *tr, const pieces *P, double b, double d) {
     return D;
 }
 
-/* The maximiser of the model over the box and the floors; false if they leave nothing. */
-static bool box_step(const tracking *tr, const pieces *P, double b, double radius, double *step) {
-    double lo = -radius, hi = radius;
+/* The pieces of P that can be their group's smallest somewhere in [lo, hi], into Q. A piece is
+ * left out where its least value there exceeds the least of the group's greatest values (each
+ * at an end: the pieces are linear) by more than the rounding of v + a d can make up (at most
+ * 2^-52 (|v| + |a d|) each, so 1e-12 of both pieces' magnitudes is ample): the computed v_j(d)
+ * then exceeds that other piece's at every d of [lo, hi], and slope's minima, its tie-breaks
+ * and so its every value are P's. */
+static void contenders(const pieces *P, double lo, double hi, pieces *Q) {
+    double reach = fmax(fabs(lo), fabs(hi)), least_top[3] = {INFINITY, INFINITY, INFINITY}, size[3] = {0.0, 0.0, 0.0};
     for (int j = 0; j < P->n; j++) {
-        double floor = tr->floor[P->group[j]], a = P->a[j], gap = floor - P->v[j];
+        int g = P->group[j];
+        double top = fmax(P->v[j] + P->a[j] * lo, P->v[j] + P->a[j] * hi);
+        if (top < least_top[g]) least_top[g] = top, size[g] = fabs(P->v[j]) + fabs(P->a[j]) * reach;
+    }
+    int n = 0;
+    for (int j = 0; j < P->n; j++) {
+        int g = P->group[j];
+        double bottom = fmin(P->v[j] + P->a[j] * lo, P->v[j] + P->a[j] * hi);
+        double slack = 1e-12 * (1.0 + fabs(P->v[j]) + fabs(P->a[j]) * reach + size[g]);
+        if (bottom - least_top[g] > slack) continue; /* (NaN: kept) */
+        Q->v[n] = P->v[j], Q->a[n] = P->a[j], Q->group[n++] = g;
+    }
+    Q->n = n;
+}
+
+/* The maximiser of the model over the box and the floors; false if they leave nothing. The
+ * bisection reads only the pieces that can bind (contenders). */
+static bool box_step(const tracking *tr, const pieces *all, double b, double radius, double *step) {
+    double lo = -radius, hi = radius;
+    for (int j = 0; j < all->n; j++) {
+        double floor = tr->floor[all->group[j]], a = all->a[j], gap = floor - all->v[j];
         if (floor == -INFINITY) continue;
         if (a > 0.0) lo = fmax(lo, gap / a);
         else if (a < 0.0) hi = fmin(hi, gap / a);
         else if (gap > 0.0) return false;
     }
     if (!(lo <= hi)) return false;
+    static pieces contending; /* (the GIL is held: one call at a time) */
+    const pieces *P = &contending;
+    contenders(all, lo, hi, &contending);
     if (slope(tr, P, b, lo) <= 0.0) return *step = lo, true;
     double left = lo, right = hi;
     if (slope(tr, P, b, hi) >= 0.0) return *step = hi, true;
@@ -109,10 +141,12 @@ static bool box_step(const tracking *tr, const pieces *P, double b, double radiu
     return true;
 }
 
-/* The second solve's root (at psi + d, hinted by q0) is taken without the windowed scan for
- * a nearer one where it continues the step's path beyond doubt (om_beyond_doubt, as follow.c
- * takes its roots); else the scan decides, and where the local solve fails, the bounded
- * search, as before. (About 15 us of the Panda's step.) */
+/* Each exact solve's root is taken without the windowed scan for a nearer one where it
+ * continues its path from the hint beyond doubt (om_beyond_doubt, as follow.c takes its
+ * roots): the second solve's (at psi + d, hinted by q0) along the self-motion, the first
+ * solve's (at psi, hinted by q_prev) along the hand's motion at fixed psi (pose_motion). Else
+ * the scan decides, and where the local solve fails, the bounded search, as before. (Each scan
+ * cost 12-15 us of the Panda's step.) The prediction: q d ahead of q along t. */
 typedef struct {
     int dof;
     const double *q, *t;
@@ -124,12 +158,67 @@ static om_root_verdict on_step(const double *x, void *context) {
     return om_beyond_doubt(p->dof, p->q, x, p->t, p->d, NULL) ? OM_ROOT_TAKE : OM_ROOT_SCAN;
 }
 
+/* x of A x = b (A n x n row-major and b destroyed, x into b) by elimination with partial
+ * pivoting; false where A is singular or x not finite. */
+static bool solve_linear(double *A, double *b, int n) {
+    for (int k = 0; k < n; k++) {
+        int p = k;
+        for (int i = k + 1; i < n; i++)
+            if (fabs(A[i * n + k]) > fabs(A[p * n + k])) p = i;
+        if (A[p * n + k] == 0.0) return false;
+        if (p != k) {
+            for (int j = k; j < n; j++) {
+                double t = A[k * n + j];
+                A[k * n + j] = A[p * n + j], A[p * n + j] = t;
+            }
+            double t = b[k];
+            b[k] = b[p], b[p] = t;
+        }
+        for (int i = k + 1; i < n; i++) {
+            double f = A[i * n + k] / A[k * n + k];
+            for (int j = k; j < n; j++) A[i * n + j] -= f * A[k * n + j];
+            b[i] -= f * b[k];
+        }
+    }
+    for (int k = n - 1; k >= 0; k--) {
+        for (int j = k + 1; j < n; j++) b[k] -= A[k * n + j] * b[j];
+        b[k] /= A[k * n + k];
+        if (!isfinite(b[k])) return false;
+    }
+    return true;
+}
+
+/* The first solve's prediction: the joints' first-order motion dq from q with psi held while
+ * the flange moves from its pose (R, p) at q to the target's (R_d, p_d),
+ *     [J(q); Dpsi(q)] dq = [p_d - p; omega; 0],
+ * J the flange's geometric Jacobian [v; omega] and omega = vee((E - E^T) / 2), E = R_d R^T, the
+ * rotation vector of E to first order (all in DH frame 0, as om_self_motion_null's J). False
+ * where the 7 x 7 system is singular: no prediction, the scan decides. */
+static bool pose_motion(const om_solver_data *s, const double *T, const double *q, double *dq) {
+    static const double eye[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    double A[7 * 7], R[9], p[3];
+    om_jacobian(s->real_table, s->n_real_rows, eye, eye, q, 7, A); /* rows 0-5 of A */
+    om_arm_angle_gradient(s->params, s->model_table, s->n_model_rows, q, A + 6 * 7);
+    om_flange(s->real_table, s->n_real_rows, q, R, p);
+    mat3 Rd;
+    vec3 pd;
+    om_flange_target(T, s->T_base_root, s->T_tool_flange, &Rd, &pd);
+    mat3 E = m_mmt(Rd, m_load(R, 0));
+    double b[7] = {pd.x - p[0], pd.y - p[1], pd.z - p[2], 0.5 * (E.r2.y - E.r1.z), 0.5 * (E.r0.z - E.r2.x),
+                   0.5 * (E.r1.x - E.r0.y), 0.0};
+    if (!solve_linear(A, b, 7)) return false;
+    memcpy(dq, b, sizeof b);
+    return true;
+}
+
 static int track(const tracking *tr, const double *T, const int64_t *signs, const double *q_prev, double *q1,
                  double *out) {
     const om_solver_data *s = tr->s;
     int dof = s->dof;
-    double psi = tr->setup[S_PSI], q0[OM_MAX_DOF], t0[OM_MAX_DOF], t1[OM_MAX_DOF];
-    om_result r = om_solve_one(s, T, signs, &psi, q_prev, q0, NULL, NULL);
+    double psi = tr->setup[S_PSI], q0[OM_MAX_DOF], t0[OM_MAX_DOF], t1[OM_MAX_DOF], dq[OM_MAX_DOF];
+    step_prediction moved = {dof, q_prev, dq, 1.0};
+    bool predicted = s->mode != OM_FIXED && pose_motion(s, T, q_prev, dq); /* (a fixed dp: no scan to spare) */
+    om_result r = om_solve_one(s, T, signs, &psi, q_prev, q0, predicted ? on_step : NULL, &moved);
     if (r.status != OM_OK || !om_continues(dof, q_prev, q0, NULL, 0.0, NULL)) return TR_NO_SOLUTION;
     if (!om_self_motion_tangent(s, q0, t0, SINGULAR_TANGENT)) return TR_SINGULAR;
     static pieces P0, P1; /* (the GIL is held: one call at a time) */

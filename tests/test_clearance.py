@@ -1,6 +1,7 @@
-"""The clearance's compiled distances (``ckernels.geom_distances``, sphere and capsule arm geoms
-against sphere, capsule and box obstacles) against MuJoCo's ``mj_geomDistance``, and their
-gradients (``ckernels.distance_gradients``) against finite differences."""
+"""The clearance's compiled kernel (``ckernels.arm_clearance``): the arm geoms placed by the arm's
+DH chain against MuJoCo's ``mj_kinematics``, the distances (sphere and capsule arm geoms against
+sphere, capsule and box obstacles) against MuJoCo's ``mj_geomDistance``, and their gradients
+against finite differences."""
 
 from __future__ import annotations
 
@@ -11,6 +12,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
+from om_redundant import ckernels
+from om_redundant.exceptions import ModelMismatch
 
 KINDS = {
     "sphere": mujoco.mjtGeom.mjGEOM_SPHERE,
@@ -68,3 +71,117 @@ def test_compiled_distances_are_mujocos(panda, kind, size, position, quat, joint
     smooth = (d > 1e-4) & (d < reach - 1e-4) & (ahead < reach) & (behind < reach)
     np.testing.assert_allclose(grad[smooth] @ direction, ((ahead - behind) / (2 * h))[smooth], atol=1e-6)
     assert not grad[d >= reach].any()
+
+
+SHIPPED = om.arm_names()  # every 7-DOF arm, and a 6-DOF one with a prismatic joint
+
+
+def within_limits(arm: om.Arm, rng: np.random.Generator, rows: int) -> np.ndarray:
+    """Joint vectors drawn within the limits (within +-pi where a joint has none)."""
+    lower = np.where(np.isfinite(arm.lower), arm.lower, -np.pi)
+    upper = np.where(np.isfinite(arm.upper), arm.upper, np.pi)
+    return rng.uniform(lower, upper, (rows, arm.dof))
+
+
+def mounted(arm: om.Arm) -> om.Clearance:
+    """The project's MJCF of the arm with its base moved and turned in the world, a sphere on
+    its last link and a box on link 5, and about it a capsule, a sphere, a box and a sphere that
+    overlaps link 3 near q = 0, as a user's scene."""
+    spec = mujoco.MjSpec.from_string(om.arm_mjcf(arm, prefix="l_"))
+    base = spec.body("l_base")
+    base.pos, base.quat = [0.3, -0.2, 0.1], [0.9, 0.1, -0.3, 0.2]
+    last = spec.body(f"l_link{arm.dof}")
+    last.add_geom(name="knob", type=KINDS["sphere"], size=[0.04, 0, 0], pos=[0.02, 0.03, 0.05])
+    # an arm geom the kernel leaves to MuJoCo (it gives the gradients of its pairs)
+    spec.body("l_link5").add_geom(
+        name="plate", type=KINDS["box"], size=[0.03, 0.05, 0.01], pos=[0.0, 0.05, 0.0]
+    )
+    model = spec.compile()
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    world = spec.worldbody
+    world.add_geom(name="pole", type=KINDS["capsule"], size=[0.05, 0.3, 0], pos=[0.7, -0.1, 0.5])
+    world.add_geom(name="ball", type=KINDS["sphere"], size=[0.1, 0, 0], pos=[0.4, 0.3, 0.7])
+    world.add_geom(name="crate", type=KINDS["box"], size=[0.1, 0.2, 0.1], pos=[0.6, -0.6, 0.2])
+    near = data.body("l_link3").xpos + np.array([0.03, 0.04, 0.05])
+    world.add_geom(name="touch", type=KINDS["sphere"], size=[0.1, 0, 0], pos=near)
+    return om.Clearance(spec.compile(), arm, ["pole", "ball", "crate", "touch"], prefix="l_")
+
+
+@pytest.mark.parametrize("name", SHIPPED)
+def test_geoms_are_placed_as_mujoco_places_them(name):
+    """Every arm geom's pose from the arm's DH chain (Clearance.geom_poses) is MuJoCo's
+    mj_kinematics of the model to 1e-12, the arm's base moved and turned in the world and a
+    geom added to the last link, on random joint vectors; and the distances are MuJoCo's."""
+    arm = om.load_arm(name)
+    clearance = mounted(arm)
+    model, data = clearance.model, mujoco.MjData(clearance.model)
+    ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, g) for g in clearance.arm_geoms]
+    assert "knob" in clearance.arm_geoms and len(ids) == len(set(ids)) > arm.dof
+    Q = within_limits(arm, np.random.default_rng(1), 40)
+    D = clearance.distances(Q)
+    for q, dist in zip(Q, D, strict=True):
+        data.qpos[:] = q
+        mujoco.mj_kinematics(model, data)
+        xpos, xmat = clearance.geom_poses(q)
+        np.testing.assert_allclose(xpos, data.geom_xpos[ids], rtol=0.0, atol=1e-12)
+        np.testing.assert_allclose(xmat.reshape(-1, 9), data.geom_xmat[ids], rtol=0.0, atol=1e-12)
+        for k, (a, o) in enumerate(clearance.pairs):
+            ab = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, g) for g in (a, o)]
+            expected = mujoco.mj_geomDistance(model, data, *ab, clearance.distmax, None)
+            assert dist[k] == pytest.approx(expected, abs=1e-12), (a, o)
+
+
+@pytest.mark.parametrize("name", SHIPPED)
+def test_gradients_are_finite_differences_on_every_arm(name):
+    """The gradients of all rows in one call (random joint vectors, and some near q = 0 where
+    a sphere overlaps link 3) match central differences of the distances (apart, and
+    overlapping but for the box: MuJoCo's depth of a capsule in a box is not smooth), and
+    equal the row-by-row ones."""
+    arm = om.load_arm(name)
+    clearance = mounted(arm)
+    rng = np.random.default_rng(2)
+    Q = np.vstack([within_limits(arm, rng, 25), rng.uniform(-0.1, 0.1, (5, arm.dof))])
+    D, grad = clearance.distances_and_gradients(Q)
+    in_box = np.array([o == "crate" for _, o in clearance.pairs])
+    h, checked = 1e-7, 0
+    for q, d, g in zip(Q, D, grad, strict=True):
+        single = clearance.distances_and_gradients(q)
+        np.testing.assert_array_equal(single[0], d)
+        np.testing.assert_array_equal(single[1], g)
+        direction = rng.normal(size=arm.dof)
+        ahead, behind = clearance.distances(q + h * direction), clearance.distances(q - h * direction)
+        smooth = (np.abs(d) > 1e-4) & (d < clearance.distmax - 1e-4) & ((d > 0.0) | ~in_box)
+        checked += smooth.sum()
+        np.testing.assert_allclose(g[smooth] @ direction, ((ahead - behind) / (2 * h))[smooth], atol=1e-6)
+    assert checked > D.size // 2
+    assert (D < 0.0).any() and (D > 0.0).any()  # overlapping pairs and pairs apart both checked
+
+
+def test_a_model_whose_links_are_not_the_arms_is_refused(panda):
+    """A link moved by 1 cm in the model: the geoms do not move like the arm's chain."""
+    spec = mujoco.MjSpec.from_string(om.arm_mjcf(panda.arm))
+    spec.body("link4").pos = spec.body("link4").pos + np.array([0.01, 0.0, 0.0])
+    spec.worldbody.add_geom(name="ball", type=KINDS["sphere"], size=[0.1, 0, 0], pos=[0.4, 0.3, 0.7])
+    with pytest.raises(ModelMismatch, match="do not move like its kinematic chain"):
+        om.Clearance(spec.compile(), panda.arm, ["ball"])
+
+
+def test_the_kernel_refuses_arrays_of_other_sizes(panda):
+    """ckernels.arm_clearance checks every array's size against the others: a ValueError, never
+    a read past an end."""
+    clearance = om.Clearance.for_arm(panda.arm, [om.Sphere([0.4, 0.1, 0.5], 0.05)])
+    arm, geoms = clearance._arguments
+    q, n_pairs = np.zeros(7), len(clearance.pairs)
+    dist, fromto, grad = np.empty(n_pairs), np.empty((n_pairs, 6)), np.empty((n_pairs, 7))
+    assert ckernels.arm_clearance(*arm, q, *geoms, 1.0, dist, fromto, grad, False) == 0
+    short = [
+        (arm, q[:6], geoms),
+        (arm, q, (geoms[0][:0], *geoms[1:])),
+        ((*arm[:3], arm[3][:-1], arm[4]), q, geoms),
+    ]
+    for a, x, g in short:
+        with pytest.raises(ValueError, match="disagree"):
+            ckernels.arm_clearance(*a, x, *g, 1.0, dist, fromto, grad, False)
+    with pytest.raises(ValueError, match="disagree"):
+        ckernels.arm_clearance(*arm, q, *geoms, 1.0, dist[:-1], fromto, grad, False)

@@ -69,6 +69,30 @@ def test_every_tick_of_a_moving_target_is_exact_feasible_and_on_its_branch(optim
 
 
 @pytest.mark.parametrize("name", list(HOMES))
+def test_the_steps_solves_are_the_full_solves_nearest_their_hints(optimizers, name):
+    """The one-call step takes each exact solve's local root without the windowed scan for
+    a nearer one where the root continues its path beyond doubt: its joints are those of the
+    full solves (scan and bounded search), at the previous psi hinted by the previous joints,
+    then at the new psi hinted by that, tick by tick along the figure eight."""
+    optimizer = optimizers[name]
+    solver = optimizer.solver
+    T_home = solver.arm.fk(HOMES[name])
+    choice = optimizer.choose(figure_eight(T_home, 0, TICKS))
+    steps = 0
+    for k in range(1, TICKS):
+        T = figure_eight(T_home, k, TICKS)
+        step = optimizer.choose(T, choice)
+        if step.intervals == ():  # the one-call step (not the window search)
+            steps += 1
+            first = solver.solve(T, choice.configuration, q_hint=choice.solution.q)
+            second = solver.solve(T, step.configuration, q_hint=first.q)
+            assert second.ok
+            assert np.abs(step.solution.q - second.q).max() <= 1e-12, k
+        choice = step
+    assert steps >= TICKS - 5
+
+
+@pytest.mark.parametrize("name", list(HOMES))
 def test_tracking_at_a_fixed_pose_converges_to_the_climbs_local_optimum(optimizers, name):
     """On random poses (from q itself), tracking until psi stops moving ends where the
     global optimiser's climb finds nothing better: within PSI_GAP rad or VALUE_GAP."""

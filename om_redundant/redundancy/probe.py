@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 from typing import NamedTuple
 
 import numpy as np
@@ -41,14 +42,14 @@ _ARRIVED, _SINGULAR = 0, 2  # ckernels.follow's status
 class _Terms:
     """The objective at a point, computed when first asked for (a path's following steps
     need only the joints and the tangent): the clearance's pair distances and gradients
-    (one ``mj_kinematics``), from which the groups with their rates, the evaluation and
-    the feasibility functions. Shared by the copies of a point at other representatives of
-    psi.
+    (one ``ckernels.arm_clearance`` call), from which the groups with their rates, the
+    evaluation and the feasibility functions. Shared by the copies of a point at other
+    representatives of psi.
     """
 
     def __init__(self, objective: Objective, q: np.ndarray, tangent: np.ndarray):
         self.objective, self.q, self.tangent = objective, q, tangent
-        self.pairs, self.evaluation, self.groups, self.pieces = None, None, None, None
+        self.pairs, self.groups, self.pieces = None, None, None
 
     def get_pairs(self) -> tuple[np.ndarray, np.ndarray] | None:
         """The clearance's pair distances and gradients at q; None without obstacles."""
@@ -56,11 +57,11 @@ class _Terms:
             self.pairs = self.objective.clearance.distances_and_gradients(self.q)
         return self.pairs
 
-    def get_evaluation(self) -> Evaluation:
-        if self.evaluation is None:
-            pairs = self.get_pairs()
-            self.evaluation = self.objective.evaluate(self.q, None if pairs is None else pairs[0])
-        return self.evaluation
+    @cached_property
+    def evaluation(self) -> Evaluation:
+        """The objective at q (an attribute once computed: points are asked for it often)."""
+        pairs = self.get_pairs()
+        return self.objective.evaluate(self.q, None if pairs is None else pairs[0])
 
     def get_pieces(self) -> tuple[np.ndarray, np.ndarray]:
         """The feasibility functions and their rates (:meth:`Point.pieces`)."""
@@ -80,7 +81,8 @@ def evaluate_points(objective: Objective, points: list[Point]) -> None:
     clearance's pair distances and gradients, their evaluations and their feasibility
     functions (what :attr:`Point.evaluation` and :meth:`Point.pieces` would compute point by
     point)."""
-    terms = list({id(p.terms): p.terms for p in points if p.terms.evaluation is None}.values())
+    # (not yet evaluated: the cached property's value not yet in the terms' __dict__)
+    terms = list({id(p.terms): p.terms for p in points if "evaluation" not in vars(p.terms)}.values())
     if not terms:
         return
     q, tangents = np.array([t.q for t in terms]), np.array([t.tangent for t in terms])
@@ -121,7 +123,7 @@ class Point:
     @property
     def evaluation(self) -> Evaluation:
         """The objective at q."""
-        return self.terms.get_evaluation()
+        return self.terms.evaluation
 
     @property
     def groups(self) -> list[Group]:

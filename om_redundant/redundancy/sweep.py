@@ -225,7 +225,7 @@ def _branch_sweep(request, objective, T, signs, hint) -> BranchSweep:
         if objective.clearance is None:
             clearance[ok] = math.inf
         else:
-            clearance[ok] = [objective.clearance.minimum(row) for row in q[ok]]
+            clearance[ok] = objective.clearance.minima(q[ok])
     with np.errstate(invalid="ignore"):
         feasible = ok & (np.min(np.nan_to_num(margin, nan=-1.0), axis=1) >= 0.0)
         feasible &= ~(clearance < objective.min_clearance)

@@ -22,6 +22,13 @@ From the previous choice (branch signs, psi, joints q'), :func:`ckernels.track_s
 5. the exact solution at :math:`\psi + \delta`, hinted by :math:`q_0` and checked to
    continue the self-motion (else :math:`\delta` is halved).
 
+Each exact solve's local root is taken without the windowed scan for a nearer root where it
+continues its path from the hint beyond doubt (within a quarter of its joint step of the
+first-order prediction, as ``ckernels.follow`` takes its roots): the first solve's along the
+hand's motion at fixed psi, :math:`[J; D\psi](q')\,\Delta q = [\Delta p; \omega; 0]` for the
+flange's move from :math:`\mathrm{fk}(q')` to T, the second's along the self-motion,
+:math:`t\,\delta`. Else the scan decides, as in :meth:`~om_redundant.OMSolver.solve`.
+
 Python then evaluates the clearance exactly at the new joints (for the feasibility check and
 as the next step's linearisation, :meth:`~om_redundant.Clearance.distances_within`), and the
 result is a :class:`~om_redundant.RedundancyChoice`. A step that cannot be taken (no exact
@@ -48,24 +55,22 @@ from .objective import SINGULARITY_CAP, Objective
 INITIAL_CURVATURE = 0.1
 _JOINT_STEP = 0.25  # rad: the step keeps the linearised joint motion within this
 # setup vector layout (csrc/tracking.c)
-_PSI, _CURVATURE, _N_SETUP = 0, 7, 11
+_PSI, _CURVATURE, _N_SETUP = 0, 7, 12
 # output layout after q (csrc/tracking.c)
 _O_PSI, _O_CURVATURE, _O_MARGIN, _O_SINGULARITY = 0, 2, 3, 4
 _O_POS, _O_ORI, _O_EVALS, _O_WITHIN, _N_OUT = 6, 7, 8, 9, 10
 
 
 class TrackingWork(NamedTuple):
-    """The arrays ``ckernels.track_step`` reads and writes, set up once per optimiser.
+    """The arrays ``ckernels.track_step`` reads and writes, set up once per optimiser (the
+    clearances it linearises, a :class:`Linearisation`, are passed as they are).
 
     Attributes:
         setup: psi, w_m, w_c, w_s, d_min/d_cap, s_cap, max_step, curvature, joint step,
-            number of singularities, number of clearance pairs.
+            d_cap, number of singularities, number of clearance pairs.
         lower, upper: (7,) joint limits (inf: not limited).
         singular_joints, singular_offsets: (k,) the singularities' joints (as floats) and
             constants (:class:`~om_redundant.Singularity`).
-        clearance_at: (7,) joints where the clearances were evaluated.
-        clearance_values: (P,) clearances there over d_cap.
-        clearance_gradients: (P, 7) their gradients over d_cap.
         q: (7,) the new joints (output).
         out: the step's results (output).
     """
@@ -75,11 +80,22 @@ class TrackingWork(NamedTuple):
     upper: np.ndarray
     singular_joints: np.ndarray
     singular_offsets: np.ndarray
-    clearance_at: np.ndarray
-    clearance_values: np.ndarray
-    clearance_gradients: np.ndarray
     q: np.ndarray
     out: np.ndarray
+
+
+class Linearisation(NamedTuple):
+    """The clearances at joints q, the tracking step's model of them about q.
+
+    Attributes:
+        q: (7,) the joints.
+        distances: (P,) the pairs' distances there (m), capped at the objective's reach.
+        gradients: (P, 7) their gradients (zero where capped).
+    """
+
+    q: np.ndarray
+    distances: np.ndarray
+    gradients: np.ndarray
 
 
 class Tracker:
@@ -106,6 +122,7 @@ class Tracker:
             max_step,
             INITIAL_CURVATURE,
             _JOINT_STEP,
+            objective.clearance_cap,
             n_sing,
             n_pairs,
         )
@@ -117,14 +134,13 @@ class Tracker:
             np.array(sing.joints[:n_sing] if n_sing else [], dtype=float),
             np.array(sing.offsets[:n_sing] if n_sing else [], dtype=float),
             np.zeros(arm.dof),
-            np.zeros(n_pairs),
-            np.zeros((n_pairs, arm.dof)),
-            np.zeros(arm.dof),
             np.zeros(_N_OUT),
         )
         # An arm near a family solves through om.near.NearKernel: no compiled tracking step.
         self._kernel = solver.kernel if isinstance(solver.kernel, ckernels.Solver) else None
-        self._last: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # q, values, gradients
+        # The last step's clearances, at its result's joints: the next step's linearisation.
+        # Without obstacles, no pairs.
+        self._last = Linearisation(np.zeros(arm.dof), np.zeros(0), np.zeros((0, arm.dof)))
         self._signs: dict[tuple[int, ...], np.ndarray] = {}  # each branch's signs as the kernel takes them
 
     def step(
@@ -141,12 +157,13 @@ class Tracker:
         work, objective = self.work, self.objective
         work.setup[_PSI] = psi
         work.setup[_CURVATURE] = curvature if math.isfinite(curvature) else INITIAL_CURVATURE
-        if objective.clearance is not None:
-            self._linearise_at(q)
+        linearised = self._linearised_at(q)
         signs_array = self._signs.get(signs)
         if signs_array is None:
             signs_array = self._signs[signs] = np.array(signs, dtype=np.int64)
-        status = ckernels.track_step(self._kernel, T, signs_array, q, *work[:-2], work.q, work.out)
+        status = ckernels.track_step(
+            self._kernel, T, signs_array, q, *work[:-2], *linearised, work.q, work.out
+        )
         if status != 0:
             return None
         out, q_new = work.out.tolist(), work.q.copy()  # Python floats: cheaper arithmetic
@@ -156,9 +173,8 @@ class Tracker:
         if work.singular_joints.size:
             value += objective.singularity_weight * min(1.0, out[_O_SINGULARITY])
         if objective.clearance is not None:
-            d, grad = objective.clearance.distances_within(q_new, objective.clearance_reach, gradient=True)
-            self._last = (q_new, d, grad)
-            clearance = float(d.min())
+            self._last = self._linearisation(q_new)
+            clearance = float(self._last.distances.min())
             if clearance >= objective.clearance_reach:  # every pair beyond the reach: D itself, uncapped
                 clearance = objective.clearance.minimum(q_new)
             value += objective.clearance_weight * min(1.0, clearance / objective.clearance_cap)
@@ -177,17 +193,17 @@ class Tracker:
         )
         return solution, margin, clearance, value, out[_O_CURVATURE]
 
-    def _linearise_at(self, q: np.ndarray) -> None:
-        """The clearances and their gradients at q, over d_cap, into the work arrays (those
-        of the last step's result when q is its joints)."""
+    def _linearised_at(self, q: np.ndarray) -> Linearisation:
+        """The clearances at q: the last step's where q is its result's joints (or there are
+        no obstacles), else evaluated."""
         last = self._last
-        if last is None or (last[0] is not q and not np.array_equal(last[0], q)):
-            d, grad = self.objective.clearance.distances_within(
-                q, self.objective.clearance_reach, gradient=True
-            )
-            last = (q, d, grad)
-        cap = self.objective.clearance_cap
-        work = self.work
-        work.clearance_at[:] = last[0]
-        np.divide(last[1], cap, out=work.clearance_values)
-        np.divide(last[2], cap, out=work.clearance_gradients)
+        if self.objective.clearance is None or last.q is q or np.array_equal(last.q, q):
+            return last
+        return self._linearisation(q)
+
+    def _linearisation(self, q: np.ndarray) -> Linearisation:
+        """The clearances at q, evaluated (the pairs within the objective's reach)."""
+        objective = self.objective
+        return Linearisation(
+            q, *objective.clearance.distances_within(q, objective.clearance_reach, gradient=True)
+        )

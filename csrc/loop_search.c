@@ -1,0 +1,363 @@
+/* psi's singular half-line searched along the real arm's self-motion loops. Next to the
+ * half-line (the model's wrist centre straight below the shoulder) psi turns by 2 pi within a
+ * few rho / v of the loop's closest pass, and the model's search (circle, torus, their charts)
+ * may find no candidate there, or only candidates of another branch: a false "no". The loop
+ * itself is smooth there. So, where the pose's wrist centre can come near the half-line, a
+ * 7-DOF S-R-S arm's configuration without a root is searched again: solutions of the pose in
+ * the same branch signs at other arm angles (the bounded search, away from the trouble) are
+ * points of its self-motion loops; each loop is traced in q at fixed T (the null vector of
+ * the real 6 x 7 Jacobian, predictor and a corrector on the pose rows, no psi
+ * parametrisation), and psi's crossings of the requested value along it are bisected to the
+ * last bit and verified as every candidate. */
+#include "om_system.h"
+
+#define LOOP_NEAR 1e-2       /* rad: the half-line's reach (om_polish_candidate's NEAR_BOUNDARY) */
+#define LOOP_STARTS 8        /* arm angles psi + 2 pi k / LOOP_STARTS whose roots start the traces */
+#define LOOP_STEP 0.05       /* largest trace step (|dq|, rad) */
+#define LOOP_STEP_MIN 1e-5   /* a step refused at this size ends the trace in that direction */
+#define LOOP_LENGTH 40.0     /* rad of |dq| per direction: a Panda loop is about 14 */
+#define LOOP_POINTS 4096     /* trace points kept (a start on a traced loop is skipped) */
+#define LOOP_CORRECT 8       /* Jacobians of the corrector per step and per projected midpoint */
+#define LOOP_ON_POSE 1e-12   /* pose residual (m, rad) of a point on the loop */
+#define LOOP_DRIFT 0.25      /* the corrector moves at most this fraction of the step */
+#define LOOP_BEND 0.9        /* the tangent turns by at most acos(LOOP_BEND) per step */
+#define LOOP_TURN (OM_PI / 4.0) /* psi's turn across a calm segment (its bound, as its ends show) */
+#define LOOP_CHORD 1e-7      /* |dq| below which a segment's midpoint is the chord's (off the loop by 1e-14 |q''|) */
+#define LOOP_PASSES 3       /* Newton passes to a closest approach, each from the last one's on the loop */
+#define LOOP_NEWTON 6       /* Newton steps of a pass along the tangent line */
+#define LOOP_DIFFERENCE 1e-6 /* step (|dq|) of the central differences of `across` along the tangent */
+#define LOOP_OFFSET_MIN 1e-16 /* the smallest offset from a closest approach: below it q does not move */
+#define LOOP_SPLITS 100000   /* midpoints per problem (a pass at rho takes about 16 log2(step / rho)) */
+
+typedef struct {
+    double q[7];
+    double miss;    /* psi's wrapped miss of the requested one, read in the requested ELBOW branch */
+    double grad[7]; /* d psi / dq */
+    vec3 across;    /* up x (W - S) of the model: zero on the half-line, smooth through it */
+    double angle;   /* of W - S from the half-line (om_srs_half_line_angle) */
+    bool below;     /* W - S below the horizon of S (the half-line's side) */
+} loop_point;
+
+typedef struct {
+    om_problem *pb;
+    om_polish_task pose; /* the corrector: the pose rows alone */
+    double *seen;        /* the points traced (LOOP_POINTS x 7) */
+    int n_seen, splits;
+} loop_search;
+
+/* The search of the problem pb (seen: room for LOOP_POINTS trace points, or NULL: no trace). */
+static loop_search _search(om_problem *pb, double *seen)
+{
+    const om_solver_data *s = pb->s;
+    loop_search ls = {pb, {s->real_table, s->n_real_rows, 7, NULL, NULL, 0, pb->t.R, pb->p, 0.0, 0.0, true}, seen, 0, 0};
+    return ls;
+}
+
+/* The largest |a cos w + b sin w| over w: the largest singular value of the 3 x 2 (a, b). */
+static double _ellipse_radius(vec3 a, vec3 b)
+{
+    double p = 0.5 * (v_dot(a, a) + v_dot(b, b)), d = 0.5 * (v_dot(a, a) - v_dot(b, b)), c = v_dot(a, b);
+    return sqrt(p + sqrt(d * d + c * c));
+}
+
+/* Whether the model's shoulder-wrist vector x may come within LOOP_NEAR rad of -up at a
+ * solution of the pose: x = p_d + R w_F - S + a(w1) + R delta(w7) lies in the ball of radius
+ * r = |(D1, D2)| + |(D4, D5)| (the ellipses' largest radii) around its centre c = p_d + R w_F
+ * - S + D3 + R D0, whose directions make the cone of half-angle asin(r / |c|) around c. */
+static bool _may_pass(const om_problem *pb)
+{
+    const double(*D)[3] = pb->s->D;
+    vec3 up = v_load(pb->s->params, SRS_UP);
+    vec3 c = v_add(v_add(pb->p, pb->t.wrist), v_add(v_load(D[3], 0), m_mv(pb->t.R, v_load(D[0], 0))));
+    double r = _ellipse_radius(v_load(D[1], 0), v_load(D[2], 0)) + _ellipse_radius(v_load(D[4], 0), v_load(D[5], 0));
+    double length = v_norm(c);
+    if (!(length > r))
+        return true;
+    return atan2(v_norm(v_cross(up, c)), -v_dot(up, c)) - asin(r / length) < LOOP_NEAR;
+}
+
+/* psi's miss and gradient at p->q. */
+static void _measure(const loop_search *ls, loop_point *p)
+{
+    const om_problem *pb = ls->pb;
+    om_arm_angle_gradient(pb->s->params, pb->s->model_table, pb->s->n_model_rows, p->q, p->grad);
+    p->across = om_srs_half_line_across(pb->s->params, p->q);
+    p->angle = om_srs_half_line_angle(pb->s->params, p->q);
+    p->below = p->angle < 0.5 * OM_PI;
+    double psi = om_srs_arm_angle_in(pb->s->params, p->q, (double)pb->signs[1]);
+    p->miss = om_wrap(psi - pb->redundancy[0]);
+}
+
+/* The unit null vector of the real Jacobian at q, turned toward `along` (NULL: as it comes);
+ * false where J has lost rank (a branch point of the loop). */
+static bool _tangent(const om_problem *pb, const double *q, const double *along, double *t)
+{
+    double n2 = 0.0, dot = 0.0;
+    om_self_motion_null(pb->s, q, t);
+    for (int j = 0; j < 7; j++) {
+        n2 += t[j] * t[j];
+        dot += along ? t[j] * along[j] : 0.0;
+    }
+    double k = (dot < 0.0 ? -1.0 : 1.0) / sqrt(n2);
+    if (!(n2 > 0.0) || !isfinite(k))
+        return false;
+    for (int j = 0; j < 7; j++)
+        t[j] *= k;
+    return true;
+}
+
+static double _distance(const double *a, const double *b)
+{
+    double d = 0.0;
+    for (int j = 0; j < 7; j++)
+        d = py_max(d, fabs(om_wrap(a[j] - b[j])));
+    return d;
+}
+
+/* The midpoint of the segment (a, b) of the loop into m: the chord's, on the loop again by
+ * the corrector where the segment is longer than LOOP_CHORD. False where it cannot be split
+ * (the midpoint is an end to the last bit, the corrector fails, the budget is spent). */
+static bool _midpoint(loop_search *ls, const loop_point *a, const loop_point *b, loop_point *m)
+{
+    bool a_end = true, b_end = true;
+    double length = 0.0;
+    for (int j = 0; j < 7; j++) {
+        m->q[j] = 0.5 * (a->q[j] + b->q[j]);
+        a_end = a_end && m->q[j] == a->q[j];
+        b_end = b_end && m->q[j] == b->q[j];
+        length = py_max(length, fabs(b->q[j] - a->q[j]));
+    }
+    if (a_end || b_end || ls->splits >= LOOP_SPLITS)
+        return false;
+    ls->splits++;
+    if (length > LOOP_CHORD && !(om_polish(&ls->pose, LOOP_CORRECT, m->q) <= LOOP_ON_POSE))
+        return false;
+    _measure(ls, m);
+    return true;
+}
+
+/* The crossing of the requested psi in (a, b), whose misses differ in sign (not a wrap):
+ * bisected to the last bit, the end nearer psi verified first. Returns the root count. */
+static int _bisect(loop_search *ls, loop_point a, loop_point b, double *roots, int count)
+{
+    loop_point m;
+    while (_midpoint(ls, &a, &b, &m)) {
+        if (m.miss * a.miss > 0.0)
+            a = m;
+        else
+            b = m;
+    }
+    loop_point *near = fabs(a.miss) <= fabs(b.miss) ? &a : &b, *far = near == &a ? &b : &a;
+    int before = count;
+    count = om_add_root(ls->pb, near->q, roots, count);
+    return count > before ? count : om_add_root(ls->pb, far->q, roots, count);
+}
+
+/* psi's crossings of the requested value on the loop's segment (a, b): a calm segment is
+ * bisected where its misses change sign; any other is split in two (next to the half-line,
+ * down to the scale rho on which psi turns). Calm: psi turns by at most LOOP_TURN across it,
+ * as its ends show and as its slopes along it at both ends extrapolate, and below the
+ * horizon the azimuth of `across` turns by at most half that. A pass at rho by the half-line
+ * turns psi by 2 pi within a few rho / v, invisible to psi at ends far from it (a full turn,
+ * slopes of rho / (v s^2)), but the azimuth of `across` turns by nearly pi between them. */
+static int _segment_roots(loop_search *ls, const loop_point *a, const loop_point *b, double *roots, int count)
+{
+    double change_a = 0.0, change_b = 0.0; /* grad psi . (b - a) at either end */
+    for (int j = 0; j < 7; j++) {
+        change_a += a->grad[j] * (b->q[j] - a->q[j]);
+        change_b += b->grad[j] * (b->q[j] - a->q[j]);
+    }
+    double azimuth = atan2(v_norm(v_cross(a->across, b->across)), v_dot(a->across, b->across));
+    bool calm = fabs(om_wrap(b->miss - a->miss)) <= LOOP_TURN && fabs(change_a) <= LOOP_TURN &&
+                fabs(change_b) <= LOOP_TURN && (!(a->below || b->below) || azimuth <= 0.5 * LOOP_TURN);
+    loop_point m;
+    if (!calm && _midpoint(ls, a, b, &m)) {
+        count = _segment_roots(ls, a, &m, roots, count);
+        return _segment_roots(ls, &m, b, roots, count);
+    }
+    if (a->miss * b->miss <= 0.0 && fabs(a->miss - b->miss) < OM_PI) /* false for NaN */
+        count = _bisect(ls, *a, *b, roots, count);
+    return count;
+}
+
+/* up x (W - S) at q + s t (x: scratch). */
+static vec3 _across_at(const om_problem *pb, const double *q, const double *t, double s, double *x)
+{
+    for (int j = 0; j < 7; j++)
+        x[j] = q[j] + s * t[j];
+    return om_srs_half_line_across(pb->s->params, x);
+}
+
+/* `across` at q + s t and its first two derivatives in s (central differences: it is smooth
+ * through the half-line, unlike psi). */
+static vec3 _across_derivatives(const om_problem *pb, const double *q, const double *t, double s, vec3 *d1, vec3 *d2)
+{
+    double x[7], d = LOOP_DIFFERENCE;
+    vec3 h = _across_at(pb, q, t, s, x), hp = _across_at(pb, q, t, s + d, x), hm = _across_at(pb, q, t, s - d, x);
+    *d1 = v_scale(0.5 / d, v_sub(hp, hm));
+    *d2 = v_scale(1.0 / (d * d), v_add(v_sub(hp, v_scale(2.0, h)), hm));
+    return h;
+}
+
+/* The point of the loop at q + s t, on the pose again by the corrector where s exceeds
+ * LOOP_CHORD (the tangent line leaves the loop by O(s^2)); false where the corrector fails. */
+static bool _loop_point_at(loop_search *ls, const double *q, const double *t, double s, loop_point *p)
+{
+    for (int j = 0; j < 7; j++)
+        p->q[j] = q[j] + s * t[j];
+    if (fabs(s) > LOOP_CHORD && !(om_polish(&ls->pose, LOOP_CORRECT, p->q) <= LOOP_ON_POSE))
+        return false;
+    _measure(ls, p);
+    return true;
+}
+
+/* The loop's closest approach to the half-line near its point b (within reach, in |dq|) and
+ * psi's crossings around it. The approach may pass the half-line at rho (a straight pass:
+ * `across` turns by pi within a few rho / v) or fold back by it (|h| about rho + |h''| s^2 /
+ * 2: a full turn, or none, within sqrt(2 rho / |h''|)); the ends of a trace step see neither.
+ * The closest approach s* (Newton on h . h' = 0 along the tangent, from the last pass's point
+ * on the loop), then points of the loop at s* +- sigma 2^k out to reach, sigma a quarter of
+ * the smaller turning scale, whose consecutive pairs are searched as any segment
+ * (_segment_roots: a part whose turn is not calm yet is split). Returns the root count. */
+static int _pass_roots(loop_search *ls, const loop_point *b, double reach, double *roots, int count)
+{
+    const om_problem *pb = ls->pb;
+    double t[7];
+    loop_point centre = *b;
+    vec3 h = v3(NAN, NAN, NAN), d1, d2;
+    for (int pass = 0; pass < LOOP_PASSES; pass++) {
+        if (!_tangent(pb, centre.q, NULL, t))
+            return count;
+        double s = 0.0;
+        for (int it = 0; it < LOOP_NEWTON; it++) {
+            h = _across_derivatives(pb, centre.q, t, s, &d1, &d2);
+            double slope = v_dot(d1, d1) + v_dot(h, d2);
+            double next = py_min(py_max(s - v_dot(h, d1) / slope, -reach), reach);
+            if (!(slope > 0.0) || !isfinite(next) || next == s)
+                break;
+            s = next;
+        }
+        loop_point moved;
+        if (!_loop_point_at(ls, centre.q, t, s, &moved))
+            return count;
+        centre = moved;
+        if (fabs(s) <= LOOP_CHORD)
+            break;
+    }
+    h = _across_derivatives(pb, centre.q, t, 0.0, &d1, &d2);
+    double rho = v_norm(h), scale = rho / py_max(v_norm(d1), sqrt(0.5 * rho * v_norm(d2)));
+    double sigma = py_max(0.25 * scale, LOOP_OFFSET_MIN);
+    if (!isfinite(sigma))
+        return count;
+    for (int side = -1; side <= 1; side += 2) { /* centre, then outward to one side */
+        loop_point inner = centre, outer;
+        for (double s = sigma; s < 2.0 * reach; s *= 2.0) {
+            if (!_loop_point_at(ls, centre.q, t, (double)side * py_min(s, reach), &outer))
+                continue;
+            count = _segment_roots(ls, &inner, &outer, roots, count);
+            inner = outer;
+        }
+    }
+    return count;
+}
+
+/* Trace the self-motion loop through the pose's solution q0 (predictor along the tangent,
+ * the corrector back onto the pose; a step halves where the corrector fails, drifts or the
+ * tangent turns), both ways until it closes or LOOP_LENGTH, and search each step for psi's
+ * crossings. Returns the root count. */
+static int _trace(loop_search *ls, const double *q0, double *roots, int count)
+{
+    om_problem *pb = ls->pb;
+    double t0[7];
+    if (!_tangent(pb, q0, NULL, t0))
+        return count;
+    for (int direction = 1; direction >= -1; direction -= 2) {
+        loop_point before, a, b;
+        bool has_before = false;
+        double t[7], tb[7], h = LOOP_STEP, length = 0.0;
+        memcpy(a.q, q0, sizeof a.q);
+        _measure(ls, &a);
+        before = a;
+        for (int j = 0; j < 7; j++)
+            t[j] = direction * t0[j];
+        while (length < LOOP_LENGTH && h >= LOOP_STEP_MIN) {
+            double drift = 0.0, turn = 0.0;
+            for (int j = 0; j < 7; j++)
+                b.q[j] = a.q[j] + h * t[j];
+            bool on = om_polish(&ls->pose, LOOP_CORRECT, b.q) <= LOOP_ON_POSE && _tangent(pb, b.q, t, tb);
+            for (int j = 0; on && j < 7; j++) {
+                drift = py_max(drift, fabs(b.q[j] - a.q[j] - h * t[j]));
+                turn += tb[j] * t[j];
+            }
+            if (!on || drift > LOOP_DRIFT * h || turn < LOOP_BEND) {
+                h *= 0.5;
+                continue;
+            }
+            _measure(ls, &b);
+            count = _segment_roots(ls, &a, &b, roots, count);
+            if (has_before && a.below && a.angle < LOOP_NEAR && a.angle < before.angle && a.angle <= b.angle)
+                count = _pass_roots(ls, &a, sqrt(7.0) * py_max(_distance(before.q, a.q), _distance(b.q, a.q)), roots,
+                                    count);
+            before = a;
+            has_before = true;
+            length += h;
+            if (ls->n_seen < LOOP_POINTS)
+                memcpy(ls->seen + 7 * ls->n_seen++, b.q, sizeof b.q);
+            a = b;
+            memcpy(t, tb, sizeof t);
+            h = py_min(2.0 * h, LOOP_STEP);
+            if (length > 4.0 * LOOP_STEP && _distance(a.q, q0) < h)
+                return count; /* closed: the other way is the same loop */
+        }
+    }
+    return count;
+}
+
+/* Whether q lies on a loop already traced: within two steps of a kept point. */
+static bool _seen(const loop_search *ls, const double *q)
+{
+    for (int k = 0; k < ls->n_seen; k++)
+        if (_distance(q, ls->seen + 7 * k) < 2.0 * LOOP_STEP)
+            return true;
+    return false;
+}
+
+int om_loop_roots(om_problem *pb, double *roots, int count)
+{
+    const om_solver_data *s = pb->s;
+    if (s->family != OM_SRS || s->dof != 7 || !_may_pass(pb))
+        return count;
+    loop_search ls = _search(pb, malloc((size_t)LOOP_POINTS * 7 * sizeof(double)));
+    if (!ls.seen)
+        return count;
+    double starts[OM_MAX_ROOTS * OM_MAX_DOF];
+    /* psi + pi first, then + pi / 2 and - pi / 2, ...: the farthest from the requested one */
+    static const int order[LOOP_STARTS - 1] = {4, 2, 6, 1, 3, 5, 7};
+    for (int i = 0; i < LOOP_STARTS - 1 && count == 0; i++) {
+        double psi = om_wrap(pb->redundancy[0] + 2.0 * OM_PI * (double)order[i] / (double)LOOP_STARTS);
+        om_problem other = *pb;
+        other.redundancy = &psi;
+        other.t = om_target_at(s->family, s->params, &pb->t.R, &psi);
+        other.counter = 0;
+        int n = om_all_roots(&other, s->scan_points, starts, pb->q_prev, INFINITY);
+        pb->counter += other.counter;
+        for (int r = 0; r < n; r++)
+            if (!_seen(&ls, starts + 7 * r))
+                count = _trace(&ls, starts + 7 * r, roots, count);
+    }
+    free(ls.seen);
+    return count;
+}
+
+bool om_loop_pass(om_problem *pb, double *q, double *pos, double *ori)
+{
+    loop_search ls = _search(pb, NULL);
+    double roots[OM_MAX_ROOTS * OM_MAX_DOF];
+    loop_point b;
+    memcpy(b.q, q, sizeof b.q);
+    _measure(&ls, &b);
+    if (_pass_roots(&ls, &b, LOOP_STEP, roots, 0) == 0)
+        return false;
+    memcpy(q, roots, sizeof b.q);
+    return om_verify(pb, q, pos, ori);
+}
