@@ -7,8 +7,11 @@
  * the same branch signs at other arm angles (the bounded search, away from the trouble) are
  * points of its self-motion loops; each loop is traced in q at fixed T (the null vector of
  * the real 6 x 7 Jacobian, predictor and a corrector on the pose rows, no psi
- * parametrisation), and psi's crossings of the requested value along it are bisected to the
- * last bit and verified as every candidate. */
+ * parametrisation), whole, through every branch it passes, and psi's crossings of the
+ * requested value along it are bisected to the last bit and verified as every candidate
+ * (in the requested signs). A candidate of the model's search that meets the pose but not
+ * psi next to the line gets the same search around the loop's closest approach
+ * (om_loop_pass). */
 #include "om_system.h"
 
 #define LOOP_NEAR 1e-2       /* rad: the half-line's reach (om_polish_candidate's NEAR_BOUNDARY) */
@@ -23,13 +26,13 @@
 #define LOOP_DRIFT 0.25      /* the corrector moves at most this fraction of the step */
 #define LOOP_BEND 0.9        /* the tangent turns by at most acos(LOOP_BEND) per step */
 #define LOOP_TURN (OM_PI / 4.0) /* psi's turn across a calm segment (its bound, as its ends show) */
-#define LOOP_CHORD 1e-7      /* |dq| below which a segment's midpoint is the chord's (off the loop by 1e-14 |q''|) */
+#define LOOP_CHORD 1e-7      /* |dq| below which a segment's midpoint is the chord's (off the loop by 1.3e-15 |q''|) */
 #define LOOP_PASSES 3       /* Newton passes to a closest approach, each from the last one's on the loop */
 #define LOOP_NEWTON 6       /* Newton steps of a pass along the tangent line */
 #define LOOP_DIFFERENCE 1e-6 /* step (|dq|) of the central differences of `across` along the tangent */
 #define LOOP_PASS_SCALES 64.0 /* a candidate's pass (om_loop_pass) is searched out to this many turning scales */
 #define LOOP_OFFSET_MIN 1e-16 /* the smallest offset from a closest approach: below it q does not move */
-#define LOOP_SPLITS 100000   /* midpoints per problem (a pass at rho takes about 16 log2(step / rho)) */
+#define LOOP_SPLITS 100000   /* midpoints per problem: a bound on the work (a loop by the line takes a few hundred) */
 
 typedef struct {
     double q[7];
