@@ -6,32 +6,16 @@
 
 enum { P_REACH, P_CAP, P_FLOOR, P_N }; /* clearance: 2 d_cap, d_cap, d_min / d_cap */
 
-/* pieces(q, t, distances, gradients, limited, lower, upper, half, numbers, g, dg) -> None:
- * objective.py's Group.constraints of the margin and clearance groups at q with dq/dpsi = t:
- * per limited joint the smaller of (q_i - l_i)/h_i and (u_i - q_i)/h_i with its rate; then per
- * pair d_k/d_cap - d_min/d_cap with its rate grad d_k . t / d_cap, a pair at 2 d_cap or more
- * taken as 2 d_cap with rate 0 when some pair is nearer (objective.py's _clearance). */
-static PyObject *om_pieces(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
-    if (check_nargs(nargs, 11, "pieces") < 0) return NULL;
-    Py_buffer v[11];
-    const buffer_spec sp[11] = {{F64, -1, 0, "q"},     {F64, -1, 0, "t"},      {F64, -1, 0, "distances"},
-                                {F64, -1, 0, "gradients"}, {I64, -1, 0, "limited"}, {F64, -1, 0, "lower"},
-                                {F64, -1, 0, "upper"}, {F64, -1, 0, "half"},   {F64, P_N, 0, "numbers"},
-                                {F64, -1, 1, "g"},     {F64, -1, 1, "dg"}};
-    if (get_buffers(args, v, sp, 11) < 0) return NULL;
-    Py_ssize_t dof = v[0].len / 8, P = v[2].len / 8, L = v[4].len / 8;
-    const int64_t *limited = v[4].buf;
-    int bad = v[1].len != dof * 8 || v[3].len != P * dof * 8 || v[5].len != L * 8 || v[6].len != L * 8 ||
-              v[7].len != L * 8 || v[9].len != (L + P) * 8 || v[10].len != (L + P) * 8;
-    for (Py_ssize_t i = 0; i < L && !bad; i++) bad = limited[i] < 0 || limited[i] >= dof;
-    if (bad) {
-        release_buffers(v, 11);
-        PyErr_SetString(PyExc_ValueError, "pieces: sizes of q, t, the pairs, the joints and g disagree");
-        return NULL;
-    }
-    const double *q = v[0].buf, *t = v[1].buf, *d = v[2].buf, *grad = v[3].buf, *lower = v[5].buf;
-    const double *upper = v[6].buf, *half = v[7].buf, *num = v[8].buf;
-    double *g = v[9].buf, *dg = v[10].buf;
+/* pieces(dof, q, t, distances, gradients, limited, lower, upper, half, numbers, g, dg) -> None:
+ * objective.py's Group.constraints of the margin and clearance groups at each of the M rows
+ * q (M x dof) with dq/dpsi = t (M x dof), the pairs' distances (M x P) and gradients
+ * (M x P x dof), into g and dg (M x (L + P)): per limited joint the smaller of
+ * (q_i - l_i)/h_i and (u_i - q_i)/h_i with its rate; then per pair d_k/d_cap - d_min/d_cap
+ * with its rate grad d_k . t / d_cap, a pair at 2 d_cap or more taken as 2 d_cap with rate 0
+ * when some pair of the row is nearer (objective.py's _clearance). */
+static void row_pieces(Py_ssize_t dof, Py_ssize_t L, Py_ssize_t P, const double *q, const double *t, const double *d,
+                       const double *grad, const int64_t *limited, const double *lower, const double *upper,
+                       const double *half, const double *num, double *g, double *dg) {
     for (Py_ssize_t i = 0; i < L; i++) {
         int64_t j = limited[i];
         double a = (q[j] - lower[i]) / half[i], b = (upper[i] - q[j]) / half[i], s = 1.0 / half[i];
@@ -53,6 +37,39 @@ static PyObject *om_pieces(PyObject *mod, PyObject *const *args, Py_ssize_t narg
         for (Py_ssize_t j = 0; j < dof; j++) rate += grad[k * dof + j] / num[P_CAP] * t[j];
         *gk = d[k] / num[P_CAP] - num[P_FLOOR], *dgk = rate;
     }
+}
+
+static PyObject *om_pieces(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 12, "pieces") < 0) return NULL;
+    Py_ssize_t dof = PyLong_AsSsize_t(args[0]);
+    if (PyErr_Occurred()) return NULL;
+    if (dof < 1) {
+        PyErr_SetString(PyExc_ValueError, "pieces: dof must be positive");
+        return NULL;
+    }
+    Py_buffer v[11];
+    const buffer_spec sp[11] = {{F64, -1, 0, "q"},     {F64, -1, 0, "t"},      {F64, -1, 0, "distances"},
+                                {F64, -1, 0, "gradients"}, {I64, -1, 0, "limited"}, {F64, -1, 0, "lower"},
+                                {F64, -1, 0, "upper"}, {F64, -1, 0, "half"},   {F64, P_N, 0, "numbers"},
+                                {F64, -1, 1, "g"},     {F64, -1, 1, "dg"}};
+    if (get_buffers(args + 1, v, sp, 11) < 0) return NULL;
+    Py_ssize_t M = v[0].len / 8 / dof, L = v[4].len / 8;
+    Py_ssize_t P = M ? v[2].len / 8 / M : 0;
+    const int64_t *limited = v[4].buf;
+    int bad = v[0].len != M * dof * 8 || v[1].len != M * dof * 8 || v[2].len != M * P * 8 ||
+              v[3].len != M * P * dof * 8 || v[5].len != L * 8 || v[6].len != L * 8 || v[7].len != L * 8 ||
+              v[9].len != M * (L + P) * 8 || v[10].len != M * (L + P) * 8;
+    for (Py_ssize_t i = 0; i < L && !bad; i++) bad = limited[i] < 0 || limited[i] >= dof;
+    if (bad) {
+        release_buffers(v, 11);
+        PyErr_SetString(PyExc_ValueError, "pieces: sizes of q, t, the pairs, the joints and g disagree");
+        return NULL;
+    }
+    const double *q = v[0].buf, *t = v[1].buf, *d = v[2].buf, *grad = v[3].buf;
+    double *g = v[9].buf, *dg = v[10].buf;
+    for (Py_ssize_t m = 0; m < M; m++)
+        row_pieces(dof, L, P, q + m * dof, t + m * dof, d + m * P, grad + m * P * dof, limited, v[5].buf, v[6].buf,
+                   v[7].buf, v[8].buf, g + m * (L + P), dg + m * (L + P));
     release_buffers(v, 11);
     Py_RETURN_NONE;
 }
@@ -109,10 +126,59 @@ static PyObject *om_surprise(PyObject *mod, PyObject *const *args, Py_ssize_t na
     return PyFloat_FromDouble((double)(changes[0] + 1 + changes[1]) / 2.0 / (double)(N + 1));
 }
 
+/* crossing(ga, da, gb, db, span, hermite) -> fraction or None: where the first of surprise's
+ * models m_j reaches zero from a feasible end a (s = 0): the first of the N points s_k =
+ * (k + 1) / (N + 1) where one is negative, refined by the secant of the most negative one
+ * from the point before (from s = 0, where that model is ga_j, at the first point); None
+ * where none is negative there. A piece that surprise's bound keeps positive is skipped. */
+static PyObject *om_crossing(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 6, "crossing") < 0) return NULL;
+    double span = PyFloat_AsDouble(args[4]);
+    if (PyErr_Occurred()) return NULL;
+    Py_buffer v[5];
+    const buffer_spec sp[5] = {{F64, -1, 0, "ga"}, {F64, -1, 0, "da"}, {F64, -1, 0, "gb"}, {F64, -1, 0, "db"},
+                               {F64, -1, 0, "hermite"}};
+    PyObject *const objs[5] = {args[0], args[1], args[2], args[3], args[5]};
+    if (get_buffers(objs, v, sp, 5) < 0) return NULL;
+    Py_ssize_t n = v[0].len / 8, N = v[4].len / 32;
+    if (v[1].len != n * 8 || v[2].len != n * 8 || v[3].len != n * 8 || v[4].len != N * 32) {
+        release_buffers(v, 5);
+        PyErr_SetString(PyExc_ValueError, "crossing: sizes of the pieces or the basis disagree");
+        return NULL;
+    }
+    const double *ga = v[0].buf, *da = v[1].buf, *gb = v[2].buf, *db = v[3].buf, *H = v[4].buf;
+    double found = -1.0;
+    Py_ssize_t first = N; /* the first point where a model is negative */
+    int j_first = -1;
+    double m_first = 0.0;
+    for (Py_ssize_t j = 0; j < n; j++) {
+        if (fmin(ga[j], gb[j]) - 4.0 / 27.0 * fabs(span) * (fabs(da[j]) + fabs(db[j])) > 0.0) continue;
+        for (Py_ssize_t k = 0; k < N && k <= first; k++) { /* (up to the first found so far) */
+            double model = ga[j] * H[k] + da[j] * span * H[N + k] + gb[j] * H[2 * N + k] + db[j] * span * H[3 * N + k];
+            if (model < 0.0) {
+                if (k < first || model < m_first) first = k, j_first = (int)j, m_first = model;
+                break;
+            }
+        }
+    }
+    if (j_first >= 0) {
+        Py_ssize_t j = j_first, k = first;
+        double s1 = (double)(k + 1) / (double)(N + 1), s0 = (double)k / (double)(N + 1), m0 = ga[j];
+        if (k > 0)
+            m0 = ga[j] * H[k - 1] + da[j] * span * H[N + k - 1] + gb[j] * H[2 * N + k - 1] + db[j] * span * H[3 * N + k - 1];
+        found = s0 + (s1 - s0) * m0 / (m0 - m_first);
+    }
+    release_buffers(v, 5);
+    if (found < 0.0) Py_RETURN_NONE;
+    return PyFloat_FromDouble(found);
+}
+
 PyMethodDef om_cell_functions[] = {
     {"pieces", (PyCFunction)(void (*)(void))om_pieces, METH_FASTCALL,
-     "pieces(q, t, distances, gradients, limited, lower, upper, half, numbers, g, dg) -> None"},
+     "pieces(dof, q, t, distances, gradients, limited, lower, upper, half, numbers, g, dg) -> None"},
     {"surprise", (PyCFunction)(void (*)(void))om_surprise, METH_FASTCALL,
      "surprise(ga, da, gb, db, span, hermite, feasible_a, feasible_b, slack) -> fraction or None"},
+    {"crossing", (PyCFunction)(void (*)(void))om_crossing, METH_FASTCALL,
+     "crossing(ga, da, gb, db, span, hermite) -> fraction or None"},
     {NULL, NULL, 0, NULL},
 };

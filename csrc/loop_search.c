@@ -7,11 +7,15 @@
  * the same branch signs at other arm angles (the bounded search, away from the trouble) are
  * points of its self-motion loops; each loop is traced in q at fixed T (the null vector of
  * the real 6 x 7 Jacobian, predictor and a corrector on the pose rows, no psi
- * parametrisation), and psi's crossings of the requested value along it are bisected to the
- * last bit and verified as every candidate. */
+ * parametrisation), whole, through every branch it passes, and psi's crossings of the
+ * requested value along it are bisected to the last bit and verified as every candidate
+ * (in the requested signs). A candidate of the model's search that meets the pose but not
+ * psi next to the line gets the same search around the loop's closest approach
+ * (om_loop_pass). */
 #include "om_system.h"
 
 #define LOOP_NEAR 1e-2       /* rad: the half-line's reach (om_polish_candidate's NEAR_BOUNDARY) */
+#define LOOP_GATE 64         /* nodes per offset angle of the cheap test whether a pose may come near the line */
 #define LOOP_STARTS 8        /* arm angles psi + 2 pi k / LOOP_STARTS whose roots start the traces */
 #define LOOP_STEP 0.05       /* largest trace step (|dq|, rad) */
 #define LOOP_STEP_MIN 1e-5   /* a step refused at this size ends the trace in that direction */
@@ -22,12 +26,13 @@
 #define LOOP_DRIFT 0.25      /* the corrector moves at most this fraction of the step */
 #define LOOP_BEND 0.9        /* the tangent turns by at most acos(LOOP_BEND) per step */
 #define LOOP_TURN (OM_PI / 4.0) /* psi's turn across a calm segment (its bound, as its ends show) */
-#define LOOP_CHORD 1e-7      /* |dq| below which a segment's midpoint is the chord's (off the loop by 1e-14 |q''|) */
+#define LOOP_CHORD 1e-7      /* |dq| below which a segment's midpoint is the chord's (off the loop by 1.3e-15 |q''|) */
 #define LOOP_PASSES 3       /* Newton passes to a closest approach, each from the last one's on the loop */
 #define LOOP_NEWTON 6       /* Newton steps of a pass along the tangent line */
 #define LOOP_DIFFERENCE 1e-6 /* step (|dq|) of the central differences of `across` along the tangent */
+#define LOOP_PASS_SCALES 64.0 /* a candidate's pass (om_loop_pass) is searched out to this many turning scales */
 #define LOOP_OFFSET_MIN 1e-16 /* the smallest offset from a closest approach: below it q does not move */
-#define LOOP_SPLITS 100000   /* midpoints per problem (a pass at rho takes about 16 log2(step / rho)) */
+#define LOOP_SPLITS 100000   /* midpoints per problem: a bound on the work (a loop by the line takes a few hundred) */
 
 typedef struct {
     double q[7];
@@ -60,20 +65,39 @@ static double _ellipse_radius(vec3 a, vec3 b)
     return sqrt(p + sqrt(d * d + c * c));
 }
 
+/* Whether some x of the ball of radius r around c is within LOOP_NEAR rad of -up: its
+ * directions make the cone of half-angle asin(r / |c|) around c. */
+static bool _ball_may_pass(vec3 up, vec3 c, double r)
+{
+    double length = v_norm(c);
+    return !(length > r) || atan2(v_norm(v_cross(up, c)), -v_dot(up, c)) - asin(r / length) < LOOP_NEAR;
+}
+
 /* Whether the model's shoulder-wrist vector x may come within LOOP_NEAR rad of -up at a
- * solution of the pose: x = p_d + R w_F - S + a(w1) + R delta(w7) lies in the ball of radius
- * r = |(D1, D2)| + |(D4, D5)| (the ellipses' largest radii) around its centre c = p_d + R w_F
- * - S + D3 + R D0, whose directions make the cone of half-angle asin(r / |c|) around c. */
+ * solution of the pose: x(w1, w7) = p_d + R w_F - S + a(w1) + R delta(w7) = c + A(w1) +
+ * B(w7), A and B ellipses of largest radii r1 = |(D4, D5)| and r7 = |(D1, D2)|, so x moves by
+ * at most (r1 + r7) pi / LOOP_GATE from the nearest node of a LOOP_GATE x LOOP_GATE grid of
+ * the two angles (one node along an angle x does not depend on). */
 static bool _may_pass(const om_problem *pb)
 {
     const double(*D)[3] = pb->s->D;
+    const mat3 *R = &pb->t.R;
     vec3 up = v_load(pb->s->params, SRS_UP);
-    vec3 c = v_add(v_add(pb->p, pb->t.wrist), v_add(v_load(D[3], 0), m_mv(pb->t.R, v_load(D[0], 0))));
-    double r = _ellipse_radius(v_load(D[1], 0), v_load(D[2], 0)) + _ellipse_radius(v_load(D[4], 0), v_load(D[5], 0));
-    double length = v_norm(c);
-    if (!(length > r))
-        return true;
-    return atan2(v_norm(v_cross(up, c)), -v_dot(up, c)) - asin(r / length) < LOOP_NEAR;
+    vec3 c = v_add(v_add(pb->p, pb->t.wrist), v_add(v_load(D[3], 0), m_mv(*R, v_load(D[0], 0))));
+    vec3 a1 = v_load(D[4], 0), a2 = v_load(D[5], 0), b1 = m_mv(*R, v_load(D[1], 0)), b2 = m_mv(*R, v_load(D[2], 0));
+    double r1 = _ellipse_radius(a1, a2), r7 = _ellipse_radius(b1, b2);
+    int n1 = r1 > 0.0 ? LOOP_GATE : 1, n7 = r7 > 0.0 ? LOOP_GATE : 1;
+    double r = (r1 + r7) * OM_PI / LOOP_GATE;
+    for (int i = 0; i < n1; i++) {
+        double w1 = 2.0 * OM_PI * (double)i / (double)n1;
+        vec3 ci = v_add(c, v_add(v_scale(cos(w1), a1), v_scale(sin(w1), a2)));
+        for (int j = 0; j < n7; j++) {
+            double w7 = 2.0 * OM_PI * (double)j / (double)n7;
+            if (_ball_may_pass(up, v_add(ci, v_add(v_scale(cos(w7), b1), v_scale(sin(w7), b2))), r))
+                return true;
+        }
+    }
+    return false;
 }
 
 /* psi's miss and gradient at p->q. */
@@ -216,10 +240,11 @@ static bool _loop_point_at(loop_search *ls, const double *q, const double *t, do
  * `across` turns by pi within a few rho / v) or fold back by it (|h| about rho + |h''| s^2 /
  * 2: a full turn, or none, within sqrt(2 rho / |h''|)); the ends of a trace step see neither.
  * The closest approach s* (Newton on h . h' = 0 along the tangent, from the last pass's point
- * on the loop), then points of the loop at s* +- sigma 2^k out to reach, sigma a quarter of
- * the smaller turning scale, whose consecutive pairs are searched as any segment
- * (_segment_roots: a part whose turn is not calm yet is split). Returns the root count. */
-static int _pass_roots(loop_search *ls, const loop_point *b, double reach, double *roots, int count)
+ * on the loop), then points of the loop at s* +- sigma 2^k out to reach, or to `scales` times
+ * the smaller turning scale, sigma a quarter of it, whose consecutive pairs are searched as
+ * any segment (_segment_roots: a part whose turn is not calm yet is split). Returns the root
+ * count. */
+static int _pass_roots(loop_search *ls, const loop_point *b, double reach, double scales, double *roots, int count)
 {
     const om_problem *pb = ls->pb;
     double t[7];
@@ -249,6 +274,7 @@ static int _pass_roots(loop_search *ls, const loop_point *b, double reach, doubl
     double sigma = py_max(0.25 * scale, LOOP_OFFSET_MIN);
     if (!isfinite(sigma))
         return count;
+    reach = py_min(reach, 4.0 * scales * sigma); /* sigma: a quarter of the scale, at least LOOP_OFFSET_MIN */
     for (int side = -1; side <= 1; side += 2) { /* centre, then outward to one side */
         loop_point inner = centre, outer;
         for (double s = sigma; s < 2.0 * reach; s *= 2.0) {
@@ -296,8 +322,8 @@ static int _trace(loop_search *ls, const double *q0, double *roots, int count)
             _measure(ls, &b);
             count = _segment_roots(ls, &a, &b, roots, count);
             if (has_before && a.below && a.angle < LOOP_NEAR && a.angle < before.angle && a.angle <= b.angle)
-                count = _pass_roots(ls, &a, sqrt(7.0) * py_max(_distance(before.q, a.q), _distance(b.q, a.q)), roots,
-                                    count);
+                count = _pass_roots(ls, &a, sqrt(7.0) * py_max(_distance(before.q, a.q), _distance(b.q, a.q)),
+                                    INFINITY, roots, count);
             before = a;
             has_before = true;
             length += h;
@@ -356,7 +382,7 @@ bool om_loop_pass(om_problem *pb, double *q, double *pos, double *ori)
     loop_point b;
     memcpy(b.q, q, sizeof b.q);
     _measure(&ls, &b);
-    if (_pass_roots(&ls, &b, LOOP_STEP, roots, 0) == 0)
+    if (_pass_roots(&ls, &b, LOOP_STEP, LOOP_PASS_SCALES, roots, 0) == 0)
         return false;
     memcpy(q, roots, sizeof b.q);
     return om_verify(pb, q, pos, ori);

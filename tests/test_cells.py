@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 import om_redundant as om
 from benchmarks.control_rate import HOMES, MIN_CLEARANCE, obstacles
 from om_redundant import ckernels
-from om_redundant.redundancy.paths import _BOUND_SLACK, _HERMITE
+from om_redundant.redundancy.paths import _BOUND_SLACK, _HERMITE, _quiet
 from om_redundant.redundancy.self_motion import self_motion_tangents
 
 
@@ -68,3 +68,48 @@ def test_surprise_is_numpys(seed, pieces, span):
     fa, fb = bool((ga >= 0).all()), bool((gb >= 0).all())
     got = ckernels.surprise(ga, da, gb, db, span, _HERMITE, fa, fb, _BOUND_SLACK)
     assert got == surprise_numpy(ga, da, gb, db, span, fa, fb)
+
+
+def crossing_numpy(ga, da, gb, db, span):
+    """The reference: the first point of the cell where a model is negative, and the secant
+    of the most negative one there from the point before (from the cell's start at the
+    first point)."""
+    models = np.column_stack([ga, da * span, gb, db * span]) @ _HERMITE
+    below = np.flatnonzero((models < 0.0).any(axis=0))
+    if len(below) == 0:
+        return None
+    k = below[0]
+    j = np.argmin(models[:, k])
+    n = models.shape[1] + 1
+    s0, m0 = (0.0, ga[j]) if k == 0 else (k / n, models[j, k - 1])
+    return s0 + (1.0 / n) * m0 / (m0 - models[j, k])
+
+
+@settings(max_examples=300, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), pieces=st.integers(1, 12), span=st.floats(-1.0, 1.0))
+def test_crossing_is_numpys(seed, pieces, span):
+    """ckernels.crossing gives the numpy models' first zero, to rounding (pieces whose bound
+    keeps them positive skipped), from a feasible end towards either side (span < 0: the
+    cell lies below the feasible end), with dips and islands between."""
+    rng = np.random.default_rng(seed)
+    ga, gb = np.abs(rng.normal(0.3, 0.5, pieces)), rng.normal(0.3, 0.5, pieces)
+    da, db = rng.normal(0.0, 3.0 / max(abs(span), 1e-6), (2, pieces))
+    got, want = ckernels.crossing(ga, da, gb, db, span, _HERMITE), crossing_numpy(ga, da, gb, db, span)
+    assert (got is None) == (want is None)
+    if want is not None:
+        assert 0.0 <= got <= 1.0 and abs(got - want) <= 1e-12
+
+
+@settings(max_examples=300, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), pieces=st.integers(1, 12), span=st.floats(-1.0, 1.0))
+def test_a_quiet_cell_has_no_surprise(seed, pieces, span):
+    """paths._quiet's bounds: where they call a cell quiet, ckernels.surprise finds no change
+    that its ends do not explain (so skipping its look changes no sample); cells drawn near
+    the bounds' edge (values small against the slopes), ends feasible or not as they say."""
+    rng = np.random.default_rng(seed)
+    ga, gb = rng.normal(0.05, 0.3, (2, pieces))
+    da, db = rng.normal(0.0, 0.5 / max(abs(span), 1e-6), (2, pieces))
+    fa, fb = bool((ga >= 0).all()), bool((gb >= 0).all())
+    quiet = _quiet(np.array([span]), ga[None], da[None], gb[None], db[None], np.array([fa]), np.array([fb]))
+    if quiet[0]:
+        assert ckernels.surprise(ga, da, gb, db, span, _HERMITE, fa, fb, _BOUND_SLACK) is None

@@ -1,6 +1,5 @@
 """The batched evaluations behind the global optimiser's sweep (issue 16): each agrees with
-the one-at-a-time evaluation it replaces, and the bounds that let a cell of a solution path
-skip its clearance gradients hold."""
+the one-at-a-time evaluation it replaces."""
 
 from __future__ import annotations
 
@@ -16,6 +15,7 @@ from benchmarks.control_rate import HOMES, MIN_CLEARANCE, obstacles
 from om_redundant.redundancy.box_qp import maximise_1d
 from om_redundant.redundancy.objective import Group
 from om_redundant.redundancy.optimizer import _StartBounds
+from om_redundant.redundancy.probe import Probe
 from om_redundant.redundancy.self_motion import self_motion_tangents
 
 
@@ -78,49 +78,38 @@ def test_batched_tangents_equal_the_single_ones(seed, name):
 
 
 @settings(max_examples=8, deadline=None)
-@given(seed=st.integers(0, 2**32 - 1), name=st.sampled_from(list(HOMES)), count=st.sampled_from([1, 3]))
-def test_constraint_bounds_bound_the_feasibility_functions_and_their_rates(seed, name, count):
-    """Objective.constraint_bounds: the margin entries are the margin feasibility functions
-    and their rates' sizes exactly; the clearance entries are at most the clearance
-    functions and equal where below 0 (where the cell test takes them as the functions),
-    and their rates at least the functions' rates' sizes, equal where the pair is within
-    2 d_cap; for all rows at once the same as row by row. Clearance.distances_and_gradients
-    of all rows gives exactly those of each row."""
+@given(seed=st.integers(0, 2**32 - 1), name=st.sampled_from(list(HOMES)), count=st.sampled_from([0, 1, 3]))
+def test_batched_pieces_and_points_equal_the_single_ones(seed, name, count):
+    """Objective.pieces of all rows at once gives exactly those of each row;
+    Clearance.distances_and_gradients of all rows exactly those of each row, from which the
+    groups are those computed afresh; and the points of Probe.points (the objective of all
+    rows in one batch, evaluate_points) carry exactly what a point evaluates alone."""
     optimizer = optimizer_of(name, count)
     objective, solver = optimizer.objective, optimizer.solver
     q = joints(optimizer, seed, 10)
     tangents = self_motion_tangents(solver, q)
-    distances, gradients = objective.clearance.distances_and_gradients(q)
-    batch = objective.constraint_bounds(q, tangents, (distances, gradients))
+    pairs = None if objective.clearance is None else objective.clearance.distances_and_gradients(q)
+    g, dg = objective.pieces(q, tangents, pairs)
     for k, row in enumerate(q):
-        d, grad = objective.clearance.distances_and_gradients(row)
-        np.testing.assert_array_equal(d, distances[k])
-        np.testing.assert_array_equal(grad, gradients[k])
-        groups = [g.along(tangents[k]) for g in objective.groups(row, jacobian=True)]
-        for mine, theirs in zip(objective.groups(row, jacobian=True, pairs=(d, grad)), groups, strict=True):
-            np.testing.assert_array_equal(mine.values, theirs.values)
-            np.testing.assert_array_equal(mine.along(tangents[k]).jacobian, theirs.jacobian)
-        values, rates = (
-            x[0]
-            for x in objective.constraint_bounds(
-                row[None], tangents[k][None], (distances[[k]], gradients[[k]])
-            )
-        )
-        np.testing.assert_array_equal(values, batch[0][k])
-        np.testing.assert_array_equal(rates, batch[1][k])
-        margin, clearance = (g.constraints() for g in groups[:2])
-        limited = len(margin[0])
-        np.testing.assert_allclose(values[:limited], margin[0], rtol=0, atol=1e-15)
-        np.testing.assert_allclose(rates[:limited], np.abs(margin[1]), rtol=1e-15, atol=0)
-        assert (clearance[0] >= values[limited:] - 1e-12).all()
-        below = values[limited:] < 0.0
-        np.testing.assert_allclose(values[limited:][below], clearance[0][below], rtol=0, atol=1e-12)
-        assert (np.abs(clearance[1]) <= rates[limited:] * (1 + 1e-9) + 1e-12).all()
-        near = d < objective.clearance_reach
-        scale = 1.0 + np.abs(rates[limited:]).max()  # (the products' rounding: cancelling terms)
-        np.testing.assert_allclose(
-            rates[limited:][near], np.abs(clearance[1][near]), rtol=0, atol=1e-13 * scale
-        )
+        mine = None
+        if pairs is not None:
+            mine = objective.clearance.distances_and_gradients(row)
+            np.testing.assert_array_equal(mine[0], pairs[0][k])
+            np.testing.assert_array_equal(mine[1], pairs[1][k])
+            groups = [g.along(tangents[k]) for g in objective.groups(row, jacobian=True)]
+            for batched, fresh in zip(objective.groups(row, jacobian=True, pairs=mine), groups, strict=True):
+                np.testing.assert_array_equal(batched.values, fresh.values)
+                np.testing.assert_array_equal(batched.along(tangents[k]).jacobian, fresh.jacobian)
+        one = objective.pieces(row, tangents[k], mine)
+        np.testing.assert_array_equal(one[0], g[k])
+        np.testing.assert_array_equal(one[1], dg[k])
+    probe = Probe(solver, objective, solver.arm.fk(q[0]), optimizer.branches[0])
+    psi = np.linspace(-1.0, 1.0, len(q))
+    for point in probe.points(psi, q):
+        alone = Probe(solver, objective, probe.T, probe.signs).point(point.psi, point.q)
+        assert point.evaluation == alone.evaluation
+        for batched, single in zip(point.pieces(), alone.pieces(), strict=True):
+            np.testing.assert_array_equal(batched, single)
 
 
 @settings(max_examples=40, deadline=None)

@@ -398,7 +398,7 @@ _LINE_RUNS: dict[str, adv.ArmRun] = {}
 
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(
-    name=st.sampled_from(["xarm7", "sawyer"]),
+    name=st.sampled_from(["xarm7", "sawyer", "panda", "fr3"]),
     seed=st.integers(0, 2**32 - 1),
     exponent=st.floats(-14.0, -3.0),
     below=st.booleans(),

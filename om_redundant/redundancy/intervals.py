@@ -5,8 +5,10 @@ A **feasible interval** is a maximal psi interval over which one solution path
 (:mod:`om_redundant.redundancy.paths`) is exact, within the limits and clear: a run of feasible
 neighbouring samples of the path, extended at each end to the boundary. Where the path's
 next sample is infeasible, the boundary is the root of the continuous feasibility slack
-(:class:`~om_redundant.redundancy.objective.Evaluation`) along the path between the two, by the
-Illinois method (:func:`refine_end`); where the path itself ends, its end; both to
+(:class:`~om_redundant.redundancy.objective.Evaluation`) along the path between the two
+(:func:`_refined`: from the root of the cubic models of the cell, Newton steps on the
+rates the trials carry, the Illinois method where those leave the bracket; every end of the
+sweep at once); where the path itself ends, its end; both to
 :data:`~om_redundant.redundancy.probe.END_TOLERANCE`.
 
 So a psi can lie in two intervals of one branch (two solution paths), and a solution that
@@ -18,14 +20,19 @@ when the arc crosses +-pi.
 from __future__ import annotations
 
 import math
+from collections.abc import Generator, Sequence
 from dataclasses import dataclass
+from typing import NamedTuple
 
+import numpy as np
+
+from .. import ckernels
 from .arm_angle import wrap_psi
-from .paths import Path
+from .paths import _HERMITE, Follow, Path, lockstep
 from .probe import END_TOLERANCE, Point, Probe
 
 SLACK_TOLERANCE = 1e-12  # a refined end whose feasibility slack is this small is on the boundary
-_MAX_REFINE = 60  # Illinois steps per refined end
+_MAX_REFINE = 60  # trials per refined end
 
 
 @dataclass(frozen=True)
@@ -62,12 +69,49 @@ class Run:
     points: list[Point]
 
 
-def feasible_runs(probe: Probe, path: Path) -> list[Run]:
-    """The feasible intervals along a path, with their ends refined."""
+def feasible_runs(paths: Sequence[tuple[Probe, Path]]) -> list[list[Run]]:
+    """The feasible intervals along each (probe, path), with their ends refined: every end
+    of every path at once (:func:`~om_redundant.redundancy.paths.lockstep`)."""
+    spans = [[(probe, span) for span in _spans(path)] for probe, path in paths]
+    ends = [
+        _refined(probe, inside, outside)
+        for path_spans in spans
+        for probe, span in path_spans
+        for inside, outside in ((span.points[0], span.before), (span.points[-1], span.after))
+        if outside is not None
+    ]
+    refined = iter(lockstep(ends))  # (in the order of ends)
+    return [
+        [
+            _run(
+                probe,
+                span,
+                None if span.before is None else next(refined),
+                None if span.after is None else next(refined),
+            )
+            for probe, span in path_spans
+        ]
+        for path_spans in spans
+    ]
+
+
+class _Span(NamedTuple):
+    """A run of feasible neighbouring samples of a path, ordered by psi, and the path's
+    infeasible samples next to its ends (None where the path ends there, or the swept
+    range does); closed: the whole loop."""
+
+    points: list[Point]
+    before: Point | None
+    after: Point | None
+    closed: bool = False
+
+
+def _spans(path: Path) -> list[_Span]:
+    """The runs of feasible samples along a path."""
     points, n = path.points, len(path.points)
     feasible = [p.evaluation.feasible for p in points]
     if path.turns and all(feasible):
-        return [Run(PsiInterval(probe.signs, -math.pi, math.pi, closed=True), list(points))]
+        return [_Span(list(points), None, None, closed=True)]
     period = 2.0 * math.pi * path.turns
     start = next((k for k in range(n) if not feasible[k - 1]), 0) if path.turns else 0
     runs, current = [], []
@@ -79,44 +123,61 @@ def feasible_runs(probe: Probe, path: Path) -> list[Run]:
             runs.append(current)
             current = []
     runs += [current] if current else []
-    return [_run(probe, path, [p for _, p in run], run[0][0], run[-1][0]) for run in runs]
+    return [_span(path, [p for _, p in run], run[0][0], run[-1][0]) for run in runs]
 
 
-def _run(probe: Probe, path: Path, points: list[Point], k_first: int, k_last: int) -> Run:
-    """The run's interval: each end refined towards the path's infeasible neighbour sample,
-    if there is one (else the run ends where the path does, or at the swept range's edge)."""
+def _span(path: Path, points: list[Point], k_first: int, k_last: int) -> _Span:
+    """The run of samples k_first..k_last with the path's samples next to it, on a loop at
+    the representatives of psi next to the run's."""
     n, period = len(path.points), 2.0 * math.pi * path.turns
+    before = after = None
     if k_first > 0 or path.turns:
         before = path.points[k_first - 1]
         before = before.at(points[0].psi - (points[0].psi - before.psi) % period) if path.turns else before
-        points = [refine_end(probe, points[0], before), *points]
     if k_last < n - 1 or path.turns:
         after = path.points[(k_last + 1) % n]
         after = after.at(points[-1].psi + (after.psi - points[-1].psi) % period) if path.turns else after
-        points = [*points, refine_end(probe, points[-1], after)]
-    lo = wrap_psi(points[0].psi)
-    shift = lo - points[0].psi
-    points = [p.at(p.psi + shift) for p in points]
-    return Run(PsiInterval(probe.signs, lo, points[-1].psi), points)
+    return _Span(points, before, after)
 
 
-def refine_end(probe: Probe, inside: Point, outside: Point) -> Point:
-    """The last feasible point between a feasible ``inside`` and an infeasible ``outside``,
-    neighbours on one path.
+def _run(probe: Probe, span: _Span, lo: Point | None, hi: Point | None) -> Run:
+    """The run's interval: from its end refined towards the sample before (lo), if there
+    is one, to its end refined towards the sample after (hi), if there is one (else the
+    run ends where the path does, or at the swept range's edge)."""
+    if span.closed:
+        return Run(PsiInterval(probe.signs, -math.pi, math.pi, closed=True), span.points)
+    points = [*([] if lo is None else [lo]), *span.points, *([] if hi is None else [hi])]
+    lo_psi = wrap_psi(points[0].psi)
+    shift = lo_psi - points[0].psi
+    points = [p.at(p.psi + shift) for p in points] if shift else points
+    return Run(PsiInterval(probe.signs, lo_psi, points[-1].psi), points)
 
-    The feasibility slack changes sign between them; the Illinois method (regula falsi that
-    halves the slack kept at a stale end) finds the root, each trial followed from the inner
-    end (:meth:`~om_redundant.redundancy.probe.Probe.follow`). It stops when the bracket is narrower
-    than :data:`~om_redundant.redundancy.probe.END_TOLERANCE` or the inner slack below
-    :data:`SLACK_TOLERANCE`.
+
+def _refined(probe: Probe, inside: Point, outside: Point) -> Generator[Follow, tuple[Point, bool], Point]:
+    r"""The last feasible point between a feasible ``inside`` and an infeasible ``outside``,
+    neighbours on one path: a process of :func:`~om_redundant.redundancy.paths.lockstep`,
+    which asks for each trial's follow.
+
+    The feasibility slack s (the smallest feasibility function g_j) changes sign between
+    them. Each trial is followed from the inner end of the bracket
+    (:meth:`~om_redundant.redundancy.probe.Probe.follow`) and replaces the end on its side.
+    The trials: first where the cubic Hermite models of the g_j (:func:`_modelled_end`)
+    first reach zero; then Newton steps on the g_j binding at the last trial, aimed at
+    :math:`s = \frac12` :data:`SLACK_TOLERANCE` with the rate dg_j/dpsi the trial carries,
+    so that they end on the feasible side; where such a step leaves the bracket, the
+    Illinois method (regula falsi that halves the slack kept at a stale end). It stops when
+    the bracket is narrower than :data:`~om_redundant.redundancy.probe.END_TOLERANCE` or the
+    inner slack below :data:`SLACK_TOLERANCE`.
     """
     a, fa, b, fb = inside, inside.evaluation.slack, outside.psi, outside.evaluation.slack
+    x = _modelled_end(inside, outside)
     stale = 0  # +1: b was kept last time, -1: a was
     for _ in range(_MAX_REFINE):
         if abs(b - a.psi) <= END_TOLERANCE or fa <= SLACK_TOLERANCE:
             break
-        x = b - fb * (b - a.psi) / (fb - fa)
-        p, arrived = probe.follow(a, x)
+        if x is None or not 0.0 < (x - a.psi) / (b - a.psi) < 1.0:
+            x = b - fb * (b - a.psi) / (fb - fa)
+        p, arrived = yield probe, a, x
         if not arrived:  # (cannot happen between neighbours of one path)
             break
         if p.evaluation.feasible:
@@ -125,4 +186,26 @@ def refine_end(probe: Probe, inside: Point, outside: Point) -> Point:
         else:
             b, fb = x, p.evaluation.slack
             fa, stale = (fa / 2.0 if stale == -1 else fa), -1
+        x = _newton(p)
     return a
+
+
+def _newton(point: Point) -> float | None:
+    """The Newton step on the feasibility function binding at point, aimed at a slack of
+    half :data:`SLACK_TOLERANCE`; None where it does not move along psi."""
+    g, dg = point.pieces()
+    if len(g) == 0:
+        return None
+    j = int(np.argmin(g))
+    return point.psi + (0.5 * SLACK_TOLERANCE - g[j]) / dg[j] if dg[j] != 0.0 else None
+
+
+def _modelled_end(inside: Point, outside: Point) -> float | None:
+    """Where the first of the feasibility functions' cubic Hermite models between inside
+    (s = 0) and outside (s = 1) reaches zero (``ckernels.crossing``, ``csrc/cells.c``): the
+    first of the _MODEL_POINTS points of the cell where one is negative, refined by that
+    model's secant from the point before; None where none is negative there."""
+    (ga, da), (gb, db) = inside.pieces(), outside.pieces()
+    span = outside.psi - inside.psi
+    s = ckernels.crossing(ga, da, gb, db, span, _HERMITE) if len(ga) else None
+    return None if s is None else inside.psi + span * s

@@ -297,56 +297,27 @@ class Objective:
     ) -> tuple[np.ndarray, np.ndarray]:
         """The feasibility functions g_j at q (>= 0 iff feasible) and dg_j/dpsi: the
         :meth:`Group.constraints` of the margin and clearance groups chained through the
-        tangent (``ckernels.pieces``, ``csrc/cells.c``; the same numbers to rounding).
+        tangent (``ckernels.pieces``, ``csrc/cells.c``; the same numbers to rounding), at one
+        joint vector or at every row of q in one call.
 
         Args:
-            q: (dof,) joint vector.
-            tangent: (dof, 1) dq/dpsi at q.
-            pairs: The pairs' distances (P,) and gradients (P, dof) at q; None without
-                obstacles.
+            q: (dof,) joint vector, or (M, dof) rows.
+            tangent: (dof, 1) dq/dpsi at q, or (M, dof, 1).
+            pairs: The pairs' distances (P,) and gradients (P, dof) at q, or (M, P) and
+                (M, P, dof); None without obstacles.
 
         Returns:
-            (g, dg), each (limited + P,).
+            (g, dg), each (limited + P,), or (M, limited + P).
         """
-        distances, gradients = self._no_pairs if pairs is None else pairs
-        g, dg = np.empty((2, len(self._limited) + len(distances)))
+        rows = q.shape[:-1]
+        if pairs is None:
+            pairs = np.zeros((*rows, 0)), np.zeros((*rows, 0, self._dof))
+        distances, gradients = (np.ascontiguousarray(x, dtype=float) for x in pairs)
+        g, dg = np.empty((2, *rows, len(self._limited) + distances.shape[-1]))
         limits = (self._limited, self._lower, self._upper, self._half)
-        q, rate = (np.ascontiguousarray(x, dtype=float) for x in (q, tangent[:, 0]))
-        ckernels.pieces(q, rate, distances, gradients, *limits, self._clearance_numbers, g, dg)
+        q, rate = (np.ascontiguousarray(x, dtype=float) for x in (q, tangent[..., 0]))
+        ckernels.pieces(self._dof, q, rate, distances, gradients, *limits, self._clearance_numbers, g, dg)
         return g, dg
-
-    def constraint_bounds(
-        self, q: np.ndarray, tangent: np.ndarray, pairs: tuple[np.ndarray, np.ndarray] | None
-    ) -> tuple[np.ndarray, np.ndarray]:
-        r"""The feasibility functions of :meth:`Group.constraints` at joint vectors q and
-        the sizes of their rates, for a cheap test of a cell of a solution path (its
-        Hermite models bounded without evaluating them).
-
-        Each limited joint's margin function :math:`1 - |q_i - c_i|/h_i`, with its rate's
-        size :math:`|t_i|/h_i` (t = dq/dpsi); then, with obstacles, per pair
-        :math:`(\min(d_k, 2 d_{cap}) - d_{min})/d_{cap}` (the clearance piece where it is
-        below 2 d_cap, a lower bound of it beyond: there the pieces report 2 d_cap, or
-        d_k when every pair is that far) and :math:`|\nabla d_k \cdot t| / d_{cap}` (at least
-        the size of the piece's rate: the pieces capped at 2 d_cap have none).
-
-        Args:
-            q: (M, dof) joint vectors.
-            tangent: (M, dof, 1) their dq/dpsi.
-            pairs: (M, P) the pairs' distances d_k(q) (m) and (M, P, dof) their gradients,
-                :meth:`Clearance.distances_and_gradients
-                <om_redundant.Clearance.distances_and_gradients>`; None without obstacles.
-
-        Returns:
-            (values (M, n), rate sizes (M, n)).
-        """
-        values = [self._margins(q)]
-        rates = [np.abs(tangent[:, self._limited, 0]) / self._half]
-        if self.clearance is not None:
-            cap = self.clearance_cap
-            distances, gradients = pairs
-            values.append((np.minimum(distances, self.clearance_reach) - self.min_clearance) / cap)
-            rates.append(np.abs(gradients @ tangent)[:, :, 0] / cap)
-        return np.concatenate(values, axis=1), np.concatenate(rates, axis=1)
 
     def term_functions(
         self, q: np.ndarray, distances: np.ndarray | None

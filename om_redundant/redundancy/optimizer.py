@@ -233,8 +233,11 @@ class RedundancyOptimizer:
     ) -> list[tuple[tuple[int, ...], list[Path], list[Run]]]:
         """Every branch's solution paths and feasible runs."""
         swept = sweep_circle(self.solver, self.objective, T, branches, self.grid_points)
+        probes = [self._probe(T, signs) for signs in branches]
+        paths = [(probe, path) for probe, paths in zip(probes, swept, strict=True) for path in paths]
+        runs = iter(feasible_runs(paths))
         return [
-            (signs, paths, [run for path in paths for run in feasible_runs(self._probe(T, signs), path)])
+            (signs, paths, [run for _ in paths for run in next(runs)])
             for signs, paths in zip(branches, swept, strict=True)
         ]
 
@@ -259,7 +262,7 @@ class RedundancyOptimizer:
             )
         probe = self._probe(T, signs, wrapped=False)  # the joints move continuously
         window = sweep_window(probe, psi, previous.solution.q, self.max_step, _WINDOW_POINTS)
-        runs = [run for path in window for run in feasible_runs(probe, path)]
+        runs = [run for path_runs in feasible_runs([(probe, path) for path in window]) for run in path_runs]
         if runs:
             return self._result(T, self._climb_all(T, runs, near=psi), runs)
         ((_, paths, branch_runs),) = self._sweep(T, [signs])

@@ -34,14 +34,16 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Generator
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from .. import ckernels
 from ..om.solver import OMSolver
 from .objective import Objective
-from .probe import END_TOLERANCE, JUMP, SAME, Point, Probe
+from .probe import END_TOLERANCE, JUMP, SAME, Point, Probe, evaluate_points
 
 FINE_STEP = 0.25  # rad: cells in which a joint moves further get samples in between
 _MODEL_POINTS = 256  # points of a cell where the Hermite models are checked
@@ -52,6 +54,10 @@ _HERMITE = np.array(
 )
 _TURN = 2.0 * math.pi
 _BOUND_SLACK = 1e-9  # covers the rounding of the Hermite models in the bounds of _quiet
+
+#: What a process of :func:`lockstep` asks for: follow from the point towards psi on the
+#: probe's branch (:meth:`Probe.follow`).
+Follow = tuple[Probe, Point, float]
 
 
 @dataclass(eq=False)
@@ -89,20 +95,34 @@ def sweep_circle(
     swept = []
     for b, signs in enumerate(branches):
         probe = Probe(solver, objective, T, signs)
-        grid, distinct = [], []  # the grid index of each distinct solution, its joints
-        for k in range(n):
-            found = []
-            for q in batch.q[rows[b, k], : batch.count[rows[b, k]]]:
-                if all(probe.step(q, f) > SAME for f in found):
-                    found.append(q)
-            grid += [k] * len(found)
-            distinct += found
+        grid, distinct = _distinct(probe, batch.q[rows[b]], batch.count[rows[b]])
         roots: list[list[Point]] = [[] for _ in range(n)]
-        if grid:
-            for k, point in zip(grid, probe.points(psi[grid], np.array(distinct)), strict=True):
+        if len(grid):
+            for k, point in zip(grid.tolist(), probe.points(psi[grid], distinct), strict=True):
                 roots[k].append(point)
-        swept.append([_with_hidden(probe, path) for path in _link(probe, psi, roots)])
-    return swept
+        swept.append([(probe, path) for path in _link(probe, psi, roots)])
+    filled = iter(_with_hidden([path for paths in swept for path in paths]))  # (every branch's at once)
+    return [[next(filled) for _ in paths] for paths in swept]
+
+
+def _distinct(probe: Probe, q: np.ndarray, count: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The distinct solutions of the grid rows q (n, roots, dof), count[k] of them in row k:
+    their grid indices, in order, and their joints. Solutions within SAME of an earlier one
+    of the row are that one; only rows with several solutions need the test."""
+    sizes = np.minimum(count, 1)
+    found = {}
+    for k in np.flatnonzero(count > 1).tolist():
+        found[k] = []
+        for row in q[k, : count[k]]:
+            if all(probe.step(row, f) > SAME for f in found[k]):
+                found[k].append(row)
+        sizes[k] = len(found[k])
+    grid = np.repeat(np.arange(len(count)), sizes)
+    distinct = q[grid, 0]
+    starts = np.cumsum(sizes) - sizes
+    for k, rows in found.items():
+        distinct[starts[k] : starts[k] + sizes[k]] = rows
+    return grid, distinct
 
 
 def _neighbours_swept(signs: tuple[int, ...], branches: list[tuple[int, ...]], n: int) -> bool:
@@ -114,6 +134,39 @@ def _neighbours_swept(signs: tuple[int, ...], branches: list[tuple[int, ...]], n
     neighbour's roots there are that neighbour's row's, the same joints and objective."""
     flips = (tuple(-s if j == i else s for j, s in enumerate(signs)) for i in range(len(signs)))
     return n % 2 == 0 and all(f in branches for f in flips)
+
+
+def lockstep(processes: list[Generator[Follow, tuple[Point, bool], Any]]) -> list[Any]:
+    """Run processes that each follow their paths one step after another (the refinement
+    of an interval's end, the look inside a cell), all at once: each round follows every
+    process's request (:data:`Follow`), evaluates the objective at all the points reached
+    in one batch (:func:`~om_redundant.redundancy.probe.evaluate_points`) and sends each
+    process its answer, ``probe.follow``'s (point reached, arrived). Each process makes the
+    same follows as it would alone; the objective is evaluated in batches instead of point
+    by point. The processes' probes share one objective.
+
+    Returns:
+        Each process's return value, in order.
+    """
+    results: list[Any] = [None] * len(processes)
+    requests: dict[int, Follow] = {}
+
+    def advance(i: int, answer: tuple[Point, bool] | None) -> None:
+        try:
+            requests[i] = processes[i].send(answer)
+        except StopIteration as done:
+            results[i] = done.value
+
+    for i in range(len(processes)):
+        advance(i, None)
+    while requests:
+        asked = list(requests.items())
+        requests.clear()
+        answers = [probe.follow(start, psi) for _, (probe, start, psi) in asked]
+        evaluate_points(asked[0][1][0].objective, [point for point, _ in answers])
+        for (i, _), answer in zip(asked, answers, strict=True):
+            advance(i, answer)
+    return results
 
 
 def sweep_window(probe: Probe, center: float, hint: np.ndarray, half_width: float, n: int) -> list[Path]:
@@ -132,8 +185,7 @@ def sweep_window(probe: Probe, center: float, hint: np.ndarray, half_width: floa
             if not arrived:
                 break
         halves.append(points[1:])
-    path = Path(halves[0][::-1] + [start] + halves[1])
-    return [_with_hidden(probe, path)]
+    return _with_hidden([(probe, Path(halves[0][::-1] + [start] + halves[1]))])
 
 
 def _link(probe: Probe, psi: np.ndarray, roots: list[list[Point]]) -> list[Path]:
@@ -178,20 +230,17 @@ def _link(probe: Probe, psi: np.ndarray, roots: list[list[Point]]) -> list[Path]
 def _continuing(probe: Probe, roots: list[list[Point]]) -> dict[Point, bool]:
     """For each solution at a grid psi followed by a single one at the next: whether that one
     continues its path (:meth:`Probe.continues`), all tested at once."""
-    pairs = [(a, roots[k][0]) for k in range(1, len(roots)) if len(roots[k]) == 1 for a in roots[k - 1]]
+    flat = [p for points in roots for p in points]
+    start = np.cumsum([0] + [len(points) for points in roots]).tolist()  # each psi's first in flat
+    single = [k for k in range(1, len(roots)) if len(roots[k]) == 1]
+    pairs = [(i, start[k]) for k in single for i in range(start[k - 1], start[k])]
     if not pairs:
         return {}
-    flags = probe.continue_rows(*(np.array([[p.psi for p in pair] for pair in pairs]).T), *_stacked(pairs))
-    return dict(zip([a for a, _ in pairs], flags.tolist(), strict=True))
-
-
-def _stacked(pairs: list[tuple[Point, Point]]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The first points' joints and tangents and the second points' joints, stacked."""
-    return (
-        np.array([a.q for a, _ in pairs]),
-        np.array([a.tangent[:, 0] for a, _ in pairs]),
-        np.array([b.q for _, b in pairs]),
-    )
+    a, b = (np.array(x) for x in zip(*pairs, strict=True))
+    psi = np.array([p.psi for p in flat])
+    q, tangents = np.array([p.q for p in flat]), np.array([p.tangent[:, 0] for p in flat])
+    flags = probe.continue_rows(psi[a], psi[b], q[a], tangents[a], q[b])
+    return dict(zip([flat[i] for i in a.tolist()], flags.tolist(), strict=True))
 
 
 def _joined(
@@ -217,7 +266,7 @@ def _joined(
         while chain[-1] in following and following[chain[-1]] not in chain:
             chain.append(following[chain[-1]])
         seen.update(chain)
-        points = [p.at(p.psi + _TURN * turn) for turn, i in enumerate(chain) for p in paths[i]]
+        points = [p.at(p.psi + _TURN * turn) if turn else p for turn, i in enumerate(chain) for p in paths[i]]
         if following.get(chain[-1]) == chain[0]:
             result.append(Path(points, turns=len(chain)))
         else:
@@ -241,37 +290,67 @@ def _same(probe: Probe, point: Point, candidates: list[Point]) -> int | None:
     return int(np.argmin(steps)) if steps and min(steps) <= SAME else None
 
 
-def _with_hidden(probe: Probe, path: Path) -> Path:
-    """The path with exact samples inserted where a cell hides a feature (module docstring)."""
-    ends = list(path.points)
-    if path.turns:  # the closing cell, to the first sample a loop later
-        ends.append(ends[0].at(ends[0].psi + _TURN * path.turns))
-    # the cells that need no look inside, all at once: no joint moves more than FINE_STEP
-    # and the cheap bounds show the models quiet (_hidden's own first test, vectorised)
-    q = np.array([p.q for p in ends])
-    calm = probe.steps(q[:-1], q[1:]) <= FINE_STEP
-    small = np.flatnonzero(calm)  # (only these cells' ends need their bounds now)
-    calm[small] = _quiet([ends[k] for k in small], [ends[k + 1] for k in small])
-    filled = [ends[0]]
-    for (a, b), skip in zip(itertools.pairwise(ends), calm.tolist(), strict=True):
-        filled += [b] if skip else [*_hidden(probe, a, b), b]
-    return Path(filled[:-1] if path.turns else filled, path.turns)
+def _with_hidden(paths: list[tuple[Probe, Path]]) -> list[Path]:
+    """The paths with exact samples inserted where a cell hides a feature (module
+    docstring): the look inside every cell of every (probe, path) at once (:func:`lockstep`).
+    The probes share one objective."""
+    if not paths:
+        return []
+    ends_of = []  # each path's samples, then a loop's closing cell's end (its first, a loop later)
+    for _, path in paths:
+        closing = [path.points[0].at(path.points[0].psi + _TURN * path.turns)] if path.turns else []
+        ends_of.append(list(path.points) + closing)
+    flat = [p for ends in ends_of for p in ends]
+    evaluate_points(paths[0][0].objective, flat)  # (the path ends that the following found)
+    # every cell's first tests at once: no joint moves more than FINE_STEP and the bounds of
+    # the cubic models show them quiet (else _hidden looks inside)
+    first = np.cumsum([0] + [len(ends) for ends in ends_of]).tolist()  # each path's first in flat
+    bounds = list(itertools.pairwise(first))
+    a = np.concatenate([np.arange(i, j - 1) for i, j in bounds])  # each cell's first end in flat
+    q = np.array([p.q for p in flat])
+    steps = np.concatenate(
+        [probe.steps(q[i : j - 1], q[i + 1 : j]) for (probe, _), (i, j) in zip(paths, bounds, strict=True)]
+    )
+    psi = np.array([p.psi for p in flat])
+    feasible = np.array([p.evaluation.feasible for p in flat], dtype=bool)
+    pieces = [p.pieces() for p in flat]
+    g, dg = np.array([x for x, _ in pieces]), np.array([x for _, x in pieces])
+    calm = (steps <= FINE_STEP) & _quiet(
+        psi[a + 1] - psi[a], g[a], dg[a], g[a + 1], dg[a + 1], feasible[a], feasible[a + 1]
+    )
+    probes = [probe for (probe, _), ends in zip(paths, ends_of, strict=True) for _ in ends[1:]]
+    looked, a = np.flatnonzero(~calm).tolist(), a.tolist()
+    cells = [_hidden(probes[c], flat[a[c]], flat[a[c] + 1], float(steps[c])) for c in looked]
+    inserted = dict(zip(looked, lockstep(cells), strict=True))
+    result, c = [], 0
+    for (_, path), ends in zip(paths, ends_of, strict=True):
+        filled = [ends[0]]
+        for b in ends[1:]:
+            filled += [*inserted.get(c, ()), b]
+            c += 1
+        result.append(Path(filled[:-1] if path.turns else filled, path.turns))
+    return result
 
 
-def _hidden(probe: Probe, a: Point, b: Point) -> list[Point]:
-    """Exact samples inserted between neighbours a and b of a path, in order: halving until
-    no joint moves more than :data:`FINE_STEP` in a sub-cell, then until the Hermite models
-    of every sub-cell agree with its ends (module docstring)."""
-    inserted, cells = [], [(a, b)]
+def _hidden(
+    probe: Probe, a: Point, b: Point, step: float
+) -> Generator[Follow, tuple[Point, bool], list[Point]]:
+    """Exact samples inserted between neighbours a and b of a path (``step``: the largest
+    joint step between them), in order: halving until no joint moves more than
+    :data:`FINE_STEP` in a sub-cell, then until the Hermite models of every sub-cell agree
+    with its ends (module docstring). A process of :func:`lockstep`, which asks for each
+    inserted sample's follow."""
+    inserted, cells = [], [(a, b, step)]
     while cells and len(inserted) < _MAX_INSERTED:
-        left, right = cells.pop()
-        t = 0.5 if probe.step(left.q, right.q) > FINE_STEP else _surprise(left, right)
+        left, right, step = cells.pop()
+        t = 0.5 if step > FINE_STEP else _surprise(left, right)
         if t is None or right.psi - left.psi <= END_TOLERANCE:
             continue
-        middle, arrived = probe.follow(left, left.psi + t * (right.psi - left.psi))
+        middle, arrived = yield probe, left, left.psi + t * (right.psi - left.psi)
         if arrived:
             inserted.append(middle)
-            cells += [(left, middle), (middle, right)]
+            before, after = probe.steps(np.array([left.q, middle.q]), np.array([middle.q, right.q])).tolist()
+            cells += [(left, middle, before), (middle, right, after)]
     return sorted(inserted, key=lambda p: p.psi)
 
 
@@ -288,30 +367,24 @@ def _surprise(a: Point, b: Point) -> float | None:
     return ckernels.surprise(ga, da, gb, db, b.psi - a.psi, _HERMITE, *feasible, _BOUND_SLACK)
 
 
-def _quiet(a: list[Point], b: list[Point]) -> np.ndarray:
-    """Whether each cell (a_k, b_k)'s cubic models cannot surprise, by bounds from the ends'
-    values and rates (:meth:`~om_redundant.redundancy.objective.Objective.constraint_bounds`):
-    on [0, 1] the Hermite basis functions of the values are >= 0 and sum to 1 and those of
-    the slopes stay within 4/27 in size, so a model lies within (4/27) span (|g'_a| + |g'_b|)
-    of the ends' range. Quiet: both ends feasible and every model stays >= 0, or both
-    infeasible and one function's model stays < 0 (the bounds below 0 are the functions
-    themselves)."""
-    feasible = np.array([p.evaluation.feasible for p in a], dtype=bool)
-    quiet = np.zeros(len(a), dtype=bool)
-    alike = np.flatnonzero(feasible == np.array([p.evaluation.feasible for p in b], dtype=bool))
-    if len(alike) == 0:  # (only cells whose ends are alike need their bounds)
-        return quiet
-    a, b = [a[k] for k in alike], [b[k] for k in alike]
-    (ga, ra), (gb, rb) = _bounds(a), _bounds(b)
-    span = np.abs(np.array([y.psi - x.psi for x, y in zip(a, b, strict=True)], dtype=float))
-    spread = 4.0 / 27.0 * span[:, None] * (ra + rb) + _BOUND_SLACK
+def _quiet(
+    span: np.ndarray,
+    ga: np.ndarray,
+    da: np.ndarray,
+    gb: np.ndarray,
+    db: np.ndarray,
+    feasible_a: np.ndarray,
+    feasible_b: np.ndarray,
+) -> np.ndarray:
+    """Whether each cell's cubic models (:func:`_surprise`'s, of its ends' feasibility
+    functions ga, gb (cells, n) and their rates da, db, :meth:`Point.pieces`; span: the
+    cell's psi) cannot surprise, by bounds: on [0, 1] the Hermite basis functions of the
+    values are >= 0 and sum to 1 and those of the slopes stay within 4/27 in size, so a
+    model lies within (4/27) |span| (|g'_a| + |g'_b|) of the ends' range. Quiet: both ends
+    feasible and every model stays >= 0, or both infeasible and one function's model stays
+    < 0; then :func:`_surprise` finds no change (it skips the pieces that this bound keeps
+    positive)."""
+    spread = 4.0 / 27.0 * np.abs(span)[:, None] * (np.abs(da) + np.abs(db)) + _BOUND_SLACK
     clear = (np.minimum(ga, gb) - spread > 0.0).all(axis=1)
     blocked = (np.maximum(ga, gb) + spread < 0.0).any(axis=1)
-    quiet[alike] = np.where(feasible[alike], clear, blocked)
-    return quiet
-
-
-def _bounds(points: list[Point]) -> tuple[np.ndarray, np.ndarray]:
-    """The points' constraint bounds stacked: values (M, n), rate bounds (M, n)."""
-    bounds = [p.terms.get_bounds() for p in points]
-    return np.array([v for v, _ in bounds]), np.array([r for _, r in bounds])
+    return (feasible_a == feasible_b) & np.where(feasible_a, clear, blocked)

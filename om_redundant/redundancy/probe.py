@@ -43,12 +43,13 @@ class _Terms:
     """The objective at a point, computed when first asked for (a path's following steps
     need only the joints and the tangent): the clearance's pair distances and gradients
     (one ``ckernels.arm_clearance`` call), from which the groups with their rates, the
-    evaluation and the constraint bounds. Shared by the copies of a point at other representatives of psi.
+    evaluation and the feasibility functions. Shared by the copies of a point at other
+    representatives of psi.
     """
 
     def __init__(self, objective: Objective, q: np.ndarray, tangent: np.ndarray):
         self.objective, self.q, self.tangent = objective, q, tangent
-        self.pairs, self.groups, self.bounds, self.pieces = None, None, None, None
+        self.pairs, self.groups, self.pieces = None, None, None
 
     def get_pairs(self) -> tuple[np.ndarray, np.ndarray] | None:
         """The clearance's pair distances and gradients at q; None without obstacles."""
@@ -62,15 +63,6 @@ class _Terms:
         pairs = self.get_pairs()
         return self.objective.evaluate(self.q, None if pairs is None else pairs[0])
 
-    def get_bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        """:meth:`~om_redundant.redundancy.objective.Objective.constraint_bounds` here."""
-        if self.bounds is None:
-            pairs = self.get_pairs()
-            pairs = None if pairs is None else (pairs[0][None], pairs[1][None])
-            values, rates = self.objective.constraint_bounds(self.q[None], self.tangent[None], pairs)
-            self.bounds = values[0], rates[0]
-        return self.bounds
-
     def get_pieces(self) -> tuple[np.ndarray, np.ndarray]:
         """The feasibility functions and their rates (:meth:`Point.pieces`)."""
         if self.pieces is None:
@@ -82,6 +74,25 @@ class _Terms:
             groups = self.objective.groups(self.q, jacobian=True, pairs=self.get_pairs())
             self.groups = [g.along(self.tangent) for g in groups]
         return self.groups
+
+
+def evaluate_points(objective: Objective, points: list[Point]) -> None:
+    """The objective at those of the points not yet evaluated, in one batch: their
+    clearance's pair distances and gradients, their evaluations and their feasibility
+    functions (what :attr:`Point.evaluation` and :meth:`Point.pieces` would compute point by
+    point)."""
+    # (not yet evaluated: the cached property's value not yet in the terms' __dict__)
+    terms = list({id(p.terms): p.terms for p in points if "evaluation" not in vars(p.terms)}.values())
+    if not terms:
+        return
+    q, tangents = np.array([t.q for t in terms]), np.array([t.tangent for t in terms])
+    clearance = objective.clearance
+    pairs = None if clearance is None else clearance.distances_and_gradients(q)
+    evaluations = objective.evaluations(q, None if pairs is None else pairs[0])
+    g, dg = objective.pieces(q, tangents, pairs)
+    for k, (t, ev) in enumerate(zip(terms, evaluations, strict=True)):
+        t.pairs = None if pairs is None else (pairs[0][k], pairs[1][k])
+        t.evaluation, t.pieces = ev, (g[k], dg[k])
 
 
 @dataclass(frozen=True, eq=False)
@@ -188,25 +199,16 @@ class Probe:
         return Point(psi, q, tangent, _Terms(self.objective, q, tangent), solution)
 
     def points(self, psi: np.ndarray, q: np.ndarray) -> list[Point]:
-        """:meth:`point` for every psi and row of q (M, dof) of a 7-DOF arm, the tangents, the
-        clearance's distances and gradients, the evaluations and the constraint bounds
-        computed for all rows at once."""
+        """:meth:`point` for every psi and row of q (M, dof) of a 7-DOF arm, the tangents and
+        the objective (:func:`evaluate_points`) computed for all rows at once."""
         q = self._represent(q)
         tangents = self_motion_tangents(self.solver, q)
         bad = ~np.isfinite(tangents).all(axis=(1, 2))
         if bad.any():
             self_motion_tangent(self.solver, q[np.argmax(bad)])  # raises SingularSelfMotion
-        clearance = self.objective.clearance
-        pairs = None if clearance is None else clearance.distances_and_gradients(q)
-        evaluations = self.objective.evaluations(q, None if pairs is None else pairs[0])
-        values, rates = self.objective.constraint_bounds(q, tangents, pairs)
-        pair_rows = [None] * len(q) if pairs is None else zip(*pairs, strict=True)  # (distances, gradients)
-        rows = zip(psi.tolist(), q, tangents, evaluations, pair_rows, values, rates, strict=True)
-        points = []
-        for x, row, t, ev, pair, v, r in rows:
-            terms = _Terms(self.objective, row, t)
-            terms.pairs, terms.evaluation, terms.bounds = pair, ev, (v, r)
-            points.append(Point(x, row, t, terms))
+        rows = zip(psi.tolist(), q, tangents, strict=True)
+        points = [Point(x, row, t, _Terms(self.objective, row, t)) for x, row, t in rows]
+        evaluate_points(self.objective, points)
         return points
 
     def at(self, psi: float | np.ndarray, hint: np.ndarray) -> Point | None:

@@ -1,0 +1,70 @@
+"""The ends of the feasible intervals (om_redundant/redundancy/intervals.py): each refined end
+is the last feasible point before the boundary, and refining every end at once (lockstep)
+makes the same follows as refining each alone."""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import om_redundant as om
+from benchmarks.control_rate import MIN_CLEARANCE, obstacles
+from om_redundant.redundancy.intervals import SLACK_TOLERANCE, _refined, _spans
+from om_redundant.redundancy.paths import lockstep, sweep_circle
+from om_redundant.redundancy.probe import END_TOLERANCE
+
+
+@functools.cache
+def solver_of(name: str) -> om.OMSolver:
+    return om.OMSolver(name)
+
+
+def alone(process):
+    """A lockstep process run by itself, each follow's point evaluated when asked."""
+    answer = None
+    try:
+        while True:
+            probe, start, psi = process.send(answer)
+            answer = probe.follow(start, psi)
+    except StopIteration as done:
+        return done.value
+
+
+@settings(max_examples=6, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1), name=st.sampled_from(["panda", "iiwa14"]), count=st.sampled_from([1, 3])
+)
+def test_refined_ends_are_the_boundary_and_lockstep_is_alone(seed, name, count):
+    """On a random reachable pose with obstacles about the hand: every end refined between a
+    run's end sample and the infeasible sample beyond is feasible, and either its slack is
+    at most SLACK_TOLERANCE or the path is infeasible 2 END_TOLERANCE farther out (beyond
+    the bracket's outer end, which is within END_TOLERANCE: a follow shorter than
+    END_TOLERANCE is refused); the ends
+    refined all at once are those refined one by one, to the bit."""
+    solver = solver_of(name)
+    q = np.random.default_rng(seed).uniform(solver.arm.lower, solver.arm.upper)
+    T = solver.arm.fk(q)
+    optimizer = om.RedundancyOptimizer(solver, obstacles(T[:3, 3], count), min_clearance=MIN_CLEARANCE)
+    probes = [optimizer._probe(T, signs) for signs in optimizer.branches]
+    swept = sweep_circle(solver, optimizer.objective, T, optimizer.branches, optimizer.grid_points)
+    ends = [
+        (probe, span.points[k], outside)
+        for probe, paths in zip(probes, swept, strict=True)
+        for path in paths
+        for span in _spans(path)
+        for k, outside in ((0, span.before), (-1, span.after))
+        if outside is not None
+    ]
+    together = lockstep([_refined(*end) for end in ends])
+    for (probe, inside, outside), end in zip(ends, together, strict=True):
+        one = alone(_refined(probe, inside, outside))
+        assert one.psi == end.psi and np.array_equal(one.q, end.q)
+        assert end.evaluation.feasible
+        direction = np.sign(outside.psi - inside.psi)
+        assert 0.0 <= (end.psi - inside.psi) * direction < abs(outside.psi - inside.psi)
+        if end.evaluation.slack > SLACK_TOLERANCE:
+            beyond, arrived = probe.follow(end, end.psi + direction * 2.0 * END_TOLERANCE)
+            assert arrived and not beyond.evaluation.feasible
