@@ -287,25 +287,39 @@ static int _pass_roots(loop_search *ls, const loop_point *b, double reach, doubl
     return count;
 }
 
+/* The search around the closest approach near the trace point a where a is below the
+ * horizon, within LOOP_NEAR of the half-line and a local minimum of the line angle between
+ * its neighbours before and after (_pass_roots, out to them). Returns the root count. */
+static int _near_pass(loop_search *ls, const loop_point *before, const loop_point *a, const loop_point *after,
+                      double *roots, int count)
+{
+    if (!(a->below && a->angle < LOOP_NEAR && a->angle < before->angle && a->angle <= after->angle))
+        return count;
+    double reach = sqrt(7.0) * py_max(_distance(before->q, a->q), _distance(after->q, a->q)); /* |dq| bound */
+    return _pass_roots(ls, a, reach, INFINITY, roots, count);
+}
+
 /* Trace the self-motion loop through the pose's solution q0 (predictor along the tangent,
  * the corrector back onto the pose; a step halves where the corrector fails, drifts or the
  * tangent turns), both ways until it closes or LOOP_LENGTH, and search each step for psi's
- * crossings. Returns the root count. */
+ * crossings, each trace point for a close approach to the half-line (q0 too: between the
+ * first points of the two ways, or between the last and the first where the loop closes).
+ * Returns the root count. */
 static int _trace(loop_search *ls, const double *q0, double *roots, int count)
 {
     om_problem *pb = ls->pb;
+    loop_point start, first[2]; /* the first point each way */
+    bool stepped[2] = {false, false};
     double t0[7];
     if (!_tangent(pb, q0, NULL, t0))
         return count;
-    for (int direction = 1; direction >= -1; direction -= 2) {
-        loop_point before, a, b;
-        bool has_before = false;
+    memcpy(start.q, q0, sizeof start.q);
+    _measure(ls, &start);
+    for (int way = 0; way < 2; way++) {
+        loop_point before = start, a = start, b;
         double t[7], tb[7], h = LOOP_STEP, length = 0.0;
-        memcpy(a.q, q0, sizeof a.q);
-        _measure(ls, &a);
-        before = a;
         for (int j = 0; j < 7; j++)
-            t[j] = direction * t0[j];
+            t[j] = (way == 0 ? 1.0 : -1.0) * t0[j];
         while (length < LOOP_LENGTH && h >= LOOP_STEP_MIN) {
             double drift = 0.0, turn = 0.0;
             for (int j = 0; j < 7; j++)
@@ -321,22 +335,26 @@ static int _trace(loop_search *ls, const double *q0, double *roots, int count)
             }
             _measure(ls, &b);
             count = _segment_roots(ls, &a, &b, roots, count);
-            if (has_before && a.below && a.angle < LOOP_NEAR && a.angle < before.angle && a.angle <= b.angle)
-                count = _pass_roots(ls, &a, sqrt(7.0) * py_max(_distance(before.q, a.q), _distance(b.q, a.q)),
-                                    INFINITY, roots, count);
+            if (stepped[way])
+                count = _near_pass(ls, &before, &a, &b, roots, count);
+            else
+                first[way] = b;
+            stepped[way] = true;
             before = a;
-            has_before = true;
             length += h;
             if (ls->n_seen < LOOP_POINTS)
                 memcpy(ls->seen + 7 * ls->n_seen++, b.q, sizeof b.q);
             a = b;
             memcpy(t, tb, sizeof t);
             h = py_min(2.0 * h, LOOP_STEP);
-            if (length > 4.0 * LOOP_STEP && _distance(a.q, q0) < h)
-                return count; /* closed: the other way is the same loop */
+            if (length > 4.0 * LOOP_STEP && _distance(a.q, q0) < h) { /* closed: the other way is the same loop */
+                count = _segment_roots(ls, &a, &start, roots, count);
+                count = _near_pass(ls, &before, &a, &start, roots, count);
+                return _near_pass(ls, &a, &start, &first[way], roots, count);
+            }
         }
     }
-    return count;
+    return stepped[0] && stepped[1] ? _near_pass(ls, &first[0], &start, &first[1], roots, count) : count;
 }
 
 /* Whether q lies on a loop already traced: within two steps of a kept point. */

@@ -564,6 +564,30 @@ def test_a_shoulder_start_may_need_the_flipped_wrist():
                 -1.7232618128951618,
             ],
         ),
+        (  # 4.6e-4 rad below: the loop's pass lay between its last trace point and its first
+            "sawyer",
+            [
+                -2.208513976127911,
+                1.8088456476318062,
+                -1.0768487877746784,
+                -0.22990247872155845,
+                2.02126459993233,
+                1.3086270522598,
+                -3.117355677633442,
+            ],
+        ),
+        (  # 3.6e-4 rad below: the same
+            "sawyer",
+            [
+                -2.345416170247093,
+                -3.8095,
+                -0.4026951905978393,
+                -1.7232469283637164,
+                -2.9551461361113107,
+                0.09312666680291232,
+                3.5877880459184803,
+            ],
+        ),
     ],
 )
 def test_the_last_false_no_next_to_the_half_line(name, q):
@@ -574,7 +598,10 @@ def test_the_last_false_no_next_to_the_half_line(name, q):
     candidates of another branch, and the Panda's loop folds back at 1e-11 rad from the line
     (psi turns by 2 pi there, unseen between points 0.05 rad apart). The configuration is now
     searched along the real arm's self-motion loops through its roots at other arm angles
-    (csrc/loop_search.c), where psi's crossings are bisected to the last bit."""
+    (csrc/loop_search.c), where psi's crossings are bisected to the last bit. The two last
+    Sawyer poses (the full run of session 12, seed 0) were "no" with the first loop search:
+    the loop's pass by the line lay between the trace's last point and its start, where it
+    closed, a step that was not searched."""
     solver = _solver(name)
     q = np.array(q)
     T, c = solver.arm.fk(q), solver.configuration_of(q)
