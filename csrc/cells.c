@@ -81,41 +81,77 @@ static PyObject *om_pieces(PyObject *mod, PyObject *const *args, Py_ssize_t narg
  * alike, once if not), else the middle of the first stretch between changes as a fraction
  * of the pattern. A piece whose model stays above `slack` by the bound of paths.py's _quiet
  * (min(ga, gb) - 4/27 span (|da| + |db|)) cannot change it and is not evaluated. */
+/* The Hermite models of a cell's pieces (surprise's and crossing's arguments ga, da, gb, db,
+ * span and the basis hermite at N points). */
+typedef struct {
+    const double *ga, *da, *gb, *db, *H;
+    double span;
+    Py_ssize_t n, N;
+} cell_models;
+
+/* The buffers of ga, da, gb, db and hermite into v (released by the caller on success) and c;
+ * -1 with a ValueError naming `name` where their sizes disagree. */
+static int _cell_models(PyObject *const *args, double span, const char *name, Py_buffer v[5], cell_models *c)
+{
+    const buffer_spec sp[5] = {{F64, -1, 0, "ga"}, {F64, -1, 0, "da"}, {F64, -1, 0, "gb"}, {F64, -1, 0, "db"},
+                               {F64, -1, 0, "hermite"}};
+    PyObject *const objs[5] = {args[0], args[1], args[2], args[3], args[5]};
+    if (get_buffers(objs, v, sp, 5) < 0) return -1;
+    Py_ssize_t n = v[0].len / 8, N = v[4].len / 32;
+    if (v[1].len != n * 8 || v[2].len != n * 8 || v[3].len != n * 8 || v[4].len != N * 32) {
+        release_buffers(v, 5);
+        PyErr_Format(PyExc_ValueError, "%s: sizes of the pieces or the basis disagree", name);
+        return -1;
+    }
+    *c = (cell_models){v[0].buf, v[1].buf, v[2].buf, v[3].buf, v[4].buf, span, n, N};
+    return 0;
+}
+
+/* Piece j's model at the basis point k. */
+static inline double _model(const cell_models *c, Py_ssize_t j, Py_ssize_t k)
+{
+    Py_ssize_t N = c->N;
+    return c->ga[j] * c->H[k] + c->da[j] * c->span * c->H[N + k] + c->gb[j] * c->H[2 * N + k] +
+           c->db[j] * c->span * c->H[3 * N + k];
+}
+
+/* Whether piece j's model stays above `slack` over the cell by paths.py's _quiet bound
+ * (min(ga, gb) - 4/27 span (|da| + |db|)). */
+static inline bool _calm(const cell_models *c, Py_ssize_t j, double slack)
+{
+    return fmin(c->ga[j], c->gb[j]) - 4.0 / 27.0 * fabs(c->span) * (fabs(c->da[j]) + fabs(c->db[j])) > slack;
+}
+
+/* surprise(ga, da, gb, db, span, hermite, feasible_a, feasible_b, slack) -> fraction or None:
+ * the models m_j(s) = ga_j H0(s) + span da_j H1(s) + gb_j H2(s) + span db_j H3(s) at the N
+ * points s of hermite (4 x N, the basis there); the pattern (feasible_a, all_j m_j >= 0 at
+ * each point, feasible_b); None if it changes no more often than its ends (0 times if
+ * alike, once if not), else the middle of the first stretch between changes as a fraction
+ * of the pattern. A piece whose model stays above `slack` by the bound of paths.py's _quiet
+ * cannot change it and is not evaluated (_calm). */
 static PyObject *om_surprise(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
     if (check_nargs(nargs, 9, "surprise") < 0) return NULL;
     double span = PyFloat_AsDouble(args[4]), slack = PyFloat_AsDouble(args[8]);
     int fa = PyObject_IsTrue(args[6]), fb = PyObject_IsTrue(args[7]);
     if (PyErr_Occurred() || fa < 0 || fb < 0) return NULL;
     Py_buffer v[5];
-    const buffer_spec sp[5] = {{F64, -1, 0, "ga"}, {F64, -1, 0, "da"}, {F64, -1, 0, "gb"}, {F64, -1, 0, "db"},
-                               {F64, -1, 0, "hermite"}};
-    PyObject *const objs[5] = {args[0], args[1], args[2], args[3], args[5]};
-    if (get_buffers(objs, v, sp, 5) < 0) return NULL;
-    Py_ssize_t n = v[0].len / 8, N = v[4].len / 32;
-    if (v[1].len != n * 8 || v[2].len != n * 8 || v[3].len != n * 8 || v[4].len != N * 32) {
-        release_buffers(v, 5);
-        PyErr_SetString(PyExc_ValueError, "surprise: sizes of the pieces or the basis disagree");
-        return NULL;
-    }
-    const double *ga = v[0].buf, *da = v[1].buf, *gb = v[2].buf, *db = v[3].buf, *H = v[4].buf;
+    cell_models c;
+    if (_cell_models(args, span, "surprise", v, &c) < 0) return NULL;
+    Py_ssize_t n = c.n, N = c.N;
     Py_ssize_t *live = PyMem_Malloc((n ? n : 1) * sizeof(Py_ssize_t)), m = 0;
     if (!live) {
         release_buffers(v, 5);
         return PyErr_NoMemory();
     }
     for (Py_ssize_t j = 0; j < n; j++)
-        if (!(fmin(ga[j], gb[j]) - 4.0 / 27.0 * fabs(span) * (fabs(da[j]) + fabs(db[j])) > slack)) live[m++] = j;
+        if (!_calm(&c, j, slack)) live[m++] = j;
     Py_ssize_t changes[2], count = 0, allowed = fa != fb;
     int previous = fa;
     for (Py_ssize_t k = 0; k <= N && count < 2; k++) { /* (the first two changes tell) */
         int feasible = fb;
         if (k < N) {
             feasible = 1;
-            for (Py_ssize_t i = 0; i < m && feasible; i++) {
-                Py_ssize_t j = live[i];
-                double model = ga[j] * H[k] + da[j] * span * H[N + k] + gb[j] * H[2 * N + k] + db[j] * span * H[3 * N + k];
-                feasible = model >= 0.0;
-            }
+            for (Py_ssize_t i = 0; i < m && feasible; i++) feasible = _model(&c, live[i], k) >= 0.0;
         }
         if (feasible != previous) changes[count++] = k;
         previous = feasible;
@@ -136,36 +172,27 @@ static PyObject *om_crossing(PyObject *mod, PyObject *const *args, Py_ssize_t na
     double span = PyFloat_AsDouble(args[4]);
     if (PyErr_Occurred()) return NULL;
     Py_buffer v[5];
-    const buffer_spec sp[5] = {{F64, -1, 0, "ga"}, {F64, -1, 0, "da"}, {F64, -1, 0, "gb"}, {F64, -1, 0, "db"},
-                               {F64, -1, 0, "hermite"}};
-    PyObject *const objs[5] = {args[0], args[1], args[2], args[3], args[5]};
-    if (get_buffers(objs, v, sp, 5) < 0) return NULL;
-    Py_ssize_t n = v[0].len / 8, N = v[4].len / 32;
-    if (v[1].len != n * 8 || v[2].len != n * 8 || v[3].len != n * 8 || v[4].len != N * 32) {
-        release_buffers(v, 5);
-        PyErr_SetString(PyExc_ValueError, "crossing: sizes of the pieces or the basis disagree");
-        return NULL;
-    }
-    const double *ga = v[0].buf, *da = v[1].buf, *gb = v[2].buf, *db = v[3].buf, *H = v[4].buf;
+    cell_models c;
+    if (_cell_models(args, span, "crossing", v, &c) < 0) return NULL;
+    Py_ssize_t n = c.n, N = c.N;
     double found = -1.0;
     Py_ssize_t first = N; /* the first point where a model is negative */
-    int j_first = -1;
+    Py_ssize_t j_first = -1;
     double m_first = 0.0;
     for (Py_ssize_t j = 0; j < n; j++) {
-        if (fmin(ga[j], gb[j]) - 4.0 / 27.0 * fabs(span) * (fabs(da[j]) + fabs(db[j])) > 0.0) continue;
+        if (_calm(&c, j, 0.0)) continue;
         for (Py_ssize_t k = 0; k < N && k <= first; k++) { /* (up to the first found so far) */
-            double model = ga[j] * H[k] + da[j] * span * H[N + k] + gb[j] * H[2 * N + k] + db[j] * span * H[3 * N + k];
+            double model = _model(&c, j, k);
             if (model < 0.0) {
-                if (k < first || model < m_first) first = k, j_first = (int)j, m_first = model;
+                if (k < first || model < m_first) first = k, j_first = j, m_first = model;
                 break;
             }
         }
     }
     if (j_first >= 0) {
-        Py_ssize_t j = j_first, k = first;
-        double s1 = (double)(k + 1) / (double)(N + 1), s0 = (double)k / (double)(N + 1), m0 = ga[j];
-        if (k > 0)
-            m0 = ga[j] * H[k - 1] + da[j] * span * H[N + k - 1] + gb[j] * H[2 * N + k - 1] + db[j] * span * H[3 * N + k - 1];
+        Py_ssize_t k = first;
+        double s1 = (double)(k + 1) / (double)(N + 1), s0 = (double)k / (double)(N + 1);
+        double m0 = k > 0 ? _model(&c, j_first, k - 1) : c.ga[j_first];
         found = s0 + (s1 - s0) * m0 / (m0 - m_first);
     }
     release_buffers(v, 5);
