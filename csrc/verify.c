@@ -4,7 +4,8 @@
 
 #define REDUNDANCY_TOL 1e-9 /* a solution's redundancy values (rad) must equal the requested ones */
 /* rad per joint: psi's own rounding at q is at most its change when each joint moves by this
- * (an ulp of pi, 2^-51), which exceeds REDUNDANCY_TOL only next to psi's singular half-line */
+ * (an ulp of pi, 2^-51), which exceeds REDUNDANCY_TOL only next to psi's singular set: the
+ * half-line, and the wrist centre at the shoulder */
 #define PSI_ROUNDING 4.440892098500626e-16
 #define SRS_ELBOW_SIGN 1    /* (SHOULDER, ELBOW, WRIST) */
 #define MAX_VALUES 16       /* branch values of a family (3 today) */
@@ -14,7 +15,9 @@
  * |grad psi|_1 PSI_ROUNDING. Next to psi's singular half-line (the wrist centre straight
  * below the shoulder, at the angle rho from it) |grad psi| grows as 1 / rho, and the last bits
  * of q, and of any pose's solution, leave psi uncertain by 1e-16 / rho: beyond REDUNDANCY_TOL
- * below rho = 1e-7, where no floating-point q can meet psi to 1e-9. */
+ * below rho = 1e-7, where no floating-point q can meet psi to 1e-9. Likewise where the model's
+ * wrist centre W is at its shoulder S (|grad psi| grows as 1 / |W - S|: a model whose upper
+ * arm and forearm are equal, folded; the Sawyer's at q4 = +-pi, beyond its limits). */
 static double psi_rounding(const om_solver_data *s, const double *q)
 {
     double grad[OM_MAX_DOF], sum = 0.0;

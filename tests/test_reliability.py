@@ -606,3 +606,21 @@ def test_the_last_false_no_next_to_the_half_line(name, q):
     q = np.array(q)
     T, c = solver.arm.fk(q), solver.configuration_of(q)
     _assert_solved(solver, T, c, q_hint=q)
+
+
+def test_psi_is_loose_where_the_model_wrist_centre_is_at_the_shoulder():
+    """The Sawyer's model has equal upper arm and forearm (d3 = d5 = 0.4 m): folded, q4 = pi,
+    its wrist centre is at the shoulder, psi's other singular point, beyond the joint limits.
+    There |W - S| is rounding and psi's own rounding (|grad psi|_1 2^-51) spans tenths of a
+    radian, so `holds` takes psi 1e-2 rad off; 1e-6 rad off the fold psi is pinned again."""
+    solver = _solver("sawyer")
+    rng = np.random.default_rng(7)
+    for _ in range(5):
+        q = rng.uniform(solver.arm.lower, solver.arm.upper)
+        q[3] = math.pi
+        assert not solver.arm.within_limits(q)
+        c = solver.configuration_of(q)
+        assert solver.holds(q, om.Configuration(c.signs, (c.redundancy[0] + 1e-2,)))
+        q[3] -= 1e-6
+        c = solver.configuration_of(q)
+        assert not solver.holds(q, om.Configuration(c.signs, (c.redundancy[0] + 1e-2,)))

@@ -249,7 +249,10 @@ class OMSolver:
         1e-9 rad modulo 2 pi, or within its own rounding at q, |d psi / dq|_1 2^-51 (psi's
         change when each joint moves by an ulp of pi: larger than 1e-9 only within about
         1e-7 rad of psi's singular half-line, the wrist centre straight below the shoulder,
-        where |d psi / dq| grows as 1 / rho), psi read in the requested ELBOW branch (the
+        where |d psi / dq| grows as 1 / rho, and where the model's wrist centre is at its
+        shoulder, where it grows as 1 / |W - S|: the folded elbow of a model with equal upper
+        arm and forearm, the Sawyer's at q4 = +-pi, beyond its limits), psi read in the
+        requested ELBOW branch (the
         elbow plane's normal flips with the branch, so at a straight elbow psi is the
         requested branch's).
         Every ``ok`` answer of :meth:`solve`, :meth:`solve_all` and :meth:`solve_batch`
