@@ -236,6 +236,15 @@ static double _curvature_at(const double *pw, const double *pg, int L, bool cycl
     return CELL_SAFETY * fabs(s1 - s0) / (0.5 * (h0 + h1));
 }
 
+/* _curvature_at point k of the run, k taken modulo L where the run is cyclic; NaN for a k
+ * beyond its ends where it is not (and for an empty run). */
+static double _curvature_near(const double *pw, const double *pg, int L, bool cyclic, int k)
+{
+    if (L < 1 || (!cyclic && (k < 0 || k >= L)))
+        return NAN;
+    return _curvature_at(pw, pg, L, cyclic, py_mod(k, L));
+}
+
 /* Add a close pair of roots on [a, b] to out[n:]: g has one sign at a, x0 and b, and its
  * extremum between them may cross zero. Returns the new count. */
 static int _pair(om_problem *pb, double a, double ga, double x0, double b, double gb, double *q, double *out, int n,
@@ -268,13 +277,20 @@ static int _run_roots(om_problem *pb, const pole_guard *pole, int depth, const d
         if (L > 1 && fabs(pg[L - 1]) < OM_TOUCH)
             n = _put(out, n, cap, pw[L - 1]);
     }
+    /* The estimates at points i - 1 .. i + 2 of cell i, each point's computed once as the
+     * window slides (NaN beyond the ends of a run that is not cyclic: none there). */
+    double near[4];
+    for (int m = 0; m < 4; m++)
+        near[m] = _curvature_near(pw, pg, L, cyclic, m - 1);
     for (int i = 0; i < L - 1 + (int)cyclic; i++) {
         int j = (i + 1) % L;
         double wj = pw[j] + (j == 0 ? 2.0 * OM_PI : 0.0);
         double curvature = 0.0; /* the largest estimate at the cell's ends and their neighbours */
-        for (int k = i - 1; k <= i + 2; k++)
-            if (cyclic || (k >= 0 && k < L))
-                curvature = py_max(curvature, _curvature_at(pw, pg, L, cyclic, py_mod(k, L)));
+        for (int m = 0; m < 4; m++)
+            if (!isnan(near[m]))
+                curvature = py_max(curvature, near[m]);
+        memmove(near, near + 1, 3 * sizeof(double));
+        near[3] = _curvature_near(pw, pg, L, cyclic, i + 3);
         double split[2 * (POLE_SPLITS + POLE_SPREAD) + 1];
         int k = pole->active && depth > 0 ? _pole_splits(pole, pw[i], wj, split) : 0;
         if (k)
@@ -322,10 +338,11 @@ bool om_margin_may_reach(const double *ms, int i, int count, bool cyclic)
 /* Whether the model may reach some point of the cell [ws[i], ws[i + 1]] (both ends out of
  * reach): on an S-R-S arm by a bound (om_srs_reach_possible); otherwise where the margin
  * may (om_margin_may_reach). */
-static bool _island_possible(om_problem *pb, const double *ws, const double *ms, int i, int count)
+static bool _island_possible(om_problem *pb, om_reach_bound *bound, const double *ws, const double *ms, int i,
+                             int count)
 {
     if (pb->s->family == OM_SRS)
-        return om_srs_reach_possible(pb, ws[i], ws[i + 1]);
+        return om_srs_reach_possible(pb, bound, ws[i], ws[i + 1]);
     return om_margin_may_reach(ms, i, count, false);
 }
 
@@ -377,6 +394,7 @@ int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool f
         ms = rms;
         ws[0] = lo + h * (double)start;
     }
+    om_reach_bound bound = OM_REACH_BOUND_NONE;
     int L = 0;
     for (int i = 0; i < count; i++) {
         double w = ws[i];
@@ -400,7 +418,7 @@ int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool f
         if (i + 1 < count && isnan(gs[i + 1])) {
             /* Both ends of this cell are out of reach: look for an island of reach between
              * them where the model may reach. */
-            if (_island_possible(pb, ws, ms, i, count)) {
+            if (_island_possible(pb, &bound, ws, ms, i, count)) {
                 double gc;
                 double c = om_extremum(pb, w, ws[i + 1], 0.5 * (w + ws[i + 1]), 1.0, true, q, &gc, NULL);
                 if (!isnan(gc)) { /* an island of reach around c */

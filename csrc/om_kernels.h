@@ -198,8 +198,14 @@ double om_g_margin(om_problem *pb, double w, double *q, bool all_joints, double 
 double om_g(om_problem *pb, double w, double *q, bool all_joints);
 /* om_g_margin's margin alone (S-R-S: no joint solved, not counted). */
 double om_reach_margin(om_problem *pb, double w, double *q);
+/* What om_srs_reach_possible keeps across the cells of one scan: the bound on the elbow's |x''|
+ * along the circle (NaN: not yet computed) and x at w, the last cell's end (NaN: none). */
+typedef struct {
+    double curvature, w, x;
+} om_reach_bound;
+#define OM_REACH_BOUND_NONE ((om_reach_bound){NAN, NAN, NAN})
 /* S-R-S: whether the model may reach the circle's points somewhere in [a, b] (a bound; see residual.c). */
-bool om_srs_reach_possible(om_problem *pb, double a, double b);
+bool om_srs_reach_possible(om_problem *pb, om_reach_bound *bound, double a, double b);
 /* S-R-S: W(w) - S = e + u1 cos w + u2 sin w on the circle. */
 void om_srs_wrist_circle(const om_problem *pb, vec3 *e, vec3 *u1, vec3 *u2);
 bool om_margin_may_reach(const double *ms, int i, int count, bool cyclic);

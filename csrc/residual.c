@@ -106,21 +106,29 @@ void om_srs_wrist_circle(const om_problem *pb, vec3 *e, vec3 *u1, vec3 *u2)
  * + b1 sin w + a2 cos 2w + b2 sin 2w (a1 = 2 e.u1, b1 = 2 e.u2, a2 = (|u1|^2 - |u2|^2) / 2,
  * b2 = u1.u2), so |x''| <= (|(a1, b1)| + 4 |(a2, b2)|) / K, and x stays within
  * (b - a)^2 / 8 times that of the chord through its ends: a proof that no island of reach
- * lies between two samples, without searching. */
-bool om_srs_reach_possible(om_problem *pb, double a, double b)
+ * lies between two samples, without searching. The bound on |x''| is the circle's, computed
+ * at the first call of a scan; x at a is the last call's x at b where a is that b (the cells
+ * of a scan in order), the same value. */
+bool om_srs_reach_possible(om_problem *pb, om_reach_bound *bound, double a, double b)
 {
     const double *P = pb->s->params;
     double xa = NAN, xb = NAN;
-    om_srs_reach(P, &pb->t, on_circle(pb, a), &xa);
+    if (a == bound->w)
+        xa = bound->x;
+    else
+        om_srs_reach(P, &pb->t, on_circle(pb, a), &xa);
     om_srs_reach(P, &pb->t, on_circle(pb, b), &xb);
+    bound->w = b, bound->x = xb;
     if (isnan(xa) || isnan(xb)) /* W = S at an end */
         return true;
-    vec3 e, u1, u2;
-    om_srs_wrist_circle(pb, &e, &u1, &u2);
-    double a1 = 2.0 * v_dot(e, u1), b1 = 2.0 * v_dot(e, u2);
-    double a2 = 0.5 * (v_dot(u1, u1) - v_dot(u2, u2)), b2 = v_dot(u1, u2);
-    double curvature = (sqrt(a1 * a1 + b1 * b1) + 4.0 * sqrt(a2 * a2 + b2 * b2)) / P[SRS_K];
-    double sag = 0.125 * (b - a) * (b - a) * curvature + REACH_BOUND_SLACK;
+    if (isnan(bound->curvature)) {
+        vec3 e, u1, u2;
+        om_srs_wrist_circle(pb, &e, &u1, &u2);
+        double a1 = 2.0 * v_dot(e, u1), b1 = 2.0 * v_dot(e, u2);
+        double a2 = 0.5 * (v_dot(u1, u1) - v_dot(u2, u2)), b2 = v_dot(u1, u2);
+        bound->curvature = (sqrt(a1 * a1 + b1 * b1) + 4.0 * sqrt(a2 * a2 + b2 * b2)) / P[SRS_K];
+    }
+    double sag = 0.125 * (b - a) * (b - a) * bound->curvature + REACH_BOUND_SLACK;
     if (xa > 1.0 && xb > 1.0)
         return py_min(xa, xb) - sag <= 1.0;
     if (xa < -1.0 && xb < -1.0)

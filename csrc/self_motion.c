@@ -8,7 +8,10 @@
  * dpsi = Dpsi(q) . n, so dq/dpsi = n / (Dpsi(q) . n). */
 #include "binding.h"
 
-/* det of the n x n matrix A (row-major, destroyed) by elimination with partial pivoting. */
+/* det of the n x n matrix A (row-major, destroyed) by elimination with partial pivoting. Columns
+ * already eliminated are not read again, so the row swap skips those left of the pivot and
+ * the update skips the pivot's own (the entries it would zero): the same determinant to the
+ * last bit, about a fifth fewer updates. */
 static double det(double *A, int n) {
     double d = 1.0;
     for (int k = 0; k < n; k++) {
@@ -17,7 +20,7 @@ static double det(double *A, int n) {
             if (fabs(A[i * n + k]) > fabs(A[p * n + k])) p = i;
         if (A[p * n + k] == 0.0) return 0.0;
         if (p != k) {
-            for (int j = 0; j < n; j++) {
+            for (int j = k; j < n; j++) {
                 double t = A[k * n + j];
                 A[k * n + j] = A[p * n + j];
                 A[p * n + j] = t;
@@ -27,7 +30,7 @@ static double det(double *A, int n) {
         d *= A[k * n + k];
         for (int i = k + 1; i < n; i++) {
             double f = A[i * n + k] / A[k * n + k];
-            for (int j = k; j < n; j++) A[i * n + j] -= f * A[k * n + j];
+            for (int j = k + 1; j < n; j++) A[i * n + j] -= f * A[k * n + j];
         }
     }
     return d;
