@@ -3,6 +3,10 @@
 #include "om_system.h"
 
 #define START_POINTS 8 /* starts on the dp circle where a first root is out of limits */
+/* rad^2: a hinted local root farther from the hint than this (squared wrapped distance) may
+ * have a nearer twin beyond the window's reach (a straight elbow's: the FR3's at 3.5 rad), so
+ * the bounded search decides which root is nearest */
+#define NEAR_HINT 1.0
 
 /* The flange pose in DH frame 0 for an end-effector pose T (4x4 row-major) in the root frame. */
 void om_flange_target(const double *T, const double *T_base_root, const double *T_tool_flange, mat3 *R, vec3 *p)
@@ -40,6 +44,17 @@ static bool _shifted(const double *a, const double *b, int dof)
  * is not representable at 1e8 rad to 1e-10): where the shifted vector no longer verifies,
  * the shift nearest zero is taken, and where that fails too, q itself. So the vector
  * returned always verifies. Returns whether it is within the limits. */
+/* The squared wrapped distance between joint vectors a and b. */
+static double _distance2(const double *a, const double *b, int dof)
+{
+    double d = 0.0;
+    for (int j = 0; j < dof; j++) {
+        double e = om_wrap(a[j] - b[j]);
+        d += e * e;
+    }
+    return d;
+}
+
 static bool _finish(om_problem *pb, const double *q, const double *hint, bool has_hint, double *q_out, double *pos,
                     double *ori)
 {
@@ -181,12 +196,19 @@ static om_result _solve(const om_solver_data *s, const double *T, const int64_t 
     } else if (!has_hint) { /* the paper's fixed-point start, p_m = p_d */
         found = om_fixed_point_start(pb, q, start);
     }
+    double local[OM_MAX_DOF], local_pos = NAN, local_ori = NAN, local_dist = INFINITY;
+    bool local_inside = false;
     if (has_hint) {
-        bool inside;
-        if (_near_hint(pb, start, &start_complete, q, q_out, &pos, &ori, &inside, as_is, context))
-            return _result(OM_OK, pos, ori, problem.counter, inside);
-        if (!search) /* not a verdict: a solution may still exist */
+        if (_near_hint(pb, start, &start_complete, q, q_out, &pos, &ori, &local_inside, as_is, context)) {
+            local_dist = _distance2(q_out, hint, dof);
+            if (!search || local_dist <= NEAR_HINT)
+                return _result(OM_OK, pos, ori, problem.counter, local_inside);
+            memcpy(local, q_out, (size_t)dof * sizeof(double));
+            local_pos = pos;
+            local_ori = ori;
+        } else if (!search) { /* not a verdict: a solution may still exist */
             return _result(OM_NO_SOLUTION_IN_CONFIGURATION, NAN, NAN, problem.counter, false);
+        }
     } else if (found && om_local_solve(pb, start, &start_complete, q, &pos, &ori)) {
         bool inside = _finish(pb, q, hint, false, q_out, &pos, &ori);
         if (inside || mode == OM_FIXED)
@@ -212,6 +234,10 @@ static om_result _solve(const om_solver_data *s, const double *T, const int64_t 
     bool neighbour_reached = false;
     if (n == 0) /* the boundary contract: a neighbour's root in the band holds this configuration */
         n = om_band_roots(pb, roots, &neighbour_reached);
+    if (n == 0 && local_dist < INFINITY) { /* the local root, which the search did not find again */
+        memcpy(q_out, local, (size_t)dof * sizeof(double));
+        return _result(OM_OK, local_pos, local_ori, problem.counter, local_inside);
+    }
     if (n == 0) {
         for (int j = 0; j < dof; j++)
             q_out[j] = NAN;
@@ -225,13 +251,7 @@ static om_result _solve(const om_solver_data *s, const double *T, const int64_t 
     int best = 0;
     double best_dist = INFINITY;
     for (int r = 0; r < n; r++) {
-        double dist = 0.0;
-        if (found) {
-            for (int j = 0; j < dof; j++) {
-                double e = om_wrap(roots[r * dof + j] - start[j]);
-                dist += e * e;
-            }
-        }
+        double dist = found ? _distance2(roots + r * dof, start, dof) : 0.0;
         if (!has_hint) {
             double shifted[OM_MAX_DOF];
             memcpy(shifted, roots + r * dof, (size_t)dof * sizeof(double));
@@ -245,6 +265,10 @@ static om_result _solve(const om_solver_data *s, const double *T, const int64_t 
     }
     om_verify(pb, roots + best * dof, &pos, &ori);
     bool inside = _finish(pb, roots + best * dof, hint, has_hint, q_out, &pos, &ori);
+    if (local_dist <= _distance2(q_out, hint, dof)) { /* the local root is (one of) the nearest */
+        memcpy(q_out, local, (size_t)dof * sizeof(double));
+        return _result(OM_OK, local_pos, local_ori, problem.counter, local_inside);
+    }
     return _result(OM_OK, pos, ori, problem.counter, inside);
 }
 

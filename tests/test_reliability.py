@@ -624,3 +624,17 @@ def test_psi_is_loose_where_the_model_wrist_centre_is_at_the_shoulder():
         q[3] -= 1e-6
         c = solver.configuration_of(q)
         assert not solver.holds(q, om.Configuration(c.signs, (c.redundancy[0] + 1e-2,)))
+
+
+def test_the_hinted_solve_returns_the_nearest_root_beyond_the_window():
+    """FR3 at a straight elbow (benchmarks.seven_dof, seed 0): the hint 0.016 rad from q, the
+    local root's twin 3.5 rad away, beyond the window's reach; the nearest root is q."""
+    solver = _solver("fr3")
+    q = np.array([0.52432708, 0.04154357, 0.22528842, -0.46925744, -1.64917994, 4.303563, -1.33344394])
+    hint = np.array([0.51730921, 0.04767133, 0.23419927, -0.46371029, -1.65409267, 4.3084661, -1.33072576])
+    T, c = solver.arm.fk(q), solver.configuration_of(q)
+    sol = solver.solve(T, c, q_hint=hint)
+    assert sol.ok, sol.status
+    _assert_exact(solver, sol.q, T, c)
+    distance = [np.linalg.norm(np.angle(np.exp(1j * (r.q - hint)))) for r in solver.solve_all(T, c)]
+    assert np.linalg.norm(np.angle(np.exp(1j * (sol.q - hint)))) <= min(distance) + 1e-9
