@@ -14,6 +14,8 @@ enum { F64, I64, U8 }; /* buffer kinds: float64, int64, bool */
 int get_buffer(PyObject *obj, Py_buffer *view, int kind, Py_ssize_t n, int writable, const char *name);
 /* A TypeError naming what takes `want` arguments where nargs came; -1 then. */
 int check_nargs(Py_ssize_t nargs, Py_ssize_t want, const char *what);
+/* An arm's joint count from obj into *dof, 1 ... OM_MAX_DOF; -1 with an error naming what. */
+int get_dof(PyObject *obj, Py_ssize_t *dof, const char *what);
 /* What get_buffers asks of one argument: kind, entries (n < 0: any), writable, name. */
 typedef struct {
     int kind;

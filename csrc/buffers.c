@@ -45,6 +45,16 @@ int check_nargs(Py_ssize_t nargs, Py_ssize_t want, const char *what) {
     return 0;
 }
 
+int get_dof(PyObject *obj, Py_ssize_t *dof, const char *what) {
+    *dof = PyLong_AsSsize_t(obj);
+    if (*dof == -1 && PyErr_Occurred()) return -1;
+    if (*dof < 1 || *dof > OM_MAX_DOF) {
+        PyErr_Format(PyExc_ValueError, "%s: dof must be 1 ... %d, got %zd", what, OM_MAX_DOF, *dof);
+        return -1;
+    }
+    return 0;
+}
+
 int get_buffers(PyObject *const *objs, Py_buffer *views, const buffer_spec *specs, int n) {
     for (int i = 0; i < n; i++) {
         if (get_buffer(objs[i], &views[i], specs[i].kind, specs[i].n, specs[i].writable, specs[i].name) < 0) {

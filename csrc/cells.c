@@ -41,12 +41,8 @@ static void row_pieces(Py_ssize_t dof, Py_ssize_t L, Py_ssize_t P, const double 
 
 static PyObject *om_pieces(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
     if (check_nargs(nargs, 12, "pieces") < 0) return NULL;
-    Py_ssize_t dof = PyLong_AsSsize_t(args[0]);
-    if (PyErr_Occurred()) return NULL;
-    if (dof < 1) {
-        PyErr_SetString(PyExc_ValueError, "pieces: dof must be positive");
-        return NULL;
-    }
+    Py_ssize_t dof;
+    if (get_dof(args[0], &dof, "pieces") < 0) return NULL;
     Py_buffer v[11];
     const buffer_spec sp[11] = {{F64, -1, 0, "q"},     {F64, -1, 0, "t"},      {F64, -1, 0, "distances"},
                                 {F64, -1, 0, "gradients"}, {I64, -1, 0, "limited"}, {F64, -1, 0, "lower"},

@@ -48,12 +48,8 @@ static void evaluate(const double *q, const double *d, Py_ssize_t P, const int64
  * d_min, s_cap). No limited joint (L = 0) or no singularity (K = 0): no such term. */
 static PyObject *om_evaluate(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
     if (check_nargs(nargs, 11, "evaluate") < 0) return NULL;
-    Py_ssize_t dof = PyLong_AsSsize_t(args[0]);
-    if (dof == -1 && PyErr_Occurred()) return NULL;
-    if (dof < 1 || dof > OM_MAX_DOF) {
-        PyErr_SetString(PyExc_ValueError, "evaluate: dof out of range");
-        return NULL;
-    }
+    Py_ssize_t dof;
+    if (get_dof(args[0], &dof, "evaluate") < 0) return NULL;
     Py_buffer v[10];
     const buffer_spec sp[10] = {{F64, -1, 0, "q"},     {F64, -1, 0, "distances"}, {I64, -1, 0, "limited"},
                                 {F64, -1, 0, "lower"}, {F64, -1, 0, "upper"},     {F64, -1, 0, "half"},
