@@ -72,10 +72,6 @@ double om_wrap_angle(double x);
  * Probe.continues): no joint moved more than 1 rad, and |dq - t d|_inf <= |dq|_inf / 2 + 1e-6;
  * t NULL: only that no joint jumped. cyclic (NULL: none): joints compared modulo 2 pi. */
 bool om_continues(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic);
-/* The max-norm joint step |q1 - q0|_inf into *moved and the first-order prediction's error
- * |q1 - q0 - t d|_inf into *error (t NULL: 0), cyclic joints modulo 2 pi (om_continues' terms). */
-void om_continuation(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic,
-                     double *moved, double *error);
 /* Whether q1 continues the path from (q0, t) d ahead beyond doubt: no joint moved more than
  * 1 rad and the first-order prediction's error is within 1/4 of the joint step. A root of
  * another path is off by the paths' separation, which no shorter step shrinks; one that

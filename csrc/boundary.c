@@ -110,23 +110,29 @@ int om_add_candidate(om_problem *pb, double *q, double *roots, int count)
     return om_add_root(pb, q, roots, count);
 }
 
+om_problem om_problem_at(const om_problem *pb, const int64_t *signs, const double *redundancy)
+{
+    const om_solver_data *s = pb->s;
+    om_problem other = *pb;
+    other.signs = signs;
+    other.redundancy = redundancy;
+    other.t = om_target_at(s->family, s->params, &pb->t.R, redundancy);
+    other.counter = 0;
+    return other;
+}
+
 /* The problem with branch i flipped: the neighbouring configuration across that boundary.
  * psi's reference flips with the ELBOW branch, so there psi becomes psi + pi. */
 static om_problem neighbour(const om_problem *pb, int i, int64_t *signs, double *redundancy)
 {
     const om_solver_data *s = pb->s;
-    om_problem other = *pb;
     memcpy(signs, pb->signs, (size_t)s->n_signs * sizeof(int64_t));
     signs[i] = -signs[i];
     for (int r = 0; r < s->n_redundancy; r++)
         redundancy[r] = pb->redundancy[r];
     if (s->family == OM_SRS && i == ELBOW_SIGN)
         redundancy[0] = om_wrap(redundancy[0] + OM_PI);
-    other.signs = signs;
-    other.redundancy = redundancy;
-    other.t = om_target_at(s->family, s->params, &pb->t.R, redundancy); /* the target's psi with it */
-    other.counter = 0;
-    return other;
+    return om_problem_at(pb, signs, redundancy);
 }
 
 /* |branch quantity i| of the model's solution at free angle w (INFINITY out of reach); q gets it. */

@@ -70,13 +70,6 @@ static PyObject *om_pieces(PyObject *mod, PyObject *const *args, Py_ssize_t narg
     Py_RETURN_NONE;
 }
 
-/* surprise(ga, da, gb, db, span, hermite, feasible_a, feasible_b, slack) -> fraction or None:
- * the models m_j(s) = ga_j H0(s) + span da_j H1(s) + gb_j H2(s) + span db_j H3(s) at the N
- * points s of hermite (4 x N, the basis there); the pattern (feasible_a, all_j m_j >= 0 at
- * each point, feasible_b); None if it changes no more often than its ends (0 times if
- * alike, once if not), else the middle of the first stretch between changes as a fraction
- * of the pattern. A piece whose model stays above `slack` by the bound of paths.py's _quiet
- * (min(ga, gb) - 4/27 span (|da| + |db|)) cannot change it and is not evaluated. */
 /* The Hermite models of a cell's pieces (surprise's and crossing's arguments ga, da, gb, db,
  * span and the basis hermite at N points). */
 typedef struct {

@@ -130,14 +130,6 @@ static bool _tangent(const om_problem *pb, const double *q, const double *along,
     return true;
 }
 
-static double _distance(const double *a, const double *b)
-{
-    double d = 0.0;
-    for (int j = 0; j < 7; j++)
-        d = py_max(d, fabs(om_wrap(a[j] - b[j])));
-    return d;
-}
-
 /* The midpoint of the segment (a, b) of the loop into m: the chord's, on the loop again by
  * the corrector where the segment is longer than LOOP_CHORD. False where it cannot be split
  * (the midpoint is an end to the last bit, the corrector fails, the budget is spent). */
@@ -295,7 +287,7 @@ static int _near_pass(loop_search *ls, const loop_point *before, const loop_poin
 {
     if (!(a->below && a->angle < LOOP_NEAR && a->angle < before->angle && a->angle <= after->angle))
         return count;
-    double reach = sqrt(7.0) * py_max(_distance(before->q, a->q), _distance(after->q, a->q)); /* |dq| bound */
+    double reach = sqrt(7.0) * py_max(om_wrapped_distance_max(before->q, a->q, 7), om_wrapped_distance_max(after->q, a->q, 7)); /* |dq| bound */
     return _pass_roots(ls, a, reach, INFINITY, roots, count);
 }
 
@@ -347,7 +339,7 @@ static int _trace(loop_search *ls, const double *q0, double *roots, int count)
             a = b;
             memcpy(t, tb, sizeof t);
             h = py_min(2.0 * h, LOOP_STEP);
-            if (length > 4.0 * LOOP_STEP && _distance(a.q, q0) < h) { /* closed: the other way is the same loop */
+            if (length > 4.0 * LOOP_STEP && om_wrapped_distance_max(a.q, q0, 7) < h) { /* closed: the other way is the same loop */
                 count = _segment_roots(ls, &a, &start, roots, count);
                 count = _near_pass(ls, &before, &a, &start, roots, count);
                 return _near_pass(ls, &a, &start, &first[way], roots, count);
@@ -361,7 +353,7 @@ static int _trace(loop_search *ls, const double *q0, double *roots, int count)
 static bool _seen(const loop_search *ls, const double *q)
 {
     for (int k = 0; k < ls->n_seen; k++)
-        if (_distance(q, ls->seen + 7 * k) < 2.0 * LOOP_STEP)
+        if (om_wrapped_distance_max(q, ls->seen + 7 * k, 7) < 2.0 * LOOP_STEP)
             return true;
     return false;
 }
@@ -379,10 +371,7 @@ int om_loop_roots(om_problem *pb, double *roots, int count)
     static const int order[LOOP_STARTS - 1] = {4, 2, 6, 1, 3, 5, 7};
     for (int i = 0; i < LOOP_STARTS - 1 && count == 0; i++) {
         double psi = om_wrap(pb->redundancy[0] + 2.0 * OM_PI * (double)order[i] / (double)LOOP_STARTS);
-        om_problem other = *pb;
-        other.redundancy = &psi;
-        other.t = om_target_at(s->family, s->params, &pb->t.R, &psi);
-        other.counter = 0;
+        om_problem other = om_problem_at(pb, pb->signs, &psi);
         int n = om_all_roots(&other, s->scan_points, starts, pb->q_prev, INFINITY);
         pb->counter += other.counter;
         for (int r = 0; r < n; r++)

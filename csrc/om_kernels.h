@@ -284,6 +284,9 @@ bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori);
 void om_self_motion_null(const om_solver_data *s, const double *q, double *n);
 /* om_add_root of q, polished first where it fails verification near the boundary. */
 int om_add_candidate(om_problem *pb, double *q, double *roots, int count);
+/* pb's pose in another configuration (signs, redundancy: kept by the caller), its target's
+ * constants for that redundancy, its evaluation counter at zero. */
+om_problem om_problem_at(const om_problem *pb, const int64_t *signs, const double *redundancy);
 
 /* For a configuration whose bounded search found no root: the roots at its touch points
  * (samples of the free angle where the model's solution meets a branch zero, refined), and

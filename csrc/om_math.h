@@ -113,4 +113,24 @@ static inline double py_max(double a, double b) { return b > a ? b : a; }
 /* Python's min(a, b) on floats: b if b < a else a. */
 static inline double py_min(double a, double b) { return b < a ? b : a; }
 
+/* sum_j wrap(a_j - b_j)^2 over n joints: the squared distance of joint vectors modulo turns. */
+static inline double om_wrapped_distance2(const double *a, const double *b, int n)
+{
+    double d = 0.0;
+    for (int j = 0; j < n; j++) {
+        double e = om_wrap(a[j] - b[j]);
+        d += e * e;
+    }
+    return d;
+}
+
+/* max_j |wrap(a_j - b_j)| over n joints. */
+static inline double om_wrapped_distance_max(const double *a, const double *b, int n)
+{
+    double d = 0.0;
+    for (int j = 0; j < n; j++)
+        d = py_max(d, fabs(om_wrap(a[j] - b[j])));
+    return d;
+}
+
 #endif

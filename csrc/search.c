@@ -195,11 +195,7 @@ bool om_exists_other(om_problem *pb, bool skip_neighbours)
 bool om_nearest_in_window(om_problem *pb, const double *hint, double *q)
 {
     int dof = pb->s->dof;
-    double d2 = 0.0;
-    for (int j = 0; j < dof; j++) {
-        double e = om_wrap(q[j] - hint[j]);
-        d2 += e * e;
-    }
+    double d2 = om_wrapped_distance2(q, hint, dof);
     double radius = sqrt(d2);
     if (radius < 1e-12)
         return false;
@@ -207,11 +203,7 @@ bool om_nearest_in_window(om_problem *pb, const double *hint, double *q)
     int n = om_all_roots(pb, WINDOW_POINTS, roots, hint, radius);
     bool replaced = false;
     for (int r = 0; r < n; r++) {
-        double e2 = 0.0;
-        for (int j = 0; j < dof; j++) {
-            double e = om_wrap(roots[r * dof + j] - hint[j]);
-            e2 += e * e;
-        }
+        double e2 = om_wrapped_distance2(roots + r * dof, hint, dof);
         if (e2 < d2) {
             d2 = e2;
             replaced = true;

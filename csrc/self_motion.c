@@ -72,8 +72,10 @@ double om_wrap_angle(double x) {
     return r - OM_PI;
 }
 
-void om_continuation(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic,
-                     double *moved, double *error) {
+/* The max-norm joint step |q1 - q0|_inf into *moved and the first-order prediction's error
+ * |q1 - q0 - t d|_inf into *error (t NULL: 0), cyclic joints modulo 2 pi (om_continues' terms). */
+static void _continuation(int dof, const double *q0, const double *q1, const double *t, double d,
+                          const uint8_t *cyclic, double *moved, double *error) {
     *moved = 0.0, *error = 0.0;
     for (int i = 0; i < dof; i++) {
         double m = q1[i] - q0[i];
@@ -85,12 +87,12 @@ void om_continuation(int dof, const double *q0, const double *q1, const double *
 
 bool om_continues(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic) {
     double moved, error;
-    om_continuation(dof, q0, q1, t, d, cyclic, &moved, &error);
+    _continuation(dof, q0, q1, t, d, cyclic, &moved, &error);
     return moved <= 1.0 && error <= 0.5 * moved + 1e-6;
 }
 
 bool om_beyond_doubt(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic) {
     double moved, error;
-    om_continuation(dof, q0, q1, t, d, cyclic, &moved, &error);
+    _continuation(dof, q0, q1, t, d, cyclic, &moved, &error);
     return moved <= 1.0 && error <= 0.25 * moved;
 }

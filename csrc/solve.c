@@ -44,17 +44,6 @@ static bool _shifted(const double *a, const double *b, int dof)
  * is not representable at 1e8 rad to 1e-10): where the shifted vector no longer verifies,
  * the shift nearest zero is taken, and where that fails too, q itself. So the vector
  * returned always verifies. Returns whether it is within the limits. */
-/* The squared wrapped distance between joint vectors a and b. */
-static double _distance2(const double *a, const double *b, int dof)
-{
-    double d = 0.0;
-    for (int j = 0; j < dof; j++) {
-        double e = om_wrap(a[j] - b[j]);
-        d += e * e;
-    }
-    return d;
-}
-
 static bool _finish(om_problem *pb, const double *q, const double *hint, bool has_hint, double *q_out, double *pos,
                     double *ori)
 {
@@ -200,7 +189,7 @@ static om_result _solve(const om_solver_data *s, const double *T, const int64_t 
     bool local_inside = false;
     if (has_hint) {
         if (_near_hint(pb, start, &start_complete, q, q_out, &pos, &ori, &local_inside, as_is, context)) {
-            local_dist = _distance2(q_out, hint, dof);
+            local_dist = om_wrapped_distance2(q_out, hint, dof);
             if (!search || local_dist <= NEAR_HINT)
                 return _result(OM_OK, pos, ori, problem.counter, local_inside);
             memcpy(local, q_out, (size_t)dof * sizeof(double));
@@ -251,7 +240,7 @@ static om_result _solve(const om_solver_data *s, const double *T, const int64_t 
     int best = 0;
     double best_dist = INFINITY;
     for (int r = 0; r < n; r++) {
-        double dist = found ? _distance2(roots + r * dof, start, dof) : 0.0;
+        double dist = found ? om_wrapped_distance2(roots + r * dof, start, dof) : 0.0;
         if (!has_hint) {
             double shifted[OM_MAX_DOF];
             memcpy(shifted, roots + r * dof, (size_t)dof * sizeof(double));
@@ -265,7 +254,7 @@ static om_result _solve(const om_solver_data *s, const double *T, const int64_t 
     }
     om_verify(pb, roots + best * dof, &pos, &ori);
     bool inside = _finish(pb, roots + best * dof, hint, has_hint, q_out, &pos, &ori);
-    if (local_dist <= _distance2(q_out, hint, dof)) { /* the local root is (one of) the nearest */
+    if (local_dist <= om_wrapped_distance2(q_out, hint, dof)) { /* the local root is (one of) the nearest */
         memcpy(q_out, local, (size_t)dof * sizeof(double));
         return _result(OM_OK, local_pos, local_ori, problem.counter, local_inside);
     }

@@ -108,9 +108,7 @@ int om_add_root(om_problem *pb, const double *q, double *roots, int count)
         return count;
     int dof = pb->s->dof;
     for (int r = 0; r < count; r++) {
-        double diff = 0.0;
-        for (int j = 0; j < dof; j++)
-            diff = py_max(diff, fabs(om_wrap(q[j] - roots[r * dof + j])));
+        double diff = om_wrapped_distance_max(q, roots + r * dof, dof);
         if (diff < OM_SAME_ROOT)
             return count;
         if (diff < OM_ONE_ROOT) {
