@@ -227,10 +227,11 @@ class Objective:
         singular = (np.zeros(0, dtype=np.int64), np.zeros(0)) if singularity is None else singularity.rows()
         numbers = (self.margin_weight, self.clearance_weight, self.singularity_weight)
         numbers += (self.clearance_cap, self.min_clearance, SINGULARITY_CAP)
-        # what ckernels.pieces reads: 2 d_cap, d_cap, d_min / d_cap; no pairs
-        self._clearance_numbers = np.array([self.clearance_reach, self.clearance_cap, 0.0])
-        self._clearance_numbers[2] = self.min_clearance / self.clearance_cap
-        self._no_pairs = (np.zeros(0), np.zeros((0, self._dof)))
+        # what ckernels.pieces reads: 2 d_cap, d_cap, d_min / d_cap
+        self._clearance_numbers = np.array(
+            [self.clearance_reach, self.clearance_cap, self.min_clearance / self.clearance_cap]
+        )
+        self._no_distances = np.zeros(0)  # ckernels.evaluate's without obstacles
         # what ckernels.evaluate reads (csrc/objective.c)
         self._terms = (self._limited, self._lower, self._upper, self._half, *singular, np.array(numbers))
         eye = np.eye(self._dof)[self._limited] / self._half[:, None]
@@ -285,7 +286,7 @@ class Objective:
         """``ckernels.evaluate`` at q, (dof,) or (M, dof): (5,) or (M, 5) the fields of
         :class:`Evaluation`."""
         if self.clearance is None:
-            distances = self._no_pairs[0]
+            distances = self._no_distances
         elif distances is None:
             distances = self.clearance.distances(q)
         out = np.empty((*q.shape[:-1], 5))

@@ -229,8 +229,7 @@ class Probe:
 
     def _continues(self, point: Point, psi: float | np.ndarray, q: np.ndarray) -> bool:
         moved = self._delta(point.q, q)
-        error = moved - point.tangent @ np.atleast_1d(psi - point.psi)
-        return np.abs(moved).max() <= JUMP and np.abs(error).max() <= 0.5 * np.abs(moved).max() + SAME
+        return bool(_continuing(moved, moved - point.tangent @ np.atleast_1d(psi - point.psi)))
 
     def continue_rows(
         self, psi_a: np.ndarray, psi_b: np.ndarray, q_a: np.ndarray, tangent_a: np.ndarray, q_b: np.ndarray
@@ -239,9 +238,7 @@ class Probe:
         the solutions (psi_b, q_b) continue the paths of (psi_a, q_a) with tangents
         ``tangent_a`` (M, dof) (r = 1)."""
         moved = self._delta(q_a, q_b)
-        error = moved - tangent_a * (psi_b - psi_a)[:, None]
-        jump = np.abs(moved).max(axis=1)
-        return (jump <= JUMP) & (np.abs(error).max(axis=1) <= 0.5 * jump + SAME)
+        return _continuing(moved, moved - tangent_a * (psi_b - psi_a)[:, None])
 
     def next(self, point: Point, psi: float | np.ndarray) -> Point | None:
         """The solution at psi nearest point, if it continues point's path (the objective
@@ -359,3 +356,10 @@ def _predicted_end(before: list[float], now: list[float], moved: float) -> float
 
 def _wrap(x: np.ndarray) -> np.ndarray:
     return np.remainder(x + math.pi, _TURN) - math.pi
+
+
+def _continuing(moved: np.ndarray, error: np.ndarray) -> np.ndarray:
+    """The rule of :meth:`Probe.continues` on the last axis: the joint step |moved|_inf at
+    most JUMP and the first-order prediction's error within half of it (plus SAME)."""
+    jump = np.abs(moved).max(axis=-1)
+    return (jump <= JUMP) & (np.abs(error).max(axis=-1) <= 0.5 * jump + SAME)
