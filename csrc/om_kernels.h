@@ -282,6 +282,9 @@ double om_polish(const om_polish_task *t, int iterations, double *q);
 bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori);
 /* self_motion.c: the null vector of the real 6 x 7 Jacobian at q by cofactors (not normalised) */
 void om_self_motion_null(const om_solver_data *s, const double *q, double *n);
+/* det A (n x n row-major, destroyed) into *det (NULL: not wanted) by elimination with partial
+ * pivoting and, b not NULL, x of A x = b into b; false where a pivot is zero (*det = 0). */
+bool om_eliminate(double *A, double *b, int n, double *det);
 /* om_add_root of q, polished first where it fails verification near the boundary. */
 int om_add_candidate(om_problem *pb, double *q, double *roots, int count);
 /* pb's pose in another configuration (signs, redundancy: kept by the caller), its target's

@@ -158,42 +158,12 @@ static om_root_verdict on_step(const double *x, void *context) {
     return om_beyond_doubt(p->dof, p->q, x, p->t, p->d, NULL) ? OM_ROOT_TAKE : OM_ROOT_SCAN;
 }
 
-/* x of A x = b (A n x n row-major and b destroyed, x into b) by elimination with partial
- * pivoting; false where A is singular or x not finite. */
-static bool solve_linear(double *A, double *b, int n) {
-    for (int k = 0; k < n; k++) {
-        int p = k;
-        for (int i = k + 1; i < n; i++)
-            if (fabs(A[i * n + k]) > fabs(A[p * n + k])) p = i;
-        if (A[p * n + k] == 0.0) return false;
-        if (p != k) {
-            for (int j = k; j < n; j++) {
-                double t = A[k * n + j];
-                A[k * n + j] = A[p * n + j], A[p * n + j] = t;
-            }
-            double t = b[k];
-            b[k] = b[p], b[p] = t;
-        }
-        for (int i = k + 1; i < n; i++) {
-            double f = A[i * n + k] / A[k * n + k];
-            for (int j = k; j < n; j++) A[i * n + j] -= f * A[k * n + j];
-            b[i] -= f * b[k];
-        }
-    }
-    for (int k = n - 1; k >= 0; k--) {
-        for (int j = k + 1; j < n; j++) b[k] -= A[k * n + j] * b[j];
-        b[k] /= A[k * n + k];
-        if (!isfinite(b[k])) return false;
-    }
-    return true;
-}
-
 /* The first solve's prediction: the joints' first-order motion dq from q with psi held while
  * the flange moves from its pose (R, p) at q to the target's (R_d, p_d),
  *     [J(q); Dpsi(q)] dq = [p_d - p; omega; 0],
  * J the flange's geometric Jacobian [v; omega] and omega = vee((E - E^T) / 2), E = R_d R^T, the
  * rotation vector of E to first order (all in DH frame 0, as om_self_motion_null's J). False
- * where the 7 x 7 system is singular: no prediction, the scan decides. */
+ * where the 7 x 7 system is singular (a zero pivot, or dq not finite): no prediction, the scan decides. */
 static bool pose_motion(const om_solver_data *s, const double *T, const double *q, double *dq) {
     static const double eye[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
     double A[7 * 7], R[9], p[3];
@@ -206,7 +176,9 @@ static bool pose_motion(const om_solver_data *s, const double *T, const double *
     mat3 E = m_mmt(Rd, m_load(R, 0));
     double b[7] = {pd.x - p[0], pd.y - p[1], pd.z - p[2], 0.5 * (E.r2.y - E.r1.z), 0.5 * (E.r0.z - E.r2.x),
                    0.5 * (E.r1.x - E.r0.y), 0.0};
-    if (!solve_linear(A, b, 7)) return false;
+    if (!om_eliminate(A, b, 7, NULL)) return false;
+    for (int i = 0; i < 7; i++)
+        if (!isfinite(b[i])) return false;
     memcpy(dq, b, sizeof b);
     return true;
 }
