@@ -27,6 +27,9 @@ typedef struct {
 int get_buffers(PyObject *const *objs, Py_buffer *views, const buffer_spec *specs, int n);
 /* Release views[0:n]. */
 void release_buffers(Py_buffer *views, int n);
+/* Whether index[k * stride] lies in [lo, hi) for every k < n (a binding's check of the
+ * joint or geom indices it is given, before it reads arrays at them). */
+bool indices_within(const int64_t *index, Py_ssize_t n, Py_ssize_t stride, int64_t lo, int64_t hi);
 /* A sequence of k signs, each -1 or +1, into out. */
 int get_signs(PyObject *obj, int64_t *out, int k);
 /* A sequence of k numbers into out. */

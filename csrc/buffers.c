@@ -69,6 +69,12 @@ void release_buffers(Py_buffer *views, int n) {
     for (int i = 0; i < n; i++) PyBuffer_Release(&views[i]);
 }
 
+bool indices_within(const int64_t *index, Py_ssize_t n, Py_ssize_t stride, int64_t lo, int64_t hi) {
+    for (Py_ssize_t k = 0; k < n; k++)
+        if (index[k * stride] < lo || index[k * stride] >= hi) return false;
+    return true;
+}
+
 /* Parse a sequence of k numbers (ints for signs) into out. */
 int get_signs(PyObject *obj, int64_t *out, int k) {
     PyObject *seq = PySequence_Fast(obj, "signs must be a sequence");

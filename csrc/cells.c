@@ -55,7 +55,7 @@ static PyObject *om_pieces(PyObject *mod, PyObject *const *args, Py_ssize_t narg
     int bad = v[0].len != M * dof * 8 || v[1].len != M * dof * 8 || v[2].len != M * P * 8 ||
               v[3].len != M * P * dof * 8 || v[5].len != L * 8 || v[6].len != L * 8 || v[7].len != L * 8 ||
               v[9].len != M * (L + P) * 8 || v[10].len != M * (L + P) * 8;
-    for (Py_ssize_t i = 0; i < L && !bad; i++) bad = limited[i] < 0 || limited[i] >= dof;
+    bad = bad || !indices_within(limited, L, 1, 0, dof);
     if (bad) {
         release_buffers(v, 11);
         PyErr_SetString(PyExc_ValueError, "pieces: sizes of q, t, the pairs, the joints and g disagree");

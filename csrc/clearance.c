@@ -221,7 +221,7 @@ static int check_arm(Py_buffer *v, Py_ssize_t A, Py_ssize_t *M, int *dof, const 
     const int64_t *link = v[2].buf;
     int bad = v[0].len != n_rows * 48 || joints < 1 || joints > OM_MAX_DOF || v[2].len != A * 8 ||
               v[3].len != A * 96 || v[4].len != joints || v[5].len % (joints * 8) != 0;
-    for (Py_ssize_t a = 0; a < A && !bad; a++) bad = link[a] < 0 || link[a] > joints;
+    bad = bad || !indices_within(link, A, 1, 0, joints + 1);
     if (bad) {
         PyErr_Format(PyExc_ValueError, "%s: sizes of the chain, geoms and joint vectors disagree", what);
         return -1;
@@ -296,8 +296,7 @@ static PyObject *om_arm_clearance(PyObject *mod, PyObject *const *args, Py_ssize
     int bad = A > G || v[6].len != (G - A) * 24 || v[7].len != (G - A) * 72 || v[9].len != G * 8 ||
               v[10].len != G * 24 || v[11].len != P * 16 || v[13].len != M * P * 8 || v[14].len != M * P * 48 ||
               (with_grad && v[15].len != M * P * dof * 8);
-    for (Py_ssize_t k = 0; k < P && !bad; k++)
-        bad = pairs[2 * k] < 0 || pairs[2 * k] >= A || pairs[2 * k + 1] < A || pairs[2 * k + 1] >= G;
+    bad = bad || !indices_within(pairs, P, 2, 0, A) || !indices_within(pairs + 1, P, 2, A, G);
     if (bad) {
         release_buffers(v, n_views);
         PyErr_SetString(PyExc_ValueError, "arm_clearance: sizes of the geoms, pairs and outputs disagree");

@@ -60,8 +60,7 @@ static PyObject *om_evaluate(PyObject *mod, PyObject *const *args, Py_ssize_t na
     const int64_t *limited = v[2].buf, *joints = v[6].buf;
     int bad = v[9].len != M * E_N * 8 || v[0].len != M * dof * 8 || v[1].len != M * P * 8 || v[3].len != L * 8 ||
               v[4].len != L * 8 || v[5].len != L * 8 || v[7].len != K * 8;
-    for (Py_ssize_t i = 0; i < L && !bad; i++) bad = limited[i] < 0 || limited[i] >= dof;
-    for (Py_ssize_t k = 0; k < K && !bad; k++) bad = joints[k] < 0 || joints[k] >= dof;
+    bad = bad || !indices_within(limited, L, 1, 0, dof) || !indices_within(joints, K, 1, 0, dof);
     if (bad) {
         release_buffers(v, 10);
         PyErr_SetString(PyExc_ValueError, "evaluate: sizes of q, the distances, the joints and out disagree");

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import threading
 
 import numpy as np
@@ -247,6 +248,79 @@ def test_the_binding_rejects_malformed_buffers_with_a_named_error(panda):
         ckernels.Solver(panda.solver_data()._replace(scan_points=2))
     with pytest.raises(AttributeError):
         ckernels.Solver(object())
+
+
+def test_the_bindings_refuse_indices_out_of_range(panda):
+    """pieces and evaluate (limited and singularity joints), arm_geom_poses and arm_clearance
+    (the geoms' links, the pairs' arm geoms and obstacles) check every index they read arrays
+    at against its range: the values at either end of it are read, those just outside are a
+    ValueError naming the sizes, never a read past an end."""
+
+    def pieces(limited):
+        q, g = np.zeros((1, 7)), np.empty((1, 1))
+        half, numbers = np.full(1, 0.5), np.array([0.2, 0.1, 0.5])
+        lower, upper = np.zeros(1), np.ones(1)
+        ckernels.pieces(
+            7, q, q, np.empty((1, 0)), np.empty((1, 0, 7)), limited, lower, upper, half, numbers, g, g
+        )
+
+    def evaluate(limited, joints):
+        q, out, one = np.zeros((1, 7)), np.empty((1, 5)), np.ones(1)
+        numbers = np.array([1.0, 1.0, 1.0, 0.1, 0.03, 0.1])
+        ckernels.evaluate(7, q, np.empty((1, 0)), limited, one - 1.0, one, one, joints, one, numbers, out)
+
+    clearance = om.Clearance.for_arm(panda.arm, [om.Sphere([0.4, 0.1, 0.5], 0.05)])
+    arm, geoms = clearance._arguments
+    q, n_arm, n_pairs = np.zeros(7), len(arm[2]), len(clearance.pairs)
+    dist, fromto, grad = np.empty(n_pairs), np.empty((n_pairs, 6)), np.empty((n_pairs, 7))
+
+    def poses(link):
+        xpos, xmat = np.empty((n_arm, 3)), np.empty((n_arm, 9))
+        ckernels.arm_geom_poses(*arm[:2], link, *arm[3:], q, xpos, xmat)
+
+    def clear(link, pairs):
+        ckernels.arm_clearance(
+            *arm[:2], link, *arm[3:], q, *geoms[:5], pairs, geoms[6], 1.0, dist, fromto, grad, False
+        )
+
+    def index(k):
+        return np.array([k], dtype=np.int64)
+
+    def link_at(value):
+        link = arm[2].copy()
+        link[0] = value
+        return link
+
+    def pair_at(side, value):
+        pairs = geoms[5].copy()
+        pairs[0, side] = value
+        return pairs
+
+    pieces_sizes = "pieces: sizes of q, t, the pairs, the joints and g disagree"
+    evaluate_sizes = "evaluate: sizes of q, the distances, the joints and out disagree"
+    chain_sizes = "{}: sizes of the chain, geoms and joint vectors disagree"
+    pair_sizes = "arm_clearance: sizes of the geoms, pairs and outputs disagree"
+    refused = [
+        *[(pieces, (index(k),), pieces_sizes) for k in (-1, 7)],
+        *[(evaluate, (index(k), index(0)), evaluate_sizes) for k in (-1, 7)],
+        *[(evaluate, (index(0), index(k)), evaluate_sizes) for k in (-1, 7)],
+        *[(poses, (link_at(k),), chain_sizes.format("arm_geom_poses")) for k in (-1, 8)],
+        *[(clear, (link_at(k), geoms[5]), chain_sizes.format("arm_clearance")) for k in (-1, 8)],
+        *[(clear, (arm[2], pair_at(0, k)), pair_sizes) for k in (-1, n_arm)],
+        *[(clear, (arm[2], pair_at(1, k)), pair_sizes) for k in (n_arm - 1, n_arm + 1)],
+    ]
+    for call, args in [
+        *[(pieces, (index(k),)) for k in (0, 6)],
+        *[(evaluate, (index(k), index(j))) for k in (0, 6) for j in (0, 6)],
+        *[(poses, (link_at(k),)) for k in (0, 7)],
+        *[(clear, (link_at(k), geoms[5])) for k in (0, 7)],
+        *[(clear, (arm[2], pair_at(0, k))) for k in (0, n_arm - 1)],
+        (clear, (arm[2], pair_at(1, n_arm))),
+    ]:
+        call(*args)
+    for call, args, message in refused:
+        with pytest.raises(ValueError, match=f"^{re.escape(message)}$"):
+            call(*args)
 
 
 def test_the_c_layouts_equal_the_python_ones():
