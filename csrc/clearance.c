@@ -136,16 +136,9 @@ static void link_frames(const double *table, int n_rows, const double *start, co
     double R[9], p[3];
     memcpy(R, start, sizeof R);
     memcpy(p, start + 9, sizeof p);
-    int j = 0;
-    for (int k = 0; k < n_rows; k++) {
-        const double *row = table + 6 * k;
-        int joint = row[5] != 2.0;
-        if (joint) memcpy(frames + 12 * j, R, sizeof R), memcpy(frames + 12 * j + 9, p, sizeof p);
-        om_apply_row(R, p, row, joint ? q[j] : 0.0);
-        j += joint;
-    }
-    memcpy(frames + 12 * j, R, sizeof R);
-    memcpy(frames + 12 * j + 9, p, sizeof p);
+    int dof = om_chain(table, n_rows, q, n_rows, R, p, frames, NULL);
+    memcpy(frames + 12 * dof, R, sizeof R);
+    memcpy(frames + 12 * dof + 9, p, sizeof p);
 }
 
 /* The world pose of each arm geom a (xpos 3, xmat 9 per geom), on link link[a] at offset[a]

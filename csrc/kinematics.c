@@ -1,6 +1,8 @@
 /* DH chains (om_redundant/kinematics/chain.py is the typed front): FK and the Jacobian as
  * explicit 4x4 products and rigid transforms, sums left to right.
  * A table row is (a, d, theta, cos(alpha), sin(alpha), kind). */
+#include <string.h>
+
 #include "om_kernels.h"
 
 /* Right-multiply the frame (R, p) in place by the standard DH row Rz(theta) Tz(d) Tx(a) Rx(alpha),
@@ -38,13 +40,10 @@ static void set_identity(double *R, double *p)
     p[0] = p[1] = p[2] = 0.0;
 }
 
-/* The chain's rows applied up to joint n+1's (every row: n = n_rows) from the identity into
- * (R, p); with axes not NULL, the axis and origin of joints 1..n; with trig not NULL, cos and
- * sin of each joint row's angle as applied (2 per joint). */
-static void chain(const double *table, int n_rows, const double *q, int n, double *axes, double *origins, double *R,
-                  double *p, double *trig)
+/* The rows from (R, p) on, each joint's frame before its row kept (om_kernels.h). */
+int om_chain(const double *table, int n_rows, const double *q, int n, double *R, double *p, double *frames,
+             double *trig)
 {
-    set_identity(R, p);
     int j = 0;
     double cs[2];
     for (int k = 0; k < n_rows; k++) {
@@ -55,37 +54,39 @@ static void chain(const double *table, int n_rows, const double *q, int n, doubl
         }
         if (j == n)
             break;
-        if (axes)
-            for (int i = 0; i < 3; i++) {
-                axes[3 * j + i] = R[3 * i + 2];
-                origins[3 * j + i] = p[i];
-            }
+        if (frames) {
+            memcpy(frames + 12 * j, R, 9 * sizeof(double));
+            memcpy(frames + 12 * j + 9, p, 3 * sizeof(double));
+        }
         double *out = trig ? trig + 2 * j : cs;
         apply_row(R, p, row, q[j], &out[0], &out[1]);
         j++;
     }
+    return j;
 }
 
-/* Axis and origin in DH frame 0 of joints 1..n (joint_axes_kernel): a standard row's joint acts
+/* The frames in DH frame 0 of joints 1..n (joint_axes_kernel): a standard row's joint acts
  * about the z-axis of the frame it starts from. (R, p) end as the frame before joint n+1's row. */
-void om_joint_axes(const double *table, int n_rows, const double *q, int n, double *axes, double *origins,
-                   double *R, double *p)
+void om_joint_frames(const double *table, int n_rows, const double *q, int n, double *frames, double *R, double *p)
 {
-    chain(table, n_rows, q, n, axes, origins, R, p, NULL);
+    set_identity(R, p);
+    om_chain(table, n_rows, q, n, R, p, frames, NULL);
 }
 
 /* The pose (R, p) of the last DH frame in DH frame 0: every row applied (no row has more
  * than n_rows joints before it). */
 void om_flange(const double *table, int n_rows, const double *q, double *R, double *p)
 {
-    chain(table, n_rows, q, n_rows, NULL, NULL, R, p, NULL);
+    set_identity(R, p);
+    om_chain(table, n_rows, q, n_rows, R, p, NULL, NULL);
 }
 
 /* om_flange, also giving cos and sin of each joint row's angle theta + q_j as the product used
  * them (trig: cos, sin per joint; a prismatic joint's are of its fixed theta). */
 void om_flange_trig(const double *table, int n_rows, const double *q, double *R, double *p, double *trig)
 {
-    chain(table, n_rows, q, n_rows, NULL, NULL, R, p, trig);
+    set_identity(R, p);
+    om_chain(table, n_rows, q, n_rows, R, p, NULL, trig);
 }
 
 /* out = A @ B for 4x4 row-major matrices (_matmul4). */
@@ -124,8 +125,8 @@ static void rigid(const double *T, const double *x, double w, double *out)
 void om_jacobian(const double *table, int n_rows, const double *base, const double *tool, const double *q, int dof,
                  double *J)
 {
-    double axes[OM_MAX_DOF * 3], origins[OM_MAX_DOF * 3], kinds[OM_MAX_DOF], R[9], p[3];
-    om_joint_axes(table, n_rows, q, dof, axes, origins, R, p);
+    double frames[OM_MAX_DOF * 12], kinds[OM_MAX_DOF], R[9], p[3];
+    om_joint_frames(table, n_rows, q, dof, frames, R, p);
     int j = 0;
     for (int k = 0; k < n_rows; k++) {
         if (table[6 * k + 5] != 2.0 && j < dof) {
@@ -141,13 +142,14 @@ void om_jacobian(const double *table, int n_rows, const double *base, const doub
     for (int i = 0; i < 6 * dof; i++)
         J[i] = 0.0;
     for (j = 0; j < dof; j++) {
+        const double *F = frames + 12 * j, axis[3] = {F[2], F[5], F[8]};
         double z[3], o[3], r[3];
-        rigid(base, axes + 3 * j, 0.0, z);
+        rigid(base, axis, 0.0, z);
         if (kinds[j] == 1.0) {
             for (int i = 0; i < 3; i++)
                 J[i * dof + j] = z[i];
         } else {
-            rigid(base, origins + 3 * j, 1.0, o);
+            rigid(base, F + 9, 1.0, o);
             for (int i = 0; i < 3; i++)
                 r[i] = p_ee[i] - o[i];
             J[0 * dof + j] = z[1] * r[2] - z[2] * r[1];

@@ -54,11 +54,17 @@ void om_apply_row(double *R, double *p, const double *row, double qi);
 /* The pose of the last DH frame in DH frame 0. */
 void om_flange(const double *table, int n_rows, const double *q, double *R, double *p);
 void om_flange_trig(const double *table, int n_rows, const double *q, double *R, double *p, double *trig);
-/* Axis and origin (in DH frame 0) of joints 1..n into axes[n*3], origins[n*3] (both NULL:
- * not written); R, p end as the frame after every row before joint n+1's (the flange for
- * n >= dof). */
-void om_joint_axes(const double *table, int n_rows, const double *q, int n, double *axes, double *origins,
-                   double *R, double *p);
+/* The chain's rows applied to the frame (R, p) in place, up to joint n+1's row (every row for
+ * n >= the joints); with frames not NULL, the frame before each joint's row (R row-major, then
+ * p: 12 per joint; the joint turns about its z axis, R's column 2, through p); with trig not
+ * NULL, cos and sin of each joint row's angle as applied (2 per joint). Returns the joints passed. */
+int om_chain(const double *table, int n_rows, const double *q, int n, double *R, double *p, double *frames,
+             double *trig);
+/* om_chain from DH frame 0 (the identity) for joints 1..n: their frames into frames; R, p end as
+ * the frame after every row before joint n+1's (the flange for n >= dof). */
+void om_joint_frames(const double *table, int n_rows, const double *q, int n, double *frames, double *R, double *p);
+/* A joint's axis in a frame of om_chain's (R's column 2); its origin is the frame's p, F + 9. */
+static inline vec3 om_frame_axis(const double *F) { return v3(F[2], F[5], F[8]); }
 /* base @ A(q) @ tool into out (4x4 row-major). */
 void om_fk(const double *table, int n_rows, const double *base, const double *tool, const double *q, double *out);
 /* Geometric Jacobian (6 x dof, row-major, rows [v; omega]) of the end-effector frame in the root frame. */

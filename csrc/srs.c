@@ -360,11 +360,11 @@ void om_srs_branch_values_trig(const double *P, const double *q, const double *t
  * unless grad is NULL (arm_angle_gradient_kernel; psi depends on joints 1-4 only). */
 double om_arm_angle_gradient(const double *P, const double *table, int n_rows, const double *q, double *grad)
 {
-    /* Axis and origin of joints 1-6 in DH frame 0; S is the origin after joint 1's row, W the one
+    /* The frames of joints 1-6 in DH frame 0; S is the origin after joint 1's row, W the one
      * after joint 5's row. */
-    double axes[6 * 3], origins[6 * 3], R[9], p[3];
-    om_joint_axes(table, n_rows, q, 6, axes, origins, R, p);
-    vec3 S = v_load(origins, 3), W = v_load(origins, 15), z4 = v_load(axes, 9);
+    double frames[6 * 12], R[9], p[3];
+    om_joint_frames(table, n_rows, q, 6, frames, R, p);
+    vec3 S = v_load(frames + 12, 9), W = v_load(frames + 60, 9), z4 = om_frame_axis(frames + 36);
     vec3 w = v_sub(W, S);
     double length = sqrt(v_dot(w, w));
     vec3 w_hat = v_scale(1.0 / length, w);
@@ -380,7 +380,7 @@ double om_arm_angle_gradient(const double *P, const double *table, int n_rows, c
     for (int j = 0; grad && j < 7; j++)
         grad[j] = 0.0;
     for (int j = 0; grad && j < 4; j++) {
-        vec3 zj = v_load(axes, 3 * j), oj = v_load(origins, 3 * j);
+        vec3 zj = om_frame_axis(frames + 12 * j), oj = v_load(frames + 12 * j, 9);
         vec3 dW = v_cross(zj, v_sub(W, oj));
         vec3 dw_hat = v_scale(1.0 / length, v_sub(dW, v_scale(v_dot(w_hat, dW), w_hat)));
         vec3 dz4 = j < 3 ? v_cross(zj, z4) : v3(0.0, 0.0, 0.0);
