@@ -44,7 +44,7 @@ static PyObject *k_jacobian(PyObject *mod, PyObject *const *args, Py_ssize_t nar
         PyErr_SetString(PyExc_ValueError, "jacobian: shapes of q and J disagree");
         return NULL;
     }
-    om_jacobian(v[0].buf, (int)rows, v[1].buf, v[2].buf, v[3].buf, (int)dof, v[4].buf);
+    om_jacobian(v[0].buf, (int)rows, v[1].buf, v[2].buf, v[3].buf, (int)dof, v[4].buf, NULL, NULL);
     release_buffers(v, 5);
     Py_RETURN_NONE;
 }

@@ -121,9 +121,10 @@ static void rigid(const double *T, const double *x, double w, double *out)
 }
 
 /* Geometric Jacobian [v; omega] (6 x dof, row-major) of the end-effector frame in the root frame
- * (jacobian_kernel): z_j x (p_ee - o_j) and z_j for a revolute joint, z_j and 0 for a prismatic one. */
+ * (jacobian_kernel): z_j x (p_ee - o_j) and z_j for a revolute joint, z_j and 0 for a prismatic one.
+ * The chain's end (R, p) into flange_R, flange_p (NULL: not wanted). */
 void om_jacobian(const double *table, int n_rows, const double *base, const double *tool, const double *q, int dof,
-                 double *J)
+                 double *J, double *flange_R, double *flange_p)
 {
     double frames[OM_MAX_DOF * 12], kinds[OM_MAX_DOF], R[9], p[3];
     om_joint_frames(table, n_rows, q, dof, frames, R, p);
@@ -159,4 +160,8 @@ void om_jacobian(const double *table, int n_rows, const double *base, const doub
                 J[(3 + i) * dof + j] = z[i];
         }
     }
+    if (flange_R)
+        memcpy(flange_R, R, sizeof R);
+    if (flange_p)
+        memcpy(flange_p, p, sizeof p);
 }

@@ -67,9 +67,11 @@ void om_joint_frames(const double *table, int n_rows, const double *q, int n, do
 static inline vec3 om_frame_axis(const double *F) { return v3(F[2], F[5], F[8]); }
 /* base @ A(q) @ tool into out (4x4 row-major). */
 void om_fk(const double *table, int n_rows, const double *base, const double *tool, const double *q, double *out);
-/* Geometric Jacobian (6 x dof, row-major, rows [v; omega]) of the end-effector frame in the root frame. */
+/* Geometric Jacobian (6 x dof, row-major, rows [v; omega]) of the end-effector frame in the root frame;
+ * the pose (R, p) of the chain's end in DH frame 0, after every row before joint dof+1's (the
+ * flange where the table has dof joints: om_flange's), into flange_R, flange_p (NULL: not wanted). */
 void om_jacobian(const double *table, int n_rows, const double *base, const double *tool, const double *q, int dof,
-                 double *J);
+                 double *J, double *flange_R, double *flange_p);
 
 /* ------------------------------------------------------------------------------------ */
 /* six_dof.c, srs.c, families.c: the model arms' closed forms (see the Python modules     */

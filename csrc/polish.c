@@ -65,7 +65,7 @@ static double residual(const om_polish_task *t, const double *q, double *e, doub
 /* The Jacobian of the pose and of psi at q (rows x dof), psi's row residual's at q. */
 static void jacobian(const om_polish_task *t, const double *q, const double *psi_row, double *J)
 {
-    om_jacobian(t->table, t->n_rows, IDENTITY, IDENTITY, q, t->dof, J);
+    om_jacobian(t->table, t->n_rows, IDENTITY, IDENTITY, q, t->dof, J, NULL, NULL);
     if (t->P)
         memcpy(J + 6 * t->dof, psi_row, (size_t)t->dof * sizeof(double));
 }

@@ -54,7 +54,7 @@ bool om_eliminate(double *A, double *b, int n, double *det) {
 void om_self_motion_null(const om_solver_data *s, const double *q, double *n) {
     static const double eye[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
     double J[6 * 7], M[36];
-    om_jacobian(s->real_table, s->n_real_rows, eye, eye, q, 7, J);
+    om_jacobian(s->real_table, s->n_real_rows, eye, eye, q, 7, J, NULL, NULL);
     for (int c = 0; c < 7; c++) {
         for (int i = 0; i < 6; i++)
             for (int j = 0, k = 0; j < 7; j++)

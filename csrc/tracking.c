@@ -167,9 +167,8 @@ static om_root_verdict on_step(const double *x, void *context) {
 static bool pose_motion(const om_solver_data *s, const double *T, const double *q, double *dq) {
     static const double eye[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
     double A[7 * 7], R[9], p[3];
-    om_jacobian(s->real_table, s->n_real_rows, eye, eye, q, 7, A); /* rows 0-5 of A */
+    om_jacobian(s->real_table, s->n_real_rows, eye, eye, q, 7, A, R, p); /* rows 0-5 of A; the flange (R, p) */
     om_arm_angle_gradient(s->params, s->model_table, s->n_model_rows, q, A + 6 * 7);
-    om_flange(s->real_table, s->n_real_rows, q, R, p);
     mat3 Rd;
     vec3 pd;
     om_flange_target(T, s->T_base_root, s->T_tool_flange, &Rd, &pd);
