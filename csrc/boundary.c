@@ -335,7 +335,7 @@ static bool q_j_swings(om_problem *pb)
     return false;
 }
 
-int om_band_roots(om_problem *pb, double *roots, bool *neighbour_reached)
+int om_band_roots(om_problem *pb, double *roots, bool *neighbour_reached, om_scan_cache *cache)
 {
     const om_solver_data *s = pb->s;
     int64_t signs[64];
@@ -358,6 +358,6 @@ int om_band_roots(om_problem *pb, double *roots, bool *neighbour_reached)
             count = om_add_root(pb, found + r * s->dof, roots, count);
     }
     if (count == 0) /* next to psi's half-line the model's search may miss what the real arm's loop meets */
-        count = om_loop_roots(pb, roots, count);
+        count = om_loop_roots(pb, roots, count, cache);
     return count;
 }

@@ -73,18 +73,27 @@ static bool _ball_may_pass(vec3 up, vec3 c, double r)
     return !(length > r) || atan2(v_norm(v_cross(up, c)), -v_dot(up, c)) - asin(r / length) < LOOP_NEAR;
 }
 
-/* Whether the model's shoulder-wrist vector x may come within LOOP_NEAR rad of -up at a
- * solution of the pose: x(w1, w7) = p_d + R w_F - S + a(w1) + R delta(w7) = c + A(w1) +
- * B(w7), A and B ellipses of largest radii r1 = |(D4, D5)| and r7 = |(D1, D2)|, so x moves by
- * at most (r1 + r7) pi / LOOP_GATE from the nearest node of a LOOP_GATE x LOOP_GATE grid of
- * the two angles (one node along an angle x does not depend on). */
-static bool _may_pass(const om_problem *pb)
+/* What _gate reads of the pose: up, the centre c of x and the ellipses' axes a1, a2 (D4, D5)
+ * and b1, b2 (R D1, R D2), 3 each (OM_GATE_KEY). */
+static void _gate_key(const om_problem *pb, double *key)
 {
     const double(*D)[3] = pb->s->D;
     const mat3 *R = &pb->t.R;
-    vec3 up = v_load(pb->s->params, SRS_UP);
-    vec3 c = v_add(v_add(pb->p, pb->t.wrist), v_add(v_load(D[3], 0), m_mv(*R, v_load(D[0], 0))));
-    vec3 a1 = v_load(D[4], 0), a2 = v_load(D[5], 0), b1 = m_mv(*R, v_load(D[1], 0)), b2 = m_mv(*R, v_load(D[2], 0));
+    const vec3 v[6] = {v_load(pb->s->params, SRS_UP), om_shoulder_wrist_centre(pb), v_load(D[4], 0),
+                       v_load(D[5], 0),  m_mv(*R, v_load(D[1], 0)),     m_mv(*R, v_load(D[2], 0))};
+    for (int i = 0; i < 6; i++)
+        key[3 * i] = v[i].x, key[3 * i + 1] = v[i].y, key[3 * i + 2] = v[i].z;
+}
+
+/* Whether the model's shoulder-wrist vector x may come within LOOP_NEAR rad of -up at a
+ * solution of the pose (key: _gate_key's): x(w1, w7) = p_d + R w_F - S + a(w1) + R delta(w7)
+ * = c + A(w1) + B(w7), A and B ellipses of largest radii r1 = |(D4, D5)| and r7 = |(D1, D2)|,
+ * so x moves by at most (r1 + r7) pi / LOOP_GATE from the nearest node of a LOOP_GATE x
+ * LOOP_GATE grid of the two angles (one node along an angle x does not depend on). */
+static bool _gate(const double *key)
+{
+    vec3 up = v_load(key, 0), c = v_load(key, 3), a1 = v_load(key, 6), a2 = v_load(key, 9);
+    vec3 b1 = v_load(key, 12), b2 = v_load(key, 15);
     double r1 = _ellipse_radius(a1, a2), r7 = _ellipse_radius(b1, b2);
     int n1 = r1 > 0.0 ? LOOP_GATE : 1, n7 = r7 > 0.0 ? LOOP_GATE : 1;
     double r = (r1 + r7) * OM_PI / LOOP_GATE;
@@ -100,15 +109,29 @@ static bool _may_pass(const om_problem *pb)
     return false;
 }
 
+/* _gate of the problem's pose, its answer kept in cache (NULL: none) for the next problem of
+ * the same pose (every configuration without a root of a pose asks it). */
+static bool _may_pass(const om_problem *pb, om_scan_cache *cache)
+{
+    double key[OM_GATE_KEY];
+    _gate_key(pb, key);
+    if (!cache)
+        return _gate(key);
+    if (!cache->gate_valid || memcmp(key, cache->gate_key, sizeof key) != 0) {
+        cache->gate = _gate(key);
+        memcpy(cache->gate_key, key, sizeof key);
+        cache->gate_valid = true;
+    }
+    return cache->gate;
+}
+
 /* psi's miss and gradient at p->q. */
 static void _measure(const loop_search *ls, loop_point *p)
 {
     const om_problem *pb = ls->pb;
     om_arm_angle_gradient(pb->s->params, pb->s->model_table, pb->s->n_model_rows, p->q, p->grad);
-    p->across = om_srs_half_line_across(pb->s->params, p->q);
-    p->angle = om_srs_half_line_angle(pb->s->params, p->q);
+    double psi = om_srs_half_line_psi(pb->s->params, p->q, (double)pb->signs[1], &p->across, &p->angle);
     p->below = p->angle < 0.5 * OM_PI;
-    double psi = om_srs_arm_angle_in(pb->s->params, p->q, (double)pb->signs[1]);
     p->miss = om_wrap(psi - pb->redundancy[0]);
 }
 
@@ -358,10 +381,10 @@ static bool _seen(const loop_search *ls, const double *q)
     return false;
 }
 
-int om_loop_roots(om_problem *pb, double *roots, int count)
+int om_loop_roots(om_problem *pb, double *roots, int count, om_scan_cache *cache)
 {
     const om_solver_data *s = pb->s;
-    if (s->family != OM_SRS || s->dof != 7 || !_may_pass(pb))
+    if (s->family != OM_SRS || s->dof != 7 || !_may_pass(pb, cache))
         return count;
     loop_search ls = _search(pb, malloc((size_t)LOOP_POINTS * 7 * sizeof(double)));
     if (!ls.seen)

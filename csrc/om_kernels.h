@@ -23,6 +23,7 @@
 #define OM_MAX_DOF 16  /* joints of an arm the kernels take (the binding checks) */
 #define OM_MAX_ROOTS 16 /* roots kept per configuration */
 #define OM_SCAN_KEY (3 + 9 + 1 + 2 + OM_MAX_DOF + 1) /* om_scan_cache's key */
+#define OM_GATE_KEY 18 /* om_scan_cache's gate key: 6 vectors */
 
 /* ------------------------------------------------------------------------------------ */
 /* om_math.h: tuple math, angle wrapping; common.c: the Euler decomposition of a revolute triple. */
@@ -144,6 +145,9 @@ void om_srs_branch_values(const double *P, const double *q, double *out);
 void om_srs_branch_values_trig(const double *P, const double *q, const double *trig, double *out);
 double om_srs_half_line_angle(const double *P, const double *q); /* w_hat's angle from -up at q */
 vec3 om_srs_half_line_across(const double *P, const double *q);  /* up x (W - S) of the model at q */
+/* The three at q from one shoulder-wrist vector: om_srs_half_line_across's into *across,
+ * om_srs_half_line_angle's into *angle; returns om_srs_arm_angle_in's psi (the same bits). */
+double om_srs_half_line_psi(const double *P, const double *q, double elbow, vec3 *across, double *angle);
 /* psi at q of the S-R-S model with parameters P and DH table; writes d psi / dq (7). */
 double om_arm_angle_gradient(const double *P, const double *table, int n_rows, const double *q, double *grad);
 
@@ -247,6 +251,9 @@ int om_wrist_offset_candidates(om_problem *pb, double lo, double hi, bool full_c
 double om_newton(om_problem *pb, vec3 x, double *q, const double *known, int n_known, vec3 *x_end);
 double om_lifted_solve(om_problem *pb, const double *start, double *q);
 int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, double radius);
+/* x = W - S of the model on the torus less its parts that turn with w1 and w7:
+ * p_d + R w_F - S + D3 + R D0 (x = it + D4 cos w1 + D5 sin w1 + R (D1 cos w7 + D2 sin w7)). */
+vec3 om_shoulder_wrist_centre(const om_problem *pb);
 
 /* verify.c */
 /* Whether q is in the configuration (signs, redundancy): every branch quantity of q has the
@@ -283,6 +290,26 @@ typedef struct {
 /* Refine q in place (at most `iterations` Jacobians); returns the residual's norm at the end. */
 double om_polish(const om_polish_task *t, int iterations, double *q);
 
+/* What one problem of a batch keeps for the next (solve_all_rows): the circle search's
+ * candidates (search.c), for a next problem that differs from it in the SHOULDER sign alone,
+ * and the loop search's gate (loop_search.c), for a next problem of the same pose. On an
+ * S-R-S arm whose dp turns with q7 the circle residual g(w) is the model's q7 less w, and q7
+ * does not depend on the SHOULDER sign (srs.c, q7_with_elbow): the scan, its brackets and
+ * refinements are the same, only the joints that each candidate becomes differ. The gate
+ * depends on the pose alone. */
+typedef struct {
+    bool valid;
+    double key[OM_SCAN_KEY];  /* the target, psi, the other signs, q_prev, the scan points */
+    int count;                /* candidates */
+    int64_t evaluations;      /* the residual evaluations they took */
+    double q[OM_MAX_DOF];     /* the scratch joints as the search left them */
+    double *candidates;       /* capacity of them */
+    int capacity;
+    bool gate_valid, gate;        /* the gate asked last, and its answer */
+    double gate_key[OM_GATE_KEY]; /* what the gate reads of its pose */
+} om_scan_cache;
+#define OM_SCAN_CAPACITY(n_scan) (8 * (n_scan) + 8 + OM_WRIST_BAND_CANDIDATES)
+
 /* boundary.c */
 /* A candidate q that failed verification, refined on the real arm where a branch quantity is
  * within 1e-2 of zero, or (S-R-S) w_hat within 1e-2 rad of psi's singular half-line (else left
@@ -303,13 +330,15 @@ om_problem om_problem_at(const om_problem *pb, const int64_t *signs, const doubl
  * (samples of the free angle where the model's solution meets a branch zero, refined), and
  * those of the neighbouring configurations (one branch flipped) that hold the problem's own
  * (their flipped branch quantity within OM_BRANCH_BAND of zero), verified, into roots
- * (OM_MAX_ROOTS x dof); returns the count. *neighbour_reached: some neighbour had a root. */
-int om_band_roots(om_problem *pb, double *roots, bool *neighbour_reached);
+ * (OM_MAX_ROOTS x dof); returns the count. *neighbour_reached: some neighbour had a root.
+ * cache: om_loop_roots's. */
+int om_band_roots(om_problem *pb, double *roots, bool *neighbour_reached, om_scan_cache *cache);
 /* loop_search.c: for a 7-DOF S-R-S configuration without a root whose pose's wrist centre may
  * come within 1e-2 rad of psi's singular half-line, the roots met where psi crosses the
  * requested value along the real arm's self-motion loops through the pose's solutions in the
- * same signs at other arm angles, into roots from count on; returns the count. */
-int om_loop_roots(om_problem *pb, double *roots, int count);
+ * same signs at other arm angles, into roots from count on; returns the count. cache (NULL:
+ * none) keeps whether the pose may come near the line for the pose's next configuration. */
+int om_loop_roots(om_problem *pb, double *roots, int count, om_scan_cache *cache);
 /* For q on the pose (within 1e-12) next to psi's half-line: psi's crossings of the requested
  * value where the self-motion loop through q passes by the line; the first root into q (*pos,
  * *ori its errors). Returns whether there was one. */
@@ -317,21 +346,6 @@ bool om_loop_pass(om_problem *pb, double *q, double *pos, double *ori);
 
 /* search.c */
 int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre, double radius);
-/* The circle search's candidates of one problem, kept for a next problem that differs from it
- * in the SHOULDER sign alone. On an S-R-S arm whose dp turns with q7 the circle residual g(w)
- * is the model's q7 less w, and q7 does not depend on the SHOULDER sign (srs.c,
- * q7_with_elbow): the scan, its brackets and refinements are the same, only the joints that
- * each candidate becomes differ. */
-typedef struct {
-    bool valid;
-    double key[OM_SCAN_KEY];  /* the target, psi, the other signs, q_prev, the scan points */
-    int count;                /* candidates */
-    int64_t evaluations;      /* the residual evaluations they took */
-    double q[OM_MAX_DOF];     /* the scratch joints as the search left them */
-    double *candidates;       /* capacity of them */
-    int capacity;
-} om_scan_cache;
-#define OM_SCAN_CAPACITY(n_scan) (8 * (n_scan) + 8 + OM_WRIST_BAND_CANDIDATES)
 /* om_all_roots on the whole circle with the candidates taken from cache where it holds this
  * problem's, else searched and kept there (cache NULL: om_all_roots). */
 int om_all_roots_cached(om_problem *pb, int n_scan, double *roots, om_scan_cache *cache);

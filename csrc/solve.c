@@ -222,7 +222,7 @@ static om_result _solve(const om_solver_data *s, const double *T, const int64_t 
     int n = om_all_roots(pb, s->scan_points, roots, hint, INFINITY);
     bool neighbour_reached = false;
     if (n == 0) /* the boundary contract: a neighbour's root in the band holds this configuration */
-        n = om_band_roots(pb, roots, &neighbour_reached);
+        n = om_band_roots(pb, roots, &neighbour_reached, NULL);
     if (n == 0 && local_dist < INFINITY) { /* the local root, which the search did not find again */
         memcpy(q_out, local, (size_t)dof * sizeof(double));
         return _result(OM_OK, local_pos, local_ori, problem.counter, local_inside);
@@ -294,7 +294,7 @@ int om_solve_all(const om_solver_data *s, const double *T, const int64_t *signs,
     int n = om_all_roots_cached(&problem, s->scan_points, roots, cache);
     bool neighbour_reached, complete = true;
     if (n == 0 && band) { /* the band's roots, and what solve finds: its local solve from the fixed-point start */
-        n = om_band_roots(&problem, roots, &neighbour_reached);
+        n = om_band_roots(&problem, roots, &neighbour_reached, cache);
         double q[OM_MAX_DOF], start[OM_MAX_DOF], pos, ori;
         nan_fill(q, OM_MAX_DOF);
         if (om_fixed_point_start(&problem, q, start) && om_local_solve(&problem, start, &complete, q, &pos, &ori))

@@ -303,39 +303,66 @@ double om_srs_arm_angle_in(const double *P, const double *q, double elbow)
     return om_srs_arm_angle_trig(P, trig, elbow);
 }
 
-/* om_srs_arm_angle_in from trig: cos and sin of phi_j = q_j + theta_j, j = 1..4 (8 values). */
-double om_srs_arm_angle_trig(const double *P, const double *trig, double elbow)
+/* The model's shoulder-wrist vector w = W - S for trig (cos and sin of phi_j = q_j + theta_j,
+ * j = 1..4), its rotation R03 into *R03. */
+static vec3 shoulder_wrist(const double *P, const double *trig, mat3 *R03)
 {
-    mat3 R03 = rotation_03(P, trig);
-    vec3 w_hat = v_unit(m_mv(R03, elbow_vector(P, trig[6], trig[7])));
+    *R03 = rotation_03(P, trig);
+    return m_mv(*R03, elbow_vector(P, trig[6], trig[7]));
+}
+
+/* psi for R03 and w = W - S, read in the ELBOW branch `elbow`. */
+static double arm_angle_of(const double *P, mat3 R03, vec3 w, double elbow)
+{
+    vec3 w_hat = v_unit(w);
     vec3 n, nw;
     om_srs_reference(P, w_hat, &n, &nw);
     vec3 b = v_scale(elbow * P[SRS_BEND], v_cross(m_col(R03, 2), w_hat));
     return atan2(v_dot(nw, b), v_dot(n, b));
 }
 
-/* The model's shoulder-wrist vector w = W - S at q (into *w) and up x w, its part across up
- * turned by pi / 2 (zero on psi's singular half-line and on its continuation above). */
-static vec3 shoulder_wrist_across(const double *P, const double *q, vec3 *w)
+/* om_srs_arm_angle_in from trig: cos and sin of phi_j = q_j + theta_j, j = 1..4 (8 values). */
+double om_srs_arm_angle_trig(const double *P, const double *trig, double elbow)
 {
-    double trig[8];
-    joint_trig(P, q, trig);
-    *w = m_mv(rotation_03(P, trig), elbow_vector(P, trig[6], trig[7]));
-    return v_cross(v_load(P, SRS_UP), *w);
+    mat3 R03;
+    vec3 w = shoulder_wrist(P, trig, &R03);
+    return arm_angle_of(P, R03, w, elbow);
 }
 
+/* The angle of w = W - S from psi's singular half-line w_hat = -up (the wrist centre straight
+ * below the shoulder), across = up x w its part across up turned by pi / 2. */
+static double line_angle(const double *P, vec3 w, vec3 across)
+{
+    return atan2(sqrt(v_dot(across, across)), -v_dot(v_load(P, SRS_UP), w));
+}
+
+/* up x (W - S) of the model at q: zero on psi's singular half-line and on its continuation above. */
 vec3 om_srs_half_line_across(const double *P, const double *q)
 {
-    vec3 w;
-    return shoulder_wrist_across(P, q, &w);
+    double trig[8];
+    mat3 R03;
+    joint_trig(P, q, trig);
+    return v_cross(v_load(P, SRS_UP), shoulder_wrist(P, trig, &R03));
 }
 
-/* The angle of the model's shoulder-wrist direction w_hat at q from psi's singular half-line
- * w_hat = -up (the wrist centre straight below the shoulder). */
 double om_srs_half_line_angle(const double *P, const double *q)
 {
-    vec3 w, across = shoulder_wrist_across(P, q, &w);
-    return atan2(sqrt(v_dot(across, across)), -v_dot(v_load(P, SRS_UP), w));
+    double trig[8];
+    mat3 R03;
+    joint_trig(P, q, trig);
+    vec3 w = shoulder_wrist(P, trig, &R03);
+    return line_angle(P, w, v_cross(v_load(P, SRS_UP), w));
+}
+
+double om_srs_half_line_psi(const double *P, const double *q, double elbow, vec3 *across, double *angle)
+{
+    double trig[8];
+    mat3 R03;
+    joint_trig(P, q, trig);
+    vec3 w = shoulder_wrist(P, trig, &R03);
+    *across = v_cross(v_load(P, SRS_UP), w);
+    *angle = line_angle(P, w, *across);
+    return arm_angle_of(P, R03, w, elbow);
 }
 
 /* The quantities whose signs are (SHOULDER, ELBOW, WRIST) at joint vector q, into out[0..2]. */

@@ -231,6 +231,12 @@ static vec3 _shoulder_wrist(om_problem *pb, double w1, double w7, vec3 *d1, vec3
     return v_add(v_add(pb->p, pb->t.wrist), v_add(a, m_mv(*R, om_delta(D, w7))));
 }
 
+vec3 om_shoulder_wrist_centre(const om_problem *pb)
+{
+    const double(*D)[3] = pb->s->D;
+    return v_add(v_add(pb->p, pb->t.wrist), v_add(v_load(D[3], 0), m_mv(pb->t.R, v_load(D[0], 0))));
+}
+
 /* The part of x across up in the basis (b1, b2) across it. */
 static void _across(vec3 x, vec3 b1, vec3 b2, double *h)
 {
@@ -252,7 +258,7 @@ static int _half_line_points(om_problem *pb, double lo1, double lo7, double step
     double r7 = v_norm(v_load(D[1], 0)) + v_norm(v_load(D[2], 0));
     /* x = centre + (D4 cos w1 + D5 sin w1) + R (D1 cos w7 + D2 sin w7), the last two at most
      * r1 and r7 long: no point where the centre's part across up, or its height, exceeds that */
-    vec3 centre = v_add(v_add(pb->p, pb->t.wrist), v_add(v_load(D[3], 0), m_mv(pb->t.R, v_load(D[0], 0))));
+    vec3 centre = om_shoulder_wrist_centre(pb);
     double h0[2];
     _across(centre, b1, b2, h0);
     if (hypot(h0[0], h0[1]) > r1 + r7 || v_dot(up, centre) > r1 + r7)
