@@ -155,7 +155,11 @@ static bool _tangent(const om_problem *pb, const double *q, const double *along,
 
 /* The midpoint of the segment (a, b) of the loop into m: the chord's, on the loop again by
  * the corrector where the segment is longer than LOOP_CHORD. False where it cannot be split
- * (the midpoint is an end to the last bit, the corrector fails, the budget is spent). */
+ * (the midpoint is an end to the last bit, the corrector fails or moves it more than
+ * LOOP_DRIFT of the segment, the budget is spent). The drift bound keeps m between the ends,
+ * each half at most 3/4 of the segment: on a long segment the corrector may take the chord's
+ * midpoint to another part of the loop, or back to an end, which splits nothing (the same
+ * segment again, up to the budget, as deep in the recursion of _segment_roots). */
 static bool _midpoint(loop_search *ls, const loop_point *a, const loop_point *b, loop_point *m)
 {
     bool a_end = true, b_end = true;
@@ -169,8 +173,16 @@ static bool _midpoint(loop_search *ls, const loop_point *a, const loop_point *b,
     if (a_end || b_end || ls->splits >= LOOP_SPLITS)
         return false;
     ls->splits++;
-    if (length > LOOP_CHORD && !(om_polish(&ls->pose, LOOP_CORRECT, m->q) <= LOOP_ON_POSE))
-        return false;
+    if (length > LOOP_CHORD) {
+        double chord[7], drift = 0.0;
+        memcpy(chord, m->q, sizeof chord);
+        if (!(om_polish(&ls->pose, LOOP_CORRECT, m->q) <= LOOP_ON_POSE))
+            return false;
+        for (int j = 0; j < 7; j++)
+            drift = py_max(drift, fabs(m->q[j] - chord[j]));
+        if (drift > LOOP_DRIFT * length)
+            return false;
+    }
     _measure(ls, m);
     return true;
 }

@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 import om_redundant as om
 from benchmarks import adversarial as adv
-from tests.conftest import random_q
+from tests.conftest import random_q, run_python
 
 _SOLVERS: dict[str, om.OMSolver] = {}
 
@@ -606,6 +606,49 @@ def test_the_last_false_no_next_to_the_half_line(name, q):
     q = np.array(q)
     T, c = solver.arm.fk(q), solver.configuration_of(q)
     _assert_solved(solver, T, c, q_hint=q)
+
+
+#: A pose whose loop search split one segment without end (see the test below).
+_FR3_LOOP_SPLIT = [
+    0.15245130410114172,
+    1.5150947881153707,
+    -4.191332515613095e-06,
+    -2.7908040309548,
+    0.8969632085911192,
+    4.198786440547809,
+    1.1369654024446558,
+]
+
+
+def test_a_loop_segment_the_corrector_cannot_split_ends_its_search():
+    """FR3 next to psi's singular half-line (the fourth pose of benchmarks.adversarial's
+    ``ArmRun("fr3", 5).near_arm_angle_line``), configuration (1, 1, 1) at psi = 3 pi / 4:
+    the loop search met a 0.87 rad segment whose chord midpoint the corrector took back to
+    an end, and split that same segment again, one recursion deeper each time, until the
+    process crashed (a stack overflow, before the budget of 1e5 midpoints). A midpoint that
+    the corrector moves by more than a quarter of its segment is no split now. Run in a fresh
+    interpreter (a crash must not take the suite with it): the roots of that configuration
+    and of q's own are exact and hold their configuration, and q's own holds q."""
+    script = f"""
+import math
+import numpy as np
+import om_redundant as om
+from tests.test_reliability import _assert_exact
+solver = om.OMSolver("fr3")
+q = np.array({_FR3_LOOP_SPLIT!r})
+T = solver.arm.fk(q)
+own = solver.configuration_of(q)
+for c in (om.Configuration((1, 1, 1), (3.0 * math.pi / 4.0,)), own):
+    for root in solver.solve_all(T, c):
+        _assert_exact(solver, root.q, T, c)
+assert any(np.abs(np.angle(np.exp(1j * (r.q - q)))).max() < 1e-6 for r in solver.solve_all(T, own))
+print("solved")
+"""
+    result = run_python("-c", script)
+    assert result.returncode == 0 and result.stdout.strip() == "solved", (
+        result.returncode,
+        result.stderr[-2000:],
+    )
 
 
 def test_psi_is_loose_where_the_model_wrist_centre_is_at_the_shoulder():
