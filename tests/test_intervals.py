@@ -49,7 +49,7 @@ def test_refined_ends_are_the_boundary_and_lockstep_is_alone(seed, name, count):
     T = solver.arm.fk(q)
     optimizer = om.RedundancyOptimizer(solver, obstacles(T[:3, 3], count), min_clearance=MIN_CLEARANCE)
     probes = [optimizer._probe(T, signs) for signs in optimizer.branches]
-    swept = sweep_circle(solver, optimizer.objective, T, optimizer.branches, optimizer.grid_points)
+    swept = sweep_circle(probes, optimizer.grid_points)
     ends = [
         (probe, span.points[k], outside)
         for probe, paths in zip(probes, swept, strict=True)

@@ -232,8 +232,8 @@ class RedundancyOptimizer:
         self, T: np.ndarray, branches: list[tuple[int, ...]]
     ) -> list[tuple[tuple[int, ...], list[Path], list[Run]]]:
         """Every branch's solution paths and feasible runs."""
-        swept = sweep_circle(self.solver, self.objective, T, branches, self.grid_points)
         probes = [self._probe(T, signs) for signs in branches]
+        swept = sweep_circle(probes, self.grid_points)
         paths = [(probe, path) for probe, paths in zip(probes, swept, strict=True) for path in paths]
         runs = iter(feasible_runs(paths))
         return [

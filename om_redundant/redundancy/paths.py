@@ -41,8 +41,6 @@ from typing import Any
 import numpy as np
 
 from .. import ckernels
-from ..om.solver import OMSolver
-from .objective import Objective
 from .probe import END_TOLERANCE, JUMP, SAME, Point, Probe, evaluate_points
 
 FINE_STEP = 0.25  # rad: cells in which a joint moves further get samples in between
@@ -75,11 +73,12 @@ class Path:
     turns: int = 0
 
 
-def sweep_circle(
-    solver: OMSolver, objective: Objective, T: np.ndarray, branches: list[tuple[int, ...]], n: int
-) -> list[list[Path]]:
-    """The solution paths of every branch over the whole circle, from the grid
-    psi_k = -pi + 2 pi k / n (module docstring)."""
+def sweep_circle(probes: list[Probe], n: int) -> list[list[Path]]:
+    """The solution paths of each probe's branch over the whole circle, from the grid
+    psi_k = -pi + 2 pi k / n (module docstring). The probes share one solver, objective and
+    pose, and each follows its own branch's paths here and after (a probe keeps no state
+    between its answers)."""
+    solver, T, branches = probes[0].solver, probes[0].T, [probe.signs for probe in probes]
     psi = -math.pi + _TURN * np.arange(n) / n
     # Rows psi by psi, the branches that differ in the first sign alone next to each other:
     # the solver shares their circle search where it is the same (S-R-S: the SHOULDER sign).
@@ -93,8 +92,7 @@ def sweep_circle(
         np.tile([not _neighbours_swept(branches[b], branches, n) for b in order], n),
     )
     swept = []
-    for b, signs in enumerate(branches):
-        probe = Probe(solver, objective, T, signs)
+    for b, probe in enumerate(probes):
         grid, distinct = _distinct(probe, batch.q[rows[b]], batch.count[rows[b]])
         roots: list[list[Point]] = [[] for _ in range(n)]
         if len(grid):
