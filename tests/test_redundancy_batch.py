@@ -4,6 +4,7 @@ the one-at-a-time evaluation it replaces."""
 from __future__ import annotations
 
 import functools
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -12,7 +13,7 @@ from hypothesis import strategies as st
 
 import om_redundant as om
 from benchmarks.control_rate import HOMES, MIN_CLEARANCE, obstacles
-from om_redundant.redundancy.box_qp import maximise_1d
+from om_redundant.redundancy.box_qp import Pieces, maximise_1d, step_1d
 from om_redundant.redundancy.objective import Group
 from om_redundant.redundancy.optimizer import _StartBounds
 from om_redundant.redundancy.probe import Probe
@@ -165,6 +166,55 @@ def test_the_one_variable_qp_step_is_the_models_maximiser(seed, pieces, curvatur
     assert all(
         (z >= 0.0).all() and z.sum() <= g.weight + 1e-12 for g, z in zip(groups, multipliers, strict=True)
     )
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    pieces=st.integers(1, 8),
+    curvature=st.floats(1e-3, 1e3),
+    reach=st.floats(1e-4, 1.0),
+    spread=st.floats(0.0, 3.0),
+)
+def test_the_climbs_one_variable_step_compiled_is_numpys(seed, pieces, curvature, reach, spread):
+    """box_qp.step_1d: ckernels.step_1d gives numpy's delta, gain and multipliers exactly,
+    with pieces spread so that some cannot be their group's minimum within the box (left
+    out: multiplier 0); its delta is maximise_1d's of the pieces kept, and its gain the
+    model's rise to it."""
+    rng = np.random.default_rng(seed)
+    groups = [
+        Group(kind, weight, floor, cap, rng.uniform(0.0, spread, pieces) + 0.3, rng.normal(size=(pieces, 1)))
+        for kind, weight, floor, cap in (
+            ("margin", rng.uniform(0, 2), 0.0, np.inf),
+            ("clearance", rng.uniform(0, 2), 0.3, 1.0),
+            ("singularity", rng.uniform(0, 1), -np.inf, 1.0),
+        )
+    ]
+    lower, upper = -reach * rng.uniform(), reach * rng.uniform()
+    found, want = (step_1d(Pieces.of(groups), curvature, lower, upper, compiled=c) for c in (True, False))
+    assert (found is None) == (want is None)
+    if found is None:
+        return
+    assert found[:2] == want[:2]
+    np.testing.assert_array_equal(found[2], want[2])
+    delta, gain, z = found
+    r = max(-lower, upper)
+    kept = [
+        g.values - np.abs(g.jacobian[:, 0]) * r <= (g.values + np.abs(g.jacobian[:, 0]) * r).min()
+        for g in groups
+    ]
+    alone = maximise_1d(
+        [replace(g, values=g.values[k], jacobian=g.jacobian[k]) for g, k in zip(groups, kept, strict=True)],
+        curvature,
+        lower,
+        upper,
+    )
+    assert delta == alone[0]
+    for z_g, k, z_kept in zip(Pieces.of(groups).split(z), kept, alone[1], strict=True):
+        np.testing.assert_array_equal(z_g[k], z_kept)
+        assert (z_g[~k] == 0.0).all()
+    model = Pieces.of(groups).model
+    assert gain == model(delta) - 0.5 * delta * curvature * delta - model(0.0)
 
 
 @settings(max_examples=40, deadline=None)

@@ -32,7 +32,7 @@ import numpy as np
 import qpsolvers
 import scipy.sparse as sp
 
-from .box_qp import Pieces, solve_1d
+from .box_qp import Pieces, step_1d
 from .objective import Group
 from .probe import Point, Probe
 
@@ -62,7 +62,13 @@ class _Step:
     multipliers: list[np.ndarray]
 
 
-def qp_step(groups: list[Group], curvature: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> _Step | None:
+def qp_step(
+    groups: list[Group],
+    curvature: np.ndarray,
+    lower: np.ndarray,
+    upper: np.ndarray,
+    pieces: Pieces | None = None,
+) -> _Step | None:
     """Solve the climb's QP (module docstring) for the step delta.
 
     Pieces that cannot be their group's minimum anywhere in the box [lower, upper] are left
@@ -72,17 +78,24 @@ def qp_step(groups: list[Group], curvature: np.ndarray, lower: np.ndarray, upper
         groups: Groups with jacobians (p_g, r) by the redundancy variables.
         curvature: B (r, r), positive definite.
         lower, upper: (r,) bounds of delta (trust region and interval), lower <= 0 <= upper.
+        pieces: With one variable, the groups' pieces if already concatenated
+            (``Pieces.of(groups)``: a climb's QPs at one point share them).
 
     Returns:
         The step, or None when the QP has no solution or OSQP returns no iterate. With one
-        variable the QP is solved exactly (:func:`~om_redundant.redundancy.box_qp.maximise_1d`);
+        variable the QP is solved exactly (:func:`~om_redundant.redundancy.box_qp.step_1d`);
         otherwise by OSQP, whose iterate is taken even when it did not meet its tolerances
         (on nearly degenerate problems, at a kink the climb has already reached): the climb
         checks every step exactly.
     """
     r = len(lower)
     if r == 1:
-        return _step_1d(Pieces.of(groups), float(curvature[0, 0]), float(lower[0]), float(upper[0]))
+        pieces = Pieces.of(groups) if pieces is None else pieces
+        found = step_1d(pieces, float(curvature[0, 0]), float(lower[0]), float(upper[0]))
+        if found is None:
+            return None
+        delta, gain, z = found
+        return _Step(np.array([delta]), gain, pieces.split(z))
     reach = np.maximum(-lower, upper)
     keep = [_may_be_least(g, reach) for g in groups]
     found = _osqp_step(groups, keep, curvature, lower, upper, reach)
@@ -94,23 +107,6 @@ def qp_step(groups: list[Group], curvature: np.ndarray, lower: np.ndarray, upper
     for full, k, z in zip(multipliers, keep, duals, strict=True):
         full[k] = z
     return _Step(delta, gain, multipliers)
-
-
-def _step_1d(pieces: Pieces, curvature: float, lower: float, upper: float) -> _Step | None:
-    """:func:`qp_step` with one variable, on the groups' pieces concatenated (the same
-    operations as the general case's, on one array instead of one per group)."""
-    reach = max(-lower, upper)
-    change = np.abs(pieces.rates) * reach
-    least = pieces.least(pieces.values + change)
-    keep = pieces.values - change <= np.repeat(least, np.diff(pieces.ends))
-    found = solve_1d(pieces.kept(keep), curvature, lower, upper)
-    if found is None:
-        return None
-    delta, z = found
-    gain = pieces.model(delta) - 0.5 * delta * curvature * delta - pieces.model(0.0)
-    multipliers = np.zeros(len(keep))
-    multipliers[keep] = z
-    return _Step(np.array([delta]), gain, pieces.split(multipliers))
 
 
 def _osqp_step(
@@ -216,12 +212,13 @@ def maximise(probe: Probe, start: Point, lower: float, upper: float, radius: flo
     if not point.groups:  # nothing to maximise: f is constant
         return start
     B = _INITIAL_CURVATURE * np.eye(len(x))
+    pieces = Pieces.of(point.groups) if len(x) == 1 else None  # (the point's, for its QPs)
     for _ in range(_MAX_CLIMB):
         radius = min(radius, _JOINT_STEP / max(float(np.abs(point.tangent).sum(axis=1).max()), 1e-12))
         if radius <= STEP_TOLERANCE:
             break
         lo = np.minimum(np.maximum(lower - x, -radius), 0.0)
-        step = qp_step(point.groups, B, lo, np.maximum(np.minimum(upper - x, radius), 0.0))
+        step = qp_step(point.groups, B, lo, np.maximum(np.minimum(upper - x, radius), 0.0), pieces)
         if step is None or np.abs(step.delta).max() <= STEP_TOLERANCE or step.gain <= GAIN_TOLERANCE:
             break
         size = np.abs(step.delta).max()
@@ -238,6 +235,7 @@ def maximise(probe: Probe, start: Point, lower: float, upper: float, radius: flo
         if gain > 0.75 * step.gain and size >= 0.9 * radius:
             radius *= 2.0
         point, x = trial, x + step.delta
+        pieces = Pieces.of(point.groups) if len(x) == 1 else None
     return replace(point, psi=_angle(x))
 
 
