@@ -180,7 +180,7 @@ def test_the_climbs_one_variable_step_compiled_is_numpys(seed, pieces, curvature
     """box_qp.step_1d: ckernels.step_1d gives numpy's delta, gain and multipliers exactly,
     with pieces spread so that some cannot be their group's minimum within the box (left
     out: multiplier 0); its delta is maximise_1d's of the pieces kept, and its gain the
-    model's rise to it."""
+    model's rise to it. Pieces.at: another point's pieces of the same groups."""
     rng = np.random.default_rng(seed)
     groups = [
         Group(kind, weight, floor, cap, rng.uniform(0.0, spread, pieces) + 0.3, rng.normal(size=(pieces, 1)))
@@ -215,6 +215,11 @@ def test_the_climbs_one_variable_step_compiled_is_numpys(seed, pieces, curvature
         assert (z_g[~k] == 0.0).all()
     model = Pieces.of(groups).model
     assert gain == model(delta) - 0.5 * delta * curvature * delta - model(0.0)
+    moved = [replace(g, values=g.values + 0.1, jacobian=-g.jacobian) for g in groups]
+    for mine, fresh in zip(Pieces.of(groups).at(moved), Pieces.of(moved), strict=True):
+        np.testing.assert_array_equal(mine, fresh)  # (another point's pieces, the structure shared)
+    with pytest.raises(ValueError, match="pieces where"):
+        Pieces.of(groups).at(groups[:2])
 
 
 @settings(max_examples=40, deadline=None)

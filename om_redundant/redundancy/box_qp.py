@@ -52,9 +52,15 @@ class Pieces(NamedTuple):
         """The pieces of groups with jacobians (p_g, 1)."""
         ends = np.cumsum([0] + [len(g.values) for g in groups], dtype=np.int64)
         numbers = np.array([(g.weight, g.floor, g.cap) for g in groups], dtype=float).T.copy()
-        values = np.concatenate([g.values for g in groups])
-        rates = np.concatenate([g.jacobian[:, 0] for g in groups])
-        return cls(values, rates, ends, *numbers)
+        return cls(*_values_and_rates(groups), ends, *numbers)
+
+    def at(self, groups: list[Group]) -> Pieces:
+        """The pieces of groups of the same sizes, weights, floors and caps as these (the same
+        objective's at another point), which share these' ends and numbers."""
+        values, rates = _values_and_rates(groups)
+        if len(values) != self.ends[-1]:
+            raise ValueError(f"{len(values)} pieces where these groups have {self.ends[-1]}")
+        return self._replace(values=values, rates=rates)
 
     def least(self, values: np.ndarray) -> np.ndarray:
         """(G,) each group's smallest of ``values`` (n,), one per piece."""
@@ -82,6 +88,11 @@ def solve_1d(pieces: Pieces, curvature: float, lower: float, upper: float) -> tu
     z = np.empty(len(pieces.values))
     delta = ckernels.maximise_1d(*pieces, curvature, lower, upper, z)
     return None if delta is None else (delta, z)
+
+
+def _values_and_rates(groups: list[Group]) -> tuple[np.ndarray, np.ndarray]:
+    """The groups' pieces v_j and rates a_j (jacobians (p_g, 1)), concatenated."""
+    return np.concatenate([g.values for g in groups]), np.concatenate([g.jacobian[:, 0] for g in groups])
 
 
 def step_1d(

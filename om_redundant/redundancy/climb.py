@@ -235,7 +235,7 @@ def maximise(probe: Probe, start: Point, lower: float, upper: float, radius: flo
         if gain > 0.75 * step.gain and size >= 0.9 * radius:
             radius *= 2.0
         point, x = trial, x + step.delta
-        pieces = Pieces.of(point.groups) if len(x) == 1 else None
+        pieces = pieces if pieces is None else pieces.at(point.groups)
     return replace(point, psi=_angle(x))
 
 
