@@ -228,7 +228,8 @@ def test_the_climbs_start_bounds_hold_for_functions_within_their_slopes(seed, ru
     """optimizer._StartBounds.within, for term functions c + A sin(omega psi + phi) (slope
     bound A omega; f's the weighted sum of its groups' largest) sampled on runs of uneven
     spacing: every start's bound is at least f anywhere within its reach (a dense grid), at
-    least f at the start and at most the bound from its own cones (``cone``, the bound before)."""
+    least f at the start and at most the bound from its own cones (``cone``, the bound before);
+    compiled exactly as numpy computes it, also without terms."""
     rng = np.random.default_rng(seed)
     groups = [(rng.uniform(0, 2), np.inf, rng.integers(1, 5)), (rng.uniform(0, 2), 1.0, rng.integers(1, 5))]
     waves = [rng.uniform([0.2, 0.0, 0.5, -3.0], [1.5, scale, 8.0, 3.0], (p, 4)) for _, _, p in groups]
@@ -253,7 +254,10 @@ def test_the_climbs_start_bounds_hold_for_functions_within_their_slopes(seed, ru
     bounds = _StartBounds(psi, f, terms, slope, slopes, first, last)
     reach = rng.uniform(0.0, 1.0, len(psi))
     cones = bounds.cone(np.arange(len(psi)), reach)
+    bare = _StartBounds(psi, f, [], slope, [], first, last)  # (no terms: f's bound capped at 0)
     for k, (x, r, f_k) in enumerate(zip(psi, reach, f, strict=True)):
         bound = bounds.within(k, r)
+        assert bound == bounds.within(k, r, compiled=False)  # (numpy's, the reference)
+        assert bare.within(k, r) == bare.within(k, r, compiled=False)
         assert bound >= objective(np.linspace(x - r, x + r, 2001)).max() - 1e-12
         assert f_k <= bound <= min(cones[k], f_k + slope * r) + 1e-12

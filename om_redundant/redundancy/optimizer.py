@@ -53,6 +53,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
+from .. import ckernels
 from ..exceptions import InvalidInput
 from ..om.configuration import Configuration
 from ..om.solver import OMSolver, Solution
@@ -408,9 +409,12 @@ class _StartBounds:
     ):
         # f and every group's functions as the columns of one array, their slope bounds L
         self.psi, self.first, self.last, self._at = psi, first, last, psi.tolist()
-        self._values = np.hstack([f[:, None]] + [v for _, _, v in terms])
+        self._values = np.ascontiguousarray(
+            np.hstack([f[:, None]] + [v for _, _, v in terms])
+        )  # (row by row)
         self._slopes = np.concatenate([[slope], *slopes])
-        self._groups = np.cumsum([1] + [v.shape[1] for _, _, v in terms[:-1]])  # each group's first column
+        # each group's first column
+        self._groups = np.cumsum([1] + [v.shape[1] for _, _, v in terms[:-1]], dtype=np.int64)[: len(terms)]
         self._weights = np.array([w for w, _, _ in terms])
         self._caps = np.array([cap for _, cap, _ in terms])
 
@@ -419,14 +423,25 @@ class _StartBounds:
         :math:`\sum_g w_g \min(cap_g, \min_j (v_{jk} + L_j R))`."""
         return self._bound(self._values[k] + self._slopes * reach[:, None])
 
-    def within(self, k: int, reach: float) -> float:
+    def within(self, k: int, reach: float, compiled: bool = True) -> float:
         r"""The bound of start k from every sample of its run within its reach R (never
         above :meth:`cone`'s for consistent slopes). Between neighbouring samples i, i + 1
         (h apart) the cones of the two meet at most at :math:`(u_i + u_{i+1} + L h)/2`; in
         a cell that R cuts, or beyond the run's end, the last sample's cone reaches
         :math:`u_i + L r` (r the reach left). Per cell or cut cell the smaller of f's bound
-        and the terms' (:meth:`cone`'s sum), the largest over the cells; at least f_k."""
-        at, a, b, x = self._at, int(self.first[k]), int(self.last[k]), self._at[k]
+        and the terms' (:meth:`cone`'s sum), the largest over the cells; at least f_k.
+
+        Args:
+            k: The start's sample.
+            reach: R >= 0.
+            compiled: By ``ckernels.start_bound`` (``csrc/start_bounds.c``, the same
+                operations); False: numpy, the reference it is tested against.
+        """
+        a, b = int(self.first[k]), int(self.last[k])
+        if compiled:
+            numbers = (self._groups, self._weights, self._caps)
+            return ckernels.start_bound(self.psi, self._values, self._slopes, *numbers, int(k), a, b, reach)
+        at, x = self._at, self._at[k]
         lo = bisect.bisect_left(at, x - reach, a, b + 1)  # the samples within reach: lo..hi
         hi = bisect.bisect_right(at, x + reach, a, b + 1) - 1
         cells = np.arange(lo - 1 if lo > a else lo, hi + 1 if hi < b else hi)  # whole and cut
