@@ -13,7 +13,9 @@ from hypothesis import strategies as st
 
 import om_redundant as om
 from benchmarks.control_rate import HOMES, MIN_CLEARANCE, obstacles
+from om_redundant.redundancy import optimizer as optimizer_module
 from om_redundant.redundancy.box_qp import Pieces, maximise_1d, step_1d
+from om_redundant.redundancy.climb import maximise
 from om_redundant.redundancy.objective import Group
 from om_redundant.redundancy.optimizer import _StartBounds
 from om_redundant.redundancy.probe import Probe
@@ -261,3 +263,28 @@ def test_the_climbs_start_bounds_hold_for_functions_within_their_slopes(seed, ru
         assert bare.within(k, r) == bare.within(k, r, compiled=False)
         assert bound >= objective(np.linspace(x - r, x + r, 2001)).max() - 1e-12
         assert f_k <= bound <= min(cones[k], f_k + slope * r) + 1e-12
+
+
+@pytest.mark.parametrize("name", list(HOMES))
+def test_the_one_variable_climb_is_the_general_one(name, monkeypatch):
+    """climb.maximise with one variable in floats climbs exactly as the general loop on
+    arrays (scalar=False, the reference): the same point, psi and value from every start
+    that global chooses with 3 obstacles about the hand climb at random poses."""
+    solver = optimizer_of(name, 0).solver
+    climbs = []
+
+    def recording(probe, start, lower, upper, radius):
+        found = maximise(probe, start, lower, upper, radius)
+        climbs.append((probe, start, lower, upper, radius, found))
+        return found
+
+    monkeypatch.setattr(optimizer_module, "maximise", recording)
+    for q in np.random.default_rng(3).uniform(solver.arm.lower, solver.arm.upper, (6, solver.arm.dof)):
+        T = solver.arm.fk(q)
+        om.RedundancyOptimizer(solver, obstacles(T[:3, 3], 3), min_clearance=MIN_CLEARANCE).choose(T)
+    assert sum(found.psi != start.psi for _, start, *_, found in climbs) >= 3  # (climbs that moved)
+    for probe, start, lower, upper, radius, found in climbs:
+        reference = maximise(probe, start, lower, upper, radius, scalar=False)
+        assert reference.psi == found.psi
+        np.testing.assert_array_equal(reference.q, found.q)
+        assert reference.evaluation == found.evaluation

@@ -192,7 +192,9 @@ def _bfgs(B: np.ndarray, s: np.ndarray, y: np.ndarray) -> np.ndarray:
     return B - np.outer(Bs, Bs) / sBs + np.outer(y, y) / sy
 
 
-def maximise(probe: Probe, start: Point, lower: float, upper: float, radius: float) -> Point:
+def maximise(
+    probe: Probe, start: Point, lower: float, upper: float, radius: float, scalar: bool = True
+) -> Point:
     """Climb from a feasible point to a local maximum of f within [lower, upper].
 
     The trust radius Delta is also kept below ``_JOINT_STEP / max_i sum_c |dq_i/dpsi_c|``,
@@ -204,13 +206,17 @@ def maximise(probe: Probe, start: Point, lower: float, upper: float, radius: flo
         start: A feasible point; every step continues from the current one.
         lower, upper: Bounds of psi (the feasible interval).
         radius: First trust radius (rad).
+        scalar: With one variable, the climb in floats (:func:`_maximise_1d`, the same
+            operations); False: the general one on arrays, the reference it is tested against.
 
     Returns:
         The best feasible point found.
     """
-    point, x = start, np.atleast_1d(start.psi).astype(float)
-    if not point.groups:  # nothing to maximise: f is constant
+    if not start.groups:  # nothing to maximise: f is constant
         return start
+    if scalar and np.ndim(start.psi) == 0:
+        return _maximise_1d(probe, start, lower, upper, radius)
+    point, x = start, np.atleast_1d(start.psi).astype(float)
     B = _INITIAL_CURVATURE * np.eye(len(x))
     pieces = Pieces.of(point.groups) if len(x) == 1 else None  # (the point's, for its QPs)
     for _ in range(_MAX_CLIMB):
@@ -237,6 +243,49 @@ def maximise(probe: Probe, start: Point, lower: float, upper: float, radius: flo
         point, x = trial, x + step.delta
         pieces = pieces if pieces is None else pieces.at(point.groups)
     return replace(point, psi=_angle(x))
+
+
+def _maximise_1d(probe: Probe, start: Point, lower: float, upper: float, radius: float) -> Point:
+    """:func:`maximise` with one variable: psi, the step, B and the BFGS update as floats,
+    the pieces of a point concatenated once (:class:`~om_redundant.redundancy.box_qp.Pieces`),
+    each operation the general loop's, so that the climb is the same to the last bit."""
+    point, x, b = start, float(start.psi), _INITIAL_CURVATURE
+    pieces = Pieces.of(point.groups)
+    for _ in range(_MAX_CLIMB):
+        radius = min(radius, _JOINT_STEP / max(float(np.abs(point.tangent).max()), 1e-12))
+        if radius <= STEP_TOLERANCE:
+            break
+        found = step_1d(pieces, b, min(max(lower - x, -radius), 0.0), max(min(upper - x, radius), 0.0))
+        if found is None or abs(found[0]) <= STEP_TOLERANCE or found[1] <= GAIN_TOLERANCE:
+            break
+        delta, model_gain, z = found
+        size = abs(delta)
+        trial = probe.next(point, x + delta)
+        gain = trial.evaluation.value - point.evaluation.value if trial is not None else -math.inf
+        if trial is None or not trial.evaluation.feasible or gain < _ACCEPT * model_gain:
+            radius = size / 4.0
+            continue
+        moved = pieces.at(trial.groups)
+        rise = moved.rates - pieces.rates  # y = -sum_j z_j (a_j^new - a_j^old), group by group
+        y = -sum(z_g @ rise_g for z_g, rise_g in zip(pieces.split(z), pieces.split(rise), strict=True))
+        b = _bfgs_1d(b, delta, y)
+        if gain > 0.75 * model_gain and size >= 0.9 * radius:
+            radius *= 2.0
+        point, x, pieces = trial, x + delta, moved
+    return replace(point, psi=x)
+
+
+def _bfgs_1d(b: float, s: float, y: float) -> float:
+    """:func:`_bfgs` of a 1 x 1 B, in its operations."""
+    bs = b * s
+    sbs = s * bs
+    if sbs <= 1e-300:
+        return b
+    sy = s * y
+    if sy < 0.2 * sbs:
+        theta = 0.8 * sbs / (sbs - sy)
+        y, sy = theta * y + (1.0 - theta) * bs, 0.2 * sbs
+    return b - bs * bs / sbs + y * y / sy
 
 
 def _angle(x: np.ndarray) -> float | np.ndarray:
