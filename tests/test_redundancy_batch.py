@@ -231,7 +231,8 @@ def test_the_climbs_start_bounds_hold_for_functions_within_their_slopes(seed, ru
     bound A omega; f's the weighted sum of its groups' largest) sampled on runs of uneven
     spacing: every start's bound is at least f anywhere within its reach (a dense grid), at
     least f at the start and at most the bound from its own cones (``cone``, the bound before);
-    compiled exactly as numpy computes it, also without terms."""
+    compiled exactly as numpy computes it, also without terms; without slopes given, L is the
+    largest slope between neighbouring samples of a run."""
     rng = np.random.default_rng(seed)
     groups = [(rng.uniform(0, 2), np.inf, rng.integers(1, 5)), (rng.uniform(0, 2), 1.0, rng.integers(1, 5))]
     waves = [rng.uniform([0.2, 0.0, 0.5, -3.0], [1.5, scale, 8.0, 3.0], (p, 4)) for _, _, p in groups]
@@ -253,10 +254,20 @@ def test_the_climbs_start_bounds_hold_for_functions_within_their_slopes(seed, ru
     last = np.append(starts[1:], len(psi))[owner] - 1
     terms = [(w, cap, v) for (w, cap, _), v in zip(groups, functions(psi), strict=True)]
     f = objective(psi)
-    bounds = _StartBounds(psi, f, terms, slope, slopes, first, last)
+    bounds = _StartBounds(psi, f, terms, first, last, slope, slopes)
     reach = rng.uniform(0.0, 1.0, len(psi))
     cones = bounds.cone(np.arange(len(psi)), reach)
-    bare = _StartBounds(psi, f, [], slope, [], first, last)  # (no terms: f's bound capped at 0)
+    bare = _StartBounds(psi, f, [], first, last, slope, [])
+    columns = np.column_stack([f] + [v for _, _, v in terms])
+    pairs = [(i, i + 1) for i in range(len(psi) - 1) if first[i] == first[i + 1]]  # neighbours on a run
+    sampled = [
+        max((abs(c[j] - c[i]) / max(psi[j] - psi[i], 1e-12) for i, j in pairs), default=0.0)
+        for c in columns.T
+    ]
+    np.testing.assert_array_equal(_StartBounds(psi, f, terms, first, last)._slopes, sampled)  # (L sampled)
+    assert (
+        np.array(sampled) <= np.concatenate([[slope], *slopes]) + 1e-9
+    ).all()  # (no terms: f's bound capped at 0)
     for k, (x, r, f_k) in enumerate(zip(psi, reach, f, strict=True)):
         bound = bounds.within(k, r)
         assert bound == bounds.within(k, r, compiled=False)  # (numpy's, the reference)
