@@ -19,7 +19,8 @@ exactly (the current q as hint); it is accepted when the exact point is feasible
 at least a tenth of the model's gain :math:`\sum_g w_g \min(cap_g, \min_j (v_j + a_j^T\delta))
 - \tfrac12\delta^T B\delta - f`; the trust radius Delta then doubles (a good full step) or
 otherwise shrinks to a quarter of the step. The climb stops when the step or the model's
-gain vanishes. Everything here is written for r redundancy variables (r = 1 for 7-DOF arms).
+gain vanishes. Everything here is written for r redundancy variables (r = 1 for 7-DOF arms);
+with one, the climb runs on Python floats and one compiled call per QP (the same operations).
 """
 
 from __future__ import annotations
