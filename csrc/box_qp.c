@@ -225,14 +225,25 @@ static PyObject *om_step_1d(PyObject *mod, PyObject *const *args, Py_ssize_t nar
     uint8_t *keep = (uint8_t *)(kept_ends + G + 1);
     Py_ssize_t m = 0;
     kept_ends[0] = 0;
+    int empty = 0;
     for (Py_ssize_t g = 0; g < G; g++) {
         double least = INFINITY;
-        for (int64_t j = q.ends[g]; j < q.ends[g + 1]; j++) least = fmin(least, q.v[j] + fabs(q.a[j]) * reach);
+        for (int64_t j = q.ends[g]; j < q.ends[g + 1]; j++) { /* (a nan propagates, as numpy's minimum) */
+            double top = q.v[j] + fabs(q.a[j]) * reach;
+            least = least <= top || isnan(least) ? least : top;
+        }
         for (int64_t j = q.ends[g]; j < q.ends[g + 1]; j++) {
             keep[j] = q.v[j] - fabs(q.a[j]) * reach <= least;
             if (keep[j]) kept_v[m] = q.v[j], kept_a[m++] = q.a[j];
         }
         kept_ends[g + 1] = m;
+        empty |= kept_ends[g + 1] == kept_ends[g];
+    }
+    if (empty) { /* (only where a piece or the box is not a number) */
+        PyMem_Free(kept_v);
+        release_buffers(v, 7);
+        PyErr_SetString(PyExc_ValueError, "step_1d: a group keeps no piece (a piece or a bound is not a number)");
+        return NULL;
     }
     qp_groups kept = {kept_v, kept_a, q.w, q.floor, q.cap, kept_ends, G};
     int found = solve(&kept, b, lo, hi, &delta, kept_z, m);

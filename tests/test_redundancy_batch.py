@@ -222,6 +222,13 @@ def test_the_climbs_one_variable_step_compiled_is_numpys(seed, pieces, curvature
         np.testing.assert_array_equal(mine, fresh)  # (another point's pieces, the structure shared)
     with pytest.raises(ValueError, match="pieces where"):
         Pieces.of(groups).at(groups[:2])
+    broken = [
+        replace(groups[0], values=np.where(np.arange(pieces) == 0, np.nan, groups[0].values)),
+        *groups[1:],
+    ]
+    for compiled in (True, False):  # (a piece that is not a number: no piece of its group is kept)
+        with pytest.raises(ValueError):
+            step_1d(Pieces.of(broken), curvature, lower, upper, compiled=compiled)
 
 
 @settings(max_examples=40, deadline=None)
