@@ -92,5 +92,6 @@ extern PyMethodDef om_tangent_functions[];   /* tangents.c: self-motion tangents
 extern PyMethodDef om_objective_functions[]; /* objective.c: the redundancy optimiser's objective */
 extern PyMethodDef om_cell_functions[];      /* cells.c: the cell test of the solution paths */
 extern PyMethodDef om_box_qp_functions[];    /* box_qp.c: the climb's QP in one variable */
+extern PyMethodDef om_start_bound_functions[]; /* start_bounds.c: what a climb from a start can reach */
 
 #endif

@@ -49,6 +49,7 @@ PyMODINIT_FUNC PyInit_ckernels(void) {
     if (PyModule_AddFunctions(m, om_objective_functions) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_cell_functions) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_box_qp_functions) < 0) goto fail;
+    if (PyModule_AddFunctions(m, om_start_bound_functions) < 0) goto fail;
     for (size_t i = 0; i < sizeof constants / sizeof constants[0]; i++)
         if (PyModule_AddIntConstant(m, constants[i].name, constants[i].value) < 0) goto fail;
     const struct {

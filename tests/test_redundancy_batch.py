@@ -4,6 +4,7 @@ the one-at-a-time evaluation it replaces."""
 from __future__ import annotations
 
 import functools
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -12,7 +13,9 @@ from hypothesis import strategies as st
 
 import om_redundant as om
 from benchmarks.control_rate import HOMES, MIN_CLEARANCE, obstacles
-from om_redundant.redundancy.box_qp import maximise_1d
+from om_redundant.redundancy import optimizer as optimizer_module
+from om_redundant.redundancy.box_qp import Pieces, maximise_1d, step_1d
+from om_redundant.redundancy.climb import maximise
 from om_redundant.redundancy.objective import Group
 from om_redundant.redundancy.optimizer import _StartBounds
 from om_redundant.redundancy.probe import Probe
@@ -167,13 +170,76 @@ def test_the_one_variable_qp_step_is_the_models_maximiser(seed, pieces, curvatur
     )
 
 
+@settings(max_examples=60, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    pieces=st.integers(1, 8),
+    curvature=st.floats(1e-3, 1e3),
+    reach=st.floats(1e-4, 1.0),
+    spread=st.floats(0.0, 3.0),
+)
+def test_the_climbs_one_variable_step_compiled_is_numpys(seed, pieces, curvature, reach, spread):
+    """box_qp.step_1d: ckernels.step_1d gives numpy's delta, gain and multipliers exactly,
+    with pieces spread so that some cannot be their group's minimum within the box (left
+    out: multiplier 0); its delta is maximise_1d's of the pieces kept, and its gain the
+    model's rise to it. Pieces.at: another point's pieces of the same groups."""
+    rng = np.random.default_rng(seed)
+    groups = [
+        Group(kind, weight, floor, cap, rng.uniform(0.0, spread, pieces) + 0.3, rng.normal(size=(pieces, 1)))
+        for kind, weight, floor, cap in (
+            ("margin", rng.uniform(0, 2), 0.0, np.inf),
+            ("clearance", rng.uniform(0, 2), 0.3, 1.0),
+            ("singularity", rng.uniform(0, 1), -np.inf, 1.0),
+        )
+    ]
+    lower, upper = -reach * rng.uniform(), reach * rng.uniform()
+    found, want = (step_1d(Pieces.of(groups), curvature, lower, upper, compiled=c) for c in (True, False))
+    assert (found is None) == (want is None)
+    if found is None:
+        return
+    assert found[:2] == want[:2]
+    np.testing.assert_array_equal(found[2], want[2])
+    delta, gain, z = found
+    r = max(-lower, upper)
+    kept = [
+        g.values - np.abs(g.jacobian[:, 0]) * r <= (g.values + np.abs(g.jacobian[:, 0]) * r).min()
+        for g in groups
+    ]
+    alone = maximise_1d(
+        [replace(g, values=g.values[k], jacobian=g.jacobian[k]) for g, k in zip(groups, kept, strict=True)],
+        curvature,
+        lower,
+        upper,
+    )
+    assert delta == alone[0]
+    for z_g, k, z_kept in zip(Pieces.of(groups).split(z), kept, alone[1], strict=True):
+        np.testing.assert_array_equal(z_g[k], z_kept)
+        assert (z_g[~k] == 0.0).all()
+    model = Pieces.of(groups).model
+    assert gain == model(delta) - 0.5 * delta * curvature * delta - model(0.0)
+    moved = [replace(g, values=g.values + 0.1, jacobian=-g.jacobian) for g in groups]
+    for mine, fresh in zip(Pieces.of(groups).at(moved), Pieces.of(moved), strict=True):
+        np.testing.assert_array_equal(mine, fresh)  # (another point's pieces, the structure shared)
+    with pytest.raises(ValueError, match="pieces where"):
+        Pieces.of(groups).at(groups[:2])
+    broken = [
+        replace(groups[0], values=np.where(np.arange(pieces) == 0, np.nan, groups[0].values)),
+        *groups[1:],
+    ]
+    for compiled in (True, False):  # (a piece that is not a number: no piece of its group is kept)
+        with pytest.raises(ValueError):
+            step_1d(Pieces.of(broken), curvature, lower, upper, compiled=compiled)
+
+
 @settings(max_examples=40, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1), runs=st.integers(1, 3), scale=st.floats(0.0, 4.0))
 def test_the_climbs_start_bounds_hold_for_functions_within_their_slopes(seed, runs, scale):
     """optimizer._StartBounds.within, for term functions c + A sin(omega psi + phi) (slope
     bound A omega; f's the weighted sum of its groups' largest) sampled on runs of uneven
     spacing: every start's bound is at least f anywhere within its reach (a dense grid), at
-    least f at the start and at most the bound from its own cones (``cone``, the bound before)."""
+    least f at the start and at most the bound from its own cones (``cone``, the bound before);
+    compiled exactly as numpy computes it, also without terms; without slopes given, L is the
+    largest slope between neighbouring samples of a run."""
     rng = np.random.default_rng(seed)
     groups = [(rng.uniform(0, 2), np.inf, rng.integers(1, 5)), (rng.uniform(0, 2), 1.0, rng.integers(1, 5))]
     waves = [rng.uniform([0.2, 0.0, 0.5, -3.0], [1.5, scale, 8.0, 3.0], (p, 4)) for _, _, p in groups]
@@ -195,10 +261,48 @@ def test_the_climbs_start_bounds_hold_for_functions_within_their_slopes(seed, ru
     last = np.append(starts[1:], len(psi))[owner] - 1
     terms = [(w, cap, v) for (w, cap, _), v in zip(groups, functions(psi), strict=True)]
     f = objective(psi)
-    bounds = _StartBounds(psi, f, terms, slope, slopes, first, last)
+    bounds = _StartBounds(psi, f, terms, first, last, slope, slopes)
     reach = rng.uniform(0.0, 1.0, len(psi))
     cones = bounds.cone(np.arange(len(psi)), reach)
+    bare = _StartBounds(psi, f, [], first, last, slope, [])
+    columns = np.column_stack([f] + [v for _, _, v in terms])
+    pairs = [(i, i + 1) for i in range(len(psi) - 1) if first[i] == first[i + 1]]  # neighbours on a run
+    sampled = [
+        max((abs(c[j] - c[i]) / max(psi[j] - psi[i], 1e-12) for i, j in pairs), default=0.0)
+        for c in columns.T
+    ]
+    np.testing.assert_array_equal(_StartBounds(psi, f, terms, first, last)._slopes, sampled)  # (L sampled)
+    assert (
+        np.array(sampled) <= np.concatenate([[slope], *slopes]) + 1e-9
+    ).all()  # (no terms: f's bound capped at 0)
     for k, (x, r, f_k) in enumerate(zip(psi, reach, f, strict=True)):
         bound = bounds.within(k, r)
+        assert bound == bounds.within(k, r, compiled=False)  # (numpy's, the reference)
+        assert bare.within(k, r) == bare.within(k, r, compiled=False)
         assert bound >= objective(np.linspace(x - r, x + r, 2001)).max() - 1e-12
         assert f_k <= bound <= min(cones[k], f_k + slope * r) + 1e-12
+
+
+@pytest.mark.parametrize("name", list(HOMES))
+def test_the_one_variable_climb_is_the_general_one(name, monkeypatch):
+    """climb.maximise with one variable in floats climbs exactly as the general loop on
+    arrays (scalar=False, the reference): the same point, psi and value from every start
+    that global chooses with 3 obstacles about the hand climb at random poses."""
+    solver = optimizer_of(name, 0).solver
+    climbs = []
+
+    def recording(probe, start, lower, upper, radius):
+        found = maximise(probe, start, lower, upper, radius)
+        climbs.append((probe, start, lower, upper, radius, found))
+        return found
+
+    monkeypatch.setattr(optimizer_module, "maximise", recording)
+    for q in np.random.default_rng(3).uniform(solver.arm.lower, solver.arm.upper, (6, solver.arm.dof)):
+        T = solver.arm.fk(q)
+        om.RedundancyOptimizer(solver, obstacles(T[:3, 3], 3), min_clearance=MIN_CLEARANCE).choose(T)
+    assert sum(found.psi != start.psi for _, start, *_, found in climbs) >= 3  # (climbs that moved)
+    for probe, start, lower, upper, radius, found in climbs:
+        reference = maximise(probe, start, lower, upper, radius, scalar=False)
+        assert reference.psi == found.psi
+        np.testing.assert_array_equal(reference.q, found.q)
+        assert reference.evaluation == found.evaluation

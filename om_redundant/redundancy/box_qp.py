@@ -18,6 +18,7 @@ that the slope balances :math:`b\delta`.
 
 from __future__ import annotations
 
+import itertools
 from typing import NamedTuple
 
 import numpy as np
@@ -51,9 +52,15 @@ class Pieces(NamedTuple):
         """The pieces of groups with jacobians (p_g, 1)."""
         ends = np.cumsum([0] + [len(g.values) for g in groups], dtype=np.int64)
         numbers = np.array([(g.weight, g.floor, g.cap) for g in groups], dtype=float).T.copy()
-        values = np.concatenate([g.values for g in groups])
-        rates = np.concatenate([g.jacobian[:, 0] for g in groups])
-        return cls(values, rates, ends, *numbers)
+        return cls(*_values_and_rates(groups), ends, *numbers)
+
+    def at(self, groups: list[Group]) -> Pieces:
+        """The pieces of groups of the same sizes, weights, floors and caps as these (the same
+        objective's at another point), which share these' ends and numbers."""
+        values, rates = _values_and_rates(groups)
+        if len(values) != self.ends[-1]:
+            raise ValueError(f"{len(values)} pieces where these groups have {self.ends[-1]}")
+        return self._replace(values=values, rates=rates)
 
     def least(self, values: np.ndarray) -> np.ndarray:
         """(G,) each group's smallest of ``values`` (n,), one per piece."""
@@ -71,8 +78,8 @@ class Pieces(NamedTuple):
         return self._replace(values=self.values[keep], rates=self.rates[keep], ends=ends)
 
     def split(self, z: np.ndarray) -> list[np.ndarray]:
-        """(n,) per piece into one array per group."""
-        return np.split(z, self.ends[1:-1])
+        """(n,) per piece into one array per group (views)."""
+        return [z[a:b] for a, b in itertools.pairwise(self.ends.tolist())]
 
 
 def solve_1d(pieces: Pieces, curvature: float, lower: float, upper: float) -> tuple[float, np.ndarray] | None:
@@ -81,6 +88,49 @@ def solve_1d(pieces: Pieces, curvature: float, lower: float, upper: float) -> tu
     z = np.empty(len(pieces.values))
     delta = ckernels.maximise_1d(*pieces, curvature, lower, upper, z)
     return None if delta is None else (delta, z)
+
+
+def _values_and_rates(groups: list[Group]) -> tuple[np.ndarray, np.ndarray]:
+    """The groups' pieces v_j and rates a_j (jacobians (p_g, 1)), concatenated."""
+    return np.concatenate([g.values for g in groups]), np.concatenate([g.jacobian[:, 0] for g in groups])
+
+
+def step_1d(
+    pieces: Pieces, curvature: float, lower: float, upper: float, compiled: bool = True
+) -> tuple[float, float, np.ndarray] | None:
+    r"""The climb's QP step in one variable (:func:`~om_redundant.redundancy.climb.qp_step`):
+    the pieces that can be their group's minimum somewhere in the box, :math:`v_j - |a_j| r
+    \le \min_{i \in g} v_i + |a_i| r` with r = max(-lower, upper) (the others' constraints
+    are implied by the minimum's), maximised as by :func:`maximise_1d`.
+
+    Args:
+        pieces: The groups' pieces.
+        curvature: b > 0.
+        lower, upper: Bounds of delta, lower <= 0 <= upper.
+        compiled: By ``ckernels.step_1d`` (``csrc/box_qp.c``, the same operations); False:
+            numpy, the reference it is tested against.
+
+    Returns:
+        (delta, the model's gain ``model(delta) - b delta^2 / 2 - model(0)`` (:meth:`Pieces.model`),
+        every piece's multiplier (n,), 0 for those left out), or None when the floors leave
+        no delta.
+    """
+    if compiled:
+        z = np.empty(len(pieces.values))
+        found = ckernels.step_1d(*pieces, curvature, lower, upper, z)
+        return None if found is None else (*found, z)
+    reach = max(-lower, upper)
+    change = np.abs(pieces.rates) * reach
+    least = pieces.least(pieces.values + change)
+    keep = pieces.values - change <= np.repeat(least, np.diff(pieces.ends))
+    found = solve_1d(pieces.kept(keep), curvature, lower, upper)
+    if found is None:
+        return None
+    delta, z = found
+    gain = pieces.model(delta) - 0.5 * delta * curvature * delta - pieces.model(0.0)
+    multipliers = np.zeros(len(keep))
+    multipliers[keep] = z
+    return delta, gain, multipliers
 
 
 def maximise_1d(

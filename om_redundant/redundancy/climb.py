@@ -19,7 +19,8 @@ exactly (the current q as hint); it is accepted when the exact point is feasible
 at least a tenth of the model's gain :math:`\sum_g w_g \min(cap_g, \min_j (v_j + a_j^T\delta))
 - \tfrac12\delta^T B\delta - f`; the trust radius Delta then doubles (a good full step) or
 otherwise shrinks to a quarter of the step. The climb stops when the step or the model's
-gain vanishes. Everything here is written for r redundancy variables (r = 1 for 7-DOF arms).
+gain vanishes. Everything here is written for r redundancy variables (r = 1 for 7-DOF arms);
+with one, the climb runs on Python floats and one compiled call per QP (the same operations).
 """
 
 from __future__ import annotations
@@ -32,7 +33,7 @@ import numpy as np
 import qpsolvers
 import scipy.sparse as sp
 
-from .box_qp import Pieces, solve_1d
+from .box_qp import Pieces, step_1d
 from .objective import Group
 from .probe import Point, Probe
 
@@ -62,7 +63,13 @@ class _Step:
     multipliers: list[np.ndarray]
 
 
-def qp_step(groups: list[Group], curvature: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> _Step | None:
+def qp_step(
+    groups: list[Group],
+    curvature: np.ndarray,
+    lower: np.ndarray,
+    upper: np.ndarray,
+    pieces: Pieces | None = None,
+) -> _Step | None:
     """Solve the climb's QP (module docstring) for the step delta.
 
     Pieces that cannot be their group's minimum anywhere in the box [lower, upper] are left
@@ -72,17 +79,24 @@ def qp_step(groups: list[Group], curvature: np.ndarray, lower: np.ndarray, upper
         groups: Groups with jacobians (p_g, r) by the redundancy variables.
         curvature: B (r, r), positive definite.
         lower, upper: (r,) bounds of delta (trust region and interval), lower <= 0 <= upper.
+        pieces: With one variable, the groups' pieces if already concatenated
+            (``Pieces.of(groups)``: a climb's QPs at one point share them).
 
     Returns:
         The step, or None when the QP has no solution or OSQP returns no iterate. With one
-        variable the QP is solved exactly (:func:`~om_redundant.redundancy.box_qp.maximise_1d`);
+        variable the QP is solved exactly (:func:`~om_redundant.redundancy.box_qp.step_1d`);
         otherwise by OSQP, whose iterate is taken even when it did not meet its tolerances
         (on nearly degenerate problems, at a kink the climb has already reached): the climb
         checks every step exactly.
     """
     r = len(lower)
     if r == 1:
-        return _step_1d(Pieces.of(groups), float(curvature[0, 0]), float(lower[0]), float(upper[0]))
+        pieces = Pieces.of(groups) if pieces is None else pieces
+        found = step_1d(pieces, float(curvature[0, 0]), float(lower[0]), float(upper[0]))
+        if found is None:
+            return None
+        delta, gain, z = found
+        return _Step(np.array([delta]), gain, pieces.split(z))
     reach = np.maximum(-lower, upper)
     keep = [_may_be_least(g, reach) for g in groups]
     found = _osqp_step(groups, keep, curvature, lower, upper, reach)
@@ -94,23 +108,6 @@ def qp_step(groups: list[Group], curvature: np.ndarray, lower: np.ndarray, upper
     for full, k, z in zip(multipliers, keep, duals, strict=True):
         full[k] = z
     return _Step(delta, gain, multipliers)
-
-
-def _step_1d(pieces: Pieces, curvature: float, lower: float, upper: float) -> _Step | None:
-    """:func:`qp_step` with one variable, on the groups' pieces concatenated (the same
-    operations as the general case's, on one array instead of one per group)."""
-    reach = max(-lower, upper)
-    change = np.abs(pieces.rates) * reach
-    least = pieces.least(pieces.values + change)
-    keep = pieces.values - change <= np.repeat(least, np.diff(pieces.ends))
-    found = solve_1d(pieces.kept(keep), curvature, lower, upper)
-    if found is None:
-        return None
-    delta, z = found
-    gain = pieces.model(delta) - 0.5 * delta * curvature * delta - pieces.model(0.0)
-    multipliers = np.zeros(len(keep))
-    multipliers[keep] = z
-    return _Step(np.array([delta]), gain, pieces.split(multipliers))
 
 
 def _osqp_step(
@@ -196,7 +193,9 @@ def _bfgs(B: np.ndarray, s: np.ndarray, y: np.ndarray) -> np.ndarray:
     return B - np.outer(Bs, Bs) / sBs + np.outer(y, y) / sy
 
 
-def maximise(probe: Probe, start: Point, lower: float, upper: float, radius: float) -> Point:
+def maximise(
+    probe: Probe, start: Point, lower: float, upper: float, radius: float, scalar: bool = True
+) -> Point:
     """Climb from a feasible point to a local maximum of f within [lower, upper].
 
     The trust radius Delta is also kept below ``_JOINT_STEP / max_i sum_c |dq_i/dpsi_c|``,
@@ -208,20 +207,25 @@ def maximise(probe: Probe, start: Point, lower: float, upper: float, radius: flo
         start: A feasible point; every step continues from the current one.
         lower, upper: Bounds of psi (the feasible interval).
         radius: First trust radius (rad).
+        scalar: With one variable, the climb in floats (:func:`_maximise_1d`, the same
+            operations); False: the general one on arrays, the reference it is tested against.
 
     Returns:
         The best feasible point found.
     """
-    point, x = start, np.atleast_1d(start.psi).astype(float)
-    if not point.groups:  # nothing to maximise: f is constant
+    if not start.groups:  # nothing to maximise: f is constant
         return start
+    if scalar and np.ndim(start.psi) == 0:
+        return _maximise_1d(probe, start, lower, upper, radius)
+    point, x = start, np.atleast_1d(start.psi).astype(float)
     B = _INITIAL_CURVATURE * np.eye(len(x))
+    pieces = Pieces.of(point.groups) if len(x) == 1 else None  # (the point's, for its QPs)
     for _ in range(_MAX_CLIMB):
         radius = min(radius, _JOINT_STEP / max(float(np.abs(point.tangent).sum(axis=1).max()), 1e-12))
         if radius <= STEP_TOLERANCE:
             break
         lo = np.minimum(np.maximum(lower - x, -radius), 0.0)
-        step = qp_step(point.groups, B, lo, np.maximum(np.minimum(upper - x, radius), 0.0))
+        step = qp_step(point.groups, B, lo, np.maximum(np.minimum(upper - x, radius), 0.0), pieces)
         if step is None or np.abs(step.delta).max() <= STEP_TOLERANCE or step.gain <= GAIN_TOLERANCE:
             break
         size = np.abs(step.delta).max()
@@ -238,7 +242,51 @@ def maximise(probe: Probe, start: Point, lower: float, upper: float, radius: flo
         if gain > 0.75 * step.gain and size >= 0.9 * radius:
             radius *= 2.0
         point, x = trial, x + step.delta
+        pieces = pieces if pieces is None else pieces.at(point.groups)
     return replace(point, psi=_angle(x))
+
+
+def _maximise_1d(probe: Probe, start: Point, lower: float, upper: float, radius: float) -> Point:
+    """:func:`maximise` with one variable: psi, the step, B and the BFGS update as floats,
+    the pieces of a point concatenated once (:class:`~om_redundant.redundancy.box_qp.Pieces`),
+    each operation the general loop's, so that the climb is the same to the last bit."""
+    point, x, b = start, float(start.psi), _INITIAL_CURVATURE
+    pieces = Pieces.of(point.groups)
+    for _ in range(_MAX_CLIMB):
+        radius = min(radius, _JOINT_STEP / max(float(np.abs(point.tangent).max()), 1e-12))
+        if radius <= STEP_TOLERANCE:
+            break
+        found = step_1d(pieces, b, min(max(lower - x, -radius), 0.0), max(min(upper - x, radius), 0.0))
+        if found is None or abs(found[0]) <= STEP_TOLERANCE or found[1] <= GAIN_TOLERANCE:
+            break
+        delta, model_gain, z = found
+        size = abs(delta)
+        trial = probe.next(point, x + delta)
+        gain = trial.evaluation.value - point.evaluation.value if trial is not None else -math.inf
+        if trial is None or not trial.evaluation.feasible or gain < _ACCEPT * model_gain:
+            radius = size / 4.0
+            continue
+        moved = pieces.at(trial.groups)
+        rise = moved.rates - pieces.rates  # y = -sum_j z_j (a_j^new - a_j^old), group by group
+        y = -sum(z_g @ rise_g for z_g, rise_g in zip(pieces.split(z), pieces.split(rise), strict=True))
+        b = _bfgs_1d(b, delta, y)
+        if gain > 0.75 * model_gain and size >= 0.9 * radius:
+            radius *= 2.0
+        point, x, pieces = trial, x + delta, moved
+    return replace(point, psi=x)
+
+
+def _bfgs_1d(b: float, s: float, y: float) -> float:
+    """:func:`_bfgs` of a 1 x 1 B, in its operations."""
+    bs = b * s
+    sbs = s * bs
+    if sbs <= 1e-300:
+        return b
+    sy = s * y
+    if sy < 0.2 * sbs:
+        theta = 0.8 * sbs / (sbs - sy)
+        y, sy = theta * y + (1.0 - theta) * bs, 0.2 * sbs
+    return b - bs * bs / sbs + y * y / sy
 
 
 def _angle(x: np.ndarray) -> float | np.ndarray:

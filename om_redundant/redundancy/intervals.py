@@ -24,8 +24,6 @@ from collections.abc import Generator, Sequence
 from dataclasses import dataclass
 from typing import NamedTuple
 
-import numpy as np
-
 from .. import ckernels
 from .arm_angle import wrap_psi
 from .paths import _HERMITE, Follow, Path, lockstep
@@ -196,8 +194,9 @@ def _newton(point: Point) -> float | None:
     g, dg = point.pieces()
     if len(g) == 0:
         return None
-    j = int(np.argmin(g))
-    return point.psi + (0.5 * SLACK_TOLERANCE - g[j]) / dg[j] if dg[j] != 0.0 else None
+    j = int(g.argmin())
+    rate = float(dg[j])  # (float arithmetic: numpy's scalars are slower)
+    return point.psi + (0.5 * SLACK_TOLERANCE - float(g[j])) / rate if rate != 0.0 else None
 
 
 def _modelled_end(inside: Point, outside: Point) -> float | None:

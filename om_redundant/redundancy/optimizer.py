@@ -53,6 +53,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
+from .. import ckernels
 from ..exceptions import InvalidInput
 from ..om.configuration import Configuration
 from ..om.solver import OMSolver, Solution
@@ -300,13 +301,6 @@ class RedundancyOptimizer:
         pairs = [p.terms.get_pairs() for p in points]  # (computed for the evaluations)
         distances = None if pairs[0] is None else np.array([d for d, _ in pairs])
         terms = self.objective.term_functions(np.array([p.q for p in points]), distances)
-        inner = owner[1:] == owner[:-1]  # neighbours on one run
-        step = np.maximum(np.diff(psi), 1e-12)[inner]
-        slope = float(np.max(np.abs(np.diff(f)[inner]) / step, initial=0.0))
-        limits = [
-            np.max(np.abs(np.diff(v, axis=0)[inner]) / step[:, None], axis=0, initial=0.0)
-            for _, _, v in terms
-        ]
         # local maxima among a run's samples (its ends against their one neighbour), and near
         rising = np.concatenate([[True], f[1:] >= f[:-1]]) | (first == np.arange(len(f)))
         falling = np.concatenate([f[:-1] >= f[1:], [True]]) | (last == np.arange(len(f)))
@@ -315,7 +309,7 @@ class RedundancyOptimizer:
             chosen |= np.array([_distance(x, near) <= END_TOLERANCE for x in psi.tolist()])
         k = np.flatnonzero(chosen)
         gap = np.maximum(psi[np.minimum(k + 1, last[k])] - psi[k], psi[k] - psi[np.maximum(k - 1, first[k])])
-        bounds = _StartBounds(psi, f, terms, slope, limits, first, last)
+        bounds = _StartBounds(psi, f, terms, first, last)
         bound = bounds.cone(k, 2.0 * gap)
         rows = zip(f[k].tolist(), gap.tolist(), bound.tolist(), k.tolist(), strict=True)
         starts = [(f_k, gap_k, bound_k, j) for f_k, gap_k, bound_k, j in rows]
@@ -392,8 +386,9 @@ class _StartBounds:
     Args:
         psi, f: (M,) the runs' samples, a run's in increasing psi, and f there.
         terms: :meth:`~om_redundant.redundancy.objective.Objective.term_functions` at them.
-        slope, slopes: L of f and of each group's functions (p_g,).
         first, last: (M,) each sample's run's first and last sample.
+        slope, slopes: L of f and of each group's functions (p_g,); None: sampled, the
+            largest slope between neighbouring samples of a run (module docstring).
     """
 
     def __init__(
@@ -401,16 +396,25 @@ class _StartBounds:
         psi: np.ndarray,
         f: np.ndarray,
         terms: list[tuple[float, float, np.ndarray]],
-        slope: float,
-        slopes: list[np.ndarray],
         first: np.ndarray,
         last: np.ndarray,
+        slope: float | None = None,
+        slopes: list[np.ndarray] | None = None,
     ):
         # f and every group's functions as the columns of one array, their slope bounds L
         self.psi, self.first, self.last, self._at = psi, first, last, psi.tolist()
-        self._values = np.hstack([f[:, None]] + [v for _, _, v in terms])
-        self._slopes = np.concatenate([[slope], *slopes])
-        self._groups = np.cumsum([1] + [v.shape[1] for _, _, v in terms[:-1]])  # each group's first column
+        self._values = np.ascontiguousarray(
+            np.hstack([f[:, None]] + [v for _, _, v in terms])
+        )  # (row by row)
+        if slope is None:
+            inner = first[1:] == first[:-1]  # neighbours on one run
+            step = np.maximum(np.diff(psi), 1e-12)[inner]
+            rise = np.abs(np.diff(self._values, axis=0)[inner])
+            self._slopes = np.max(rise / step[:, None], axis=0, initial=0.0)
+        else:
+            self._slopes = np.concatenate([[slope], *slopes])
+        # each group's first column
+        self._groups = np.cumsum([1] + [v.shape[1] for _, _, v in terms[:-1]], dtype=np.int64)[: len(terms)]
         self._weights = np.array([w for w, _, _ in terms])
         self._caps = np.array([cap for _, cap, _ in terms])
 
@@ -419,14 +423,25 @@ class _StartBounds:
         :math:`\sum_g w_g \min(cap_g, \min_j (v_{jk} + L_j R))`."""
         return self._bound(self._values[k] + self._slopes * reach[:, None])
 
-    def within(self, k: int, reach: float) -> float:
+    def within(self, k: int, reach: float, compiled: bool = True) -> float:
         r"""The bound of start k from every sample of its run within its reach R (never
         above :meth:`cone`'s for consistent slopes). Between neighbouring samples i, i + 1
         (h apart) the cones of the two meet at most at :math:`(u_i + u_{i+1} + L h)/2`; in
         a cell that R cuts, or beyond the run's end, the last sample's cone reaches
         :math:`u_i + L r` (r the reach left). Per cell or cut cell the smaller of f's bound
-        and the terms' (:meth:`cone`'s sum), the largest over the cells; at least f_k."""
-        at, a, b, x = self._at, int(self.first[k]), int(self.last[k]), self._at[k]
+        and the terms' (:meth:`cone`'s sum), the largest over the cells; at least f_k.
+
+        Args:
+            k: The start's sample.
+            reach: R >= 0.
+            compiled: By ``ckernels.start_bound`` (``csrc/start_bounds.c``, the same
+                operations); False: numpy, the reference it is tested against.
+        """
+        a, b = int(self.first[k]), int(self.last[k])
+        if compiled:
+            numbers = (self._groups, self._weights, self._caps)
+            return ckernels.start_bound(self.psi, self._values, self._slopes, *numbers, int(k), a, b, reach)
+        at, x = self._at, self._at[k]
         lo = bisect.bisect_left(at, x - reach, a, b + 1)  # the samples within reach: lo..hi
         hi = bisect.bisect_right(at, x + reach, a, b + 1) - 1
         cells = np.arange(lo - 1 if lo > a else lo, hi + 1 if hi < b else hi)  # whole and cut
