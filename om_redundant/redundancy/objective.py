@@ -261,6 +261,23 @@ class Objective:
         groups = [self._margin(q, jacobian)] if len(self._limited) else []
         return groups + ([self._clearance(q, jacobian, pairs)] if self.clearance is not None else [])
 
+    def pairs(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        """The clearance's pair distances at q and the gradients that :meth:`groups` and
+        :meth:`pieces` read: those of the pairs within :attr:`clearance_reach` where one is,
+        else all (:meth:`Clearance.distances_and_gradients
+        <om_redundant.Clearance.distances_and_gradients>` with ``near``); None without
+        obstacles.
+
+        Args:
+            q: (dof,) joint vector, or (M, dof) rows.
+
+        Returns:
+            (P,) distances and (P, dof) gradients, or (M, P) and (M, P, dof); or None.
+        """
+        if self.clearance is None:
+            return None
+        return self.clearance.distances_and_gradients(q, near=self.clearance_reach)
+
     def evaluate(self, q: np.ndarray, distances: np.ndarray | None = None) -> Evaluation:
         """f(q), M(q), D(q), the feasibility slack and S(q): each group's minimum
         (the smallest of its pieces, :meth:`groups`) capped and weighted, summed in the
