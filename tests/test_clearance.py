@@ -177,6 +177,17 @@ def test_gradients_near_are_the_full_ones_where_the_objective_reads_them(name):
         *arm_args, Q, *geoms, clearance.distmax, math.inf, left, np.empty((*every.shape, 6)), None, False
     )
     assert np.isnan(left).any()
+    model, data = clearance.model, mujoco.MjData(clearance.model)
+    for q, dist, row in zip(Q, every, left, strict=True):  # MuJoCo's pairs as mj_kinematics places the arm
+        if not np.isnan(row).any():
+            continue
+        data.qpos[:] = q
+        mujoco.mj_kinematics(model, data)
+        for k in np.flatnonzero(np.isnan(row)).tolist():
+            ab = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, g) for g in clearance.pairs[k]]
+            assert dist[k] == pytest.approx(
+                mujoco.mj_geomDistance(model, data, *ab, clearance.distmax, None), abs=1e-12
+            )
     for near in (0.05, 0.2, 0.5):
         d, grad = clearance.distances_and_gradients(Q, near)
         np.testing.assert_array_equal(d, every)
