@@ -215,8 +215,8 @@ def test_a_model_whose_links_are_not_the_arms_is_refused(panda):
 
 
 def test_the_kernel_refuses_arrays_of_other_sizes(panda):
-    """ckernels.arm_clearance checks every array's size against the others: a ValueError, never
-    a read past an end."""
+    """ckernels.arm_clearance and arm_geom_poses check every array's size against the others: a
+    ValueError, never a read past an end."""
     clearance = om.Clearance.for_arm(panda.arm, [om.Sphere([0.4, 0.1, 0.5], 0.05)])
     arm, geoms = clearance._arguments
     q, n_pairs = np.zeros(7), len(clearance.pairs)
@@ -232,3 +232,10 @@ def test_the_kernel_refuses_arrays_of_other_sizes(panda):
             ckernels.arm_clearance(*a, x, *g, 1.0, math.inf, dist, fromto, grad, False)
     with pytest.raises(ValueError, match="disagree"):
         ckernels.arm_clearance(*arm, q, *geoms, 1.0, math.inf, dist[:-1], fromto, grad, False)
+    # arm_geom_poses: A poses for each of the M rows of q
+    rows, n_arm = np.zeros((3, 7)), len(clearance.arm_geoms)
+    ckernels.arm_geom_poses(*arm, rows, np.empty((3, n_arm, 3)), np.empty((3, n_arm, 9)))
+    with pytest.raises(ValueError, match="poses per joint vector"):
+        ckernels.arm_geom_poses(*arm, rows, np.empty((2, n_arm, 3)), np.empty((3, n_arm, 9)))
+    with pytest.raises(ValueError, match="poses per joint vector"):
+        ckernels.arm_geom_poses(*arm, rows, np.empty((3, n_arm, 3)), np.empty((3, n_arm - 1, 9)))
