@@ -180,14 +180,20 @@ static long distances(const int64_t *kind, const double *radius, const double *h
 }
 
 /* The gradient over the dof joints of each pair's distance (zero where capped at reach, 0 or
- * left to MuJoCo); the first link[a] joints move arm geom a, the first of the pair. */
+ * left to MuJoCo, and, where some pair of the row is nearer than `near`, for the pairs at
+ * `near` or farther: what the objective does not read); the first link[a] joints move arm
+ * geom a, the first of the pair. */
 static void gradients(const double *dist, const double *fromto, const int64_t *pairs, const int64_t *link,
-                      const double *frames, const uint8_t *slide, Py_ssize_t P, int dof, double reach, double *grad) {
+                      const double *frames, const uint8_t *slide, Py_ssize_t P, int dof, double reach, double near,
+                      double *grad) {
+    double least = INFINITY;
+    for (Py_ssize_t k = 0; k < P; k++) least = fmin(least, dist[k]);
+    if (!(least < near)) near = INFINITY;
     for (Py_ssize_t k = 0; k < P; k++) {
         double *row = grad + k * dof;
         const double *p = fromto + 6 * k;
         memset(row, 0, dof * sizeof(double));
-        if (!(dist[k] < reach && dist[k] != 0.0)) continue;
+        if (!(dist[k] < reach && dist[k] != 0.0 && dist[k] < near)) continue;
         double nk[3] = {(p[3] - p[0]) / dist[k], (p[4] - p[1]) / dist[k], (p[5] - p[2]) / dist[k]};
         for (int j = 0; j < link[pairs[2 * k]]; j++) {
             const double *F = frames + 12 * j;
@@ -224,8 +230,8 @@ static int check_arm(Py_buffer *v, Py_ssize_t A, Py_ssize_t *M, int *dof, const 
     return 0;
 }
 
-/* arm_geom_poses(table, start, link, offset, slide, q, xpos, xmat): the world poses (A, 3) and
- * (A, 3, 3) of the arm's A geoms at the joint vector q. */
+/* arm_geom_poses(table, start, link, offset, slide, q, xpos, xmat): the world poses (M, A, 3) and
+ * (M, A, 3, 3) of the arm's A geoms at each of the M rows of q (M, dof). */
 static PyObject *om_arm_geom_poses(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
     if (check_nargs(nargs, N_ARM + 1, "arm_geom_poses") < 0) return NULL;
     Py_buffer v[N_ARM + 1];
@@ -235,32 +241,36 @@ static PyObject *om_arm_geom_poses(PyObject *mod, PyObject *const *args, Py_ssiz
     if (get_buffers(args, v, sp, N_ARM + 1) < 0) return NULL;
     Py_ssize_t A = v[2].len / 8, M;
     int dof;
-    if (check_arm(v, A, &M, &dof, "arm_geom_poses") < 0 || M != 1 || v[6].len != A * 24 || v[7].len != A * 72) {
-        if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "arm_geom_poses: one joint vector, A poses");
+    if (check_arm(v, A, &M, &dof, "arm_geom_poses") < 0 || v[6].len != M * A * 24 || v[7].len != M * A * 72) {
+        if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "arm_geom_poses: A poses per joint vector");
         release_buffers(v, N_ARM + 1);
         return NULL;
     }
-    double frames[12 * (OM_MAX_DOF + 1)];
-    link_frames(v[0].buf, (int)(v[0].len / 48), v[1].buf, v[5].buf, frames);
-    place(frames, v[2].buf, v[3].buf, A, v[6].buf, v[7].buf);
+    double frames[12 * (OM_MAX_DOF + 1)], *xpos = v[6].buf, *xmat = v[7].buf;
+    const double *q = v[5].buf;
+    for (Py_ssize_t m = 0; m < M; m++) {
+        link_frames(v[0].buf, (int)(v[0].len / 48), v[1].buf, q + m * dof, frames);
+        place(frames, v[2].buf, v[3].buf, A, xpos + 3 * A * m, xmat + 9 * A * m);
+    }
     release_buffers(v, N_ARM + 1);
     Py_RETURN_NONE;
 }
 
 /* arm_clearance(table, start, link, offset, slide, q, obstacle_pos, obstacle_mat, kind, radius,
- * half, pairs, bounds, reach, dist, fromto, grad, given) -> left: the geoms are the arm's A and
+ * half, pairs, bounds, reach, near, dist, fromto, grad, given) -> left: the geoms are the arm's A and
  * the O obstacles (poses (O, 3) and (O, 9)), G = A + O; for each row m of q (M, dof), the arm's
  * geoms placed (in this call's own work array: calls may run in parallel), each pair's
  * distance (M, P) capped at reach and nearest points (M, P, 6) (nan: the `left` pairs MuJoCo
- * must compute), and unless grad is None their gradients (M, P, dof). given true: dist and
+ * must compute), and unless grad is None their gradients (M, P, dof), in a row with a pair
+ * nearer than `near` only those of the pairs nearer than it (the others 0). given true: dist and
  * fromto are read, not written, for the gradients of pairs MuJoCo computed. Pairs (P, 2) index
  * the geoms, an arm geom first. */
 static PyObject *om_arm_clearance(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
     enum { N = N_ARM + 9 }; /* buffers: the arm's, obstacle_mat ... bounds, dist, fromto, grad */
-    if (check_nargs(nargs, 18, "arm_clearance") < 0) return NULL;
-    double reach = PyFloat_AsDouble(args[13]);
-    if (reach == -1.0 && PyErr_Occurred()) return NULL;
-    int given = PyObject_IsTrue(args[17]), with_grad = args[16] != Py_None;
+    if (check_nargs(nargs, 19, "arm_clearance") < 0) return NULL;
+    double reach = PyFloat_AsDouble(args[13]), near = PyFloat_AsDouble(args[14]);
+    if (PyErr_Occurred()) return NULL;
+    int given = PyObject_IsTrue(args[18]), with_grad = args[17] != Py_None;
     if (given < 0) return NULL;
     if (given && !with_grad) {
         PyErr_SetString(PyExc_ValueError, "arm_clearance: given distances need grad");
@@ -276,7 +286,7 @@ static PyObject *om_arm_clearance(PyObject *mod, PyObject *const *args, Py_ssize
         {F64, -1, !given, "dist"}, {F64, -1, !given, "fromto"}, {F64, -1, 1, "grad"}};
     memcpy(sp + N_ARM, rest, sizeof rest);
     PyObject *const objs[N] = {args[0],  args[1],  args[2],  args[3],  args[4],  args[5],  args[6], args[7],
-                               args[8],  args[9],  args[10], args[11], args[12], args[14], args[15], args[16]};
+                               args[8],  args[9],  args[10], args[11], args[12], args[15], args[16], args[17]};
     int n_views = with_grad ? N : N - 1;
     if (get_buffers(objs, v, sp, n_views) < 0) return NULL;
     Py_ssize_t A = v[2].len / 8, G = v[8].len / 8, P = v[12].len / 8, M;
@@ -316,7 +326,7 @@ static PyObject *om_arm_clearance(PyObject *mod, PyObject *const *args, Py_ssize
             place(frames, link, offset, A, xpos, xmat);
             left += distances(kind, radius, half, xpos, xmat, pairs, bounds, P, reach, d, ft);
         }
-        if (grad) gradients(d, ft, pairs, link, frames, slide, P, dof, reach, grad + m * P * dof);
+        if (grad) gradients(d, ft, pairs, link, frames, slide, P, dof, reach, near, grad + m * P * dof);
     }
     Py_END_ALLOW_THREADS PyMem_RawFree(xpos);
     release_buffers(v, n_views);
@@ -328,6 +338,6 @@ PyMethodDef om_clearance_functions[] = {
      "arm_geom_poses(table, start, link, offset, slide, q, xpos, xmat)"},
     {"arm_clearance", (PyCFunction)(void (*)(void))om_arm_clearance, METH_FASTCALL,
      "arm_clearance(table, start, link, offset, slide, q, obstacle_pos, obstacle_mat, kind, radius, half, pairs, "
-     "bounds, reach, dist, fromto, grad, given) -> pairs left to MuJoCo"},
+     "bounds, reach, near, dist, fromto, grad, given) -> pairs left to MuJoCo"},
     {NULL, NULL, 0, NULL},
 };

@@ -5,6 +5,8 @@ against finite differences."""
 
 from __future__ import annotations
 
+import math
+
 import mujoco
 import numpy as np
 import pytest
@@ -158,6 +160,51 @@ def test_gradients_are_finite_differences_on_every_arm(name):
     assert (D < 0.0).any() and (D > 0.0).any()  # overlapping pairs and pairs apart both checked
 
 
+@pytest.mark.parametrize("name", SHIPPED)
+def test_gradients_near_are_the_full_ones_where_the_objective_reads_them(name):
+    """distances_and_gradients(q, near): the same distances, and in a row with a pair nearer
+    than near the gradients of those pairs (the others zero), else all; also in the rows
+    whose pairs MuJoCo computed (the overlapping sphere and the box touched). The arm geoms'
+    poses of many rows in one ckernels.arm_geom_poses call are each row's."""
+    arm = om.load_arm(name)
+    clearance = mounted(arm)
+    rng = np.random.default_rng(3)
+    Q = np.vstack([within_limits(arm, rng, 25), rng.uniform(-0.1, 0.1, (5, arm.dof))])
+    every, full = clearance.distances_and_gradients(Q)
+    arm_args, geoms = clearance._arguments
+    left = np.empty(every.shape)  # which pairs the kernel leaves to MuJoCo
+    ckernels.arm_clearance(
+        *arm_args, Q, *geoms, clearance.distmax, math.inf, left, np.empty((*every.shape, 6)), None, False
+    )
+    assert np.isnan(left).any()
+    model, data = clearance.model, mujoco.MjData(clearance.model)
+    for q, dist, row in zip(Q, every, left, strict=True):  # MuJoCo's pairs as mj_kinematics places the arm
+        if not np.isnan(row).any():
+            continue
+        data.qpos[:] = q
+        mujoco.mj_kinematics(model, data)
+        for k in np.flatnonzero(np.isnan(row)).tolist():
+            ab = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, g) for g in clearance.pairs[k]]
+            assert dist[k] == pytest.approx(
+                mujoco.mj_geomDistance(model, data, *ab, clearance.distmax, None), abs=1e-12
+            )
+    for near in (0.05, 0.2, 0.5):
+        d, grad = clearance.distances_and_gradients(Q, near)
+        np.testing.assert_array_equal(d, every)
+        read = (every < near) | (every.min(axis=1) >= near)[:, None]
+        assert read.any() and not read.all()
+        np.testing.assert_array_equal(grad, np.where(read[..., None], full, 0.0))
+    xpos, xmat = (
+        np.empty((len(Q), len(clearance.arm_geoms), 3)),
+        np.empty((len(Q), len(clearance.arm_geoms), 9)),
+    )
+    ckernels.arm_geom_poses(*arm_args, Q, xpos, xmat)
+    for q, x, m in zip(Q, xpos, xmat, strict=True):
+        single = clearance.geom_poses(q)
+        np.testing.assert_array_equal(x, single[0])
+        np.testing.assert_array_equal(m, single[1].reshape(-1, 9))
+
+
 def test_a_model_whose_links_are_not_the_arms_is_refused(panda):
     """A link moved by 1 cm in the model: the geoms do not move like the arm's chain."""
     spec = mujoco.MjSpec.from_string(om.arm_mjcf(panda.arm))
@@ -168,13 +215,13 @@ def test_a_model_whose_links_are_not_the_arms_is_refused(panda):
 
 
 def test_the_kernel_refuses_arrays_of_other_sizes(panda):
-    """ckernels.arm_clearance checks every array's size against the others: a ValueError, never
-    a read past an end."""
+    """ckernels.arm_clearance and arm_geom_poses check every array's size against the others: a
+    ValueError, never a read past an end."""
     clearance = om.Clearance.for_arm(panda.arm, [om.Sphere([0.4, 0.1, 0.5], 0.05)])
     arm, geoms = clearance._arguments
     q, n_pairs = np.zeros(7), len(clearance.pairs)
     dist, fromto, grad = np.empty(n_pairs), np.empty((n_pairs, 6)), np.empty((n_pairs, 7))
-    assert ckernels.arm_clearance(*arm, q, *geoms, 1.0, dist, fromto, grad, False) == 0
+    assert ckernels.arm_clearance(*arm, q, *geoms, 1.0, math.inf, dist, fromto, grad, False) == 0
     short = [
         (arm, q[:6], geoms),
         (arm, q, (geoms[0][:0], *geoms[1:])),
@@ -182,6 +229,13 @@ def test_the_kernel_refuses_arrays_of_other_sizes(panda):
     ]
     for a, x, g in short:
         with pytest.raises(ValueError, match="disagree"):
-            ckernels.arm_clearance(*a, x, *g, 1.0, dist, fromto, grad, False)
+            ckernels.arm_clearance(*a, x, *g, 1.0, math.inf, dist, fromto, grad, False)
     with pytest.raises(ValueError, match="disagree"):
-        ckernels.arm_clearance(*arm, q, *geoms, 1.0, dist[:-1], fromto, grad, False)
+        ckernels.arm_clearance(*arm, q, *geoms, 1.0, math.inf, dist[:-1], fromto, grad, False)
+    # arm_geom_poses: A poses for each of the M rows of q
+    rows, n_arm = np.zeros((3, 7)), len(clearance.arm_geoms)
+    ckernels.arm_geom_poses(*arm, rows, np.empty((3, n_arm, 3)), np.empty((3, n_arm, 9)))
+    with pytest.raises(ValueError, match="poses per joint vector"):
+        ckernels.arm_geom_poses(*arm, rows, np.empty((2, n_arm, 3)), np.empty((3, n_arm, 9)))
+    with pytest.raises(ValueError, match="poses per joint vector"):
+        ckernels.arm_geom_poses(*arm, rows, np.empty((3, n_arm, 3)), np.empty((3, n_arm - 1, 9)))

@@ -113,6 +113,12 @@ def test_batched_pieces_and_points_equal_the_single_ones(seed, name, count):
         assert point.evaluation == alone.evaluation
         for batched, single in zip(point.pieces(), alone.pieces(), strict=True):
             np.testing.assert_array_equal(batched, single)
+        # the groups from the pairs' gradients the batch computed (objective.pairs: the near
+        # pairs' only) are those computed afresh
+        fresh = [g.along(point.tangent) for g in objective.groups(point.q, jacobian=True)]
+        for batched, single in zip(point.groups, fresh, strict=True):
+            np.testing.assert_array_equal(batched.values, single.values)
+            np.testing.assert_array_equal(batched.jacobian, single.jacobian)
 
 
 @settings(max_examples=40, deadline=None)

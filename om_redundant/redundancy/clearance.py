@@ -42,6 +42,7 @@ gripper's) stay at ``qpos0``.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from typing import NamedTuple
 
@@ -112,18 +113,20 @@ class Clearance:
         for o in obstacles:
             if moving[model.geom_bodyid[o]]:
                 raise InvalidInput(f"obstacle geom '{model.geom(o).name}' moves with the arm")
-        # the model's geom ids of each pair (arm geom, obstacle), for mj_geomDistance
-        self._pairs = np.array([(a, o) for a in arm_geoms for o in obstacles], dtype=np.int64).reshape(-1, 2)
+        # the model's geom ids of each pair (arm geom, obstacle) and the arm geom's index, for
+        # mj_geomDistance
+        self._pair_geoms = [(a, o, i) for i, a in enumerate(arm_geoms) for o in obstacles]
         self._arm_ids = np.array(arm_geoms, dtype=np.int64)
         self._data = mujoco.MjData(model)  # at qpos0, placed: the obstacles and mj_geomDistance's scratch
         mujoco.mj_kinematics(model, self._data)
+        self._placed = (self._data.geom_xpos, self._data.geom_xmat)  # (views of the data's arrays)
         self._cores = _arm_cores(model, self._data, joints, arm_geoms, obstacles)
         # arm_clearance's arguments before and after q
-        self._arguments, self._n_pairs = (self._cores[:5], self._cores[5:]), len(self._pairs)
+        self._arguments, self._n_pairs = (self._cores[:5], self._cores[5:]), len(self._pair_geoms)
         self.arm_geoms: tuple[str, ...] = tuple(model.geom(g).name for g in arm_geoms)
         _check_placement(self, joints)
         self.pairs: tuple[tuple[str, str], ...] = tuple(
-            (model.geom(a).name, model.geom(o).name) for a, o in self._pairs
+            (model.geom(a).name, model.geom(o).name) for a, o, _ in self._pair_geoms
         )
 
     @classmethod
@@ -165,11 +168,19 @@ class Clearance:
         """The clearance D(q) = min_k d_k(q) in metres."""
         return float(self.distances(q).min())
 
-    def distances_and_gradients(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def distances_and_gradients(self, q: np.ndarray, near: float = math.inf) -> tuple[np.ndarray, np.ndarray]:
         """d_k(q) and their gradients dd_k/dq (module docstring): (P,) and (P, dof) for a
         joint vector q (dof,), (M, P) and (M, P, dof) for the rows of q (M, dof), all rows
-        in one ``ckernels.arm_clearance`` call."""
-        return self._evaluate(q, self.distmax, gradient=True)
+        in one ``ckernels.arm_clearance`` call.
+
+        Args:
+            q: (dof,) joint vector, or (M, dof) rows.
+            near: Where a pair of a row is nearer than this (m), only the gradients of the
+                pairs nearer than it, the others zero (the objective reads no more:
+                :attr:`Objective.clearance_reach
+                <om_redundant.redundancy.objective.Objective.clearance_reach>`); all by default.
+        """
+        return self._evaluate(q, self.distmax, gradient=True, near=near)
 
     def distances_within(
         self, q: np.ndarray, reach: float, gradient: bool = False
@@ -217,8 +228,11 @@ class Clearance:
         ckernels.arm_geom_poses(*self._arguments[0], q, xpos, xmat)
         return xpos, xmat.reshape(-1, 3, 3)
 
-    def _evaluate(self, q: np.ndarray, reach: float, gradient: bool) -> tuple[np.ndarray, np.ndarray | None]:
-        """Distances capped at reach and, if asked (else None), their gradients at a joint
+    def _evaluate(
+        self, q: np.ndarray, reach: float, gradient: bool, near: float = math.inf
+    ) -> tuple[np.ndarray, np.ndarray | None]:
+        """Distances capped at reach and, if asked (else None), their gradients (only the
+        pairs nearer than ``near`` where one is: :meth:`distances_and_gradients`) at a joint
         vector or the rows of q: one ``ckernels.arm_clearance`` call, then
         ``mj_geomDistance`` for the pairs it leaves (:meth:`_by_mujoco`)."""
         q = as_joint_vector(q, self._dof)
@@ -226,28 +240,41 @@ class Clearance:
         dist, fromto = np.empty(shape), np.empty((*shape, 6))
         grad = np.empty((*shape, self._dof)) if gradient else None
         arm, geoms = self._arguments
-        if ckernels.arm_clearance(*arm, q, *geoms, reach, dist, fromto, grad, False):
-            self._by_mujoco(q.reshape(-1, self._dof), reach, dist.reshape(-1, self._n_pairs), fromto, grad)
+        if ckernels.arm_clearance(*arm, q, *geoms, reach, near, dist, fromto, grad, False):
+            self._by_mujoco(
+                q.reshape(-1, self._dof), reach, near, dist.reshape(-1, self._n_pairs), fromto, grad
+            )
         return dist, grad
 
     def _by_mujoco(
-        self, q: np.ndarray, reach: float, dist: np.ndarray, fromto: np.ndarray, grad: np.ndarray | None
+        self,
+        q: np.ndarray,
+        reach: float,
+        near: float,
+        dist: np.ndarray,
+        fromto: np.ndarray,
+        grad: np.ndarray | None,
     ) -> None:
         """The pairs ``ckernels.arm_clearance`` left (nan: kinds it does not compute, cores
         touching, boxes touched) by ``mj_geomDistance``, the arm geoms placed as it places
-        them, and those rows' gradients."""
+        them (all those rows' in one call), and those rows' gradients (in one call)."""
         m, d, n_pairs = self.model, self._data, self._n_pairs
         fromto = fromto.reshape(-1, n_pairs, 6)
-        grad = None if grad is None else grad.reshape(-1, n_pairs, self._dof)
-        for row in np.flatnonzero(np.isnan(dist).any(axis=1)).tolist():
-            xpos, xmat = self.geom_poses(q[row])
-            d.geom_xpos[self._arm_ids], d.geom_xmat[self._arm_ids] = xpos, xmat.reshape(-1, 9)
-            for k in np.flatnonzero(np.isnan(dist[row])).tolist():
-                a, o = self._pairs[k].tolist()
-                dist[row, k] = mujoco.mj_geomDistance(m, d, a, o, reach, fromto[row, k])
-            if grad is not None:
-                arm, geoms = self._arguments
-                ckernels.arm_clearance(*arm, q[row], *geoms, reach, dist[row], fromto[row], grad[row], True)
+        left = np.isnan(dist)
+        rows = np.flatnonzero(left.any(axis=1))
+        arm, geoms = self._arguments
+        n_arm = len(self._arm_ids)
+        xpos, xmat = np.empty((len(rows), n_arm, 3)), np.empty((len(rows), n_arm, 9))
+        ckernels.arm_geom_poses(*arm, q[rows], xpos, xmat)
+        at, placed = rows.tolist(), self._placed
+        for r, k in np.argwhere(left[rows]).tolist():  # (only the pair's arm geom placed: the one read)
+            a, o, i = self._pair_geoms[k]
+            placed[0][a], placed[1][a] = xpos[r, i], xmat[r, i]
+            dist[at[r], k] = mujoco.mj_geomDistance(m, d, a, o, reach, fromto[at[r], k])
+        if grad is not None:
+            given = np.empty((len(rows), n_pairs, self._dof))
+            ckernels.arm_clearance(*arm, q[rows], *geoms, reach, near, dist[rows], fromto[rows], given, True)
+            grad.reshape(-1, n_pairs, self._dof)[rows] = given
 
 
 class ArmCores(NamedTuple):

@@ -52,9 +52,10 @@ class _Terms:
         self.pairs, self.groups, self.pieces = None, None, None
 
     def get_pairs(self) -> tuple[np.ndarray, np.ndarray] | None:
-        """The clearance's pair distances and gradients at q; None without obstacles."""
+        """The clearance's pair distances and gradients at q (:meth:`Objective.pairs`); None
+        without obstacles."""
         if self.pairs is None and self.objective.clearance is not None:
-            self.pairs = self.objective.clearance.distances_and_gradients(self.q)
+            self.pairs = self.objective.pairs(self.q)
         return self.pairs
 
     @cached_property
@@ -83,16 +84,25 @@ def evaluate_points(objective: Objective, points: list[Point]) -> None:
     point)."""
     # (not yet evaluated: the cached property's value not yet in the terms' __dict__)
     terms = list({id(p.terms): p.terms for p in points if "evaluation" not in vars(p.terms)}.values())
-    if not terms:
-        return
-    q, tangents = np.array([t.q for t in terms]), np.array([t.tangent for t in terms])
-    clearance = objective.clearance
-    pairs = None if clearance is None else clearance.distances_and_gradients(q)
+    if terms:
+        _evaluate_terms(
+            objective, terms, np.array([t.q for t in terms]), np.array([t.tangent for t in terms])
+        )
+
+
+def _evaluate_terms(objective: Objective, terms: list[_Terms], q: np.ndarray, tangents: np.ndarray) -> None:
+    """:func:`evaluate_points` of distinct terms not yet evaluated, their joints q (M, dof)
+    and tangents (M, dof, 1) stacked."""
+    pairs = objective.pairs(q)
     evaluations = objective.evaluations(q, None if pairs is None else pairs[0])
     g, dg = objective.pieces(q, tangents, pairs)
-    for k, (t, ev) in enumerate(zip(terms, evaluations, strict=True)):
-        t.pairs = None if pairs is None else (pairs[0][k], pairs[1][k])
-        t.evaluation, t.pieces = ev, (g[k], dg[k])
+    rows = zip(terms, evaluations, g, dg, strict=True)
+    if pairs is None:
+        for t, ev, gk, dgk in rows:
+            t.evaluation, t.pieces = ev, (gk, dgk)
+        return
+    for (t, ev, gk, dgk), dk, gradk in zip(rows, *pairs, strict=True):
+        t.evaluation, t.pieces, t.pairs = ev, (gk, dgk), (dk, gradk)
 
 
 @dataclass(frozen=True, eq=False)
@@ -206,10 +216,9 @@ class Probe:
         bad = ~np.isfinite(tangents).all(axis=(1, 2))
         if bad.any():
             self_motion_tangent(self.solver, q[np.argmax(bad)])  # raises SingularSelfMotion
-        rows = zip(psi.tolist(), q, tangents, strict=True)
-        points = [Point(x, row, t, _Terms(self.objective, row, t)) for x, row, t in rows]
-        evaluate_points(self.objective, points)
-        return points
+        terms = [_Terms(self.objective, row, t) for row, t in zip(q, tangents, strict=True)]
+        _evaluate_terms(self.objective, terms, q, tangents)
+        return [Point(x, t.q, t.tangent, t) for x, t in zip(psi.tolist(), terms, strict=True)]
 
     def at(self, psi: float | np.ndarray, hint: np.ndarray) -> Point | None:
         """The solution at psi nearest ``hint``, if there is one."""
