@@ -280,7 +280,7 @@ def test_the_bindings_refuse_indices_out_of_range(panda):
 
     def clear(link, pairs):
         ckernels.arm_clearance(
-            *arm[:2], link, *arm[3:], q, *geoms[:5], pairs, geoms[6], 1.0, dist, fromto, grad, False
+            *arm[:2], link, *arm[3:], q, *geoms[:5], pairs, geoms[6], 1.0, 1.0, dist, fromto, grad, False
         )
 
     def index(k):
