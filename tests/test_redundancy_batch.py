@@ -280,7 +280,7 @@ def test_the_climbs_start_bounds_hold_for_functions_within_their_slopes(seed, ru
     np.testing.assert_array_equal(_StartBounds(psi, f, terms, first, last)._slopes, sampled)  # (L sampled)
     assert (
         np.array(sampled) <= np.concatenate([[slope], *slopes]) + 1e-9
-    ).all()  # (no terms: f's bound capped at 0)
+    ).all()  # (the fixture's own bounds hold)
     for k, (x, r, f_k) in enumerate(zip(psi, reach, f, strict=True)):
         bound = bounds.within(k, r)
         assert bound == bounds.within(k, r, compiled=False)  # (numpy's, the reference)

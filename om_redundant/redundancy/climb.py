@@ -68,7 +68,6 @@ def qp_step(
     curvature: np.ndarray,
     lower: np.ndarray,
     upper: np.ndarray,
-    pieces: Pieces | None = None,
 ) -> _Step | None:
     """Solve the climb's QP (module docstring) for the step delta.
 
@@ -79,8 +78,6 @@ def qp_step(
         groups: Groups with jacobians (p_g, r) by the redundancy variables.
         curvature: B (r, r), positive definite.
         lower, upper: (r,) bounds of delta (trust region and interval), lower <= 0 <= upper.
-        pieces: With one variable, the groups' pieces if already concatenated
-            (``Pieces.of(groups)``: a climb's QPs at one point share them).
 
     Returns:
         The step, or None when the QP has no solution or OSQP returns no iterate. With one
@@ -91,7 +88,7 @@ def qp_step(
     """
     r = len(lower)
     if r == 1:
-        pieces = Pieces.of(groups) if pieces is None else pieces
+        pieces = Pieces.of(groups)
         found = step_1d(pieces, float(curvature[0, 0]), float(lower[0]), float(upper[0]))
         if found is None:
             return None
@@ -219,13 +216,12 @@ def maximise(
         return _maximise_1d(probe, start, lower, upper, radius)
     point, x = start, np.atleast_1d(start.psi).astype(float)
     B = _INITIAL_CURVATURE * np.eye(len(x))
-    pieces = Pieces.of(point.groups) if len(x) == 1 else None  # (the point's, for its QPs)
     for _ in range(_MAX_CLIMB):
         radius = min(radius, _JOINT_STEP / max(float(np.abs(point.tangent).sum(axis=1).max()), 1e-12))
         if radius <= STEP_TOLERANCE:
             break
         lo = np.minimum(np.maximum(lower - x, -radius), 0.0)
-        step = qp_step(point.groups, B, lo, np.maximum(np.minimum(upper - x, radius), 0.0), pieces)
+        step = qp_step(point.groups, B, lo, np.maximum(np.minimum(upper - x, radius), 0.0))
         if step is None or np.abs(step.delta).max() <= STEP_TOLERANCE or step.gain <= GAIN_TOLERANCE:
             break
         size = np.abs(step.delta).max()
@@ -242,7 +238,6 @@ def maximise(
         if gain > 0.75 * step.gain and size >= 0.9 * radius:
             radius *= 2.0
         point, x = trial, x + step.delta
-        pieces = pieces if pieces is None else pieces.at(point.groups)
     return replace(point, psi=_angle(x))
 
 

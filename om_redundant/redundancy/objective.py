@@ -156,8 +156,9 @@ class Group:
 
 
 class Evaluation(NamedTuple):
-    """The objective at one joint vector (a named tuple: the sweep builds one per sample, and
-    a tuple is built several times faster than a frozen dataclass).
+    """The objective at one joint vector (a named tuple: the path sweep,
+    ``paths.sweep_circle``, builds one per sample, and a tuple is built several times faster
+    than a frozen dataclass).
 
     Attributes:
         value: f(q).
@@ -378,8 +379,9 @@ class Objective:
         """The clearance pieces d_k / d_cap, computed only for the pairs within 2 d_cap (the
         others report 2 with zero gradient: beyond the cap they change neither the term,
         the slack's minimum nor, far above the floor, a feasibility model); all of them
-        exactly when no pair is that near, so that D(q) is exact. From ``pairs`` (every
-        pair's distance and gradient) the same pieces, capped here."""
+        exactly when no pair is that near, so that D(q) is exact. From ``pairs`` (the pairs'
+        distances and gradients, every gradient or only the near ones': :meth:`pairs`) the
+        same pieces, capped here."""
         floor, cap, reach = self.min_clearance / self.clearance_cap, self.clearance_cap, self.clearance_reach
         if pairs is not None:
             d, grad = pairs

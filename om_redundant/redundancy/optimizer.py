@@ -291,7 +291,7 @@ class RedundancyOptimizer:
         where it was instead of jumping to whichever sample rounding favours, farther than
         the joints can follow in one tick.
         """
-        # every run's samples at once; the slopes between neighbours of one run only
+        # every run's samples at once (their slope bounds: _StartBounds)
         points = [p for run in runs for p in run.points]
         owner = np.repeat(np.arange(len(runs)), [len(run.points) for run in runs])
         first = np.flatnonzero(np.diff(owner, prepend=-1))  # each run's first sample
@@ -402,7 +402,7 @@ class _StartBounds:
         slopes: list[np.ndarray] | None = None,
     ):
         # f and every group's functions as the columns of one array, their slope bounds L
-        self.psi, self.first, self.last, self._at = psi, first, last, psi.tolist()
+        self.psi, self.first, self.last = psi, first, last
         self._values = np.ascontiguousarray(
             np.hstack([f[:, None]] + [v for _, _, v in terms])
         )  # (row by row)
@@ -441,7 +441,8 @@ class _StartBounds:
         if compiled:
             numbers = (self._groups, self._weights, self._caps)
             return ckernels.start_bound(self.psi, self._values, self._slopes, *numbers, int(k), a, b, reach)
-        at, x = self._at, self._at[k]
+        at = self.psi.tolist()
+        x = at[k]
         lo = bisect.bisect_left(at, x - reach, a, b + 1)  # the samples within reach: lo..hi
         hi = bisect.bisect_right(at, x + reach, a, b + 1) - 1
         cells = np.arange(lo - 1 if lo > a else lo, hi + 1 if hi < b else hi)  # whole and cut

@@ -96,13 +96,9 @@ def _evaluate_terms(objective: Objective, terms: list[_Terms], q: np.ndarray, ta
     pairs = objective.pairs(q)
     evaluations = objective.evaluations(q, None if pairs is None else pairs[0])
     g, dg = objective.pieces(q, tangents, pairs)
-    rows = zip(terms, evaluations, g, dg, strict=True)
-    if pairs is None:
-        for t, ev, gk, dgk in rows:
-            t.evaluation, t.pieces = ev, (gk, dgk)
-        return
-    for (t, ev, gk, dgk), dk, gradk in zip(rows, *pairs, strict=True):
-        t.evaluation, t.pieces, t.pairs = ev, (gk, dgk), (dk, gradk)
+    per_row = [None] * len(terms) if pairs is None else zip(*pairs, strict=True)  # each row's (d, grad)
+    for t, ev, gk, dgk, pk in zip(terms, evaluations, g, dg, per_row, strict=True):
+        t.evaluation, t.pieces, t.pairs = ev, (gk, dgk), pk
 
 
 @dataclass(frozen=True, eq=False)
