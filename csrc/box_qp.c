@@ -39,14 +39,17 @@ static double rate_at(const qp_groups *q, double x) {
     return slope;
 }
 
+/* Group g's linearised minimum at x: min_j v_j + a_j x. */
+static double group_least(const qp_groups *q, Py_ssize_t g, double x) {
+    double least = INFINITY;
+    for (int64_t j = q->ends[g]; j < q->ends[g + 1]; j++) least = fmin(least, q->v[j] + q->a[j] * x);
+    return least;
+}
+
 /* phi(x). */
 static double phi(const qp_groups *q, double b, double x) {
     double value = -0.5 * b * (x * x);
-    for (Py_ssize_t g = 0; g < q->G; g++) {
-        double least = INFINITY;
-        for (int64_t j = q->ends[g]; j < q->ends[g + 1]; j++) least = fmin(least, q->v[j] + q->a[j] * x);
-        value += q->w[g] * fmin(q->cap[g], least);
-    }
+    for (Py_ssize_t g = 0; g < q->G; g++) value += q->w[g] * fmin(q->cap[g], group_least(q, g, x));
     return value;
 }
 
@@ -63,8 +66,7 @@ static void multipliers(const qp_groups *q, double b, double delta, double *z, P
     }
     rising = falling + (q->G ? q->G : 1);
     for (Py_ssize_t g = 0; g < q->G; g++) {
-        double least = INFINITY;
-        for (int64_t j = q->ends[g]; j < q->ends[g + 1]; j++) least = fmin(least, q->v[j] + q->a[j] * delta);
+        double least = group_least(q, g, delta);
         if (least > q->cap[g] + TIE || q->w[g] == 0.0) continue;
         int64_t first = -1, low = -1, high = -1, count = 0;
         for (int64_t j = q->ends[g]; j < q->ends[g + 1]; j++) {
@@ -154,11 +156,7 @@ static int solve(const qp_groups *q, double b, double lo, double hi, double *del
  * order (box_qp.py's Pieces.model). */
 static double model(const qp_groups *q, double x) {
     double total = 0.0;
-    for (Py_ssize_t g = 0; g < q->G; g++) {
-        double least = INFINITY;
-        for (int64_t j = q->ends[g]; j < q->ends[g + 1]; j++) least = fmin(least, q->v[j] + q->a[j] * x);
-        total += q->w[g] * fmin(q->cap[g], least);
-    }
+    for (Py_ssize_t g = 0; g < q->G; g++) total += q->w[g] * fmin(q->cap[g], group_least(q, g, x));
     return total;
 }
 
@@ -178,7 +176,7 @@ static int get_groups(PyObject *const *args, Py_ssize_t nargs, const char *what,
     Py_ssize_t n = views[0].len / 8, G = views[3].len / 8;
     *q = (qp_groups){views[0].buf, views[1].buf, views[3].buf, views[4].buf, views[5].buf, views[2].buf, G};
     int bad = views[1].len != n * 8 || views[2].len != (G + 1) * 8 || views[4].len != G * 8 ||
-              views[5].len != G * 8 || views[6].len != n * 8 || (G > 0 && (q->ends[0] != 0 || q->ends[G] != n));
+              views[5].len != G * 8 || views[6].len != n * 8 || q->ends[0] != 0 || q->ends[G] != n;
     for (Py_ssize_t g = 0; g < G && !bad; g++) bad = q->ends[g + 1] <= q->ends[g];
     if (bad) {
         release_buffers(views, 7);

@@ -311,6 +311,14 @@ static vec3 shoulder_wrist(const double *P, const double *trig, mat3 *R03)
     return m_mv(*R03, elbow_vector(P, trig[6], trig[7]));
 }
 
+/* shoulder_wrist at joint vector q. */
+static vec3 shoulder_wrist_at(const double *P, const double *q, mat3 *R03)
+{
+    double trig[8];
+    joint_trig(P, q, trig);
+    return shoulder_wrist(P, trig, R03);
+}
+
 /* psi for R03 and w = W - S, read in the ELBOW branch `elbow`. */
 static double arm_angle_of(const double *P, mat3 R03, vec3 w, double elbow)
 {
@@ -339,27 +347,21 @@ static double line_angle(const double *P, vec3 w, vec3 across)
 /* up x (W - S) of the model at q: zero on psi's singular half-line and on its continuation above. */
 vec3 om_srs_half_line_across(const double *P, const double *q)
 {
-    double trig[8];
     mat3 R03;
-    joint_trig(P, q, trig);
-    return v_cross(v_load(P, SRS_UP), shoulder_wrist(P, trig, &R03));
+    return v_cross(v_load(P, SRS_UP), shoulder_wrist_at(P, q, &R03));
 }
 
 double om_srs_half_line_angle(const double *P, const double *q)
 {
-    double trig[8];
     mat3 R03;
-    joint_trig(P, q, trig);
-    vec3 w = shoulder_wrist(P, trig, &R03);
+    vec3 w = shoulder_wrist_at(P, q, &R03);
     return line_angle(P, w, v_cross(v_load(P, SRS_UP), w));
 }
 
 double om_srs_half_line_psi(const double *P, const double *q, double elbow, vec3 *across, double *angle)
 {
-    double trig[8];
     mat3 R03;
-    joint_trig(P, q, trig);
-    vec3 w = shoulder_wrist(P, trig, &R03);
+    vec3 w = shoulder_wrist_at(P, q, &R03);
     *across = v_cross(v_load(P, SRS_UP), w);
     *angle = line_angle(P, w, *across);
     return arm_angle_of(P, R03, w, elbow);

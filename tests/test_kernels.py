@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import re
 import threading
 
@@ -321,6 +322,48 @@ def test_the_bindings_refuse_indices_out_of_range(panda):
     for call, args, message in refused:
         with pytest.raises(ValueError, match=f"^{re.escape(message)}$"):
             call(*args)
+
+
+def test_the_climb_bindings_refuse_groups_and_indices_out_of_range():
+    """maximise_1d and step_1d read the pieces of each group between its ends: ends that do not
+    start at 0, end at the pieces' count and increase are a ValueError, with no groups too;
+    start_bound reads the samples a..b of its start k: k, a and b out of order or out of
+    range, a group column out of range, or a reach that is not >= 0, are a ValueError."""
+    v, a, z = np.arange(5.0), np.ones(5), np.empty(5)
+    one, none = np.ones(1), np.empty(0)
+
+    def groups(ends, w=one, n=5):
+        for kernel in (ckernels.maximise_1d, ckernels.step_1d):
+            kernel(v[:n], a[:n], np.array(ends, dtype=np.int64), w, -w, w, 1.0, -1.0, 1.0, z[:n])
+
+    groups([0, 5])
+    groups([0], none, 0)
+    for ends, w, n in (([0], none, 5), ([1, 5], one, 5), ([0, 4], one, 5), ([0, 5, 5], np.ones(2), 5)):
+        with pytest.raises(ValueError, match="sizes of the pieces, the groups and z disagree"):
+            groups(ends, w, n)
+
+    psi, values, slopes = np.linspace(0.0, 1.0, 4), np.zeros((4, 3)), np.ones(3)
+
+    def bound(k, first, last, reach=0.5, columns=(1, 2)):
+        group_columns = np.array(columns, dtype=np.int64)
+        weights = np.ones(len(columns))
+        return ckernels.start_bound(
+            psi, values, slopes, group_columns, weights, weights, k, first, last, reach
+        )
+
+    assert all(bound(k, 0, 3) >= values[k, 0] for k in range(4))  # (at least f_k, read at either end)
+    for k, first, last, reach, columns in (
+        (-1, 0, 3, 0.5, (1, 2)),
+        (2, 3, 3, 0.5, (1, 2)),
+        (1, 0, 4, 0.5, (1, 2)),
+        (1, 0, 3, -1.0, (1, 2)),
+        (1, 0, 3, math.nan, (1, 2)),
+        (1, 0, 3, 0.5, (0, 2)),
+        (1, 0, 3, 0.5, (1, 3)),
+        (1, 0, 3, 0.5, (2, 1)),
+    ):
+        with pytest.raises(ValueError, match="start_bound: sizes or indices of the samples disagree"):
+            bound(k, first, last, reach, columns)
 
 
 def test_the_c_layouts_equal_the_python_ones():
