@@ -40,6 +40,18 @@ typedef struct {
     double d;
 } prediction;
 
+/* The prediction's largest joint move, max_i |t_i d|. A root that continues the path
+ * (om_continues) moves each joint by m_i with |m_i| <= moved <= 1 and |m_i - t_i d| <= moved / 2
+ * + 1e-6, so |t_i d| <= 1.5 moved + 1e-6 <= 1.5 + 1e-6: a step whose prediction moves a joint
+ * farther than 1.5 + 2e-6 (1e-6 more for the representatives' rounding) fails whatever the
+ * solve would find, and is not solved (the steps into a fold, where |t| grows without bound). */
+static double farthest(const prediction *p) {
+    double r = 0.0;
+    for (int i = 0; i < p->dof; i++) r = fmax(r, fabs(p->t[i] * p->d));
+    return r;
+}
+#define FARTHEST_CONTINUED (1.5 + 2e-6)
+
 /* What the attempt makes of the local solve's root x (at its representative; om_solve_near's
  * as_is test). Taken without the windowed scan for a nearer root where it lies on the
  * prediction's path beyond doubt (om_beyond_doubt). Rejected, without the scan, where no root at most as far
@@ -51,16 +63,15 @@ typedef struct {
  * none. Else the scan decides. */
 static om_root_verdict on_path(const double *x, void *context) {
     const prediction *p = context;
-    double r[OM_MAX_DOF], d2 = 0.0, farthest = 0.0;
+    double r[OM_MAX_DOF], d2 = 0.0;
     memcpy(r, x, (size_t)p->dof * sizeof(double));
     represent(p->dof, p->centred, p->centre, r);
     if (om_beyond_doubt(p->dof, p->q, r, p->t, p->d, p->cyclic)) return OM_ROOT_TAKE;
     for (int i = 0; i < p->dof; i++) {
         double e = om_wrap_angle(r[i] - p->q[i]);
         d2 += e * e;
-        farthest = fmax(farthest, fabs(p->t[i] * p->d));
     }
-    return farthest > 1.5 * fmin(sqrt(d2), 1.0) + 2e-6 ? OM_ROOT_REJECT : OM_ROOT_SCAN;
+    return farthest(p) > 1.5 * fmin(sqrt(d2), 1.0) + 2e-6 ? OM_ROOT_REJECT : OM_ROOT_SCAN;
 }
 
 /* What ends a path, as functions of its point (q, t) that fall to zero there linearly in psi
@@ -107,7 +118,7 @@ static int follow(const om_solver_data *s, const double *T, const int64_t *signs
         double aim = moved > 0.0 ? fmax(AIM * predicted_end(n_ends, ends_prev, ends, moved), 1.5 * min_step) : INFINITY;
         if (aim < fabs(x - *psi)) x = *psi + copysign(aim, step);
         prediction p = {dof, cyclic, centred, centre, q, t, x - *psi};
-        bool ok = om_solve_near(s, T, signs, &x, q, x_q, on_path, &p, NULL);
+        bool ok = farthest(&p) <= FARTHEST_CONTINUED && om_solve_near(s, T, signs, &x, q, x_q, on_path, &p, NULL);
         if (ok) {
             represent(dof, centred, centre, x_q);
             ok = om_continues(dof, q, x_q, t, x - *psi, cyclic);

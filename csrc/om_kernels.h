@@ -73,6 +73,9 @@ void om_fk(const double *table, int n_rows, const double *base, const double *to
  * flange where the table has dof joints: om_flange's), into flange_R, flange_p (NULL: not wanted). */
 void om_jacobian(const double *table, int n_rows, const double *base, const double *tool, const double *q, int dof,
                  double *J, double *flange_R, double *flange_p);
+/* om_jacobian from a walk already made: om_joint_frames' frames (dof of them) and its chain end (R, p). */
+void om_jacobian_from_frames(const double *table, int n_rows, const double *base, const double *tool,
+                             const double *frames, const double *R, const double *p, int dof, double *J);
 
 /* ------------------------------------------------------------------------------------ */
 /* six_dof.c, srs.c, families.c: the model arms' closed forms (see the Python modules     */
