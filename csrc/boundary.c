@@ -31,7 +31,7 @@ static double nearest_branch(const om_solver_data *s, const double *q, int *inde
     return nearest;
 }
 
-bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori, bool split_starts)
+bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori)
 {
     const om_solver_data *s = pb->s;
     int branch = -1;
@@ -66,7 +66,7 @@ bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori, bo
      * q1 and in the ARM quantity); with a lateral offset, as at every other boundary, only
      * within SPLIT_NEAR of it. */
     bool on_axis = s->family == OM_SRS || s->params[SD_LATERAL] == 0.0;
-    if (!split_starts || !(nearest < NEAR_BOUNDARY) || branch == ELBOW_SIGN ||
+    if (!pb->split_starts || !(nearest < NEAR_BOUNDARY) || branch == ELBOW_SIGN ||
         ((branch != SHOULDER_SIGN || !on_axis) && !(nearest < SPLIT_NEAR)))
         return false;
     /* The wrist centre on joint 1's axis: the model's q1 is arbitrary there (atan2 of a
@@ -105,7 +105,7 @@ bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori, bo
 
 int om_add_candidate(om_problem *pb, double *q, double *roots, int count)
 {
-    if (!om_verify(pb, q, NULL, NULL) && !om_polish_candidate(pb, q, NULL, NULL, true))
+    if (!om_verify(pb, q, NULL, NULL) && !om_polish_candidate(pb, q, NULL, NULL))
         return count;
     return om_add_root(pb, q, roots, count);
 }
@@ -179,7 +179,7 @@ static int dip_roots(om_problem *pb, int i, double w, double h, double *roots, i
     double start[OM_MAX_DOF], pos, ori;
     bool complete = true;
     memcpy(start, q, (size_t)pb->s->dof * sizeof(double));
-    if (om_local_solve(pb, start, &complete, q, &pos, &ori, true)) /* as a hint at the bottom would */
+    if (om_local_solve(pb, start, &complete, q, &pos, &ori)) /* as a hint at the bottom would */
         count = om_add_root(pb, q, roots, count);
     return count;
 }

@@ -54,16 +54,18 @@ static double farthest(const prediction *p) {
 
 /* What the attempt makes of the local solve's root x (at its representative; om_solve_near's
  * as_is test). Taken without the windowed scan for a nearer root where it lies on the
- * prediction's path beyond doubt (om_beyond_doubt). Rejected, without the scan, where no root at most as far
- * from q as x can continue the path, the attempt's answer whatever the scan finds: such a
- * root is within d = |x - q| of q (every joint wrapped, the scan's distance), so it moves each
- * joint by m_i with |m_i| <= moved <= min(d, 1) and |m_i - t_i h| <= moved / 2 + 1e-6
- * (om_continues), whence |t_i h| <= 1.5 min(d, 1) + 1e-6; a prediction that moves some joint
- * farther (h the step, the prediction's d; 1e-6 more for the representatives' rounding) leaves
- * none. Else the scan decides. */
+ * prediction's path beyond doubt (om_beyond_doubt). Rejected, without the scan, where no root at
+ * most as far from q as x can continue the path, the attempt's answer whatever the scan finds:
+ * such a root is within d = |x - q|_2 of q (every joint wrapped, the scan's distance), so it
+ * moves each joint by m_i with |m_i| <= moved <= r = min(d, 1) and |m_i - t_i h| <= moved / 2 +
+ * 1e-6 (om_continues; h the step, the prediction's d), whence |t_i h| <= 1.5 r + 1e-6 and
+ * |m_i| >= a_i = max(0, |t_i h| - r / 2 - 1e-6), so sum_i a_i^2 <= |m|_2^2 < d^2 (x itself: = d^2);
+ * a prediction that moves some joint farther, or whose a_i exceed that, leaves none (with 1e-6
+ * more in each for the representatives' rounding: the a_i are then short of |m_i| by 1e-6 each,
+ * far more than d^2's rounding). Else the scan decides. */
 static om_root_verdict on_path(const double *x, void *context) {
     const prediction *p = context;
-    double r[OM_MAX_DOF], d2 = 0.0;
+    double r[OM_MAX_DOF], d2 = 0.0, least = 0.0; /* least: sum_i a_i^2 */
     memcpy(r, x, (size_t)p->dof * sizeof(double));
     represent(p->dof, p->centred, p->centre, r);
     if (om_beyond_doubt(p->dof, p->q, r, p->t, p->d, p->cyclic)) return OM_ROOT_TAKE;
@@ -71,7 +73,12 @@ static om_root_verdict on_path(const double *x, void *context) {
         double e = om_wrap_angle(r[i] - p->q[i]);
         d2 += e * e;
     }
-    return farthest(p) > 1.5 * fmin(sqrt(d2), 1.0) + 2e-6 ? OM_ROOT_REJECT : OM_ROOT_SCAN;
+    double reach = fmin(sqrt(d2), 1.0);
+    for (int i = 0; i < p->dof; i++) {
+        double a = fabs(p->t[i] * p->d) - 0.5 * reach - 2e-6;
+        if (a > 0.0) least += a * a;
+    }
+    return farthest(p) > 1.5 * reach + 2e-6 || least >= d2 ? OM_ROOT_REJECT : OM_ROOT_SCAN;
 }
 
 /* What ends a path, as functions of its point (q, t) that fall to zero there linearly in psi

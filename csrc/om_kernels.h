@@ -204,6 +204,10 @@ typedef struct {
     const double *redundancy;
     const double *q_prev; /* joints kept at singularities */
     int64_t counter;      /* residual evaluations */
+    /* whether om_polish_candidate also refines from starts around the model's split of a
+     * singular joint pair where that split is arbitrary (false: the hinted local part alone,
+     * om_solve_near, whose model takes the split from its hint) */
+    bool split_starts;
 } om_problem;
 
 /* residual.c */
@@ -316,9 +320,8 @@ typedef struct {
 /* boundary.c */
 /* A candidate q that failed verification, refined on the real arm where a branch quantity is
  * within 1e-2 of zero, or (S-R-S) w_hat within 1e-2 rad of psi's singular half-line (else left
- * as it is); returns whether it now verifies. split_starts: where the model's split of a
- * singular joint pair is arbitrary, refinements from starts around it too (see there). */
-bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori, bool split_starts);
+ * as it is); returns whether it now verifies. */
+bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori);
 /* self_motion.c: the null vector of the real 6 x 7 Jacobian at q by cofactors (not normalised) */
 void om_self_motion_null(const om_solver_data *s, const double *q, double *n);
 /* det A (n x n row-major, destroyed) into *det (NULL: not wanted) by elimination with partial
@@ -361,8 +364,7 @@ void om_complete_start(om_problem *pb, double *start, bool *complete);
  * or the point of the dp circle the model reaches with the smallest residual (q: scratch,
  * dof). Returns whether there is a start. */
 bool om_fixed_point_start(om_problem *pb, double *q, double *start);
-bool om_local_solve(om_problem *pb, double *start, bool *start_complete, double *q, double *pos, double *ori,
-                    bool split_starts);
+bool om_local_solve(om_problem *pb, double *start, bool *start_complete, double *q, double *pos, double *ori);
 bool om_exists_other(om_problem *pb, bool skip_neighbours);
 bool om_nearest_in_window(om_problem *pb, const double *hint, double *q);
 

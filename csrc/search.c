@@ -145,8 +145,7 @@ bool om_fixed_point_start(om_problem *pb, double *q, double *start)
  * its q_J; on the torus, and on a 7-DOF circle arm where the secant fails, the lifted Newton
  * (from the whole start: see om_complete_start); near the singular boundary, the refinement
  * on the real arm last. Returns accepted (errors into *pos, *ori); q holds the model IK at the end. */
-bool om_local_solve(om_problem *pb, double *start, bool *start_complete, double *q, double *pos, double *ori,
-                    bool split_starts)
+bool om_local_solve(om_problem *pb, double *start, bool *start_complete, double *q, double *pos, double *ori)
 {
     const om_solver_data *data = pb->s;
     if (data->mode == OM_TORUS) {
@@ -160,7 +159,7 @@ bool om_local_solve(om_problem *pb, double *start, bool *start_complete, double 
         om_lifted_solve(pb, start, q);
         accepted = om_verify(pb, q, pos, ori);
     }
-    return accepted || om_polish_candidate(pb, q, pos, ori, split_starts);
+    return accepted || om_polish_candidate(pb, q, pos, ori);
 }
 
 /* Whether any configuration other than the problem's has a solution (with skip_neighbours,

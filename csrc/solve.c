@@ -121,6 +121,7 @@ static void _problem(om_problem *pb, const om_solver_data *s, const double *T, c
     pb->redundancy = reduced;
     pb->q_prev = q_prev;
     pb->counter = 0;
+    pb->split_starts = true;
 }
 
 /* A hinted solve's local part (the hint is pb->q_prev, copied into start): the local solve
@@ -130,9 +131,9 @@ static void _problem(om_problem *pb, const om_solver_data *s, const double *T, c
  * local solve fails (q_out not written) or as_is rejects; else *pos, *ori are q_out's errors
  * and *inside whether it is within the limits. q: scratch (dof). */
 static bool _near_hint(om_problem *pb, double *start, bool *start_complete, double *q, double *q_out, double *pos,
-                       double *ori, bool *inside, om_root_test as_is, void *context, bool split_starts)
+                       double *ori, bool *inside, om_root_test as_is, void *context)
 {
-    if (!om_local_solve(pb, start, start_complete, q, pos, ori, split_starts))
+    if (!om_local_solve(pb, start, start_complete, q, pos, ori))
         return false;
     if (as_is) {
         double local_pos = *pos, local_ori = *ori;
@@ -167,6 +168,7 @@ static om_result _solve(const om_solver_data *s, const double *T, const int64_t 
     om_problem problem;
     double psi[1];
     _problem(&problem, s, T, signs, redundancy, psi, hint);
+    problem.split_starts = search;
     om_problem *pb = &problem;
     double q[OM_MAX_DOF], start[OM_MAX_DOF];
     /* local_solve verifies q even where the secant's first point is out of reach and q was
@@ -188,7 +190,7 @@ static om_result _solve(const om_solver_data *s, const double *T, const int64_t 
     double local[OM_MAX_DOF], local_pos = NAN, local_ori = NAN, local_dist = INFINITY;
     bool local_inside = false;
     if (has_hint) {
-        if (_near_hint(pb, start, &start_complete, q, q_out, &pos, &ori, &local_inside, as_is, context, search)) {
+        if (_near_hint(pb, start, &start_complete, q, q_out, &pos, &ori, &local_inside, as_is, context)) {
             local_dist = om_wrapped_distance2(q_out, hint, dof);
             if (!search || local_dist <= NEAR_HINT)
                 return _result(OM_OK, pos, ori, problem.counter, local_inside);
@@ -198,7 +200,7 @@ static om_result _solve(const om_solver_data *s, const double *T, const int64_t 
         } else if (!search) { /* not a verdict: a solution may still exist */
             return _result(OM_NO_SOLUTION_IN_CONFIGURATION, NAN, NAN, problem.counter, false);
         }
-    } else if (found && om_local_solve(pb, start, &start_complete, q, &pos, &ori, true)) {
+    } else if (found && om_local_solve(pb, start, &start_complete, q, &pos, &ori)) {
         bool inside = _finish(pb, q, hint, false, q_out, &pos, &ori);
         if (inside || mode == OM_FIXED)
             return _result(OM_OK, pos, ori, problem.counter, inside);
@@ -297,7 +299,7 @@ int om_solve_all(const om_solver_data *s, const double *T, const int64_t *signs,
         n = om_band_roots(&problem, roots, &neighbour_reached, cache);
         double q[OM_MAX_DOF], start[OM_MAX_DOF], pos, ori;
         nan_fill(q, OM_MAX_DOF);
-        if (om_fixed_point_start(&problem, q, start) && om_local_solve(&problem, start, &complete, q, &pos, &ori, true))
+        if (om_fixed_point_start(&problem, q, start) && om_local_solve(&problem, start, &complete, q, &pos, &ori))
             n = om_add_root(&problem, q, roots, n);
     }
     for (int r = 0; r < n; r++) {
