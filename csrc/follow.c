@@ -14,9 +14,12 @@
  * short of the next step, h aims just short of it (see follow). The solve is the hinted
  * one's local part alone (om_solve_near): where the local solve from q_k fails, the step is
  * halved without the bounded search, whose answer there is mostly a costly "no" (q_k is
- * nearer the solution at a shorter step, where the local solve succeeds). Below min_step
- * (probe.py's END_TOLERANCE) the path has ended there; min_step = |psi* - psi_0| makes it
- * one attempt (Probe.next).
+ * nearer the solution at a shorter step, where the local solve succeeds); at a singular
+ * boundary it refines from q_k's split of the singular joints alone (om_problem.split_starts:
+ * the split starts were half the cost of a follow into an aligned wrist). A step whose
+ * prediction moves a joint farther than any continuing root can (farthest) is not solved.
+ * Below min_step (probe.py's END_TOLERANCE) the path has ended there; min_step = |psi* -
+ * psi_0| makes it one attempt (Probe.next).
  * Each accepted point's tangent is om_self_motion_tangent's; where it does not exist (a
  * fold met exactly) the call stops and says so: the caller's own loop then decides. */
 #include <string.h>

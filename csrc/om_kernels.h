@@ -393,7 +393,11 @@ om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *
  * when called): taken as it is, or rejected, without the scan. Returns false where the local
  * solve fails, without the bounded search that would follow in om_solve_one: a solution may
  * still exist (the path following halves such a step, where that search's costly "no" would
- * be wasted); and where as_is rejects. result (NULL: not wanted): om_solve_one's for the root. */
+ * be wasted); and where as_is rejects. A candidate at a singular boundary is refined from the
+ * hint's split of the singular joints alone (om_problem.split_starts), in the local solve and
+ * in the scan (the model takes that split from the hint; the split starts begin 2 pi / 16 or
+ * more from it in two joints, and cost a follow most of its time at an aligned wrist). result (NULL: not wanted): om_solve_one's
+ * for the root. */
 bool om_solve_near(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
                    const double *hint, double *q_out, om_root_test as_is, void *context, om_result *result);
 /* Every root (OM_MAX_ROOTS x dof) with per root (position error, orientation error, within limits)
