@@ -66,7 +66,7 @@ bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori)
      * q1 and in the ARM quantity); with a lateral offset, as at every other boundary, only
      * within SPLIT_NEAR of it. */
     bool on_axis = s->family == OM_SRS || s->params[SD_LATERAL] == 0.0;
-    if (!(nearest < NEAR_BOUNDARY) || branch == ELBOW_SIGN ||
+    if (!pb->split_starts || !(nearest < NEAR_BOUNDARY) || branch == ELBOW_SIGN ||
         ((branch != SHOULDER_SIGN || !on_axis) && !(nearest < SPLIT_NEAR)))
         return false;
     /* The wrist centre on joint 1's axis: the model's q1 is arbitrary there (atan2 of a

@@ -14,9 +14,12 @@
  * short of the next step, h aims just short of it (see follow). The solve is the hinted
  * one's local part alone (om_solve_near): where the local solve from q_k fails, the step is
  * halved without the bounded search, whose answer there is mostly a costly "no" (q_k is
- * nearer the solution at a shorter step, where the local solve succeeds). Below min_step
- * (probe.py's END_TOLERANCE) the path has ended there; min_step = |psi* - psi_0| makes it
- * one attempt (Probe.next).
+ * nearer the solution at a shorter step, where the local solve succeeds); at a singular
+ * boundary it refines from q_k's split of the singular joints alone (om_problem.split_starts:
+ * the split starts were half the cost of a follow into an aligned wrist). A step whose
+ * prediction moves a joint farther than any continuing root can (farthest) is not solved.
+ * Below min_step (probe.py's END_TOLERANCE) the path has ended there; min_step = |psi* -
+ * psi_0| makes it one attempt (Probe.next).
  * Each accepted point's tangent is om_self_motion_tangent's; where it does not exist (a
  * fold met exactly) the call stops and says so: the caller's own loop then decides. */
 #include <string.h>
@@ -40,27 +43,45 @@ typedef struct {
     double d;
 } prediction;
 
+/* The prediction's largest joint move, max_i |t_i d|. A root that continues the path
+ * (om_continues) moves each joint by m_i with |m_i| <= moved <= 1 and |m_i - t_i d| <= moved / 2
+ * + 1e-6, so |t_i d| <= 1.5 moved + 1e-6 <= 1.5 + 1e-6: a step whose prediction moves a joint
+ * farther than 1.5 + 2e-6 (1e-6 more for the representatives' rounding) fails whatever the
+ * solve would find, and is not solved (the steps into a fold, where |t| grows without bound). */
+static double farthest(const prediction *p) {
+    double r = 0.0;
+    for (int i = 0; i < p->dof; i++) r = fmax(r, fabs(p->t[i] * p->d));
+    return r;
+}
+#define FARTHEST_CONTINUED (1.5 + 2e-6)
+
 /* What the attempt makes of the local solve's root x (at its representative; om_solve_near's
  * as_is test). Taken without the windowed scan for a nearer root where it lies on the
- * prediction's path beyond doubt (om_beyond_doubt). Rejected, without the scan, where no root at most as far
- * from q as x can continue the path, the attempt's answer whatever the scan finds: such a
- * root is within d = |x - q| of q (every joint wrapped, the scan's distance), so it moves each
- * joint by m_i with |m_i| <= moved <= min(d, 1) and |m_i - t_i h| <= moved / 2 + 1e-6
- * (om_continues), whence |t_i h| <= 1.5 min(d, 1) + 1e-6; a prediction that moves some joint
- * farther (h the step, the prediction's d; 1e-6 more for the representatives' rounding) leaves
- * none. Else the scan decides. */
+ * prediction's path beyond doubt (om_beyond_doubt). Rejected, without the scan, where no root at
+ * most as far from q as x can continue the path, the attempt's answer whatever the scan finds:
+ * such a root is within d = |x - q|_2 of q (every joint wrapped, the scan's distance), so it
+ * moves each joint by m_i with |m_i| <= moved <= r = min(d, 1) and |m_i - t_i h| <= moved / 2 +
+ * 1e-6 (om_continues; h the step, the prediction's d), whence |t_i h| <= 1.5 r + 1e-6 and
+ * |m_i| >= a_i = max(0, |t_i h| - r / 2 - 1e-6), so sum_i a_i^2 <= |m|_2^2 < d^2 (x itself: = d^2);
+ * a prediction that moves some joint farther, or whose a_i exceed that, leaves none (with 1e-6
+ * more in each for the representatives' rounding: the a_i are then short of |m_i| by 1e-6 each,
+ * far more than d^2's rounding). Else the scan decides. */
 static om_root_verdict on_path(const double *x, void *context) {
     const prediction *p = context;
-    double r[OM_MAX_DOF], d2 = 0.0, farthest = 0.0;
+    double r[OM_MAX_DOF], d2 = 0.0, least = 0.0; /* least: sum_i a_i^2 */
     memcpy(r, x, (size_t)p->dof * sizeof(double));
     represent(p->dof, p->centred, p->centre, r);
     if (om_beyond_doubt(p->dof, p->q, r, p->t, p->d, p->cyclic)) return OM_ROOT_TAKE;
     for (int i = 0; i < p->dof; i++) {
         double e = om_wrap_angle(r[i] - p->q[i]);
         d2 += e * e;
-        farthest = fmax(farthest, fabs(p->t[i] * p->d));
     }
-    return farthest > 1.5 * fmin(sqrt(d2), 1.0) + 2e-6 ? OM_ROOT_REJECT : OM_ROOT_SCAN;
+    double reach = fmin(sqrt(d2), 1.0);
+    for (int i = 0; i < p->dof; i++) {
+        double a = fabs(p->t[i] * p->d) - 0.5 * reach - 2e-6;
+        if (a > 0.0) least += a * a;
+    }
+    return farthest(p) > 1.5 * reach + 2e-6 || least >= d2 ? OM_ROOT_REJECT : OM_ROOT_SCAN;
 }
 
 /* What ends a path, as functions of its point (q, t) that fall to zero there linearly in psi
@@ -107,7 +128,7 @@ static int follow(const om_solver_data *s, const double *T, const int64_t *signs
         double aim = moved > 0.0 ? fmax(AIM * predicted_end(n_ends, ends_prev, ends, moved), 1.5 * min_step) : INFINITY;
         if (aim < fabs(x - *psi)) x = *psi + copysign(aim, step);
         prediction p = {dof, cyclic, centred, centre, q, t, x - *psi};
-        bool ok = om_solve_near(s, T, signs, &x, q, x_q, on_path, &p, NULL);
+        bool ok = farthest(&p) <= FARTHEST_CONTINUED && om_solve_near(s, T, signs, &x, q, x_q, on_path, &p, NULL);
         if (ok) {
             represent(dof, centred, centre, x_q);
             ok = om_continues(dof, q, x_q, t, x - *psi, cyclic);

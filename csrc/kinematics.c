@@ -121,13 +121,12 @@ static void rigid(const double *T, const double *x, double w, double *out)
 }
 
 /* Geometric Jacobian [v; omega] (6 x dof, row-major) of the end-effector frame in the root frame
- * (jacobian_kernel): z_j x (p_ee - o_j) and z_j for a revolute joint, z_j and 0 for a prismatic one.
- * The chain's end (R, p) into flange_R, flange_p (NULL: not wanted). */
-void om_jacobian(const double *table, int n_rows, const double *base, const double *tool, const double *q, int dof,
-                 double *J, double *flange_R, double *flange_p)
+ * from om_joint_frames' frames and chain end (R, p) (jacobian_kernel): z_j x (p_ee - o_j) and z_j
+ * for a revolute joint, z_j and 0 for a prismatic one. */
+void om_jacobian_from_frames(const double *table, int n_rows, const double *base, const double *tool,
+                             const double *frames, const double *R, const double *p, int dof, double *J)
 {
-    double frames[OM_MAX_DOF * 12], kinds[OM_MAX_DOF], R[9], p[3];
-    om_joint_frames(table, n_rows, q, dof, frames, R, p);
+    double kinds[OM_MAX_DOF];
     int j = 0;
     for (int k = 0; k < n_rows; k++) {
         if (table[6 * k + 5] != 2.0 && j < dof) {
@@ -160,6 +159,16 @@ void om_jacobian(const double *table, int n_rows, const double *base, const doub
                 J[(3 + i) * dof + j] = z[i];
         }
     }
+}
+
+/* The geometric Jacobian at q (om_jacobian_from_frames of one walk of the chain). The chain's
+ * end (R, p) into flange_R, flange_p (NULL: not wanted). */
+void om_jacobian(const double *table, int n_rows, const double *base, const double *tool, const double *q, int dof,
+                 double *J, double *flange_R, double *flange_p)
+{
+    double frames[OM_MAX_DOF * 12], R[9], p[3];
+    om_joint_frames(table, n_rows, q, dof, frames, R, p);
+    om_jacobian_from_frames(table, n_rows, base, tool, frames, R, p, dof, J);
     if (flange_R)
         memcpy(flange_R, R, sizeof R);
     if (flange_p)

@@ -73,6 +73,9 @@ void om_fk(const double *table, int n_rows, const double *base, const double *to
  * flange where the table has dof joints: om_flange's), into flange_R, flange_p (NULL: not wanted). */
 void om_jacobian(const double *table, int n_rows, const double *base, const double *tool, const double *q, int dof,
                  double *J, double *flange_R, double *flange_p);
+/* om_jacobian from a walk already made: om_joint_frames' frames (dof of them) and its chain end (R, p). */
+void om_jacobian_from_frames(const double *table, int n_rows, const double *base, const double *tool,
+                             const double *frames, const double *R, const double *p, int dof, double *J);
 
 /* ------------------------------------------------------------------------------------ */
 /* six_dof.c, srs.c, families.c: the model arms' closed forms (see the Python modules     */
@@ -201,6 +204,10 @@ typedef struct {
     const double *redundancy;
     const double *q_prev; /* joints kept at singularities */
     int64_t counter;      /* residual evaluations */
+    /* whether om_polish_candidate also refines from starts around the model's split of a
+     * singular joint pair where that split is arbitrary (false: the hinted local part alone,
+     * om_solve_near, whose model takes the split from its hint) */
+    bool split_starts;
 } om_problem;
 
 /* residual.c */
@@ -386,7 +393,11 @@ om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *
  * when called): taken as it is, or rejected, without the scan. Returns false where the local
  * solve fails, without the bounded search that would follow in om_solve_one: a solution may
  * still exist (the path following halves such a step, where that search's costly "no" would
- * be wasted); and where as_is rejects. result (NULL: not wanted): om_solve_one's for the root. */
+ * be wasted); and where as_is rejects. A candidate at a singular boundary is refined from the
+ * hint's split of the singular joints alone (om_problem.split_starts), in the local solve and
+ * in the scan (the model takes that split from the hint; the split starts begin 2 pi / 16 or
+ * more from it in two joints, and cost a follow most of its time at an aligned wrist). result (NULL: not wanted): om_solve_one's
+ * for the root. */
 bool om_solve_near(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
                    const double *hint, double *q_out, om_root_test as_is, void *context, om_result *result);
 /* Every root (OM_MAX_ROOTS x dof) with per root (position error, orientation error, within limits)

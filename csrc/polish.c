@@ -29,11 +29,14 @@ static double psi_row_scale(const double *grad, int dof)
 
 /* The residual e (rows: p - p(q); the rotation vector of R R(q)^T; psi - psi(q), divided by
  * psi_row_scale) in DH frame 0; returns its squared norm. With the arm angle, its Jacobian row
- * (d psi / dq over the same scale) into psi_row (dof): computed here, with psi. */
-static double residual(const om_polish_task *t, const double *q, double *e, double *psi_row)
+ * (d psi / dq over the same scale) into psi_row (dof): computed here, with psi. The chain's walk
+ * to the flange keeps the joints' frames (frames, 12 per joint) and the flange (chain_end: R, then
+ * p), from which the Jacobian at q follows without a second walk (jacobian). */
+static double residual(const om_polish_task *t, const double *q, double *e, double *psi_row, double *frames,
+                       double *chain_end)
 {
-    double Rc[9], pc[3];
-    om_flange(t->table, t->n_rows, q, Rc, pc);
+    double *Rc = chain_end, *pc = chain_end + 9;
+    om_joint_frames(t->table, t->n_rows, q, t->dof, frames, Rc, pc); /* (every row: the table has dof joints) */
     e[0] = t->p.x - pc[0];
     e[1] = t->p.y - pc[1];
     e[2] = t->p.z - pc[2];
@@ -62,10 +65,11 @@ static double residual(const om_polish_task *t, const double *q, double *e, doub
     return cost;
 }
 
-/* The Jacobian of the pose and of psi at q (rows x dof), psi's row residual's at q. */
-static void jacobian(const om_polish_task *t, const double *q, const double *psi_row, double *J)
+/* The Jacobian of the pose and of psi at q (rows x dof) from residual's outputs at q. */
+static void jacobian(const om_polish_task *t, const double *frames, const double *chain_end, const double *psi_row,
+                     double *J)
 {
-    om_jacobian(t->table, t->n_rows, IDENTITY, IDENTITY, q, t->dof, J, NULL, NULL);
+    om_jacobian_from_frames(t->table, t->n_rows, IDENTITY, IDENTITY, frames, chain_end, chain_end + 9, t->dof, J);
     if (t->P)
         memcpy(J + 6 * t->dof, psi_row, (size_t)t->dof * sizeof(double));
 }
@@ -114,8 +118,9 @@ double om_polish(const om_polish_task *t, int iterations, double *q)
     double e[POLISH_ROWS], e_try[POLISH_ROWS], J[POLISH_ROWS * OM_MAX_DOF], A[POLISH_ROWS * POLISH_ROWS];
     double G[POLISH_ROWS * POLISH_ROWS];
     double y[POLISH_ROWS], q_try[OM_MAX_DOF], psi_row[OM_MAX_DOF], psi_row_try[OM_MAX_DOF];
-    double cost = residual(t, q, e, psi_row);
-    jacobian(t, q, psi_row, J);
+    double frames[12 * OM_MAX_DOF], chain_end[12];
+    double cost = residual(t, q, e, psi_row, frames, chain_end);
+    jacobian(t, frames, chain_end, psi_row, J);
     double damping = POLISH_DAMPING;
     double window_cost = cost; /* the cost POLISH_WINDOW Jacobians ago */
     for (int it = 0; it < iterations && cost > POLISH_DONE * POLISH_DONE && isfinite(cost); it++) {
@@ -148,13 +153,13 @@ double om_polish(const om_polish_task *t, int iterations, double *q)
                         dq += J[a * dof + j] * y[a];
                     q_try[j] = q[j] + dq;
                 }
-                double c = residual(t, q_try, e_try, psi_row_try);
+                double c = residual(t, q_try, e_try, psi_row_try, frames, chain_end);
                 improved = c < cost;
                 if (improved) {
                     memcpy(q, q_try, (size_t)dof * sizeof(double));
                     memcpy(e, e_try, sizeof e);
                     cost = c;
-                    jacobian(t, q, psi_row_try, J);
+                    jacobian(t, frames, chain_end, psi_row_try, J);
                     damping = py_max(damping / 10.0, POLISH_DAMPING_MIN);
                     break;
                 }

@@ -121,6 +121,7 @@ static void _problem(om_problem *pb, const om_solver_data *s, const double *T, c
     pb->redundancy = reduced;
     pb->q_prev = q_prev;
     pb->counter = 0;
+    pb->split_starts = true;
 }
 
 /* A hinted solve's local part (the hint is pb->q_prev, copied into start): the local solve
@@ -167,6 +168,7 @@ static om_result _solve(const om_solver_data *s, const double *T, const int64_t 
     om_problem problem;
     double psi[1];
     _problem(&problem, s, T, signs, redundancy, psi, hint);
+    problem.split_starts = search;
     om_problem *pb = &problem;
     double q[OM_MAX_DOF], start[OM_MAX_DOF];
     /* local_solve verifies q even where the secant's first point is out of reach and q was
