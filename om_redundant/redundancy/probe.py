@@ -18,9 +18,9 @@ fails without it, as it would with it); Python builds only the point reached.
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
-from functools import cached_property
 from typing import NamedTuple
 
 import numpy as np
@@ -41,15 +41,27 @@ _ARRIVED, _SINGULAR = 0, 2  # ckernels.follow's status
 
 class _Terms:
     """The objective at a point, computed when first asked for (a path's following steps
-    need only the joints and the tangent): the clearance's pair distances and gradients
-    (one ``ckernels.arm_clearance`` call), from which the groups with their rates, the
-    evaluation and the feasibility functions. Shared by the copies of a point at other
-    representatives of psi.
+    need only the joints and the tangent), or given by a batch (:func:`evaluate_points`):
+    the clearance's pair distances and gradients (one ``ckernels.arm_clearance`` call), from
+    which the groups with their rates, the evaluation and the feasibility functions. Shared
+    by the copies of a point at other representatives of psi. (Slots: the sweep builds
+    hundreds per pose, and each would otherwise carry a dict for the garbage collector.)
     """
 
-    def __init__(self, objective: Objective, q: np.ndarray, tangent: np.ndarray):
+    __slots__ = ("evaluation", "groups", "objective", "pairs", "pieces", "q", "tangent")
+
+    def __init__(
+        self,
+        objective: Objective,
+        q: np.ndarray,
+        tangent: np.ndarray,
+        evaluation: Evaluation | None = None,
+        pieces: tuple[np.ndarray, np.ndarray] | None = None,
+        pairs: tuple[np.ndarray, np.ndarray] | None = None,
+    ):
         self.objective, self.q, self.tangent = objective, q, tangent
-        self.pairs, self.groups, self.pieces = None, None, None
+        self.evaluation, self.pieces, self.pairs = evaluation, pieces, pairs
+        self.groups: list[Group] | None = None
 
     def get_pairs(self) -> tuple[np.ndarray, np.ndarray] | None:
         """The clearance's pair distances and gradients at q (:meth:`Objective.pairs`); None
@@ -58,11 +70,12 @@ class _Terms:
             self.pairs = self.objective.pairs(self.q)
         return self.pairs
 
-    @cached_property
-    def evaluation(self) -> Evaluation:
-        """The objective at q (an attribute once computed: points are asked for it often)."""
-        pairs = self.get_pairs()
-        return self.objective.evaluate(self.q, None if pairs is None else pairs[0])
+    def get_evaluation(self) -> Evaluation:
+        """The objective at q."""
+        if self.evaluation is None:
+            pairs = self.get_pairs()
+            self.evaluation = self.objective.evaluate(self.q, None if pairs is None else pairs[0])
+        return self.evaluation
 
     def get_pieces(self) -> tuple[np.ndarray, np.ndarray]:
         """The feasibility functions and their rates (:meth:`Point.pieces`)."""
@@ -71,9 +84,9 @@ class _Terms:
         return self.pieces
 
     def get_groups(self) -> list[Group]:
+        """The groups at q, their jacobians by psi (:meth:`Objective.groups` with the tangent)."""
         if self.groups is None:
-            groups = self.objective.groups(self.q, jacobian=True, pairs=self.get_pairs())
-            self.groups = [g.along(self.tangent) for g in groups]
+            self.groups = self.objective.groups(self.q, pairs=self.get_pairs(), tangent=self.tangent)
         return self.groups
 
 
@@ -82,28 +95,32 @@ def evaluate_points(objective: Objective, points: list[Point]) -> None:
     clearance's pair distances and gradients, their evaluations and their feasibility
     functions (what :attr:`Point.evaluation` and :meth:`Point.pieces` would compute point by
     point)."""
-    # (not yet evaluated: the cached property's value not yet in the terms' __dict__)
-    terms = list({id(p.terms): p.terms for p in points if "evaluation" not in vars(p.terms)}.values())
+    terms = list(dict.fromkeys(p.terms for p in points if p.terms.evaluation is None))  # (distinct)
     if terms:
-        _evaluate_terms(
-            objective, terms, np.array([t.q for t in terms]), np.array([t.tangent for t in terms])
-        )
+        q, tangents = np.array([t.q for t in terms]), np.array([t.tangent for t in terms])
+        evaluations, pieces, pairs = _evaluated(objective, q, tangents)
+        for t, ev, pk, pr in zip(terms, evaluations, pieces, pairs, strict=True):
+            t.evaluation, t.pieces, t.pairs = ev, pk, pr
 
 
-def _evaluate_terms(objective: Objective, terms: list[_Terms], q: np.ndarray, tangents: np.ndarray) -> None:
-    """:func:`evaluate_points` of distinct terms not yet evaluated, their joints q (M, dof)
-    and tangents (M, dof, 1) stacked."""
+def _evaluated(
+    objective: Objective, q: np.ndarray, tangents: np.ndarray
+) -> tuple[list[Evaluation], list[tuple[np.ndarray, np.ndarray]], list[tuple[np.ndarray, np.ndarray] | None]]:
+    """The terms of the rows of q (M, dof) with tangents (M, dof, 1), one call each for all
+    rows: per row its evaluation, its feasibility functions and rates (g, dg), and its pair
+    distances and gradients (d, grad), None without obstacles (the arrays: views of the
+    batch's)."""
     pairs = objective.pairs(q)
     evaluations = objective.evaluations(q, None if pairs is None else pairs[0])
-    g, dg = objective.pieces(q, tangents, pairs)
-    per_row = [None] * len(terms) if pairs is None else zip(*pairs, strict=True)  # each row's (d, grad)
-    for t, ev, gk, dgk, pk in zip(terms, evaluations, g, dg, per_row, strict=True):
-        t.evaluation, t.pieces, t.pairs = ev, (gk, dgk), pk
+    pieces = list(zip(*objective.pieces(q, tangents, pairs), strict=True))
+    return evaluations, pieces, [None] * len(q) if pairs is None else list(zip(*pairs, strict=True))
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(eq=False, slots=True)
 class Point:
-    """An exact solution on a branch, its objective, and their rates along psi.
+    """An exact solution on a branch, its objective, and their rates along psi. (Not frozen,
+    but never changed: a frozen dataclass is built several times slower, and the sweep builds
+    hundreds of points per pose.)
 
     Attributes:
         psi: The redundancy value (rad); an (r,) array for r > 1 redundancy variables.
@@ -129,7 +146,8 @@ class Point:
     @property
     def evaluation(self) -> Evaluation:
         """The objective at q."""
-        return self.terms.evaluation
+        evaluation = self.terms.evaluation  # (read often: the call only when not yet computed)
+        return self.terms.get_evaluation() if evaluation is None else evaluation
 
     @property
     def groups(self) -> list[Group]:
@@ -212,9 +230,11 @@ class Probe:
         bad = ~np.isfinite(tangents).all(axis=(1, 2))
         if bad.any():
             self_motion_tangent(self.solver, q[np.argmax(bad)])  # raises SingularSelfMotion
-        terms = [_Terms(self.objective, row, t) for row, t in zip(q, tangents, strict=True)]
-        _evaluate_terms(self.objective, terms, q, tangents)
-        return [Point(x, t.q, t.tangent, t) for x, t in zip(psi.tolist(), terms, strict=True)]
+        rows, rates = list(q), list(tangents)  # (each row's views, shared by its point and terms)
+        terms = map(
+            _Terms, itertools.repeat(self.objective), rows, rates, *_evaluated(self.objective, q, tangents)
+        )
+        return list(map(Point, psi.tolist(), rows, rates, terms))
 
     def at(self, psi: float | np.ndarray, hint: np.ndarray) -> Point | None:
         """The solution at psi nearest ``hint``, if there is one."""
