@@ -21,7 +21,7 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -44,11 +44,16 @@ class _Terms:
     need only the joints and the tangent), or given by a batch (:func:`evaluate_points`):
     the clearance's pair distances and gradients (one ``ckernels.arm_clearance`` call), from
     which the groups with their rates, the evaluation and the feasibility functions. Shared
-    by the copies of a point at other representatives of psi. (Slots: the sweep builds
-    hundreds per pose, and each would otherwise carry a dict for the garbage collector.)
+    by the copies of a point at other representatives of psi. (Slots, the arrays of a pair
+    each in its own: the sweep keeps hundreds of terms per pose, and each container they
+    hold would count towards the garbage collector's next pass.)
+
+    Attributes:
+        d, grad: The pairs' distances (P,) and gradients (P, dof), or None.
+        g, dg: The feasibility functions and their rates, or None.
     """
 
-    __slots__ = ("evaluation", "groups", "objective", "pairs", "pieces", "q", "tangent")
+    __slots__ = ("d", "dg", "evaluation", "g", "grad", "groups", "objective", "q", "tangent")
 
     def __init__(
         self,
@@ -56,19 +61,23 @@ class _Terms:
         q: np.ndarray,
         tangent: np.ndarray,
         evaluation: Evaluation | None = None,
-        pieces: tuple[np.ndarray, np.ndarray] | None = None,
-        pairs: tuple[np.ndarray, np.ndarray] | None = None,
+        g: np.ndarray | None = None,
+        dg: np.ndarray | None = None,
+        d: np.ndarray | None = None,
+        grad: np.ndarray | None = None,
     ):
-        self.objective, self.q, self.tangent = objective, q, tangent
-        self.evaluation, self.pieces, self.pairs = evaluation, pieces, pairs
+        self.objective, self.q, self.tangent, self.evaluation = objective, q, tangent, evaluation
+        self.g, self.dg, self.d, self.grad = g, dg, d, grad
         self.groups: list[Group] | None = None
 
     def get_pairs(self) -> tuple[np.ndarray, np.ndarray] | None:
         """The clearance's pair distances and gradients at q (:meth:`Objective.pairs`); None
         without obstacles."""
-        if self.pairs is None and self.objective.clearance is not None:
-            self.pairs = self.objective.pairs(self.q)
-        return self.pairs
+        if self.d is None:
+            if self.objective.clearance is None:
+                return None
+            self.d, self.grad = self.objective.pairs(self.q)
+        return self.d, self.grad
 
     def get_evaluation(self) -> Evaluation:
         """The objective at q."""
@@ -79,9 +88,9 @@ class _Terms:
 
     def get_pieces(self) -> tuple[np.ndarray, np.ndarray]:
         """The feasibility functions and their rates (:meth:`Point.pieces`)."""
-        if self.pieces is None:
-            self.pieces = self.objective.pieces(self.q, self.tangent, self.get_pairs())
-        return self.pieces
+        if self.g is None:
+            self.g, self.dg = self.objective.pieces(self.q, self.tangent, self.get_pairs())
+        return self.g, self.dg
 
     def get_groups(self) -> list[Group]:
         """The groups at q, their jacobians by psi (:meth:`Objective.groups` with the tangent)."""
@@ -98,22 +107,20 @@ def evaluate_points(objective: Objective, points: list[Point]) -> None:
     terms = list(dict.fromkeys(p.terms for p in points if p.terms.evaluation is None))  # (distinct)
     if terms:
         q, tangents = np.array([t.q for t in terms]), np.array([t.tangent for t in terms])
-        evaluations, pieces, pairs = _evaluated(objective, q, tangents)
-        for t, ev, pk, pr in zip(terms, evaluations, pieces, pairs, strict=True):
-            t.evaluation, t.pieces, t.pairs = ev, pk, pr
+        for t, ev, g, dg, d, grad in zip(terms, *_evaluated(objective, q, tangents), strict=True):
+            t.evaluation, t.g, t.dg, t.d, t.grad = ev, g, dg, d, grad
 
 
-def _evaluated(
-    objective: Objective, q: np.ndarray, tangents: np.ndarray
-) -> tuple[list[Evaluation], list[tuple[np.ndarray, np.ndarray]], list[tuple[np.ndarray, np.ndarray] | None]]:
+def _evaluated(objective: Objective, q: np.ndarray, tangents: np.ndarray) -> tuple[list[Any], ...]:
     """The terms of the rows of q (M, dof) with tangents (M, dof, 1), one call each for all
-    rows: per row its evaluation, its feasibility functions and rates (g, dg), and its pair
-    distances and gradients (d, grad), None without obstacles (the arrays: views of the
-    batch's)."""
+    rows: the rows' evaluations, feasibility functions g and rates dg, pair distances d and
+    gradients grad (None without obstacles), the arrays views of the batch's, in the order
+    of :class:`_Terms`' arguments."""
     pairs = objective.pairs(q)
     evaluations = objective.evaluations(q, None if pairs is None else pairs[0])
-    pieces = list(zip(*objective.pieces(q, tangents, pairs), strict=True))
-    return evaluations, pieces, [None] * len(q) if pairs is None else list(zip(*pairs, strict=True))
+    g, dg = objective.pieces(q, tangents, pairs)
+    d, grad = ([None] * len(q),) * 2 if pairs is None else pairs
+    return evaluations, list(g), list(dg), list(d), list(grad)
 
 
 @dataclass(eq=False, slots=True)
