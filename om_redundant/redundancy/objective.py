@@ -240,8 +240,9 @@ class Objective:
             [self.clearance_reach, self.clearance_cap, self.min_clearance / self.clearance_cap]
         )
         self._no_distances = np.zeros(0)  # ckernels.evaluate's without obstacles
-        # what ckernels.evaluate reads (csrc/objective.c)
-        self._terms = (self._limited, self._lower, self._upper, self._half, *singular, np.array(numbers))
+        # what ckernels.pieces reads of the limits, and ckernels.evaluate of every term (csrc/objective.c)
+        self._limits = (self._limited, self._lower, self._upper, self._half)
+        self._terms = (*self._limits, *singular, np.array(numbers))
         eye = np.eye(self._dof)[self._limited] / self._half[:, None]
         self._margin_jacobian = np.vstack([eye, -eye])  # pieces (q - l)/h, then (u - q)/h
 
@@ -353,11 +354,12 @@ class Objective:
         rows = q.shape[:-1]
         if pairs is None:
             pairs = np.zeros((*rows, 0)), np.zeros((*rows, 0, self._dof))
-        distances, gradients = (np.ascontiguousarray(x, dtype=float) for x in pairs)
+        distances, gradients = np.ascontiguousarray(pairs[0], float), np.ascontiguousarray(pairs[1], float)
         g, dg = np.empty((2, *rows, len(self._limited) + distances.shape[-1]))
-        limits = (self._limited, self._lower, self._upper, self._half)
-        q, rate = (np.ascontiguousarray(x, dtype=float) for x in (q, tangent[..., 0]))
-        ckernels.pieces(self._dof, q, rate, distances, gradients, *limits, self._clearance_numbers, g, dg)
+        q, rate = np.ascontiguousarray(q, float), np.ascontiguousarray(tangent[..., 0], float)
+        ckernels.pieces(
+            self._dof, q, rate, distances, gradients, *self._limits, self._clearance_numbers, g, dg
+        )
         return g, dg
 
     def term_functions(
