@@ -193,8 +193,8 @@ class Probe:
         self._centred = self._cyclic & np.isfinite(arm.lower) & np.isfinite(arm.upper)
         self._centre = np.where(self._centred, (arm.lower + arm.upper) / 2.0, 0.0)
         # (where every joint is cyclic, or centred, no np.where picks between the two)
-        self._all_cyclic, self._all_centred = bool(self._cyclic.all()), bool(self._centred.all())
         self._cyclic_flags = self._cyclic.tolist()
+        self._all_cyclic, self._all_centred = all(self._cyclic_flags), all(self._centred.tolist())
         self._work = None  # the compiled follow's arrays: a 7-DOF arm's compiled solver only
         if compiled and isinstance(solver.kernel, ckernels.Solver) and arm.dof == 7:
             self._work = FollowWork(
