@@ -121,6 +121,34 @@ def test_batched_pieces_and_points_equal_the_single_ones(seed, name, count):
             np.testing.assert_array_equal(batched.jacobian, single.jacobian)
 
 
+@settings(max_examples=10, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), name=st.sampled_from(list(HOMES)), wrapped=st.booleans())
+def test_a_probe_step_is_the_largest_joint_step(seed, name, wrapped):
+    """Probe.step (in floats) gives exactly Probe.steps' numbers (numpy's), and those are the
+    largest |b_i - a_i| with the differences of compared-modulo-2-pi joints taken to
+    [-pi, pi) by np.remainder: also differences of whole multiples of pi, or none."""
+    solver = optimizer_of(name, 0).solver
+    probe = Probe(
+        solver, optimizer_of(name, 0).objective, np.eye(4), optimizer_of(name, 0).branches[0], wrapped
+    )
+    rng = np.random.default_rng(seed)
+    a = rng.uniform(-10.0, 10.0, (40, solver.arm.dof))
+    moved = np.where(
+        rng.random(a.shape) < 0.3, rng.integers(-4, 5, a.shape) * np.pi, rng.normal(0.0, 3.0, a.shape)
+    )
+    b = a + moved * (rng.random(a.shape) < 0.9)
+    d, cyclic = b - a, solver.arm.revolute & wrapped
+    expected = np.abs(np.where(cyclic, np.remainder(d + np.pi, 2.0 * np.pi) - np.pi, d)).max(axis=1)
+    assert (
+        [probe.step(x, y) for x, y in zip(a, b, strict=True)]
+        == probe.steps(a, b).tolist()
+        == expected.tolist()
+    )
+    z = np.zeros(solver.arm.dof)
+    turned = np.where(np.arange(solver.arm.dof) == 0, 1.5 * np.pi, 0.0)
+    assert probe.step(z, turned) == pytest.approx(0.5 * np.pi if cyclic[0] else 1.5 * np.pi, abs=1e-15)
+
+
 @settings(max_examples=40, deadline=None)
 @given(
     seed=st.integers(0, 2**32 - 1),

@@ -40,6 +40,7 @@ clearance and S), and pieces :math:`v_j(q)` whose minimum it takes. The QP linea
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Any, NamedTuple
@@ -106,10 +107,11 @@ def check_weights(
         )
 
 
-@dataclass(frozen=True)
+@dataclass(slots=True)
 class Group:
     """One term of the objective: ``weight * min(cap, min_j values_j)``, feasible if
-    ``min_j values_j >= floor``.
+    ``min_j values_j >= floor``. (Not frozen, but never changed: a frozen dataclass is built
+    several times slower, and each step of a climb builds the groups of its point.)
 
     Attributes:
         kind: ``"margin"``, ``"clearance"`` or ``"singularity"``.
@@ -180,6 +182,11 @@ class Evaluation(NamedTuple):
         return self.slack >= 0.0
 
 
+#: An :class:`Evaluation` of a row of ``ckernels.evaluate``'s five numbers: ``Evaluation._make``
+#: without its length check (the kernel writes five), the cheapest way to build hundreds.
+_evaluation_of_row = functools.partial(tuple.__new__, Evaluation)
+
+
 class Objective:
     """The objective f and the feasibility test of the module docstring.
 
@@ -233,13 +240,18 @@ class Objective:
             [self.clearance_reach, self.clearance_cap, self.min_clearance / self.clearance_cap]
         )
         self._no_distances = np.zeros(0)  # ckernels.evaluate's without obstacles
-        # what ckernels.evaluate reads (csrc/objective.c)
-        self._terms = (self._limited, self._lower, self._upper, self._half, *singular, np.array(numbers))
+        # what ckernels.pieces reads of the limits, and ckernels.evaluate of every term (csrc/objective.c)
+        self._limits = (self._limited, self._lower, self._upper, self._half)
+        self._terms = (*self._limits, *singular, np.array(numbers))
         eye = np.eye(self._dof)[self._limited] / self._half[:, None]
         self._margin_jacobian = np.vstack([eye, -eye])  # pieces (q - l)/h, then (u - q)/h
 
     def groups(
-        self, q: np.ndarray, jacobian: bool = False, pairs: tuple[np.ndarray, np.ndarray] | None = None
+        self,
+        q: np.ndarray,
+        jacobian: bool = False,
+        pairs: tuple[np.ndarray, np.ndarray] | None = None,
+        tangent: np.ndarray | None = None,
     ) -> list[Group]:
         """The groups at q (module docstring): margin (if any joint is limited), clearance
         (if there are obstacles), then singularity (if given); their jacobians by q if asked.
@@ -250,17 +262,28 @@ class Objective:
             pairs: The clearance's pair distances (P,) and gradients (P, dof) at q if
                 already computed (:meth:`Clearance.distances_and_gradients
                 <om_redundant.Clearance.distances_and_gradients>`): the same groups from them.
+            tangent: (dof, r) dq/dpsi at q: the jacobians chained through it, by psi
+                (:meth:`Group.along`; implies ``jacobian``).
         """
-        singularity = [self._singularity(q, jacobian)] if self.singularity is not None else []
-        return self.constrained_groups(q, jacobian, pairs) + singularity
+        groups = self.constrained_groups(q, jacobian or tangent is not None, pairs, tangent)
+        if self.singularity is not None:
+            groups.append(self._singularity(q, jacobian or tangent is not None, tangent))
+        return groups
 
     def constrained_groups(
-        self, q: np.ndarray, jacobian: bool = False, pairs: tuple[np.ndarray, np.ndarray] | None = None
+        self,
+        q: np.ndarray,
+        jacobian: bool = False,
+        pairs: tuple[np.ndarray, np.ndarray] | None = None,
+        tangent: np.ndarray | None = None,
     ) -> list[Group]:
         """The groups of :meth:`groups` that have a floor (margin, clearance): those whose
         :meth:`Group.constraints` define feasibility."""
-        groups = [self._margin(q, jacobian)] if len(self._limited) else []
-        return groups + ([self._clearance(q, jacobian, pairs)] if self.clearance is not None else [])
+        jacobian = jacobian or tangent is not None
+        groups = [self._margin(q, jacobian, tangent)] if len(self._limited) else []
+        if self.clearance is not None:
+            groups.append(self._clearance(q, jacobian, pairs, tangent))
+        return groups
 
     def pairs(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
         """The clearance's pair distances at q and the gradients that :meth:`groups` and
@@ -298,7 +321,7 @@ class Objective:
             distances: (M, P) the rows' pair distances if already computed (with obstacles).
         """
         q = as_joint_vector(q, self._dof).reshape(-1, self._dof)
-        return list(map(Evaluation._make, self._evaluated(q, distances).tolist()))
+        return list(map(_evaluation_of_row, self._evaluated(q, distances).tolist()))
 
     def _evaluated(self, q: np.ndarray, distances: np.ndarray | None) -> np.ndarray:
         """``ckernels.evaluate`` at q, (dof,) or (M, dof): (5,) or (M, 5) the fields of
@@ -331,11 +354,12 @@ class Objective:
         rows = q.shape[:-1]
         if pairs is None:
             pairs = np.zeros((*rows, 0)), np.zeros((*rows, 0, self._dof))
-        distances, gradients = (np.ascontiguousarray(x, dtype=float) for x in pairs)
+        distances, gradients = np.ascontiguousarray(pairs[0], float), np.ascontiguousarray(pairs[1], float)
         g, dg = np.empty((2, *rows, len(self._limited) + distances.shape[-1]))
-        limits = (self._limited, self._lower, self._upper, self._half)
-        q, rate = (np.ascontiguousarray(x, dtype=float) for x in (q, tangent[..., 0]))
-        ckernels.pieces(self._dof, q, rate, distances, gradients, *limits, self._clearance_numbers, g, dg)
+        q, rate = np.ascontiguousarray(q, float), np.ascontiguousarray(tangent[..., 0], float)
+        ckernels.pieces(
+            self._dof, q, rate, distances, gradients, *self._limits, self._clearance_numbers, g, dg
+        )
         return g, dg
 
     def term_functions(
@@ -368,14 +392,19 @@ class Objective:
         """The limited joints' margins m_i at the rows of q (M, dof): (M, limited)."""
         return np.minimum(*_limit_distances(q[:, self._limited], self._lower, self._upper, self._half))
 
-    def _margin(self, q: np.ndarray, jacobian: bool) -> Group:
+    def _margin(self, q: np.ndarray, jacobian: bool, tangent: np.ndarray | None) -> Group:
         lim = self._limited
         pieces = np.concatenate(_limit_distances(q[lim], self._lower, self._upper, self._half))
-        return Group(
-            "margin", self.margin_weight, 0.0, math.inf, pieces, self._margin_jacobian if jacobian else None
-        )
+        rates = _chained(self._margin_jacobian, tangent) if jacobian else None
+        return Group("margin", self.margin_weight, 0.0, math.inf, pieces, rates)
 
-    def _clearance(self, q: np.ndarray, jacobian: bool, pairs: tuple[np.ndarray, np.ndarray] | None) -> Group:
+    def _clearance(
+        self,
+        q: np.ndarray,
+        jacobian: bool,
+        pairs: tuple[np.ndarray, np.ndarray] | None,
+        tangent: np.ndarray | None,
+    ) -> Group:
         """The clearance pieces d_k / d_cap, computed only for the pairs within 2 d_cap (the
         others report 2 with zero gradient: beyond the cap they change neither the term,
         the slack's minimum nor, far above the floor, a feasibility model); all of them
@@ -385,30 +414,48 @@ class Objective:
         floor, cap, reach = self.min_clearance / self.clearance_cap, self.clearance_cap, self.clearance_reach
         if pairs is not None:
             d, grad = pairs
-            if d.min() < reach:
+            if np.minimum.reduce(d) < reach:
                 near = d < reach
                 d = np.where(near, d, reach)
                 grad = np.where(near[:, None], grad, 0.0) if jacobian else None
-            return Group(
-                "clearance", self.clearance_weight, floor, 1.0, d / cap, grad / cap if jacobian else None
-            )
+            rates = _chained(grad / cap, tangent) if jacobian else None
+            return Group("clearance", self.clearance_weight, floor, 1.0, d / cap, rates)
         d, grad = self.clearance.distances_within(q, reach, gradient=jacobian)
-        if d.min() < reach:
-            scaled = grad / cap if jacobian else None
-            return Group("clearance", self.clearance_weight, floor, 1.0, d / cap, scaled)
-        return _capped("clearance", self.clearance_weight, floor, self.clearance, cap, q, jacobian)
+        if np.minimum.reduce(d) < reach:
+            rates = _chained(grad / cap, tangent) if jacobian else None
+            return Group("clearance", self.clearance_weight, floor, 1.0, d / cap, rates)
+        return _capped("clearance", self.clearance_weight, floor, self.clearance, cap, q, jacobian, tangent)
 
-    def _singularity(self, q: np.ndarray, jacobian: bool) -> Group:
+    def _singularity(self, q: np.ndarray, jacobian: bool, tangent: np.ndarray | None = None) -> Group:
         return _capped(
-            "singularity", self.singularity_weight, -math.inf, self.singularity, SINGULARITY_CAP, q, jacobian
+            "singularity",
+            self.singularity_weight,
+            -math.inf,
+            self.singularity,
+            SINGULARITY_CAP,
+            q,
+            jacobian,
+            tangent,
         )
 
 
 def _capped(
-    kind: str, weight: float, floor: float, source: Any, cap: float, q: np.ndarray, jacobian: bool
+    kind: str,
+    weight: float,
+    floor: float,
+    source: Any,
+    cap: float,
+    q: np.ndarray,
+    jacobian: bool,
+    tangent: np.ndarray | None = None,
 ) -> Group:
     """The group of distances capped at ``cap``: ``source.distances(q) / cap``, cap 1."""
     if jacobian:
         d, grad = source.distances_and_gradients(q)
-        return Group(kind, weight, floor, 1.0, d / cap, grad / cap)
+        return Group(kind, weight, floor, 1.0, d / cap, _chained(grad / cap, tangent))
     return Group(kind, weight, floor, 1.0, source.distances(q) / cap)
+
+
+def _chained(jacobian: np.ndarray, tangent: np.ndarray | None) -> np.ndarray:
+    """The jacobian by q, or by psi through dq/dpsi = tangent (:meth:`Group.along`)."""
+    return jacobian if tangent is None else jacobian @ tangent

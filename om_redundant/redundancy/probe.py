@@ -18,10 +18,10 @@ fails without it, as it would with it); Python builds only the point reached.
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
-from functools import cached_property
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -41,39 +41,61 @@ _ARRIVED, _SINGULAR = 0, 2  # ckernels.follow's status
 
 class _Terms:
     """The objective at a point, computed when first asked for (a path's following steps
-    need only the joints and the tangent): the clearance's pair distances and gradients
-    (one ``ckernels.arm_clearance`` call), from which the groups with their rates, the
-    evaluation and the feasibility functions. Shared by the copies of a point at other
-    representatives of psi.
+    need only the joints and the tangent), or given by a batch (:func:`evaluate_points`):
+    the clearance's pair distances and gradients (one ``ckernels.arm_clearance`` call), from
+    which the groups with their rates, the evaluation and the feasibility functions. Shared
+    by the copies of a point at other representatives of psi. (Slots, the arrays of a pair
+    each in its own: the sweep keeps hundreds of terms per pose, and each container they
+    hold would count towards the garbage collector's next pass.)
+
+    Attributes:
+        d, grad: The pairs' distances (P,) and gradients (P, dof), or None.
+        g, dg: The feasibility functions and their rates, or None.
     """
 
-    def __init__(self, objective: Objective, q: np.ndarray, tangent: np.ndarray):
-        self.objective, self.q, self.tangent = objective, q, tangent
-        self.pairs, self.groups, self.pieces = None, None, None
+    __slots__ = ("d", "dg", "evaluation", "g", "grad", "groups", "objective", "q", "tangent")
+
+    def __init__(
+        self,
+        objective: Objective,
+        q: np.ndarray,
+        tangent: np.ndarray,
+        evaluation: Evaluation | None = None,
+        g: np.ndarray | None = None,
+        dg: np.ndarray | None = None,
+        d: np.ndarray | None = None,
+        grad: np.ndarray | None = None,
+    ):
+        self.objective, self.q, self.tangent, self.evaluation = objective, q, tangent, evaluation
+        self.g, self.dg, self.d, self.grad = g, dg, d, grad
+        self.groups: list[Group] | None = None
 
     def get_pairs(self) -> tuple[np.ndarray, np.ndarray] | None:
         """The clearance's pair distances and gradients at q (:meth:`Objective.pairs`); None
         without obstacles."""
-        if self.pairs is None and self.objective.clearance is not None:
-            self.pairs = self.objective.pairs(self.q)
-        return self.pairs
+        if self.d is None:
+            if self.objective.clearance is None:
+                return None
+            self.d, self.grad = self.objective.pairs(self.q)
+        return self.d, self.grad
 
-    @cached_property
-    def evaluation(self) -> Evaluation:
-        """The objective at q (an attribute once computed: points are asked for it often)."""
-        pairs = self.get_pairs()
-        return self.objective.evaluate(self.q, None if pairs is None else pairs[0])
+    def get_evaluation(self) -> Evaluation:
+        """The objective at q."""
+        if self.evaluation is None:
+            pairs = self.get_pairs()
+            self.evaluation = self.objective.evaluate(self.q, None if pairs is None else pairs[0])
+        return self.evaluation
 
     def get_pieces(self) -> tuple[np.ndarray, np.ndarray]:
         """The feasibility functions and their rates (:meth:`Point.pieces`)."""
-        if self.pieces is None:
-            self.pieces = self.objective.pieces(self.q, self.tangent, self.get_pairs())
-        return self.pieces
+        if self.g is None:
+            self.g, self.dg = self.objective.pieces(self.q, self.tangent, self.get_pairs())
+        return self.g, self.dg
 
     def get_groups(self) -> list[Group]:
+        """The groups at q, their jacobians by psi (:meth:`Objective.groups` with the tangent)."""
         if self.groups is None:
-            groups = self.objective.groups(self.q, jacobian=True, pairs=self.get_pairs())
-            self.groups = [g.along(self.tangent) for g in groups]
+            self.groups = self.objective.groups(self.q, pairs=self.get_pairs(), tangent=self.tangent)
         return self.groups
 
 
@@ -82,28 +104,30 @@ def evaluate_points(objective: Objective, points: list[Point]) -> None:
     clearance's pair distances and gradients, their evaluations and their feasibility
     functions (what :attr:`Point.evaluation` and :meth:`Point.pieces` would compute point by
     point)."""
-    # (not yet evaluated: the cached property's value not yet in the terms' __dict__)
-    terms = list({id(p.terms): p.terms for p in points if "evaluation" not in vars(p.terms)}.values())
+    terms = list(dict.fromkeys(p.terms for p in points if p.terms.evaluation is None))  # (distinct)
     if terms:
-        _evaluate_terms(
-            objective, terms, np.array([t.q for t in terms]), np.array([t.tangent for t in terms])
-        )
+        q, tangents = np.array([t.q for t in terms]), np.array([t.tangent for t in terms])
+        for t, ev, g, dg, d, grad in zip(terms, *_evaluated(objective, q, tangents), strict=True):
+            t.evaluation, t.g, t.dg, t.d, t.grad = ev, g, dg, d, grad
 
 
-def _evaluate_terms(objective: Objective, terms: list[_Terms], q: np.ndarray, tangents: np.ndarray) -> None:
-    """:func:`evaluate_points` of distinct terms not yet evaluated, their joints q (M, dof)
-    and tangents (M, dof, 1) stacked."""
+def _evaluated(objective: Objective, q: np.ndarray, tangents: np.ndarray) -> tuple[list[Any], ...]:
+    """The terms of the rows of q (M, dof) with tangents (M, dof, 1), one call each for all
+    rows: the rows' evaluations, feasibility functions g and rates dg, pair distances d and
+    gradients grad (None without obstacles), the arrays views of the batch's, in the order
+    of :class:`_Terms`' arguments."""
     pairs = objective.pairs(q)
     evaluations = objective.evaluations(q, None if pairs is None else pairs[0])
     g, dg = objective.pieces(q, tangents, pairs)
-    per_row = [None] * len(terms) if pairs is None else zip(*pairs, strict=True)  # each row's (d, grad)
-    for t, ev, gk, dgk, pk in zip(terms, evaluations, g, dg, per_row, strict=True):
-        t.evaluation, t.pieces, t.pairs = ev, (gk, dgk), pk
+    d, grad = ([None] * len(q),) * 2 if pairs is None else pairs
+    return evaluations, list(g), list(dg), list(d), list(grad)
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(eq=False, slots=True)
 class Point:
-    """An exact solution on a branch, its objective, and their rates along psi.
+    """An exact solution on a branch, its objective, and their rates along psi. (Not frozen,
+    but never changed: a frozen dataclass is built several times slower, and the sweep builds
+    hundreds of points per pose.)
 
     Attributes:
         psi: The redundancy value (rad); an (r,) array for r > 1 redundancy variables.
@@ -129,7 +153,8 @@ class Point:
     @property
     def evaluation(self) -> Evaluation:
         """The objective at q."""
-        return self.terms.evaluation
+        evaluation = self.terms.evaluation  # (read often: the call only when not yet computed)
+        return self.terms.get_evaluation() if evaluation is None else evaluation
 
     @property
     def groups(self) -> list[Group]:
@@ -167,6 +192,9 @@ class Probe:
         self._cyclic = arm.revolute & wrapped
         self._centred = self._cyclic & np.isfinite(arm.lower) & np.isfinite(arm.upper)
         self._centre = np.where(self._centred, (arm.lower + arm.upper) / 2.0, 0.0)
+        # (where every joint is cyclic, or centred, no np.where picks between the two)
+        self._cyclic_flags = self._cyclic.tolist()
+        self._all_cyclic, self._all_centred = all(self._cyclic_flags), all(self._centred.tolist())
         self._work = None  # the compiled follow's arrays: a 7-DOF arm's compiled solver only
         if compiled and isinstance(solver.kernel, ckernels.Solver) and arm.dof == 7:
             self._work = FollowWork(
@@ -182,23 +210,26 @@ class Probe:
             )
 
     def step(self, a: np.ndarray, b: np.ndarray) -> float:
-        """The largest joint step between joint vectors a and b."""
-        return float(np.abs(self._delta(a, b)).max())
+        """The largest joint step between joint vectors a and b (:meth:`steps`' operations in
+        floats: for one pair, several times faster than numpy's)."""
+        moved = zip(a.tolist(), b.tolist(), self._cyclic_flags, strict=True)
+        return max([abs(_wrap(y - x) if cyclic else y - x) for x, y, cyclic in moved])
 
     def steps(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """:meth:`step` between the rows of a and b (M, dof)."""
-        return np.abs(self._delta(a, b)).max(axis=1, initial=0.0)
+        return np.maximum.reduce(np.abs(self._delta(a, b)), axis=1, initial=0.0)
 
     def _delta(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         d = b - a
-        return np.where(self._cyclic, _wrap(d), d)
+        return _wrap(d) if self._all_cyclic else np.where(self._cyclic, _wrap(d), d)
 
     def point(self, psi: float | np.ndarray, q: np.ndarray, solution: Solution | None = None) -> Point:
         """The point of solution q at psi, q at its representative (see the class)."""
         return self._point(psi, self._represent(q), solution)
 
     def _represent(self, q: np.ndarray) -> np.ndarray:
-        return np.where(self._centred, self._centre + _wrap(q - self._centre), q)
+        centred = self._centre + _wrap(q - self._centre)
+        return centred if self._all_centred else np.where(self._centred, centred, q)
 
     def _point(self, psi: float | np.ndarray, q: np.ndarray, solution: Solution | None) -> Point:
         tangent = self_motion_tangent(self.solver, q)
@@ -212,9 +243,11 @@ class Probe:
         bad = ~np.isfinite(tangents).all(axis=(1, 2))
         if bad.any():
             self_motion_tangent(self.solver, q[np.argmax(bad)])  # raises SingularSelfMotion
-        terms = [_Terms(self.objective, row, t) for row, t in zip(q, tangents, strict=True)]
-        _evaluate_terms(self.objective, terms, q, tangents)
-        return [Point(x, t.q, t.tangent, t) for x, t in zip(psi.tolist(), terms, strict=True)]
+        rows, rates = list(q), list(tangents)  # (each row's views, shared by its point and terms)
+        terms = map(
+            _Terms, itertools.repeat(self.objective), rows, rates, *_evaluated(self.objective, q, tangents)
+        )
+        return list(map(Point, psi.tolist(), rows, rates, terms))
 
     def at(self, psi: float | np.ndarray, hint: np.ndarray) -> Point | None:
         """The solution at psi nearest ``hint``, if there is one."""
@@ -359,8 +392,10 @@ def _predicted_end(before: list[float], now: list[float], moved: float) -> float
     return min(ahead, default=math.inf)
 
 
-def _wrap(x: np.ndarray) -> np.ndarray:
-    return np.remainder(x + math.pi, _TURN) - math.pi
+def _wrap(x: np.ndarray | float) -> np.ndarray | float:
+    """x taken to [-pi, pi): by operators, so that an array's is ``np.remainder``'s and a
+    float's the same operations in floats (Python's % rounds as ``np.remainder`` does)."""
+    return (x + math.pi) % _TURN - math.pi
 
 
 def _continuing(moved: np.ndarray, error: np.ndarray) -> np.ndarray:

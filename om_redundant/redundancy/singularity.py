@@ -24,6 +24,7 @@ within its offsets.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -103,7 +104,14 @@ class Singularity:
             (k,) distances and (k, dof) their gradients (module docstring).
         """
         x = as_joint_vector(q, self.dof)[self.joints] + self.offsets
-        sine = np.sin(x)
-        gradient = np.zeros((len(self.joints), self.dof))
-        gradient[np.arange(len(self.joints)), self.joints] = np.where(sine < 0.0, -1.0, 1.0) * np.cos(x)
-        return np.abs(sine), gradient
+        sine, slope = np.sin(x), np.cos(x)
+        np.negative(slope, out=slope, where=sine < 0.0)  # sign(sin x) cos x, +cos x where sin x = 0
+        gradient = np.zeros(len(self.joints) * self.dof)
+        gradient[self._entries] = slope
+        return np.abs(sine), gradient.reshape(len(self.joints), self.dof)
+
+    @cached_property
+    def _entries(self) -> np.ndarray:
+        """Where each singularity's derivative sits in its (k, dof) gradient, flattened: row
+        k, column j_k."""
+        return np.arange(len(self.joints)) * self.dof + self.joints
