@@ -37,6 +37,8 @@ SAME = 1e-6  # rad, max-norm: two solutions at one psi this close are one
 _AIM = 63.0 / 64.0  # of the distance to a path's predicted end, a step aimed there goes (csrc/follow.c)
 _TURN = 2.0 * math.pi
 _ARRIVED, _SINGULAR = 0, 2  # ckernels.follow's status
+_LINKED = 0  # ckernels.link_paths' status where it linked the paths
+_LINK_ROWS = 4  # per grid psi, the points that Probe.link's following may add
 
 
 class _Terms:
@@ -236,15 +238,6 @@ class Probe:
         moved = self._delta(point.q, q)
         return bool(_continuing(moved, moved - point.tangent @ np.atleast_1d(psi - point.psi)))
 
-    def continue_rows(
-        self, psi_a: np.ndarray, psi_b: np.ndarray, q_a: np.ndarray, tangent_a: np.ndarray, q_b: np.ndarray
-    ) -> np.ndarray:
-        """:meth:`continues` for M pairs at once (the same operations row by row): whether
-        the solutions (psi_b, q_b) continue the paths of (psi_a, q_a) with tangents
-        ``tangent_a`` (M, dof) (r = 1)."""
-        moved = self._delta(q_a, q_b)
-        return _continuing(moved, moved - tangent_a * (psi_b - psi_a)[:, None])
-
     def next(self, point: Point, psi: float | np.ndarray) -> Point | None:
         """The solution at psi nearest point, if it continues point's path (the objective
         evaluated only then): one attempt of :meth:`follow`'s loop."""
@@ -324,6 +317,38 @@ class Probe:
             return start, status == _ARRIVED
         q, tangent = work.q.copy(), work.t.copy()[:, None]
         return Point(reached, q, tangent, _Terms(self.objective, q, tangent)), status == _ARRIVED
+
+    def link(self, psi: np.ndarray, roots: list[list[Point]]) -> list[tuple[list[Point], int]] | None:
+        """The paths through the solutions ``roots[k]`` at the increasing grid psi[k] (within a
+        turn) that :func:`~om_redundant.redundancy.paths._link`'s loop finds, in one
+        ``ckernels.link_paths`` call (``csrc/link.c``: the same follows, in the same order, and
+        the same decisions): each path's points and turns. Python builds only the points that
+        following added. None where the solver is not a 7-DOF arm's compiled one, where a
+        follow met a fold exactly (:meth:`_follow_compiled`) or where following added more
+        than :data:`_LINK_ROWS` points per grid psi: the loop then decides."""
+        work = self._work
+        if work is None:
+            return None
+        flat = [p for points in roots for p in points]
+        counts = np.array([len(points) for points in roots], dtype=np.int64)
+        q = np.array([p.q for p in flat], dtype=float).reshape(len(flat), 7)
+        t = np.array([p.tangent[:, 0] for p in flat], dtype=float).reshape(len(flat), 7)
+        capacity = _LINK_ROWS * len(psi)
+        new_psi, new_q, new_t = np.empty(capacity), np.empty((capacity, 7)), np.empty((capacity, 7))
+        members, paths = np.empty((2, len(flat) + capacity, 2), dtype=np.int64)
+        out = np.empty(3, dtype=np.int64)
+        ckernels.link_paths(*work[:6], psi, counts, q, t, new_psi, new_q, new_t, members, paths, out)
+        status, added, n_paths = out.tolist()
+        if status != _LINKED:
+            return None
+        for x, qk, tk in zip(new_psi[:added].tolist(), new_q[:added], new_t[:added, :, None], strict=True):
+            flat.append(Point(x, qk, tk, _Terms(self.objective, qk, tk)))
+        linked, begin = [], 0
+        for end, turns in paths[:n_paths].tolist():  # (a member's k: the turns of psi it is taken at)
+            rows = members[begin:end].tolist()
+            linked.append(([flat[r].at(flat[r].psi + _TURN * k) if k else flat[r] for r, k in rows], turns))
+            begin = end
+        return linked
 
 
 class FollowWork(NamedTuple):
