@@ -109,12 +109,13 @@ typedef struct {
 
 /* The paths through the grid roots (the top of this file) into l, the joined ones and their
  * order into members/paths as link_paths outputs them. */
-static int link_roots(linker *l, int64_t n, const double *grid, const int64_t *counts, scratch *w, int64_t *members,
-                int64_t *paths) {
+static int link_roots(linker *l, int64_t n, const double *grid, const int64_t *counts, scratch *w,
+                      int64_t *members, int64_t *paths) {
     int64_t n_ongoing = 0, start = 0, reached;
     for (int64_t k = 0; k < n; k++) {
         int64_t n_candidates = 0, n_reaching = 0;
-        for (int64_t r = start; r < start + counts[k]; r++) w->candidates[n_candidates] = r, w->taken[n_candidates++] = 0;
+        for (int64_t r = start; r < start + counts[k]; r++)
+            w->candidates[n_candidates] = r, w->taken[n_candidates++] = 0;
         start += counts[k];
         for (int64_t o = 0; o < n_ongoing; o++) {
             int64_t i = w->ongoing[o], last = l->tail[i], only = n_candidates == 1 ? w->candidates[0] : -1;
@@ -198,8 +199,9 @@ static int link_roots(linker *l, int64_t n, const double *grid, const int64_t *c
             }
         }
         for (int64_t c = 0; c < n_chain; c++)
-            for (int64_t r = l->head[chain[c]]; r >= 0; r = l->next[r]) members[2 * n_members] = r, members[2 * n_members++ + 1] = c;
-        paths[2 * n_out] = n_members, paths[2 * n_out++ + 1] = loop ? n_chain : 0;
+            for (int64_t r = l->head[chain[c]]; r >= 0; r = l->next[r], n_members++)
+                members[2 * n_members] = r, members[2 * n_members + 1] = c;
+        paths[2 * n_out] = n_members, paths[2 * n_out + 1] = loop ? n_chain : 0, n_out++;
     }
     l->n_paths = n_out;
     return LINK_DONE;

@@ -13,7 +13,10 @@ call (``ckernels.follow``, ``csrc/follow.c``: the same steps and tests, the tang
 is a failed step without the bounded search, a root within a quarter of its step of the
 first-order prediction is taken without the scan for a nearer one, and a step whose
 prediction moves a joint farther than any root as near as the local one could continue
-fails without it, as it would with it); Python builds only the point reached.
+fails without it, as it would with it); Python builds only the point reached. The linking of
+a branch's grid roots into paths runs in one call too (:meth:`Probe.link`,
+``ckernels.link_paths``, ``csrc/link.c``: those follows and the decisions of
+:func:`~om_redundant.redundancy.paths._link`'s loop).
 """
 
 from __future__ import annotations
@@ -38,7 +41,6 @@ _AIM = 63.0 / 64.0  # of the distance to a path's predicted end, a step aimed th
 _TURN = 2.0 * math.pi
 _ARRIVED, _SINGULAR = 0, 2  # ckernels.follow's status
 _LINKED = 0  # ckernels.link_paths' status where it linked the paths
-_LINK_ROWS = 4  # per grid psi, the points that Probe.link's following may add
 
 
 class _Terms:
@@ -325,7 +327,9 @@ class Probe:
         the same decisions): each path's points and turns. Python builds only the points that
         following added. None where the solver is not a 7-DOF arm's compiled one, where a
         follow met a fold exactly (:meth:`_follow_compiled`) or where following added more
-        than :data:`_LINK_ROWS` points per grid psi: the loop then decides."""
+        points than the call has room for: the loop then decides. (Room for two per root and
+        one per grid psi: paths start only at listed roots and end once on each side, and a
+        root that the bounded search did not list, which a follow arrives at, is rare.)"""
         work = self._work
         if work is None:
             return None
@@ -333,7 +337,7 @@ class Probe:
         counts = np.array([len(points) for points in roots], dtype=np.int64)
         q = np.array([p.q for p in flat], dtype=float).reshape(len(flat), 7)
         t = np.array([p.tangent[:, 0] for p in flat], dtype=float).reshape(len(flat), 7)
-        capacity = _LINK_ROWS * len(psi)
+        capacity = 2 * len(flat) + len(psi)
         new_psi, new_q, new_t = np.empty(capacity), np.empty((capacity, 7)), np.empty((capacity, 7))
         members, paths = np.empty((2, len(flat) + capacity, 2), dtype=np.int64)
         out = np.empty(3, dtype=np.int64)
