@@ -81,7 +81,7 @@ bool om_continues(int dof, const double *q0, const double *q1, const double *t, 
  * merely continues (om_continues: within 1/2) may be the partner at a fold. */
 bool om_beyond_doubt(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic);
 /* The largest joint step |q1 - q0|_inf, cyclic joints (NULL: none) modulo 2 pi (Probe.step). */
-double om_joint_step(int dof, const double *q0, const double *q1, const uint8_t *cyclic);
+double om_largest_joint_step(int dof, const double *q0, const double *q1, const uint8_t *cyclic);
 
 /* follow.c: what om_follow_path answers. */
 enum { OM_FOLLOW_ARRIVED = 0, OM_FOLLOW_ENDED = 1, OM_FOLLOW_SINGULAR = 2 };

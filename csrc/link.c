@@ -96,7 +96,7 @@ static int64_t same(const linker *l, int64_t r, const int64_t *candidates, int64
     int64_t best = -1;
     double nearest = 0.0;
     for (int64_t j = 0; j < n; j++) {
-        double step = om_joint_step(7, row_q(l, r), row_q(l, candidates[j]), l->cyclic);
+        double step = om_largest_joint_step(7, row_q(l, r), row_q(l, candidates[j]), l->cyclic);
         if (best < 0 || step < nearest) best = j, nearest = step;
     }
     return best >= 0 && nearest <= SAME ? best : -1;

@@ -336,7 +336,7 @@ class Probe:
         flat = [p for points in roots for p in points]
         counts = np.array([len(points) for points in roots], dtype=np.int64)
         q = np.array([p.q for p in flat], dtype=float).reshape(len(flat), 7)
-        t = np.array([p.tangent[:, 0] for p in flat], dtype=float).reshape(len(flat), 7)
+        t = np.array([p.tangent for p in flat], dtype=float).reshape(len(flat), 7)  # (each (7, 1))
         capacity = 2 * len(flat) + len(psi)
         new_psi, new_q, new_t = np.empty(capacity), np.empty((capacity, 7)), np.empty((capacity, 7))
         members, paths = np.empty((2, len(flat) + capacity, 2), dtype=np.int64)
