@@ -356,7 +356,8 @@ class Probe:
 
 
 class FollowWork(NamedTuple):
-    """The arrays ``ckernels.follow`` reads and writes, set up once per :class:`Probe`.
+    """The arrays ``ckernels.follow`` reads and writes, set up once per :class:`Probe` (the
+    first six: the branch that ``ckernels.link_paths`` links).
 
     Attributes:
         kernel: The compiled solver.
