@@ -80,6 +80,20 @@ bool om_continues(int dof, const double *q0, const double *q1, const double *t, 
  * another path is off by the paths' separation, which no shorter step shrinks; one that
  * merely continues (om_continues: within 1/2) may be the partner at a fold. */
 bool om_beyond_doubt(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic);
+/* The largest joint step |q1 - q0|_inf, cyclic joints (NULL: none) modulo 2 pi (Probe.step). */
+double om_largest_joint_step(int dof, const double *q0, const double *q1, const uint8_t *cyclic);
+
+/* follow.c: what om_follow_path answers. */
+enum { OM_FOLLOW_ARRIVED = 0, OM_FOLLOW_ENDED = 1, OM_FOLLOW_SINGULAR = 2 };
+/* A 7-DOF branch's solution path followed from (*psi, q, t) (t = dq/dpsi) towards target
+ * (probe.py's Probe.follow), *psi, q and t updated in place to the point reached, *steps the
+ * accepted steps: OM_FOLLOW_ARRIVED there, OM_FOLLOW_ENDED where the step fell below min_step
+ * (the path ended on the way), OM_FOLLOW_SINGULAR where an accepted point has no tangent (a
+ * fold met exactly; the point reached is then the last one that has). Revolute joints are
+ * compared modulo 2 pi where cyclic, and taken nearest mid-range centre where centred. */
+int om_follow_path(const om_solver_data *s, const double *T, const int64_t *signs, const uint8_t *cyclic,
+                   const uint8_t *centred, const double *centre, double *psi, double *q, double *t, double target,
+                   double min_step, int *steps);
 
 extern PyTypeObject om_SolverType;        /* solver_type.c: Solver(SolverData) */
 /* solver_type.c: obj's data if it is a 7-DOF (S-R-S) Solver; NULL with an error naming what. */
@@ -88,6 +102,7 @@ extern PyMethodDef om_kernel_functions[]; /* functions.c: kinematics and closed 
 extern PyMethodDef om_tracking_functions[]; /* tracking.c: the redundancy optimiser's tracking step */
 extern PyMethodDef om_clearance_functions[]; /* clearance.c: distances of arm and obstacle geoms */
 extern PyMethodDef om_follow_functions[];    /* follow.c: a solution path followed along psi */
+extern PyMethodDef om_link_functions[];      /* link.c: a branch's solution paths through its grid roots */
 extern PyMethodDef om_tangent_functions[];   /* tangents.c: self-motion tangents of many rows */
 extern PyMethodDef om_objective_functions[]; /* objective.c: the redundancy optimiser's objective */
 extern PyMethodDef om_cell_functions[];      /* cells.c: the cell test of the solution paths */

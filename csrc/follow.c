@@ -1,5 +1,5 @@
 /* A solution path of one branch followed along the arm angle in one call: the loop of
- * Probe.follow (om_redundant/redundancy/paths.py) for a 7-DOF arm's compiled solver.
+ * Probe.follow (om_redundant/redundancy/probe.py) for a 7-DOF arm's compiled solver (also link.c's).
  *
  * From the point (psi_0, q_0) with tangent t_0 = dq/dpsi towards psi*: the step h starts at
  * psi* - psi_0; at x = psi_k + h (psi* once within reach) the exact solution q nearest q_k
@@ -26,7 +26,6 @@
 
 #include "binding.h"
 
-enum { FOLLOW_ARRIVED = 0, FOLLOW_ENDED = 1, FOLLOW_SINGULAR = 2 };
 enum { F_PSI, F_STATUS, F_STEPS, F_N }; /* the out vector */
 #define AIM (63.0 / 64.0) /* of the distance to a predicted end, a step aimed there goes */
 
@@ -107,23 +106,23 @@ static double predicted_end(int n, const double *f_prev, const double *f, double
     return r;
 }
 
-/* Follow from (psi, q, t) towards target; q and t are updated in place to the point reached.
- * Where the secant of an end measure predicts the path's end short of the next step, the step
+/* Follow from (psi, q, t) towards target; q and t are updated in place to the point reached
+ * (binding.h). Where the secant of an end measure predicts the path's end short of the next step, the step
  * aims just short of it instead (AIM of the way, at least 1.5 min_step): the end is then
  * approached in a few successful steps rather than by halving, each halving costing about
  * two attempts, most of them failing beyond the end, where a failed local solve is the
  * costliest. A step of 1.5 min_step that fails ends the path as the halving would (below
  * min_step); an aimed step that fails is halved, one that succeeds doubled, as any other. */
-static int follow(const om_solver_data *s, const double *T, const int64_t *signs, const uint8_t *cyclic,
-                  const uint8_t *centred, const double *centre, double *psi, double *q, double *t, double target,
-                  double min_step, int *steps) {
+int om_follow_path(const om_solver_data *s, const double *T, const int64_t *signs, const uint8_t *cyclic,
+                   const uint8_t *centred, const double *centre, double *psi, double *q, double *t, double target,
+                   double min_step, int *steps) {
     int dof = s->dof, n_ends = 1 + s->n_signs;
     double step = target - *psi, x_q[OM_MAX_DOF], x_t[OM_MAX_DOF];
     double ends[4], ends_prev[4], moved = 0.0; /* moved: psi from the point before (0: none yet) */
     end_measures(s, signs, q, t, ends);
     *steps = 0;
     while (*psi != target) {
-        if (fabs(step) < min_step) return FOLLOW_ENDED;
+        if (fabs(step) < min_step) return OM_FOLLOW_ENDED;
         double x = fabs(target - *psi) <= fabs(step) ? target : *psi + step;
         double aim = moved > 0.0 ? fmax(AIM * predicted_end(n_ends, ends_prev, ends, moved), 1.5 * min_step) : INFINITY;
         if (aim < fabs(x - *psi)) x = *psi + copysign(aim, step);
@@ -137,7 +136,7 @@ static int follow(const om_solver_data *s, const double *T, const int64_t *signs
             step = 0.5 * (x - *psi);
             continue;
         }
-        if (!om_self_motion_tangent(s, x_q, x_t, 0.0)) return FOLLOW_SINGULAR;
+        if (!om_self_motion_tangent(s, x_q, x_t, 0.0)) return OM_FOLLOW_SINGULAR;
         moved = fabs(x - *psi);
         step = 2.0 * (x - *psi);
         *psi = x;
@@ -147,7 +146,7 @@ static int follow(const om_solver_data *s, const double *T, const int64_t *signs
         end_measures(s, signs, q, t, ends);
         (*steps)++;
     }
-    return FOLLOW_ARRIVED;
+    return OM_FOLLOW_ARRIVED;
 }
 
 /* follow(solver, T, signs, cyclic, centred, centre, q, t, out, psi, target, min_step) -> None:
@@ -164,8 +163,8 @@ static PyObject *om_follow(PyObject *mod, PyObject *const *args, Py_ssize_t narg
                                {F64, 7, 1, "t"}, {F64, F_N, 1, "out"}};
     if (get_buffers(args + 1, v, sp, 8) < 0) return NULL;
     int steps = 0, status;
-    Py_BEGIN_ALLOW_THREADS status = follow(s, v[0].buf, v[1].buf, v[2].buf, v[3].buf, v[4].buf, &psi, v[5].buf,
-                                           v[6].buf, target, min_step, &steps);
+    Py_BEGIN_ALLOW_THREADS status = om_follow_path(s, v[0].buf, v[1].buf, v[2].buf, v[3].buf, v[4].buf, &psi,
+                                                   v[5].buf, v[6].buf, target, min_step, &steps);
     Py_END_ALLOW_THREADS double *out = v[7].buf;
     out[F_PSI] = psi, out[F_STATUS] = status, out[F_STEPS] = steps;
     release_buffers(v, 8);

@@ -108,6 +108,12 @@ bool om_continues(int dof, const double *q0, const double *q1, const double *t, 
     return moved <= 1.0 && error <= 0.5 * moved + 1e-6;
 }
 
+double om_largest_joint_step(int dof, const double *q0, const double *q1, const uint8_t *cyclic) {
+    double moved, error;
+    _continuation(dof, q0, q1, NULL, 0.0, cyclic, &moved, &error);
+    return moved;
+}
+
 bool om_beyond_doubt(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic) {
     double moved, error;
     _continuation(dof, q0, q1, t, d, cyclic, &moved, &error);

@@ -1,8 +1,13 @@
 """The compiled path following (``ckernels.follow``, csrc/follow.c) against the Python loop
 it replaces (``Probe(..., compiled=False).follow``): the same point reached, the same answer
-whether it arrived, on random poses and steps of both 7-DOF arms."""
+whether it arrived, on random poses and steps of both 7-DOF arms; and the compiled linking of
+a branch's grid roots into paths (``ckernels.link_paths``, csrc/link.c) against the Python
+loop (``paths._link(..., compiled=False)``): the same paths, to the bit."""
 
 from __future__ import annotations
+
+import functools
+from unittest import mock
 
 import numpy as np
 import pytest
@@ -10,7 +15,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
-from om_redundant.redundancy.probe import END_TOLERANCE, Probe
+from benchmarks.control_rate import MIN_CLEARANCE, obstacles
+from om_redundant import ckernels
+from om_redundant.redundancy import paths
+from om_redundant.redundancy.probe import END_TOLERANCE, Point, Probe
 from tests.test_redundancy_batch import optimizer_of
 
 
@@ -87,3 +95,85 @@ def test_a_path_ends_where_follow_says(seed, name, compiled):
         end, arrived = probe.follow(probe.point(psi, q), psi + side * np.pi)
         if not arrived:
             assert probe.next(end, end.psi + side * 2.0 * END_TOLERANCE) is None
+
+
+@functools.cache
+def solver_of(name: str) -> om.OMSolver:
+    return om.OMSolver(name)
+
+
+def grid_roots(name: str, seed: int) -> list[tuple[Probe, np.ndarray, list[list[Point]]]]:
+    """Every branch's (probe, grid psi, roots at each grid psi) that ``sweep_circle`` links,
+    at the pose of random joints of the arm (each joint within its limits and a turn)."""
+    solver = solver_of(name)
+    arm = solver.arm
+    q = np.random.default_rng(seed).uniform(np.maximum(arm.lower, -np.pi), np.minimum(arm.upper, np.pi))
+    T = arm.fk(q)
+    optimizer = om.RedundancyOptimizer(solver, obstacles(T[:3, 3], 1), min_clearance=MIN_CLEARANCE)
+    linked, link = [], paths._link
+
+    def recorded(probe, psi, roots):
+        linked.append((probe, psi, [list(points) for points in roots]))
+        return link(probe, psi, roots)
+
+    with mock.patch.object(paths, "_link", recorded):
+        paths.sweep_circle(
+            [optimizer._probe(T, signs) for signs in optimizer.branches], optimizer.grid_points
+        )
+    return linked
+
+
+@settings(max_examples=10, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), name=st.sampled_from(["panda", "iiwa14", "sawyer", "xarm7", "fr3"]))
+def test_compiled_link_makes_the_python_loops_paths(seed, name):
+    """On random poses of several arms, every branch's paths linked in one call are those of
+    the Python loop: the same paths, turns and points (psi, joints and tangents to the bit),
+    the grid roots themselves where the loop has them, and the call links them itself."""
+    for probe, psi, roots in grid_roots(name, seed):
+        assert probe.link(psi, [list(points) for points in roots]) is not None
+        fast = paths._link(probe, psi, [list(points) for points in roots])
+        slow = paths._link(probe, psi, [list(points) for points in roots], compiled=False)
+        grid = {id(p) for points in roots for p in points}
+        assert [path.turns for path in fast] == [path.turns for path in slow]
+        for a, b in zip(fast, slow, strict=True):
+            assert len(a.points) == len(b.points)
+            for p, r in zip(a.points, b.points, strict=True):
+                assert p.psi == r.psi and np.array_equal(p.q, r.q) and np.array_equal(p.tangent, r.tangent)
+                assert (p is r) == (id(r) in grid)
+
+
+def link_rows(probe: Probe, psi: np.ndarray, flat: list[Point], counts: np.ndarray, capacity: int):
+    """``ckernels.link_paths`` of the roots ``flat`` (counts[k] at psi[k]) with room for
+    ``capacity`` added rows: (status, rows added, paths), members, the paths' (end, turns),
+    the added rows' psi."""
+    q = np.array([p.q for p in flat], dtype=float).reshape(-1, 7)
+    t = np.array([p.tangent[:, 0] for p in flat], dtype=float).reshape(-1, 7)
+    members, ends = np.empty((2, len(flat) + capacity, 2), dtype=np.int64)
+    out = np.empty(3, dtype=np.int64)
+    rows = np.empty(capacity), np.empty((capacity, 7)), np.empty((capacity, 7))
+    ckernels.link_paths(*probe._work[:6], psi, counts, q, t, *rows, members, ends, out)
+    return out.tolist(), members, ends, rows[0]
+
+
+def test_link_paths_puts_every_row_on_one_path_and_says_when_it_has_no_room():
+    """With room for the points that following adds, every row (the roots, then those
+    points) is on exactly one path, in increasing psi along it; without room, status 2 (the
+    caller's loop decides) and no path. On every branch of a pose whose linking adds points."""
+    added_somewhere = False
+    for probe, psi, roots in grid_roots("panda", 0):
+        flat = [p for points in roots for p in points]
+        counts = np.array([len(points) for points in roots], dtype=np.int64)
+        (status, added, n_paths), members, ends, new_psi = link_rows(
+            probe, psi, flat, counts, 2 * len(flat) + len(psi)
+        )
+        assert status == 0
+        on_paths = members[: ends[n_paths - 1, 0] if n_paths else 0]
+        assert sorted(on_paths[:, 0].tolist()) == list(range(len(flat) + added))
+        row_psi = np.concatenate([[p.psi for p in flat], new_psi[:added]])
+        for begin, end in zip([0, *ends[: n_paths - 1, 0]], ends[:n_paths, 0], strict=True):
+            along = row_psi[members[begin:end, 0]] + 2.0 * np.pi * members[begin:end, 1]
+            assert (np.diff(along) > 0.0).all()
+        if added:
+            added_somewhere = True
+            assert link_rows(probe, psi, flat, counts, 0)[0] == [2, 0, 0]
+    assert added_somewhere

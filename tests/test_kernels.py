@@ -13,6 +13,7 @@ import om_redundant as om
 from om_redundant import ckernels
 from om_redundant.om.families import six_dof, srs
 from om_redundant.om.system import MAX_ROOTS, SolverData
+from om_redundant.redundancy.self_motion import self_motion_tangent
 from tests.conftest import random_q
 from tests.test_reliability import BOUNDARY_CASES
 
@@ -364,6 +365,71 @@ def test_the_climb_bindings_refuse_groups_and_indices_out_of_range():
     ):
         with pytest.raises(ValueError, match="start_bound: sizes or indices of the samples disagree"):
             bound(k, first, last, reach, columns)
+
+
+def test_link_paths_refuses_grids_counts_and_outputs_that_disagree(panda):
+    """link_paths reads counts[k] roots at grid[k] from q and t and writes its rows and paths
+    into outputs sized by the roots and the room given: counts that are negative or do not
+    add up to the roots, roots, tangents or outputs of other sizes, and a grid that is not
+    finite, increasing and within a turn are a ValueError, never a read or write past an
+    end; a consistent call links (status 0)."""
+    q0 = np.array([0.3, -0.4, 0.2, -2.0, 0.1, 1.6, 0.5])
+    configuration = panda.configuration_of(q0)
+    (psi0,) = configuration.redundancy
+    work = (
+        panda.kernel,
+        panda.arm.fk(q0),
+        np.array(configuration.signs, dtype=np.int64),
+        np.ones(7, dtype=np.uint8),
+        np.zeros(7, dtype=np.uint8),
+        np.zeros(7),
+    )
+    tangent = self_motion_tangent(panda, q0)[:, 0]
+
+    def link(
+        grid=(0.0, 0.1, 0.2), counts=(1, 0, 0), roots=1, tangents=1, room=8, q_out=8, members=9, paths=9
+    ):
+        out = np.empty(3, dtype=np.int64)
+        ckernels.link_paths(
+            *work,
+            psi0 + np.array(grid),
+            np.array(counts, dtype=np.int64),
+            np.tile(q0, (roots, 1)),
+            np.tile(tangent, (tangents, 1)),
+            np.empty(room),
+            np.empty((q_out, 7)),
+            np.empty((room, 7)),
+            np.empty((members, 2), dtype=np.int64),
+            np.empty((paths, 2), dtype=np.int64),
+            out,
+        )
+        return out
+
+    status, added, n_paths = link().tolist()
+    assert status == 0 and n_paths == 1 and 2 <= added <= 4  # (the roots at 0.1 and 0.2 unlisted)
+    assert link(counts=(0, 0, 0), roots=0, tangents=0, members=8, paths=8).tolist() == [0, 0, 0]
+    message = (
+        "link_paths: sizes of the grid, counts, roots and outputs disagree, or the grid is not "
+        "increasing within a turn"
+    )
+    for bad in [
+        {"counts": (1, 0)},
+        {"counts": (2, -1, 0)},
+        {"counts": (0, 0, 0)},
+        {"counts": (1, 1, 0)},
+        {"tangents": 2},
+        {"roots": 2, "counts": (1, 1, 0)},
+        {"q_out": 7},
+        {"members": 8},
+        {"paths": 10},
+        {"grid": (0.0, 0.2, 0.1)},
+        {"grid": (0.0, 0.0, 0.1)},
+        {"grid": (0.0, 0.1, np.nan)},
+        {"grid": (0.0, 0.1, 2.0 * np.pi)},
+        {"grid": (), "counts": (), "roots": 0, "tangents": 0, "members": 8, "paths": 8},
+    ]:
+        with pytest.raises(ValueError, match=f"^{re.escape(message)}$"):
+            link(**bad)
 
 
 def test_the_c_layouts_equal_the_python_ones():

@@ -186,21 +186,23 @@ def sweep_window(probe: Probe, center: float, hint: np.ndarray, half_width: floa
     return _with_hidden([(probe, Path(halves[0][::-1] + [start] + halves[1]))])
 
 
-def _link(probe: Probe, psi: np.ndarray, roots: list[list[Point]]) -> list[Path]:
-    """Paths through the solutions at each grid psi (module docstring)."""
+def _link(probe: Probe, psi: np.ndarray, roots: list[list[Point]], compiled: bool = True) -> list[Path]:
+    """Paths through the solutions at each grid psi (module docstring). In one call where the
+    probe follows compiled (:meth:`Probe.link`), else in the loop here, which makes the same
+    follows and decisions (``compiled=False``: the loop, the reference it is tested against)."""
+    linked = probe.link(psi, roots) if compiled else None
+    if linked is not None:
+        return [Path(points, turns) for points, turns in linked]
     n = len(psi)
     paths: list[list[Point]] = []
     first: list[int] = []  # grid index of each path's first sample
     ongoing: list[int] = []  # paths that reached the previous grid psi
-    continuing = _continuing(probe, roots)
     for k in range(n):
         taken = [False] * len(roots[k])
         reaching = []
         for i in ongoing:
             last = paths[i][-1]
-            if len(roots[k]) == 1 and (
-                continuing[last] if last in continuing else probe.continues(last, roots[k][0])
-            ):
+            if len(roots[k]) == 1 and probe.continues(last, roots[k][0]):
                 reached, arrived = roots[k][0], True  # the only solution, and it continues the path
             else:
                 reached, arrived = probe.follow(paths[i][-1], psi[k])
@@ -223,22 +225,6 @@ def _link(probe: Probe, psi: np.ndarray, roots: list[list[Point]]) -> list[Path]
                 reaching.append(len(paths) - 1)
         ongoing = reaching
     return _joined(probe, psi, paths, first, ongoing)
-
-
-def _continuing(probe: Probe, roots: list[list[Point]]) -> dict[Point, bool]:
-    """For each solution at a grid psi followed by a single one at the next: whether that one
-    continues its path (:meth:`Probe.continues`), all tested at once."""
-    flat = [p for points in roots for p in points]
-    start = np.cumsum([0] + [len(points) for points in roots]).tolist()  # each psi's first in flat
-    single = [k for k in range(1, len(roots)) if len(roots[k]) == 1]
-    pairs = [(i, start[k]) for k in single for i in range(start[k - 1], start[k])]
-    if not pairs:
-        return {}
-    a, b = (np.array(x) for x in zip(*pairs, strict=True))
-    psi = np.array([p.psi for p in flat])
-    q, tangents = np.array([p.q for p in flat]), np.array([p.tangent[:, 0] for p in flat])
-    flags = probe.continue_rows(psi[a], psi[b], q[a], tangents[a], q[b])
-    return dict(zip([flat[i] for i in a.tolist()], flags.tolist(), strict=True))
 
 
 def _joined(

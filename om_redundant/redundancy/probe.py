@@ -13,7 +13,10 @@ call (``ckernels.follow``, ``csrc/follow.c``: the same steps and tests, the tang
 is a failed step without the bounded search, a root within a quarter of its step of the
 first-order prediction is taken without the scan for a nearer one, and a step whose
 prediction moves a joint farther than any root as near as the local one could continue
-fails without it, as it would with it); Python builds only the point reached.
+fails without it, as it would with it); Python builds only the point reached. The linking of
+a branch's grid roots into paths runs in one call too (:meth:`Probe.link`,
+``ckernels.link_paths``, ``csrc/link.c``: those follows and the decisions of
+:func:`~om_redundant.redundancy.paths._link`'s loop).
 """
 
 from __future__ import annotations
@@ -37,6 +40,7 @@ SAME = 1e-6  # rad, max-norm: two solutions at one psi this close are one
 _AIM = 63.0 / 64.0  # of the distance to a path's predicted end, a step aimed there goes (csrc/follow.c)
 _TURN = 2.0 * math.pi
 _ARRIVED, _SINGULAR = 0, 2  # ckernels.follow's status
+_LINKED = 0  # ckernels.link_paths' status where it linked the paths
 
 
 class _Terms:
@@ -269,15 +273,6 @@ class Probe:
         moved = self._delta(point.q, q)
         return bool(_continuing(moved, moved - point.tangent @ np.atleast_1d(psi - point.psi)))
 
-    def continue_rows(
-        self, psi_a: np.ndarray, psi_b: np.ndarray, q_a: np.ndarray, tangent_a: np.ndarray, q_b: np.ndarray
-    ) -> np.ndarray:
-        """:meth:`continues` for M pairs at once (the same operations row by row): whether
-        the solutions (psi_b, q_b) continue the paths of (psi_a, q_a) with tangents
-        ``tangent_a`` (M, dof) (r = 1)."""
-        moved = self._delta(q_a, q_b)
-        return _continuing(moved, moved - tangent_a * (psi_b - psi_a)[:, None])
-
     def next(self, point: Point, psi: float | np.ndarray) -> Point | None:
         """The solution at psi nearest point, if it continues point's path (the objective
         evaluated only then): one attempt of :meth:`follow`'s loop."""
@@ -358,9 +353,44 @@ class Probe:
         q, tangent = work.q.copy(), work.t.copy()[:, None]
         return Point(reached, q, tangent, _Terms(self.objective, q, tangent)), status == _ARRIVED
 
+    def link(self, psi: np.ndarray, roots: list[list[Point]]) -> list[tuple[list[Point], int]] | None:
+        """The paths through the solutions ``roots[k]`` at the increasing grid psi[k] (within a
+        turn) that :func:`~om_redundant.redundancy.paths._link`'s loop finds, in one
+        ``ckernels.link_paths`` call (``csrc/link.c``: the same follows, in the same order, and
+        the same decisions): each path's points and turns. Python builds only the points that
+        following added. None where the solver is not a 7-DOF arm's compiled one, where a
+        follow met a fold exactly (:meth:`_follow_compiled`) or where following added more
+        points than the call has room for: the loop then decides. (Room for two per root and
+        one per grid psi: paths start only at listed roots and end once on each side, and a
+        root that the bounded search did not list, which a follow arrives at, is rare.)"""
+        work = self._work
+        if work is None:
+            return None
+        flat = [p for points in roots for p in points]
+        counts = np.array([len(points) for points in roots], dtype=np.int64)
+        q = np.array([p.q for p in flat], dtype=float).reshape(len(flat), 7)
+        t = np.array([p.tangent for p in flat], dtype=float).reshape(len(flat), 7)  # (each (7, 1))
+        capacity = 2 * len(flat) + len(psi)
+        new_psi, new_q, new_t = np.empty(capacity), np.empty((capacity, 7)), np.empty((capacity, 7))
+        members, paths = np.empty((2, len(flat) + capacity, 2), dtype=np.int64)
+        out = np.empty(3, dtype=np.int64)
+        ckernels.link_paths(*work[:6], psi, counts, q, t, new_psi, new_q, new_t, members, paths, out)
+        status, added, n_paths = out.tolist()
+        if status != _LINKED:
+            return None
+        for x, qk, tk in zip(new_psi[:added].tolist(), new_q[:added], new_t[:added, :, None], strict=True):
+            flat.append(Point(x, qk, tk, _Terms(self.objective, qk, tk)))
+        linked, begin = [], 0
+        for end, turns in paths[:n_paths].tolist():  # (a member's k: the turns of psi it is taken at)
+            rows = members[begin:end].tolist()
+            linked.append(([flat[r].at(flat[r].psi + _TURN * k) if k else flat[r] for r, k in rows], turns))
+            begin = end
+        return linked
+
 
 class FollowWork(NamedTuple):
-    """The arrays ``ckernels.follow`` reads and writes, set up once per :class:`Probe`.
+    """The arrays ``ckernels.follow`` reads and writes, set up once per :class:`Probe` (the
+    first six: the branch that ``ckernels.link_paths`` links).
 
     Attributes:
         kernel: The compiled solver.

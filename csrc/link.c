@@ -1,0 +1,274 @@
+/* The solution paths of one branch through its roots at the grid psi, in one call: paths.py's
+ * _link (its loop, _joined, _back_to_end and _same) for a 7-DOF arm's compiled solver, the same
+ * follows (om_follow_path, follow.c) in the same order and the same decisions.
+ *
+ * Rows: the grid roots are rows 0 .. M-1, counts[k] of them at grid psi_k in order (their psi
+ * psi_k, their joints and tangents given); the points that following adds are rows M, M + 1,
+ * ... Every row lies on one path: a root on the path that takes it or starts there, a point
+ * that following added on the path that was followed.
+ *
+ * Grid psi by grid psi, each path that reached the previous one (in the order they reached it)
+ * moves on: where psi_k has a single root that continues the path (om_continues) to it;
+ * else it is followed to psi_k: where it ends on the way, the point reached is its last; where
+ * it arrives, at the root that is the same solution (the nearest within SAME, max-norm of the
+ * joint step), else at a new root (one the bounded search did not list), which it takes unless
+ * another path took it first (then two paths met: this one stops at psi_{k-1}). The roots no
+ * path took start paths. Then the paths that reached the last grid psi are followed across
+ * +-pi to psi_0 + 2 pi and joined to the path starting at psi_0 with the same solution (one
+ * not yet joined to); the chains of joined paths are output from their heads, then the closed
+ * ones as loops; in front of a chain that is not a loop, where its first path ends, followed
+ * back from its first sample towards the grid psi before. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "binding.h"
+
+#define SAME 1e-6            /* rad, max-norm: two solutions at one psi this close are one (probe.py) */
+#define END_TOLERANCE 1e-9   /* rad: a following step below this has ended the path (probe.py) */
+#define TURN (2.0 * OM_PI)   /* (paths.py's _TURN) */
+enum { LINK_DONE = 0, LINK_SINGULAR = 1, LINK_FULL = 2 };
+enum { L_STATUS, L_ROWS, L_PATHS, L_N }; /* the out vector */
+
+/* The branch, the rows and the paths being linked. */
+typedef struct {
+    const om_solver_data *s;
+    const double *T, *centre;
+    const int64_t *signs;
+    const uint8_t *cyclic, *centred;
+    int64_t n_roots, n_rows, capacity; /* capacity: of the rows following adds */
+    const double *root_psi, *root_q, *root_t;
+    double *new_psi, *new_q, *new_t;
+    double x_psi, x_q[OM_MAX_DOF], x_t[OM_MAX_DOF]; /* the point the last follow reached */
+    int64_t *next;                                  /* per row, the next on its path (-1: none) */
+    int64_t n_paths, *head, *tail, *first;          /* per path, its first and last rows, first's grid index */
+} linker;
+
+enum { REACHED = -1 }; /* the row index of the point the last follow reached (x_psi, x_q, x_t) */
+
+static double row_psi(const linker *l, int64_t r) {
+    return r == REACHED ? l->x_psi : r < l->n_roots ? l->root_psi[r] : l->new_psi[r - l->n_roots];
+}
+static const double *row_q(const linker *l, int64_t r) {
+    return r == REACHED ? l->x_q : r < l->n_roots ? l->root_q + 7 * r : l->new_q + 7 * (r - l->n_roots);
+}
+static const double *row_t(const linker *l, int64_t r) {
+    return r == REACHED ? l->x_t : r < l->n_roots ? l->root_t + 7 * r : l->new_t + 7 * (r - l->n_roots);
+}
+
+/* Follow from row r towards target into x_*: the status, *reached the row reached (r itself
+ * where no step was taken, else REACHED). */
+static int follow_from(linker *l, int64_t r, double target, int64_t *reached) {
+    int steps;
+    l->x_psi = row_psi(l, r);
+    memcpy(l->x_q, row_q(l, r), sizeof(double) * 7);
+    memcpy(l->x_t, row_t(l, r), sizeof(double) * 7);
+    int status = om_follow_path(l->s, l->T, l->signs, l->cyclic, l->centred, l->centre, &l->x_psi, l->x_q, l->x_t,
+                                target, END_TOLERANCE, &steps);
+    *reached = steps == 0 ? r : REACHED;
+    return status;
+}
+
+/* The point the last follow reached as a new row (-1 where the rows are full). */
+static int64_t add_reached(linker *l) {
+    int64_t i = l->n_rows - l->n_roots;
+    if (i >= l->capacity) return -1;
+    l->new_psi[i] = l->x_psi;
+    memcpy(l->new_q + 7 * i, l->x_q, sizeof(double) * 7);
+    memcpy(l->new_t + 7 * i, l->x_t, sizeof(double) * 7);
+    l->next[l->n_rows] = -1;
+    return l->n_rows++;
+}
+
+static void append(linker *l, int64_t path, int64_t r) {
+    l->next[l->tail[path]] = r, l->next[r] = -1, l->tail[path] = r;
+}
+
+static int64_t start_path(linker *l, int64_t k, int64_t r) {
+    l->head[l->n_paths] = l->tail[l->n_paths] = r, l->first[l->n_paths] = k, l->next[r] = -1;
+    return l->n_paths++;
+}
+
+/* The index of the candidate row that is the same solution as row r (itself, else the first
+ * nearest within SAME: paths.py's _same), -1 if none. */
+static int64_t same(const linker *l, int64_t r, const int64_t *candidates, int64_t n) {
+    for (int64_t j = 0; j < n; j++)
+        if (candidates[j] == r) return j;
+    int64_t best = -1;
+    double nearest = 0.0;
+    for (int64_t j = 0; j < n; j++) {
+        double step = om_largest_joint_step(7, row_q(l, r), row_q(l, candidates[j]), l->cyclic);
+        if (best < 0 || step < nearest) best = j, nearest = step;
+    }
+    return best >= 0 && nearest <= SAME ? best : -1;
+}
+
+/* What work (8 N entries, N = the rows' capacity) holds while linking. */
+typedef struct {
+    int64_t *ongoing, *reaching, *candidates, *taken, *following, *joined, *seen, *chain;
+} scratch;
+
+/* The paths through the grid roots (the top of this file) into l, the joined ones and their
+ * order into members/paths as link_paths outputs them. */
+static int link_roots(linker *l, int64_t n, const double *grid, const int64_t *counts, scratch *w,
+                      int64_t *members, int64_t *paths) {
+    int64_t n_ongoing = 0, start = 0, reached;
+    for (int64_t k = 0; k < n; k++) {
+        int64_t n_candidates = 0, n_reaching = 0;
+        for (int64_t r = start; r < start + counts[k]; r++)
+            w->candidates[n_candidates] = r, w->taken[n_candidates++] = 0;
+        start += counts[k];
+        for (int64_t o = 0; o < n_ongoing; o++) {
+            int64_t i = w->ongoing[o], last = l->tail[i], only = n_candidates == 1 ? w->candidates[0] : -1;
+            bool arrived = only >= 0 && om_continues(7, row_q(l, last), row_q(l, only), row_t(l, last),
+                                                     row_psi(l, only) - row_psi(l, last), l->cyclic);
+            if (arrived) /* the only solution, and it continues the path */
+                reached = only;
+            else {
+                int status = follow_from(l, last, grid[k], &reached);
+                if (status == OM_FOLLOW_SINGULAR) return LINK_SINGULAR;
+                arrived = status == OM_FOLLOW_ARRIVED;
+            }
+            if (!arrived) {
+                if (reached == REACHED) {
+                    int64_t r = add_reached(l);
+                    if (r < 0) return LINK_FULL;
+                    append(l, i, r);
+                }
+                continue;
+            }
+            int64_t j = same(l, reached, w->candidates, n_candidates);
+            if (j < 0) { /* a solution the bounded search did not list (a follow's: grid[k] is not last's psi) */
+                int64_t r = add_reached(l);
+                if (r < 0) return LINK_FULL;
+                w->candidates[n_candidates] = r, w->taken[n_candidates] = 0, j = n_candidates++;
+            }
+            if (!w->taken[j]) { /* (else two paths met: this one stops here) */
+                w->taken[j] = 1;
+                append(l, i, w->candidates[j]);
+                w->reaching[n_reaching++] = i;
+            }
+        }
+        for (int64_t j = 0; j < n_candidates; j++)
+            if (!w->taken[j]) w->reaching[n_reaching++] = start_path(l, k, w->candidates[j]);
+        int64_t *swap = w->ongoing;
+        w->ongoing = w->reaching, w->reaching = swap, n_ongoing = n_reaching;
+    }
+    /* _joined: following[i], the path that path i continues into across +-pi (-1: none) */
+    for (int64_t i = 0; i < l->n_paths; i++) w->following[i] = -1, w->joined[i] = 0, w->seen[i] = 0;
+    int64_t *keys = w->reaching, n_keys = 0, *starts = w->candidates, *heads = w->taken;
+    for (int64_t o = 0; o < n_ongoing; o++) {
+        int64_t i = w->ongoing[o];
+        int status = follow_from(l, l->tail[i], grid[0] + TURN, &reached);
+        if (status == OM_FOLLOW_SINGULAR) return LINK_SINGULAR;
+        if (status == OM_FOLLOW_ARRIVED) {
+            int64_t n_starts = 0;
+            for (int64_t j = 0; j < l->n_paths; j++)
+                if (l->first[j] == 0 && !w->joined[j]) starts[n_starts] = j, heads[n_starts++] = l->head[j];
+            int64_t j = same(l, reached, heads, n_starts);
+            if (j >= 0) w->following[i] = starts[j], w->joined[starts[j]] = 1, keys[n_keys++] = i;
+        } else if (reached == REACHED) {
+            int64_t r = add_reached(l);
+            if (r < 0) return LINK_FULL;
+            append(l, i, r);
+        }
+    }
+    /* the chains from their heads (the paths not joined to), then the loops */
+    int64_t n_out = 0, n_members = 0;
+    for (int64_t h = 0; h < l->n_paths + n_keys; h++) {
+        int64_t head = h < l->n_paths ? h : keys[h - l->n_paths];
+        if ((h < l->n_paths && w->joined[head]) || w->seen[head]) continue;
+        int64_t n_chain = 1, *chain = w->chain;
+        chain[0] = head;
+        for (;;) {
+            int64_t to = w->following[chain[n_chain - 1]];
+            bool in_chain = to < 0;
+            for (int64_t c = 0; c < n_chain && !in_chain; c++) in_chain = chain[c] == to;
+            if (in_chain) break;
+            chain[n_chain++] = to;
+        }
+        for (int64_t c = 0; c < n_chain; c++) w->seen[chain[c]] = 1;
+        bool loop = w->following[chain[n_chain - 1]] == chain[0];
+        if (!loop) { /* _back_to_end: where it ends before its first grid sample */
+            int64_t k = l->first[chain[0]], first_row = l->head[chain[0]];
+            int status = follow_from(l, first_row, k > 0 ? grid[k - 1] : grid[n - 1] - TURN, &reached);
+            if (status == OM_FOLLOW_SINGULAR) return LINK_SINGULAR;
+            if (reached == REACHED) {
+                int64_t r = add_reached(l);
+                if (r < 0) return LINK_FULL;
+                l->next[r] = first_row, l->head[chain[0]] = r;
+            }
+        }
+        for (int64_t c = 0; c < n_chain; c++)
+            for (int64_t r = l->head[chain[c]]; r >= 0; r = l->next[r], n_members++)
+                members[2 * n_members] = r, members[2 * n_members + 1] = c;
+        paths[2 * n_out] = n_members, paths[2 * n_out + 1] = loop ? n_chain : 0, n_out++;
+    }
+    l->n_paths = n_out;
+    return LINK_DONE;
+}
+
+/* link_paths(solver, T, signs, cyclic, centred, centre, grid, counts, q, t, psi_out, q_out,
+ * t_out, members, paths, out) -> None: the branch's paths through its roots (the top of this
+ * file): the roots' joints q and tangents t (M, 7), counts[k] of them at grid[k] (n, increasing,
+ * within a turn); the rows that following adds into psi_out (R), q_out and t_out (R, 7); each
+ * path's rows, in order, into members (M + R, 2: the row, and the turns of psi it is taken
+ * at), and into paths (M + R, 2) where its members end and its turns (a loop's, else 0); out =
+ * (status: 0 done, 1 a follow met a fold exactly, 2 more than R rows added; the rows added,
+ * the paths). The caller's loop decides where the status is not 0. */
+static PyObject *om_link_paths(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 16, "link_paths") < 0) return NULL;
+    const om_solver_data *s = om_srs7_solver(args[0], "link_paths");
+    if (s == NULL) return NULL;
+    Py_buffer v[15];
+    const buffer_spec sp[15] = {
+        {F64, 16, 0, "T"},      {I64, s->n_signs, 0, "signs"}, {U8, 7, 0, "cyclic"},      {U8, 7, 0, "centred"},
+        {F64, 7, 0, "centre"},  {F64, -1, 0, "grid"},          {I64, -1, 0, "counts"},     {F64, -1, 0, "q"},
+        {F64, -1, 0, "t"},      {F64, -1, 1, "psi_out"},       {F64, -1, 1, "q_out"},      {F64, -1, 1, "t_out"},
+        {I64, -1, 1, "members"}, {I64, -1, 1, "paths"},        {I64, L_N, 1, "out"},
+    };
+    if (get_buffers(args + 1, v, sp, 15) < 0) return NULL;
+    const double *grid = v[5].buf;
+    const int64_t *counts = v[6].buf;
+    Py_ssize_t n = v[6].len / 8, m = v[7].len / 8 / 7, capacity = v[9].len / 8, rows = m + capacity, total = 0;
+    bool ok = n >= 1 && v[5].len / 8 == n && v[7].len == 8 * 7 * m && v[8].len == v[7].len;
+    ok = ok && v[10].len == 8 * 7 * capacity && v[11].len == v[10].len && v[12].len == 8 * 2 * rows &&
+         v[13].len == v[12].len;
+    for (Py_ssize_t k = 0; ok && k < n; k++) {
+        ok = counts[k] >= 0 && counts[k] <= m && isfinite(grid[k]) && (k == 0 || grid[k] > grid[k - 1]);
+        total += ok ? counts[k] : 0;
+    }
+    if (!ok || total != m || !(grid[n - 1] - grid[0] < TURN)) {
+        release_buffers(v, 15);
+        PyErr_SetString(PyExc_ValueError, "link_paths: sizes of the grid, counts, roots and outputs disagree, or "
+                                          "the grid is not increasing within a turn");
+        return NULL;
+    }
+    int64_t *work = malloc(sizeof(int64_t) * (size_t)(12 * rows + 1));
+    double *root_psi = malloc(sizeof(double) * (size_t)(m + 1));
+    if (!work || !root_psi) {
+        free(work), free(root_psi), release_buffers(v, 15);
+        return PyErr_NoMemory();
+    }
+    for (Py_ssize_t k = 0, r = 0; k < n; k++)
+        for (int64_t c = 0; c < counts[k]; c++) root_psi[r++] = grid[k];
+    linker l = {.s = s, .T = v[0].buf, .signs = v[1].buf, .cyclic = v[2].buf, .centred = v[3].buf,
+                .centre = v[4].buf, .n_roots = m, .n_rows = m, .capacity = capacity, .root_psi = root_psi,
+                .root_q = v[7].buf, .root_t = v[8].buf, .new_psi = v[9].buf, .new_q = v[10].buf, .new_t = v[11].buf,
+                .next = work, .n_paths = 0, .head = work + rows, .tail = work + 2 * rows, .first = work + 3 * rows};
+    scratch w = {work + 4 * rows, work + 5 * rows, work + 6 * rows, work + 7 * rows,
+                 work + 8 * rows, work + 9 * rows, work + 10 * rows, work + 11 * rows};
+    int status;
+    Py_BEGIN_ALLOW_THREADS status = link_roots(&l, n, grid, counts, &w, v[12].buf, v[13].buf);
+    Py_END_ALLOW_THREADS int64_t *out = v[14].buf;
+    out[L_STATUS] = status, out[L_ROWS] = l.n_rows - m, out[L_PATHS] = status == LINK_DONE ? l.n_paths : 0;
+    free(work), free(root_psi);
+    release_buffers(v, 15);
+    Py_RETURN_NONE;
+}
+
+PyMethodDef om_link_functions[] = {
+    {"link_paths", (PyCFunction)(void (*)(void))om_link_paths, METH_FASTCALL,
+     "link_paths(solver, T, signs, cyclic, centred, centre, grid, counts, q, t, psi_out, q_out, t_out, members, "
+     "paths, out) -> None"},
+    {NULL, NULL, 0, NULL},
+};
