@@ -104,11 +104,33 @@ static inline double _model(const cell_models *c, Py_ssize_t j, Py_ssize_t k)
            c->db[j] * c->span * c->H[3 * N + k];
 }
 
-/* Whether piece j's model stays above `slack` over the cell by paths.py's _quiet bound
+/* Whether piece j's model stays above `slack` over the cell by cell_looks' quiet bound
  * (min(ga, gb) - 4/27 span (|da| + |db|)). */
 static inline bool _calm(const cell_models *c, Py_ssize_t j, double slack)
 {
     return fmin(c->ga[j], c->gb[j]) - 4.0 / 27.0 * fabs(c->span) * (fabs(c->da[j]) + fabs(c->db[j])) > slack;
+}
+
+/* The pattern's surprise of surprise()'s docstring below for the cell c with ends feasible
+ * fa, fb: the fraction, or -1 where there is none; live: room for c->n piece indices. */
+static double _surprise(const cell_models *c, int fa, int fb, double slack, Py_ssize_t *live)
+{
+    Py_ssize_t n = c->n, N = c->N, m = 0;
+    for (Py_ssize_t j = 0; j < n; j++)
+        if (!_calm(c, j, slack)) live[m++] = j;
+    Py_ssize_t changes[2], count = 0, allowed = fa != fb;
+    int previous = fa;
+    for (Py_ssize_t k = 0; k <= N && count < 2; k++) { /* (the first two changes tell) */
+        int feasible = fb;
+        if (k < N) {
+            feasible = 1;
+            for (Py_ssize_t i = 0; i < m && feasible; i++) feasible = _model(c, live[i], k) >= 0.0;
+        }
+        if (feasible != previous) changes[count++] = k;
+        previous = feasible;
+    }
+    if (count <= allowed) return -1.0;
+    return (double)(changes[0] + 1 + changes[1]) / 2.0 / (double)(N + 1);
 }
 
 /* surprise(ga, da, gb, db, span, hermite, feasible_a, feasible_b, slack) -> fraction or None:
@@ -116,8 +138,8 @@ static inline bool _calm(const cell_models *c, Py_ssize_t j, double slack)
  * points s of hermite (4 x N, the basis there); the pattern (feasible_a, all_j m_j >= 0 at
  * each point, feasible_b); None if it changes no more often than its ends (0 times if
  * alike, once if not), else the middle of the first stretch between changes as a fraction
- * of the pattern. A piece whose model stays above `slack` by the bound of paths.py's _quiet
- * cannot change it and is not evaluated (_calm). */
+ * of the pattern. A piece whose model stays above `slack` by the bound of cell_looks'
+ * quiet test cannot change it and is not evaluated (_calm). */
 static PyObject *om_surprise(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
     if (check_nargs(nargs, 9, "surprise") < 0) return NULL;
     double span = PyFloat_AsDouble(args[4]), slack = PyFloat_AsDouble(args[8]);
@@ -126,29 +148,129 @@ static PyObject *om_surprise(PyObject *mod, PyObject *const *args, Py_ssize_t na
     Py_buffer v[5];
     cell_models c;
     if (_cell_models(args, span, "surprise", v, &c) < 0) return NULL;
-    Py_ssize_t n = c.n, N = c.N;
-    Py_ssize_t *live = PyMem_Malloc((n ? n : 1) * sizeof(Py_ssize_t)), m = 0;
+    Py_ssize_t *live = PyMem_Malloc((c.n ? c.n : 1) * sizeof(Py_ssize_t));
     if (!live) {
         release_buffers(v, 5);
         return PyErr_NoMemory();
     }
-    for (Py_ssize_t j = 0; j < n; j++)
-        if (!_calm(&c, j, slack)) live[m++] = j;
-    Py_ssize_t changes[2], count = 0, allowed = fa != fb;
-    int previous = fa;
-    for (Py_ssize_t k = 0; k <= N && count < 2; k++) { /* (the first two changes tell) */
-        int feasible = fb;
-        if (k < N) {
-            feasible = 1;
-            for (Py_ssize_t i = 0; i < m && feasible; i++) feasible = _model(&c, live[i], k) >= 0.0;
-        }
-        if (feasible != previous) changes[count++] = k;
-        previous = feasible;
-    }
+    double found = _surprise(&c, fa, fb, slack, live);
     PyMem_Free(live);
     release_buffers(v, 5);
-    if (count <= allowed) Py_RETURN_NONE;
-    return PyFloat_FromDouble((double)(changes[0] + 1 + changes[1]) / 2.0 / (double)(N + 1));
+    if (found < 0.0) Py_RETURN_NONE;
+    return PyFloat_FromDouble(found);
+}
+
+/* The largest joint step from a to b, max_i |d_i| with d = b - a, a cyclic joint's d taken
+ * as numpy's remainder(d + pi, 2 pi) - pi (probe.py's Probe.steps, the same operations:
+ * remainder is fmod moved onto the divisor's side, a NaN step is NaN). */
+static double _joint_step(Py_ssize_t dof, const uint8_t *cyclic, const double *a, const double *b)
+{
+    double largest = 0.0;
+    for (Py_ssize_t i = 0; i < dof; i++) {
+        double d = b[i] - a[i];
+        if (cyclic[i]) {
+            double r = fmod(d + OM_PI, 2.0 * OM_PI);
+            if (r != 0.0) {
+                if (r < 0.0) r += 2.0 * OM_PI;
+            } else {
+                r = 0.0; /* (+0: the divisor's sign) */
+            }
+            d = r - OM_PI;
+        }
+        d = fabs(d);
+        if (isnan(d)) return d;
+        if (d > largest) largest = d;
+    }
+    return largest;
+}
+
+/* joint_step(cyclic, a, b) -> float: the largest joint step from a to b (dof,), the cyclic
+ * (bool, dof) joints compared modulo 2 pi (probe.py's Probe.step). */
+static PyObject *om_joint_step(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 3, "joint_step") < 0) return NULL;
+    Py_buffer v[3];
+    const buffer_spec sp[3] = {{U8, -1, 0, "cyclic"}, {F64, -1, 0, "a"}, {F64, -1, 0, "b"}};
+    if (get_buffers(args, v, sp, 3) < 0) return NULL;
+    Py_ssize_t dof = v[0].len;
+    if (v[1].len != dof * 8 || v[2].len != dof * 8) {
+        release_buffers(v, 3);
+        PyErr_SetString(PyExc_ValueError, "joint_step: sizes of cyclic, a and b disagree");
+        return NULL;
+    }
+    double step = _joint_step(dof, v[0].buf, v[1].buf, v[2].buf);
+    release_buffers(v, 3);
+    return PyFloat_FromDouble(step);
+}
+
+/* Whether the cell c with ends feasible fa, fb is quiet by the bounds of cell_looks. The
+ * minimum and maximum propagate NaN as numpy's do. */
+static bool _quiet(const cell_models *c, int fa, int fb, double slack)
+{
+    if (fa != fb) return false;
+    for (Py_ssize_t j = 0; j < c->n; j++) {
+        double ga = c->ga[j], gb = c->gb[j];
+        double spread = 4.0 / 27.0 * fabs(c->span) * (fabs(c->da[j]) + fabs(c->db[j])) + slack;
+        bool nan = isnan(ga) || isnan(gb);
+        if (fa && !((nan ? NAN : fmin(ga, gb)) - spread > 0.0)) return false; /* a model may dip */
+        if (!fa && (nan ? NAN : fmax(ga, gb)) + spread < 0.0) return true;   /* one stays below */
+    }
+    return fa;
+}
+
+/* cell_looks(q, psi, g, dg, feasible, cyclic, fine_step, slack, hermite, steps, first) -> None:
+ * the first tests of the cells between the K neighbouring samples of a path (paths.py's
+ * _with_hidden), samples k, k + 1 for cell k: their joints q (K x dof), psi (K,), their
+ * feasibility functions g and rates dg (K x n, Point.pieces) and feasibility (bool, K);
+ * cyclic (bool, dof) the joints compared modulo 2 pi. Into steps (K - 1,) each cell's
+ * largest joint step (joint_step); into first (K - 1,) where _hidden first samples the
+ * cell: NaN where it does not look inside, the cell being calm (no step above fine_step,
+ * and the bounds of its cubic models quiet), or where surprise finds nothing; 1/2 where a
+ * step is above fine_step; else surprise's fraction. Quiet: on [0, 1] the Hermite basis
+ * functions of the values are >= 0 and sum to 1 and those of the slopes stay within 4/27
+ * in size, so a model lies within (4/27) |span| (|g'_a| + |g'_b|) (+ slack, for rounding)
+ * of the ends' range: both ends feasible and every model stays > 0, or both infeasible and
+ * one function's model stays < 0; then surprise finds no change (it skips the pieces that
+ * this bound keeps positive). */
+static PyObject *om_cell_looks(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 11, "cell_looks") < 0) return NULL;
+    double fine = PyFloat_AsDouble(args[6]), slack = PyFloat_AsDouble(args[7]);
+    if (PyErr_Occurred()) return NULL;
+    Py_buffer v[9];
+    const buffer_spec sp[9] = {{F64, -1, 0, "q"},       {F64, -1, 0, "psi"},     {F64, -1, 0, "g"},
+                               {F64, -1, 0, "dg"},      {U8, -1, 0, "feasible"}, {U8, -1, 0, "cyclic"},
+                               {F64, -1, 0, "hermite"}, {F64, -1, 1, "steps"},   {F64, -1, 1, "first"}};
+    PyObject *const objs[9] = {args[0], args[1], args[2], args[3], args[4], args[5], args[8], args[9], args[10]};
+    if (get_buffers(objs, v, sp, 9) < 0) return NULL;
+    Py_ssize_t K = v[1].len / 8, dof = v[5].len, N = v[6].len / 32;
+    Py_ssize_t n = K ? v[2].len / 8 / K : 0, cells = K ? K - 1 : 0;
+    int bad = v[0].len != K * dof * 8 || v[2].len != K * n * 8 || v[3].len != K * n * 8 || v[4].len != K ||
+              v[6].len != N * 32 || v[7].len != cells * 8 || v[8].len != cells * 8;
+    Py_ssize_t *live = bad ? NULL : PyMem_Malloc((n ? n : 1) * sizeof(Py_ssize_t));
+    if (bad || !live) {
+        release_buffers(v, 9);
+        if (bad) PyErr_SetString(PyExc_ValueError, "cell_looks: sizes of the samples, cyclic or the outputs disagree");
+        return bad ? NULL : PyErr_NoMemory();
+    }
+    const double *q = v[0].buf, *psi = v[1].buf, *g = v[2].buf, *dg = v[3].buf;
+    const uint8_t *feasible = v[4].buf, *cyclic = v[5].buf;
+    double *steps = v[7].buf, *first = v[8].buf;
+    for (Py_ssize_t k = 0; k < cells; k++) {
+        cell_models c = {g + k * n, dg + k * n, g + (k + 1) * n, dg + (k + 1) * n, v[6].buf, psi[k + 1] - psi[k], n, N};
+        int fa = feasible[k] != 0, fb = feasible[k + 1] != 0;
+        double step = _joint_step(dof, cyclic, q + k * dof, q + (k + 1) * dof);
+        steps[k] = step;
+        if (step <= fine && _quiet(&c, fa, fb, slack))
+            first[k] = NAN;
+        else if (step > fine)
+            first[k] = 0.5;
+        else {
+            double t = n ? _surprise(&c, fa, fb, slack, live) : -1.0;
+            first[k] = t < 0.0 ? NAN : t;
+        }
+    }
+    PyMem_Free(live);
+    release_buffers(v, 9);
+    Py_RETURN_NONE;
 }
 
 /* crossing(ga, da, gb, db, span, hermite) -> fraction or None: where the first of surprise's
@@ -196,5 +318,8 @@ PyMethodDef om_cell_functions[] = {
      "surprise(ga, da, gb, db, span, hermite, feasible_a, feasible_b, slack) -> fraction or None"},
     {"crossing", (PyCFunction)(void (*)(void))om_crossing, METH_FASTCALL,
      "crossing(ga, da, gb, db, span, hermite) -> fraction or None"},
+    {"joint_step", (PyCFunction)(void (*)(void))om_joint_step, METH_FASTCALL, "joint_step(cyclic, a, b) -> float"},
+    {"cell_looks", (PyCFunction)(void (*)(void))om_cell_looks, METH_FASTCALL,
+     "cell_looks(q, psi, g, dg, feasible, cyclic, fine_step, slack, hermite, steps, first) -> None"},
     {NULL, NULL, 0, NULL},
 };

@@ -1,20 +1,24 @@
-"""The compiled cell test of the global choose's solution paths (``ckernels.pieces`` and
-``ckernels.surprise``, csrc/cells.c) against the numpy it replaces: the feasibility functions
-of the margin and clearance groups and their rates, and where the cubic Hermite models of a
-cell predict a feasibility its ends do not explain."""
+"""The compiled cell test of the global choose's solution paths (``ckernels.pieces``,
+``ckernels.surprise``, ``ckernels.joint_step`` and ``ckernels.cell_looks``, csrc/cells.c)
+against the numpy it replaces: the feasibility functions of the margin and clearance groups
+and their rates, where the cubic Hermite models of a cell predict a feasibility its ends do
+not explain, the largest joint step, and the first tests of every cell of a path."""
 
 from __future__ import annotations
 
 import functools
+import itertools
+import math
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
 from benchmarks.control_rate import HOMES, MIN_CLEARANCE, obstacles
 from om_redundant import ckernels
-from om_redundant.redundancy.paths import _BOUND_SLACK, _HERMITE, _quiet
+from om_redundant.redundancy.paths import _BOUND_SLACK, _HERMITE, FINE_STEP
 from om_redundant.redundancy.self_motion import self_motion_tangents
 
 
@@ -100,16 +104,116 @@ def test_crossing_is_numpys(seed, pieces, span):
         assert 0.0 <= got <= 1.0 and abs(got - want) <= 1e-12
 
 
+def quiet_numpy(span, ga, da, gb, db, feasible_a, feasible_b):
+    """The reference of cell_looks' quiet test, cells (rows) at once: a model lies within
+    (4/27) |span| (|g'_a| + |g'_b|) of the ends' range; quiet: both ends feasible and every
+    model stays > 0, or both infeasible and one function's model stays < 0."""
+    spread = 4.0 / 27.0 * np.abs(span)[:, None] * (np.abs(da) + np.abs(db)) + _BOUND_SLACK
+    clear = (np.minimum(ga, gb) - spread > 0.0).all(axis=1)
+    blocked = (np.maximum(ga, gb) + spread < 0.0).any(axis=1)
+    return (feasible_a == feasible_b) & np.where(feasible_a, clear, blocked)
+
+
+def steps_numpy(cyclic, a, b):
+    """The reference of joint_step, rows at once: Probe.steps' operations."""
+    d = b - a
+    d = np.where(cyclic, np.remainder(d + math.pi, 2.0 * math.pi) - math.pi, d)
+    return np.abs(d).max(axis=1, initial=0.0)
+
+
+def looks_numpy(q, psi, g, dg, feasible, cyclic):
+    """The reference of cell_looks: each cell's step, and NaN where it is calm (no step above
+    FINE_STEP, quiet), 1/2 where a step is above FINE_STEP, else the numpy surprise (NaN for
+    none)."""
+    steps = steps_numpy(cyclic, q[:-1], q[1:])
+    quiet = quiet_numpy(psi[1:] - psi[:-1], g[:-1], dg[:-1], g[1:], dg[1:], feasible[:-1], feasible[1:])
+    first = []
+    for k in range(len(steps)):
+        if steps[k] <= FINE_STEP and quiet[k]:
+            first.append(np.nan)
+        elif steps[k] > FINE_STEP:
+            first.append(0.5)
+        else:
+            t = surprise_numpy(
+                g[k], dg[k], g[k + 1], dg[k + 1], psi[k + 1] - psi[k], feasible[k], feasible[k + 1]
+            )
+            first.append(np.nan if t is None or g.shape[1] == 0 else t)
+    return steps, np.array(first)
+
+
+def cell_looks(q, psi, g, dg, feasible, cyclic):
+    steps, first = np.full((2, max(len(psi) - 1, 0)), -7.0)
+    ckernels.cell_looks(q, psi, g, dg, feasible, cyclic, FINE_STEP, _BOUND_SLACK, _HERMITE, steps, first)
+    return steps, first
+
+
 @settings(max_examples=300, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1), pieces=st.integers(1, 12), span=st.floats(-1.0, 1.0))
 def test_a_quiet_cell_has_no_surprise(seed, pieces, span):
-    """paths._quiet's bounds: where they call a cell quiet, ckernels.surprise finds no change
+    """cell_looks' bounds: where they call a cell quiet, ckernels.surprise finds no change
     that its ends do not explain (so skipping its look changes no sample); cells drawn near
-    the bounds' edge (values small against the slopes), ends feasible or not as they say."""
+    the bounds' edge (values small against the slopes), ends feasible or not as they say;
+    and the bounds are numpy's (quiet_numpy)."""
     rng = np.random.default_rng(seed)
     ga, gb = rng.normal(0.05, 0.3, (2, pieces))
     da, db = rng.normal(0.0, 0.5 / max(abs(span), 1e-6), (2, pieces))
     fa, fb = bool((ga >= 0).all()), bool((gb >= 0).all())
-    quiet = _quiet(np.array([span]), ga[None], da[None], gb[None], db[None], np.array([fa]), np.array([fb]))
+    q, cyclic = np.zeros((2, 7)), np.ones(7, dtype=bool)  # (no step: the looks are the bounds')
+    _, first = cell_looks(
+        q, np.array([0.0, span]), np.array([ga, gb]), np.array([da, db]), np.array([fa, fb]), cyclic
+    )
+    quiet = quiet_numpy(
+        np.array([span]), ga[None], da[None], gb[None], db[None], np.array([fa]), np.array([fb])
+    )
+    surprise = ckernels.surprise(ga, da, gb, db, span, _HERMITE, fa, fb, _BOUND_SLACK)
+    assert np.isnan(first[0]) == (quiet[0] or surprise is None)
     if quiet[0]:
-        assert ckernels.surprise(ga, da, gb, db, span, _HERMITE, fa, fb, _BOUND_SLACK) is None
+        assert surprise is None
+
+
+@settings(max_examples=300, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), dof=st.integers(1, 7), scale=st.sampled_from([0.1, 1.0, 10.0, 1e3]))
+def test_joint_step_is_probe_steps(seed, dof, scale):
+    """ckernels.joint_step is Probe.steps' numpy to the bit: joints drawn far apart (turns
+    of the cyclic ones) and at exact multiples of pi apart, where the remainder's sign rule
+    decides."""
+    rng = np.random.default_rng(seed)
+    cyclic = rng.random(dof) < 0.7
+    a = rng.normal(0.0, scale, (8, dof))
+    b = a + rng.normal(0.0, scale, (8, dof))
+    b[-2:] = a[-2:] + math.pi * rng.integers(-4, 5, (2, dof))  # (rounded: near the turn's edge)
+    want = steps_numpy(cyclic, a, b)
+    got = [ckernels.joint_step(cyclic, x, y) for x, y in zip(a, b, strict=True)]
+    assert np.array_equal(got, want)
+
+
+@pytest.mark.parametrize("wrapped", [True, False])
+def test_joint_step_is_the_probes(wrapped):
+    """With a probe's cyclic joints (the revolute ones when wrapped, none otherwise),
+    joint_step is the probe's own Probe.step, on joints drawn over several turns."""
+    optimizer = optimizer_of("panda", 0)
+    arm = optimizer.solver.arm
+    probe = optimizer._probe(arm.fk(HOMES["panda"]), optimizer.branches[0], wrapped=wrapped)
+    q = np.random.default_rng(5).uniform(-10.0, 10.0, (50, arm.dof))
+    for a, b in itertools.pairwise(q):
+        assert ckernels.joint_step(probe.cyclic, a, b) == probe.step(a, b)
+
+
+@settings(max_examples=200, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), samples=st.integers(1, 12), pieces=st.integers(0, 9))
+def test_cell_looks_are_numpys(seed, samples, pieces):
+    """ckernels.cell_looks gives numpy's steps to the bit, and each cell's first look as the
+    reference (calm: NaN; a step above FINE_STEP: 1/2; else the numpy surprise): samples
+    close and far apart in the joints, values small against the slopes (dips and islands),
+    ends feasible or not as they say, no pieces at all."""
+    rng = np.random.default_rng(seed)
+    cyclic = rng.random(7) < 0.8
+    q = np.cumsum(rng.normal(0.0, rng.choice([0.02, 0.3]), (samples, 7)), axis=0)
+    psi = np.cumsum(rng.uniform(1e-6, 0.2, samples))
+    g = rng.normal(0.1, 0.3, (samples, pieces))
+    dg = rng.normal(0.0, 2.0, (samples, pieces))
+    feasible = (g >= 0.0).all(axis=1)
+    steps, first = cell_looks(q, psi, g, dg, feasible, cyclic)
+    want_steps, want_first = looks_numpy(q, psi, g, dg, feasible, cyclic)
+    assert np.array_equal(steps, want_steps)
+    assert np.array_equal(first, want_first, equal_nan=True)

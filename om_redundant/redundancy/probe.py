@@ -185,6 +185,11 @@ class Probe:
         """The largest joint step between joint vectors a and b."""
         return float(np.abs(self._delta(a, b)).max())
 
+    @property
+    def cyclic(self) -> np.ndarray:
+        """(dof,) bool: the joints that :meth:`step` compares modulo 2 pi."""
+        return self._cyclic
+
     def steps(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """:meth:`step` between the rows of a and b (M, dof)."""
         return np.abs(self._delta(a, b)).max(axis=1, initial=0.0)
