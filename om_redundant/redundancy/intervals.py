@@ -115,9 +115,9 @@ def _spans(path: Path) -> list[_Span]:
     period = 2.0 * math.pi * path.turns
     # a loop is scanned from after an infeasible sample (rotated to start there), so that no
     # run wraps past the scan's end; a run of a loop past its last sample continues a turn later
-    start = int(np.argmin(np.roll(feasible, 1))) if path.turns else 0
-    scan = np.roll(feasible, -start)
-    edges = np.flatnonzero(np.diff(scan, prepend=False, append=False)).tolist()  # runs [i, j) of scan
+    start = int(np.argmin(feasible)) + 1 if path.turns and feasible[-1] else 0
+    scan = np.concatenate(([False], feasible[start:], feasible[:start], [False]))  # (padded)
+    edges = np.flatnonzero(scan[1:] != scan[:-1]).tolist()  # the runs [i, j) of the scan
     spans = []
     for i, j in zip(edges[::2], edges[1::2], strict=True):
         k_first, k_last = (start + i) % n, (start + j - 1) % n

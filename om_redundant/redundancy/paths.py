@@ -146,23 +146,19 @@ def lockstep(processes: list[Generator[Follow, tuple[Point, bool], Any]]) -> lis
         Each process's return value, in order.
     """
     results: list[Any] = [None] * len(processes)
-    requests: dict[int, Follow] = {}
-
-    def advance(i: int, answer: tuple[Point, bool] | None) -> None:
-        try:
-            requests[i] = processes[i].send(answer)
-        except StopIteration as done:
-            results[i] = done.value
-
-    for i in range(len(processes)):
-        advance(i, None)
-    while requests:
-        asked = list(requests.items())
-        requests.clear()
+    going = list(range(len(processes)))  # the processes going on, in order, and their answers
+    answers: list[tuple[Point, bool] | None] = [None] * len(processes)
+    while going:
+        asked: list[tuple[int, Follow]] = []
+        for i, answer in zip(going, answers, strict=True):
+            try:
+                asked.append((i, processes[i].send(answer)))
+            except StopIteration as done:
+                results[i] = done.value
         answers = [probe.follow(start, psi) for _, (probe, start, psi) in asked]
-        evaluate_points(asked[0][1][0].objective, [point for point, _ in answers])
-        for (i, _), answer in zip(asked, answers, strict=True):
-            advance(i, answer)
+        if asked:
+            evaluate_points(asked[0][1][0].objective, [point for point, _ in answers])
+        going = [i for i, _ in asked]
     return results
 
 
