@@ -2,6 +2,8 @@
  * _surprise, whose numpy version is the reference): the feasibility functions g_j of a point
  * and their rates along psi, and where their cubic Hermite models between two neighbouring
  * points predict a feasibility that the ends do not explain. */
+#include <string.h>
+
 #include "binding.h"
 
 enum { P_REACH, P_CAP, P_FLOOR, P_N }; /* clearance: 2 d_cap, d_cap, d_min / d_cap */
@@ -217,48 +219,56 @@ static bool _quiet(const cell_models *c, int fa, int fb, double slack)
     return fa;
 }
 
-/* cell_looks(q, psi, g, dg, feasible, cyclic, fine_step, slack, hermite, steps, first) -> None:
- * the first tests of the cells between the K neighbouring samples of a path (paths.py's
- * _with_hidden), samples k, k + 1 for cell k: their joints q (K x dof), psi (K,), their
- * feasibility functions g and rates dg (K x n, Point.pieces) and feasibility (bool, K);
- * cyclic (bool, dof) the joints compared modulo 2 pi. Into steps (K - 1,) each cell's
- * largest joint step (joint_step); into first (K - 1,) where _hidden first samples the
- * cell: NaN where it does not look inside, the cell being calm (no step above fine_step,
- * and the bounds of its cubic models quiet), or where surprise finds nothing; 1/2 where a
- * step is above fine_step; else surprise's fraction. Quiet: on [0, 1] the Hermite basis
- * functions of the values are >= 0 and sum to 1 and those of the slopes stay within 4/27
- * in size, so a model lies within (4/27) |span| (|g'_a| + |g'_b|) (+ slack, for rounding)
- * of the ends' range: both ends feasible and every model stays > 0, or both infeasible and
- * one function's model stays < 0; then surprise finds no change (it skips the pieces that
- * this bound keeps positive). */
-static PyObject *om_cell_looks(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
-    if (check_nargs(nargs, 11, "cell_looks") < 0) return NULL;
-    double fine = PyFloat_AsDouble(args[6]), slack = PyFloat_AsDouble(args[7]);
-    if (PyErr_Occurred()) return NULL;
-    Py_buffer v[9];
-    const buffer_spec sp[9] = {{F64, -1, 0, "q"},       {F64, -1, 0, "psi"},     {F64, -1, 0, "g"},
-                               {F64, -1, 0, "dg"},      {U8, -1, 0, "feasible"}, {U8, -1, 0, "cyclic"},
-                               {F64, -1, 0, "hermite"}, {F64, -1, 1, "steps"},   {F64, -1, 1, "first"}};
-    PyObject *const objs[9] = {args[0], args[1], args[2], args[3], args[4], args[5], args[8], args[9], args[10]};
-    if (get_buffers(objs, v, sp, 9) < 0) return NULL;
-    Py_ssize_t K = v[1].len / 8, dof = v[5].len, N = v[6].len / 32;
-    Py_ssize_t n = K ? v[2].len / 8 / K : 0, cells = K ? K - 1 : 0;
-    int bad = v[0].len != K * dof * 8 || v[2].len != K * n * 8 || v[3].len != K * n * 8 || v[4].len != K ||
-              v[6].len != N * 32 || v[7].len != cells * 8 || v[8].len != cells * 8;
-    Py_ssize_t *live = bad ? NULL : PyMem_Malloc((n ? n : 1) * sizeof(Py_ssize_t));
-    if (bad || !live) {
-        release_buffers(v, 9);
-        if (bad) PyErr_SetString(PyExc_ValueError, "cell_looks: sizes of the samples, cyclic or the outputs disagree");
-        return bad ? NULL : PyErr_NoMemory();
+/* Row m of rows (M x n) from obj, a float64 array of n entries (-1 with a TypeError or
+ * ValueError naming what, as get_buffer's). */
+static int _row(PyObject *obj, double *rows, Py_ssize_t m, Py_ssize_t n, const char *what)
+{
+    Py_buffer view;
+    if (get_buffer(obj, &view, F64, n, 0, what) < 0) return -1;
+    memcpy(rows + m * n, view.buf, n * sizeof(double));
+    PyBuffer_Release(&view);
+    return 0;
+}
+
+/* The M samples' joints (M x dof), psi, feasibility functions and rates (M x n each) and
+ * feasibility from cell_looks' lists (each of M items) into the arrays of s; -1 with an
+ * error where an item is not what cell_looks takes. */
+typedef struct {
+    double *q, *psi, *g, *dg;
+    uint8_t *feasible;
+} samples;
+
+static int _samples(PyObject *const *lists, Py_ssize_t M, Py_ssize_t dof, Py_ssize_t n, samples *s)
+{
+    for (Py_ssize_t m = 0; m < M; m++) {
+        PyObject *pieces = PySequence_Fast_GET_ITEM(lists[2], m);
+        if (!PyTuple_Check(pieces) || PyTuple_GET_SIZE(pieces) != 2) {
+            PyErr_SetString(PyExc_TypeError, "cell_looks: each pieces item must be a tuple (g, dg)");
+            return -1;
+        }
+        if (_row(PySequence_Fast_GET_ITEM(lists[0], m), s->q, m, dof, "q") < 0 ||
+            _row(PyTuple_GET_ITEM(pieces, 0), s->g, m, n, "g") < 0 ||
+            _row(PyTuple_GET_ITEM(pieces, 1), s->dg, m, n, "dg") < 0)
+            return -1;
+        s->psi[m] = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(lists[1], m));
+        int f = PyObject_IsTrue(PySequence_Fast_GET_ITEM(lists[3], m));
+        if (f < 0 || PyErr_Occurred()) return -1;
+        s->feasible[m] = (uint8_t)f;
     }
-    const double *q = v[0].buf, *psi = v[1].buf, *g = v[2].buf, *dg = v[3].buf;
-    const uint8_t *feasible = v[4].buf, *cyclic = v[5].buf;
-    double *steps = v[7].buf, *first = v[8].buf;
-    for (Py_ssize_t k = 0; k < cells; k++) {
-        cell_models c = {g + k * n, dg + k * n, g + (k + 1) * n, dg + (k + 1) * n, v[6].buf, psi[k + 1] - psi[k], n, N};
-        int fa = feasible[k] != 0, fb = feasible[k + 1] != 0;
-        double step = _joint_step(dof, cyclic, q + k * dof, q + (k + 1) * dof);
-        steps[k] = step;
+    return 0;
+}
+
+/* The looks of the cells of one path, samples a .. b - 1 of s (cell k: samples k, k + 1),
+ * into first (cell_looks' docstring); live: room for n piece indices. */
+static void _path_looks(const samples *s, Py_ssize_t a, Py_ssize_t b, Py_ssize_t dof, Py_ssize_t n,
+                        const uint8_t *cyclic, double fine, double slack, const double *H, Py_ssize_t N,
+                        double *first, Py_ssize_t *live)
+{
+    for (Py_ssize_t k = a; k + 1 < b; k++) {
+        const double *g = s->g, *dg = s->dg;
+        cell_models c = {g + k * n, dg + k * n, g + (k + 1) * n, dg + (k + 1) * n, H, s->psi[k + 1] - s->psi[k], n, N};
+        int fa = s->feasible[k], fb = s->feasible[k + 1];
+        double step = _joint_step(dof, cyclic, s->q + k * dof, s->q + (k + 1) * dof);
         if (step <= fine && _quiet(&c, fa, fb, slack))
             first[k] = NAN;
         else if (step > fine)
@@ -268,9 +278,78 @@ static PyObject *om_cell_looks(PyObject *mod, PyObject *const *args, Py_ssize_t 
             first[k] = t < 0.0 ? NAN : t;
         }
     }
-    PyMem_Free(live);
-    release_buffers(v, 9);
+    if (b > a) first[b - 1] = NAN; /* (the path's last sample starts no cell) */
+}
+
+/* cell_looks(q, psi, pieces, feasible, bounds, cyclic, fine_step, slack, hermite, first) -> None: the first tests of the cells between neighbouring samples of paths (paths.py's
+ * _with_hidden). The M samples of every path, path after path, as lists of M items: their
+ * joints q (float64 arrays (dof,)), psi (floats), pieces ((g, dg), float64 arrays (n,): the
+ * feasibility functions and their rates, Point.pieces) and feasibility (bools); bounds
+ * (int64, P + 1) each path's first sample, then M; cyclic (bool, P x dof) each path's joints
+ * compared modulo 2 pi. Cell k lies between samples k and k + 1 of one path; into first
+ * (M,) where _hidden first samples it: NaN where it does not look inside, the cell being
+ * calm (no joint_step above fine_step, and the bounds of its cubic models quiet), or where
+ * surprise finds nothing; 1/2 where a step is above fine_step; else surprise's fraction. A
+ * path's last sample's entry is NaN. Quiet:
+ * on [0, 1] the Hermite basis functions of the values are >= 0 and sum to 1 and those of the
+ * slopes stay within 4/27 in size, so a model lies within (4/27) |span| (|g'_a| + |g'_b|)
+ * (+ slack, for rounding) of the ends' range: both ends feasible and every model stays > 0,
+ * or both infeasible and one function's model stays < 0; then surprise finds no change (it
+ * skips the pieces that this bound keeps positive). */
+static PyObject *om_cell_looks(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 10, "cell_looks") < 0) return NULL;
+    double fine = PyFloat_AsDouble(args[6]), slack = PyFloat_AsDouble(args[7]);
+    if (PyErr_Occurred()) return NULL;
+    PyObject *lists[4] = {NULL, NULL, NULL, NULL};
+    Py_buffer v[4];
+    const buffer_spec sp[4] = {
+        {I64, -1, 0, "bounds"}, {U8, -1, 0, "cyclic"}, {F64, -1, 0, "hermite"}, {F64, -1, 1, "first"}};
+    PyObject *const objs[4] = {args[4], args[5], args[8], args[9]};
+    for (int i = 0; i < 4; i++) {
+        lists[i] = PySequence_Fast(args[i], "cell_looks: q, psi, pieces and feasible must be sequences");
+        if (!lists[i]) goto lists_fail;
+    }
+    if (get_buffers(objs, v, sp, 4) < 0) goto lists_fail;
+    Py_ssize_t M = PySequence_Fast_GET_SIZE(lists[0]), P = v[0].len / 8 - 1, N = v[2].len / 32;
+    const int64_t *bounds = v[0].buf;
+    Py_ssize_t dof = P > 0 ? v[1].len / P : 0, n = 0;
+    int bad = P < 0 || v[1].len != P * dof || v[2].len != N * 32 || v[3].len != M * 8 ||
+              (P > 0 && (dof < 1 || dof > OM_MAX_DOF));
+    for (int i = 1; i < 4; i++) bad = bad || PySequence_Fast_GET_SIZE(lists[i]) != M;
+    bad = bad || bounds[0] != 0 || bounds[P] != M; /* each path's first sample, from 0 to M, increasing */
+    for (Py_ssize_t p = 1; p <= P && !bad; p++) bad = bounds[p] < bounds[p - 1];
+    if (bad) {
+        PyErr_SetString(PyExc_ValueError, "cell_looks: sizes of the samples, bounds, cyclic or the outputs disagree");
+        goto fail;
+    }
+    if (M) { /* the pieces' count from the first sample's */
+        PyObject *pieces = PySequence_Fast_GET_ITEM(lists[2], 0);
+        if (PyTuple_Check(pieces) && PyTuple_GET_SIZE(pieces) == 2) n = PyObject_Length(PyTuple_GET_ITEM(pieces, 0));
+        if (n < 0) goto fail;
+    }
+    double *store = PyMem_Malloc((M * (dof + 1 + 2 * n) + 1) * sizeof(double));
+    uint8_t *feasible = PyMem_Malloc(M + 1);
+    Py_ssize_t *live = PyMem_Malloc((n + 1) * sizeof(Py_ssize_t));
+    if (!store || !feasible || !live) {
+        PyMem_Free(store), PyMem_Free(feasible), PyMem_Free(live);
+        PyErr_NoMemory();
+        goto fail;
+    }
+    samples s = {store, store + M * dof, store + M * (dof + 1), store + M * (dof + 1 + n), feasible};
+    int ok = _samples(lists, M, dof, n, &s) == 0;
+    const uint8_t *cyclic = v[1].buf;
+    for (Py_ssize_t p = 0; p < P && ok; p++)
+        _path_looks(&s, bounds[p], bounds[p + 1], dof, n, cyclic + p * dof, fine, slack, v[2].buf, N, v[3].buf, live);
+    PyMem_Free(store), PyMem_Free(feasible), PyMem_Free(live);
+    release_buffers(v, 4);
+    for (int i = 0; i < 4; i++) Py_DECREF(lists[i]);
+    if (!ok) return NULL;
     Py_RETURN_NONE;
+fail:
+    release_buffers(v, 4);
+lists_fail:
+    for (int i = 0; i < 4; i++) Py_XDECREF(lists[i]);
+    return NULL;
 }
 
 /* crossing(ga, da, gb, db, span, hermite) -> fraction or None: where the first of surprise's
@@ -320,6 +399,6 @@ PyMethodDef om_cell_functions[] = {
      "crossing(ga, da, gb, db, span, hermite) -> fraction or None"},
     {"joint_step", (PyCFunction)(void (*)(void))om_joint_step, METH_FASTCALL, "joint_step(cyclic, a, b) -> float"},
     {"cell_looks", (PyCFunction)(void (*)(void))om_cell_looks, METH_FASTCALL,
-     "cell_looks(q, psi, g, dg, feasible, cyclic, fine_step, slack, hermite, steps, first) -> None"},
+     "cell_looks(q, psi, pieces, feasible, bounds, cyclic, fine_step, slack, hermite, first) -> None"},
     {NULL, NULL, 0, NULL},
 };

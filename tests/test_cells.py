@@ -122,9 +122,9 @@ def steps_numpy(cyclic, a, b):
 
 
 def looks_numpy(q, psi, g, dg, feasible, cyclic):
-    """The reference of cell_looks: each cell's step, and NaN where it is calm (no step above
+    """The reference of cell_looks for one path: NaN where a cell is calm (no step above
     FINE_STEP, quiet), 1/2 where a step is above FINE_STEP, else the numpy surprise (NaN for
-    none)."""
+    none); NaN for the last sample."""
     steps = steps_numpy(cyclic, q[:-1], q[1:])
     quiet = quiet_numpy(psi[1:] - psi[:-1], g[:-1], dg[:-1], g[1:], dg[1:], feasible[:-1], feasible[1:])
     first = []
@@ -134,17 +134,27 @@ def looks_numpy(q, psi, g, dg, feasible, cyclic):
         elif steps[k] > FINE_STEP:
             first.append(0.5)
         else:
-            t = surprise_numpy(
-                g[k], dg[k], g[k + 1], dg[k + 1], psi[k + 1] - psi[k], feasible[k], feasible[k + 1]
-            )
+            span = psi[k + 1] - psi[k]
+            t = surprise_numpy(g[k], dg[k], g[k + 1], dg[k + 1], span, feasible[k], feasible[k + 1])
             first.append(np.nan if t is None or g.shape[1] == 0 else t)
-    return steps, np.array(first)
+    return np.array([*first, np.nan])
 
 
-def cell_looks(q, psi, g, dg, feasible, cyclic):
-    steps, first = np.full((2, max(len(psi) - 1, 0)), -7.0)
-    ckernels.cell_looks(q, psi, g, dg, feasible, cyclic, FINE_STEP, _BOUND_SLACK, _HERMITE, steps, first)
-    return steps, first
+def cell_looks(paths):
+    """ckernels.cell_looks of paths [(q, psi, g, dg, feasible, cyclic)], given as lists of
+    samples; each path's looks."""
+    lengths = [len(psi) for _, psi, *_ in paths]
+    q, psi, pieces, feasible = [], [], [], []
+    for q_p, psi_p, g_p, dg_p, feasible_p, _ in paths:
+        q += list(q_p)
+        psi += psi_p.tolist()
+        pieces += list(zip(g_p, dg_p, strict=True))
+        feasible += feasible_p.tolist()
+    bounds = np.cumsum([0, *lengths])
+    cyclic = np.array([c for *_, c in paths], dtype=bool).reshape(-1, 7)
+    first = np.full(len(psi), -7.0)
+    ckernels.cell_looks(q, psi, pieces, feasible, bounds, cyclic, FINE_STEP, _BOUND_SLACK, _HERMITE, first)
+    return np.split(first, bounds[1:-1]) if paths else []
 
 
 @settings(max_examples=300, deadline=None)
@@ -159,8 +169,9 @@ def test_a_quiet_cell_has_no_surprise(seed, pieces, span):
     da, db = rng.normal(0.0, 0.5 / max(abs(span), 1e-6), (2, pieces))
     fa, fb = bool((ga >= 0).all()), bool((gb >= 0).all())
     q, cyclic = np.zeros((2, 7)), np.ones(7, dtype=bool)  # (no step: the looks are the bounds')
-    _, first = cell_looks(
-        q, np.array([0.0, span]), np.array([ga, gb]), np.array([da, db]), np.array([fa, fb]), cyclic
+    feasible = np.array([fa, fb])
+    (first,) = cell_looks(
+        [(q, np.array([0.0, span]), np.array([ga, gb]), np.array([da, db]), feasible, cyclic)]
     )
     quiet = quiet_numpy(
         np.array([span]), ga[None], da[None], gb[None], db[None], np.array([fa]), np.array([fb])
@@ -200,20 +211,42 @@ def test_joint_step_is_the_probes(wrapped):
 
 
 @settings(max_examples=200, deadline=None)
-@given(seed=st.integers(0, 2**32 - 1), samples=st.integers(1, 12), pieces=st.integers(0, 9))
-def test_cell_looks_are_numpys(seed, samples, pieces):
-    """ckernels.cell_looks gives numpy's steps to the bit, and each cell's first look as the
-    reference (calm: NaN; a step above FINE_STEP: 1/2; else the numpy surprise): samples
-    close and far apart in the joints, values small against the slopes (dips and islands),
-    ends feasible or not as they say, no pieces at all."""
+@given(
+    seed=st.integers(0, 2**32 - 1), paths=st.lists(st.integers(1, 12), max_size=4), pieces=st.integers(0, 9)
+)
+def test_cell_looks_are_numpys(seed, paths, pieces):
+    """ckernels.cell_looks gives each cell's first look as the reference (calm: NaN; a step
+    above FINE_STEP: 1/2; else the numpy surprise), path by path with each path's cyclic
+    joints: samples close and far apart in the joints, values small against the slopes
+    (dips and islands), ends feasible or not as they say, no pieces at all, no paths."""
     rng = np.random.default_rng(seed)
-    cyclic = rng.random(7) < 0.8
-    q = np.cumsum(rng.normal(0.0, rng.choice([0.02, 0.3]), (samples, 7)), axis=0)
-    psi = np.cumsum(rng.uniform(1e-6, 0.2, samples))
-    g = rng.normal(0.1, 0.3, (samples, pieces))
-    dg = rng.normal(0.0, 2.0, (samples, pieces))
-    feasible = (g >= 0.0).all(axis=1)
-    steps, first = cell_looks(q, psi, g, dg, feasible, cyclic)
-    want_steps, want_first = looks_numpy(q, psi, g, dg, feasible, cyclic)
-    assert np.array_equal(steps, want_steps)
-    assert np.array_equal(first, want_first, equal_nan=True)
+    drawn = []
+    for samples in paths:
+        q = np.cumsum(rng.normal(0.0, rng.choice([0.02, 0.3]), (samples, 7)), axis=0)
+        psi = np.cumsum(rng.uniform(1e-6, 0.2, samples))
+        g = rng.normal(0.1, 0.3, (samples, pieces))
+        dg = rng.normal(0.0, 2.0, (samples, pieces))
+        drawn.append((q, psi, g, dg, (g >= 0.0).all(axis=1), rng.random(7) < 0.8))
+    for got, path in zip(cell_looks(drawn), drawn, strict=True):
+        assert np.array_equal(got, looks_numpy(*path), equal_nan=True)
+
+
+def test_cell_looks_refuses_what_it_cannot_read():
+    """Samples of another size or kind than the first's, and bounds that do not cover the
+    samples, are refused with the error named (not read past)."""
+    q, pieces, feasible = [np.zeros(7)] * 2, [(np.zeros(3), np.zeros(3))] * 2, [True, True]
+    bounds, cyclic, first = np.array([0, 2]), np.ones((1, 7), dtype=bool), np.empty(2)
+    rest = (FINE_STEP, _BOUND_SLACK, _HERMITE, first)
+    ckernels.cell_looks(q, [0.0, 0.1], pieces, feasible, bounds, cyclic, *rest)
+    assert first[0] == 0.5 or np.isnan(first[0])
+    wider = [pieces[0], (np.zeros(4), np.zeros(4))]
+    with pytest.raises(ValueError, match="g must have 3 entries"):
+        ckernels.cell_looks(q, [0.0, 0.1], wider, feasible, bounds, cyclic, *rest)
+    with pytest.raises(TypeError, match="q must be float64"):
+        ckernels.cell_looks(
+            [q[0], np.zeros(7, np.float32)], [0.0, 0.1], pieces, feasible, bounds, cyclic, *rest
+        )
+    with pytest.raises(ValueError, match="disagree"):
+        ckernels.cell_looks(q, [0.0, 0.1], pieces, feasible, np.array([0, 3]), cyclic, *rest)
+    with pytest.raises(ValueError, match="disagree"):
+        ckernels.cell_looks(q, [0.0], pieces, feasible, bounds, cyclic, *rest)

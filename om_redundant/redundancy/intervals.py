@@ -24,8 +24,6 @@ from collections.abc import Generator, Sequence
 from dataclasses import dataclass
 from typing import NamedTuple
 
-import numpy as np
-
 from .. import ckernels
 from .arm_angle import wrap_psi
 from .paths import _HERMITE, Follow, Path, lockstep
@@ -109,23 +107,21 @@ class _Span(NamedTuple):
 def _spans(path: Path) -> list[_Span]:
     """The runs of feasible samples along a path."""
     points, n = path.points, len(path.points)
-    feasible = np.array([p.evaluation.feasible for p in points], dtype=bool)
-    if path.turns and feasible.all():
+    feasible = [p.evaluation.feasible for p in points]
+    if path.turns and all(feasible):
         return [_Span(list(points), None, None, closed=True)]
     period = 2.0 * math.pi * path.turns
-    # a loop is scanned from after an infeasible sample (rotated to start there), so that no
-    # run wraps past the scan's end; a run of a loop past its last sample continues a turn later
-    start = int(np.argmin(feasible)) + 1 if path.turns and feasible[-1] else 0
-    scan = np.concatenate(([False], feasible[start:], feasible[:start], [False]))  # (padded)
-    edges = np.flatnonzero(scan[1:] != scan[:-1]).tolist()  # the runs [i, j) of the scan
-    spans = []
-    for i, j in zip(edges[::2], edges[1::2], strict=True):
-        k_first, k_last = (start + i) % n, (start + j - 1) % n
-        run = points[k_first : k_last + 1] if k_first <= k_last else points[k_first:] + points[: k_last + 1]
-        if k_first > k_last:
-            run[n - k_first :] = [p.at(p.psi + period) for p in run[n - k_first :]]
-        spans.append(_span(path, run, k_first, k_last))
-    return spans
+    start = next((k for k in range(n) if not feasible[k - 1]), 0) if path.turns else 0
+    runs, current = [], []
+    for k in [*range(start, n), *range(start)]:  # a loop is scanned from after an infeasible sample
+        if feasible[k]:
+            wrapped = bool(current) and k < current[0][0]  # (a run of a loop past its last sample)
+            current.append((k, points[k].at(points[k].psi + period) if wrapped else points[k]))
+        elif current:
+            runs.append(current)
+            current = []
+    runs += [current] if current else []
+    return [_span(path, [p for _, p in run], run[0][0], run[-1][0]) for run in runs]
 
 
 def _span(path: Path, points: list[Point], k_first: int, k_last: int) -> _Span:

@@ -295,21 +295,23 @@ def _with_hidden(paths: list[tuple[Probe, Path]]) -> list[Path]:
         ends_of.append(list(path.points) + closing)
     flat = [p for ends in ends_of for p in ends]
     evaluate_points(paths[0][0].objective, flat)  # (the path ends that the following found)
-    # every cell's first tests, path by path (ckernels.cell_looks), on the samples' arrays
-    # stacked once (concatenated rows: faster than np.array of the rows)
-    pieces = [p.pieces() for p in flat]
-    q, g, dg = (
-        np.concatenate(rows).reshape(len(flat), -1)
-        for rows in ([p.q for p in flat], [x for x, _ in pieces], [x for _, x in pieces])
+    # every cell's first tests at once (ckernels.cell_looks, which reads the samples' lists)
+    lengths = [len(ends) for ends in ends_of]
+    owner = np.repeat(np.arange(len(paths)), lengths).tolist()  # each end's path
+    start = np.cumsum([0, *lengths]).tolist()  # each path's first end in flat
+    first = np.empty(len(flat))  # cell a: between ends a, a + 1
+    ckernels.cell_looks(
+        [p.q for p in flat],
+        [p.psi for p in flat],
+        [p.pieces() for p in flat],
+        [p.evaluation.feasible for p in flat],
+        np.array(start, dtype=np.int64),
+        np.array([probe.cyclic for probe, _ in paths]),
+        FINE_STEP,
+        _BOUND_SLACK,
+        _HERMITE,
+        first,
     )
-    psi = np.array([p.psi for p in flat])
-    feasible = np.array([p.evaluation.feasible for p in flat], dtype=bool)
-    owner = np.repeat(np.arange(len(paths)), [len(ends) for ends in ends_of]).tolist()  # each end's path
-    start = np.cumsum([0] + [len(ends) for ends in ends_of]).tolist()  # each path's first end in flat
-    steps, first = np.empty(len(flat)), np.full(len(flat), np.nan)  # cell a: between ends a, a + 1
-    for (probe, _), i, j in zip(paths, start[:-1], start[1:], strict=True):
-        looks = (q[i:j], psi[i:j], g[i:j], dg[i:j], feasible[i:j], probe.cyclic)
-        ckernels.cell_looks(*looks, FINE_STEP, _BOUND_SLACK, _HERMITE, steps[i : j - 1], first[i : j - 1])
     looked = np.flatnonzero(~np.isnan(first)).tolist()
     t = first[looked].tolist()
     cells = [_hidden(paths[owner[a]][0], flat[a], flat[a + 1], t_a) for a, t_a in zip(looked, t, strict=True)]
