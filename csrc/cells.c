@@ -2,6 +2,8 @@
  * _surprise, whose numpy version is the reference): the feasibility functions g_j of a point
  * and their rates along psi, and where their cubic Hermite models between two neighbouring
  * points predict a feasibility that the ends do not explain. */
+#include <string.h>
+
 #include "binding.h"
 
 enum { P_REACH, P_CAP, P_FLOOR, P_N }; /* clearance: 2 d_cap, d_cap, d_min / d_cap */
@@ -104,11 +106,33 @@ static inline double _model(const cell_models *c, Py_ssize_t j, Py_ssize_t k)
            c->db[j] * c->span * c->H[3 * N + k];
 }
 
-/* Whether piece j's model stays above `slack` over the cell by paths.py's _quiet bound
+/* Whether piece j's model stays above `slack` over the cell by cell_looks' quiet bound
  * (min(ga, gb) - 4/27 span (|da| + |db|)). */
 static inline bool _calm(const cell_models *c, Py_ssize_t j, double slack)
 {
     return fmin(c->ga[j], c->gb[j]) - 4.0 / 27.0 * fabs(c->span) * (fabs(c->da[j]) + fabs(c->db[j])) > slack;
+}
+
+/* The pattern's surprise of surprise()'s docstring below for the cell c with ends feasible
+ * fa, fb: the fraction, or -1 where there is none; live: room for c->n piece indices. */
+static double _surprise(const cell_models *c, int fa, int fb, double slack, Py_ssize_t *live)
+{
+    Py_ssize_t n = c->n, N = c->N, m = 0;
+    for (Py_ssize_t j = 0; j < n; j++)
+        if (!_calm(c, j, slack)) live[m++] = j;
+    Py_ssize_t changes[2], count = 0, allowed = fa != fb;
+    int previous = fa;
+    for (Py_ssize_t k = 0; k <= N && count < 2; k++) { /* (the first two changes tell) */
+        int feasible = fb;
+        if (k < N) {
+            feasible = 1;
+            for (Py_ssize_t i = 0; i < m && feasible; i++) feasible = _model(c, live[i], k) >= 0.0;
+        }
+        if (feasible != previous) changes[count++] = k;
+        previous = feasible;
+    }
+    if (count <= allowed) return -1.0;
+    return (double)(changes[0] + 1 + changes[1]) / 2.0 / (double)(N + 1);
 }
 
 /* surprise(ga, da, gb, db, span, hermite, feasible_a, feasible_b, slack) -> fraction or None:
@@ -116,8 +140,8 @@ static inline bool _calm(const cell_models *c, Py_ssize_t j, double slack)
  * points s of hermite (4 x N, the basis there); the pattern (feasible_a, all_j m_j >= 0 at
  * each point, feasible_b); None if it changes no more often than its ends (0 times if
  * alike, once if not), else the middle of the first stretch between changes as a fraction
- * of the pattern. A piece whose model stays above `slack` by the bound of paths.py's _quiet
- * cannot change it and is not evaluated (_calm). */
+ * of the pattern. A piece whose model stays above `slack` by the bound of cell_looks'
+ * quiet test cannot change it and is not evaluated (_calm). */
 static PyObject *om_surprise(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
     if (check_nargs(nargs, 9, "surprise") < 0) return NULL;
     double span = PyFloat_AsDouble(args[4]), slack = PyFloat_AsDouble(args[8]);
@@ -126,29 +150,206 @@ static PyObject *om_surprise(PyObject *mod, PyObject *const *args, Py_ssize_t na
     Py_buffer v[5];
     cell_models c;
     if (_cell_models(args, span, "surprise", v, &c) < 0) return NULL;
-    Py_ssize_t n = c.n, N = c.N;
-    Py_ssize_t *live = PyMem_Malloc((n ? n : 1) * sizeof(Py_ssize_t)), m = 0;
+    Py_ssize_t *live = PyMem_Malloc((c.n ? c.n : 1) * sizeof(Py_ssize_t));
     if (!live) {
         release_buffers(v, 5);
         return PyErr_NoMemory();
     }
-    for (Py_ssize_t j = 0; j < n; j++)
-        if (!_calm(&c, j, slack)) live[m++] = j;
-    Py_ssize_t changes[2], count = 0, allowed = fa != fb;
-    int previous = fa;
-    for (Py_ssize_t k = 0; k <= N && count < 2; k++) { /* (the first two changes tell) */
-        int feasible = fb;
-        if (k < N) {
-            feasible = 1;
-            for (Py_ssize_t i = 0; i < m && feasible; i++) feasible = _model(&c, live[i], k) >= 0.0;
-        }
-        if (feasible != previous) changes[count++] = k;
-        previous = feasible;
-    }
+    double found = _surprise(&c, fa, fb, slack, live);
     PyMem_Free(live);
     release_buffers(v, 5);
-    if (count <= allowed) Py_RETURN_NONE;
-    return PyFloat_FromDouble((double)(changes[0] + 1 + changes[1]) / 2.0 / (double)(N + 1));
+    if (found < 0.0) Py_RETURN_NONE;
+    return PyFloat_FromDouble(found);
+}
+
+/* The largest joint step from a to b, max_i |d_i| with d = b - a, a cyclic joint's d taken
+ * as numpy's remainder(d + pi, 2 pi) - pi (probe.py's Probe.steps, the same operations:
+ * remainder is fmod moved onto the divisor's side, a NaN step is NaN). */
+static double _joint_step(Py_ssize_t dof, const uint8_t *cyclic, const double *a, const double *b)
+{
+    double largest = 0.0;
+    for (Py_ssize_t i = 0; i < dof; i++) {
+        double d = b[i] - a[i];
+        if (cyclic[i]) {
+            double r = fmod(d + OM_PI, 2.0 * OM_PI);
+            if (r != 0.0) {
+                if (r < 0.0) r += 2.0 * OM_PI;
+            } else {
+                r = 0.0; /* (+0: the divisor's sign) */
+            }
+            d = r - OM_PI;
+        }
+        d = fabs(d);
+        if (isnan(d)) return d;
+        if (d > largest) largest = d;
+    }
+    return largest;
+}
+
+/* joint_step(cyclic, a, b) -> float: the largest joint step from a to b (dof,), the cyclic
+ * (bool, dof) joints compared modulo 2 pi (probe.py's Probe.step). */
+static PyObject *om_joint_step(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 3, "joint_step") < 0) return NULL;
+    Py_buffer v[3];
+    const buffer_spec sp[3] = {{U8, -1, 0, "cyclic"}, {F64, -1, 0, "a"}, {F64, -1, 0, "b"}};
+    if (get_buffers(args, v, sp, 3) < 0) return NULL;
+    Py_ssize_t dof = v[0].len;
+    if (v[1].len != dof * 8 || v[2].len != dof * 8) {
+        release_buffers(v, 3);
+        PyErr_SetString(PyExc_ValueError, "joint_step: sizes of cyclic, a and b disagree");
+        return NULL;
+    }
+    double step = _joint_step(dof, v[0].buf, v[1].buf, v[2].buf);
+    release_buffers(v, 3);
+    return PyFloat_FromDouble(step);
+}
+
+/* Whether the cell c with ends feasible fa, fb is quiet by the bounds of cell_looks. The
+ * minimum and maximum propagate NaN as numpy's do. */
+static bool _quiet(const cell_models *c, int fa, int fb, double slack)
+{
+    if (fa != fb) return false;
+    for (Py_ssize_t j = 0; j < c->n; j++) {
+        double ga = c->ga[j], gb = c->gb[j];
+        double spread = 4.0 / 27.0 * fabs(c->span) * (fabs(c->da[j]) + fabs(c->db[j])) + slack;
+        bool nan = isnan(ga) || isnan(gb);
+        if (fa && !((nan ? NAN : fmin(ga, gb)) - spread > 0.0)) return false; /* a model may dip */
+        if (!fa && (nan ? NAN : fmax(ga, gb)) + spread < 0.0) return true;   /* one stays below */
+    }
+    return fa;
+}
+
+/* Row m of rows (M x n) from obj, a float64 array of n entries (-1 with a TypeError or
+ * ValueError naming what, as get_buffer's). */
+static int _row(PyObject *obj, double *rows, Py_ssize_t m, Py_ssize_t n, const char *what)
+{
+    Py_buffer view;
+    if (get_buffer(obj, &view, F64, n, 0, what) < 0) return -1;
+    memcpy(rows + m * n, view.buf, n * sizeof(double));
+    PyBuffer_Release(&view);
+    return 0;
+}
+
+/* The M samples' joints (M x dof), psi, feasibility functions and rates (M x n each) and
+ * feasibility from cell_looks' lists (each of M items) into the arrays of s; -1 with an
+ * error where an item is not what cell_looks takes. */
+typedef struct {
+    double *q, *psi, *g, *dg;
+    uint8_t *feasible;
+} samples;
+
+static int _samples(PyObject *const *lists, Py_ssize_t M, Py_ssize_t dof, Py_ssize_t n, samples *s)
+{
+    for (Py_ssize_t m = 0; m < M; m++) {
+        PyObject *pieces = PySequence_Fast_GET_ITEM(lists[2], m);
+        if (!PyTuple_Check(pieces) || PyTuple_GET_SIZE(pieces) != 2) {
+            PyErr_SetString(PyExc_TypeError, "cell_looks: each pieces item must be a tuple (g, dg)");
+            return -1;
+        }
+        if (_row(PySequence_Fast_GET_ITEM(lists[0], m), s->q, m, dof, "q") < 0 ||
+            _row(PyTuple_GET_ITEM(pieces, 0), s->g, m, n, "g") < 0 ||
+            _row(PyTuple_GET_ITEM(pieces, 1), s->dg, m, n, "dg") < 0)
+            return -1;
+        s->psi[m] = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(lists[1], m));
+        int f = PyObject_IsTrue(PySequence_Fast_GET_ITEM(lists[3], m));
+        if (f < 0 || PyErr_Occurred()) return -1;
+        s->feasible[m] = (uint8_t)f;
+    }
+    return 0;
+}
+
+/* The looks of the cells of one path, samples a .. b - 1 of s (cell k: samples k, k + 1),
+ * into first (cell_looks' docstring); live: room for n piece indices. */
+static void _path_looks(const samples *s, Py_ssize_t a, Py_ssize_t b, Py_ssize_t dof, Py_ssize_t n,
+                        const uint8_t *cyclic, double fine, double slack, const double *H, Py_ssize_t N,
+                        double *first, Py_ssize_t *live)
+{
+    for (Py_ssize_t k = a; k + 1 < b; k++) {
+        const double *g = s->g, *dg = s->dg;
+        cell_models c = {g + k * n, dg + k * n, g + (k + 1) * n, dg + (k + 1) * n, H, s->psi[k + 1] - s->psi[k], n, N};
+        int fa = s->feasible[k], fb = s->feasible[k + 1];
+        double step = _joint_step(dof, cyclic, s->q + k * dof, s->q + (k + 1) * dof);
+        if (step <= fine && _quiet(&c, fa, fb, slack))
+            first[k] = NAN;
+        else if (step > fine)
+            first[k] = 0.5;
+        else {
+            double t = n ? _surprise(&c, fa, fb, slack, live) : -1.0;
+            first[k] = t < 0.0 ? NAN : t;
+        }
+    }
+    if (b > a) first[b - 1] = NAN; /* (the path's last sample starts no cell) */
+}
+
+/* cell_looks(q, psi, pieces, feasible, bounds, cyclic, fine_step, slack, hermite, first) -> None: the first tests of the cells between neighbouring samples of paths (paths.py's
+ * _with_hidden). The M samples of every path, path after path, as lists of M items: their
+ * joints q (float64 arrays (dof,)), psi (floats), pieces ((g, dg), float64 arrays (n,): the
+ * feasibility functions and their rates, Point.pieces) and feasibility (bools); bounds
+ * (int64, P + 1) each path's first sample, then M; cyclic (bool, P x dof) each path's joints
+ * compared modulo 2 pi. Cell k lies between samples k and k + 1 of one path; into first
+ * (M,) where _hidden first samples it: NaN where it does not look inside, the cell being
+ * calm (no joint_step above fine_step, and the bounds of its cubic models quiet), or where
+ * surprise finds nothing; 1/2 where a step is above fine_step; else surprise's fraction. A
+ * path's last sample's entry is NaN. Quiet:
+ * on [0, 1] the Hermite basis functions of the values are >= 0 and sum to 1 and those of the
+ * slopes stay within 4/27 in size, so a model lies within (4/27) |span| (|g'_a| + |g'_b|)
+ * (+ slack, for rounding) of the ends' range: both ends feasible and every model stays > 0,
+ * or both infeasible and one function's model stays < 0; then surprise finds no change (it
+ * skips the pieces that this bound keeps positive). */
+static PyObject *om_cell_looks(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 10, "cell_looks") < 0) return NULL;
+    double fine = PyFloat_AsDouble(args[6]), slack = PyFloat_AsDouble(args[7]);
+    if (PyErr_Occurred()) return NULL;
+    PyObject *lists[4] = {NULL, NULL, NULL, NULL};
+    Py_buffer v[4];
+    const buffer_spec sp[4] = {
+        {I64, -1, 0, "bounds"}, {U8, -1, 0, "cyclic"}, {F64, -1, 0, "hermite"}, {F64, -1, 1, "first"}};
+    PyObject *const objs[4] = {args[4], args[5], args[8], args[9]};
+    for (int i = 0; i < 4; i++) {
+        lists[i] = PySequence_Fast(args[i], "cell_looks: q, psi, pieces and feasible must be sequences");
+        if (!lists[i]) goto lists_fail;
+    }
+    if (get_buffers(objs, v, sp, 4) < 0) goto lists_fail;
+    Py_ssize_t M = PySequence_Fast_GET_SIZE(lists[0]), P = v[0].len / 8 - 1, N = v[2].len / 32;
+    const int64_t *bounds = v[0].buf;
+    Py_ssize_t dof = P > 0 ? v[1].len / P : 0, n = 0;
+    int bad = P < 0 || v[1].len != P * dof || v[2].len != N * 32 || v[3].len != M * 8 ||
+              (P > 0 && (dof < 1 || dof > OM_MAX_DOF));
+    for (int i = 1; i < 4; i++) bad = bad || PySequence_Fast_GET_SIZE(lists[i]) != M;
+    bad = bad || bounds[0] != 0 || bounds[P] != M; /* each path's first sample, from 0 to M, increasing */
+    for (Py_ssize_t p = 1; p <= P && !bad; p++) bad = bounds[p] < bounds[p - 1];
+    if (bad) {
+        PyErr_SetString(PyExc_ValueError, "cell_looks: sizes of the samples, bounds, cyclic or the outputs disagree");
+        goto fail;
+    }
+    if (M) { /* the pieces' count from the first sample's */
+        PyObject *pieces = PySequence_Fast_GET_ITEM(lists[2], 0);
+        if (PyTuple_Check(pieces) && PyTuple_GET_SIZE(pieces) == 2) n = PyObject_Length(PyTuple_GET_ITEM(pieces, 0));
+        if (n < 0) goto fail;
+    }
+    double *store = PyMem_Malloc((M * (dof + 1 + 2 * n) + 1) * sizeof(double));
+    uint8_t *feasible = PyMem_Malloc(M + 1);
+    Py_ssize_t *live = PyMem_Malloc((n + 1) * sizeof(Py_ssize_t));
+    if (!store || !feasible || !live) {
+        PyMem_Free(store), PyMem_Free(feasible), PyMem_Free(live);
+        PyErr_NoMemory();
+        goto fail;
+    }
+    samples s = {store, store + M * dof, store + M * (dof + 1), store + M * (dof + 1 + n), feasible};
+    int ok = _samples(lists, M, dof, n, &s) == 0;
+    const uint8_t *cyclic = v[1].buf;
+    for (Py_ssize_t p = 0; p < P && ok; p++)
+        _path_looks(&s, bounds[p], bounds[p + 1], dof, n, cyclic + p * dof, fine, slack, v[2].buf, N, v[3].buf, live);
+    PyMem_Free(store), PyMem_Free(feasible), PyMem_Free(live);
+    release_buffers(v, 4);
+    for (int i = 0; i < 4; i++) Py_DECREF(lists[i]);
+    if (!ok) return NULL;
+    Py_RETURN_NONE;
+fail:
+    release_buffers(v, 4);
+lists_fail:
+    for (int i = 0; i < 4; i++) Py_XDECREF(lists[i]);
+    return NULL;
 }
 
 /* crossing(ga, da, gb, db, span, hermite) -> fraction or None: where the first of surprise's
@@ -196,5 +397,8 @@ PyMethodDef om_cell_functions[] = {
      "surprise(ga, da, gb, db, span, hermite, feasible_a, feasible_b, slack) -> fraction or None"},
     {"crossing", (PyCFunction)(void (*)(void))om_crossing, METH_FASTCALL,
      "crossing(ga, da, gb, db, span, hermite) -> fraction or None"},
+    {"joint_step", (PyCFunction)(void (*)(void))om_joint_step, METH_FASTCALL, "joint_step(cyclic, a, b) -> float"},
+    {"cell_looks", (PyCFunction)(void (*)(void))om_cell_looks, METH_FASTCALL,
+     "cell_looks(q, psi, pieces, feasible, bounds, cyclic, fine_step, slack, hermite, first) -> None"},
     {NULL, NULL, 0, NULL},
 };

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 
 import om_redundant as om
 from benchmarks.control_rate import MIN_CLEARANCE, obstacles
-from om_redundant.redundancy.intervals import SLACK_TOLERANCE, _refined, _spans
+from om_redundant.redundancy.intervals import SLACK_TOLERANCE, _refined, _runs, _spans
 from om_redundant.redundancy.paths import lockstep, sweep_circle
 from om_redundant.redundancy.probe import END_TOLERANCE
 
@@ -68,3 +68,14 @@ def test_refined_ends_are_the_boundary_and_lockstep_is_alone(seed, name, count):
         if end.evaluation.slack > SLACK_TOLERANCE:
             beyond, arrived = probe.follow(end, end.psi + direction * 2.0 * END_TOLERANCE)
             assert arrived and not beyond.evaluation.feasible
+
+
+@given(flags=st.lists(st.booleans(), max_size=40))
+def test_runs_are_the_maximal_runs_of_true_flags(flags):
+    """_runs: every true flag in exactly one run [i, j), all of a run's flags true, and the
+    flags just outside a run false (or the list's ends)."""
+    runs = _runs(flags)
+    covered = [k for i, j in runs for k in range(i, j)]
+    assert covered == [k for k, flag in enumerate(flags) if flag]
+    for i, j in runs:
+        assert i < j and (i == 0 or not flags[i - 1]) and (j == len(flags) or not flags[j])

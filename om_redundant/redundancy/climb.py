@@ -268,7 +268,7 @@ def _maximise_1d(probe: Probe, start: Point, lower: float, upper: float, radius:
         if gain > 0.75 * model_gain and size >= 0.9 * radius:
             radius *= 2.0
         point, x, pieces = trial, x + delta, moved
-    return replace(point, psi=x)
+    return point.at(x)
 
 
 def _bfgs_1d(b: float, s: float, y: float) -> float:

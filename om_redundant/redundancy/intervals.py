@@ -111,17 +111,35 @@ def _spans(path: Path) -> list[_Span]:
     if path.turns and all(feasible):
         return [_Span(list(points), None, None, closed=True)]
     period = 2.0 * math.pi * path.turns
+    # a loop is scanned from after an infeasible sample (so that no run wraps past the scan's
+    # end); a run of a loop past its last sample continues a turn later
     start = next((k for k in range(n) if not feasible[k - 1]), 0) if path.turns else 0
-    runs, current = [], []
-    for k in [*range(start, n), *range(start)]:  # a loop is scanned from after an infeasible sample
-        if feasible[k]:
-            wrapped = bool(current) and k < current[0][0]  # (a run of a loop past its last sample)
-            current.append((k, points[k].at(points[k].psi + period) if wrapped else points[k]))
-        elif current:
-            runs.append(current)
-            current = []
-    runs += [current] if current else []
-    return [_span(path, [p for _, p in run], run[0][0], run[-1][0]) for run in runs]
+    spans = []
+    for i, j in _runs(feasible[start:] + feasible[:start]):
+        k_first, k_last = (start + i) % n, (start + j - 1) % n
+        if k_first <= k_last:
+            run = points[k_first : k_last + 1]
+        else:
+            run = points[k_first:] + [p.at(p.psi + period) for p in points[: k_last + 1]]
+        spans.append(_span(path, run, k_first, k_last))
+    return spans
+
+
+def _runs(flags: list[bool]) -> list[tuple[int, int]]:
+    """The maximal runs [i, j) of true flags (found by list.index, not flag by flag)."""
+    runs, i, n = [], 0, len(flags)
+    while i < n:
+        try:
+            i = flags.index(True, i)
+        except ValueError:
+            break
+        try:
+            j = flags.index(False, i)
+        except ValueError:
+            j = n
+        runs.append((i, j))
+        i = j
+    return runs
 
 
 def _span(path: Path, points: list[Point], k_first: int, k_last: int) -> _Span:

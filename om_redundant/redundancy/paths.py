@@ -32,7 +32,6 @@ elbow), so the solutions of a branch are organised as *paths*:
 
 from __future__ import annotations
 
-import itertools
 import math
 from collections.abc import Generator
 from dataclasses import dataclass
@@ -51,7 +50,7 @@ _HERMITE = np.array(
     [2 * _T**3 - 3 * _T**2 + 1, _T**3 - 2 * _T**2 + _T, -2 * _T**3 + 3 * _T**2, _T**3 - _T**2]
 )
 _TURN = 2.0 * math.pi
-_BOUND_SLACK = 1e-9  # covers the rounding of the Hermite models in the bounds of _quiet
+_BOUND_SLACK = 1e-9  # covers the rounding of the Hermite models in cell_looks' bounds
 
 #: What a process of :func:`lockstep` asks for: follow from the point towards psi on the
 #: probe's branch (:meth:`Probe.follow`).
@@ -147,23 +146,19 @@ def lockstep(processes: list[Generator[Follow, tuple[Point, bool], Any]]) -> lis
         Each process's return value, in order.
     """
     results: list[Any] = [None] * len(processes)
-    requests: dict[int, Follow] = {}
-
-    def advance(i: int, answer: tuple[Point, bool] | None) -> None:
-        try:
-            requests[i] = processes[i].send(answer)
-        except StopIteration as done:
-            results[i] = done.value
-
-    for i in range(len(processes)):
-        advance(i, None)
-    while requests:
-        asked = list(requests.items())
-        requests.clear()
+    going = list(range(len(processes)))  # the processes going on, in order, and their answers
+    answers: list[tuple[Point, bool] | None] = [None] * len(processes)
+    while going:
+        asked: list[tuple[int, Follow]] = []
+        for i, answer in zip(going, answers, strict=True):
+            try:
+                asked.append((i, processes[i].send(answer)))
+            except StopIteration as done:
+                results[i] = done.value
         answers = [probe.follow(start, psi) for _, (probe, start, psi) in asked]
-        evaluate_points(asked[0][1][0].objective, [point for point, _ in answers])
-        for (i, _), answer in zip(asked, answers, strict=True):
-            advance(i, answer)
+        if asked:
+            evaluate_points(asked[0][1][0].objective, [point for point, _ in answers])
+        going = [i for i, _ in asked]
     return results
 
 
@@ -286,56 +281,61 @@ def _with_hidden(paths: list[tuple[Probe, Path]]) -> list[Path]:
         ends_of.append(list(path.points) + closing)
     flat = [p for ends in ends_of for p in ends]
     evaluate_points(paths[0][0].objective, flat)  # (the path ends that the following found)
-    # every cell's first tests at once: no joint moves more than FINE_STEP and the bounds of
-    # the cubic models show them quiet (else _hidden looks inside)
-    first = np.cumsum([0] + [len(ends) for ends in ends_of]).tolist()  # each path's first in flat
-    bounds = list(itertools.pairwise(first))
-    a = np.concatenate([np.arange(i, j - 1) for i, j in bounds])  # each cell's first end in flat
-    q = np.array([p.q for p in flat])
-    steps = np.concatenate(
-        [probe.steps(q[i : j - 1], q[i + 1 : j]) for (probe, _), (i, j) in zip(paths, bounds, strict=True)]
+    # every cell's first tests at once (ckernels.cell_looks, which reads the samples' lists)
+    lengths = [len(ends) for ends in ends_of]
+    owner = np.repeat(np.arange(len(paths)), lengths).tolist()  # each end's path
+    start = np.cumsum([0, *lengths]).tolist()  # each path's first end in flat
+    first = np.empty(len(flat))  # cell a: between ends a, a + 1
+    ckernels.cell_looks(
+        [p.q for p in flat],
+        [p.psi for p in flat],
+        [p.pieces() for p in flat],
+        [p.evaluation.feasible for p in flat],
+        np.array(start, dtype=np.int64),
+        np.array([probe.cyclic for probe, _ in paths]),
+        FINE_STEP,
+        _BOUND_SLACK,
+        _HERMITE,
+        first,
     )
-    psi = np.array([p.psi for p in flat])
-    feasible = np.array([p.evaluation.feasible for p in flat], dtype=bool)
-    pieces = [p.pieces() for p in flat]
-    g, dg = np.array([x for x, _ in pieces]), np.array([x for _, x in pieces])
-    calm = (steps <= FINE_STEP) & _quiet(
-        psi[a + 1] - psi[a], g[a], dg[a], g[a + 1], dg[a + 1], feasible[a], feasible[a + 1]
-    )
-    probes = [probe for (probe, _), ends in zip(paths, ends_of, strict=True) for _ in ends[1:]]
-    looked, a = np.flatnonzero(~calm).tolist(), a.tolist()
-    cells = [_hidden(probes[c], flat[a[c]], flat[a[c] + 1], float(steps[c])) for c in looked]
-    inserted = dict(zip(looked, lockstep(cells), strict=True))
-    result, c = [], 0
-    for (_, path), ends in zip(paths, ends_of, strict=True):
-        filled = [ends[0]]
-        for b in ends[1:]:
-            filled += [*inserted.get(c, ()), b]
-            c += 1
-        result.append(Path(filled[:-1] if path.turns else filled, path.turns))
-    return result
+    looked = np.flatnonzero(~np.isnan(first)).tolist()
+    t = first[looked].tolist()
+    cells = [_hidden(paths[owner[a]][0], flat[a], flat[a + 1], t_a) for a, t_a in zip(looked, t, strict=True)]
+    filled = [list(ends) for ends in ends_of]
+    for a, points in zip(reversed(looked), reversed(lockstep(cells)), strict=True):  # (back to front)
+        at = a - start[owner[a]] + 1
+        filled[owner[a]][at:at] = points
+    return [
+        Path(points[:-1] if path.turns else points, path.turns)
+        for (_, path), points in zip(paths, filled, strict=True)
+    ]
 
 
-def _hidden(
-    probe: Probe, a: Point, b: Point, step: float
-) -> Generator[Follow, tuple[Point, bool], list[Point]]:
-    """Exact samples inserted between neighbours a and b of a path (``step``: the largest
-    joint step between them), in order: halving until no joint moves more than
-    :data:`FINE_STEP` in a sub-cell, then until the Hermite models of every sub-cell agree
-    with its ends (module docstring). A process of :func:`lockstep`, which asks for each
-    inserted sample's follow."""
-    inserted, cells = [], [(a, b, step)]
-    while cells and len(inserted) < _MAX_INSERTED:
-        left, right, step = cells.pop()
-        t = 0.5 if step > FINE_STEP else _surprise(left, right)
-        if t is None or right.psi - left.psi <= END_TOLERANCE:
-            continue
-        middle, arrived = yield probe, left, left.psi + t * (right.psi - left.psi)
-        if arrived:
-            inserted.append(middle)
-            before, after = probe.steps(np.array([left.q, middle.q]), np.array([middle.q, right.q])).tolist()
-            cells += [(left, middle, before), (middle, right, after)]
-    return sorted(inserted, key=lambda p: p.psi)
+def _hidden(probe: Probe, a: Point, b: Point, t: float) -> Generator[Follow, tuple[Point, bool], list[Point]]:
+    """Exact samples inserted between neighbours a and b of a path, in order, the first at
+    the fraction t of the cell (where :func:`_look` would look; ``ckernels.cell_looks``):
+    halving until no joint moves more than :data:`FINE_STEP` in a sub-cell, then until the
+    Hermite models of every sub-cell agree with its ends (module docstring). A process of
+    :func:`lockstep`, which asks for each inserted sample's follow."""
+    inserted, cells, cyclic = [], [], probe.cyclic
+    left, right = a, b
+    while True:
+        if t is not None and right.psi - left.psi > END_TOLERANCE:
+            middle, arrived = yield probe, left, left.psi + t * (right.psi - left.psi)
+            if arrived:
+                inserted.append(middle)
+                cells += [(left, middle), (middle, right)]
+        if not cells or len(inserted) >= _MAX_INSERTED:
+            return sorted(inserted, key=lambda p: p.psi)
+        left, right = cells.pop()
+        t = _look(cyclic, left, right)
+
+
+def _look(cyclic: np.ndarray, a: Point, b: Point) -> float | None:
+    """Where, as a fraction of the cell between a and b, :func:`_hidden` samples it: the
+    middle where a joint moves more than :data:`FINE_STEP` (``cyclic``: the probe's joints
+    compared modulo 2 pi, :meth:`Probe.step`), else :func:`_surprise`'s."""
+    return 0.5 if ckernels.joint_step(cyclic, a.q, b.q) > FINE_STEP else _surprise(a, b)
 
 
 def _surprise(a: Point, b: Point) -> float | None:
@@ -343,32 +343,10 @@ def _surprise(a: Point, b: Point) -> float | None:
     the ends do not explain: more changes between feasible and infeasible than the ends'
     (none if alike, one if not), at the _MODEL_POINTS points of the cell. Returns the middle
     of the first unexplained stretch. (``ckernels.surprise``, ``csrc/cells.c``; a piece
-    that :func:`_quiet`'s bound keeps positive cannot change the pattern and is skipped.)"""
+    that the bound of ``ckernels.cell_looks`` keeps positive cannot change the pattern and
+    is skipped.)"""
     (ga, da), (gb, db) = a.pieces(), b.pieces()
     if len(ga) == 0:
         return None
     feasible = a.evaluation.feasible, b.evaluation.feasible
     return ckernels.surprise(ga, da, gb, db, b.psi - a.psi, _HERMITE, *feasible, _BOUND_SLACK)
-
-
-def _quiet(
-    span: np.ndarray,
-    ga: np.ndarray,
-    da: np.ndarray,
-    gb: np.ndarray,
-    db: np.ndarray,
-    feasible_a: np.ndarray,
-    feasible_b: np.ndarray,
-) -> np.ndarray:
-    """Whether each cell's cubic models (:func:`_surprise`'s, of its ends' feasibility
-    functions ga, gb (cells, n) and their rates da, db, :meth:`Point.pieces`; span: the
-    cell's psi) cannot surprise, by bounds: on [0, 1] the Hermite basis functions of the
-    values are >= 0 and sum to 1 and those of the slopes stay within 4/27 in size, so a
-    model lies within (4/27) |span| (|g'_a| + |g'_b|) of the ends' range. Quiet: both ends
-    feasible and every model stays >= 0, or both infeasible and one function's model stays
-    < 0; then :func:`_surprise` finds no change (it skips the pieces that this bound keeps
-    positive)."""
-    spread = 4.0 / 27.0 * np.abs(span)[:, None] * (np.abs(da) + np.abs(db)) + _BOUND_SLACK
-    clear = (np.minimum(ga, gb) - spread > 0.0).all(axis=1)
-    blocked = (np.maximum(ga, gb) + spread < 0.0).any(axis=1)
-    return (feasible_a == feasible_b) & np.where(feasible_a, clear, blocked)

@@ -219,6 +219,11 @@ class Probe:
         moved = zip(a.tolist(), b.tolist(), self._cyclic_flags, strict=True)
         return max([abs(_wrap(y - x) if cyclic else y - x) for x, y, cyclic in moved])
 
+    @property
+    def cyclic(self) -> np.ndarray:
+        """(dof,) bool: the joints that :meth:`step` compares modulo 2 pi."""
+        return self._cyclic
+
     def steps(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """:meth:`step` between the rows of a and b (M, dof)."""
         return np.maximum.reduce(np.abs(self._delta(a, b)), axis=1, initial=0.0)
