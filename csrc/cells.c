@@ -162,30 +162,6 @@ static PyObject *om_surprise(PyObject *mod, PyObject *const *args, Py_ssize_t na
     return PyFloat_FromDouble(found);
 }
 
-/* The largest joint step from a to b, max_i |d_i| with d = b - a, a cyclic joint's d taken
- * as numpy's remainder(d + pi, 2 pi) - pi (probe.py's Probe.steps, the same operations:
- * remainder is fmod moved onto the divisor's side, a NaN step is NaN). */
-static double _joint_step(Py_ssize_t dof, const uint8_t *cyclic, const double *a, const double *b)
-{
-    double largest = 0.0;
-    for (Py_ssize_t i = 0; i < dof; i++) {
-        double d = b[i] - a[i];
-        if (cyclic[i]) {
-            double r = fmod(d + OM_PI, 2.0 * OM_PI);
-            if (r != 0.0) {
-                if (r < 0.0) r += 2.0 * OM_PI;
-            } else {
-                r = 0.0; /* (+0: the divisor's sign) */
-            }
-            d = r - OM_PI;
-        }
-        d = fabs(d);
-        if (isnan(d)) return d;
-        if (d > largest) largest = d;
-    }
-    return largest;
-}
-
 /* joint_step(cyclic, a, b) -> float: the largest joint step from a to b (dof,), the cyclic
  * (bool, dof) joints compared modulo 2 pi (probe.py's Probe.step). */
 static PyObject *om_joint_step(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
@@ -199,7 +175,7 @@ static PyObject *om_joint_step(PyObject *mod, PyObject *const *args, Py_ssize_t 
         PyErr_SetString(PyExc_ValueError, "joint_step: sizes of cyclic, a and b disagree");
         return NULL;
     }
-    double step = _joint_step(dof, v[0].buf, v[1].buf, v[2].buf);
+    double step = om_largest_joint_step((int)dof, v[1].buf, v[2].buf, v[0].buf);
     release_buffers(v, 3);
     return PyFloat_FromDouble(step);
 }
@@ -268,7 +244,7 @@ static void _path_looks(const samples *s, Py_ssize_t a, Py_ssize_t b, Py_ssize_t
         const double *g = s->g, *dg = s->dg;
         cell_models c = {g + k * n, dg + k * n, g + (k + 1) * n, dg + (k + 1) * n, H, s->psi[k + 1] - s->psi[k], n, N};
         int fa = s->feasible[k], fb = s->feasible[k + 1];
-        double step = _joint_step(dof, cyclic, s->q + k * dof, s->q + (k + 1) * dof);
+        double step = om_largest_joint_step((int)dof, s->q + k * dof, s->q + (k + 1) * dof, cyclic);
         if (step <= fine && _quiet(&c, fa, fb, slack))
             first[k] = NAN;
         else if (step > fine)

@@ -109,9 +109,15 @@ bool om_continues(int dof, const double *q0, const double *q1, const double *t, 
 }
 
 double om_largest_joint_step(int dof, const double *q0, const double *q1, const uint8_t *cyclic) {
-    double moved, error;
-    _continuation(dof, q0, q1, NULL, 0.0, cyclic, &moved, &error);
-    return moved;
+    double largest = 0.0;
+    for (int i = 0; i < dof; i++) {
+        double m = q1[i] - q0[i];
+        if (cyclic && cyclic[i]) m = om_wrap_angle(m);
+        m = fabs(m);
+        if (isnan(m)) return m; /* (numpy's maximum: a NaN step is NaN) */
+        if (m > largest) largest = m;
+    }
+    return largest;
 }
 
 bool om_beyond_doubt(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic) {
