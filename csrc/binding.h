@@ -84,6 +84,11 @@ bool om_beyond_doubt(int dof, const double *q0, const double *q1, const double *
  * Probe.steps' operations: numpy's remainder, a NaN step is NaN). */
 double om_largest_joint_step(int dof, const double *q0, const double *q1, const uint8_t *cyclic);
 
+/* Paths in the arm angle (probe.py's END_TOLERANCE and SAME, read from here): a following step
+ * below OM_END_TOLERANCE (rad) has ended its path; two solutions at one psi within OM_PATH_SAME
+ * (rad, max-norm) are one. */
+#define OM_END_TOLERANCE 1e-9
+#define OM_PATH_SAME 1e-6
 /* follow.c: what om_follow_path answers. */
 enum { OM_FOLLOW_ARRIVED = 0, OM_FOLLOW_ENDED = 1, OM_FOLLOW_SINGULAR = 2 };
 /* A 7-DOF branch's solution path followed from (*psi, q, t) (t = dq/dpsi) towards target

@@ -10,7 +10,7 @@
  * Grid psi by grid psi, each path that reached the previous one (in the order they reached it)
  * moves on: where psi_k has a single root that continues the path (om_continues) to it;
  * else it is followed to psi_k: where it ends on the way, the point reached is its last; where
- * it arrives, at the root that is the same solution (the nearest within SAME, max-norm of the
+ * it arrives, at the root that is the same solution (the nearest within OM_PATH_SAME, max-norm of the
  * joint step), else at a new root (one the bounded search did not list), which it takes unless
  * another path took it first (then two paths met: this one stops at psi_{k-1}). The roots no
  * path took start paths. Then the paths that reached the last grid psi are followed across
@@ -23,8 +23,6 @@
 
 #include "binding.h"
 
-#define SAME 1e-6            /* rad, max-norm: two solutions at one psi this close are one (probe.py) */
-#define END_TOLERANCE 1e-9   /* rad: a following step below this has ended the path (probe.py) */
 #define TURN (2.0 * OM_PI)   /* (paths.py's _TURN) */
 enum { LINK_DONE = 0, LINK_SINGULAR = 1, LINK_FULL = 2 };
 enum { L_STATUS, L_ROWS, L_PATHS, L_N }; /* the out vector */
@@ -63,7 +61,7 @@ static int follow_from(linker *l, int64_t r, double target, int64_t *reached) {
     memcpy(l->x_q, row_q(l, r), sizeof(double) * 7);
     memcpy(l->x_t, row_t(l, r), sizeof(double) * 7);
     int status = om_follow_path(l->s, l->T, l->signs, l->cyclic, l->centred, l->centre, &l->x_psi, l->x_q, l->x_t,
-                                target, END_TOLERANCE, &steps);
+                                target, OM_END_TOLERANCE, &steps);
     *reached = steps == 0 ? r : REACHED;
     return status;
 }
@@ -89,7 +87,7 @@ static int64_t start_path(linker *l, int64_t k, int64_t r) {
 }
 
 /* The index of the candidate row that is the same solution as row r (itself, else the first
- * nearest within SAME: paths.py's _same), -1 if none. */
+ * nearest within OM_PATH_SAME: paths.py's _same), -1 if none. */
 static int64_t same(const linker *l, int64_t r, const int64_t *candidates, int64_t n) {
     for (int64_t j = 0; j < n; j++)
         if (candidates[j] == r) return j;
@@ -99,7 +97,7 @@ static int64_t same(const linker *l, int64_t r, const int64_t *candidates, int64
         double step = om_largest_joint_step(7, row_q(l, r), row_q(l, candidates[j]), l->cyclic);
         if (best < 0 || step < nearest) best = j, nearest = step;
     }
-    return best >= 0 && nearest <= SAME ? best : -1;
+    return best >= 0 && nearest <= OM_PATH_SAME ? best : -1;
 }
 
 /* What work (8 N entries, N = the rows' capacity) holds while linking. */

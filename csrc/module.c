@@ -57,7 +57,8 @@ PyMODINIT_FUNC PyInit_ckernels(void) {
         const char *name;
         double value;
     } floats[] = {
-        {"REACH_SLACK", OM_REACH_SLACK}, {"BRANCH_BAND", OM_BRANCH_BAND}, {"ORTHONORMALITY_TOLERANCE", OM_ORTHONORMALITY_TOL}};
+        {"REACH_SLACK", OM_REACH_SLACK}, {"BRANCH_BAND", OM_BRANCH_BAND}, {"ORTHONORMALITY_TOLERANCE", OM_ORTHONORMALITY_TOL},
+        {"END_TOLERANCE", OM_END_TOLERANCE}, {"PATH_SAME", OM_PATH_SAME}};
     for (size_t i = 0; i < sizeof floats / sizeof floats[0]; i++) {
         PyObject *v = PyFloat_FromDouble(floats[i].value);
         if (!v || PyModule_AddObject(m, floats[i].name, v) < 0) {

@@ -35,8 +35,10 @@ from .objective import Evaluation, Group, Objective
 from .self_motion import self_motion_tangent, self_motion_tangents
 
 JUMP = 1.0  # rad, max-norm joint step between neighbouring solutions of one path
-END_TOLERANCE = 1e-9  # rad: a path whose following step falls below this has ended (csrc/follow.c)
-SAME = 1e-6  # rad, max-norm: two solutions at one psi this close are one
+#: rad: a path whose following step falls below this has ended (one value with csrc/binding.h's).
+END_TOLERANCE = ckernels.END_TOLERANCE
+#: rad, max-norm: two solutions at one psi this close are one (csrc/link.c reads it there too).
+SAME = ckernels.PATH_SAME
 _AIM = 63.0 / 64.0  # of the distance to a path's predicted end, a step aimed there goes (csrc/follow.c)
 _TURN = 2.0 * math.pi
 _ARRIVED, _SINGULAR = 0, 2  # ckernels.follow's status
