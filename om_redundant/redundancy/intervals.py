@@ -167,20 +167,21 @@ def _refined(probe: Probe, inside: Point, outside: Point) -> Generator[Follow, t
     the bracket is narrower than :data:`~om_redundant.redundancy.probe.END_TOLERANCE` or the
     inner slack below :data:`SLACK_TOLERANCE`.
 
-    **Path ends.** ``inside`` can be where its path ends (the path's first or last sample,
-    a run of that sample alone): at a fold, where the path turns back in psi and
-    :math:`q - q_f \sim (\psi_f - \psi)^{1/2}`, it lies within END_TOLERANCE of the fold and
-    :math:`|dq/d\psi|` there is 1e4-1e10. No follow leaves it (the first-order prediction of
-    a step longer than its distance to the fold overshoots), and its rates, the models', are
-    not a smooth function's (g_j too goes as the square root). The path between it and
-    ``outside`` is one sheet over psi, which a follow from ``outside`` traces. So where the
-    trial from ``inside``, or one farther than END_TOLERANCE from a later inner end, is not
-    arrived at, the inner end is taken as the path's end: the trials are followed from the
-    bracket's outer end (the path's point at b), placed by the Illinois method (not by the
-    inner end's rates), until one is feasible and becomes the inner end. (A trial nearer a
-    later inner end than END_TOLERANCE is refused by the follow: then the boundary, which
-    the trial's Newton step predicts from rates of a point that a follow arrived at, is
-    within END_TOLERANCE of it.)
+    **Path ends.** ``inside`` can be where its path ends (a run that is its path's first or
+    last sample alone): at a fold, where the path turns back in psi and
+    :math:`q - q_f \sim (\psi_f - \psi)^{1/2}`, the sample lies within END_TOLERANCE of the
+    fold, :math:`|dq/d\psi|` there about 1e4-1e10. No follow leaves it (the first-order
+    prediction of a step longer than its distance to the fold overshoots; a shorter one is
+    refused), and its rates, which the models use, are a square root's (g_j goes as one
+    too), not a smooth function's. The path between it and ``outside`` is one sheet over
+    psi, which a follow from ``outside`` traces. So where the trial from ``inside`` is not
+    arrived at, or one farther than END_TOLERANCE from a later inner end (then that end is
+    where the path ends), the trials are followed from the bracket's outer end (the path's
+    point at b) instead, the next one placed by the Illinois method (not by the inner end's
+    rates), until one is feasible and becomes the inner end; a follow from the outer end
+    that is not arrived at stops the refinement. A trial nearer a later inner end than
+    END_TOLERANCE is refused by the follow and stops it: its Newton step (from the rates of
+    a point that a follow arrived at) or secant puts the boundary within END_TOLERANCE.
     """
     a, fa, b, fb = inside, inside.evaluation.slack, outside.psi, outside.evaluation.slack
     beyond, ended = outside, False  # the path's point at b; a is the path's end (see above)
