@@ -7,7 +7,7 @@ from __future__ import annotations
 import functools
 
 import numpy as np
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
@@ -35,15 +35,25 @@ def alone(process):
 
 @settings(max_examples=6, deadline=None)
 @given(
-    seed=st.integers(0, 2**32 - 1), name=st.sampled_from(["panda", "iiwa14"]), count=st.sampled_from([1, 3])
+    seed=st.integers(0, 2**32 - 1),
+    name=st.sampled_from(["panda", "iiwa14", "fr3"]),
+    count=st.sampled_from([1, 3]),
 )
+# Runs that are their path's fold end alone (intervals._refined, "Path ends"): the follow
+# from the fold cannot leave it (seeds 9, 385, 104), the cubic models' trial from it lies
+# within END_TOLERANCE of it (seeds 315, 385); each such end stayed at the fold, its slack
+# 2e-2 to 1e-1.
+@example(seed=9, name="panda", count=1)
+@example(seed=315, name="panda", count=1)
+@example(seed=385, name="panda", count=3)
+@example(seed=104, name="fr3", count=3)
 def test_refined_ends_are_the_boundary_and_lockstep_is_alone(seed, name, count):
     """On a random reachable pose with obstacles about the hand: every end refined between a
     run's end sample and the infeasible sample beyond is feasible, and either its slack is
     at most SLACK_TOLERANCE or the path is infeasible 2 END_TOLERANCE farther out (beyond
     the bracket's outer end, which is within END_TOLERANCE: a follow shorter than
-    END_TOLERANCE is refused); the ends
-    refined all at once are those refined one by one, to the bit."""
+    END_TOLERANCE is refused), also where the run's end sample is where its path ends; the
+    ends refined all at once are those refined one by one, to the bit."""
     solver = solver_of(name)
     q = np.random.default_rng(seed).uniform(solver.arm.lower, solver.arm.upper)
     T = solver.arm.fk(q)

@@ -184,8 +184,25 @@ def _refined(probe: Probe, inside: Point, outside: Point) -> Generator[Follow, t
     Illinois method (regula falsi that halves the slack kept at a stale end). It stops when
     the bracket is narrower than :data:`~om_redundant.redundancy.probe.END_TOLERANCE` or the
     inner slack below :data:`SLACK_TOLERANCE`.
+
+    **Path ends.** ``inside`` can be where its path ends (a run that is its path's first or
+    last sample alone): at a fold, where the path turns back in psi and
+    :math:`q - q_f \sim (\psi_f - \psi)^{1/2}`, the sample lies within END_TOLERANCE of the
+    fold, :math:`|dq/d\psi|` there about 1e4-1e10. No follow leaves it (the first-order
+    prediction of a step longer than its distance to the fold overshoots; a shorter one is
+    refused), and its rates, which the models use, are a square root's (g_j goes as one
+    too), not a smooth function's. The path between it and ``outside`` is one sheet over
+    psi, which a follow from ``outside`` traces. So where the trial from ``inside`` is not
+    arrived at, or one farther than END_TOLERANCE from a later inner end (then that end is
+    where the path ends), the trials are followed from the bracket's outer end (the path's
+    point at b) instead, the next one placed by the Illinois method (not by the inner end's
+    rates), until one is feasible and becomes the inner end; a follow from the outer end
+    that is not arrived at stops the refinement. A trial nearer a later inner end than
+    END_TOLERANCE is refused by the follow and stops it: its Newton step (from the rates of
+    a point that a follow arrived at) or secant puts the boundary within END_TOLERANCE.
     """
     a, fa, b, fb = inside, inside.evaluation.slack, outside.psi, outside.evaluation.slack
+    beyond, ended = outside, False  # the path's point at b; a is the path's end (see above)
     x = _modelled_end(inside, outside)
     stale = 0  # +1: b was kept last time, -1: a was
     for _ in range(_MAX_REFINE):
@@ -193,14 +210,17 @@ def _refined(probe: Probe, inside: Point, outside: Point) -> Generator[Follow, t
             break
         if x is None or not 0.0 < (x - a.psi) / (b - a.psi) < 1.0:
             x = b - fb * (b - a.psi) / (fb - fa)
-        p, arrived = yield probe, a, x
-        if not arrived:  # (cannot happen between neighbours of one path)
-            break
+        p, arrived = yield probe, beyond if ended else a, x
+        if not arrived:
+            if ended or (a is not inside and abs(x - a.psi) < END_TOLERANCE):
+                break
+            ended, x = True, None
+            continue
         if p.evaluation.feasible:
-            a, fa = p, p.evaluation.slack
+            a, fa, ended = p, p.evaluation.slack, False
             fb, stale = (fb / 2.0 if stale == 1 else fb), 1
         else:
-            b, fb = x, p.evaluation.slack
+            b, fb, beyond = x, p.evaluation.slack, p
             fa, stale = (fa / 2.0 if stale == -1 else fa), -1
         x = _newton(p)
     return a
