@@ -11,6 +11,140 @@
 #define POLE_NEWTON 8            /* Newton steps to the closest pass of h to zero in a cell */
 #define POLE_ROUNDING 1e-15      /* relative rounding of W - S: of |e| + |u1| + |u2| (DBL_EPSILON 2.2e-16) */
 
+#define MEMO_POINTS 128 /* a scan of at most this many points shares its samples' model parts (scan_memo) */
+#define MEMO_EDGES 16   /* edges of reach a scan memo keeps */
+#define MEMO_KEY (SRS_N_PARAMS + 9 + 9 + 3 + 3)
+
+/* An edge of reach a scan met (om_reach_edge(inside, outside) = w), the model's parts there and
+ * the wrist's terms for the arm angle psi (terms_valid). */
+typedef struct {
+    double inside, outside, w;
+    om_srs_elbow parts;
+    om_srs_wrist_terms terms;
+    bool terms_valid;
+    double psi;
+} memo_edge;
+
+/* What the last scan of the circle of an S-R-S arm whose dp turns with q7 in this thread, in
+ * one ELBOW branch, keeps for the next: the model's parts at its samples w_k that do not
+ * depend on the arm angle (om_srs_elbow_at: those of the hand position p_d + R delta(w_k),
+ * the orientation and the ELBOW sign), those that do not depend on the WRIST sign
+ * (om_srs_wrist_terms_of) for the arm angle psi, and the edges of reach it met (the reach
+ * margin depends on the pose alone) with the same parts there. A grid of problems of one pose
+ * (solve_grid: arm angles, each in 8 branches) scans the same samples again and again; a scan
+ * whose key is the last one's takes these instead of computing them again (the same
+ * arithmetic on the same inputs: the same bits), and solves q7 alone. */
+typedef struct {
+    bool valid;
+    double key[MEMO_KEY]; /* the model's parameters, delta's D0-D2, R, p_d, lo, h, the points */
+    om_srs_elbow parts[MEMO_POINTS];
+    bool terms_valid;
+    double psi;
+    om_srs_wrist_terms terms[MEMO_POINTS];
+    int n_edges;
+    memo_edge edges[MEMO_EDGES];
+} scan_memo;
+
+static OM_THREAD_LOCAL scan_memo memos[2]; /* ELBOW -1, +1 */
+
+static void _memo_key(const om_problem *pb, double lo, double h, int n_pts, double *key)
+{
+    const mat3 *R = &pb->t.R;
+    const vec3 rows[3] = {R->r0, R->r1, R->r2};
+    memcpy(key, pb->s->params, SRS_N_PARAMS * sizeof(double));
+    double *k = key + SRS_N_PARAMS;
+    for (int i = 0; i < 3; i++)
+        *k++ = pb->s->D[i][0], *k++ = pb->s->D[i][1], *k++ = pb->s->D[i][2];
+    for (int i = 0; i < 3; i++)
+        *k++ = rows[i].x, *k++ = rows[i].y, *k++ = rows[i].z;
+    *k++ = pb->p.x, *k++ = pb->p.y, *k++ = pb->p.z;
+    *k++ = lo, *k++ = h;
+    *k = (double)n_pts;
+}
+
+/* Whether two doubles have the same bits (cos and sin of -0.0 and 0.0 differ in a sign). */
+static bool _same_bits(double a, double b) { return memcmp(&a, &b, sizeof a) == 0; }
+
+/* g at w and the reach margin as om_g_margin computes them (one residual evaluation; q as it
+ * leaves q), from the model's parts e there: the wrist's terms from *terms where fresh (for
+ * this arm angle), else computed into it. */
+static double _g_of_parts(om_problem *pb, double w, const om_srs_elbow *e, om_srs_wrist_terms *terms, bool fresh,
+                          double *q, double *margin)
+{
+    const double *P = pb->s->params;
+    pb->counter++;
+    *margin = e->margin;
+    if (e->margin < -OM_REACH_SLACK)
+        return NAN;
+    if (!fresh)
+        *terms = om_srs_wrist_terms_of(P, &pb->t, e);
+    om_srs_q7_of(P, &pb->t, e, terms, pb->signs, pb->q_prev, q);
+    return om_wrap(q[6] - w);
+}
+
+/* g and the reach margin at the scan's points ws[k] = lo + h k, k < n_pts, into gs and ms as
+ * om_g_margin computes them, the parts that the thread's scan_memo holds for them taken from
+ * it. Returns that memo, now this scan's (NULL where the arm keeps none), valid until the
+ * thread's next scan. */
+static scan_memo *_sample(om_problem *pb, double lo, double h, int n_pts, double *ws, double *gs, double *ms,
+                          double *q)
+{
+    const om_solver_data *s = pb->s;
+    for (int k = 0; k < n_pts; k++)
+        ws[k] = lo + h * (double)k;
+    if (s->family != OM_SRS || s->mode != OM_CIRCLE || s->dp_joint != 6 || n_pts > MEMO_POINTS) {
+        for (int k = 0; k < n_pts; k++)
+            gs[k] = om_g_margin(pb, ws[k], q, false, &ms[k]);
+        return NULL;
+    }
+    double elbow = (double)pb->signs[1];
+    scan_memo *memo = &memos[elbow > 0.0];
+    double key[MEMO_KEY];
+    _memo_key(pb, lo, h, n_pts, key);
+    if (!memo->valid || memcmp(key, memo->key, sizeof key) != 0) {
+        for (int k = 0; k < n_pts; k++)
+            om_srs_elbow_at(s->params, &pb->t, om_on_circle(pb, ws[k]), elbow, &memo->parts[k]);
+        memcpy(memo->key, key, sizeof key);
+        memo->valid = true;
+        memo->terms_valid = false;
+        memo->n_edges = 0;
+    }
+    bool fresh = memo->terms_valid && _same_bits(memo->psi, pb->t.psi);
+    for (int k = 0; k < n_pts; k++)
+        gs[k] = _g_of_parts(pb, ws[k], &memo->parts[k], &memo->terms[k], fresh, q, &ms[k]);
+    memo->psi = pb->t.psi;
+    memo->terms_valid = true;
+    return memo;
+}
+
+/* The edge of reach om_reach_edge(inside, outside) and g there (om_g) into *g, through this
+ * scan's memo (NULL: none): an edge that the memo's scans met is the same, and g there is
+ * evaluated from the parts kept. */
+static double _edge(om_problem *pb, scan_memo *memo, double inside, double outside, double *q, double *g)
+{
+    memo_edge *edge = NULL;
+    for (int i = 0; memo && i < memo->n_edges && !edge; i++)
+        if (_same_bits(memo->edges[i].inside, inside) && _same_bits(memo->edges[i].outside, outside))
+            edge = &memo->edges[i];
+    if (!edge) {
+        double w = om_reach_edge(pb, inside, outside, q);
+        if (!memo || memo->n_edges == MEMO_EDGES) {
+            *g = om_g(pb, w, q, false);
+            return w;
+        }
+        edge = &memo->edges[memo->n_edges++];
+        edge->inside = inside, edge->outside = outside, edge->w = w;
+        om_srs_elbow_at(pb->s->params, &pb->t, om_on_circle(pb, w), (double)pb->signs[1], &edge->parts);
+        edge->terms_valid = false;
+    }
+    double margin;
+    *g = _g_of_parts(pb, edge->w, &edge->parts, &edge->terms, edge->terms_valid && _same_bits(edge->psi, pb->t.psi),
+                     q, &margin);
+    edge->psi = pb->t.psi;
+    edge->terms_valid = true;
+    return edge->w;
+}
+
 /* out[n] = v if there is room; returns the new count (the candidates' capacity is a bound, checked). */
 static int _put(double *out, int n, int cap, double v)
 {
@@ -199,7 +333,7 @@ static int _pole_splits(const pole_guard *pole, double a, double b, double *spli
 }
 
 static int _run_roots(om_problem *pb, const pole_guard *pole, int depth, const double *pw, const double *pg, int L,
-                      bool cyclic, double *q, double *out, int n, int cap);
+                      bool cyclic, double *curvatures, double *q, double *out, int n, int cap);
 
 /* The roots on the cell [a, b] of a run (both ends reachable) split at the points split[0 ..
  * k): a run of its own (_run_roots, depth splits more at most), so that its parts get the
@@ -209,6 +343,7 @@ static int _split_roots(om_problem *pb, const pole_guard *pole, int depth, doubl
                         int k, double b, double gb, double *q, double *out, int n, int cap)
 {
     double sw[2 * (POLE_SPLITS + POLE_SPREAD) + 3], sg[2 * (POLE_SPLITS + POLE_SPREAD) + 3];
+    double curvatures[2 * (POLE_SPLITS + POLE_SPREAD) + 3];
     int m = 1;
     sw[0] = a;
     sg[0] = ga;
@@ -219,30 +354,36 @@ static int _split_roots(om_problem *pb, const pole_guard *pole, int depth, doubl
     }
     sw[m] = b;
     sg[m] = gb;
-    return _run_roots(pb, pole, depth, sw, sg, m + 1, false, q, out, n, cap);
+    return _run_roots(pb, pole, depth, sw, sg, m + 1, false, curvatures, q, out, n, cap);
 }
 
-/* CELL_SAFETY times |g''| estimated at run point i from the wrapped slopes of its two cells
- * (0 at the ends of a run that is not cyclic). */
-static double _curvature_at(const double *pw, const double *pg, int L, bool cyclic, int i)
+/* CELL_SAFETY times |g''| estimated at each run point i from the wrapped slopes of its two
+ * cells (0 at the ends of a run that is not cyclic, and where a cell is empty) into out[0 ..
+ * L); each cell's slope is computed once, for both of its ends. */
+static void _curvatures(const double *pw, const double *pg, int L, bool cyclic, double *out)
 {
-    if (!cyclic && (i <= 0 || i >= L - 1))
-        return 0.0;
-    int before = py_mod(i - 1, L), after = py_mod(i + 1, L);
-    double h0 = om_wrap(pw[i] - pw[before]), h1 = om_wrap(pw[after] - pw[i]);
-    if (L < 3 || !(h0 > 0.0) || !(h1 > 0.0))
-        return 0.0;
-    double s0 = om_wrap(pg[i] - pg[before]) / h0, s1 = om_wrap(pg[after] - pg[i]) / h1;
-    return CELL_SAFETY * fabs(s1 - s0) / (0.5 * (h0 + h1));
+    double h0 = 0.0, s0 = 0.0; /* the cell before point i (from point i - 1) */
+    if (cyclic && L > 0) {
+        h0 = om_wrap(pw[0] - pw[L - 1]);
+        s0 = om_wrap(pg[0] - pg[L - 1]) / h0;
+    }
+    for (int i = 0; i < L; i++) {
+        int after = (i + 1) % L;
+        double h1 = om_wrap(pw[after] - pw[i]), s1 = om_wrap(pg[after] - pg[i]) / h1;
+        bool end = !cyclic && (i <= 0 || i >= L - 1);
+        out[i] = end || L < 3 || !(h0 > 0.0) || !(h1 > 0.0) ? 0.0 : CELL_SAFETY * fabs(s1 - s0) / (0.5 * (h0 + h1));
+        h0 = h1;
+        s0 = s1;
+    }
 }
 
-/* _curvature_at point k of the run, k taken modulo L where the run is cyclic; NaN for a k
- * beyond its ends where it is not (and for an empty run). */
-static double _curvature_near(const double *pw, const double *pg, int L, bool cyclic, int k)
+/* The estimate of _curvatures at point k of the run, k taken modulo L where the run is cyclic;
+ * NaN for a k beyond its ends where it is not (and for an empty run). */
+static double _curvature_near(const double *curvatures, int L, bool cyclic, int k)
 {
     if (L < 1 || (!cyclic && (k < 0 || k >= L)))
         return NAN;
-    return _curvature_at(pw, pg, L, cyclic, py_mod(k, L));
+    return curvatures[py_mod(k, L)];
 }
 
 /* Add a close pair of roots on [a, b] to out[n:]: g has one sign at a, x0 and b, and its
@@ -267,9 +408,9 @@ static int _pair(om_problem *pb, double a, double ga, double x0, double b, doubl
  * zero (|g| < OM_TOUCH without a crossing, also at an edge of reach) is a candidate for the
  * singular boundary, where the closed form's last digits are lost. A cell where w_hat passes
  * close by psi's half-line is split first (_pole_splits, at most depth times nested). A
- * cyclic run covers the whole circle. */
+ * cyclic run covers the whole circle. curvatures: scratch for L doubles. */
 static int _run_roots(om_problem *pb, const pole_guard *pole, int depth, const double *pw, const double *pg, int L,
-                      bool cyclic, double *q, double *out, int n, int cap)
+                      bool cyclic, double *curvatures, double *q, double *out, int n, int cap)
 {
     if (!cyclic) { /* g near zero at an edge of reach: a root at the singular boundary there */
         if (fabs(pg[0]) < OM_TOUCH)
@@ -277,11 +418,12 @@ static int _run_roots(om_problem *pb, const pole_guard *pole, int depth, const d
         if (L > 1 && fabs(pg[L - 1]) < OM_TOUCH)
             n = _put(out, n, cap, pw[L - 1]);
     }
-    /* The estimates at points i - 1 .. i + 2 of cell i, each point's computed once as the
-     * window slides (NaN beyond the ends of a run that is not cyclic: none there). */
+    /* The estimates at points i - 1 .. i + 2 of cell i, as the window slides (NaN beyond the
+     * ends of a run that is not cyclic: none there). */
+    _curvatures(pw, pg, L, cyclic, curvatures);
     double near[4];
     for (int m = 0; m < 4; m++)
-        near[m] = _curvature_near(pw, pg, L, cyclic, m - 1);
+        near[m] = _curvature_near(curvatures, L, cyclic, m - 1);
     for (int i = 0; i < L - 1 + (int)cyclic; i++) {
         int j = (i + 1) % L;
         double wj = pw[j] + (j == 0 ? 2.0 * OM_PI : 0.0);
@@ -290,7 +432,7 @@ static int _run_roots(om_problem *pb, const pole_guard *pole, int depth, const d
             if (!isnan(near[m]))
                 curvature = py_max(curvature, near[m]);
         memmove(near, near + 1, 3 * sizeof(double));
-        near[3] = _curvature_near(pw, pg, L, cyclic, i + 3);
+        near[3] = _curvature_near(curvatures, L, cyclic, i + 3);
         double split[2 * (POLE_SPLITS + POLE_SPREAD) + 1];
         int k = pole->active && depth > 0 ? _pole_splits(pole, pw[i], wj, split) : 0;
         if (k)
@@ -354,8 +496,9 @@ int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool f
 {
     double h = (hi - lo) / (double)(full_circle ? n_pts : n_pts - 1);
     int count = full_circle ? n_pts + 1 : n_pts;
-    /* ws, gs, ms (n_pts + 1 each), their rotations (count each), pw, pg (count + 2 each) */
-    size_t size = (size_t)(3 * (n_pts + 1) + 3 * count + 2 * (count + 2));
+    /* ws, gs, ms (n_pts + 1 each), their rotations (count each), pw, pg and a run's curvature
+     * estimates (count + 2 each) */
+    size_t size = (size_t)(3 * (n_pts + 1) + 3 * count + 3 * (count + 2));
     double *buffer = malloc(size * sizeof(double));
     int *order = malloc((size_t)count * sizeof(int));
     if (!buffer || !order) {
@@ -365,18 +508,16 @@ int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool f
     }
     double *ws = buffer, *gs = ws + (n_pts + 1), *ms = gs + (n_pts + 1);
     double *rws = ms + (n_pts + 1), *rgs = rws + count, *rms = rgs + count;
-    double *pw = rms + count, *pg = pw + (count + 2);
+    double *pw = rms + count, *pg = pw + (count + 2), *curvatures = pg + (count + 2);
     pole_guard pole = _pole_guard(pb, h);
     int start = -1;
-    for (int k = 0; k < n_pts; k++) {
-        ws[k] = lo + h * (double)k;
-        gs[k] = om_g_margin(pb, ws[k], q, false, &ms[k]);
-        if (start < 0 && isnan(gs[k]))
+    scan_memo *memo = _sample(pb, lo, h, n_pts, ws, gs, ms, q);
+    for (int k = 0; k < n_pts && start < 0; k++)
+        if (isnan(gs[k]))
             start = k;
-    }
     int n = 0;
     if (full_circle && start < 0) { /* reachable everywhere: one cyclic run */
-        n = _run_roots(pb, &pole, POLE_DEPTH, ws, gs, n_pts, true, q, cands, n, cap);
+        n = _run_roots(pb, &pole, POLE_DEPTH, ws, gs, n_pts, true, curvatures, q, cands, n, cap);
         free(buffer);
         free(order);
         return n;
@@ -395,13 +536,13 @@ int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool f
         ws[0] = lo + h * (double)start;
     }
     om_reach_bound bound = OM_REACH_BOUND_NONE;
+    bound.samples = memo ? memo->parts : NULL, bound.lo = lo, bound.h = h, bound.n = n_pts;
     int L = 0;
     for (int i = 0; i < count; i++) {
         double w = ws[i];
         if (!isnan(gs[i])) {
             if (L == 0 && i > 0) { /* entering reach */
-                pw[0] = om_reach_edge(pb, w, ws[i - 1], q);
-                pg[0] = om_g(pb, pw[0], q, false);
+                pw[0] = _edge(pb, memo, w, ws[i - 1], q, &pg[0]);
                 L = 1;
             }
             pw[L] = w;
@@ -410,9 +551,8 @@ int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool f
             continue;
         }
         if (L > 0) { /* leaving reach */
-            pw[L] = om_reach_edge(pb, pw[L - 1], w, q);
-            pg[L] = om_g(pb, pw[L], q, false);
-            n = _run_roots(pb, &pole, POLE_DEPTH, pw, pg, L + 1, false, q, cands, n, cap);
+            pw[L] = _edge(pb, memo, pw[L - 1], w, q, &pg[L]);
+            n = _run_roots(pb, &pole, POLE_DEPTH, pw, pg, L + 1, false, curvatures, q, cands, n, cap);
             L = 0;
         }
         if (i + 1 < count && isnan(gs[i + 1])) {
@@ -428,13 +568,13 @@ int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool f
                     pw[2] = om_reach_edge(pb, c, ws[i + 1], q);
                     pg[0] = om_g(pb, pw[0], q, false);
                     pg[2] = om_g(pb, pw[2], q, false);
-                    n = _run_roots(pb, &pole, POLE_DEPTH, pw, pg, 3, false, q, cands, n, cap);
+                    n = _run_roots(pb, &pole, POLE_DEPTH, pw, pg, 3, false, curvatures, q, cands, n, cap);
                 }
             }
         }
     }
     if (L > 0) /* a run that reaches the end of the window */
-        n = _run_roots(pb, &pole, POLE_DEPTH, pw, pg, L, false, q, cands, n, cap);
+        n = _run_roots(pb, &pole, POLE_DEPTH, pw, pg, L, false, curvatures, q, cands, n, cap);
     free(buffer);
     free(order);
     return n;

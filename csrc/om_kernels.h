@@ -131,6 +131,26 @@ double om_srs_reach(const double *P, const om_target *t, vec3 p, double *x);
 /* q7 alone (q[6]; the rest of q untouched), for the circle residual. Returns the margin. */
 double om_srs_model_q7(const double *P, const om_target *t, vec3 p, const int64_t *signs, const double *q_prev,
                        double *q);
+/* om_srs_model_q7 in three parts, for a caller that shares the first two between problems:
+ * what depends on the hand position p, the target's orientation and the ELBOW sign alone
+ * (om_srs_elbow_at; the rest unset where the margin is below -OM_REACH_SLACK), what the
+ * target's arm angle adds (om_srs_wrist_terms_of), and q7 for the WRIST sign (om_srs_q7_of:
+ * q[6]; near the wrist's singularity from every joint, with q_prev). */
+typedef struct {
+    double margin;     /* the reach margin */
+    vec3 w;            /* W - S */
+    double L2, x;      /* |W - S|^2 and the elbow's x (x also out of reach; NaN where W = S) */
+    vec3 w_hat, n, nw; /* w / |w|, the arm angle's reference n there and w_hat x n */
+    mat3 B;            /* the frame-3 triad (v_hat, b3_hat, v_hat x b3_hat), rows */
+    mat3 X4;           /* Rz(phi4) X4 */
+} om_srs_elbow;
+typedef struct {
+    double radial, v, m20, m21; /* the wrist's |u|, v and M[2][0], M[2][1] (srs.c) */
+} om_srs_wrist_terms;
+double om_srs_elbow_at(const double *P, const om_target *t, vec3 p, double elbow, om_srs_elbow *e);
+om_srs_wrist_terms om_srs_wrist_terms_of(const double *P, const om_target *t, const om_srs_elbow *e);
+void om_srs_q7_of(const double *P, const om_target *t, const om_srs_elbow *e, const om_srs_wrist_terms *terms,
+                  const int64_t *signs, const double *q_prev, double *q);
 bool om_srs_model_q7_at_reach(const double *P, const om_target *t, vec3 p, const int64_t *signs,
                               const double *q_prev, double *q);
 bool om_srs_model_ik_at_reach(const double *P, const om_target *t, vec3 p, const int64_t *signs,
@@ -212,17 +232,23 @@ typedef struct {
 
 /* residual.c */
 vec3 om_delta(const double D[6][3], double w);
+/* The model's hand position on the circle, p_d + R delta(w) (not counted as an evaluation). */
+vec3 om_on_circle(const om_problem *pb, double w);
 double om_model_ik_at(om_problem *pb, double w, double *q, bool all_joints); /* returns the reach margin */
 double om_g_margin(om_problem *pb, double w, double *q, bool all_joints, double *margin); /* g (NaN out of reach) */
 double om_g(om_problem *pb, double w, double *q, bool all_joints);
 /* om_g_margin's margin alone (S-R-S: no joint solved, not counted). */
 double om_reach_margin(om_problem *pb, double w, double *q);
 /* What om_srs_reach_possible keeps across the cells of one scan: the bound on the elbow's |x''|
- * along the circle (NaN: not yet computed) and x at w, the last cell's end (NaN: none). */
+ * along the circle (NaN: not yet computed), x at w, the last cell's end (NaN: none), and the
+ * scan's samples w_k = lo + h k, k < n, whose parts are known (samples NULL: none). */
 typedef struct {
     double curvature, w, x;
+    const om_srs_elbow *samples;
+    double lo, h;
+    int n;
 } om_reach_bound;
-#define OM_REACH_BOUND_NONE ((om_reach_bound){NAN, NAN, NAN})
+#define OM_REACH_BOUND_NONE ((om_reach_bound){NAN, NAN, NAN, NULL, 0.0, 0.0, 0})
 /* S-R-S: whether the model may reach the circle's points somewhere in [a, b] (a bound; see residual.c). */
 bool om_srs_reach_possible(om_problem *pb, om_reach_bound *bound, double a, double b);
 /* S-R-S: W(w) - S = e + u1 cos w + u2 sin w on the circle. */

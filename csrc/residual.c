@@ -14,7 +14,7 @@ vec3 om_delta(const double D[6][3], double w)
 
 /* The model's hand position on the circle, p_m = p_d + R delta(w) (a wrist with a4 != 0:
  * p_d + dp(w), w = q1, see wrist_offset.c). */
-static vec3 on_circle(const om_problem *pb, double w)
+vec3 om_on_circle(const om_problem *pb, double w)
 {
     if (pb->s->family != OM_SRS && pb->s->params[SD_WRIST_OFFSET] != 0.0)
         return om_wrist_offset_point(pb->s->params, &pb->t, pb->p, (double)pb->signs[2], w);
@@ -29,7 +29,7 @@ static vec3 on_circle(const om_problem *pb, double w)
 static vec3 circle_point(om_problem *pb, double w)
 {
     pb->counter++;
-    return on_circle(pb, w);
+    return om_on_circle(pb, w);
 }
 
 /* Model IK for p_m = p_d + R delta(w), one residual evaluation; returns the reach margin
@@ -82,7 +82,7 @@ double om_reach_margin(om_problem *pb, double w, double *q)
 {
     if (pb->s->family == OM_SRS) {
         double x;
-        return om_srs_reach(pb->s->params, &pb->t, on_circle(pb, w), &x);
+        return om_srs_reach(pb->s->params, &pb->t, om_on_circle(pb, w), &x);
     }
     double margin;
     om_g_margin(pb, w, q, false, &margin);
@@ -100,6 +100,21 @@ void om_srs_wrist_circle(const om_problem *pb, vec3 *e, vec3 *u1, vec3 *u2)
     *u2 = m_mv(*R, v_load(D[2], 0));
 }
 
+/* The S-R-S model's elbow x at p_d + R delta(w) (NaN where W = S): the bound's sample's where w
+ * is one, bit for bit (the same arithmetic on the same inputs), else computed. */
+static double _elbow_x(om_problem *pb, const om_reach_bound *bound, double w)
+{
+    if (bound->samples) {
+        double k = round((w - bound->lo) / bound->h);
+        double wk = bound->lo + bound->h * k;
+        if (k >= 0.0 && k < (double)bound->n && memcmp(&wk, &w, sizeof w) == 0)
+            return bound->samples[(int)k].x;
+    }
+    double x = NAN;
+    om_srs_reach(pb->s->params, &pb->t, om_on_circle(pb, w), &x);
+    return x;
+}
+
 /* Whether an S-R-S model may reach p_d + R delta(w) for some w in [a, b], where it reaches
  * neither end: the elbow's x(w) = (L2(w) - k0) / K must come within [-1, 1]. With e = p_d +
  * R D0 + R w_F - S, u1 = R D1, u2 = R D2, L2(w) = |e + u1 cos w + u2 sin w|^2 = c0 + a1 cos w
@@ -108,16 +123,11 @@ void om_srs_wrist_circle(const om_problem *pb, vec3 *e, vec3 *u1, vec3 *u2)
  * (b - a)^2 / 8 times that of the chord through its ends: a proof that no island of reach
  * lies between two samples, without searching. The bound on |x''| is the circle's, computed
  * at the first call of a scan; x at a is the last call's x at b where a is that b (the cells
- * of a scan in order), the same value. */
+ * of a scan in order), the same value, and at a sample of the scan its part's (_elbow_x). */
 bool om_srs_reach_possible(om_problem *pb, om_reach_bound *bound, double a, double b)
 {
     const double *P = pb->s->params;
-    double xa = NAN, xb = NAN;
-    if (a == bound->w)
-        xa = bound->x;
-    else
-        om_srs_reach(P, &pb->t, on_circle(pb, a), &xa);
-    om_srs_reach(P, &pb->t, on_circle(pb, b), &xb);
+    double xa = a == bound->w ? bound->x : _elbow_x(pb, bound, a), xb = _elbow_x(pb, bound, b);
     bound->w = b, bound->x = xb;
     if (isnan(xa) || isnan(xb)) /* W = S at an end */
         return true;

@@ -71,21 +71,40 @@ static elbow_cs elbow_root(const double *P, double x, double elbow, double *phi4
     return e;
 }
 
-/* R03 for W - S = w, the elbow angle phi4 (cos c4, sin c4) and the target's arm angle: it
- * maps the frame-3 triad (v_hat, b3_hat, v_hat x b3_hat) onto (w_hat, m, w_hat x m). */
-static mat3 rotation_03_at(const double *P, const om_target *t, vec3 w, double L2, double c4, double s4,
-                           double elbow)
+/* w_hat = w / |w| for W - S = w (L2 = |w|^2), and the arm angle's reference n, w_hat x n there. */
+static void shoulder_wrist_triad(const double *P, vec3 w, double L2, vec3 *w_hat, vec3 *n, vec3 *nw)
 {
-    vec3 w_hat = v_scale(1.0 / sqrt(L2), w);
-    vec3 n, nw;
-    om_srs_reference(P, w_hat, &n, &nw);
-    vec3 m = v_add(v_scale(t->cos_psi, n), v_scale(t->sin_psi, nw));
+    *w_hat = v_scale(1.0 / sqrt(L2), w);
+    om_srs_reference(P, *w_hat, n, nw);
+}
+
+/* The frame-3 triad (v_hat, b3_hat, v_hat x b3_hat) as rows, for the elbow angle phi4 (cos
+ * c4, sin s4) in the ELBOW branch `elbow`. */
+static mat3 elbow_triad(const double *P, double c4, double s4, double elbow)
+{
     vec3 v = elbow_vector(P, c4, s4);
     vec3 v_hat = v_unit(v);
     vec3 b3 = v_unit(v_scale(elbow * P[SRS_BEND], v3(-v.y, v.x, 0.0)));
-    mat3 A = {w_hat, m, v_cross(w_hat, m)};
     mat3 B = {v_hat, b3, v_cross(v_hat, b3)};
+    return B;
+}
+
+/* R03 for the target's arm angle: it maps the frame-3 triad B (elbow_triad) onto (w_hat, m,
+ * w_hat x m), m = n cos psi + (w_hat x n) sin psi. */
+static mat3 rotation_03_of(const om_target *t, vec3 w_hat, vec3 n, vec3 nw, mat3 B)
+{
+    vec3 m = v_add(v_scale(t->cos_psi, n), v_scale(t->sin_psi, nw));
+    mat3 A = {w_hat, m, v_cross(w_hat, m)};
     return m_mtm(A, B);
+}
+
+/* R03 for W - S = w, the elbow angle phi4 (cos c4, sin s4) and the target's arm angle. */
+static mat3 rotation_03_at(const double *P, const om_target *t, vec3 w, double L2, double c4, double s4,
+                           double elbow)
+{
+    vec3 w_hat, n, nw;
+    shoulder_wrist_triad(P, w, L2, &w_hat, &n, &nw);
+    return rotation_03_of(t, w_hat, n, nw, elbow_triad(P, c4, s4, elbow));
 }
 
 /* Joints 1-3 (if shoulder) and 4-7 for the elbow's root at x (elbow_root), W - S = w and the
@@ -149,35 +168,80 @@ double om_srs_model_ik(const double *P, const om_target *t, vec3 p, const int64_
     return margin;
 }
 
-/* Joint 7 alone, as ik_with_elbow computes it for the elbow's root at x (q[6] written, the
- * rest of q untouched): what the circle residual g needs of the model. The wrist's
- * M = R04^T R E^T = Rz(phi5) Rx(alpha5) Rz(phi6) Rx(beta) Rz(phi7) is not formed: its last
- * column gives (sin phi6, cos phi6 cos beta) up to one positive factor (the Euler
- * decomposition's phi6), and its last row is sigma5 (u cos phi7 + v sin phi7, v cos phi7 -
- * u sin phi7) for that pair (u, v), which gives phi7 without phi5. Near the wrist singularity
- * (u = 0), where the closed form takes phi5 from q_prev, it decides. */
-static void q7_with_elbow(const double *P, const om_target *t, vec3 w, double L2, double x, const int64_t *signs,
-                          const double *q_prev, double *q)
+/* What q7_with_elbow computes of the elbow's root at x, W - S = w and L2 = |w|^2 before the
+ * target's arm angle enters (into e, its margin left to the caller). */
+static void elbow_parts(const double *P, vec3 w, double L2, double x, double elbow, om_srs_elbow *e)
 {
-    double elbow = (double)signs[1];
-    elbow_cs e = elbow_root(P, x, elbow, NULL);
-    double c4 = e.c4, s4 = e.s4;
-    mat3 R04 = m_mm(rotation_03_at(P, t, w, L2, c4, s4, elbow), m_rz_cs_times(c4, s4, m_load(P, SRS_X4)));
+    elbow_cs root = elbow_root(P, x, elbow, NULL);
+    e->w = w;
+    e->L2 = L2;
+    e->x = x;
+    shoulder_wrist_triad(P, w, L2, &e->w_hat, &e->n, &e->nw);
+    e->B = elbow_triad(P, root.c4, root.s4, elbow);
+    e->X4 = m_rz_cs_times(root.c4, root.s4, m_load(P, SRS_X4));
+}
+
+/* The parts of the hand position p (reach, then elbow_parts within reach); returns the margin. */
+double om_srs_elbow_at(const double *P, const om_target *t, vec3 p, double elbow, om_srs_elbow *e)
+{
+    vec3 w;
+    double L2, x = NAN;
+    e->margin = reach(P, t, p, &w, &L2, &x);
+    e->x = x;
+    if (e->margin >= -OM_REACH_SLACK)
+        elbow_parts(P, w, L2, x, elbow, e);
+    return e->margin;
+}
+
+/* The wrist's M = R04^T R E^T = Rz(phi5) Rx(alpha5) Rz(phi6) Rx(beta) Rz(phi7) is not formed:
+ * its last column gives (sin phi6, cos phi6 cos beta) up to one positive factor (the Euler
+ * decomposition's phi6), (u, v) with u = WRIST radial; its last row is sigma5 (u cos phi7 + v
+ * sin phi7, v cos phi7 - u sin phi7) for that pair: (m20, m21) = (M[2][0], M[2][1]) give phi7
+ * without phi5 (om_srs_q7_of). */
+om_srs_wrist_terms om_srs_wrist_terms_of(const double *P, const om_target *t, const om_srs_elbow *e)
+{
+    mat3 R04 = m_mm(rotation_03_of(t, e->w_hat, e->n, e->nw, e->B), e->X4);
     mat3 RE_cols = m_transpose(t->RE);
     vec3 z4 = m_col(R04, 2); /* M[i][j] = (column i of R04) . (column j of R E^T) */
     double ax = v_dot(m_col(R04, 0), RE_cols.r2), ay = v_dot(m_col(R04, 1), RE_cols.r2), az = v_dot(z4, RE_cols.r2);
     double sigma = P[SRS_SIGMA5], sin_b = P[SRS_SIN_BETA], cos_b = P[SRS_COS_BETA];
     double radial_2 = ax * ax + ay * ay - cos_b * cos_b; /* as om_euler_zxzxz */
-    double radial = sqrt(0.0 > radial_2 ? 0.0 : radial_2);
-    if (!(radial > NEAR_SINGULAR_WRIST)) {
+    om_srs_wrist_terms terms = {
+        .radial = sqrt(0.0 > radial_2 ? 0.0 : radial_2),
+        .v = -sigma * (sin_b > 0.0 ? 1.0 : -1.0) * az * cos_b,
+        .m20 = v_dot(z4, RE_cols.r0),
+        .m21 = v_dot(z4, RE_cols.r1),
+    };
+    return terms;
+}
+
+/* Near the wrist singularity (radial = 0), where the closed form takes phi5 from q_prev, it
+ * decides q7. */
+void om_srs_q7_of(const double *P, const om_target *t, const om_srs_elbow *e, const om_srs_wrist_terms *terms,
+                  const int64_t *signs, const double *q_prev, double *q)
+{
+    if (!(terms->radial > NEAR_SINGULAR_WRIST)) {
         double wrist_joints[7];
-        ik_with_elbow(P, t, w, L2, x, signs, q_prev, wrist_joints, false);
+        ik_with_elbow(P, t, e->w, e->L2, e->x, signs, q_prev, wrist_joints, false);
         q[6] = wrist_joints[6];
         return;
     }
-    double u = (double)signs[2] * radial, v = -sigma * (sin_b > 0.0 ? 1.0 : -1.0) * az * cos_b;
-    double m20 = v_dot(z4, RE_cols.r0), m21 = v_dot(z4, RE_cols.r1);
-    q[6] = om_wrap(atan2(sigma * (v * m20 - u * m21), sigma * (u * m20 + v * m21)) - P[SRS_THETA + 6]);
+    double sigma = P[SRS_SIGMA5], u = (double)signs[2] * terms->radial, v = terms->v;
+    q[6] = om_wrap(atan2(sigma * (v * terms->m20 - u * terms->m21), sigma * (u * terms->m20 + v * terms->m21)) -
+                   P[SRS_THETA + 6]);
+}
+
+/* Joint 7 alone, as ik_with_elbow computes it for the elbow's root at x (q[6] written, the
+ * rest of q untouched): what the circle residual g needs of the model, in the three parts
+ * above (elbow_parts, om_srs_wrist_terms_of, om_srs_q7_of), which a scan of the circle shares
+ * between problems (circle.c). */
+static void q7_with_elbow(const double *P, const om_target *t, vec3 w, double L2, double x, const int64_t *signs,
+                          const double *q_prev, double *q)
+{
+    om_srs_elbow e;
+    elbow_parts(P, w, L2, x, (double)signs[1], &e);
+    om_srs_wrist_terms terms = om_srs_wrist_terms_of(P, t, &e);
+    om_srs_q7_of(P, t, &e, &terms, signs, q_prev, q);
 }
 
 /* Joint 7 alone, as om_srs_model_ik computes it (q7_with_elbow). Returns the reach margin as

@@ -1,0 +1,61 @@
+"""The circle search's scan memo (csrc/circle.c): a thread keeps the model's parts at the scan's
+samples and edges of reach for its next scan of the same pose, so a row's answer must not depend
+on which rows the thread solved before it, to the last bit."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import om_redundant as om
+from tests.conftest import random_q
+
+
+def _grid(solver: om.OMSolver, T: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The rows of a sweep of pose T (paths.sweep_circle's layout): n arm angles, each in every
+    branch, the branches that differ in the SHOULDER sign alone next to each other."""
+    branches = sorted((c.signs for c in solver.configurations()), key=lambda s: (s[1:], s[0]))
+    psi = -np.pi + 2.0 * np.pi * np.arange(n) / n
+    return (
+        np.repeat(T[None], n * len(branches), axis=0),
+        np.tile(branches, (n, 1)),
+        np.repeat(psi, len(branches)),
+    )
+
+
+def _rows(batch: om.BatchRoots, order: np.ndarray) -> list[np.ndarray]:
+    return [
+        batch.q[order],
+        batch.count[order],
+        batch.position_error[order],
+        batch.orientation_error[order],
+        batch.iterations[order],
+        batch.within_limits[order],
+    ]
+
+
+@pytest.mark.parametrize(("name", "seed"), [("panda", 4), ("xarm7", 1)])  # poses with 0, 1 and 2 roots
+def test_grid_rows_do_not_depend_on_the_rows_before(name, seed):
+    """A sweep's grid in its own order (every scan after the first of a pose takes the memo's
+    parts), in a random order (arm angles and branches mixed: other parts kept, others
+    replaced), and row by row with a scan of another arm and of another pose before each
+    (every scan computes its parts afresh) give the same roots, errors and evaluation counts."""
+    solver, other = om.OMSolver(name), om.OMSolver("fr3")
+    rng = np.random.default_rng(seed)
+    T, T_other = solver.arm.fk(random_q(solver.arm, 2, rng))
+    Ts, signs, psi = _grid(solver, T, 16)
+    band = rng.uniform(size=len(Ts)) < 0.5
+    swept = solver.solve_grid(Ts, signs, psi, band, threads=1)
+    assert (swept.count == 0).any() and (swept.count > 1).any()
+    everything = np.arange(len(Ts))
+    order = rng.permutation(len(Ts))
+    mixed = solver.solve_grid(Ts[order], signs[order], psi[order], band[order], threads=1)
+    for a, b in zip(_rows(swept, order), _rows(mixed, everything), strict=True):
+        np.testing.assert_array_equal(a, b)
+    for i in rng.choice(len(Ts), 12, replace=False):
+        # The same matrix on another arm (other parameters), then another pose on this one.
+        other.solve_grid(Ts[:1], signs[:1], psi[:1], band[:1], threads=1)
+        solver.solve_grid(T_other[None], signs[:1], psi[:1], band[:1], threads=1)
+        alone = solver.solve_grid(Ts[i : i + 1], signs[i : i + 1], psi[i : i + 1], band[i : i + 1], threads=1)
+        for a, b in zip(_rows(swept, np.array([i])), _rows(alone, np.array([0])), strict=True):
+            np.testing.assert_array_equal(a, b)
