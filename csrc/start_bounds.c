@@ -4,6 +4,11 @@
  * reach R, of f (column 0) and of each group's functions (the other columns). */
 #include "binding.h"
 
+/* numpy's minimum and maximum: a NaN operand gives NaN (fmin and fmax drop it), so that a NaN
+ * bound is NaN as the reference's, and no start is skipped for it (optimizer.py compares). */
+static double least_of(double a, double b) { return isnan(a) ? a : isnan(b) ? b : fmin(a, b); }
+static double most_of(double a, double b) { return isnan(a) ? a : isnan(b) ? b : fmax(a, b); }
+
 typedef struct {
     const double *psi, *values, *slopes, *weights, *caps;
     const int64_t *groups; /* each group's first column */
@@ -17,10 +22,10 @@ static double bound(const start_bounds *s, const double *row) {
     for (Py_ssize_t g = 0; g < s->G; g++) {
         Py_ssize_t end = g + 1 < s->G ? s->groups[g + 1] : s->columns;
         double least = row[s->groups[g]];
-        for (Py_ssize_t j = s->groups[g] + 1; j < end; j++) least = fmin(least, row[j]);
-        total = total + s->weights[g] * fmin(s->caps[g], least);
+        for (Py_ssize_t j = s->groups[g] + 1; j < end; j++) least = least_of(least, row[j]);
+        total = total + s->weights[g] * least_of(s->caps[g], least);
     }
-    return fmin(row[0], total);
+    return least_of(row[0], total);
 }
 
 /* The bound of the cell of samples c, c + 1: the cones' meeting points, at least the ends. */
@@ -28,8 +33,8 @@ static double cell(const start_bounds *s, Py_ssize_t c, double *row) {
     const double *u = s->values + c * s->columns, *v = u + s->columns;
     double h = s->psi[c + 1] - s->psi[c];
     for (Py_ssize_t j = 0; j < s->columns; j++) {
-        double peak = 0.5 * (u[j] + v[j] + s->slopes[j] * h), top = fmax(u[j], v[j]);
-        row[j] = fmax(peak, top);
+        double peak = 0.5 * (u[j] + v[j] + s->slopes[j] * h), top = most_of(u[j], v[j]);
+        row[j] = most_of(peak, top);
     }
     return bound(s, row);
 }
@@ -37,7 +42,7 @@ static double cell(const start_bounds *s, Py_ssize_t c, double *row) {
 /* The bound beyond sample e, reach - |psi_e - x| of the reach left. */
 static double beyond(const start_bounds *s, Py_ssize_t e, double x, double reach, double *row) {
     const double *u = s->values + e * s->columns;
-    double left = fmax(reach - fabs(s->psi[e] - x), 0.0);
+    double left = most_of(reach - fabs(s->psi[e] - x), 0.0);
     for (Py_ssize_t j = 0; j < s->columns; j++) row[j] = u[j] + s->slopes[j] * left;
     return bound(s, row);
 }
@@ -74,13 +79,13 @@ static PyObject *om_start_bound(PyObject *mod, PyObject *const *args, Py_ssize_t
     while (s.psi[lo] < low) lo++;
     while (s.psi[hi] > high) hi--;
     double best = s.values[k * C]; /* f_k */
-    for (Py_ssize_t c = lo; c < hi; c++) best = fmax(best, cell(&s, c, row));
+    for (Py_ssize_t c = lo; c < hi; c++) best = most_of(best, cell(&s, c, row));
     double cut = beyond(&s, lo, x, reach, row);
-    if (lo > a) cut = fmin(cut, cell(&s, lo - 1, row));
-    best = fmax(best, cut);
+    if (lo > a) cut = least_of(cut, cell(&s, lo - 1, row));
+    best = most_of(best, cut);
     cut = beyond(&s, hi, x, reach, row);
-    if (hi < b) cut = fmin(cut, cell(&s, hi, row));
-    best = fmax(best, cut);
+    if (hi < b) cut = least_of(cut, cell(&s, hi, row));
+    best = most_of(best, cut);
     PyMem_Free(row);
     release_buffers(v, 6);
     return PyFloat_FromDouble(best);

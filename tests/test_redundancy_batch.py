@@ -315,6 +315,11 @@ def test_the_climbs_start_bounds_hold_for_functions_within_their_slopes(seed, ru
         assert bare.within(k, r) == bare.within(k, r, compiled=False)
         assert bound >= objective(np.linspace(x - r, x + r, 2001)).max() - 1e-12
         assert f_k <= bound <= min(cones[k], f_k + slope * r) + 1e-12
+    holed = terms[0][2].copy()
+    holed[rng.integers(len(psi)), 0] = np.nan  # (a function that is not a number at one sample)
+    nan_bounds = _StartBounds(psi, f, [(*terms[0][:2], holed), *terms[1:]], first, last, slope, slopes)
+    for k, r in enumerate(reach.tolist()):  # NaN where numpy's is (then no start is skipped for it)
+        np.testing.assert_equal(nan_bounds.within(k, r), nan_bounds.within(k, r, compiled=False))
 
 
 @pytest.mark.parametrize("name", list(HOMES))

@@ -454,7 +454,8 @@ class _StartBounds:
         bounded = np.full(hi - lo + 2, math.inf)  # the cut cells', then the whole ones
         bounded[int(lo == a) : len(cells) + int(lo == a)] = bounds[: len(cells)]
         cut = np.minimum(bounded[[0, -1]], bounds[len(cells) :])
-        return max(float(bounded[1:-1].max(initial=-math.inf)), float(cut.max()), float(self._values[k, 0]))
+        whole = bounded[1:-1].max(initial=-math.inf)
+        return float(np.max([whole, cut.max(), self._values[k, 0]]))  # (NaN if any is: numpy's max)
 
     def _bound(self, values: np.ndarray) -> np.ndarray:
         """(N,) the smaller of f's bound and sum_g w_g min(cap_g, min_j bound_j), from bounds
