@@ -312,16 +312,33 @@ def _with_hidden(paths: list[tuple[Probe, Path]]) -> list[Path]:
 
 
 def _hidden(probe: Probe, a: Point, b: Point, t: float) -> Generator[Follow, tuple[Point, bool], list[Point]]:
-    """Exact samples inserted between neighbours a and b of a path, in order, the first at
+    r"""Exact samples inserted between neighbours a and b of a path, in order, the first at
     the fraction t of the cell (where :func:`_look` would look; ``ckernels.cell_looks``):
     halving until no joint moves more than :data:`FINE_STEP` in a sub-cell, then until the
     Hermite models of every sub-cell agree with its ends (module docstring). A process of
-    :func:`lockstep`, which asks for each inserted sample's follow."""
+    :func:`lockstep`, which asks for each inserted sample's follow: from the sub-cell's left
+    end, and where that is not arrived at, from its right end.
+
+    **Path ends.** a can be where its path ends: a path's first sample, followed back to a
+    fold (:func:`_back_to_end`), where :math:`q - q_f \sim (\psi - \psi_f)^{1/2}` and
+    :math:`|dq/d\psi|` is about 1e4-1e10. No follow leaves it (the first-order prediction of
+    a step longer than its distance to the fold overshoots; a shorter one, below
+    :data:`END_TOLERANCE`, is refused), so the samples of such a cell are followed from its
+    right end, which traces the one sheet between them; once a follow from a has not left
+    it, the sub-cells that start at a are followed from their right end alone. (A path's
+    last sample at a fold is the right end of its cell: the follows from the left reach
+    it.)"""
     inserted, cells, cyclic = [], [], probe.cyclic
-    left, right = a, b
+    left, right, ended = a, b, False  # ended: a follow from a did not leave it (see above)
     while True:
         if t is not None and right.psi - left.psi > END_TOLERANCE:
-            middle, arrived = yield probe, left, left.psi + t * (right.psi - left.psi)
+            x = left.psi + t * (right.psi - left.psi)
+            middle, arrived = left, False
+            if not (ended and left is a):
+                middle, arrived = yield probe, left, x
+                ended = ended or middle is a
+            if not arrived:
+                middle, arrived = yield probe, right, x
             if arrived:
                 inserted.append(middle)
                 cells += [(left, middle), (middle, right)]
