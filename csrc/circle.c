@@ -13,7 +13,7 @@
 
 #define MEMO_POINTS 128 /* a scan of at most this many points shares its samples' model parts (scan_memo) */
 #define MEMO_EDGES 16   /* edges of reach a scan memo keeps */
-#define MEMO_KEY (SRS_N_PARAMS + 9 + 9 + 3 + 3)
+#define MEMO_KEY (9 + 3 + 3)
 
 /* An edge of reach a scan met (om_reach_edge(inside, outside) = w), the model's parts there and
  * the wrist's terms for the arm angle psi (terms_valid). */
@@ -25,7 +25,7 @@ typedef struct {
     double psi;
 } memo_edge;
 
-/* What the last scan of the circle of an S-R-S arm whose dp turns with q7 in this thread, in
+/* What the last scan of the circle of an S-R-S arm whose dp turns with q7 through a memo, in
  * one ELBOW branch, keeps for the next: the model's parts at its samples w_k that do not
  * depend on the arm angle (om_srs_elbow_at: those of the hand position p_d + R delta(w_k),
  * the orientation and the ELBOW sign), those that do not depend on the WRIST sign
@@ -36,7 +36,7 @@ typedef struct {
  * arithmetic on the same inputs: the same bits), and solves q7 alone. */
 typedef struct {
     bool valid;
-    double key[MEMO_KEY]; /* the model's parameters, delta's D0-D2, R, p_d, lo, h, the points */
+    double key[MEMO_KEY]; /* R, p_d, lo, h, the points (the model's parameters: one solver's) */
     om_srs_elbow parts[MEMO_POINTS];
     bool terms_valid;
     double psi;
@@ -45,16 +45,21 @@ typedef struct {
     memo_edge edges[MEMO_EDGES];
 } scan_memo;
 
-static OM_THREAD_LOCAL scan_memo memos[2]; /* ELBOW -1, +1 */
+/* The scan memos of the problems of one solver (its parameters and delta fixed: not in the
+ * key), one per ELBOW branch; om_scan_cache owns it for a batch. */
+struct om_scan_memo {
+    scan_memo branches[2]; /* ELBOW -1, +1 */
+};
+
+om_scan_memo *om_scan_memo_new(void) { return calloc(1, sizeof(om_scan_memo)); }
+
+void om_scan_memo_free(om_scan_memo *memo) { free(memo); }
 
 static void _memo_key(const om_problem *pb, double lo, double h, int n_pts, double *key)
 {
     const mat3 *R = &pb->t.R;
     const vec3 rows[3] = {R->r0, R->r1, R->r2};
-    memcpy(key, pb->s->params, SRS_N_PARAMS * sizeof(double));
-    double *k = key + SRS_N_PARAMS;
-    for (int i = 0; i < 3; i++)
-        *k++ = pb->s->D[i][0], *k++ = pb->s->D[i][1], *k++ = pb->s->D[i][2];
+    double *k = key;
     for (int i = 0; i < 3; i++)
         *k++ = rows[i].x, *k++ = rows[i].y, *k++ = rows[i].z;
     *k++ = pb->p.x, *k++ = pb->p.y, *k++ = pb->p.z;
@@ -83,22 +88,22 @@ static double _g_of_parts(om_problem *pb, double w, const om_srs_elbow *e, om_sr
 }
 
 /* g and the reach margin at the scan's points ws[k] = lo + h k, k < n_pts, into gs and ms as
- * om_g_margin computes them, the parts that the thread's scan_memo holds for them taken from
- * it. Returns that memo, now this scan's (NULL where the arm keeps none), valid until the
- * thread's next scan. */
+ * om_g_margin computes them, the parts that the problem's memo holds for them taken from it.
+ * Returns that memo's branch, now this scan's (NULL where the problem or the arm keeps
+ * none), valid until the memo's next scan. */
 static scan_memo *_sample(om_problem *pb, double lo, double h, int n_pts, double *ws, double *gs, double *ms,
                           double *q)
 {
     const om_solver_data *s = pb->s;
     for (int k = 0; k < n_pts; k++)
         ws[k] = lo + h * (double)k;
-    if (s->family != OM_SRS || s->mode != OM_CIRCLE || s->dp_joint != 6 || n_pts > MEMO_POINTS) {
+    if (!pb->memo || s->family != OM_SRS || s->mode != OM_CIRCLE || s->dp_joint != 6 || n_pts > MEMO_POINTS) {
         for (int k = 0; k < n_pts; k++)
             gs[k] = om_g_margin(pb, ws[k], q, false, &ms[k]);
         return NULL;
     }
     double elbow = (double)pb->signs[1];
-    scan_memo *memo = &memos[elbow > 0.0];
+    scan_memo *memo = &pb->memo->branches[elbow > 0.0];
     double key[MEMO_KEY];
     _memo_key(pb, lo, h, n_pts, key);
     if (!memo->valid || memcmp(key, memo->key, sizeof key) != 0) {

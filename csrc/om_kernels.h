@@ -214,6 +214,9 @@ typedef struct {
     bool trig_shared; /* om_trig_shared: verify reuses the real FK's cos and sin in the configuration check */
 } om_solver_data;
 
+/* What the circle scans of a batch's problems share (circle.c; om_scan_cache owns it). */
+typedef struct om_scan_memo om_scan_memo;
+
 /* One target. */
 typedef struct {
     const om_solver_data *s;
@@ -228,6 +231,9 @@ typedef struct {
      * singular joint pair where that split is arbitrary (false: the hinted local part alone,
      * om_solve_near, whose model takes the split from its hint) */
     bool split_starts;
+    /* the model's parts at the circle scan's samples, which the problem's scans (its own, its
+     * neighbours') take from the scans before them and keep for those after (NULL: none) */
+    om_scan_memo *memo;
 } om_problem;
 
 /* residual.c */
@@ -272,9 +278,15 @@ double om_wrist_secant(om_problem *pb, double w0, double *q);
 double om_extremum(om_problem *pb, double a, double b, double x0, double sign, bool of_margin, double *q,
                    double *g_out, double *margin_out);
 
-/* circle.c: candidates into cands (capacity cap); returns the count. */
+/* circle.c: candidates into cands (capacity cap); returns the count. On an S-R-S arm whose
+ * dp turns with q7 the scan's samples take the model's parts from pb->memo where it holds
+ * them, and keep them there (the same bits as computed). */
 int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool full_circle, double *q,
                          double *cands, int cap);
+/* A scan memo for the problems of one solver, none held yet (NULL: out of memory); freed by
+ * om_scan_memo_free (NULL: nothing). */
+om_scan_memo *om_scan_memo_new(void);
+void om_scan_memo_free(om_scan_memo *memo);
 /* wrist_offset.c: candidates in the bands around the singular wrist of an arm with a4 != 0. */
 #define OM_WRIST_BAND_CANDIDATES 256 /* room for them */
 int om_wrist_offset_candidates(om_problem *pb, double lo, double hi, bool full_circle, double *q, double *cands,
@@ -325,11 +337,12 @@ double om_polish(const om_polish_task *t, int iterations, double *q);
 
 /* What one problem of a batch keeps for the next (solve_all_rows): the circle search's
  * candidates (search.c), for a next problem that differs from it in the SHOULDER sign alone,
- * and the loop search's gate (loop_search.c), for a next problem of the same pose. On an
- * S-R-S arm whose dp turns with q7 the circle residual g(w) is the model's q7 less w, and q7
- * does not depend on the SHOULDER sign (srs.c, q7_with_elbow): the scan, its brackets and
- * refinements are the same, only the joints that each candidate becomes differ. The gate
- * depends on the pose alone. */
+ * the loop search's gate (loop_search.c), for a next problem of the same pose, and the scan
+ * memo (circle.c), for the next scan of the same pose in the same ELBOW sign. On an S-R-S arm
+ * whose dp turns with q7 the circle residual g(w) is the model's q7 less w, and q7 does not
+ * depend on the SHOULDER sign (srs.c, q7_with_elbow): the scan, its brackets and refinements
+ * are the same, only the joints that each candidate becomes differ. The gate depends on the
+ * pose alone. */
 typedef struct {
     bool valid;
     double key[OM_SCAN_KEY];  /* the target, psi, the other signs, q_prev, the scan points */
@@ -340,6 +353,7 @@ typedef struct {
     int capacity;
     bool gate_valid, gate;        /* the gate asked last, and its answer */
     double gate_key[OM_GATE_KEY]; /* what the gate reads of its pose */
+    om_scan_memo *memo;           /* the problems' (om_problem.memo; NULL: none) */
 } om_scan_cache;
 #define OM_SCAN_CAPACITY(n_scan) (8 * (n_scan) + 8 + OM_WRIST_BAND_CANDIDATES)
 

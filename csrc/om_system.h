@@ -10,13 +10,6 @@
 #include "om_kernels.h"
 
 
-/* Storage of which each thread has its own (circle.c's scan memo). */
-#if defined(_MSC_VER)
-#define OM_THREAD_LOCAL __declspec(thread)
-#else
-#define OM_THREAD_LOCAL _Thread_local
-#endif
-
 /* Python's a % n for n > 0 (never negative). */
 static inline int py_mod(int a, int n) { int r = a % n; return r < 0 ? r + n : r; }
 

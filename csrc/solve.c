@@ -122,6 +122,7 @@ static void _problem(om_problem *pb, const om_solver_data *s, const double *T, c
     pb->q_prev = q_prev;
     pb->counter = 0;
     pb->split_starts = true;
+    pb->memo = NULL;
 }
 
 /* A hinted solve's local part (the hint is pb->q_prev, copied into start): the local solve
@@ -284,7 +285,8 @@ bool om_solve_near(const om_solver_data *s, const double *T, const int64_t *sign
  * orientation error, within limits) in info (OM_MAX_ROOTS x 3). Returns the count. band:
  * where the bounded search finds none, the band's roots and the local solve's. cache (NULL:
  * none): the circle search's candidates shared with the previous problem where they are
- * the same (om_scan_cache). */
+ * the same, and the scan memo that this problem's scans share with the batch's
+ * (om_scan_cache). */
 int om_solve_all(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
                  double *roots, double *info, int64_t *evaluations, bool band, om_scan_cache *cache)
 {
@@ -293,6 +295,7 @@ int om_solve_all(const om_solver_data *s, const double *T, const int64_t *signs,
     double psi[1];
     om_problem problem;
     _problem(&problem, s, T, signs, redundancy, psi, zeros);
+    problem.memo = cache ? cache->memo : NULL;
     int n = om_all_roots_cached(&problem, s->scan_points, roots, cache);
     bool neighbour_reached, complete = true;
     if (n == 0 && band) { /* the band's roots, and what solve finds: its local solve from the fixed-point start */

@@ -234,9 +234,11 @@ static PyObject *Solver_solve_all_rows(Solver *self, PyObject *const *args, Py_s
     double *roots = v[3].buf, *info = v[4].buf;
     int64_t *counts = v[5].buf;
     const uint8_t *band = v[6].buf;
-    /* Neighbouring rows that differ in the SHOULDER sign alone share the circle's candidates. */
+    /* Neighbouring rows that differ in the SHOULDER sign alone share the circle's candidates,
+     * and the rows' scans of one pose the model's parts at their samples (the memo). */
     om_scan_cache cache = {.valid = false, .capacity = OM_SCAN_CAPACITY(s->scan_points)};
     Py_BEGIN_ALLOW_THREADS cache.candidates = malloc((size_t)cache.capacity * sizeof(double));
+    cache.memo = om_scan_memo_new();
     for (Py_ssize_t i = start; i < stop; i++) {
         int64_t evaluations;
         counts[2 * i] = om_solve_all(s, Tb + 16 * i, sb + k * i, rb + nr * i, roots + OM_MAX_ROOTS * dof * i,
@@ -245,6 +247,7 @@ static PyObject *Solver_solve_all_rows(Solver *self, PyObject *const *args, Py_s
         counts[2 * i + 1] = evaluations;
     }
     free(cache.candidates);
+    om_scan_memo_free(cache.memo);
     Py_END_ALLOW_THREADS release_buffers(v, 7);
     Py_RETURN_NONE;
 }

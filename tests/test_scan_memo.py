@@ -1,6 +1,6 @@
-"""The circle search's scan memo (csrc/circle.c): a thread keeps the model's parts at the scan's
-samples and edges of reach for its next scan of the same pose, so a row's answer must not depend
-on which rows the thread solved before it, to the last bit."""
+"""The circle search's scan memo (csrc/circle.c): a batch's scan cache keeps the model's parts at
+the scan's samples and edges of reach for its next scan of the same pose, so a row's answer must
+not depend on which rows the batch solved before it, to the last bit."""
 
 from __future__ import annotations
 
@@ -38,9 +38,10 @@ def _rows(batch: om.BatchRoots, order: np.ndarray) -> list[np.ndarray]:
 def test_grid_rows_do_not_depend_on_the_rows_before(name, seed):
     """A sweep's grid in its own order (every scan after the first of a pose takes the memo's
     parts), in a random order (arm angles and branches mixed: other parts kept, others
-    replaced), and row by row with a scan of another arm and of another pose before each
-    (every scan computes its parts afresh) give the same roots, errors and evaluation counts."""
-    solver, other = om.OMSolver(name), om.OMSolver("fr3")
+    replaced), with rows of poses of another position and of another orientation before
+    each row (every scan computes its parts afresh), and row by row (each row a batch of its
+    own: a memo of its own) give the same roots, errors and evaluation counts."""
+    solver = om.OMSolver(name)
     rng = np.random.default_rng(seed)
     T, T_other = solver.arm.fk(random_q(solver.arm, 2, rng))
     Ts, signs, psi = _grid(solver, T, 16)
@@ -52,10 +53,17 @@ def test_grid_rows_do_not_depend_on_the_rows_before(name, seed):
     mixed = solver.solve_grid(Ts[order], signs[order], psi[order], band[order], threads=1)
     for a, b in zip(_rows(swept, order), _rows(mixed, everything), strict=True):
         np.testing.assert_array_equal(a, b)
+    # Row 3 i is row i of the sweep, rows 3 i + 1 and 3 i + 2 the same branch and arm angle at
+    # poses that differ from T in the position alone and in the orientation alone.
+    moved, turned = T.copy(), T.copy()
+    moved[:3, 3] = T_other[:3, 3]
+    turned[:3, :3] = T_other[:3, :3]
+    thrice = np.repeat(everything, 3)
+    poses = np.tile(np.stack([T, moved, turned]), (len(Ts), 1, 1))
+    interleaved = solver.solve_grid(poses, signs[thrice], psi[thrice], band[thrice], threads=1)
+    for a, b in zip(_rows(swept, everything), _rows(interleaved, 3 * everything), strict=True):
+        np.testing.assert_array_equal(a, b)
     for i in rng.choice(len(Ts), 12, replace=False):
-        # The same matrix on another arm (other parameters), then another pose on this one.
-        other.solve_grid(Ts[:1], signs[:1], psi[:1], band[:1], threads=1)
-        solver.solve_grid(T_other[None], signs[:1], psi[:1], band[:1], threads=1)
         alone = solver.solve_grid(Ts[i : i + 1], signs[i : i + 1], psi[i : i + 1], band[i : i + 1], threads=1)
         for a, b in zip(_rows(swept, np.array([i])), _rows(alone, np.array([0])), strict=True):
             np.testing.assert_array_equal(a, b)
