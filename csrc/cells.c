@@ -188,9 +188,8 @@ static bool _quiet(const cell_models *c, int fa, int fb, double slack)
     for (Py_ssize_t j = 0; j < c->n; j++) {
         double ga = c->ga[j], gb = c->gb[j];
         double spread = 4.0 / 27.0 * fabs(c->span) * (fabs(c->da[j]) + fabs(c->db[j])) + slack;
-        bool nan = isnan(ga) || isnan(gb);
-        if (fa && !((nan ? NAN : fmin(ga, gb)) - spread > 0.0)) return false; /* a model may dip */
-        if (!fa && (nan ? NAN : fmax(ga, gb)) + spread < 0.0) return true;   /* one stays below */
+        if (fa && !(om_least(ga, gb) - spread > 0.0)) return false; /* a model may dip */
+        if (!fa && om_most(ga, gb) + spread < 0.0) return true;    /* one stays below */
     }
     return fa;
 }

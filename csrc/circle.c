@@ -51,7 +51,20 @@ struct om_scan_memo {
     scan_memo branches[2]; /* ELBOW -1, +1 */
 };
 
-om_scan_memo *om_scan_memo_new(void) { return calloc(1, sizeof(om_scan_memo)); }
+/* Whether the scans of solver s keep a memo: those of an S-R-S arm whose dp turns with q7. */
+static bool _keeps_memo(const om_solver_data *s) { return s->family == OM_SRS && s->mode == OM_CIRCLE && s->dp_joint == 6; }
+
+/* (86 kB: allocated only for an arm that keeps one, and not zeroed: a branch's parts are
+ * written where its key is.) */
+om_scan_memo *om_scan_memo_new(const om_solver_data *s)
+{
+    if (!_keeps_memo(s))
+        return NULL;
+    om_scan_memo *memo = malloc(sizeof(om_scan_memo));
+    if (memo)
+        memo->branches[0].valid = memo->branches[1].valid = false;
+    return memo;
+}
 
 void om_scan_memo_free(om_scan_memo *memo) { free(memo); }
 
@@ -97,7 +110,7 @@ static scan_memo *_sample(om_problem *pb, double lo, double h, int n_pts, double
     const om_solver_data *s = pb->s;
     for (int k = 0; k < n_pts; k++)
         ws[k] = lo + h * (double)k;
-    if (!pb->memo || s->family != OM_SRS || s->mode != OM_CIRCLE || s->dp_joint != 6 || n_pts > MEMO_POINTS) {
+    if (!pb->memo || n_pts > MEMO_POINTS) { /* (pb->memo: an arm that keeps one, om_scan_memo_new) */
         for (int k = 0; k < n_pts; k++)
             gs[k] = om_g_margin(pb, ws[k], q, false, &ms[k]);
         return NULL;

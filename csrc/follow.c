@@ -34,25 +34,26 @@ static void represent(int dof, const uint8_t *centred, const double *centre, dou
         if (centred[i]) q[i] = centre[i] + om_wrap_angle(q[i] - centre[i]);
 }
 
-/* A step's prediction from the path's last point: (q, t) at psi, d ahead. */
-typedef struct {
-    int dof;
-    const uint8_t *cyclic, *centred;
-    const double *centre, *q, *t;
-    double d;
-} prediction;
-
-/* The prediction's largest joint move, max_i |t_i d|. A root that continues the path
+/* The largest joint move max_i |t_i d| of a step d along the tangent t. A root that continues the path
  * (om_continues) moves each joint by m_i with |m_i| <= moved <= 1 and |m_i - t_i d| <= moved / 2
  * + 1e-6, so |t_i d| <= 1.5 moved + 1e-6 <= 1.5 + 1e-6: a step whose prediction moves a joint
  * farther than 1.5 + 2e-6 (1e-6 more for the representatives' rounding) fails whatever the
  * solve would find, and is not solved (the steps into a fold, where |t| grows without bound). */
-static double farthest(const prediction *p) {
+static double farthest(int dof, const double *t, double d) {
     double r = 0.0;
-    for (int i = 0; i < p->dof; i++) r = fmax(r, fabs(p->t[i] * p->d));
+    for (int i = 0; i < dof; i++) r = fmax(r, fabs(t[i] * d));
     return r;
 }
 #define FARTHEST_CONTINUED (1.5 + 2e-6)
+
+/* A step's prediction from the path's last point: (q, t) at psi, d ahead, its largest joint
+ * move farthest(t, d). */
+typedef struct {
+    int dof;
+    const uint8_t *cyclic, *centred;
+    const double *centre, *q, *t;
+    double d, farthest;
+} prediction;
 
 /* What the attempt makes of the local solve's root x (at its representative; om_solve_near's
  * as_is test). Taken without the windowed scan for a nearer root where it lies on the
@@ -80,7 +81,7 @@ static om_root_verdict on_path(const double *x, void *context) {
         double a = fabs(p->t[i] * p->d) - 0.5 * reach - 2e-6;
         if (a > 0.0) least += a * a;
     }
-    return farthest(p) > 1.5 * reach + 2e-6 || least >= d2 ? OM_ROOT_REJECT : OM_ROOT_SCAN;
+    return p->farthest > 1.5 * reach + 2e-6 || (least > 0.0 && least >= d2) ? OM_ROOT_REJECT : OM_ROOT_SCAN;
 }
 
 /* What ends a path, as functions of its point (q, t) that fall to zero there linearly in psi
@@ -126,8 +127,8 @@ int om_follow_path(const om_solver_data *s, const double *T, const int64_t *sign
         double x = fabs(target - *psi) <= fabs(step) ? target : *psi + step;
         double aim = moved > 0.0 ? fmax(AIM * predicted_end(n_ends, ends_prev, ends, moved), 1.5 * min_step) : INFINITY;
         if (aim < fabs(x - *psi)) x = *psi + copysign(aim, step);
-        prediction p = {dof, cyclic, centred, centre, q, t, x - *psi};
-        bool ok = farthest(&p) <= FARTHEST_CONTINUED && om_solve_near(s, T, signs, &x, q, x_q, on_path, &p, NULL);
+        prediction p = {dof, cyclic, centred, centre, q, t, x - *psi, farthest(dof, t, x - *psi)};
+        bool ok = p.farthest <= FARTHEST_CONTINUED && om_solve_near(s, T, signs, &x, q, x_q, on_path, &p, NULL);
         if (ok) {
             represent(dof, centred, centre, x_q);
             ok = om_continues(dof, q, x_q, t, x - *psi, cyclic);

@@ -283,9 +283,9 @@ double om_extremum(om_problem *pb, double a, double b, double x0, double sign, b
  * them, and keep them there (the same bits as computed). */
 int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool full_circle, double *q,
                          double *cands, int cap);
-/* A scan memo for the problems of one solver, none held yet (NULL: out of memory); freed by
- * om_scan_memo_free (NULL: nothing). */
-om_scan_memo *om_scan_memo_new(void);
+/* A scan memo for the problems of solver s, none held yet (NULL: an arm whose scans keep none,
+ * or out of memory); freed by om_scan_memo_free (NULL: nothing). */
+om_scan_memo *om_scan_memo_new(const om_solver_data *s);
 void om_scan_memo_free(om_scan_memo *memo);
 /* wrist_offset.c: candidates in the bands around the singular wrist of an arm with a4 != 0. */
 #define OM_WRIST_BAND_CANDIDATES 256 /* room for them */

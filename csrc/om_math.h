@@ -24,6 +24,10 @@ static inline double om_wrap(double x)
     return turns >= 0.0 && turns < 1.0 ? x : x - 2.0 * OM_PI * floor(turns);
 }
 
+/* numpy's minimum and maximum of two floats: a NaN operand gives NaN (fmin and fmax drop it). */
+static inline double om_least(double a, double b) { return isnan(a) ? a : isnan(b) ? b : fmin(a, b); }
+static inline double om_most(double a, double b) { return isnan(a) ? a : isnan(b) ? b : fmax(a, b); }
+
 /* np.sign of a float as numba computes it: +-1, and x itself for 0 (keeping -0) and NaN. */
 static inline double om_sign(double x)
 {

@@ -238,7 +238,7 @@ static PyObject *Solver_solve_all_rows(Solver *self, PyObject *const *args, Py_s
      * and the rows' scans of one pose the model's parts at their samples (the memo). */
     om_scan_cache cache = {.valid = false, .capacity = OM_SCAN_CAPACITY(s->scan_points)};
     Py_BEGIN_ALLOW_THREADS cache.candidates = malloc((size_t)cache.capacity * sizeof(double));
-    cache.memo = om_scan_memo_new();
+    cache.memo = om_scan_memo_new(s);
     for (Py_ssize_t i = start; i < stop; i++) {
         int64_t evaluations;
         counts[2 * i] = om_solve_all(s, Tb + 16 * i, sb + k * i, rb + nr * i, roots + OM_MAX_ROOTS * dof * i,

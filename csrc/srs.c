@@ -135,12 +135,12 @@ static void ik_with_elbow(const double *P, const om_target *t, vec3 w, double L2
 }
 
 /* W - S = w for the flange position p, L2 = |w|^2 and the elbow's x = (L2 - k0) / K; returns
- * the reach margin 1 - x^2 (-1 where W = S: x not written). */
+ * the reach margin 1 - x^2 (-1 where W = S or w is not a number: x not written). */
 static double reach(const double *P, const om_target *t, vec3 p, vec3 *w, double *L2, double *x)
 {
     *w = v_add(p, t->wrist);
     *L2 = v_dot(*w, *w);
-    if (*L2 < DEGENERATE) /* wrist centre at the shoulder centre */
+    if (!(*L2 >= DEGENERATE)) /* wrist centre at the shoulder centre, or not a number */
         return -1.0;
     *x = (*L2 - P[SRS_K0]) / P[SRS_K];
     return 1.0 - *x * *x;
@@ -266,7 +266,7 @@ static bool at_reach(const double *P, const om_target *t, vec3 p, const int64_t 
     vec3 w;
     double L2, x;
     reach(P, t, p, &w, &L2, &x);
-    if (L2 < DEGENERATE) /* x not written */
+    if (!(L2 >= DEGENERATE)) /* x not written (reach) */
         return false;
     if (every_joint)
         ik_with_elbow(P, t, w, L2, x, signs, q_prev, q, true);

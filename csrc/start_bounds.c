@@ -1,13 +1,10 @@
 /* The bound of what a climb from a start can reach (om_redundant/redundancy/optimizer.py's
  * _StartBounds.within, whose numpy version is the reference; the same operations in its
  * order): from the cones u_i + L |x - psi_i| of every sample of the start's run within its
- * reach R, of f (column 0) and of each group's functions (the other columns). */
+ * reach R, of f (column 0) and of each group's functions (the other columns). Minima and maxima
+ * are numpy's (om_least, om_most): a NaN bound is NaN as the reference's, and no start is skipped
+ * for it (optimizer.py compares). */
 #include "binding.h"
-
-/* numpy's minimum and maximum: a NaN operand gives NaN (fmin and fmax drop it), so that a NaN
- * bound is NaN as the reference's, and no start is skipped for it (optimizer.py compares). */
-static double least_of(double a, double b) { return isnan(a) ? a : isnan(b) ? b : fmin(a, b); }
-static double most_of(double a, double b) { return isnan(a) ? a : isnan(b) ? b : fmax(a, b); }
 
 typedef struct {
     const double *psi, *values, *slopes, *weights, *caps;
@@ -22,10 +19,10 @@ static double bound(const start_bounds *s, const double *row) {
     for (Py_ssize_t g = 0; g < s->G; g++) {
         Py_ssize_t end = g + 1 < s->G ? s->groups[g + 1] : s->columns;
         double least = row[s->groups[g]];
-        for (Py_ssize_t j = s->groups[g] + 1; j < end; j++) least = least_of(least, row[j]);
-        total = total + s->weights[g] * least_of(s->caps[g], least);
+        for (Py_ssize_t j = s->groups[g] + 1; j < end; j++) least = om_least(least, row[j]);
+        total = total + s->weights[g] * om_least(s->caps[g], least);
     }
-    return least_of(row[0], total);
+    return om_least(row[0], total);
 }
 
 /* The bound of the cell of samples c, c + 1: the cones' meeting points, at least the ends. */
@@ -33,8 +30,8 @@ static double cell(const start_bounds *s, Py_ssize_t c, double *row) {
     const double *u = s->values + c * s->columns, *v = u + s->columns;
     double h = s->psi[c + 1] - s->psi[c];
     for (Py_ssize_t j = 0; j < s->columns; j++) {
-        double peak = 0.5 * (u[j] + v[j] + s->slopes[j] * h), top = most_of(u[j], v[j]);
-        row[j] = most_of(peak, top);
+        double peak = 0.5 * (u[j] + v[j] + s->slopes[j] * h), top = om_most(u[j], v[j]);
+        row[j] = om_most(peak, top);
     }
     return bound(s, row);
 }
@@ -42,7 +39,7 @@ static double cell(const start_bounds *s, Py_ssize_t c, double *row) {
 /* The bound beyond sample e, reach - |psi_e - x| of the reach left. */
 static double beyond(const start_bounds *s, Py_ssize_t e, double x, double reach, double *row) {
     const double *u = s->values + e * s->columns;
-    double left = most_of(reach - fabs(s->psi[e] - x), 0.0);
+    double left = om_most(reach - fabs(s->psi[e] - x), 0.0);
     for (Py_ssize_t j = 0; j < s->columns; j++) row[j] = u[j] + s->slopes[j] * left;
     return bound(s, row);
 }
@@ -79,13 +76,13 @@ static PyObject *om_start_bound(PyObject *mod, PyObject *const *args, Py_ssize_t
     while (s.psi[lo] < low) lo++;
     while (s.psi[hi] > high) hi--;
     double best = s.values[k * C]; /* f_k */
-    for (Py_ssize_t c = lo; c < hi; c++) best = most_of(best, cell(&s, c, row));
+    for (Py_ssize_t c = lo; c < hi; c++) best = om_most(best, cell(&s, c, row));
     double cut = beyond(&s, lo, x, reach, row);
-    if (lo > a) cut = least_of(cut, cell(&s, lo - 1, row));
-    best = most_of(best, cut);
+    if (lo > a) cut = om_least(cut, cell(&s, lo - 1, row));
+    best = om_most(best, cut);
     cut = beyond(&s, hi, x, reach, row);
-    if (hi < b) cut = least_of(cut, cell(&s, hi, row));
-    best = most_of(best, cut);
+    if (hi < b) cut = om_least(cut, cell(&s, hi, row));
+    best = om_most(best, cut);
     PyMem_Free(row);
     release_buffers(v, 6);
     return PyFloat_FromDouble(best);

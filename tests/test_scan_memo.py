@@ -67,3 +67,32 @@ def test_grid_rows_do_not_depend_on_the_rows_before(name, seed):
         alone = solver.solve_grid(Ts[i : i + 1], signs[i : i + 1], psi[i : i + 1], band[i : i + 1], threads=1)
         for a, b in zip(_rows(swept, np.array([i])), _rows(alone, np.array([0])), strict=True):
             np.testing.assert_array_equal(a, b)
+
+
+def _solve_all_rows(solver: om.OMSolver, Ts: np.ndarray, signs: np.ndarray, psi: np.ndarray) -> np.ndarray:
+    """The kernel's (count, evaluations) of each row, the rows one batch (one scan memo), without
+    the library's checks of the poses (which refuse a pose that is not a number)."""
+    m = len(Ts)
+    roots = np.full((m, om.om.system.MAX_ROOTS, solver.arm.dof), np.nan)
+    info = np.full((m, om.om.system.MAX_ROOTS, 3), np.nan)
+    counts = np.zeros((m, 2), dtype=np.int64)
+    band = np.ones(m, dtype=bool)
+    solver.kernel.solve_all_rows(Ts, signs, psi[:, None], 0, m, roots, info, counts, band)
+    return counts
+
+
+def test_a_pose_that_is_not_a_number_does_not_read_the_rows_before():
+    """The kernel's rows of a pose with a NaN position (reached only past the library's checks)
+    are out of the model's reach at every sample whatever the batch solved before: no root, and
+    the same evaluations as alone (a memo's parts of the pose before must not stand in for the
+    parts that a NaN hand has none of)."""
+    solver = om.OMSolver("panda")
+    T = solver.arm.fk(random_q(solver.arm, 1, np.random.default_rng(4))[0])
+    Ts, signs, psi = _grid(solver, T, 4)
+    broken = T.copy()
+    broken[0, 3] = np.nan
+    after = np.concatenate([Ts, np.repeat(broken[None], len(Ts), axis=0)])
+    counts = _solve_all_rows(solver, after, np.concatenate([signs, signs]), np.concatenate([psi, psi]))
+    alone = _solve_all_rows(solver, after[len(Ts) :], signs, psi)
+    assert (counts[len(Ts) :, 0] == 0).all()
+    np.testing.assert_array_equal(counts[len(Ts) :], alone)
