@@ -80,8 +80,8 @@ bool om_continues(int dof, const double *q0, const double *q1, const double *t, 
  * another path is off by the paths' separation, which no shorter step shrinks; one that
  * merely continues (om_continues: within 1/2) may be the partner at a fold. */
 bool om_beyond_doubt(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic);
-/* The largest joint step |q1 - q0|_inf, cyclic joints (NULL: none) modulo 2 pi (Probe.step's and
- * Probe.steps' operations: numpy's remainder, a NaN step is NaN). */
+/* The largest joint step |q1 - q0|_inf, cyclic joints (NULL: none) modulo 2 pi (Probe.step; numpy's
+ * remainder and maximum: a NaN step is NaN). */
 double om_largest_joint_step(int dof, const double *q0, const double *q1, const uint8_t *cyclic);
 
 /* Paths in the arm angle (probe.py's END_TOLERANCE and SAME, read from here): a following step

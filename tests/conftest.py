@@ -3,6 +3,8 @@ running the checkout's code in a fresh interpreter."""
 
 from __future__ import annotations
 
+import functools
+import math
 import os
 import subprocess
 import sys
@@ -66,6 +68,26 @@ def random_q(arm, n: int, rng: np.random.Generator) -> np.ndarray:
     lower = np.where(np.isfinite(arm.lower), arm.lower, -np.pi)
     upper = np.where(np.isfinite(arm.upper), arm.upper, np.pi)
     return rng.uniform(lower, upper, (n, arm.dof))
+
+
+@functools.cache
+def solver_of(name: str) -> om.OMSolver:
+    """The named arm's solver, one per test process."""
+    return om.OMSolver(name)
+
+
+def random_pose(solver: om.OMSolver, seed: int) -> np.ndarray:
+    """A random reachable pose of the solver's arm: the hand at joints drawn within the limits."""
+    return solver.arm.fk(np.random.default_rng(seed).uniform(solver.arm.lower, solver.arm.upper))
+
+
+def steps_numpy(cyclic: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The reference of the largest joint step (``ckernels.joint_step``, ``Probe.step``) between
+    the rows of a and b (M, dof): max_i |b_i - a_i|, the differences of the cyclic joints taken
+    to [-pi, pi) by np.remainder; numpy's maximum, so a NaN difference gives NaN."""
+    d = b - a
+    d = np.where(cyclic, np.remainder(d + math.pi, 2.0 * math.pi) - math.pi, d)
+    return np.abs(d).max(axis=1, initial=0.0)
 
 
 @pytest.fixture

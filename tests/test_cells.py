@@ -6,8 +6,6 @@ not explain, the largest joint step, and the first tests of every cell of a path
 
 from __future__ import annotations
 
-import functools
-import itertools
 import math
 
 import numpy as np
@@ -15,18 +13,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import om_redundant as om
-from benchmarks.control_rate import HOMES, MIN_CLEARANCE, obstacles
+from benchmarks.control_rate import HOMES
 from om_redundant import ckernels
 from om_redundant.redundancy.paths import _BOUND_SLACK, _HERMITE, FINE_STEP
 from om_redundant.redundancy.self_motion import self_motion_tangents
-
-
-@functools.cache
-def optimizer_of(name: str, count: int) -> om.RedundancyOptimizer:
-    solver = om.OMSolver(name)
-    shapes = obstacles(solver.arm.fk(HOMES[name])[:3, 3], count)
-    return om.RedundancyOptimizer(solver, shapes or None, min_clearance=MIN_CLEARANCE)
+from tests.conftest import steps_numpy
+from tests.test_redundancy_batch import optimizer_of
 
 
 @settings(max_examples=8, deadline=None)
@@ -42,7 +34,7 @@ def test_pieces_are_the_groups_constraints(seed, name, count):
     for row, t in zip(q, tangents, strict=True):
         pairs = None if objective.clearance is None else objective.clearance.distances_and_gradients(row)
         g, dg = objective.pieces(row, t, pairs)
-        groups = [group.along(t) for group in objective.constrained_groups(row, jacobian=True)]
+        groups = objective.constrained_groups(row, tangent=t)
         want_g, want_dg = (
             np.concatenate(x) for x in zip(*(group.constraints() for group in groups), strict=True)
         )
@@ -114,13 +106,6 @@ def quiet_numpy(span, ga, da, gb, db, feasible_a, feasible_b):
     return (feasible_a == feasible_b) & np.where(feasible_a, clear, blocked)
 
 
-def steps_numpy(cyclic, a, b):
-    """The reference of joint_step, rows at once: Probe.steps' operations."""
-    d = b - a
-    d = np.where(cyclic, np.remainder(d + math.pi, 2.0 * math.pi) - math.pi, d)
-    return np.abs(d).max(axis=1, initial=0.0)
-
-
 def looks_numpy(q, psi, g, dg, feasible, cyclic):
     """The reference of cell_looks for one path: NaN where a cell is calm (no step above
     FINE_STEP, quiet), 1/2 where a step is above FINE_STEP, else the numpy surprise (NaN for
@@ -184,10 +169,10 @@ def test_a_quiet_cell_has_no_surprise(seed, pieces, span):
 
 @settings(max_examples=300, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1), dof=st.integers(1, 7), scale=st.sampled_from([0.1, 1.0, 10.0, 1e3]))
-def test_joint_step_is_probe_steps(seed, dof, scale):
-    """ckernels.joint_step is Probe.steps' numpy to the bit: joints drawn far apart (turns
-    of the cyclic ones) and at exact multiples of pi apart, where the remainder's sign rule
-    decides."""
+def test_joint_step_is_the_numpy_step(seed, dof, scale):
+    """ckernels.joint_step is the numpy reference (steps_numpy) to the bit: joints drawn far
+    apart (turns of the cyclic ones) and at exact multiples of pi apart, where the remainder's
+    sign rule decides."""
     rng = np.random.default_rng(seed)
     cyclic = rng.random(dof) < 0.7
     a = rng.normal(0.0, scale, (8, dof))
@@ -196,18 +181,6 @@ def test_joint_step_is_probe_steps(seed, dof, scale):
     want = steps_numpy(cyclic, a, b)
     got = [ckernels.joint_step(cyclic, x, y) for x, y in zip(a, b, strict=True)]
     assert np.array_equal(got, want)
-
-
-@pytest.mark.parametrize("wrapped", [True, False])
-def test_joint_step_is_the_probes(wrapped):
-    """With a probe's cyclic joints (the revolute ones when wrapped, none otherwise),
-    joint_step is the probe's own Probe.step, on joints drawn over several turns."""
-    optimizer = optimizer_of("panda", 0)
-    arm = optimizer.solver.arm
-    probe = optimizer._probe(arm.fk(HOMES["panda"]), optimizer.branches[0], wrapped=wrapped)
-    q = np.random.default_rng(5).uniform(-10.0, 10.0, (50, arm.dof))
-    for a, b in itertools.pairwise(q):
-        assert ckernels.joint_step(probe.cyclic, a, b) == probe.step(a, b)
 
 
 @settings(max_examples=200, deadline=None)

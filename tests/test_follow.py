@@ -6,7 +6,6 @@ loop (``paths._link(..., compiled=False)``): the same paths, to the bit."""
 
 from __future__ import annotations
 
-import functools
 from unittest import mock
 
 import numpy as np
@@ -19,6 +18,7 @@ from benchmarks.control_rate import MIN_CLEARANCE, obstacles
 from om_redundant import ckernels
 from om_redundant.redundancy import paths
 from om_redundant.redundancy.probe import END_TOLERANCE, Point, Probe
+from tests.conftest import solver_of
 from tests.test_redundancy_batch import optimizer_of
 
 
@@ -95,11 +95,6 @@ def test_a_path_ends_where_follow_says(seed, name, compiled):
         end, arrived = probe.follow(probe.point(psi, q), psi + side * np.pi)
         if not arrived:
             assert probe.next(end, end.psi + side * 2.0 * END_TOLERANCE) is None
-
-
-@functools.cache
-def solver_of(name: str) -> om.OMSolver:
-    return om.OMSolver(name)
 
 
 def grid_roots(name: str, seed: int) -> list[tuple[Probe, np.ndarray, list[list[Point]]]]:

@@ -4,8 +4,6 @@ makes the same follows as refining each alone."""
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
@@ -15,11 +13,7 @@ from benchmarks.control_rate import MIN_CLEARANCE, obstacles
 from om_redundant.redundancy.intervals import SLACK_TOLERANCE, _refined, _runs, _spans
 from om_redundant.redundancy.paths import lockstep, sweep_circle
 from om_redundant.redundancy.probe import END_TOLERANCE
-
-
-@functools.cache
-def solver_of(name: str) -> om.OMSolver:
-    return om.OMSolver(name)
+from tests.conftest import random_pose, solver_of
 
 
 def alone(process):
@@ -55,8 +49,7 @@ def test_refined_ends_are_the_boundary_and_lockstep_is_alone(seed, name, count):
     END_TOLERANCE is refused), also where the run's end sample is where its path ends; the
     ends refined all at once are those refined one by one, to the bit."""
     solver = solver_of(name)
-    q = np.random.default_rng(seed).uniform(solver.arm.lower, solver.arm.upper)
-    T = solver.arm.fk(q)
+    T = random_pose(solver, seed)
     optimizer = om.RedundancyOptimizer(solver, obstacles(T[:3, 3], count), min_clearance=MIN_CLEARANCE)
     probes = [optimizer._probe(T, signs) for signs in optimizer.branches]
     swept = sweep_circle(probes, optimizer.grid_points)

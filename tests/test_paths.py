@@ -7,7 +7,6 @@ that such a cell's ends do not show is found."""
 from __future__ import annotations
 
 import dataclasses
-import functools
 import itertools
 from unittest import mock
 
@@ -20,16 +19,7 @@ from benchmarks.control_rate import MIN_CLEARANCE, obstacles
 from om_redundant import ckernels
 from om_redundant.redundancy import paths
 from om_redundant.redundancy.paths import _TURN, FINE_STEP, sweep_circle
-
-
-@functools.cache
-def solver_of(name: str) -> om.OMSolver:
-    return om.OMSolver(name)
-
-
-def pose(solver: om.OMSolver, seed: int) -> np.ndarray:
-    """A random reachable pose of the solver's arm."""
-    return solver.arm.fk(np.random.default_rng(seed).uniform(solver.arm.lower, solver.arm.upper))
+from tests.conftest import random_pose, solver_of
 
 
 def swept(solver: om.OMSolver, T: np.ndarray, count: int, looked: bool = True):
@@ -74,7 +64,7 @@ def test_every_traced_cell_is_finer_than_fine_step(seed, name, count):
     that a follow traces from either end to its middle, no joint moves more than FINE_STEP
     (compared as the probe compares them)."""
     solver = solver_of(name)
-    probes, found = swept(solver, pose(solver, seed), count)
+    probes, found = swept(solver, random_pose(solver, seed), count)
     for probe, branch in zip(probes, found, strict=True):
         for path in branch:
             for a, b in cells(path):
@@ -89,7 +79,7 @@ def test_a_dip_in_the_first_cell_of_a_path_that_starts_at_a_fold_is_found():
     and the nearer end's value, the cell hides an infeasible dip; the look inside finds it:
     an infeasible sample between the ends, which stay feasible."""
     solver = solver_of("panda")
-    T = pose(solver, 9)
+    T = random_pose(solver, 9)
     probes, raw = swept(solver, T, 1, looked=False)
     dips = []  # (signs, a, b, joint, limit side, limit)
     for probe, branch in zip(probes, raw, strict=True):

@@ -281,9 +281,12 @@ def test_derivatives_match_finite_differences_of_exact_solutions(name, request):
         np.testing.assert_allclose(grad[near] @ direction, differences[near], atol=1e-6)
 
         for group, ahead_group, behind_group in zip(
-            objective.groups(q, jacobian=True), objective.groups(ahead), objective.groups(behind), strict=True
+            objective.groups(q, tangent=tangent[:, None]),
+            objective.groups(ahead),
+            objective.groups(behind),
+            strict=True,
         ):
-            slopes = group.along(om.self_motion_tangent(solver, q)).jacobian[:, 0]
+            slopes = group.jacobian[:, 0]
             np.testing.assert_allclose(
                 slopes, (ahead_group.values - behind_group.values) / (2 * h), atol=1e-5
             )

@@ -83,8 +83,9 @@ def test_the_objective_group_along_psi_matches_finite_differences(solvers, name)
         ahead, behind = (
             solver.solve(T, om.Configuration(c.signs, (c.redundancy[0] + s,)), q_hint=q).q for s in (H, -H)
         )
-        (group,) = [g for g in objective.groups(q, jacobian=True) if g.kind == "singularity"]
-        slopes = group.along(om.self_motion_tangent(solver, q)).jacobian[:, 0] * SINGULARITY_CAP
+        tangent = om.self_motion_tangent(solver, q)
+        (group,) = [g for g in objective.groups(q, tangent=tangent) if g.kind == "singularity"]
+        slopes = group.jacobian[:, 0] * SINGULARITY_CAP
         differences = (singularity.distances(ahead) - singularity.distances(behind)) / (2 * H)
         np.testing.assert_allclose(slopes, differences, atol=1e-5)
         evaluation = objective.evaluate(q)

@@ -152,10 +152,6 @@ class Group:
         lower = v[:half] <= v[half:]
         return np.where(lower, v[:half], v[half:]), np.where(lower, d[:half], d[half:])
 
-    def along(self, tangent: np.ndarray) -> Group:
-        """The same group with the jacobian chained through dq/dpsi = tangent (dof, r)."""
-        return Group(self.kind, self.weight, self.floor, self.cap, self.values, self.jacobian @ tangent)
-
 
 class Evaluation(NamedTuple):
     """The objective at one joint vector (a named tuple: the path sweep,
@@ -263,11 +259,12 @@ class Objective:
                 already computed (:meth:`Clearance.distances_and_gradients
                 <om_redundant.Clearance.distances_and_gradients>`): the same groups from them.
             tangent: (dof, r) dq/dpsi at q: the jacobians chained through it, by psi
-                (:meth:`Group.along`; implies ``jacobian``).
+                (J_q dq/dpsi; implies ``jacobian``).
         """
-        groups = self.constrained_groups(q, jacobian or tangent is not None, pairs, tangent)
+        jacobian = jacobian or tangent is not None
+        groups = self.constrained_groups(q, jacobian, pairs, tangent)
         if self.singularity is not None:
-            groups.append(self._singularity(q, jacobian or tangent is not None, tangent))
+            groups.append(self._singularity(q, jacobian, tangent))
         return groups
 
     def constrained_groups(
@@ -457,5 +454,5 @@ def _capped(
 
 
 def _chained(jacobian: np.ndarray, tangent: np.ndarray | None) -> np.ndarray:
-    """The jacobian by q, or by psi through dq/dpsi = tangent (:meth:`Group.along`)."""
+    """The jacobian by q, or by psi through dq/dpsi = tangent: J_q dq/dpsi."""
     return jacobian if tangent is None else jacobian @ tangent

@@ -199,8 +199,7 @@ class Probe:
         self._centred = self._cyclic & np.isfinite(arm.lower) & np.isfinite(arm.upper)
         self._centre = np.where(self._centred, (arm.lower + arm.upper) / 2.0, 0.0)
         # (where every joint is cyclic, or centred, no np.where picks between the two)
-        self._cyclic_flags = self._cyclic.tolist()
-        self._all_cyclic, self._all_centred = all(self._cyclic_flags), all(self._centred.tolist())
+        self._all_cyclic, self._all_centred = all(self._cyclic.tolist()), all(self._centred.tolist())
         self._work = None  # the compiled follow's arrays: a 7-DOF arm's compiled solver only
         if compiled and isinstance(solver.kernel, ckernels.Solver) and arm.dof == 7:
             self._work = FollowWork(
@@ -216,19 +215,15 @@ class Probe:
             )
 
     def step(self, a: np.ndarray, b: np.ndarray) -> float:
-        """The largest joint step between joint vectors a and b (:meth:`steps`' operations in
-        floats: for one pair, several times faster than numpy's)."""
-        moved = zip(a.tolist(), b.tolist(), self._cyclic_flags, strict=True)
-        return max([abs(_wrap(y - x) if cyclic else y - x) for x, y, cyclic in moved])
+        """The largest joint step max_i |b_i - a_i| between joint vectors a and b (float64,
+        (dof,)), the :attr:`cyclic` joints' differences taken to [-pi, pi); NaN where a
+        joint's is (``ckernels.joint_step``)."""
+        return ckernels.joint_step(self._cyclic, a, b)
 
     @property
     def cyclic(self) -> np.ndarray:
         """(dof,) bool: the joints that :meth:`step` compares modulo 2 pi."""
         return self._cyclic
-
-    def steps(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        """:meth:`step` between the rows of a and b (M, dof)."""
-        return np.maximum.reduce(np.abs(self._delta(a, b)), axis=1, initial=0.0)
 
     def _delta(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         d = b - a
@@ -429,9 +424,8 @@ def _predicted_end(before: list[float], now: list[float], moved: float) -> float
     return min(ahead, default=math.inf)
 
 
-def _wrap(x: np.ndarray | float) -> np.ndarray | float:
-    """x taken to [-pi, pi): by operators, so that an array's is ``np.remainder``'s and a
-    float's the same operations in floats (Python's % rounds as ``np.remainder`` does)."""
+def _wrap(x: np.ndarray) -> np.ndarray:
+    """x taken to [-pi, pi) (``np.remainder``'s, as csrc/'s ``om_wrap_angle``)."""
     return (x + math.pi) % _TURN - math.pi
 
 
