@@ -241,9 +241,15 @@ PyObject *om_track_step(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) 
     int status = -1;
     const double *setup = v[3].buf;
     Py_ssize_t n_sing = v[6].len / 8, n_clear = v[9].len / 8;
+    const double *sing_joint = v[6].buf;
+    bool joints_ok = true; /* each a joint's index (read as q[j], t[j]) */
+    for (Py_ssize_t k = 0; k < n_sing; k++)
+        joints_ok &= sing_joint[k] >= 0.0 && sing_joint[k] < 7.0 && sing_joint[k] == floor(sing_joint[k]);
     if (v[3].len < S_HEAD * 8 || setup[S_N_SING] != (double)n_sing || v[7].len != v[6].len ||
         setup[S_N_CLEAR] != (double)n_clear || v[10].len != n_clear * 7 * 8 || 14 + n_clear + n_sing > MAX_PIECES)
         PyErr_SetString(PyExc_ValueError, "track_step: sizes of setup, singularities and clearances disagree");
+    else if (!joints_ok)
+        PyErr_SetString(PyExc_ValueError, "track_step: a singularity's joint is not a joint index in [0, 7)");
     else {
         tracking tr = {s, setup, v[4].buf, v[5].buf, v[6].buf, v[7].buf, v[8].buf, v[9].buf, v[10].buf,
                        {setup[S_WM], setup[S_WC], setup[S_WS]}, {0.0, setup[S_FLOOR_C], -INFINITY},

@@ -23,6 +23,7 @@ from benchmarks.control_rate import (
     obstacles,
     turned,
 )
+from om_redundant.redundancy.tracking import Tracker
 
 TICKS = 200  # of a figure eight, one lap
 MAX_STEP = 0.005
@@ -142,6 +143,23 @@ def test_the_tracking_step_carries_its_curvature(optimizers):
     assert math.isnan(first.curvature)
     step = optimizer.choose(T, first)
     assert step.ok and 0.0 < step.curvature < math.inf
+
+
+@pytest.mark.parametrize("joint", [7.0, -1.0, 2.5, math.nan, 1e300])
+def test_the_tracking_kernel_refuses_a_singularity_that_is_not_a_joint(optimizers, joint):
+    """ckernels.track_step reads q and dq/dpsi at each singularity's joint: an index outside
+    [0, 7), or not an integer, is a named ValueError (not a read past the arrays); the
+    optimiser's own arrays pass."""
+    optimizer = optimizers["panda"]
+    T = optimizer.solver.arm.fk(HOMES["panda"])
+    first = optimizer.choose(T)
+    tracker = Tracker(optimizer.solver, optimizer.objective, MAX_STEP)
+    assert tracker.work.singular_joints.size  # (the term is weighted: its joints are read)
+    args = (first.configuration.signs, first.configuration.redundancy[0], first.solution.q, math.nan)
+    assert tracker.step(T, *args) is not None
+    tracker.work.singular_joints[0] = joint
+    with pytest.raises(ValueError, match="not a joint index"):
+        tracker.step(T, *args)
 
 
 KINKS = {  # u in [0, 1]^7 of the joint ranges: optima at a kink of the objective
