@@ -18,6 +18,7 @@ from hypothesis import settings
 import om_redundant as om
 from om_redundant import ckernels
 from om_redundant.mujoco_io.model_match import load_mujoco_model
+from om_redundant.redundancy.objective import Group
 
 # The suite's property tests draw the same examples on every run, so that CI answers for the
 # code and not for the draw; HYPOTHESIS_PROFILE=explore draws new ones (run it to hunt bugs:
@@ -79,6 +80,21 @@ def solver_of(name: str) -> om.OMSolver:
 def random_pose(solver: om.OMSolver, seed: int) -> np.ndarray:
     """A random reachable pose of the solver's arm: the hand at joints drawn within the limits."""
     return solver.arm.fk(np.random.default_rng(seed).uniform(solver.arm.lower, solver.arm.upper))
+
+
+def random_groups(rng: np.random.Generator, r: int, values) -> list[Group]:
+    """The objective's three kinds of group (margin, clearance with floor 0.3, singularity), of
+    random weights, pieces ``values(floor)`` and rates by r variables drawn from N(0, 1): the
+    climb's QP problems."""
+    groups = []
+    for kind, weight, floor, cap in (
+        ("margin", rng.uniform(0, 2), 0.0, np.inf),
+        ("clearance", rng.uniform(0, 2), 0.3, 1.0),
+        ("singularity", rng.uniform(0, 1), -np.inf, 1.0),
+    ):
+        v = values(floor)
+        groups.append(Group(kind, weight, floor, cap, v, rng.normal(size=(len(v), r))))
+    return groups
 
 
 def steps_numpy(cyclic: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:

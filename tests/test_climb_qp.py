@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 from om_redundant.redundancy.box_qp import Pieces, step_1d
 from om_redundant.redundancy.climb import qp_step
 from om_redundant.redundancy.objective import Group
+from tests.conftest import random_groups
 
 # OSQP's tolerances (climb._OSQP: 1e-6, absolute and relative, then polished): a proposal, which
 # the climb checks exactly, within this of the model's optimum and of its floors.
@@ -18,18 +19,17 @@ OSQP_GAP = 1e-5
 
 
 def _groups(rng: np.random.Generator, pieces: int, r: int) -> list[Group]:
-    """The three kinds of group the objective has, each piece within its floor at delta = 0
-    (a climb's point is feasible)."""
-    return [
-        Group(
-            kind, weight, floor, cap, rng.uniform(max(floor, 0.0), 1.5, pieces), rng.normal(size=(pieces, r))
-        )
-        for kind, weight, floor, cap in (
-            ("margin", rng.uniform(0, 2), 0.0, np.inf),
-            ("clearance", rng.uniform(0, 2), 0.3, 1.0),
-            ("singularity", rng.uniform(0, 1), -np.inf, 1.0),
-        )
-    ]
+    """Groups whose pieces are within their floors at delta = 0 (a climb's point is feasible)."""
+    return random_groups(rng, r, lambda floor: rng.uniform(max(floor, 0.0), 1.5, pieces))
+
+
+# The problems: 1-6 pieces per group, b (or B's scale) and the box's reach.
+_PROBLEMS = given(
+    seed=st.integers(0, 2**32 - 1),
+    pieces=st.integers(1, 6),
+    curvature=st.floats(1e-2, 1e2),
+    reach=st.floats(1e-3, 1.0),
+)
 
 
 def _model(groups: list[Group], curvature: np.ndarray, deltas: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -43,12 +43,7 @@ def _model(groups: list[Group], curvature: np.ndarray, deltas: np.ndarray) -> tu
 
 
 @settings(max_examples=30, deadline=None)
-@given(
-    seed=st.integers(0, 2**32 - 1),
-    pieces=st.integers(1, 6),
-    curvature=st.floats(1e-2, 1e2),
-    reach=st.floats(1e-3, 1.0),
-)
+@_PROBLEMS
 def test_the_two_variable_step_is_the_models_maximiser(seed, pieces, curvature, reach):
     """A delta within the box and (to OSQP's tolerance) the floors, whose model value no point
     of a 401 x 401 grid of the box that keeps the floors beats; the gain it reports is the
@@ -76,12 +71,7 @@ def test_the_two_variable_step_is_the_models_maximiser(seed, pieces, curvature, 
 
 
 @settings(max_examples=30, deadline=None)
-@given(
-    seed=st.integers(0, 2**32 - 1),
-    pieces=st.integers(1, 6),
-    curvature=st.floats(1e-2, 1e2),
-    reach=st.floats(1e-3, 1.0),
-)
+@_PROBLEMS
 def test_a_second_variable_held_at_zero_gives_the_exact_one_variable_step(seed, pieces, curvature, reach):
     """With a second variable that moves nothing and whose box is [0, 0], OSQP's step is the one
     that box_qp solves exactly with one variable, to OSQP's tolerance."""

@@ -20,7 +20,7 @@ from om_redundant.redundancy.objective import Group
 from om_redundant.redundancy.optimizer import _StartBounds
 from om_redundant.redundancy.probe import Probe
 from om_redundant.redundancy.self_motion import self_motion_tangents
-from tests.conftest import steps_numpy
+from tests.conftest import random_groups, steps_numpy
 
 
 @functools.cache
@@ -168,16 +168,7 @@ def test_the_one_variable_qp_step_is_the_models_maximiser(seed, pieces, curvatur
     beats, and multipliers in [0, w_g] per group; compiled exactly as numpy computes it,
     also from points below the floors (where they may leave no delta)."""
     rng = np.random.default_rng(seed)
-    groups = [
-        Group(
-            kind, weight, floor, cap, rng.uniform(max(floor, 0.0), 1.5, pieces), rng.normal(size=(pieces, 1))
-        )
-        for kind, weight, floor, cap in (
-            ("margin", rng.uniform(0, 2), 0.0, np.inf),
-            ("clearance", rng.uniform(0, 2), 0.3, 1.0),
-            ("singularity", rng.uniform(0, 1), -np.inf, 1.0),
-        )
-    ]
+    groups = random_groups(rng, 1, lambda floor: rng.uniform(max(floor, 0.0), 1.5, pieces))
     lower, upper = -reach * rng.uniform(), reach * rng.uniform()
     grid = np.linspace(lower, upper, 20001)
     pieces_at = [g.values[None, :] + g.jacobian[None, :, 0] * grid[:, None] for g in groups]
@@ -224,14 +215,7 @@ def test_the_climbs_one_variable_step_compiled_is_numpys(seed, pieces, curvature
     out: multiplier 0); its delta is maximise_1d's of the pieces kept, and its gain the
     model's rise to it. Pieces.at: another point's pieces of the same groups."""
     rng = np.random.default_rng(seed)
-    groups = [
-        Group(kind, weight, floor, cap, rng.uniform(0.0, spread, pieces) + 0.3, rng.normal(size=(pieces, 1)))
-        for kind, weight, floor, cap in (
-            ("margin", rng.uniform(0, 2), 0.0, np.inf),
-            ("clearance", rng.uniform(0, 2), 0.3, 1.0),
-            ("singularity", rng.uniform(0, 1), -np.inf, 1.0),
-        )
-    ]
+    groups = random_groups(rng, 1, lambda floor: rng.uniform(0.0, spread, pieces) + 0.3)
     lower, upper = -reach * rng.uniform(), reach * rng.uniform()
     found, want = (step_1d(Pieces.of(groups), curvature, lower, upper, compiled=c) for c in (True, False))
     assert (found is None) == (want is None)
