@@ -46,8 +46,10 @@ def _model(groups: list[Group], curvature: np.ndarray, deltas: np.ndarray) -> tu
 @_PROBLEMS
 def test_the_two_variable_step_is_the_models_maximiser(seed, pieces, curvature, reach):
     """A delta within the box and (to OSQP's tolerance) the floors, whose model value no point
-    of a 401 x 401 grid of the box that keeps the floors beats; the gain it reports is the
-    model's from delta = 0; multipliers in [0, w_g] per group."""
+    of a 401 x 401 grid of the box that keeps the floors beats (where OSQP certifies its
+    solution: about 1 % of random problems end at its iteration limit, a known gap listed in
+    the README's Status); the gain it reports is the model's from delta = 0; multipliers >= 0
+    that sum to w_g per group where neither its floor nor its cap holds it."""
     rng = np.random.default_rng(seed)
     groups = _groups(rng, pieces, 2)
     root = rng.normal(size=(2, 2))
@@ -63,11 +65,14 @@ def test_the_two_variable_step_is_the_models_maximiser(seed, pieces, curvature, 
     assert np.all(lower - OSQP_GAP <= step.delta) and np.all(step.delta <= upper + OSQP_GAP)
     assert step_slack >= -OSQP_GAP
     assert value >= values[slack >= 0.0].max() - OSQP_GAP
-    assert step.gain == value - start
-    assert all(
-        (z >= 0.0).all() and z.sum() <= g.weight + OSQP_GAP
-        for g, z in zip(groups, step.multipliers, strict=True)
-    )
+    assert abs(step.gain - (value - start)) <= 1e-12  # (the same sums, in another order)
+    for g, z in zip(groups, step.multipliers, strict=True):
+        # KKT in t_g: sum_j z_j = w_g + (the floor's multiplier) - (the cap's), each active only
+        # where the group's least piece is at it.
+        least = (g.values + g.jacobian @ step.delta).min()
+        assert (z >= 0.0).all()
+        assert least <= g.floor + OSQP_GAP or z.sum() <= g.weight + OSQP_GAP
+        assert least >= g.cap - OSQP_GAP or z.sum() >= g.weight - OSQP_GAP
 
 
 @settings(max_examples=30, deadline=None)
