@@ -6,6 +6,7 @@ against finite differences."""
 from __future__ import annotations
 
 import math
+import threading
 
 import mujoco
 import numpy as np
@@ -137,6 +138,30 @@ def test_a_capsule_through_a_thin_box_overlaps(panda):
     depth = overlaps(np.vstack([R.T, np.cross(u, R.T)])).min()
     assert found == pytest.approx(-(depth + radius), abs=1e-12)
     assert depth <= overlaps(np.random.default_rng(0).normal(size=(200_000, 3))).min() + 1e-12
+
+
+def test_threads_sharing_a_clearance_get_its_answers():
+    """Four threads that share one Clearance (whose MuJoCo pairs are computed in one MjData)
+    get, row by row, exactly the distances and gradients it gives one call at a time."""
+    arm = om.load_arm("gen3")
+    clearance = mounted(arm)
+    Q = within_limits(arm, np.random.default_rng(0), 200)
+    alone = [clearance.distances_and_gradients(q) for q in Q]
+    shared = [None] * len(Q)
+
+    def work(rows: range) -> None:
+        for _ in range(5):
+            for i in rows:
+                shared[i] = clearance.distances_and_gradients(Q[i])
+
+    threads = [threading.Thread(target=work, args=(range(k, len(Q), 4),)) for k in range(4)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    for (d, g), (d_shared, g_shared) in zip(alone, shared, strict=True):
+        np.testing.assert_array_equal(d, d_shared)
+        np.testing.assert_array_equal(g, g_shared)
 
 
 SHIPPED = om.arm_names()  # every 7-DOF arm, and a 6-DOF one with a prismatic joint

@@ -6,6 +6,8 @@ is a typed error."""
 from __future__ import annotations
 
 import math
+import sys
+import threading
 
 import numpy as np
 import pytest
@@ -24,6 +26,7 @@ from benchmarks.control_rate import (
     turned,
 )
 from om_redundant.redundancy.tracking import Tracker
+from tests.conftest import random_q
 
 TICKS = 200  # of a figure eight, one lap
 MAX_STEP = 0.005
@@ -143,6 +146,40 @@ def test_the_tracking_step_carries_its_curvature(optimizers):
     assert math.isnan(first.curvature)
     step = optimizer.choose(T, first)
     assert step.ok and 0.0 < step.curvature < math.inf
+
+
+def test_threads_sharing_an_optimiser_track_as_one(optimizers):
+    """Four threads that share one optimiser (its tracking step's work arrays) each get, for
+    their poses, exactly the tracking step it gives one call at a time; the interpreter
+    switches threads as often as it can."""
+    optimizer = optimizers["panda"]
+    arm = optimizer.solver.arm
+    poses = [arm.fk(q) for q in random_q(arm, 12, np.random.default_rng(5))]
+    first = [optimizer.choose(T) for T in poses]
+    cases = [(T, c) for T, c in zip(poses, first, strict=True) if c.ok]
+
+    def step(T, previous):
+        c = optimizer.choose(T, previous)
+        return c.ok, c.configuration.redundancy, None if c.solution is None else c.solution.q.tobytes()
+
+    alone = [step(T, c) for T, c in cases]
+    differ = []
+
+    def work(rows: range) -> None:
+        for _ in range(200):
+            differ.extend(i for i in rows if step(*cases[i]) != alone[i])
+
+    interval = sys.getswitchinterval()
+    sys.setswitchinterval(1e-6)
+    try:
+        threads = [threading.Thread(target=work, args=(range(k, len(cases), 4),)) for k in range(4)]
+        for thread in threads:
+            thread.start()
+        for thread in threads:
+            thread.join()
+    finally:
+        sys.setswitchinterval(interval)
+    assert len(cases) >= 8 and not differ
 
 
 @pytest.mark.parametrize("joint", [7.0, -1.0, 2.5, math.nan, 1e300])

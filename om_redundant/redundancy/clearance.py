@@ -47,6 +47,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import threading
 from collections.abc import Sequence
 from typing import NamedTuple
 
@@ -67,6 +68,9 @@ _CHECKS = 3  # random joint vectors at which the geoms' placement is checked aga
 
 class Clearance:
     """Signed distances between an arm's collision geoms and obstacle geoms (module docstring).
+
+    Threads may share one: its MuJoCo data, where the pairs left to MuJoCo are computed, is
+    taken by one call at a time.
 
     Args:
         model: A MuJoCo model holding the arm and the obstacles, e.g. the user's scene.
@@ -124,6 +128,7 @@ class Clearance:
         self._data = mujoco.MjData(model)  # at qpos0, placed: the obstacles and mj_geomDistance's scratch
         mujoco.mj_kinematics(model, self._data)
         self._placed = (self._data.geom_xpos, self._data.geom_xmat)  # (views of the data's arrays)
+        self._data_lock = threading.Lock()  # the data is every call's scratch: one call at a time
         self._cores = _arm_cores(model, self._data, joints, arm_geoms, obstacles)
         # arm_clearance's arguments before and after q
         self._arguments, self._n_pairs = (self._cores[:5], self._cores[5:]), len(self._pair_geoms)
@@ -274,8 +279,9 @@ class Clearance:
         kind, radius, half = self._cores.kind, self._cores.radius, self._cores.half
         for r, k in np.argwhere(left[rows]).tolist():  # (only the pair's arm geom placed: the one read)
             a, o, i = self._pair_geoms[k]
-            placed[0][a], placed[1][a] = xpos[r, i], xmat[r, i]
-            found = mujoco.mj_geomDistance(m, d, a, o, reach, fromto[at[r], k])
+            with self._data_lock:
+                placed[0][a], placed[1][a] = xpos[r, i], xmat[r, i]
+                found = mujoco.mj_geomDistance(m, d, a, o, reach, fromto[at[r], k])
             b = self._cores.pairs[k, 1]
             if found > 0.0 and kind[b] == _BOX and kind[i] in (_POINT, _SEGMENT):
                 # The kernel leaves such a pair where the cores say it overlaps; MuJoCo's

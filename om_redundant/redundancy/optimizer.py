@@ -122,6 +122,10 @@ class RedundancyOptimizer:
     """Picks the arm angle psi (and branch) of a 7-DOF arm for margin, clearance and distance
     from singularities.
 
+    Threads may share an optimiser (and its :class:`~om_redundant.Clearance`): the scratch
+    that calls share (the tracking step's arrays, the MuJoCo data of the clearance's MuJoCo
+    pairs) is taken by one call at a time.
+
     Args:
         solver: The OM solver of an arm with one redundancy variable.
         obstacles: None; shapes (:class:`~om_redundant.Sphere`, ``Capsule``, ``Box``) or a

@@ -41,6 +41,7 @@ objective on the branch (a Newton-like iteration on the crossing of the active p
 from __future__ import annotations
 
 import math
+import threading
 from typing import NamedTuple
 
 import numpy as np
@@ -142,6 +143,7 @@ class Tracker:
         # Without obstacles, no pairs.
         self._last = Linearisation(np.zeros(arm.dof), np.zeros(0), np.zeros((0, arm.dof)))
         self._signs: dict[tuple[int, ...], np.ndarray] = {}  # each branch's signs as the kernel takes them
+        self._lock = threading.Lock()  # the work arrays and the last linearisation: one step at a time
 
     def step(
         self, T: np.ndarray, signs: tuple[int, ...], psi: float, q: np.ndarray, curvature: float
@@ -154,6 +156,12 @@ class Tracker:
         """
         if self._kernel is None:
             return None
+        with self._lock:
+            return self._step(T, signs, psi, q, curvature)
+
+    def _step(
+        self, T: np.ndarray, signs: tuple[int, ...], psi: float, q: np.ndarray, curvature: float
+    ) -> tuple[Solution, float, float, float, float] | None:
         work, objective = self.work, self.objective
         work.setup[_PSI] = psi
         work.setup[_CURVATURE] = curvature if math.isfinite(curvature) else INITIAL_CURVATURE
