@@ -46,6 +46,7 @@ from .om import (
     nominal_arm,
 )
 from .redundancy import (
+    MAX_EXTENT,
     Box,
     Capsule,
     Clearance,
@@ -66,6 +67,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "BRANCH_BAND",
+    "MAX_EXTENT",
     "NEAR_TWIST",
     "Arm",
     "ArmAngleTask",

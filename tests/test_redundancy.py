@@ -333,6 +333,20 @@ def test_bad_input_is_named_and_nothing_feasible_says_why(panda):
         om.Clearance(om.arm_model(panda.arm), panda.arm, ["link7_capsule0"])
     with pytest.raises(om.InvalidInput, match="obstacle name 'link4_capsule0' is already taken"):
         om.Clearance.for_arm(panda.arm, [om.Sphere([0, 0, 1], 0.1, name="link4_capsule0")])
+    # Beyond om.MAX_EXTENT distances lose their precision (a sphere of radius 1e155 about the arm
+    # was reported clear: the squares overflow); within it they are kept.
+    within = 0.5 * om.MAX_EXTENT
+    om.Clearance.for_arm(panda.arm, [om.Sphere([within, 0, 0], 0.1), om.Box([within, within, 0.1])])
+    for huge in (
+        om.Sphere([0.4, 0.0, 0.5 + 1e155], 1e155),
+        om.Sphere([2.0 * om.MAX_EXTENT, 0.0, 0.0], 0.1),
+        om.Box([2.0 * om.MAX_EXTENT, 1.0, 1.0]),
+        om.Capsule([0.4, 0.0, 0.5], [0.4, 0.0, 1e12], 0.05),
+    ):
+        with pytest.raises(
+            om.InvalidInput, match="obstacle geom 'obstacle0': its position and sizes must be within"
+        ):
+            om.RedundancyOptimizer(panda, [huge])
 
     optimizer = om.RedundancyOptimizer(panda)
     T = panda.arm.fk(np.array([0.2, 0.4, -0.3, -1.8, 0.5, 1.9, 0.6]))

@@ -6,7 +6,7 @@
 shows (:mod:`.sweep`)."""
 
 from .arm_angle import arm_angle_and_gradient
-from .clearance import Clearance
+from .clearance import MAX_EXTENT, Clearance
 from .intervals import PsiInterval
 from .objective import Evaluation, Objective, joint_margins
 from .optimizer import RedundancyChoice, RedundancyOptimizer
@@ -25,6 +25,7 @@ from .sweep import (
 )
 
 __all__ = [
+    "MAX_EXTENT",
     "Box",
     "BranchSweep",
     "Capsule",

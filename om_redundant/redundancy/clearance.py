@@ -66,6 +66,12 @@ DEFAULT_DISTMAX = 1.0  # m: pairs farther apart report this distance
 _CHECKS = 3  # random joint vectors at which the geoms' placement is checked against MuJoCo's
 
 
+#: The largest coordinate or size (m) of an obstacle geom: distances are computed in doubles to
+#: about 1e-16 of the largest coordinates, 1e-10 m at this extent; beyond about 1e154 their
+#: squares overflow (a sphere of radius 1e155 about the arm was reported clear).
+MAX_EXTENT = 1e6
+
+
 class Clearance:
     """Signed distances between an arm's collision geoms and obstacle geoms (module docstring).
 
@@ -127,6 +133,13 @@ class Clearance:
         self._arm_ids = np.array(arm_geoms, dtype=np.int64)
         self._data = mujoco.MjData(model)  # at qpos0, placed: the obstacles and mj_geomDistance's scratch
         mujoco.mj_kinematics(model, self._data)
+        for o in obstacles:
+            extent = max(np.abs(self._data.geom_xpos[o]).max(), model.geom_size[o].max())
+            if not extent <= MAX_EXTENT:
+                raise InvalidInput(
+                    f"obstacle geom '{model.geom(o).name}': its position and sizes must be within "
+                    f"{MAX_EXTENT:g} m, got {extent:.3g} m"
+                )
         self._placed = (self._data.geom_xpos, self._data.geom_xmat)  # (views of the data's arrays)
         self._data_lock = threading.Lock()  # the data is every call's scratch: one call at a time
         self._cores = _arm_cores(model, self._data, joints, arm_geoms, obstacles)
