@@ -97,6 +97,17 @@ static void core(const double *xpos, const double *xmat, const double *half, int
     for (int i = 0; i < 3; i++) a[i] = pos[i] - l * mat[3 * i + 2], b[i] = pos[i] + l * mat[3 * i + 2];
 }
 
+/* Point x in the frame of a box at pos (rotation R, row-major): R^T (x - pos). */
+static void to_box(const double *pos, const double *R, const double *x, double *out) {
+    double d[3] = {x[0] - pos[0], x[1] - pos[1], x[2] - pos[2]};
+    for (int i = 0; i < 3; i++) out[i] = R[i] * d[0] + R[3 + i] * d[1] + R[6 + i] * d[2];
+}
+
+/* Point k of a box's frame in the world: pos + R k. */
+static void from_box(const double *pos, const double *R, const double *k, double *out) {
+    for (int i = 0; i < 3; i++) out[i] = pos[i] + dot3(R + 3 * i, k);
+}
+
 /* The signed distance of geoms g1 (point or segment core) and g2 (any core but MuJoCo's),
  * their nearest points into fromto: negative where a sphere or capsule overlaps one whose
  * core it does not touch (the depth MuJoCo gives); nan where the cores touch, or a box is
@@ -107,13 +118,10 @@ static double pair_distance(const int64_t *kind, const double *radius, const dou
     core(xpos, xmat, half, g1, a1, b1);
     if (kind[g2] == CORE_BOX) {
         const double *pos = xpos + 3 * g2, *R = xmat + 9 * g2;
-        double a[3], b[3], d[3], e[3], k1[3] = {0.0}, k2[3] = {0.0};
-        for (int i = 0; i < 3; i++) d[i] = a1[i] - pos[i], e[i] = b1[i] - pos[i];
-        for (int i = 0; i < 3; i++) /* R^T (x - pos) */
-            a[i] = R[i] * d[0] + R[3 + i] * d[1] + R[6 + i] * d[2], b[i] = R[i] * e[0] + R[3 + i] * e[1] + R[6 + i] * e[2];
+        double a[3], b[3], k1[3] = {0.0}, k2[3] = {0.0};
+        to_box(pos, R, a1, a), to_box(pos, R, b1, b);
         segment_box(a, b, half + 3 * g2, k1, k2);
-        for (int i = 0; i < 3; i++) /* back to the world */
-            c1[i] = pos[i] + dot3(R + 3 * i, k1), c2[i] = pos[i] + dot3(R + 3 * i, k2);
+        from_box(pos, R, k1, c1), from_box(pos, R, k2, c2);
     } else {
         double a2[3], b2[3];
         core(xpos, xmat, half, g2, a2, b2);
@@ -128,6 +136,56 @@ static double pair_distance(const int64_t *kind, const double *radius, const dou
         fromto[3 + i] = c2[i] - radius[g2] * n;
     }
     return dist;
+}
+
+/* The signed distance (<= 0) of a sphere or capsule (core p-q, radius r) that overlaps the box
+ * at pos (rotation R, half sizes h), exactly, with its nearest points (arm, box) into fromto:
+ * for the pairs whose overlap MuJoCo's distance contradicts (clearance.py). Where the core
+ * stays outside the box, at distance l from it, the distance is l - r (the capsule is the core
+ * swollen by r). Where it touches the box, it is -(depth + r), the depth that of the core in
+ * the box: the least, over the separating axes n of a segment and a box (the box's axes e_i and
+ * u x e_i for the segment's direction u: the normals of their Minkowski difference's faces), of
+ * how far the core must move along +-n to leave the box; the arm point is the core's point
+ * deepest along that escape direction, less r, the box point where it leaves the box. */
+static double overlap_with_box(const double *p, const double *q, double r, const double *pos, const double *R,
+                               const double *h, double *fromto) {
+    double a[3], b[3], k1[3] = {0.0}, k2[3] = {0.0}, v[3], arm[3], box[3], distance;
+    to_box(pos, R, p, a), to_box(pos, R, q, b);
+    segment_box(a, b, h, k1, k2);
+    for (int i = 0; i < 3; i++) v[i] = k2[i] - k1[i];
+    double length = sqrt(dot3(v, v));
+    if (length > 0.0) {
+        for (int i = 0; i < 3; i++) arm[i] = k1[i] + r * v[i] / length, box[i] = k2[i];
+        distance = length - r;
+    } else {
+        double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, depth = INFINITY, escape[3] = {0.0};
+        const double *deepest = a;
+        for (int m = 0; m < 6; m++) {
+            double n[3] = {0.0, 0.0, 0.0};
+            if (m < 3)
+                n[m] = 1.0;
+            else { /* u x e_{m-3}, where u is not along e_{m-3} */
+                int j = m - 3, j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+                n[j1] = u[j2], n[j2] = -u[j1];
+                double size = sqrt(dot3(n, n));
+                if (!(size > 1e-12 * sqrt(dot3(u, u)))) continue;
+                for (int i = 0; i < 3; i++) n[i] /= size;
+            }
+            double sa = dot3(a, n), sb = dot3(b, n), extent = fabs(n[0]) * h[0] + fabs(n[1]) * h[1] + fabs(n[2]) * h[2];
+            for (int side = -1; side <= 1; side += 2) { /* escaping along side n: the overlap to clear */
+                double overlap = side < 0 ? fmax(sa, sb) + extent : extent - fmin(sa, sb);
+                if (overlap < depth) {
+                    depth = overlap;
+                    for (int i = 0; i < 3; i++) escape[i] = side * n[i];
+                    deepest = side * (sa - sb) < 0.0 ? a : b;
+                }
+            }
+        }
+        for (int i = 0; i < 3; i++) box[i] = deepest[i] + depth * escape[i], arm[i] = deepest[i] - r * escape[i];
+        distance = -(depth + r);
+    }
+    from_box(pos, R, arm, fromto), from_box(pos, R, box, fromto + 3);
+    return distance;
 }
 
 /* The world poses of links 0..dof at q (rows of R (9) and p (3) in frames, (dof + 1) x 12):
@@ -333,7 +391,29 @@ static PyObject *om_arm_clearance(PyObject *mod, PyObject *const *args, Py_ssize
     return PyLong_FromLong(left);
 }
 
+/* box_overlap(pos, mat, half, radius, box_pos, box_mat, box_half, fromto) -> distance:
+ * overlap_with_box of a sphere or capsule geom at pos (3; rotation mat, 9 row-major; half sizes
+ * half, 3: a capsule's (0, 0, l)) and a box, in the world; fromto (6). */
+static PyObject *om_box_overlap(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 8, "box_overlap") < 0) return NULL;
+    double radius = PyFloat_AsDouble(args[3]);
+    if (PyErr_Occurred()) return NULL;
+    PyObject *const objs[7] = {args[0], args[1], args[2], args[4], args[5], args[6], args[7]};
+    const buffer_spec sp[7] = {{F64, 3, 0, "pos"},     {F64, 9, 0, "mat"},      {F64, 3, 0, "half"},
+                               {F64, 3, 0, "box_pos"}, {F64, 9, 0, "box_mat"}, {F64, 3, 0, "box_half"},
+                               {F64, 6, 1, "fromto"}};
+    Py_buffer v[7];
+    if (get_buffers(objs, v, sp, 7) < 0) return NULL;
+    double p[3], q[3];
+    core(v[0].buf, v[1].buf, v[2].buf, 0, p, q);
+    double distance = overlap_with_box(p, q, radius, v[3].buf, v[4].buf, v[5].buf, v[6].buf);
+    release_buffers(v, 7);
+    return PyFloat_FromDouble(distance);
+}
+
 PyMethodDef om_clearance_functions[] = {
+    {"box_overlap", (PyCFunction)(void (*)(void))om_box_overlap, METH_FASTCALL,
+     "box_overlap(pos, mat, half, radius, box_pos, box_mat, box_half, fromto) -> distance"},
     {"arm_geom_poses", (PyCFunction)(void (*)(void))om_arm_geom_poses, METH_FASTCALL,
      "arm_geom_poses(table, start, link, offset, slide, q, xpos, xmat)"},
     {"arm_clearance", (PyCFunction)(void (*)(void))om_arm_clearance, METH_FASTCALL,

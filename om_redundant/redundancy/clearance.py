@@ -21,7 +21,7 @@ segment and a box, in closed form; overlapping where the cores do not touch), an
 geoms placed as the kernel places them; ``tests/test_clearance.py`` checks both against
 MuJoCo. Where MuJoCo says a sphere or capsule is apart from a box that its core overlaps (its
 box-capsule distance is positive for about 0.3 % of such pairs, up to 0.09 m, a capsule
-through a thin box), the exact signed distance is taken instead (``_overlap_with_box``).
+through a thin box), the exact signed distance is taken instead (``ckernels.box_overlap``).
 With :math:`p_A, p_O` the nearest points and :math:`n_k = (p_O - p_A)/d_k` the unit direction
 from the arm geom to the obstacle (the division by the signed distance keeps it pointing that
 way when the geoms overlap), moving the arm point by :math:`dp` changes the distance by
@@ -45,7 +45,6 @@ gripper's) stay at ``qpos0``.
 
 from __future__ import annotations
 
-import itertools
 import math
 import threading
 from collections.abc import Sequence
@@ -70,6 +69,8 @@ _CHECKS = 3  # random joint vectors at which the geoms' placement is checked aga
 #: about 1e-16 of the largest coordinates, 1e-10 m at this extent; beyond about 1e154 their
 #: squares overflow (a sphere of radius 1e155 about the arm was reported clear).
 MAX_EXTENT = 1e6
+
+_POINT, _SEGMENT, _BOX = 1, 2, 3  # ArmCores.kind: the cores that ckernels.arm_clearance computes
 
 
 class Clearance:
@@ -300,12 +301,13 @@ class Clearance:
                 # The kernel leaves such a pair where the cores say it overlaps; MuJoCo's
                 # box-capsule distance can be positive for a capsule whose core pierces a
                 # thin box (0.3 % of such pairs, up to 0.09 m): the exact depth instead.
-                found = _overlap_with_box(
+                found = ckernels.box_overlap(
                     xpos[r, i],
-                    xmat[r, i].reshape(3, 3)[:, 2] * half[i, 2],
+                    xmat[r, i],
+                    half[i],
                     radius[i],
                     d.geom_xpos[o],
-                    d.geom_xmat[o].reshape(3, 3),
+                    d.geom_xmat[o],
                     half[b],
                     fromto[at[r], k],
                 )
@@ -314,77 +316,6 @@ class Clearance:
             given = np.empty((len(rows), n_pairs, self._dof))
             ckernels.arm_clearance(*arm, q[rows], *geoms, reach, near, dist[rows], fromto[rows], given, True)
             grad.reshape(-1, n_pairs, self._dof)[rows] = given
-
-
-_POINT, _SEGMENT, _BOX = 1, 2, 3  # ArmCores.kind
-
-
-def _overlap_with_box(
-    centre: np.ndarray,
-    half_axis: np.ndarray,
-    radius: float,
-    box_pos: np.ndarray,
-    box_R: np.ndarray,
-    box_half: np.ndarray,
-    fromto: np.ndarray,
-) -> float:
-    r"""The signed distance (<= 0) of a sphere or capsule (core segment centre +- half_axis,
-    radius) that overlaps a box, and its nearest points into fromto (arm, box), exactly.
-
-    Where the core stays outside the box, at distance l > 0 from it (nearest points c_A, c_B),
-    the distance is l - radius (the capsule is the core swollen by the radius). Where it
-    touches the box, the depth is that of the core into the box, found on the separating axes
-    of a segment and a box: the box's three axes e_i and u x e_i for the segment's direction
-    u (the normals of the faces of their Minkowski difference). On each axis n the overlap is
-    :math:`\min(s_{max} - b_{min}, b_{max} - s_{min})` of the two projections, and the depth
-    the least; the distance is -(depth + radius), the arm point the core's point deepest along
-    the escape direction, less the radius.
-    """
-    a = box_R.T @ (centre - half_axis - box_pos)  # the core in the box's frame
-    b = box_R.T @ (centre + half_axis - box_pos)
-    # Nearest points of the segment and the box: g(t) = |p(t) - clip(p(t))|^2 is convex and
-    # quadratic between the t where a coordinate crosses a face; its least on each piece.
-    u = b - a
-    cuts = [0.0, 1.0]
-    for j in range(3):
-        if u[j] != 0.0:
-            cuts += [t for t in ((-box_half[j] - a[j]) / u[j], (box_half[j] - a[j]) / u[j]) if 0.0 < t < 1.0]
-    cuts.sort()
-    best, t_best = math.inf, 0.0
-    for lo, hi in itertools.pairwise(cuts):
-        x = a + 0.5 * (lo + hi) * u
-        beyond = np.abs(x) > box_half
-        face = np.sign(x) * box_half
-        den = float(u[beyond] @ u[beyond])
-        t = lo if den == 0.0 else min(max(float((face - a)[beyond] @ u[beyond]) / den, lo), hi)
-        x = a + t * u
-        gap = x - np.clip(x, -box_half, box_half)
-        if gap @ gap < best:
-            best, t_best = float(gap @ gap), t
-    core = a + t_best * u
-    length = math.sqrt(best)
-    if length > 0.0:
-        box = np.clip(core, -box_half, box_half)
-        arm, distance = core + radius * (box - core) / length, length - radius
-    else:
-        axes = [np.eye(3)[j] for j in range(3)]
-        axes += [
-            c / np.linalg.norm(c)
-            for c in np.cross(u, np.eye(3))
-            if np.linalg.norm(c) > 1e-12 * np.linalg.norm(u)
-        ]
-        depth = math.inf
-        for n in axes:
-            ends, extent = sorted((float(a @ n), float(b @ n))), float(np.abs(n) @ box_half)
-            for overlap, escape in ((ends[1] + extent, -n), (extent - ends[0], n)):
-                if overlap < depth:  # the core escapes by `overlap` along `escape`
-                    deepest = a if (a - b) @ escape < 0.0 else b
-                    depth, deepest_point, out = overlap, deepest, escape
-        distance = -(depth + radius)
-        box = deepest_point + depth * out  # where the core's deepest point leaves the box
-        arm = deepest_point - radius * out
-    fromto[:3], fromto[3:] = box_pos + box_R @ arm, box_pos + box_R @ box
-    return distance
 
 
 class ArmCores(NamedTuple):
@@ -452,11 +383,11 @@ def _arm_cores(
     for i, g in enumerate(geoms):
         size = model.geom_size[g]
         if model.geom_type[g] == mujoco.mjtGeom.mjGEOM_SPHERE:
-            kind[i], radius[i] = 1, size[0]
+            kind[i], radius[i] = _POINT, size[0]
         elif model.geom_type[g] == mujoco.mjtGeom.mjGEOM_CAPSULE:
-            kind[i], radius[i], half[i, 2] = 2, size[0], size[1]
+            kind[i], radius[i], half[i, 2] = _SEGMENT, size[0], size[1]
         elif model.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX:
-            kind[i], half[i] = 3, size
+            kind[i], half[i] = _BOX, size
     n_arm = len(arm_geoms)
     pairs = np.array([(a, n_arm + o) for a in range(n_arm) for o in range(len(obstacles))], dtype=np.int64)
     pairs = pairs.reshape(-1, 2)
