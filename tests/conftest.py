@@ -8,12 +8,14 @@ import math
 import os
 import subprocess
 import sys
+import threading
 from pathlib import Path
 
 import mujoco
 import numpy as np
 import pytest
-from hypothesis import settings
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import om_redundant as om
 from om_redundant import ckernels
@@ -80,6 +82,24 @@ def solver_of(name: str) -> om.OMSolver:
 def random_pose(solver: om.OMSolver, seed: int) -> np.ndarray:
     """A random reachable pose of the solver's arm: the hand at joints drawn within the limits."""
     return solver.arm.fk(np.random.default_rng(seed).uniform(solver.arm.lower, solver.arm.upper))
+
+
+def in_threads(work, rows: int, threads: int = 4) -> None:
+    """work(range(k, rows, threads)) on each of `threads` threads at once, all joined."""
+    running = [threading.Thread(target=work, args=(range(k, rows, threads),)) for k in range(threads)]
+    for thread in running:
+        thread.start()
+    for thread in running:
+        thread.join()
+
+
+# The optimiser's sweep at a random reachable pose (random_pose's seed) of an arm, with 1 or 3
+# obstacles about the hand (benchmarks.control_rate.obstacles): the property tests' scenes.
+random_scenes = given(
+    seed=st.integers(0, 2**32 - 1),
+    name=st.sampled_from(["panda", "iiwa14", "fr3"]),
+    count=st.sampled_from([1, 3]),
+)
 
 
 def random_groups(rng: np.random.Generator, r: int, values) -> list[Group]:

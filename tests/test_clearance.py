@@ -6,7 +6,6 @@ against finite differences."""
 from __future__ import annotations
 
 import math
-import threading
 
 import mujoco
 import numpy as np
@@ -17,6 +16,7 @@ from hypothesis import strategies as st
 import om_redundant as om
 from om_redundant import ckernels
 from om_redundant.exceptions import ModelMismatch
+from tests.conftest import in_threads
 
 KINDS = {
     "sphere": mujoco.mjtGeom.mjGEOM_SPHERE,
@@ -109,8 +109,9 @@ def _core_box_gap(model: mujoco.MjModel, data: mujoco.MjData, a: int, o: int, po
 def test_a_capsule_through_a_thin_box_overlaps(panda):
     """A scene hypothesis found: link 5's capsule passes through a thin box (its core crosses
     the box's slab) and MuJoCo's mj_geomDistance says 0.0015 m apart. The clearance says they
-    overlap by the depth of the core in the box plus the radius: the least, over a dense
-    sample of directions n, of the distance the core must move along n to leave the box."""
+    overlap by the depth of the core in the box plus the radius: the least distance the core
+    must move along a separating axis n to leave the box, which no direction of a dense sample
+    beats."""
     arm = panda.arm
     clearance = scene(arm, "box", [0.25, 0.03125, 0.25], [0.0, 0.1875, 0.5], [0.0, 0.0, 0.5, 0.375])
     q = arm.lower + np.array([0.0, 0.625, 0.0, 0.0, 0.0, 0.0, 0.0]) * (arm.upper - arm.lower)
@@ -140,6 +141,38 @@ def test_a_capsule_through_a_thin_box_overlaps(panda):
     assert depth <= overlaps(np.random.default_rng(0).normal(size=(200_000, 3))).min() + 1e-12
 
 
+@pytest.mark.parametrize(
+    ("pos", "half", "distance", "arm_point", "box_point"),
+    [
+        ([0.9, 0.0, 0.0], [0.0, 0.0, 0.0], -0.15, [0.85, 0.0, 0.0], [1.0, 0.0, 0.0]),  # centre inside
+        ([1.02, 0.0, 0.0], [0.0, 0.0, 0.5], -0.03, [0.97, 0.0, -0.5], [1.0, 0.0, -0.5]),  # core outside
+        ([0.0, 0.0, 0.0], [0.0, 0.0, 2.0], -1.05, [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]),  # through the box
+    ],
+)
+def test_box_overlap_is_the_exact_signed_distance(pos, half, distance, arm_point, box_point):
+    """ckernels.box_overlap (the pairs whose overlap MuJoCo contradicts) on shapes whose answer
+    is known, rotated and moved together: a sphere whose centre is 0.1 inside a face (radius
+    0.05), a capsule along a face 0.02 outside it, a capsule through the box (its core leaves
+    by 1 along x or y, its depth 1 + the radius); wrong sizes are named."""
+    turn = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]) @ np.array(
+        [[1.0, 0.0, 0.0], [0.0, 0.6, -0.8], [0.0, 0.8, 0.6]]
+    )
+    shift = np.array([0.3, -0.2, 0.5])
+    fromto = np.empty(6)
+    found = ckernels.box_overlap(
+        turn @ pos + shift, turn.ravel(), np.array(half), 0.05, shift, turn.ravel(), np.ones(3), fromto
+    )
+    assert found == pytest.approx(distance, abs=1e-15)
+    if arm_point != box_point:  # (through the box: either of the faces it ties on)
+        np.testing.assert_allclose(
+            fromto, np.concatenate([turn @ arm_point, turn @ box_point]) + np.tile(shift, 2), atol=1e-15
+        )
+    with pytest.raises(ValueError, match="box_half"):
+        ckernels.box_overlap(
+            shift, turn.ravel(), np.array(half), 0.05, shift, turn.ravel(), np.ones(2), fromto
+        )
+
+
 def test_threads_sharing_a_clearance_get_its_answers():
     """Four threads that share one Clearance (whose MuJoCo pairs are computed in one MjData)
     get, row by row, exactly the distances and gradients it gives one call at a time."""
@@ -154,11 +187,7 @@ def test_threads_sharing_a_clearance_get_its_answers():
             for i in rows:
                 shared[i] = clearance.distances_and_gradients(Q[i])
 
-    threads = [threading.Thread(target=work, args=(range(k, len(Q), 4),)) for k in range(4)]
-    for thread in threads:
-        thread.start()
-    for thread in threads:
-        thread.join()
+    in_threads(work, len(Q))
     for (d, g), (d_shared, g_shared) in zip(alone, shared, strict=True):
         np.testing.assert_array_equal(d, d_shared)
         np.testing.assert_array_equal(g, g_shared)

@@ -13,7 +13,7 @@ from benchmarks.control_rate import MIN_CLEARANCE, obstacles
 from om_redundant.redundancy.intervals import SLACK_TOLERANCE, _refined, _runs, _spans
 from om_redundant.redundancy.paths import lockstep, sweep_circle
 from om_redundant.redundancy.probe import END_TOLERANCE
-from tests.conftest import random_pose, solver_of
+from tests.conftest import random_pose, random_scenes, solver_of
 
 
 def alone(process):
@@ -28,11 +28,7 @@ def alone(process):
 
 
 @settings(max_examples=6, deadline=None)
-@given(
-    seed=st.integers(0, 2**32 - 1),
-    name=st.sampled_from(["panda", "iiwa14", "fr3"]),
-    count=st.sampled_from([1, 3]),
-)
+@random_scenes
 # Runs that are their path's fold end alone (intervals._refined, "Path ends"): the follow
 # from the fold cannot leave it (seeds 9, 385, 104), the cubic models' trial from it lies
 # within END_TOLERANCE of it (seeds 315, 385); each such end stayed at the fold, its slack

@@ -11,15 +11,14 @@ import itertools
 from unittest import mock
 
 import numpy as np
-from hypothesis import example, given, settings
-from hypothesis import strategies as st
+from hypothesis import example, settings
 
 import om_redundant as om
 from benchmarks.control_rate import MIN_CLEARANCE, obstacles
 from om_redundant import ckernels
 from om_redundant.redundancy import paths
 from om_redundant.redundancy.paths import _TURN, FINE_STEP, sweep_circle
-from tests.conftest import random_pose, solver_of
+from tests.conftest import random_pose, random_scenes, solver_of
 
 
 def swept(solver: om.OMSolver, T: np.ndarray, count: int, looked: bool = True):
@@ -49,11 +48,7 @@ def traced(probe, a, b) -> bool:
 
 
 @settings(max_examples=6, deadline=None)
-@given(
-    seed=st.integers(0, 2**32 - 1),
-    name=st.sampled_from(["panda", "iiwa14", "fr3"]),
-    count=st.sampled_from([1, 3]),
-)
+@random_scenes
 # Paths that start at a fold, their first cells 0.25-0.77 rad in the joints (main left them
 # unsampled: no follow leaves the fold).
 @example(seed=9, name="panda", count=1)

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import math
 import sys
-import threading
 
 import numpy as np
 import pytest
@@ -26,7 +25,7 @@ from benchmarks.control_rate import (
     turned,
 )
 from om_redundant.redundancy.tracking import Tracker
-from tests.conftest import random_q
+from tests.conftest import in_threads, random_q
 
 TICKS = 200  # of a figure eight, one lap
 MAX_STEP = 0.005
@@ -172,11 +171,7 @@ def test_threads_sharing_an_optimiser_track_as_one(optimizers):
     interval = sys.getswitchinterval()
     sys.setswitchinterval(1e-6)
     try:
-        threads = [threading.Thread(target=work, args=(range(k, len(cases), 4),)) for k in range(4)]
-        for thread in threads:
-            thread.start()
-        for thread in threads:
-            thread.join()
+        in_threads(work, len(cases))
     finally:
         sys.setswitchinterval(interval)
     assert len(cases) >= 8 and not differ
