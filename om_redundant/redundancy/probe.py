@@ -197,7 +197,9 @@ class Probe:
         arm = solver.arm
         self._cyclic = arm.revolute & wrapped
         self._centred = self._cyclic & np.isfinite(arm.lower) & np.isfinite(arm.upper)
-        self._centre = np.where(self._centred, (arm.lower + arm.upper) / 2.0, 0.0)
+        # (inf + -inf of an unlimited joint would be NaN: only finite limits are added)
+        lower, upper = np.where(self._centred, arm.lower, 0.0), np.where(self._centred, arm.upper, 0.0)
+        self._centre = (lower + upper) / 2.0
         # (where every joint is cyclic, or centred, no np.where picks between the two)
         self._all_cyclic, self._all_centred = all(self._cyclic.tolist()), all(self._centred.tolist())
         self._work = None  # the compiled follow's arrays: a 7-DOF arm's compiled solver only
