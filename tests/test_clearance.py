@@ -289,7 +289,7 @@ def test_gradients_near_are_the_full_ones_where_the_objective_reads_them(name):
     rng = np.random.default_rng(3)
     Q = np.vstack([within_limits(arm, rng, 25), rng.uniform(-0.1, 0.1, (5, arm.dof))])
     every, full = clearance.distances_and_gradients(Q)
-    arm_args, geoms = clearance._arguments
+    arm_args, geoms = clearance._cores.links, clearance._cores.geoms
     left = np.empty(every.shape)  # which pairs the kernel leaves to MuJoCo
     ckernels.arm_clearance(
         *arm_args, Q, *geoms, clearance.distmax, math.inf, left, np.empty((*every.shape, 6)), None, False
@@ -334,7 +334,7 @@ def test_the_kernel_refuses_arrays_of_other_sizes(panda):
     """ckernels.arm_clearance and arm_geom_poses check every array's size against the others: a
     ValueError, never a read past an end."""
     clearance = om.Clearance.for_arm(panda.arm, [om.Sphere([0.4, 0.1, 0.5], 0.05)])
-    arm, geoms = clearance._arguments
+    arm, geoms = clearance._cores.links, clearance._cores.geoms
     q, n_pairs = np.zeros(7), len(clearance.pairs)
     dist, fromto, grad = np.empty(n_pairs), np.empty((n_pairs, 6)), np.empty((n_pairs, 7))
     assert ckernels.arm_clearance(*arm, q, *geoms, 1.0, math.inf, dist, fromto, grad, False) == 0

@@ -272,7 +272,7 @@ def test_the_bindings_refuse_indices_out_of_range(panda):
         ckernels.evaluate(7, q, np.empty((1, 0)), limited, one - 1.0, one, one, joints, one, numbers, out)
 
     clearance = om.Clearance.for_arm(panda.arm, [om.Sphere([0.4, 0.1, 0.5], 0.05)])
-    arm, geoms = clearance._arguments
+    arm, geoms = clearance._cores.links, clearance._cores.geoms
     q, n_arm, n_pairs = np.zeros(7), len(arm[2]), len(clearance.pairs)
     dist, fromto, grad = np.empty(n_pairs), np.empty((n_pairs, 6)), np.empty((n_pairs, 7))
 

@@ -99,7 +99,7 @@ class PickConfigurationOf:
     def __init__(self, solver):
         self.solver, self.q, self.previous = solver, None, []
 
-    def choose(self, T, previous=None):
+    def choose(self, T, previous=None, *, q_current=None):
         self.previous.append(previous)
         c = self.solver.configuration_of(self.q)
         sol = self.solver.solve(T, c, q_hint=self.q)
@@ -285,7 +285,7 @@ class SwingElbow:
     def __init__(self, solver, signs, psi):
         self.solver, self.signs, self.psi = solver, signs, psi
 
-    def choose(self, T, previous=None):
+    def choose(self, T, previous=None, *, q_current=None):
         c = om.Configuration(self.signs if previous is None else previous.configuration.signs, (self.psi,))
         sol = self.solver.solve(T, c, q_hint=None if previous is None else previous.solution.q)
         return SimpleNamespace(ok=sol.ok, solution=sol, configuration=c, reason=sol.status)
@@ -542,23 +542,64 @@ def test_a_frame_that_does_not_exist_is_named(panda, panda_model):
         om.ExactPoseTask(panda, panda_model, arm_configuration=c, frame_type="joint")
 
 
-def test_a_frame_that_is_not_the_arm_end_effector_is_refused(panda, panda_with_hand):
-    """Menagerie's hand body sits at the flange turned -45 deg, not at the arm's frame (+135 deg)."""
+def test_a_frame_fixed_to_the_last_link_takes_the_targets(panda):
+    """Menagerie's panda.xml as it is (no attachment_site): the hand body, and a TCP site on it,
+    sit at the flange turned and moved by constants, which the task measures (ArmRoot.tool);
+    mink ends exactly on targets given for them, in the requested configuration."""
+    load_reference_model("franka_emika_panda/panda.xml")  # skips where missing
+    spec = reference_spec("franka_emika_panda/panda.xml")
+    spec.body("hand").add_site(name="tcp", pos=[0.01, -0.02, 0.1034], quat=[0.9, 0.1, -0.2, 0.3])
+    model = spec.compile()
+    rng = np.random.default_rng(12)
+    limits = [mink.ConfigurationLimit(model)]
+    for name, kind in (("hand", "body"), ("tcp", "site")):
+        exact = om.ExactPoseTask(
+            panda, model, arm_configuration=panda.configuration_of(Q_PANDA), frame_name=name, frame_type=kind
+        )
+        frame = mink.FrameTask(name, kind, position_cost=1.0, orientation_cost=1.0, lm_damping=1.0)
+        configuration = mink.Configuration(model)
+        for q in random_joints(panda.arm, 5, rng):
+            configuration.update(np.concatenate([q, [0.0, 0.0]]))
+            T = configuration.get_transform_frame_to_world(name, kind)  # the frame's pose at q
+            configuration.update(np.concatenate([home_joints(panda.arm), [0.0, 0.0]]))
+            exact.set_target(T, panda.configuration_of(q))
+            frame.set_target(T)
+            np.testing.assert_allclose(exact.joint_target, q, atol=1e-9)
+            for _ in range(10):
+                step(configuration, [frame, exact], limits)
+            hand = configuration.get_transform_frame_to_world(name, kind).as_matrix()
+            assert max(pose_errors(hand, T.as_matrix())) < 1e-9
+            assert panda.configuration_of(configuration.q[:7]).isclose(panda.configuration_of(q), 1e-6)
+
+
+def test_a_frame_that_does_not_move_with_the_last_link_is_refused(panda, panda_with_hand):
     c = panda.configuration_of(Q_PANDA)
-    with pytest.raises(om.ModelMismatch, match="body 'hand' does not move like the end effector"):
-        om.ExactPoseTask(panda, panda_with_hand, arm_configuration=c, frame_name="hand", frame_type="body")
     with pytest.raises(om.ModelMismatch, match="not moved by the joints of arm 'panda'"):
         om.ExactPoseTask(panda, panda_with_hand, arm_configuration=c, frame_name="world", frame_type="body")
+    with pytest.raises(om.ModelMismatch, match=r"joints \['finger_joint1'\] move body 'left_finger'"):
+        om.ExactPoseTask(
+            panda, panda_with_hand, arm_configuration=c, frame_name="left_finger", frame_type="body"
+        )
+    with pytest.raises(om.ModelMismatch, match="does not move rigidly with the end effector of arm 'panda'"):
+        om.ExactPoseTask(panda, panda_with_hand, arm_configuration=c, frame_name="link6", frame_type="body")
 
 
 def test_the_model_of_another_arm_is_refused(panda):
-    """fr3 joint names on a Panda model: mapped by name (prefix fr3_), but not the same arm."""
+    """iiwa14 joint names (joint1..joint7) on a Panda model: mapped by name, but not the same
+    arm: no frame fixed to its last link moves like the iiwa14's flange. (The FR3's chain is
+    the Panda's, its frame turned: a Panda model serves it, through its tool offset.)"""
+    iiwa14 = om.OMSolver("iiwa14")
+    model = om.arm_model(panda.arm)
+    with pytest.raises(om.ModelMismatch, match="does not move rigidly with the end effector of arm 'iiwa14'"):
+        om.ExactPoseTask(iiwa14, model, arm_configuration=iiwa14.configuration_of(np.full(7, 0.3)))
     fr3 = om.OMSolver("fr3")
-    model = om.arm_model(panda.arm, prefix="fr3_")
-    with pytest.raises(om.ModelMismatch, match="does not move like the end effector of arm 'fr3'"):
-        om.ExactPoseTask(
-            fr3, model, arm_configuration=fr3.configuration_of(Q_PANDA), frame_name="fr3_attachment_site"
-        )
+    task = om.ExactPoseTask(
+        fr3,
+        om.arm_model(panda.arm, prefix="fr3_"),
+        arm_configuration=fr3.configuration_of(Q_PANDA),
+        frame_name="fr3_attachment_site",
+    )
+    assert not np.allclose(task.root.tool, np.eye(4))
 
 
 def test_targets_and_configurations_of_another_model(panda, panda_model):

@@ -54,6 +54,7 @@ def table(request: SweepRequest, result: SweepResult) -> str:
             lines.append(
                 f"{i:>5}  {x:7.3f} {y:7.3f} {z:7.3f}  {signs:<9} {psi:7.3f}  "
                 f"{margin_text(c.margin):>7}  {clearance_text(c.clearance)}"
+                + ("  (chosen afresh)" if c.rechosen else "")
                 + ("  (branch flipped)" if c.branch_flipped else "")
             )
             if pose.note:
@@ -159,7 +160,7 @@ def json_data(request: SweepRequest, result: SweepResult) -> dict:
             for b in pose.branches
         ]
         if c is not None:
-            chosen.update(value=c.value, branch_flipped=c.branch_flipped)
+            chosen.update(value=c.value, branch_flipped=c.branch_flipped, rechosen=c.rechosen)
         poses.append({"target": pose.pose, "chosen": chosen, "note": pose.note, "branches": branches})
     return {
         "arm": solver.arm.name,

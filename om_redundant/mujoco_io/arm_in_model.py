@@ -12,6 +12,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 from mink import FRAME_TO_ENUM, FRAME_TO_POS_ATTR, FRAME_TO_XMAT_ATTR, SUPPORTED_FRAMES, UnsupportedFrame
+from scipy.spatial.transform import Rotation
 
 from ..exceptions import FrameNotFound, JointNotFound, ModelMismatch
 from ..kinematics.arm import Arm
@@ -20,8 +21,8 @@ from .mjcf import DEFAULT_SITE
 
 #: Largest disagreement (m, rad) accepted between ``arm.fk`` and the model's end-effector frame.
 MATCH_TOLERANCE = 1e-6
-#: Random joint vectors at which the end-effector frame is checked against ``arm.fk``.
-_CHECKS = 3
+#: Random joint vectors from which the root and tool offsets are measured and checked.
+_CHECKS = 6
 
 
 class ArmJoints:
@@ -116,37 +117,48 @@ class ArmJoints:
 
 
 class ArmRoot:
-    r"""The arm's root frame in a MuJoCo model, located through its end-effector frame.
+    r"""The arm's root frame in a MuJoCo model, located through an end-effector frame.
 
-    ``arm.fk(q)`` is the pose of the end-effector frame E in the root frame. Nothing moves
-    between the root and the body B that carries the arm's first joint's body (its parent),
-    so :math:`T_{world,root} = T_{world,B}\, C` with a constant C. C is measured from the
-    model, :math:`C = T_{world,B}^{-1}\, T_{world,E}(q)\, \mathrm{fk}(q)^{-1}`, and checked at
-    random joint vectors: a frame that does not move
-    like the arm's end effector (a tool frame with an offset, another arm) is refused. This
-    holds wherever the arm is mounted: on the world (any pose), on a mobile base, on a
-    mocap body.
+    ``arm.fk(q)`` is the pose of the arm's end-effector frame F in the root frame. Nothing
+    moves between the root and the body B that carries the arm's first joint's body (its
+    parent), nor between F and the frame E named here (the arm's own frame, or any frame
+    fixed to its last link: a hand, a TCP site), so
+
+    .. math::  T_{world,E}(q) = T_{world,B}\, C\, \mathrm{fk}(q)\, X
+
+    with constants C (the root in B) and X (E in F). Both are measured from the model at
+    random joint vectors :math:`q_i`: with :math:`M_i = T_{world,B}^{-1} T_{world,E}(q_i)` and
+    :math:`F_i = \mathrm{fk}(q_i)`, the relative motions :math:`A_i = F_0^{-1} F_i` and
+    :math:`B_i = M_0^{-1} M_i` satisfy :math:`A_i X = X B_i` (the hand-eye equation): X's
+    rotation carries each :math:`B_i`'s rotation axis onto :math:`A_i`'s (Kabsch, weighted by
+    the angle), its translation solves :math:`(R_{A_i} - I)\, t = R_X t_{B_i} - t_{A_i}` by least
+    squares, and :math:`C = M_0 X^{-1} F_0^{-1}`. The fit is then checked at every sample: a
+    frame that does not move rigidly with the arm's last link (another arm's, a finger's) is
+    refused. This holds wherever the arm is mounted: on the world (any pose), on a mobile
+    base, on a mocap body.
 
     Args:
         joints: The arm's joints in the model.
-        frame_name: The end-effector frame in the model, the frame ``arm.fk`` gives. Default:
-            the prefix plus the arm's frame name (``arm.frame_name``, Menagerie's), else
+        frame_name: The end-effector frame E in the model: the arm's own (the frame
+            ``arm.fk`` gives) or any frame fixed to its last link. Default: the prefix plus
+            the arm's frame name (``arm.frame_name``, Menagerie's), else
             ``prefix + "end_effector"``.
         frame_type: ``"site"``, ``"body"`` or ``"geom"``; default the arm's (``"site"`` if it
             names none).
 
     Attributes:
-        frame_name, frame_type: The end-effector frame.
+        frame_name, frame_type: The end-effector frame E.
         body: Id of B.
         offset: (4, 4) C, the root frame in B.
+        tool: (4, 4) X, E in the arm's end-effector frame (the identity for the arm's own).
         fixed_pose: (4, 4) world pose of the root when B is welded to the world, else None
             (the root moves with other joints or a mocap body; see :meth:`pose`).
 
     Raises:
         FrameNotFound: No frame of that name and type.
         mink.UnsupportedFrame: frame_type is none of the above.
-        ModelMismatch: The frame is not below the arm's joints, or does not move like
-            ``arm.fk``.
+        ModelMismatch: The frame is not below the arm's joints, or does not move rigidly with
+            the arm's end effector.
     """
 
     def __init__(self, joints: ArmJoints, frame_name: str | None = None, frame_type: str | None = None):
@@ -166,20 +178,21 @@ class ArmRoot:
         self.body = int(model.body_parentid[model.jnt_bodyid[joints.joint_ids[0]]])
         self._check_path()
         data = mujoco.MjData(model)
-        rng = np.random.default_rng(0)
         low = np.where(np.isfinite(joints.lower), joints.lower, -np.pi)
         high = np.where(np.isfinite(joints.upper), joints.upper, np.pi)
-        checks = rng.uniform(low, high, (_CHECKS, arm.dof))
-        offsets = [self._offset(data, q) for q in checks]
-        self.offset = offsets[0]
-        for q, offset in zip(checks[1:], offsets[1:], strict=True):
-            position, angle = _distance(offset, self.offset)
+        samples = np.random.default_rng(0).uniform(low, high, (_CHECKS, arm.dof))
+        seen = np.array([self._in_body(data, q) for q in samples])  # M_i
+        flange = arm.fk(samples)  # F_i
+        self.tool = _tool_offset(flange, seen)
+        self.offset = seen[0] @ np.linalg.inv(self.tool) @ np.linalg.inv(flange[0])
+        for q, F, M in zip(samples, flange, seen, strict=True):
+            position, angle = _distance(self.offset @ F @ self.tool, M)
             if max(position, angle) > MATCH_TOLERANCE:
                 raise ModelMismatch(
-                    f"{self.frame_type} '{self.frame_name}' does not move like the end effector of arm "
-                    f"'{arm.name}' ({position:.2g} m, {angle:.2g} rad off at q = {np.round(q, 3).tolist()}): "
-                    "the model holds another arm, or this frame is not the one arm.fk gives "
-                    f"(Menagerie's is {arm.frame_type} '{arm.frame_name}')"
+                    f"{self.frame_type} '{self.frame_name}' does not move rigidly with the end effector of "
+                    f"arm '{arm.name}' ({position:.2g} m, {angle:.2g} rad off at q = "
+                    f"{np.round(q, 3).tolist()}): the model holds another arm, or this frame is moved by "
+                    f"more than the arm's joints (Menagerie's frame is {arm.frame_type} '{arm.frame_name}')"
                 )
         self.fixed_pose: np.ndarray | None = None
         if model.body_weldid[self.body] == 0:
@@ -192,13 +205,14 @@ class ArmRoot:
             return self.fixed_pose
         return _body_pose(data, self.body) @ self.offset
 
-    def _offset(self, data: mujoco.MjData, q: np.ndarray) -> np.ndarray:
+    def _in_body(self, data: mujoco.MjData, q: np.ndarray) -> np.ndarray:
+        """The frame's pose in body B at the arm's joints q (the model's other joints at qpos0)."""
         data.qpos[:] = self.joints.qpos_with(self.joints.model.qpos0, q)
         mujoco.mj_kinematics(self.joints.model, data)
         frame = np.eye(4)
         frame[:3, :3] = getattr(data, self._xmat)[self._frame].reshape(3, 3)
         frame[:3, 3] = getattr(data, self._pos)[self._frame]
-        return np.linalg.solve(_body_pose(data, self.body), frame) @ np.linalg.inv(self.joints.arm.fk(q))
+        return np.linalg.solve(_body_pose(data, self.body), frame)
 
     def _check_path(self) -> None:
         """The frame must hang below body B through the arm's joints only."""
@@ -227,6 +241,22 @@ def _body_pose(data: mujoco.MjData, body: int) -> np.ndarray:
     T[:3, :3] = data.xmat[body].reshape(3, 3)
     T[:3, 3] = data.xpos[body]
     return T
+
+
+def _tool_offset(flange: np.ndarray, seen: np.ndarray) -> np.ndarray:
+    """X of :class:`ArmRoot`'s hand-eye equation :math:`A_i X = X B_i` from the poses
+    F_i (flange) and M_i (seen), (n, 4, 4) each (:class:`ArmRoot`'s docstring)."""
+    A = np.linalg.solve(flange[0], flange[1:])  # F_0^-1 F_i
+    B = np.linalg.solve(seen[0], seen[1:])
+    axes_a = Rotation.from_matrix(A[:, :3, :3]).as_rotvec()
+    axes_b = Rotation.from_matrix(B[:, :3, :3]).as_rotvec()
+    U, _, Vt = np.linalg.svd(axes_b.T @ axes_a)  # R_X axis(B_i) = axis(A_i): Kabsch
+    R = Vt.T @ np.diag([1.0, 1.0, np.sign(np.linalg.det(Vt.T @ U.T))]) @ U.T
+    lhs = (A[:, :3, :3] - np.eye(3)).reshape(-1, 3)
+    rhs = (B[:, :3, 3] @ R.T - A[:, :3, 3]).reshape(-1)
+    X = np.eye(4)
+    X[:3, :3], X[:3, 3] = R, np.linalg.lstsq(lhs, rhs, rcond=None)[0]
+    return X
 
 
 def _distance(A: np.ndarray, B: np.ndarray) -> tuple[float, float]:

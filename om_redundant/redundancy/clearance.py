@@ -6,26 +6,21 @@ geoms and the obstacle geoms,
 .. math::  D(q) = \min_k d_k(q), \qquad d_k(q) = \mathrm{dist}\big(A_k(q), O_k\big),
 
 over the pairs k of (arm geom :math:`A_k`, obstacle geom :math:`O_k`), negative when the
-geoms overlap, capped at ``distmax``. The arm geoms are placed by the arm's DH chain: a geom
-moved by joints 1..l sits at a fixed offset :math:`G` in link l's frame :math:`F_l(q)` (the
-chain's frame before joint l+1's row), :math:`X(q) = K F_l(q) G`, with :math:`K` the world
-pose of DH frame 0. Both are taken once from the model at its ``qpos0``: :math:`K` carries
-the joints' axis lines of the chain onto MuJoCo's (``xaxis``, ``xanchor``), and
-:math:`G = (K F_l(q_0))^{-1} X(q_0)`; the set-up checks the placement against MuJoCo's
-``mj_kinematics`` at random joint vectors (:class:`~om_redundant.ModelMismatch` otherwise).
-One compiled call (``ckernels.arm_clearance``, ``csrc/clearance.c``) places the geoms for
-every row of a batch of joint vectors and computes the pairs of a sphere or capsule arm
-geom and a sphere, capsule or box obstacle exactly (closest points of segments, and of a
-segment and a box, in closed form; overlapping where the cores do not touch), and
-``mujoco.mj_geomDistance`` the rest (other kinds, cores touching, boxes touched), the arm
-geoms placed as the kernel places them; ``tests/test_clearance.py`` checks both against
-MuJoCo. Where MuJoCo says a sphere or capsule is apart from a box that its core overlaps (its
-box-capsule distance is positive for about 0.3 % of such pairs, up to 0.09 m, a capsule
-through a thin box), the exact signed distance is taken instead (``ckernels.box_overlap``).
-With :math:`p_A, p_O` the nearest points and :math:`n_k = (p_O - p_A)/d_k` the unit direction
-from the arm geom to the obstacle (the division by the signed distance keeps it pointing that
-way when the geoms overlap), moving the arm point by :math:`dp` changes the distance by
-:math:`-n_k \cdot dp`, so
+geoms overlap, capped at ``distmax``. The arm geoms are placed by the arm's DH chain
+(:mod:`~om_redundant.redundancy.arm_geoms`: each at its offset in its link, checked against
+MuJoCo's ``mj_kinematics`` at set-up). One compiled call (``ckernels.arm_clearance``,
+``csrc/clearance.c``) places the geoms for every row of a batch of joint vectors and computes
+the pairs of a sphere or capsule arm geom and a sphere, capsule or box obstacle exactly
+(closest points of segments, and of a segment and a box, in closed form; overlapping where
+the cores do not touch), and ``mujoco.mj_geomDistance`` the rest (other kinds, cores
+touching, boxes touched), the arm geoms placed as the kernel places them;
+``tests/test_clearance.py`` checks both against MuJoCo. Where MuJoCo says a sphere or capsule
+is apart from a box that its core overlaps (its box-capsule distance is positive for about
+0.3 % of such pairs, up to 0.09 m, a capsule through a thin box), the exact signed distance is
+taken instead (``ckernels.box_overlap``). With :math:`p_A, p_O` the nearest points and
+:math:`n_k = (p_O - p_A)/d_k` the unit direction from the arm geom to the obstacle (the
+division by the signed distance keeps it pointing that way when the geoms overlap), moving
+the arm point by :math:`dp` changes the distance by :math:`-n_k \cdot dp`, so
 
 .. math::  \frac{\partial d_k}{\partial q_j} = -n_k \cdot \big(a_j \times (p_A - o_j)\big)
 
@@ -33,6 +28,17 @@ for each revolute joint j <= l (axis :math:`a_j` through :math:`o_j`, the z axis
 of the chain's frame before joint j's row; :math:`-n_k \cdot a_j` for a prismatic joint),
 computed in the same call. A pair farther apart than ``distmax`` reports ``distmax`` with a
 zero gradient.
+
+**The world moves.** The obstacles and the arm's root are where the model puts them at its
+``qpos0`` until :meth:`Clearance.update` reads them from a ``mujoco.MjData`` of the model:
+mocap bodies, bodies moved by other joints (a second arm, a conveyor), the arm's own mobile
+base. :class:`~om_redundant.ExactPoseTask` does this every tick from its
+``mink.Configuration`` when the optimiser's clearance is of the task's model.
+
+**Along a motion.** :meth:`Clearance.minimum_along` bounds the clearance along a straight
+joint-space segment from below: every pair's distance changes by at most
+:math:`\sum_j r_j |\Delta q_j|` (:func:`~om_redundant.redundancy.arm_geoms.lever_arms`), so
+two ends' distances certify the segment between them, split where they do not.
 
 Obstacles come three ways: simple shapes (:class:`Sphere`, :class:`Capsule`, :class:`Box`)
 or the primitive geoms of a MuJoCo model, placed in the arm's root frame and combined with
@@ -48,36 +54,46 @@ from __future__ import annotations
 import math
 import threading
 from collections.abc import Sequence
-from typing import NamedTuple
 
 import mujoco
 import numpy as np
 
 from .. import ckernels
-from ..exceptions import InvalidInput, ModelMismatch
+from ..exceptions import InvalidInput
 from ..kinematics.arm import Arm
-from ..mujoco_io.arm_in_model import MATCH_TOLERANCE, ArmJoints
+from ..mujoco_io.arm_in_model import ArmJoints
 from ..mujoco_io.mjcf import arm_mjcf
-from ..validation import as_instance, as_joint_vector, as_positive
+from ..validation import as_instance, as_joint_vector, as_number, as_positive
+from .arm_geoms import (
+    BOX,
+    POINT,
+    SEGMENT,
+    ArmCores,
+    arm_cores,
+    as_row,
+    body_pose,
+    check_placement,
+    geom_label,
+    lever_arms,
+    subtree,
+)
 from .shapes import Shape, model_geoms, shape_geoms
 
 DEFAULT_DISTMAX = 1.0  # m: pairs farther apart report this distance
-_CHECKS = 3  # random joint vectors at which the geoms' placement is checked against MuJoCo's
-
+#: m: :meth:`Clearance.minimum_along` stops splitting a segment whose bound is this close to its ends'.
+ALONG_TOLERANCE = 1e-3
 
 #: The largest coordinate or size (m) of an obstacle geom: distances are computed in doubles to
 #: about 1e-16 of the largest coordinates, 1e-10 m at this extent; beyond about 1e154 their
 #: squares overflow (a sphere of radius 1e155 about the arm was reported clear).
 MAX_EXTENT = 1e6
 
-_POINT, _SEGMENT, _BOX = 1, 2, 3  # ArmCores.kind: the cores that ckernels.arm_clearance computes
-
 
 class Clearance:
     """Signed distances between an arm's collision geoms and obstacle geoms (module docstring).
 
     Threads may share one: its MuJoCo data, where the pairs left to MuJoCo are computed, is
-    taken by one call at a time.
+    taken by one call at a time, and :meth:`update` swaps in the new poses at once.
 
     Args:
         model: A MuJoCo model holding the arm and the obstacles, e.g. the user's scene.
@@ -86,12 +102,21 @@ class Clearance:
         prefix: Prepended to the arm's joint names.
         distmax: Pairs farther apart than this (m) report ``distmax``.
 
+    Attributes:
+        model, arm: As given.
+        arm_geoms: The arm's collision geoms' names (unnamed ones as ``"<body>/geom<k>"``).
+        pairs: (arm geom, obstacle) names of every pair, in the order of :meth:`distances`.
+        geom_pairs: The same pairs as mink's ``CollisionAvoidanceLimit`` takes them (geom ids):
+            ``mink.CollisionAvoidanceLimit(model, clearance.geom_pairs, ...)`` keeps mink's
+            steps clear of what the optimiser keeps its choices clear of.
+        version: Counts the moves :meth:`update` has read.
+
     Raises:
         JointNotFound: A joint is not in the model (as in :class:`~om_redundant.ArmJoints`).
         ModelMismatch: A joint's type differs from the arm's, or the arm's collision geoms do
             not move like its kinematic chain (another arm).
         InvalidInput: A geom is missing, an obstacle geom moves with the arm, no obstacle is
-            given, or distmax is not positive.
+            given, the arm has no collision geoms, or distmax is not positive.
 
     Example::
 
@@ -116,41 +141,50 @@ class Clearance:
         self.model, self.arm, self._dof = model, arm, arm.dof
         self.distmax = as_positive(distmax, "distmax")
         joints = ArmJoints(arm, model, prefix)
-        moving = _subtree(model, model.jnt_bodyid[joints.joint_ids[0]])
+        first_body = model.jnt_bodyid[joints.joint_ids[0]]
+        moving = subtree(model, first_body)
         arm_geoms = [
             g
             for g in range(model.ngeom)
             if moving[model.geom_bodyid[g]] and (model.geom_contype[g] or model.geom_conaffinity[g])
         ]
+        if not arm_geoms:
+            raise InvalidInput(
+                f"the bodies that the joints of arm '{arm.name}' move carry no collision geoms (geoms with "
+                "a non-zero contype or conaffinity); a Menagerie model loaded without its meshes has "
+                "none: add primitive geoms (capsules) to its links, or use om.arm_model(arm)"
+            )
         if not obstacle_geoms:
             raise InvalidInput("no obstacle geoms given")
-        obstacles = [_find(model, mujoco.mjtObj.mjOBJ_GEOM, name, "geom") for name in obstacle_geoms]
+        obstacles = [_find(model, name) for name in obstacle_geoms]
         for o in obstacles:
             if moving[model.geom_bodyid[o]]:
-                raise InvalidInput(f"obstacle geom '{model.geom(o).name}' moves with the arm")
+                raise InvalidInput(f"obstacle geom '{geom_label(model, o)}' moves with the arm")
         # the model's geom ids of each pair (arm geom, obstacle) and the arm geom's index, for
         # mj_geomDistance
         self._pair_geoms = [(a, o, i) for i, a in enumerate(arm_geoms) for o in obstacles]
-        self._arm_ids = np.array(arm_geoms, dtype=np.int64)
+        self._arm_ids, self._obstacle_ids = np.array(arm_geoms, dtype=np.int64), np.array(obstacles)
         self._data = mujoco.MjData(model)  # at qpos0, placed: the obstacles and mj_geomDistance's scratch
         mujoco.mj_kinematics(model, self._data)
-        for o in obstacles:
-            extent = max(np.abs(self._data.geom_xpos[o]).max(), model.geom_size[o].max())
-            if not extent <= MAX_EXTENT:
-                raise InvalidInput(
-                    f"obstacle geom '{model.geom(o).name}': its position and sizes must be within "
-                    f"{MAX_EXTENT:g} m, got {extent:.3g} m"
-                )
+        _check_extent(model, obstacles, self._data.geom_xpos[obstacles])
         self._placed = (self._data.geom_xpos, self._data.geom_xmat)  # (views of the data's arrays)
         self._data_lock = threading.Lock()  # the data is every call's scratch: one call at a time
-        self._cores = _arm_cores(model, self._data, joints, arm_geoms, obstacles)
-        # arm_clearance's arguments before and after q
-        self._arguments, self._n_pairs = (self._cores[:5], self._cores[5:]), len(self._pair_geoms)
-        self.arm_geoms: tuple[str, ...] = tuple(model.geom(g).name for g in arm_geoms)
-        _check_placement(self, joints)
+        self._cores = arm_cores(model, self._data, joints, arm_geoms, obstacles)
+        self._n_pairs = len(self._pair_geoms)
+        # The arm's root body (its first joint's body's parent) carries DH frame 0: K_root, K in it.
+        self._root = int(model.body_parentid[first_body])
+        self._root_moves = bool(model.body_weldid[self._root] != 0)
+        K = np.eye(4)
+        K[:3, :3], K[:3, 3] = self._cores.start[:9].reshape(3, 3), self._cores.start[9:]
+        self._start_in_root = np.linalg.solve(body_pose(self._data, self._root), K)
+        self._lever = lever_arms(model, self._cores, arm_geoms, joints)
+        self.version = 0
+        self.arm_geoms: tuple[str, ...] = tuple(geom_label(model, g) for g in arm_geoms)
+        check_placement(model, joints, self._arm_ids, self.geom_poses)
         self.pairs: tuple[tuple[str, str], ...] = tuple(
-            (model.geom(a).name, model.geom(o).name) for a, o, _ in self._pair_geoms
+            (geom_label(model, a), geom_label(model, o)) for a, o, _ in self._pair_geoms
         )
+        self.geom_pairs: list[tuple[list[int], list[int]]] = [(list(arm_geoms), list(obstacles))]
 
     @classmethod
     def for_arm(
@@ -248,8 +282,99 @@ class Clearance:
         """
         q = as_joint_vector(q, self._dof, stack=False)
         xpos, xmat = np.empty((len(self.arm_geoms), 3)), np.empty((len(self.arm_geoms), 9))
-        ckernels.arm_geom_poses(*self._arguments[0], q, xpos, xmat)
+        ckernels.arm_geom_poses(*self._cores.links, q, xpos, xmat)
         return xpos, xmat.reshape(-1, 3, 3)
+
+    def update(self, data: mujoco.MjData) -> bool:
+        """Read where the obstacles and the arm's root are now.
+
+        Takes the obstacle geoms' poses and the arm's root body's pose from ``data``'s
+        kinematics as last computed (``mj_kinematics``, ``mj_forward``, or
+        ``mink.Configuration.update``, which run it): mocap bodies, bodies moved by other
+        joints (another arm), the arm's own mobile base. The arm's joints are not read: the
+        distances are of the joints asked for.
+
+        Args:
+            data: A ``mujoco.MjData`` of this clearance's model.
+
+        Returns:
+            Whether anything moved since the last read (then :attr:`version` counts it).
+
+        Raises:
+            InvalidInput: data is of another model, or an obstacle beyond :data:`MAX_EXTENT`.
+        """
+        if not (isinstance(data, mujoco.MjData) and data.model is self.model):
+            what = "the data of another model" if isinstance(data, mujoco.MjData) else type(data).__name__
+            raise InvalidInput(
+                f"Clearance.update takes a mujoco.MjData of the clearance's own model, got {what}"
+            )
+        cores = self._cores
+        ids = self._obstacle_ids
+        position, rotation = data.geom_xpos[ids], data.geom_xmat[ids]
+        start = cores.start
+        if self._root_moves:
+            start = as_row(body_pose(data, self._root) @ self._start_in_root)
+        if (
+            np.array_equal(position, cores.obstacle_pos)
+            and np.array_equal(rotation, cores.obstacle_mat)
+            and np.array_equal(start, cores.start)
+        ):
+            return False
+        _check_extent(self.model, ids.tolist(), position)
+        # (one assignment: a call in another thread reads the old poses or the new, whole)
+        self._cores = cores._replace(
+            start=np.ascontiguousarray(start),
+            obstacle_pos=np.ascontiguousarray(position),
+            obstacle_mat=np.ascontiguousarray(rotation),
+        )
+        self.version += 1
+        return True
+
+    def minimum_along(self, q_from: np.ndarray, q_to: np.ndarray, floor: float) -> float:
+        r"""The clearance along the straight joint-space segment from q_from to q_to, as far
+        as it matters against ``floor``.
+
+        Every distance changes by at most :math:`L h` over a piece of the segment h long (in
+        its parameter), :math:`L = \sum_j r_j |q_{to,j} - q_{from,j}|` (module docstring), so
+        a piece whose ends' clearances are :math:`D_0, D_1` stays above
+        :math:`(D_0 + D_1 - L h) / 2`. Pieces whose bound is below ``floor`` are halved (all
+        the midpoints of a round in one call) until one's end falls below ``floor`` or the
+        piece is within :data:`ALONG_TOLERANCE` of its ends.
+
+        Returns:
+            At least ``floor`` only if the whole segment is clear of ``floor`` (a certified
+            lower bound); else a sampled clearance below ``floor``, or a bound within
+            :data:`ALONG_TOLERANCE` of the segment's true clearance.
+        """
+        q_from = as_joint_vector(q_from, self._dof, stack=False)
+        q_to = as_joint_vector(q_to, self._dof, stack=False)
+        floor = as_number(floor, "floor")
+        lipschitz = float(self._lever @ np.abs(q_to - q_from))
+        t = np.array([0.0, 1.0])
+        ends = self.distances(np.array([q_from, q_to])).min(axis=1)
+        pieces = [(0.0, 1.0, ends[0], ends[1])]
+        least = math.inf
+        while pieces:
+            lowest = min(min(d0, d1) for _, _, d0, d1 in pieces)
+            if lowest < floor:
+                return lowest
+            split = []
+            for t0, t1, d0, d1 in pieces:
+                bound = 0.5 * (d0 + d1 - lipschitz * (t1 - t0))
+                if bound >= floor or lipschitz * (t1 - t0) <= ALONG_TOLERANCE:
+                    least = min(least, bound)
+                else:
+                    split.append((t0, t1, d0, d1))
+            if not split:
+                break
+            t = np.array([0.5 * (t0 + t1) for t0, t1, _, _ in split])
+            middle = self.distances(q_from + t[:, None] * (q_to - q_from)).min(axis=1).tolist()
+            pieces = [
+                piece
+                for (t0, t1, d0, d1), tm, dm in zip(split, t.tolist(), middle, strict=True)
+                for piece in ((t0, tm, d0, dm), (tm, t1, dm, d1))
+            ]
+        return least
 
     def _evaluate(
         self, q: np.ndarray, reach: float, gradient: bool, near: float = math.inf
@@ -262,15 +387,16 @@ class Clearance:
         shape = (*q.shape[:-1], self._n_pairs)
         dist, fromto = np.empty(shape), np.empty((*shape, 6))
         grad = np.empty((*shape, self._dof)) if gradient else None
-        arm, geoms = self._arguments
-        if ckernels.arm_clearance(*arm, q, *geoms, reach, near, dist, fromto, grad, False):
+        cores = self._cores
+        if ckernels.arm_clearance(*cores.links, q, *cores.geoms, reach, near, dist, fromto, grad, False):
             self._by_mujoco(
-                q.reshape(-1, self._dof), reach, near, dist.reshape(-1, self._n_pairs), fromto, grad
+                cores, q.reshape(-1, self._dof), reach, near, dist.reshape(-1, self._n_pairs), fromto, grad
             )
         return dist, grad
 
     def _by_mujoco(
         self,
+        cores: ArmCores,
         q: np.ndarray,
         reach: float,
         near: float,
@@ -285,19 +411,20 @@ class Clearance:
         fromto = fromto.reshape(-1, n_pairs, 6)
         left = np.isnan(dist)
         rows = np.flatnonzero(left.any(axis=1))
-        arm, geoms = self._arguments
         n_arm = len(self._arm_ids)
         xpos, xmat = np.empty((len(rows), n_arm, 3)), np.empty((len(rows), n_arm, 9))
-        ckernels.arm_geom_poses(*arm, q[rows], xpos, xmat)
+        ckernels.arm_geom_poses(*cores.links, q[rows], xpos, xmat)
         at, placed = rows.tolist(), self._placed
-        kind, radius, half = self._cores.kind, self._cores.radius, self._cores.half
-        for r, k in np.argwhere(left[rows]).tolist():  # (only the pair's arm geom placed: the one read)
+        kind, radius, half = cores.kind, cores.radius, cores.half
+        for r, k in np.argwhere(left[rows]).tolist():  # (only the pair's geoms placed: the ones read)
             a, o, i = self._pair_geoms[k]
+            b = cores.pairs[k, 1]
+            at_pos, at_mat = cores.obstacle_pos[b - n_arm], cores.obstacle_mat[b - n_arm]
             with self._data_lock:
                 placed[0][a], placed[1][a] = xpos[r, i], xmat[r, i]
+                placed[0][o], placed[1][o] = at_pos, at_mat
                 found = mujoco.mj_geomDistance(m, d, a, o, reach, fromto[at[r], k])
-            b = self._cores.pairs[k, 1]
-            if found > 0.0 and kind[b] == _BOX and kind[i] in (_POINT, _SEGMENT):
+            if found > 0.0 and kind[b] == BOX and kind[i] in (POINT, SEGMENT):
                 # The kernel leaves such a pair where the cores say it overlaps; MuJoCo's
                 # box-capsule distance can be positive for a capsule whose core pierces a
                 # thin box (0.3 % of such pairs, up to 0.09 m): the exact depth instead.
@@ -306,176 +433,33 @@ class Clearance:
                     xmat[r, i],
                     half[i],
                     radius[i],
-                    d.geom_xpos[o],
-                    d.geom_xmat[o],
+                    at_pos,
+                    at_mat,
                     half[b],
                     fromto[at[r], k],
                 )
             dist[at[r], k] = found
         if grad is not None:
             given = np.empty((len(rows), n_pairs, self._dof))
-            ckernels.arm_clearance(*arm, q[rows], *geoms, reach, near, dist[rows], fromto[rows], given, True)
+            ckernels.arm_clearance(
+                *cores.links, q[rows], *cores.geoms, reach, near, dist[rows], fromto[rows], given, True
+            )
             grad.reshape(-1, n_pairs, self._dof)[rows] = given
 
 
-class ArmCores(NamedTuple):
-    """What ``ckernels.arm_clearance`` reads, in its order, set up once per :class:`Clearance`:
-    the arm's links (its DH chain placed in the world) with the arm geoms' offsets in them,
-    and the geoms as cores, the arm's A geoms first, then the O obstacles (G = A + O).
-
-    Attributes:
-        table: The arm's DH table (``KinematicChain.table``).
-        start: (12,) world pose of DH frame 0: rotation (row-major) and position.
-        link: (A,) each arm geom's link: the number of the arm's joints that move it.
-        offset: (A, 12) each arm geom's pose in its link's frame, as ``start``.
-        slide: (dof,) which joints slide (else turn).
-        obstacle_pos, obstacle_mat: (O, 3), (O, 9) the obstacles' world poses.
-        kind: (G,) each geom's core: 1 a point (sphere), 2 a segment (capsule), 3 a box;
-            0 where MuJoCo computes its distances (other kinds, arm geoms other than
-            spheres and capsules).
-        radius: (G,) radius about the core (0 for a box).
-        half: (G, 3) half length of a segment along its z axis (0, 0, l); a box's half sizes.
-        pairs: (P, 2) each pair's geoms: (arm geom, obstacle) in this numbering.
-        bounds: (P,) sum of each pair's bounding-sphere radii (inf: a plane).
-    """
-
-    table: np.ndarray
-    start: np.ndarray
-    link: np.ndarray
-    offset: np.ndarray
-    slide: np.ndarray
-    obstacle_pos: np.ndarray
-    obstacle_mat: np.ndarray
-    kind: np.ndarray
-    radius: np.ndarray
-    half: np.ndarray
-    pairs: np.ndarray
-    bounds: np.ndarray
-
-
-def _arm_cores(
-    model: mujoco.MjModel, data: mujoco.MjData, joints: ArmJoints, arm_geoms: list[int], obstacles: list[int]
-) -> ArmCores:
-    """The :class:`ArmCores` of a model placed at its ``qpos0`` in data: DH frame 0's world
-    pose fitted to the joints' axis lines (:func:`_dh_frame_zero`), and each arm geom's
-    offset in its link, :math:`G = F_l(q_0)^{-1} X(q_0)` at the arm's joints in ``qpos0``."""
-    arm, geoms = joints.arm, arm_geoms + obstacles
-    table = np.ascontiguousarray(arm.chain.table)
-    slide = np.ascontiguousarray(~arm.revolute, dtype=np.uint8)
-    q0 = np.ascontiguousarray(data.qpos[joints.qpos_ids])
-    frames = _link_frames(table, np.concatenate([np.eye(3).ravel(), np.zeros(3)]), slide, q0)
-    start = _dh_frame_zero(frames, data.xaxis[joints.joint_ids], data.xanchor[joints.joint_ids], arm.revolute)
-    frames = _link_frames(table, _as_row(start), slide, q0)
-    inside = np.array([_subtree(model, model.jnt_bodyid[j]) for j in joints.joint_ids])  # (dof, nbody)
-    link = inside[:, model.geom_bodyid[arm_geoms]].sum(axis=0)
-    for g, n in zip(arm_geoms, link.tolist(), strict=True):
-        if not inside[:n, model.geom_bodyid[g]].all():
-            raise ModelMismatch(
-                f"geom '{model.geom(g).name}' is moved by joints of arm '{arm.name}' out of the chain's order"
-            )
-    offset = np.empty((len(arm_geoms), 12))
-    for a, (g, n) in enumerate(zip(arm_geoms, link.tolist(), strict=True)):
-        X = np.eye(4)
-        X[:3, :3], X[:3, 3] = data.geom_xmat[g].reshape(3, 3), data.geom_xpos[g]
-        offset[a] = _as_row(np.linalg.solve(frames[n], X))
-    kind = np.zeros(len(geoms), dtype=np.int64)
-    radius, half = np.zeros(len(geoms)), np.zeros((len(geoms), 3))
-    for i, g in enumerate(geoms):
-        size = model.geom_size[g]
-        if model.geom_type[g] == mujoco.mjtGeom.mjGEOM_SPHERE:
-            kind[i], radius[i] = _POINT, size[0]
-        elif model.geom_type[g] == mujoco.mjtGeom.mjGEOM_CAPSULE:
-            kind[i], radius[i], half[i, 2] = _SEGMENT, size[0], size[1]
-        elif model.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX:
-            kind[i], half[i] = _BOX, size
-    n_arm = len(arm_geoms)
-    pairs = np.array([(a, n_arm + o) for a in range(n_arm) for o in range(len(obstacles))], dtype=np.int64)
-    pairs = pairs.reshape(-1, 2)
-    # bounding-sphere radii (MuJoCo's rbound; 0 means unbounded, a plane)
-    rbound = np.where(model.geom_rbound[geoms] > 0.0, model.geom_rbound[geoms], np.inf)
-    return ArmCores(
-        table,
-        np.ascontiguousarray(_as_row(start)),
-        np.ascontiguousarray(link, dtype=np.int64),
-        offset,
-        slide,
-        np.ascontiguousarray(data.geom_xpos[obstacles]),
-        np.ascontiguousarray(data.geom_xmat[obstacles]),
-        kind,
-        radius,
-        half,
-        pairs,
-        np.ascontiguousarray(rbound[pairs[:, 0]] + rbound[pairs[:, 1]]),
-    )
-
-
-def _link_frames(table: np.ndarray, start: np.ndarray, slide: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """The (dof + 1, 4, 4) poses of links 0..dof at q, DH frame 0 at ``start`` (csrc/clearance.c):
-    ``ckernels.arm_geom_poses`` of a geom at the origin of every link."""
-    links = np.arange(len(q) + 1, dtype=np.int64)
-    identity = np.tile(np.concatenate([np.eye(3).ravel(), np.zeros(3)]), (len(links), 1))
-    xpos, xmat = np.empty((len(links), 3)), np.empty((len(links), 9))
-    ckernels.arm_geom_poses(table, start, links, identity, slide, q, xpos, xmat)
-    frames = np.tile(np.eye(4), (len(links), 1, 1))
-    frames[:, :3, :3], frames[:, :3, 3] = xmat.reshape(-1, 3, 3), xpos
-    return frames
-
-
-def _dh_frame_zero(
-    frames: np.ndarray, axes: np.ndarray, anchors: np.ndarray, revolute: np.ndarray
-) -> np.ndarray:
-    r"""The world pose (4, 4) of the arm's DH frame 0 that carries the joints' axis lines in
-    DH frame 0 (z axes and origins of ``frames``, links 0..dof-1 at the same q) onto the
-    model's (MuJoCo's ``xaxis`` and ``xanchor``): the rotation by the SVD of
-    :math:`\sum_j a_j w_j^T` (Kabsch), the translation by least squares of
-    :math:`(I - w_j w_j^T)(R o_j + t - x_j) = 0` over the revolute joints (a slide's line may
-    lie anywhere along its axis)."""
-    a, o = frames[:-1, :3, 2], frames[:-1, :3, 3]
-    U, _, Vt = np.linalg.svd(a.T @ axes)
-    R = Vt.T @ np.diag([1.0, 1.0, np.sign(np.linalg.det(Vt.T @ U.T))]) @ U.T
-    across = np.eye(3) - axes[revolute, :, None] * axes[revolute, None, :]  # (n, 3, 3)
-    rhs = np.einsum("nij,nj->ni", across, anchors[revolute] - o[revolute] @ R.T)
-    t = np.linalg.lstsq(across.reshape(-1, 3), rhs.reshape(-1), rcond=None)[0]
-    T = np.eye(4)
-    T[:3, :3], T[:3, 3] = R, t
-    return T
-
-
-def _check_placement(clearance: Clearance, joints: ArmJoints) -> None:
-    """The arm geoms' poses from the arm's chain (:meth:`Clearance.geom_poses`) must be
-    MuJoCo's at random joint vectors within the limits, to :data:`MATCH_TOLERANCE`."""
-    model, data = clearance.model, mujoco.MjData(clearance.model)
-    low = np.where(np.isfinite(joints.lower), joints.lower, -np.pi)
-    high = np.where(np.isfinite(joints.upper), joints.upper, np.pi)
-    ids = clearance._arm_ids
-    for q in np.random.default_rng(0).uniform(low, high, (_CHECKS, joints.arm.dof)):
-        data.qpos[:] = joints.qpos_with(model.qpos0, q)
-        mujoco.mj_kinematics(model, data)
-        xpos, xmat = clearance.geom_poses(q)
-        position = np.abs(xpos - data.geom_xpos[ids]).max(initial=0.0)
-        rotation = np.abs(xmat.reshape(-1, 9) - data.geom_xmat[ids]).max(initial=0.0)
-        if max(position, rotation) > MATCH_TOLERANCE:
-            raise ModelMismatch(
-                f"the collision geoms of arm '{joints.arm.name}' in the model do not move like its "
-                f"kinematic chain ({position:.2g} m, {rotation:.2g} off at q = {np.round(q, 3).tolist()})"
-            )
-
-
-def _as_row(T: np.ndarray) -> np.ndarray:
-    """A pose (4, 4) as (12,): rotation row-major, then position (csrc/clearance.c)."""
-    return np.concatenate([T[:3, :3].ravel(), T[:3, 3]])
-
-
-def _find(model: mujoco.MjModel, kind: mujoco.mjtObj, name: str, what: str) -> int:
-    index = mujoco.mj_name2id(model, kind, name)
+def _find(model: mujoco.MjModel, name: str) -> int:
+    index = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, name)
     if index < 0:
-        raise InvalidInput(f"the MuJoCo model has no {what} named '{name}'")
+        raise InvalidInput(f"the MuJoCo model has no geom named '{name}'")
     return index
 
 
-def _subtree(model: mujoco.MjModel, root: int) -> np.ndarray:
-    """Whether each body is ``root`` or one of its descendants."""
-    inside = np.zeros(model.nbody, dtype=bool)
-    for b in range(model.nbody):  # parents come before their children
-        inside[b] = b == root or (b > 0 and inside[model.body_parentid[b]])
-    return inside
+def _check_extent(model: mujoco.MjModel, obstacles: list[int], position: np.ndarray) -> None:
+    """Every obstacle's position and sizes within :data:`MAX_EXTENT` (m)."""
+    for o, p in zip(obstacles, position, strict=True):
+        extent = max(np.abs(p).max(), model.geom_size[o].max())
+        if not extent <= MAX_EXTENT:
+            raise InvalidInput(
+                f"obstacle geom '{geom_label(model, o)}': its position and sizes must be within "
+                f"{MAX_EXTENT:g} m, got {extent:.3g} m"
+            )

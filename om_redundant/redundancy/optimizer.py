@@ -31,15 +31,20 @@ the exact OM solution in it:
    whose QP, solved by OSQP, linearises margins and clearances around the current exact
    solution, within the interval. The result is the best point's own exact solve.
 
-**Tracking** (``choose(T, previous)``): first the one-call tracking step of
+**Tracking** (``choose(T, previous)``): the one-call tracking step of
 :mod:`~om_redundant.redundancy.tracking` (an exact solve at the previous psi, the 1-variable
-box QP along the self-motion, an exact solve at the new psi); where it cannot step or lands
-on an infeasible point, the window search: the previous branch only, psi within
-``max_step`` of the previous psi, every solution continued from the previous joints; among
-the optima within :data:`PLATEAU` of the best, the one nearest the previous psi. The branch is left
-only when it has no feasible psi at all at this pose, and the result says so
-(``branch_flipped``, ``reason``); if it is feasible only farther than ``max_step`` away, the
-result is not ok and names where.
+box QP along the self-motion, an exact solve at the new psi). Where it cannot step, lands on
+an infeasible point, or (given the arm's joints ``q_current``) the way there is no longer
+clear, the optimiser **chooses afresh from the arm's joints**
+(:mod:`~om_redundant.redundancy.reachable`): the previous branch's feasible samples first,
+scored by f less the joint travel from ``q_current``, the first with a clear way winning;
+the other branches only if the previous one has no feasible sample with a clear way. The
+result says so (``rechosen``, ``branch_flipped``, ``reason``). It is not ok only when no
+branch has a feasible arm angle at this pose: then :meth:`RedundancyOptimizer.intervals` is
+empty too.
+
+**From the arm's joints** (``choose(T, q_current=q)``): the same fresh choice without a
+previous one, for the first target of a mink loop.
 """
 
 from __future__ import annotations
@@ -57,7 +62,7 @@ from .. import ckernels
 from ..exceptions import InvalidInput
 from ..om.configuration import Configuration
 from ..om.solver import OMSolver, Solution
-from ..validation import as_count, as_instance, as_number, as_pose, as_signs
+from ..validation import as_count, as_instance, as_joint_vector, as_number, as_pose, as_signs
 from .arm_angle import wrap_psi
 from .clearance import DEFAULT_DISTMAX, Clearance
 from .climb import maximise
@@ -69,15 +74,13 @@ from .objective import (
     Objective,
     check_weights,
 )
-from .paths import Path, sweep_circle, sweep_window
-from .probe import END_TOLERANCE, Point, Probe
+from .paths import Path, sweep_circle
+from .probe import Point, Probe
+from .reachable import DEFAULT_TRAVEL_WEIGHT, Way, candidates, clear_way, way_clearance, way_floor
 from .shapes import Shape
 from .singularity import Singularity
-from .tracking import Tracker
+from .tracking import Tracked, Tracker
 
-_WINDOW_POINTS = 4  # tracking samples on each side of the previous psi
-#: Tracking: optima within this of the best objective value are equal; the nearest wins.
-PLATEAU = 1e-6
 #: Global choose: a start whose bound is within this of the best found is not climbed (it can
 #: at most tie).
 _CLIMB_ROUNDING = 1e-12
@@ -96,14 +99,24 @@ class RedundancyChoice:
         margin: Smallest normalised joint-limit margin M(q) (nan if not ok).
         clearance: Clearance D(q) in metres (inf without obstacles, nan if not ok).
         value: The objective f(q) (nan if not ok).
-        intervals: The feasible intervals searched: every allowed branch's, or in tracking
-            mode those within ``max_step`` of the previous psi; empty from the one-call
-            tracking step (:mod:`~om_redundant.redundancy.tracking`), which searches none.
-        reason: Why nothing is feasible, or why the branch flipped; "" otherwise.
-        branch_flipped: Tracking mode left the previous branch (it had no feasible psi).
+        intervals: The feasible intervals searched: every allowed branch's, or, chosen
+            afresh from the arm's joints, those of the branches swept (the previous one
+            first); empty from the one-call tracking step
+            (:mod:`~om_redundant.redundancy.tracking`), which searches none.
+        reason: Why nothing is feasible, or why tracking chose afresh; "" otherwise.
+        branch_flipped: The choice left the previous choice's branch.
         curvature: The curvature (per rad^2) of the objective along psi that the next
             tracking step's model takes (:mod:`~om_redundant.redundancy.tracking`); nan:
             its initial value.
+        rechosen: Tracking could not continue from the previous choice, and this choice
+            was made afresh from the arm's joints (``reason`` says why).
+        travel: Joint travel (rad, Euclidean) from the arm's joints ``q_current`` (or the
+            previous choice's) to ``solution.q``; nan from a global choice.
+        way_clearance: A lower bound of the clearance along the straight joint-space way
+            from those joints to ``solution.q``
+            (:meth:`~om_redundant.Clearance.minimum_along`): at least
+            ``min(min_clearance, D(q_current))`` less 1 mm where the way is clear; inf
+            without obstacles; nan without ``q_current``.
     """
 
     ok: bool
@@ -116,6 +129,9 @@ class RedundancyChoice:
     reason: str = ""
     branch_flipped: bool = False
     curvature: float = math.nan
+    rechosen: bool = False
+    travel: float = math.nan
+    way_clearance: float = math.nan
 
 
 class RedundancyOptimizer:
@@ -137,6 +153,8 @@ class RedundancyOptimizer:
         branches: Allowed branch signs, e.g. ``[(1, -1, 1)]``; default all.
         grid_points: psi samples per branch of the sweep, a whole number from 16 to 100,000.
         max_step: Largest psi change (rad) per tracking call, in (0, pi].
+        travel_weight: w_t >= 0, the objective given up per radian of joint travel when
+            choosing from the arm's joints (:mod:`~om_redundant.redundancy.reachable`).
 
     Raises:
         InvalidInput: An argument of the wrong type or out of range (named); numbers must be
@@ -163,6 +181,7 @@ class RedundancyOptimizer:
         branches: Sequence[Sequence[int]] | None = None,
         grid_points: int = 64,
         max_step: float = 0.05,
+        travel_weight: float = DEFAULT_TRAVEL_WEIGHT,
     ):
         as_instance(solver, OMSolver, "solver")
         if len(solver.redundancy_names) != 1:
@@ -196,40 +215,64 @@ class RedundancyOptimizer:
         self.max_step = as_number(max_step, "max_step")
         if not 0.0 < self.max_step <= math.pi:
             raise InvalidInput(f"max_step must be in (0, pi] rad, got {max_step}")
+        self.travel_weight = as_number(travel_weight, "travel_weight")
+        if not self.travel_weight >= 0.0:
+            raise InvalidInput(f"travel_weight must be >= 0, got {travel_weight}")
         self._tracker = Tracker(solver, self.objective, self.max_step)
+
+    @property
+    def clearance(self) -> Clearance | None:
+        """The obstacles' :class:`~om_redundant.Clearance` (None without obstacles)."""
+        return self.objective.clearance
 
     def intervals(self, T: Any) -> list[PsiInterval]:
         """The feasible psi intervals of every allowed branch at pose T."""
         T = as_pose(T)
         return [run.interval for _, _, runs in self._sweep(T, self.branches) for run in runs]
 
-    def choose(self, T: Any, previous: RedundancyChoice | None = None) -> RedundancyChoice:
-        """The best configuration for pose T, or with ``previous`` the best near it.
+    def choose(
+        self,
+        T: Any,
+        previous: RedundancyChoice | None = None,
+        *,
+        q_current: Any = None,
+    ) -> RedundancyChoice:
+        """The best configuration for pose T; with ``previous``, the best near it; with the
+        arm's joints ``q_current``, one the arm can reach from where it is.
 
         Args:
             T: Target pose of the end effector in the root frame: 4x4 or ``mink.SE3``.
             previous: The choice for the previous pose of a path: tracking mode (module
                 docstring). A previous choice that is not ok starts afresh.
+            q_current: The arm's joints now (dof,), e.g. a mink configuration's: a fresh
+                choice weighs the joint travel from them and wants a clear way from them;
+                tracking checks that its way from them stays clear. Default: a global
+                choice, or the previous choice's joints when tracking.
 
         Returns:
-            A :class:`RedundancyChoice`; ``ok`` is False, with the reason, when nothing is
-            feasible.
+            A :class:`RedundancyChoice`; ``ok`` is False, with the reason, only when no
+            allowed branch has a feasible arm angle at T.
 
         Raises:
-            InvalidInput: A malformed pose or previous choice.
+            InvalidInput: A malformed pose, previous choice or joint vector.
             SingularSelfMotion: A solution met where psi does not move along the
                 self-motion (a stretched arm, e.g. the iiwa14 at q = 0), so no rates exist.
         """
         T = as_pose(T)
-        if previous is None or (isinstance(previous, RedundancyChoice) and not previous.ok):
-            return self._best_anywhere(T, self.branches)
-        if not isinstance(previous, RedundancyChoice):
+        if q_current is not None:
+            q_current = as_joint_vector(q_current, self.solver.arm.dof, "q_current", stack=False)
+        if previous is not None and not isinstance(previous, RedundancyChoice):
             raise InvalidInput(f"previous must be a RedundancyChoice, got {type(previous).__name__}")
+        if previous is None or not previous.ok:
+            if q_current is None:
+                return self._best_anywhere(T, self.branches)
+            signs = self.solver.configuration_of(q_current).signs
+            return self._from_joints(T, q_current, signs if signs in self.branches else None)
         if previous.configuration.signs not in self.branches:
             raise InvalidInput(
                 f"previous branch {previous.configuration.signs} is not among the allowed branches"
             )
-        return self._track(T, previous)
+        return self._track(T, previous, q_current)
 
     # -----------------------------------------------------------------------------------
 
@@ -246,8 +289,8 @@ class RedundancyOptimizer:
             for signs, paths in zip(branches, swept, strict=True)
         ]
 
-    def _probe(self, T: np.ndarray, signs: tuple[int, ...], wrapped: bool = True) -> Probe:
-        return Probe(self.solver, self.objective, T, signs, wrapped)
+    def _probe(self, T: np.ndarray, signs: tuple[int, ...]) -> Probe:
+        return Probe(self.solver, self.objective, T, signs)
 
     def _best_anywhere(self, T: np.ndarray, branches: list[tuple[int, ...]]) -> RedundancyChoice:
         swept = self._sweep(T, branches)
@@ -257,44 +300,109 @@ class RedundancyOptimizer:
             return _failure((), f"no feasible arm angle: {why}")
         return self._result(T, self._climb_all(T, runs), runs)
 
-    def _track(self, T: np.ndarray, previous: RedundancyChoice) -> RedundancyChoice:
+    def _track(
+        self, T: np.ndarray, previous: RedundancyChoice, q_current: np.ndarray | None
+    ) -> RedundancyChoice:
         signs, (psi,) = previous.configuration.signs, previous.configuration.redundancy
-        step = self._tracker.step(T, signs, psi, previous.solution.q, previous.curvature)
-        if step is not None:
-            solution, margin, clearance, value, curvature = step
-            return RedundancyChoice(
-                True, solution.configuration, solution, margin, clearance, value, (), curvature=curvature
+        q_previous = previous.solution.q
+        step = self._tracker.step(T, signs, psi, q_previous, previous.curvature)
+        if isinstance(step, Tracked):
+            choice = RedundancyChoice(
+                True,
+                step.solution.configuration,
+                step.solution,
+                step.margin,
+                step.clearance,
+                step.value,
+                (),
+                curvature=step.curvature,
             )
-        probe = self._probe(T, signs, wrapped=False)  # the joints move continuously
-        window = sweep_window(probe, psi, previous.solution.q, self.max_step, _WINDOW_POINTS)
-        runs = [run for path_runs in feasible_runs([(probe, path) for path in window]) for run in path_runs]
-        if runs:
-            return self._result(T, self._climb_all(T, runs, near=psi), runs)
-        ((_, paths, branch_runs),) = self._sweep(T, [signs])
-        if branch_runs:
-            where = ", ".join(f"[{r.interval.lo:+.3f}, {r.interval.hi:+.3f}]" for r in branch_runs)
-            return _failure(
-                tuple(r.interval for r in branch_runs),
-                f"branch {signs}: no feasible psi within max_step = {self.max_step} rad of psi = "
-                f"{psi:+.4f}; the branch is feasible at psi in {where}",
+            if q_current is None:
+                return choice
+            floor = way_floor(self.objective, q_current)
+            along = way_clearance(self.objective, q_current, step.solution.q, floor)
+            choice = replace(
+                choice, travel=float(np.linalg.norm(step.solution.q - q_current)), way_clearance=along
             )
-        others = [b for b in self.branches if b != signs]
-        choice = self._best_anywhere(T, others) if others else _failure((), "no other branch is allowed")
-        why = f"branch {signs} has no feasible psi at this pose ({self._why(signs, paths)})"
-        if not choice.ok:
-            return replace(choice, reason=f"{why}; {choice.reason}")
-        return replace(choice, branch_flipped=True, reason=f"{why}; switched to {choice.configuration.signs}")
+            # a way that was clear and is no longer (an obstacle moved in): choose afresh; one
+            # that was not clear either is left to mink's collision limit until it clears
+            if along >= floor or not previous.way_clearance >= floor:
+                return choice
+            to = step.solution.configuration.redundancy[0]
+            why = f"the way from the arm's joints to psi = {to:+.4f} is blocked"
+        else:
+            why = step
+        start = q_previous if q_current is None else q_current
+        chosen = self._from_joints(T, start, signs)
+        if not chosen.ok:
+            return chosen
+        flipped = chosen.configuration.signs != signs
+        reason = (
+            f"tracking from branch {signs} at psi = {psi:+.4f} stopped: {why}; chose afresh from the "
+            f"arm's joints: branch {chosen.configuration.signs} at psi = "
+            f"{chosen.configuration.redundancy[0]:+.4f}, {chosen.travel:.3f} rad of joint travel"
+        )
+        if chosen.reason:
+            reason += f" ({chosen.reason})"
+        return replace(chosen, rechosen=True, branch_flipped=flipped, reason=reason)
 
-    def _climb_all(self, T: np.ndarray, runs: list[Run], near: float | None = None) -> tuple[Run, Point]:
-        """The global maximum over the runs: climbs from the best starts (module docstring).
+    def _from_joints(
+        self, T: np.ndarray, q_from: np.ndarray, signs: tuple[int, ...] | None
+    ) -> RedundancyChoice:
+        """The fresh choice from the arm's joints (:mod:`~om_redundant.redundancy.reachable`):
+        branch ``signs`` first (None: every allowed branch at once)."""
+        first = [signs] if signs is not None else self.branches
+        swept = self._sweep(T, first)
+        runs = [run for _, _, branch_runs in swept for run in branch_runs]
+        way = self._way(runs, q_from)
+        note = ""
+        if (way is None or not way.clear) and signs is not None:
+            note = f"branch {signs} has no {'clear way' if runs else 'feasible arm angle at this pose'}"
+            others = [b for b in self.branches if b != signs]
+            more = self._sweep(T, others)
+            runs += [run for _, _, branch_runs in more for run in branch_runs]
+            swept += more
+            way = self._way(runs, q_from)
+        if way is not None and not way.clear:
+            note = "; ".join(filter(None, [note, "no candidate has a clear way: the best is taken"]))
+        if way is None:
+            why = "; ".join(self._why(s, paths) for s, paths, _ in swept)
+            return _failure((), f"no feasible arm angle: {why}")
+        return self._chosen(T, way, tuple(r.interval for r in runs), note)
 
-        With ``near`` (tracking: the previous psi; distances modulo 2 pi), the sample at
-        ``near`` is a start too, and the optimum is the one nearest ``near`` among those
-        within :data:`PLATEAU` of the best: on a flat objective (a joint that the
-        self-motion does not move binding the margin, the clearance at its cap) psi stays
-        where it was instead of jumping to whichever sample rounding favours, farther than
-        the joints can follow in one tick.
-        """
+    def _way(self, runs: list[Run], q_from: np.ndarray) -> Way | None:
+        """The best candidate of the runs with a clear way from q_from (or the best)."""
+        return clear_way(self.objective, candidates(self.objective, runs, q_from, self.travel_weight), q_from)
+
+    def _chosen(
+        self, T: np.ndarray, way: Way, intervals: tuple[PsiInterval, ...], note: str
+    ) -> RedundancyChoice:
+        """The choice of a candidate: its exact solution at its joints."""
+        candidate = way.candidate
+        configuration = Configuration(candidate.run.interval.signs, (wrap_psi(candidate.point.psi),))
+        solution = candidate.point.solution or self.solver.solve(T, configuration, q_hint=candidate.point.q)
+        solution = replace(
+            solution,
+            q=candidate.q,
+            configuration=configuration,
+            within_limits=self.solver.arm.within_limits(candidate.q),
+        )
+        ev = candidate.evaluation
+        return RedundancyChoice(
+            solution.ok,
+            configuration,
+            solution,
+            ev.margin,
+            ev.clearance,
+            ev.value,
+            intervals,
+            reason=note,
+            travel=candidate.travel,
+            way_clearance=way.clearance,
+        )
+
+    def _climb_all(self, T: np.ndarray, runs: list[Run]) -> tuple[Run, Point]:
+        """The global maximum over the runs: climbs from the best starts (module docstring)."""
         # every run's samples at once (their slope bounds: _StartBounds)
         points = [p for run in runs for p in run.points]
         owner = np.repeat(np.arange(len(runs)), [len(run.points) for run in runs])
@@ -305,13 +413,10 @@ class RedundancyOptimizer:
         pairs = [p.terms.get_pairs() for p in points]  # (computed for the evaluations)
         distances = None if pairs[0] is None else np.array([d for d, _ in pairs])
         terms = self.objective.term_functions(np.array([p.q for p in points]), distances)
-        # local maxima among a run's samples (its ends against their one neighbour), and near
+        # local maxima among a run's samples (its ends against their one neighbour)
         rising = np.concatenate([[True], f[1:] >= f[:-1]]) | (first == np.arange(len(f)))
         falling = np.concatenate([f[:-1] >= f[1:], [True]]) | (last == np.arange(len(f)))
-        chosen = rising & falling
-        if near is not None:
-            chosen |= np.array([_distance(x, near) <= END_TOLERANCE for x in psi.tolist()])
-        k = np.flatnonzero(chosen)
+        k = np.flatnonzero(rising & falling)
         gap = np.maximum(psi[np.minimum(k + 1, last[k])] - psi[k], psi[k] - psi[np.maximum(k - 1, first[k])])
         bounds = _StartBounds(psi, f, terms, first, last)
         bound = bounds.cone(k, 2.0 * gap)
@@ -322,21 +427,18 @@ class RedundancyOptimizer:
         best = found[0][1].evaluation.value
         probes = {}
         for _, gap, bound, j in starts:
-            least = best + _CLIMB_ROUNDING if near is None else best - PLATEAU  # what a climb must reach
+            least = best + _CLIMB_ROUNDING  # what a climb must reach
             if bound < least or bounds.within(j, 2.0 * gap) < least:  # (the cheap bound first)
                 continue
             run, start = runs[owner[j]], points[j]
             lo, hi = (-math.inf, math.inf) if run.interval.closed else (run.interval.lo, run.interval.hi)
             signs = run.interval.signs
             if signs not in probes:
-                probes[signs] = self._probe(T, signs, wrapped=near is None)
+                probes[signs] = self._probe(T, signs)
             point = maximise(probes[signs], start, lo, hi, max(gap, 1e-6))
             found.append((run, point))
             best = max(best, point.evaluation.value)
-        if near is None:
-            return next((run, point) for run, point in found if point.evaluation.value == best)
-        optima = [(run, point) for run, point in found if point.evaluation.value >= best - PLATEAU]
-        return min(optima, key=lambda found: _distance(found[1].psi, near))
+        return next((run, point) for run, point in found if point.evaluation.value == best)
 
     def _result(self, T: np.ndarray, best: tuple[Run, Point], runs: list[Run]) -> RedundancyChoice:
         run, point = best
@@ -471,11 +573,6 @@ class _StartBounds:
         for column in terms.T:
             total = total + column
         return np.minimum(values[:, 0], total)
-
-
-def _distance(a: float, b: float) -> float:
-    """The distance of two angles on the circle."""
-    return abs(math.remainder(a - b, 2.0 * math.pi))
 
 
 def _failure(intervals: tuple[PsiInterval, ...], reason: str) -> RedundancyChoice:

@@ -40,7 +40,7 @@ from typing import Any
 import numpy as np
 
 from .. import ckernels
-from .probe import END_TOLERANCE, JUMP, SAME, Point, Probe, evaluate_points
+from .probe import END_TOLERANCE, SAME, Point, Probe, evaluate_points
 
 FINE_STEP = 0.25  # rad: cells in which a joint moves further get samples in between
 _MODEL_POINTS = 256  # points of a cell where the Hermite models are checked
@@ -160,25 +160,6 @@ def lockstep(processes: list[Generator[Follow, tuple[Point, bool], Any]]) -> lis
             evaluate_points(asked[0][1][0].objective, [point for point, _ in answers])
         going = [i for i, _ in asked]
     return results
-
-
-def sweep_window(probe: Probe, center: float, hint: np.ndarray, half_width: float, n: int) -> list[Path]:
-    """The path through the solution nearest ``hint`` at the centre, followed outwards
-    through center + half_width * j / n, j = -n..n, to the window's edges or its ends."""
-    start = probe.at(center, hint)
-    if start is None or probe.step(hint, start.q) > JUMP:
-        return []
-    halves = []
-    for side in (-1, 1):
-        points = [start]
-        for j in range(1, n + 1):
-            reached, arrived = probe.follow(points[-1], center + side * half_width * j / n)
-            if reached is not points[-1]:
-                points.append(reached)
-            if not arrived:
-                break
-        halves.append(points[1:])
-    return _with_hidden([(probe, Path(halves[0][::-1] + [start] + halves[1]))])
 
 
 def _link(probe: Probe, psi: np.ndarray, roots: list[list[Point]], compiled: bool = True) -> list[Path]:

@@ -123,12 +123,13 @@ class Choice:
     clearance: float  # m; +inf without obstacles
     value: float = math.nan  # the optimiser's objective
     branch_flipped: bool = False  # path mode: left the previous branch
+    rechosen: bool = False  # path mode: tracking stopped, chosen afresh from the previous joints
 
 
 @dataclass(frozen=True, eq=False)
 class PoseSweep:
     """The sweep of one pose: every requested branch, and the choice (None if none is feasible);
-    ``note``: why nothing was chosen, or (path mode) why the branch flipped."""
+    ``note``: why nothing was chosen, or (path mode) why tracking chose afresh."""
 
     pose: np.ndarray
     branches: tuple[BranchSweep, ...]
@@ -201,6 +202,7 @@ def compute_sweep(request: SweepRequest) -> SweepResult:
                 float(choice.clearance),
                 float(choice.value),
                 choice.branch_flipped,
+                choice.rechosen,
             )
         poses.append(PoseSweep(T, tuple(branches), chosen, choice.reason))
         request.progress(i + 1)

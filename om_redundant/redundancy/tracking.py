@@ -32,10 +32,11 @@ flange's move from :math:`\mathrm{fk}(q')` to T, the second's along the self-mot
 Python then evaluates the clearance exactly at the new joints (for the feasibility check and
 as the next step's linearisation, :meth:`~om_redundant.Clearance.distances_within`), and the
 result is a :class:`~om_redundant.RedundancyChoice`. A step that cannot be taken (no exact
-solution, a fold of the self-motion, nothing feasible within the step, the result
-infeasible) answers None: the optimiser then takes its general path, which flips the
-branch or says why. Repeated at one pose the steps converge to a local optimum of the
-objective on the branch (a Newton-like iteration on the crossing of the active pieces).
+solution continues the previous joints, a fold of the self-motion, nothing feasible within
+the step, the result infeasible) answers why, in words: the optimiser then chooses afresh
+from the arm's joints (:mod:`~om_redundant.redundancy.reachable`). Repeated at one pose the
+steps converge to a local optimum of the objective on the branch (a Newton-like iteration on
+the crossing of the active pieces).
 """
 
 from __future__ import annotations
@@ -60,6 +61,13 @@ _PSI, _CURVATURE, _N_SETUP = 0, 7, 12
 # output layout after q (csrc/tracking.c)
 _O_PSI, _O_CURVATURE, _O_MARGIN, _O_SINGULARITY = 0, 2, 3, 4
 _O_POS, _O_ORI, _O_EVALS, _O_WITHIN, _N_OUT = 6, 7, 8, 9, 10
+#: Why ckernels.track_step refused, by its status (csrc/tracking.c).
+_REFUSED = {
+    1: "no exact solution at the previous psi continues the previous joints",
+    2: "the self-motion folds there (psi does not move along it)",
+    3: "nothing within the limits and clearance within max_step",
+    4: "the step along the self-motion left the solution path",
+}
 
 
 class TrackingWork(NamedTuple):
@@ -92,11 +100,30 @@ class Linearisation(NamedTuple):
         q: (7,) the joints.
         distances: (P,) the pairs' distances there (m), capped at the objective's reach.
         gradients: (P, 7) their gradients (zero where capped).
+        version: The clearance's :attr:`~om_redundant.Clearance.version` (the obstacles'
+            poses) they were computed with.
     """
 
     q: np.ndarray
     distances: np.ndarray
     gradients: np.ndarray
+    version: int = 0
+
+
+class Tracked(NamedTuple):
+    """A tracking step taken: the exact solution at the new psi and the objective there.
+
+    Attributes:
+        solution: The exact solution (configuration: the branch and the new psi).
+        margin, clearance, value: M, D and f at its joints.
+        curvature: The curvature the next step's model takes.
+    """
+
+    solution: Solution
+    margin: float
+    clearance: float
+    value: float
+    curvature: float
 
 
 class Tracker:
@@ -147,21 +174,21 @@ class Tracker:
 
     def step(
         self, T: np.ndarray, signs: tuple[int, ...], psi: float, q: np.ndarray, curvature: float
-    ) -> tuple[Solution, float, float, float, float] | None:
+    ) -> Tracked | str:
         """One tracking step from (signs, psi, q) to pose T.
 
         Returns:
-            (solution, margin, clearance, value, curvature) at the new psi, or None when
-            the step cannot be taken or lands on an infeasible point (module docstring).
+            The step at the new psi, or why it cannot be taken or lands on an infeasible
+            point (module docstring).
         """
         if self._kernel is None:
-            return None
+            return "an arm near a family has no compiled tracking step"
         with self._lock:
             return self._step(T, signs, psi, q, curvature)
 
     def _step(
         self, T: np.ndarray, signs: tuple[int, ...], psi: float, q: np.ndarray, curvature: float
-    ) -> tuple[Solution, float, float, float, float] | None:
+    ) -> Tracked | str:
         work, objective = self.work, self.objective
         work.setup[_PSI] = psi
         work.setup[_CURVATURE] = curvature if math.isfinite(curvature) else INITIAL_CURVATURE
@@ -170,10 +197,10 @@ class Tracker:
         if signs_array is None:
             signs_array = self._signs[signs] = np.array(signs, dtype=np.int64)
         status = ckernels.track_step(
-            self._kernel, T, signs_array, q, *work[:-2], *linearised, work.q, work.out
+            self._kernel, T, signs_array, q, *work[:-2], *linearised[:3], work.q, work.out
         )
         if status != 0:
-            return None
+            return _REFUSED[status]
         out, q_new = work.out.tolist(), work.q.copy()  # Python floats: cheaper arithmetic
         margin = out[_O_MARGIN]
         clearance = math.inf
@@ -186,8 +213,10 @@ class Tracker:
             if clearance >= objective.clearance_reach:  # every pair beyond the reach: D itself, uncapped
                 clearance = objective.clearance.minimum(q_new)
             value += objective.clearance_weight * min(1.0, clearance / objective.clearance_cap)
-        if not (margin >= 0.0 and clearance >= objective.min_clearance):
-            return None
+        if not margin >= 0.0:
+            return f"the step's joints leave the limits (margin {margin:.3g})"
+        if not clearance >= objective.min_clearance:
+            return f"the step's joints come within {clearance:.4f} m of an obstacle"
         configuration = Configuration(signs, (wrap_psi(out[_O_PSI]),))
         solution = Solution(
             q_new,
@@ -199,19 +228,23 @@ class Tracker:
             int(out[_O_EVALS]),
             bool(out[_O_WITHIN]),
         )
-        return solution, margin, clearance, value, out[_O_CURVATURE]
+        return Tracked(solution, margin, clearance, value, out[_O_CURVATURE])
 
     def _linearised_at(self, q: np.ndarray) -> Linearisation:
-        """The clearances at q: the last step's where q is its result's joints (or there are
-        no obstacles), else evaluated."""
-        last = self._last
-        if self.objective.clearance is None or last.q is q or np.array_equal(last.q, q):
+        """The clearances at q: the last step's where q is its result's joints and the
+        obstacles have not moved since (or there are no obstacles), else evaluated."""
+        last, clearance = self._last, self.objective.clearance
+        if clearance is None:
+            return last
+        if last.version == clearance.version and (last.q is q or np.array_equal(last.q, q)):
             return last
         return self._linearisation(q)
 
     def _linearisation(self, q: np.ndarray) -> Linearisation:
         """The clearances at q, evaluated (the pairs within the objective's reach)."""
         objective = self.objective
+        clearance = objective.clearance
+        version = clearance.version  # (read first: an update meanwhile makes the next step evaluate again)
         return Linearisation(
-            q, *objective.clearance.distances_within(q, objective.clearance_reach, gradient=True)
+            q, *clearance.distances_within(q, objective.clearance_reach, gradient=True), version
         )

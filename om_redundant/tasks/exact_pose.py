@@ -9,6 +9,7 @@ model (:class:`~om_redundant.ArmRoot`).
 
 from __future__ import annotations
 
+import warnings
 from typing import Any, Protocol
 
 import mujoco
@@ -31,22 +32,28 @@ EXACT_POSE_COST = 10.0
 
 
 class RedundancyOptimizer(Protocol):
-    """What :class:`ExactPoseTask` needs of a redundancy optimiser (duck-typed).
+    """What :class:`ExactPoseTask` needs of a redundancy optimiser (duck-typed, as
+    :class:`~om_redundant.RedundancyOptimizer`).
 
-    ``choose(T, previous)`` takes a pose in the arm's root frame and the previous choice (or
-    None) and returns an object with ``ok`` (bool), ``solution`` (an om
-    :class:`~om_redundant.Solution`), ``configuration`` (its
+    ``choose(T, previous, q_current=q)`` takes a pose in the arm's root frame, the previous
+    choice (or None) and the arm's joints now (or None), and returns an object with ``ok``
+    (bool), ``solution`` (an om :class:`~om_redundant.Solution`), ``configuration`` (its
     :class:`~om_redundant.Configuration`) and ``reason`` (str, why when not ok).
+    ``clearance`` is its :class:`~om_redundant.Clearance` or None.
     """
 
-    def choose(self, T: np.ndarray, previous: Any = None) -> Any: ...
+    clearance: Any
+
+    def choose(self, T: np.ndarray, previous: Any = None, *, q_current: Any = None) -> Any: ...
 
 
 class ExactPoseTask(ArmTask):
     r"""Pull the arm's joints to the exact solution of a hand pose in a chosen configuration.
 
     On :meth:`set_target` the OM solver gives :math:`q^*` with :math:`\mathrm{fk}(q^*) =
-    T_{root,world} T_{world,target}` exactly, in the configuration c given
+    T_{root,world} T_{world,target} X^{-1}` exactly (X the target frame in the arm's
+    end-effector frame: the identity for the arm's own frame, a constant for a hand or TCP
+    fixed to its last link, :class:`~om_redundant.ArmRoot`), in the configuration c given
     (``arm_configuration``) or chosen by ``optimizer``, within the joint limits (the tighter
     of the arm's and the model's). The task's error and Jacobian are
 
@@ -66,15 +73,26 @@ class ExactPoseTask(ArmTask):
     so close to :math:`q^*` that none remains. With equal costs about a third of random
     targets on the Panda end at such a point, from the middle of the joint ranges.
 
-    The arm's root may move (a mobile base, a mocap body): then :math:`q^*` is solved again
-    whenever the root has moved, at the next :meth:`compute_error`; the Jacobian's columns
-    of the base stay zero (the base follows the other tasks). :meth:`set_target` solves for
-    the root where the task last saw it (in the ``mink.Configuration`` of its last
-    ``compute_*``, :meth:`seed` or :meth:`set_target_from_configuration`); a target set
-    before the task has seen any is solved at the next ``compute_*``.
+    The world may move: the arm's root (a mobile base, a mocap body) and, with an optimiser
+    whose :class:`~om_redundant.Clearance` is of this task's model, the obstacles (mocap
+    bodies, other arms: :meth:`Clearance.update <om_redundant.Clearance.update>` reads them
+    from the configuration). Then :math:`q^*` is solved again whenever they have moved, at
+    the next ``compute_*``; the Jacobian's columns of the base stay zero (the base follows
+    the other tasks). :meth:`set_target` solves for the world as the task last saw it (in
+    the ``mink.Configuration`` of its last ``compute_*``, :meth:`seed` or
+    :meth:`set_target_from_configuration`); a target set before the task has seen any is
+    solved at the next ``compute_*``.
+
+    With an optimiser, each solve tracks the previous choice and gives it the arm's joints
+    as last seen (``q_current``): where tracking cannot continue (a target that jumps, a
+    feasible range that moves away, an obstacle moved onto the way), the optimiser chooses
+    afresh from where the arm is, weighing the joint travel and wanting a clear way
+    (:attr:`choice` says so: ``rechosen``, ``reason``). :meth:`reset_choice` forces a fresh
+    choice at the next target.
 
     Failure is never silent: if the pose is out of reach, has no solution in c, or only
-    solutions that break a joint limit, :meth:`set_target` raises
+    solutions that break a joint limit (with an optimiser: no feasible arm angle on any
+    allowed branch, the limits and the clearance kept), :meth:`set_target` raises
     :class:`~om_redundant.UnreachableTarget` naming the reason, and the task keeps its
     previous target (catch it to hold the arm where it was going). A target is never taken
     unsolved: when the first solve of a target set before the task saw its root fails, the
@@ -86,11 +104,12 @@ class ExactPoseTask(ArmTask):
         model: The MuJoCo model that holds the arm (possibly among other joints).
         arm_configuration: The configuration c to solve in (branch signs and, for a 7-DOF
             arm, the arm angle psi).
-        optimizer: Instead of c: a redundancy optimiser, asked
-            ``optimizer.choose(T_root, previous=<its last choice>)`` at each target.
+        optimizer: Instead of c: a redundancy optimiser, asked ``optimizer.choose(T_root,
+            previous=<its last choice>, q_current=<the arm's joints>)`` at each target.
         prefix: Prefix of the arm's joint names in the model, e.g. ``"l_"``.
-        frame_name, frame_type: The arm's end-effector frame in the model (the one
-            ``arm.fk`` gives); default the prefix plus the arm's Menagerie frame.
+        frame_name, frame_type: The frame the targets are for: the arm's end-effector frame
+            (the one ``arm.fk`` gives) or any frame fixed to its last link (a hand body, a
+            TCP site); default the prefix plus the arm's Menagerie frame.
         cost: Cost per joint error (1/rad), one value or one per joint.
         gain: Task gain in [0, 1].
         lm_damping: Levenberg-Marquardt damping (see ``mink.Task``).
@@ -124,7 +143,10 @@ class ExactPoseTask(ArmTask):
         fixed = self.root.fixed_pose
         self._root_at_origin = fixed is not None and np.array_equal(fixed, np.eye(4))
         self._world_to_fixed_root = None if fixed is None else _inverse(fixed)
+        tool = self.root.tool
+        self._tool_to_flange = None if np.array_equal(tool, np.eye(4)) else _inverse(tool)
         self.optimizer = optimizer
+        self._clearance = self._live_clearance(optimizer, model)
         self.arm_configuration = arm_configuration
         if arm_configuration is not None:
             solver.check_configuration(arm_configuration)  # raises InvalidInput naming the problem
@@ -132,7 +154,8 @@ class ExactPoseTask(ArmTask):
         self.choice: Any = None
         self._q_target: np.ndarray | None = None
         self._root_pose: np.ndarray | None = None
-        self._data: mujoco.MjData | None = None  # of the configuration last seen: where the root is
+        self._data: mujoco.MjData | None = None  # of the configuration last seen: where the world is
+        self._seen = -1  # the clearance's version the target was solved for
         self._unsolved_fallback: tuple[SE3 | None, Configuration | None] | None = None
         self._jacobian = self.scatter(np.eye(self.k))
         self._jacobian.setflags(write=False)
@@ -172,6 +195,8 @@ class ExactPoseTask(ArmTask):
         else:
             self.solver.check_configuration(arm_configuration)  # raises InvalidInput naming the problem
         if self.root.fixed_pose is not None or self._data is not None:
+            if self._clearance is not None and self._data is not None:
+                self._clearance.update(self._data)
             self._solve(T, self.root.pose(self._data), self._q_target, arm_configuration)  # or raises
             self._unsolved_fallback = None
         else:  # the root moves and the task has not seen where: solved at the next compute_*
@@ -194,6 +219,11 @@ class ExactPoseTask(ArmTask):
         self.arm_configuration = c
         self.transform_target_to_world = SE3.from_matrix(T)
 
+    def reset_choice(self) -> None:
+        """Forget the optimiser's last choice: the next solve chooses afresh (from the arm's
+        joints as last seen) instead of tracking it. The current target stays until then."""
+        self.choice = None
+
     def seed(self, configuration: MinkConfiguration) -> None:
         """Put the arm's joints of ``configuration`` at :math:`q^*` (the other joints stay)."""
         _, q_target = self._joint_target(configuration)
@@ -212,29 +242,34 @@ class ExactPoseTask(ArmTask):
     # -----------------------------------------------------------------------------------
 
     def _joint_target(self, configuration: MinkConfiguration) -> tuple[np.ndarray, np.ndarray]:
-        """The arm's joints q and :math:`q^*` for the configuration's root pose, solved again
-        if the root moved."""
+        """The arm's joints q and :math:`q^*` for the configuration's world, solved again if
+        the root or the obstacles moved."""
         q = self._arm_q(configuration)
         if self.transform_target_to_world is None:
             raise TargetNotSet(self.__class__.__name__)
-        if self.root.fixed_pose is None:
-            root = self.root.pose(configuration.data)
-            if self._root_pose is None or not np.array_equal(root, self._root_pose):
-                T = self.transform_target_to_world.as_matrix()
-                try:
-                    self._solve(T, root, self._q_target, self.arm_configuration)
-                except UnreachableTarget as exc:
-                    if self._unsolved_fallback is None:
-                        raise  # a solved target the root has moved away from: kept
-                    self.transform_target_to_world, self.arm_configuration = self._unsolved_fallback
-                    self._unsolved_fallback = None
-                    raise UnreachableTarget(f"{exc}; the target is dropped for the previous one") from None
+        root = self.root.pose(configuration.data)
+        moved = self._root_pose is None or (
+            root is not self._root_pose and not np.array_equal(root, self._root_pose)
+        )
+        if self._clearance is not None:
+            self._clearance.update(configuration.data)
+            moved = moved or self._clearance.version != self._seen
+        if moved:
+            T = self.transform_target_to_world.as_matrix()
+            try:
+                self._solve(T, root, self._q_target, self.arm_configuration)
+            except UnreachableTarget as exc:
+                if self._unsolved_fallback is None:
+                    raise  # a solved target the world has moved away from: kept
+                self.transform_target_to_world, self.arm_configuration = self._unsolved_fallback
                 self._unsolved_fallback = None
+                raise UnreachableTarget(f"{exc}; the target is dropped for the previous one") from None
+            self._unsolved_fallback = None
         assert self._q_target is not None
         return q, self._q_target
 
     def _arm_q(self, configuration: MinkConfiguration) -> np.ndarray:
-        """The arm's joints (checked as :meth:`arm_q`); remembers where the root is."""
+        """The arm's joints (checked as :meth:`arm_q`); remembers where the world is."""
         q = self.arm_q(configuration)
         self._data = configuration.data
         return q
@@ -246,7 +281,8 @@ class ExactPoseTask(ArmTask):
         hint: np.ndarray | None,
         arm_configuration: Configuration | None,
     ) -> None:
-        """Solve T_world for the root at root_pose and, only if that succeeds, take it."""
+        """Solve T_world (the target frame's pose) for the root at root_pose and, only if that
+        succeeds, take it."""
         if root_pose is self.root.fixed_pose:
             T_root = T_world if self._root_at_origin else self._world_to_fixed_root @ T_world
         else:
@@ -254,8 +290,11 @@ class ExactPoseTask(ArmTask):
             T_root = np.eye(4)
             T_root[:3, :3] = R.T @ T_world[:3, :3]
             T_root[:3, 3] = R.T @ (T_world[:3, 3] - p)
+        if self._tool_to_flange is not None:
+            T_root = T_root @ self._tool_to_flange
         if arm_configuration is None:
-            choice = self.optimizer.choose(T_root, previous=self.choice)
+            q_current = None if self._data is None else self.joints.q(self._data.qpos)
+            choice = self.optimizer.choose(T_root, previous=self.choice, q_current=q_current)
             if not choice.ok:
                 raise UnreachableTarget(
                     f"ExactPoseTask: the optimizer found no configuration for the target: {choice.reason}"
@@ -269,6 +308,23 @@ class ExactPoseTask(ArmTask):
         else:
             choice, q = None, self._solve_in(T_root, arm_configuration, hint)
         self._q_target, self.choice, self._root_pose = q, choice, root_pose
+        if self._clearance is not None:
+            self._seen = self._clearance.version
+
+    def _live_clearance(self, optimizer: RedundancyOptimizer | None, model: mujoco.MjModel) -> Any:
+        """The optimiser's clearance where the task reads its obstacles from the model (the
+        clearance is of this model), else None."""
+        clearance = getattr(optimizer, "clearance", None)
+        if clearance is None or clearance.model is model:
+            return clearance
+        if self.root.fixed_pose is None:
+            warnings.warn(
+                "ExactPoseTask: the optimizer's obstacles are not in this task's model, so they stay in "
+                "the arm's root frame and move with its root; for obstacles that stay in the world, build "
+                "the optimizer's Clearance on this model",
+                stacklevel=3,
+            )
+        return None
 
     def _solve_in(self, T_root: np.ndarray, c: Configuration, hint: np.ndarray | None) -> np.ndarray:
         """The exact solution in configuration c within the limits, nearest the hint."""

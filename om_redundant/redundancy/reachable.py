@@ -1,0 +1,126 @@
+r"""Choices reachable from where the arm is: joint travel, and clearance along the way.
+
+When the optimiser chooses from the arm's current joints :math:`q_0` (a fresh choice in a
+mink loop, or a re-choice where tracking cannot continue), each feasible sample of the
+sweep (:mod:`~om_redundant.redundancy.intervals`) is a candidate. A revolute joint is taken
+at the turn nearest :math:`q_0` that stays within its limits (an unlimited joint goes the
+short way round), and the candidate scores
+
+.. math::  f(q) - w_t \, \lVert q - q_0 \rVert_2,
+
+the objective less :math:`w_t` per radian (metre, for a slide) of joint travel. Candidates
+are taken best first, and the first whose straight joint-space segment from :math:`q_0` is
+certified clear (:meth:`~om_redundant.Clearance.minimum_along`, above
+:math:`\min(d_{min}, D(q_0))` less :data:`~om_redundant.redundancy.clearance.ALONG_TOLERANCE`:
+an arm already nearer an obstacle than :math:`d_{min}` may stay as near, never nearer)
+wins; where none is, the best candidate, with the clearance its way has.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+
+from ..kinematics.arm import Arm
+from .clearance import ALONG_TOLERANCE
+from .intervals import Run
+from .objective import Evaluation, Objective
+from .probe import Point
+
+#: w_t: objective given up per radian of joint travel (default).
+DEFAULT_TRAVEL_WEIGHT = 0.25
+#: Candidates whose way is checked, best first, before the best is taken as it is.
+MAX_WAY_CHECKS = 24
+
+
+class Candidate(NamedTuple):
+    """A feasible sample taken at the joints nearest the arm's.
+
+    Attributes:
+        run: Its feasible run.
+        point: The sample (its ``q`` at the turns nearest mid-range).
+        q: The joints at the turns nearest the arm's, within the limits.
+        evaluation: The objective at ``q``.
+        travel: Joint travel from the arm's joints (rad, Euclidean).
+        score: f(q) less the travel's weight.
+    """
+
+    run: Run
+    point: Point
+    q: np.ndarray
+    evaluation: Evaluation
+    travel: float
+    score: float
+
+
+class Way(NamedTuple):
+    """The chosen candidate and the clearance along its way (inf without obstacles)."""
+
+    candidate: Candidate
+    clearance: float
+    clear: bool
+
+
+def nearest_turns(arm: Arm, q: np.ndarray, q_from: np.ndarray) -> np.ndarray:
+    """q (M, dof) with each revolute joint moved by the whole turns k that bring it nearest
+    q_from (dof,) while it stays within the arm's limits: the k nearest the unconstrained
+    best, among those of the limits (q itself within them: an interval of k holding 0)."""
+    turn = 2.0 * math.pi
+    k = np.clip(
+        np.round((q_from - q) / turn), np.ceil((arm.lower - q) / turn), np.floor((arm.upper - q) / turn)
+    )
+    return np.where(arm.revolute, q + turn * k, q)
+
+
+def candidates(
+    objective: Objective, runs: list[Run], q_from: np.ndarray, travel_weight: float
+) -> list[Candidate]:
+    """Every feasible sample of the runs as a :class:`Candidate`, best score first."""
+    found = [(run, p) for run in runs for p in run.points if p.evaluation.feasible]
+    if not found:
+        return []
+    q = nearest_turns(objective.arm, np.array([p.q for _, p in found]), q_from)
+    pairs = [p.terms.get_pairs() for _, p in found]
+    distances = None if pairs[0] is None else np.array([d for d, _ in pairs])
+    evaluations = objective.evaluations(q, distances)  # (the margins of the joints moved by turns)
+    travel = np.linalg.norm(q - q_from, axis=1).tolist()
+    rows = [
+        Candidate(run, p, q_k, ev, t, ev.value - travel_weight * t)
+        for (run, p), q_k, ev, t in zip(found, q, evaluations, travel, strict=True)
+        if ev.feasible
+    ]
+    return sorted(rows, key=lambda c: -c.score)
+
+
+def way_floor(objective: Objective, q_from: np.ndarray) -> float:
+    r"""What a clear way from q_from keeps: :math:`\min(d_{min}, D(q_0))` less
+    :data:`~om_redundant.redundancy.clearance.ALONG_TOLERANCE` (-inf without obstacles)."""
+    if objective.clearance is None:
+        return -math.inf
+    return min(objective.min_clearance, objective.clearance.minimum(q_from)) - ALONG_TOLERANCE
+
+
+def way_clearance(objective: Objective, q_from: np.ndarray, q_to: np.ndarray, floor: float) -> float:
+    """The clearance along the way from q_from to q_to, as far as it matters against
+    ``floor`` (:meth:`~om_redundant.Clearance.minimum_along`; inf without obstacles)."""
+    if objective.clearance is None:
+        return math.inf
+    return objective.clearance.minimum_along(q_from, q_to, floor)
+
+
+def clear_way(objective: Objective, ranked: list[Candidate], q_from: np.ndarray) -> Way | None:
+    """The first of the ranked candidates whose way from q_from is clear (module docstring);
+    else the first, with its way's clearance; None if there are none."""
+    if not ranked:
+        return None
+    floor = way_floor(objective, q_from)
+    first = None
+    for candidate in ranked[:MAX_WAY_CHECKS]:
+        along = way_clearance(objective, q_from, candidate.q, floor)
+        if along >= floor:
+            return Way(candidate, along, True)
+        if first is None:
+            first = Way(candidate, along, False)
+    return first
