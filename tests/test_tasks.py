@@ -120,8 +120,10 @@ def test_optimizer_choice_is_reached(panda, panda_model):
         frame.set_target(mink.SE3.from_matrix(T))
         assert task.choice.configuration.isclose(panda.configuration_of(q))
         configuration.update(home)
-        for _ in range(10):
+        for _ in range(100):  # (after a jump the task aims a lead ahead of the hand: a few steps more)
             step(configuration, [frame, task], limits)
+            if max(hand_error(configuration, "attachment_site", T)) < 1e-9:
+                break
         assert max(hand_error(configuration, "attachment_site", T)) < 1e-9
         assert panda.configuration_of(configuration.q).isclose(panda.configuration_of(q), 1e-6)
     assert optimizer.previous[0] is None and optimizer.previous[1] is not None

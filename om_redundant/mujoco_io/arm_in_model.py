@@ -205,14 +205,18 @@ class ArmRoot:
             return self.fixed_pose
         return _body_pose(data, self.body) @ self.offset
 
+    def frame_pose(self, data: mujoco.MjData) -> np.ndarray:
+        """World pose (4, 4) of the end-effector frame E in data's kinematics as last computed."""
+        frame = np.eye(4)
+        frame[:3, :3] = getattr(data, self._xmat)[self._frame].reshape(3, 3)
+        frame[:3, 3] = getattr(data, self._pos)[self._frame]
+        return frame
+
     def _in_body(self, data: mujoco.MjData, q: np.ndarray) -> np.ndarray:
         """The frame's pose in body B at the arm's joints q (the model's other joints at qpos0)."""
         data.qpos[:] = self.joints.qpos_with(self.joints.model.qpos0, q)
         mujoco.mj_kinematics(self.joints.model, data)
-        frame = np.eye(4)
-        frame[:3, :3] = getattr(data, self._xmat)[self._frame].reshape(3, 3)
-        frame[:3, 3] = getattr(data, self._pos)[self._frame]
-        return np.linalg.solve(_body_pose(data, self.body), frame)
+        return np.linalg.solve(_body_pose(data, self.body), self.frame_pose(data))
 
     def _check_path(self) -> None:
         """The frame must hang below body B through the arm's joints only."""

@@ -33,6 +33,9 @@ from .probe import Point
 DEFAULT_TRAVEL_WEIGHT = 0.25
 #: Candidates whose way is checked, best first, before the best is taken as it is.
 MAX_WAY_CHECKS = 24
+#: A candidate's feasibility slack must exceed this: a refined interval end lies on the
+#: boundary (slack ~1e-12), where the next tracking step's rounding leaves the feasible set.
+INTERIOR = 1e-6
 
 
 class Candidate(NamedTuple):
@@ -77,8 +80,11 @@ def nearest_turns(arm: Arm, q: np.ndarray, q_from: np.ndarray) -> np.ndarray:
 def candidates(
     objective: Objective, runs: list[Run], q_from: np.ndarray, travel_weight: float
 ) -> list[Candidate]:
-    """Every feasible sample of the runs as a :class:`Candidate`, best score first."""
-    found = [(run, p) for run in runs for p in run.points if p.evaluation.feasible]
+    """Every feasible sample of the runs inside the feasible set (slack above
+    :data:`INTERIOR`; on its boundary only where no other is) as a :class:`Candidate`, best
+    score first."""
+    found = [(run, p) for run in runs for p in run.points if p.evaluation.slack > INTERIOR]
+    found = found or [(run, p) for run in runs for p in run.points if p.evaluation.feasible]
     if not found:
         return []
     q = nearest_turns(objective.arm, np.array([p.q for _, p in found]), q_from)

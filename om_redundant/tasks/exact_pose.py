@@ -18,12 +18,13 @@ import numpy.typing as npt
 from mink import SE3, TargetNotSet, TaskDefinitionError
 from mink import Configuration as MinkConfiguration
 
-from ..exceptions import UnreachableTarget
+from ..exceptions import InvalidInput, UnreachableTarget
 from ..mujoco_io.arm_in_model import ArmRoot
 from ..om.configuration import Configuration
 from ..om.solver import OMSolver
-from ..validation import as_instance, as_pose
+from ..validation import as_instance, as_pose, as_vector
 from .arm_task import ArmTask
+from .lead import DEFAULT_LEAD, lead_pose, pose_gap
 
 #: Default cost of :class:`ExactPoseTask`, per radian (metre for prismatic joints). With
 #: mink's usual ``FrameTask`` costs of 1 it makes the exact target dominate far from it,
@@ -132,6 +133,7 @@ class ExactPoseTask(ArmTask):
         cost: npt.ArrayLike = EXACT_POSE_COST,
         gain: float = 1.0,
         lm_damping: float = 0.0,
+        lead: tuple[float, float] | None = DEFAULT_LEAD,
     ):
         as_instance(solver, OMSolver, "solver")
         if (arm_configuration is None) == (optimizer is None):
@@ -156,6 +158,9 @@ class ExactPoseTask(ArmTask):
         self._root_pose: np.ndarray | None = None
         self._data: mujoco.MjData | None = None  # of the configuration last seen: where the world is
         self._seen = -1  # the clearance's version the target was solved for
+        self.lead = None if lead is None else _as_lead(lead)
+        self._aim: np.ndarray | None = None  # the world pose q* was solved for: the target or a lead
+        self._leading = False  # a target jumped to: the aim runs ahead of the hand until it is near
         self._unsolved_fallback: tuple[SE3 | None, Configuration | None] | None = None
         self._jacobian = self.scatter(np.eye(self.k))
         self._jacobian.setflags(write=False)
@@ -197,12 +202,17 @@ class ExactPoseTask(ArmTask):
         if self.root.fixed_pose is not None or self._data is not None:
             if self._clearance is not None and self._data is not None:
                 self._clearance.update(self._data)
-            self._solve(T, self.root.pose(self._data), self._q_target, arm_configuration)  # or raises
+            root = self.root.pose(self._data)
+            if self._jumped(T):
+                self._check_reachable(T, root)  # or raises
+                self._leading = True
+            self._solve(T, root, self._q_target, arm_configuration)  # or raises
             self._unsolved_fallback = None
         else:  # the root moves and the task has not seen where: solved at the next compute_*
             if self._unsolved_fallback is None:
                 self._unsolved_fallback = (self.transform_target_to_world, self.arm_configuration)
             self._root_pose = None
+            self._leading = False
         # (an SE3 given is kept as it is: SE3.from_matrix costs as much as the tracking step)
         given = transform_target_to_world
         self.transform_target_to_world = given if isinstance(given, SE3) else SE3.from_matrix(T)
@@ -225,8 +235,9 @@ class ExactPoseTask(ArmTask):
         self.choice = None
 
     def seed(self, configuration: MinkConfiguration) -> None:
-        """Put the arm's joints of ``configuration`` at :math:`q^*` (the other joints stay)."""
-        _, q_target = self._joint_target(configuration)
+        """Put the arm's joints of ``configuration`` at :math:`q^*` of the target itself (not of
+        a lead ahead of the hand; the other joints stay)."""
+        _, q_target = self._joint_target(configuration, lead=False)
         configuration.update(self.joints.qpos_with(configuration.data.qpos, q_target))
 
     def compute_error(self, configuration: MinkConfiguration) -> np.ndarray:
@@ -241,9 +252,12 @@ class ExactPoseTask(ArmTask):
 
     # -----------------------------------------------------------------------------------
 
-    def _joint_target(self, configuration: MinkConfiguration) -> tuple[np.ndarray, np.ndarray]:
+    def _joint_target(
+        self, configuration: MinkConfiguration, lead: bool = True
+    ) -> tuple[np.ndarray, np.ndarray]:
         """The arm's joints q and :math:`q^*` for the configuration's world, solved again if
-        the root or the obstacles moved."""
+        the root or the obstacles moved, or the aim (a lead ahead of the hand, or with
+        ``lead=False`` the target itself) did."""
         q = self._arm_q(configuration)
         if self.transform_target_to_world is None:
             raise TargetNotSet(self.__class__.__name__)
@@ -254,10 +268,17 @@ class ExactPoseTask(ArmTask):
         if self._clearance is not None:
             self._clearance.update(configuration.data)
             moved = moved or self._clearance.version != self._seen
+        T = self.transform_target_to_world.as_matrix()
+        if not moved:  # the aim moved? (one running ahead of the hand moves with it)
+            aim = (
+                lead_pose(self.root.frame_pose(configuration.data), T, self.lead)
+                if lead and self._leads()
+                else T
+            )
+            moved = self._aim is None or not np.array_equal(aim, self._aim)
         if moved:
-            T = self.transform_target_to_world.as_matrix()
             try:
-                self._solve(T, root, self._q_target, self.arm_configuration)
+                self._solve(T, root, self._q_target, self.arm_configuration, lead)
             except UnreachableTarget as exc:
                 if self._unsolved_fallback is None:
                     raise  # a solved target the world has moved away from: kept
@@ -280,9 +301,53 @@ class ExactPoseTask(ArmTask):
         root_pose: np.ndarray,
         hint: np.ndarray | None,
         arm_configuration: Configuration | None,
+        lead: bool = True,
     ) -> None:
-        """Solve T_world (the target frame's pose) for the root at root_pose and, only if that
-        succeeds, take it."""
+        """Solve T_world (the target frame's pose), or the lead ahead of the hand on the way
+        there, for the root at root_pose and, only if that succeeds, take it. Where the lead
+        has no feasible choice (the straight way passes through an obstacle or out of reach),
+        the target itself, from then on until the target jumps."""
+        if lead and self._leads():
+            aim = lead_pose(self.root.frame_pose(self._data), T_world, self.lead)
+            if aim is not T_world:
+                try:
+                    self._solve_at(aim, root_pose, hint, arm_configuration)
+                    self._aim = aim
+                    return
+                except UnreachableTarget:
+                    pass
+            self._leading = False  # arrived, or the lead's way is blocked: the target itself
+        self._solve_at(T_world, root_pose, hint, arm_configuration)
+        self._aim = T_world
+
+    def _leads(self) -> bool:
+        """Whether the task aims a lead ahead of the hand: after a jump of the target (with an
+        optimiser and a lead), until the hand is near it or the lead's way is blocked."""
+        return self._leading and self._data is not None
+
+    def _jumped(self, T_world: np.ndarray) -> bool:
+        """Whether a new target lies farther than the lead from the last one (or there is none),
+        with an optimiser, a lead and the hand seen: then the aim leads the hand, and the
+        target's reachability is checked at once (:meth:`_check_reachable`)."""
+        if self.optimizer is None or self.lead is None or self._data is None:
+            return False
+        if self.transform_target_to_world is None:
+            return True
+        distance, angle = pose_gap(self.transform_target_to_world.as_matrix(), T_world)
+        return distance > self.lead[0] or angle > self.lead[1]
+
+    def _check_reachable(self, T_world: np.ndarray, root_pose: np.ndarray) -> None:
+        """Raise UnreachableTarget unless the optimiser has a feasible choice at the target
+        (the task aims at a lead first, which may be reachable where the target is not)."""
+        q_current = self.joints.q(self._data.qpos)
+        choice = self.optimizer.choose(self._in_root(T_world, root_pose), q_current=q_current)
+        if not choice.ok:
+            raise UnreachableTarget(
+                f"ExactPoseTask: the optimizer found no configuration for the target: {choice.reason}"
+            )
+
+    def _in_root(self, T_world: np.ndarray, root_pose: np.ndarray) -> np.ndarray:
+        """A target frame's world pose as the pose of the arm's end-effector frame in its root."""
         if root_pose is self.root.fixed_pose:
             T_root = T_world if self._root_at_origin else self._world_to_fixed_root @ T_world
         else:
@@ -292,6 +357,18 @@ class ExactPoseTask(ArmTask):
             T_root[:3, 3] = R.T @ (T_world[:3, 3] - p)
         if self._tool_to_flange is not None:
             T_root = T_root @ self._tool_to_flange
+        return T_root
+
+    def _solve_at(
+        self,
+        T_world: np.ndarray,
+        root_pose: np.ndarray,
+        hint: np.ndarray | None,
+        arm_configuration: Configuration | None,
+    ) -> None:
+        """Solve the world pose T_world for the root at root_pose and, only if that succeeds,
+        take it."""
+        T_root = self._in_root(T_world, root_pose)
         if arm_configuration is None:
             q_current = None if self._data is None else self.joints.q(self._data.qpos)
             choice = self.optimizer.choose(T_root, previous=self.choice, q_current=q_current)
@@ -339,6 +416,13 @@ class ExactPoseTask(ArmTask):
                 f"ExactPoseTask: every solution for the target in configuration {c} breaks a joint limit"
             )
         return min(inside, key=lambda q: float(np.linalg.norm(q - solution.q)))
+
+
+def _as_lead(lead: Any) -> tuple[float, float]:
+    distance, angle = as_vector(lead, 2, "lead").tolist()
+    if not (distance > 0.0 and angle > 0.0):
+        raise InvalidInput(f"lead must be (metres, radians), both positive, got {lead!r}")
+    return distance, angle
 
 
 def _inverse(pose: np.ndarray) -> np.ndarray:
