@@ -42,7 +42,9 @@ HOLD = 3.0  # s a waypoint is held at most
 SPEED = 0.5  # m/s of an interpolated target
 REACHED = (1e-3, np.deg2rad(1.0))  # m, rad
 MIN_CLEARANCE = 0.03  # m the optimiser keeps
-MINK_MARGIN = 0.005  # m: CollisionAvoidanceLimit's minimum distance
+#: m: mink's CollisionAvoidanceLimit keeps MIN_CLEARANCE less this (its safety layer under the
+#: optimiser's choices)
+MINK_MARGIN = 0.005
 MAX_STEP = 0.005  # rad of psi per tick at 500 Hz
 VELOCITY = 2.0  # rad/s, every joint
 BALL = dict(centre=np.array([0.45, 0.0, 0.72]), amplitude=0.3, period=10.0, radius=0.05)
@@ -150,7 +152,10 @@ def run(
         mink.ConfigurationLimit(model),
         mink.VelocityLimit(model, {name: VELOCITY for name in arm.joint_names}),
         mink.CollisionAvoidanceLimit(
-            model, clearance.geom_pairs, minimum_distance_from_collisions=MINK_MARGIN, collision_detection_distance=0.1
+            model,
+            clearance.geom_pairs,
+            minimum_distance_from_collisions=MIN_CLEARANCE - MINK_MARGIN,
+            collision_detection_distance=0.1,
         ),
     ]
     ball, target = model.body("ball").mocapid[0], model.body("target").mocapid[0]
@@ -160,7 +165,9 @@ def run(
     t = 0.0
     T_from = arm.fk(configuration.q[: arm.dof])
     for T_goal in poses:
-        moving = max(np.linalg.norm(T_goal[:3, 3] - T_from[:3, 3]) / SPEED, 0.2) if mode == "interpolated" else 0.0
+        moving = (
+            max(np.linalg.norm(T_goal[:3, 3] - T_from[:3, 3]) / SPEED, 0.2) if mode == "interpolated" else 0.0
+        )
         for k in range(round((HOLD + moving) / DT)):
             s = min(1.0, k * DT / moving) if moving else 1.0
             T = _between(T_from, T_goal, s)
@@ -296,7 +303,9 @@ def video(name: str, poses: list[np.ndarray], q_start: np.ndarray, file: Path, f
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--arms", nargs="+", default=["panda", "iiwa14", "gen3"])
-    parser.add_argument("--modes", nargs="+", default=["step", "interpolated"], choices=["step", "interpolated"])
+    parser.add_argument(
+        "--modes", nargs="+", default=["step", "interpolated"], choices=["step", "interpolated"]
+    )
     parser.add_argument("--waypoints", type=int, default=WAYPOINTS)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--out", type=Path, help="write the results table (markdown) and JSON beside it")

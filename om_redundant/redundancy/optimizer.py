@@ -33,9 +33,8 @@ the exact OM solution in it:
 
 **Tracking** (``choose(T, previous)``): the one-call tracking step of
 :mod:`~om_redundant.redundancy.tracking` (an exact solve at the previous psi, the 1-variable
-box QP along the self-motion, an exact solve at the new psi). Where it cannot step, lands on
-an infeasible point, or (given the arm's joints ``q_current``) the way there is no longer
-clear, the optimiser **chooses afresh from the arm's joints**
+box QP along the self-motion, an exact solve at the new psi). Where it cannot step or lands
+on an infeasible point, the optimiser **chooses afresh from the arm's joints** ``q_current``
 (:mod:`~om_redundant.redundancy.reachable`): the previous branch's feasible samples first,
 scored by f less the joint travel from ``q_current``, the first with a clear way winning;
 the other branches only if the previous one has no feasible sample with a clear way. The
@@ -76,7 +75,7 @@ from .objective import (
 )
 from .paths import Path, sweep_circle
 from .probe import Point, Probe
-from .reachable import DEFAULT_TRAVEL_WEIGHT, Way, candidates, clear_way, way_clearance, way_floor
+from .reachable import DEFAULT_TRAVEL_WEIGHT, Way, candidates, clear_way
 from .shapes import Shape
 from .singularity import Singularity
 from .tracking import Tracked, Tracker
@@ -112,11 +111,13 @@ class RedundancyChoice:
             was made afresh from the arm's joints (``reason`` says why).
         travel: Joint travel (rad, Euclidean) from the arm's joints ``q_current`` (or the
             previous choice's) to ``solution.q``; nan from a global choice.
-        way_clearance: A lower bound of the clearance along the straight joint-space way
-            from those joints to ``solution.q``
-            (:meth:`~om_redundant.Clearance.minimum_along`): at least
+        way_clearance: Of a choice made afresh from the arm's joints: a lower bound of the
+            clearance along the straight joint-space way from them to ``solution.q``
+            (:meth:`~om_redundant.Clearance.minimum_along`), at least
             ``min(min_clearance, D(q_current))`` less 1 mm where the way is clear; inf
-            without obstacles; nan without ``q_current``.
+            without obstacles; nan otherwise (a tracking step moves the joints a step at a
+            time, each step's joints clear).
+        way_clear: The way is certified clear, or none was checked (``way_clearance`` nan).
     """
 
     ok: bool
@@ -132,6 +133,7 @@ class RedundancyChoice:
     rechosen: bool = False
     travel: float = math.nan
     way_clearance: float = math.nan
+    way_clear: bool = True
 
 
 class RedundancyOptimizer:
@@ -245,9 +247,8 @@ class RedundancyOptimizer:
             previous: The choice for the previous pose of a path: tracking mode (module
                 docstring). A previous choice that is not ok starts afresh.
             q_current: The arm's joints now (dof,), e.g. a mink configuration's: a fresh
-                choice weighs the joint travel from them and wants a clear way from them;
-                tracking checks that its way from them stays clear. Default: a global
-                choice, or the previous choice's joints when tracking.
+                choice weighs the joint travel from them and wants a clear way from them.
+                Default: a global choice, or the previous choice's joints when tracking.
 
         Returns:
             A :class:`RedundancyChoice`; ``ok`` is False, with the reason, only when no
@@ -317,28 +318,16 @@ class RedundancyOptimizer:
                 (),
                 curvature=step.curvature,
             )
-            if q_current is None:
-                return choice
-            floor = way_floor(self.objective, q_current)
-            along = way_clearance(self.objective, q_current, step.solution.q, floor)
-            choice = replace(
-                choice, travel=float(np.linalg.norm(step.solution.q - q_current)), way_clearance=along
-            )
-            # a way that was clear and is no longer (an obstacle moved in): choose afresh; one
-            # that was not clear either is left to mink's collision limit until it clears
-            if along >= floor or not previous.way_clearance >= floor:
-                return choice
-            to = step.solution.configuration.redundancy[0]
-            why = f"the way from the arm's joints to psi = {to:+.4f} is blocked"
-        else:
-            why = step
+            if q_current is not None:
+                choice = replace(choice, travel=float(np.linalg.norm(step.solution.q - q_current)))
+            return choice
         start = q_previous if q_current is None else q_current
         chosen = self._from_joints(T, start, signs)
         if not chosen.ok:
             return chosen
         flipped = chosen.configuration.signs != signs
         reason = (
-            f"tracking from branch {signs} at psi = {psi:+.4f} stopped: {why}; chose afresh from the "
+            f"tracking from branch {signs} at psi = {psi:+.4f} stopped: {step}; chose afresh from the "
             f"arm's joints: branch {chosen.configuration.signs} at psi = "
             f"{chosen.configuration.redundancy[0]:+.4f}, {chosen.travel:.3f} rad of joint travel"
         )
@@ -399,6 +388,7 @@ class RedundancyOptimizer:
             reason=note,
             travel=candidate.travel,
             way_clearance=way.clearance,
+            way_clear=way.clear,
         )
 
     def _climb_all(self, T: np.ndarray, runs: list[Run]) -> tuple[Run, Point]:

@@ -8,9 +8,13 @@ short way round), and the candidate scores
 
 .. math::  f(q) - w_t \, \lVert q - q_0 \rVert_2,
 
-the objective less :math:`w_t` per radian (metre, for a slide) of joint travel. Candidates
-are taken best first, and the first whose straight joint-space segment from :math:`q_0` is
-certified clear (:meth:`~om_redundant.Clearance.minimum_along`, above
+the objective less :math:`w_t` per radian (metre, for a slide) of joint travel, plus the
+clearance term of the objective taken along the way,
+:math:`w_c \min(1, D_{way}/d_{cap})`, :math:`D_{way}` the smallest clearance at
+:data:`WAY_SAMPLES` points along the straight joint-space segment from :math:`q_0` (every
+candidate's in one batch): of two ways, the one that keeps farther from the obstacles (a
+hand that stays above the table rather than diving to it). Candidates are taken best
+first, and the first whose segment is certified clear (:meth:`~om_redundant.Clearance.minimum_along`, above
 :math:`\min(d_{min}, D(q_0))` less :data:`~om_redundant.redundancy.clearance.ALONG_TOLERANCE`:
 an arm already nearer an obstacle than :math:`d_{min}` may stay as near, never nearer)
 wins; where none is, the best candidate, with the clearance its way has.
@@ -33,6 +37,8 @@ from .probe import Point
 DEFAULT_TRAVEL_WEIGHT = 0.25
 #: Candidates whose way is checked, best first, before the best is taken as it is.
 MAX_WAY_CHECKS = 24
+#: Points inside a way at which its clearance is sampled for the score.
+WAY_SAMPLES = 7
 #: A candidate's feasibility slack must exceed this: a refined interval end lies on the
 #: boundary (slack ~1e-12), where the next tracking step's rounding leaves the feasible set.
 INTERIOR = 1e-6
@@ -47,7 +53,7 @@ class Candidate(NamedTuple):
         q: The joints at the turns nearest the arm's, within the limits.
         evaluation: The objective at ``q``.
         travel: Joint travel from the arm's joints (rad, Euclidean).
-        score: f(q) less the travel's weight.
+        score: f(q) less the travel's weight, plus the way's sampled clearance term.
     """
 
     run: Run
@@ -59,7 +65,8 @@ class Candidate(NamedTuple):
 
 
 class Way(NamedTuple):
-    """The chosen candidate and the clearance along its way (inf without obstacles)."""
+    """The chosen candidate, the clearance along its way (inf without obstacles), and
+    whether that is clear (:func:`clear_way`)."""
 
     candidate: Candidate
     clearance: float
@@ -91,10 +98,18 @@ def candidates(
     pairs = [p.terms.get_pairs() for _, p in found]
     distances = None if pairs[0] is None else np.array([d for d, _ in pairs])
     evaluations = objective.evaluations(q, distances)  # (the margins of the joints moved by turns)
-    travel = np.linalg.norm(q - q_from, axis=1).tolist()
+    travel = np.linalg.norm(q - q_from, axis=1)
+    score = np.array([ev.value for ev in evaluations]) - travel_weight * travel
+    if objective.clearance is not None:  # the ways' sampled clearance, capped and weighted
+        s = np.arange(1, WAY_SAMPLES + 1) / (WAY_SAMPLES + 1)
+        ways = q_from + s[None, :, None] * (q - q_from)[:, None, :]  # (K, S, dof)
+        along = objective.clearance.minima(ways.reshape(-1, len(q_from))).reshape(len(q), WAY_SAMPLES)
+        score += objective.clearance_weight * np.minimum(1.0, along.min(axis=1) / objective.clearance_cap)
     rows = [
-        Candidate(run, p, q_k, ev, t, ev.value - travel_weight * t)
-        for (run, p), q_k, ev, t in zip(found, q, evaluations, travel, strict=True)
+        Candidate(run, p, q_k, ev, t, sc)
+        for (run, p), q_k, ev, t, sc in zip(
+            found, q, evaluations, travel.tolist(), score.tolist(), strict=True
+        )
         if ev.feasible
     ]
     return sorted(rows, key=lambda c: -c.score)

@@ -26,6 +26,11 @@ from ..validation import as_instance, as_pose, as_vector
 from .arm_task import ArmTask
 from .lead import DEFAULT_LEAD, lead_pose, pose_gap
 
+#: An arm held short of :math:`q^*` (farther than :data:`_NEAR` rad) whose joints move less than
+#: :data:`_STILL` rad per tick for this many ticks is stalled: the optimiser chooses afresh.
+STALL_TICKS = 50
+_NEAR, _STILL = 1e-3, 1e-4
+
 #: Default cost of :class:`ExactPoseTask`, per radian (metre for prismatic joints). With
 #: mink's usual ``FrameTask`` costs of 1 it makes the exact target dominate far from it,
 #: which removes the spurious stationary points of the sum (see :class:`ExactPoseTask`).
@@ -39,8 +44,11 @@ class RedundancyOptimizer(Protocol):
     ``choose(T, previous, q_current=q)`` takes a pose in the arm's root frame, the previous
     choice (or None) and the arm's joints now (or None), and returns an object with ``ok``
     (bool), ``solution`` (an om :class:`~om_redundant.Solution`), ``configuration`` (its
-    :class:`~om_redundant.Configuration`) and ``reason`` (str, why when not ok).
-    ``clearance`` is its :class:`~om_redundant.Clearance` or None.
+    :class:`~om_redundant.Configuration`), ``reason`` (str, why when not ok), ``rechosen``
+    (bool: chosen afresh where tracking could not continue) and ``way_clear`` (bool: the
+    joint-space way from ``q_current`` is clear), as a
+    :class:`~om_redundant.RedundancyChoice` has them. ``clearance`` is its
+    :class:`~om_redundant.Clearance` or None.
     """
 
     clearance: Any
@@ -133,7 +141,7 @@ class ExactPoseTask(ArmTask):
         cost: npt.ArrayLike = EXACT_POSE_COST,
         gain: float = 1.0,
         lm_damping: float = 0.0,
-        lead: tuple[float, float] | None = DEFAULT_LEAD,
+        lead: tuple[float, float, float] | None = DEFAULT_LEAD,
     ):
         as_instance(solver, OMSolver, "solver")
         if (arm_configuration is None) == (optimizer is None):
@@ -160,7 +168,11 @@ class ExactPoseTask(ArmTask):
         self._seen = -1  # the clearance's version the target was solved for
         self.lead = None if lead is None else _as_lead(lead)
         self._aim: np.ndarray | None = None  # the world pose q* was solved for: the target or a lead
+        self._way: tuple[np.ndarray, float] | None = None  # a joint-space way to q*: start, fraction
         self._leading = False  # a target jumped to: the aim runs ahead of the hand until it is near
+        self._blind = False  # the optimiser chose without the arm's joints (none seen yet)
+        self._last_q: np.ndarray | None = None  # the arm's joints at the last compute_error
+        self._stalled, self._patience = 0, STALL_TICKS  # ticks without progress; how many to bear
         self._unsolved_fallback: tuple[SE3 | None, Configuration | None] | None = None
         self._jacobian = self.scatter(np.eye(self.k))
         self._jacobian.setflags(write=False)
@@ -204,9 +216,9 @@ class ExactPoseTask(ArmTask):
                 self._clearance.update(self._data)
             root = self.root.pose(self._data)
             if self._jumped(T):
-                self._check_reachable(T, root)  # or raises
-                self._leading = True
-            self._solve(T, root, self._q_target, arm_configuration)  # or raises
+                self._jump(T, root)  # or raises
+            else:
+                self._solve(T, root, self._q_target, arm_configuration)  # or raises
             self._unsolved_fallback = None
         else:  # the root moves and the task has not seen where: solved at the next compute_*
             if self._unsolved_fallback is None:
@@ -233,6 +245,21 @@ class ExactPoseTask(ArmTask):
         """Forget the optimiser's last choice: the next solve chooses afresh (from the arm's
         joints as last seen) instead of tracking it. The current target stays until then."""
         self.choice = None
+        self._leading, self._way = False, None
+
+    def _stall(self, q: np.ndarray, gap: float) -> bool:
+        """Whether the arm, far from where the error pulls it, has stood still for
+        ``self._patience`` ticks (compute_error calls, one per ``solve_ik``); each fresh
+        choice that leaves it stalled doubles the patience, arriving resets it."""
+        still = self._last_q is not None and float(np.abs(q - self._last_q).max()) < _STILL
+        self._last_q = q
+        if gap <= _NEAR:
+            self._stalled, self._patience = 0, STALL_TICKS
+        self._stalled = self._stalled + 1 if still and gap > _NEAR else 0
+        if self._stalled < self._patience:
+            return False
+        self._stalled, self._patience = 0, 2 * self._patience
+        return True
 
     def seed(self, configuration: MinkConfiguration) -> None:
         """Put the arm's joints of ``configuration`` at :math:`q^*` of the target itself (not of
@@ -243,7 +270,30 @@ class ExactPoseTask(ArmTask):
     def compute_error(self, configuration: MinkConfiguration) -> np.ndarray:
         r"""The joint error :math:`e(q) = q_{arm} - \tilde q^*` (dof,)."""
         q, q_target = self._joint_target(configuration)
-        return q - self.joints.nearest_turn(q_target, q)
+        error = q - self._pull_to(q, q_target)
+        if self.optimizer is not None and self._stall(q, float(np.abs(error).max())):
+            self.reset_choice()  # held short of q* (by a collision or joint limit): choose afresh
+            q, q_target = self._joint_target(configuration, resolve=True)
+            error = q - self._pull_to(q, q_target)
+        return error
+
+    def _pull_to(self, q: np.ndarray, q_target: np.ndarray) -> np.ndarray:
+        """What the error pulls the arm's joints to: :math:`\tilde q^*`, or on a joint-space way
+        to a choice made afresh, the way's aim: a point of the straight segment from where the
+        arm was to :math:`q^*`, moved on by the joint lead (max-norm) whenever the arm is within
+        half of it (so that mink's steps, clipped by velocity limits joint by joint, keep to the
+        segment whose clearance the optimiser checked)."""
+        if self._way is None:
+            return self.joints.nearest_turn(q_target, q)
+        start, s = self._way
+        delta = q_target - start
+        step = self.lead[2] / max(float(np.abs(delta).max()), self.lead[2])
+        aim = start + s * delta
+        while s < 1.0 and np.abs(q - aim).max() <= 0.5 * self.lead[2]:
+            s = min(1.0, s + step)
+            aim = start + s * delta
+        self._way = None if s >= 1.0 else (start, s)
+        return aim
 
     def compute_jacobian(self, configuration: MinkConfiguration) -> np.ndarray:
         """The identity in the arm's dof columns, (dof, nv)."""
@@ -253,7 +303,7 @@ class ExactPoseTask(ArmTask):
     # -----------------------------------------------------------------------------------
 
     def _joint_target(
-        self, configuration: MinkConfiguration, lead: bool = True
+        self, configuration: MinkConfiguration, lead: bool = True, resolve: bool = False
     ) -> tuple[np.ndarray, np.ndarray]:
         """The arm's joints q and :math:`q^*` for the configuration's world, solved again if
         the root or the obstacles moved, or the aim (a lead ahead of the hand, or with
@@ -269,16 +319,17 @@ class ExactPoseTask(ArmTask):
             self._clearance.update(configuration.data)
             moved = moved or self._clearance.version != self._seen
         T = self.transform_target_to_world.as_matrix()
-        if not moved:  # the aim moved? (one running ahead of the hand moves with it)
-            aim = (
-                lead_pose(self.root.frame_pose(configuration.data), T, self.lead)
-                if lead and self._leads()
-                else T
-            )
+        blind = lead and self._blind and self.lead is not None  # chosen before the arm was seen
+        moved = moved or resolve
+        if not (moved or blind):  # the aim moved on?
+            aim = self._aim_for(T, configuration.data) if lead and self._leads() else T
             moved = self._aim is None or not np.array_equal(aim, self._aim)
-        if moved:
+        if moved or blind:
             try:
-                self._solve(T, root, self._q_target, self.arm_configuration, lead)
+                if blind:  # chosen afresh from the arm's joints, and led there
+                    self._jump(T, root)
+                else:
+                    self._solve(T, root, self._q_target, self.arm_configuration, lead)
             except UnreachableTarget as exc:
                 if self._unsolved_fallback is None:
                     raise  # a solved target the world has moved away from: kept
@@ -308,17 +359,33 @@ class ExactPoseTask(ArmTask):
         has no feasible choice (the straight way passes through an obstacle or out of reach),
         the target itself, from then on until the target jumps."""
         if lead and self._leads():
-            aim = lead_pose(self.root.frame_pose(self._data), T_world, self.lead)
+            aim = self._aim_for(T_world, self._data)
             if aim is not T_world:
+                taken = self.choice
                 try:
                     self._solve_at(aim, root_pose, hint, arm_configuration)
-                    self._aim = aim
-                    return
+                    if not (self.choice.rechosen and not self.choice.way_clear):
+                        self._aim = aim
+                        return
                 except UnreachableTarget:
                     pass
-            self._leading = False  # arrived, or the lead's way is blocked: the target itself
+                self.choice = taken  # (the target itself is chosen from where the lead's was)
+            self._leading = False  # arrived, or the way on from here is blocked: the target itself
         self._solve_at(T_world, root_pose, hint, arm_configuration)
         self._aim = T_world
+
+    def _aim_for(self, T_world: np.ndarray, data: mujoco.MjData) -> np.ndarray:
+        """The aim while leading: the first a lead ahead of the hand; the next a lead further
+        along from the last once the hand is within half the lead of it (so that consecutive
+        aims lie a lead apart on the way, and the arm is near each aim's joints when the next
+        is solved: the optimiser tracks from one to the next); meanwhile the last."""
+        hand = self.root.frame_pose(data)
+        if self._aim is None:
+            return lead_pose(hand, T_world, self.lead)
+        distance, angle = pose_gap(hand, self._aim)
+        if distance <= 0.5 * self.lead[0] and angle <= 0.5 * self.lead[1]:
+            return lead_pose(self._aim, T_world, self.lead)
+        return self._aim
 
     def _leads(self) -> bool:
         """Whether the task aims a lead ahead of the hand: after a jump of the target (with an
@@ -328,7 +395,7 @@ class ExactPoseTask(ArmTask):
     def _jumped(self, T_world: np.ndarray) -> bool:
         """Whether a new target lies farther than the lead from the last one (or there is none),
         with an optimiser, a lead and the hand seen: then the aim leads the hand, and the
-        target's reachability is checked at once (:meth:`_check_reachable`)."""
+        target is chosen at once (:meth:`_jump`)."""
         if self.optimizer is None or self.lead is None or self._data is None:
             return False
         if self.transform_target_to_world is None:
@@ -336,15 +403,32 @@ class ExactPoseTask(ArmTask):
         distance, angle = pose_gap(self.transform_target_to_world.as_matrix(), T_world)
         return distance > self.lead[0] or angle > self.lead[1]
 
-    def _check_reachable(self, T_world: np.ndarray, root_pose: np.ndarray) -> None:
-        """Raise UnreachableTarget unless the optimiser has a feasible choice at the target
-        (the task aims at a lead first, which may be reachable where the target is not)."""
+    def _jump(self, T_world: np.ndarray, root_pose: np.ndarray) -> None:
+        """A target that jumped. Where tracking can follow the hand's straight way there, a
+        lead at a time (:meth:`_tracks_to`: then the target is reachable), the task leads the
+        hand (:meth:`_aim_for`); else the optimiser's fresh choice there from the arm's joints
+        is the target (UnreachableTarget if it has none), the arm going there in joint space."""
+        self._stalled, self._patience = 0, STALL_TICKS
+        if self.choice is not None and self._tracks_to(T_world, root_pose):
+            self._leading, self._aim = True, None  # the first aim: a lead from the hand
+            self._solve(T_world, root_pose, self._q_target, None)
+            return
         q_current = self.joints.q(self._data.qpos)
-        choice = self.optimizer.choose(self._in_root(T_world, root_pose), q_current=q_current)
-        if not choice.ok:
-            raise UnreachableTarget(
-                f"ExactPoseTask: the optimizer found no configuration for the target: {choice.reason}"
-            )
+        self._take(self.optimizer.choose(self._in_root(T_world, root_pose), q_current=q_current), root_pose)
+        self._aim, self._leading, self._way = T_world, False, (q_current, 0.0)
+
+    def _tracks_to(self, T_world: np.ndarray, root_pose: np.ndarray) -> bool:
+        """Whether the optimiser tracks from its last choice to the target along the hand's
+        straight way there, a lead at a time (the aims :meth:`_aim_for` will take, the arm
+        taken to follow each), without choosing afresh or losing a clear way."""
+        previous, aim = self.choice, self.root.frame_pose(self._data)
+        while aim is not T_world:
+            aim = lead_pose(aim, T_world, self.lead)
+            q = previous.solution.q
+            previous = self.optimizer.choose(self._in_root(aim, root_pose), previous=previous, q_current=q)
+            if not (previous.ok and not previous.rechosen and previous.way_clear):
+                return False
+        return True
 
     def _in_root(self, T_world: np.ndarray, root_pose: np.ndarray) -> np.ndarray:
         """A target frame's world pose as the pose of the arm's end-effector frame in its root."""
@@ -371,22 +455,34 @@ class ExactPoseTask(ArmTask):
         T_root = self._in_root(T_world, root_pose)
         if arm_configuration is None:
             q_current = None if self._data is None else self.joints.q(self._data.qpos)
-            choice = self.optimizer.choose(T_root, previous=self.choice, q_current=q_current)
-            if not choice.ok:
-                raise UnreachableTarget(
-                    f"ExactPoseTask: the optimizer found no configuration for the target: {choice.reason}"
-                )
-            q = np.asarray(choice.solution.q, dtype=np.float64)
-            if not (choice.solution.ok and self.joints.within_limits(q)):
-                raise UnreachableTarget(
-                    f"ExactPoseTask: the optimizer's solution {np.round(q, 4).tolist()} "
-                    f"({choice.solution.status}) does not reach the target within the joint limits"
-                )
-        else:
-            choice, q = None, self._solve_in(T_root, arm_configuration, hint)
+            self._blind = q_current is None
+            self._take(self.optimizer.choose(T_root, previous=self.choice, q_current=q_current), root_pose)
+            return
+        self._q_target, self.choice, self._root_pose = (
+            self._solve_in(T_root, arm_configuration, hint),
+            None,
+            root_pose,
+        )
+        if self._clearance is not None:
+            self._seen = self._clearance.version
+
+    def _take(self, choice: Any, root_pose: np.ndarray) -> None:
+        """Take the optimiser's choice (UnreachableTarget if it is none within the limits)."""
+        if not choice.ok:
+            raise UnreachableTarget(
+                f"ExactPoseTask: the optimizer found no configuration for the target: {choice.reason}"
+            )
+        q = np.asarray(choice.solution.q, dtype=np.float64)
+        if not (choice.solution.ok and self.joints.within_limits(q)):
+            raise UnreachableTarget(
+                f"ExactPoseTask: the optimizer's solution {np.round(q, 4).tolist()} "
+                f"({choice.solution.status}) does not reach the target within the joint limits"
+            )
         self._q_target, self.choice, self._root_pose = q, choice, root_pose
         if self._clearance is not None:
             self._seen = self._clearance.version
+        if choice.rechosen and self._data is not None:  # q* jumped: a joint-space way there
+            self._way = (self.joints.q(self._data.qpos), 0.0)
 
     def _live_clearance(self, optimizer: RedundancyOptimizer | None, model: mujoco.MjModel) -> Any:
         """The optimiser's clearance where the task reads its obstacles from the model (the
@@ -418,11 +514,11 @@ class ExactPoseTask(ArmTask):
         return min(inside, key=lambda q: float(np.linalg.norm(q - solution.q)))
 
 
-def _as_lead(lead: Any) -> tuple[float, float]:
-    distance, angle = as_vector(lead, 2, "lead").tolist()
-    if not (distance > 0.0 and angle > 0.0):
-        raise InvalidInput(f"lead must be (metres, radians), both positive, got {lead!r}")
-    return distance, angle
+def _as_lead(lead: Any) -> tuple[float, float, float]:
+    distance, angle, joints = as_vector(lead, 3, "lead").tolist()
+    if not (distance > 0.0 and angle > 0.0 and joints > 0.0):
+        raise InvalidInput(f"lead must be (metres, radians, radians), all positive, got {lead!r}")
+    return distance, angle, joints
 
 
 def _inverse(pose: np.ndarray) -> np.ndarray:

@@ -17,8 +17,9 @@ import math
 
 import numpy as np
 
-#: Default lead (m, rad) of the aim ahead of the hand.
-DEFAULT_LEAD = (0.05, 0.25)
+#: Default leads of :class:`~om_redundant.ExactPoseTask`'s aims: of the hand on its straight
+#: way (m, rad), and of the joints on a joint-space way (rad, max-norm).
+DEFAULT_LEAD = (0.05, 0.25, 0.05)
 
 
 def pose_gap(A: np.ndarray, B: np.ndarray) -> tuple[float, float]:
@@ -27,7 +28,7 @@ def pose_gap(A: np.ndarray, B: np.ndarray) -> tuple[float, float]:
     return float(np.linalg.norm(B[:3, 3] - A[:3, 3])), math.acos(min(1.0, max(-1.0, cos)))
 
 
-def lead_pose(hand: np.ndarray, target: np.ndarray, lead: tuple[float, float]) -> np.ndarray:
+def lead_pose(hand: np.ndarray, target: np.ndarray, lead: tuple[float, ...]) -> np.ndarray:
     """The aim (module docstring): ``target`` itself (the same object) when it lies within
     the lead of the hand, else the pose a fraction s of the way there."""
     distance, angle = pose_gap(hand, target)
