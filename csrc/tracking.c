@@ -31,6 +31,9 @@ enum { O_PSI, O_STEP, O_CURVATURE, O_MARGIN, O_SINGULARITY, O_CLEARANCE, O_POS, 
 #define MIN_CURVATURE 1e-3
 #define MAX_CURVATURE 1e3
 #define SINGULAR_TANGENT 1e-9 /* |Dpsi . n| below this of |Dpsi| |n|: a fold, no step */
+/* The step keeps the floors' pieces this far above them: a step to a floor itself lands the
+ * exact solve's rounding (1e-16 of the pieces) on either side, and one just outside is refused */
+#define FLOOR_SLACK 1e-9
 
 typedef struct {
     int n;
@@ -252,7 +255,8 @@ PyObject *om_track_step(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) 
         PyErr_SetString(PyExc_ValueError, "track_step: a singularity's joint is not a joint index in [0, 7)");
     else {
         tracking tr = {s, setup, v[4].buf, v[5].buf, v[6].buf, v[7].buf, v[8].buf, v[9].buf, v[10].buf,
-                       {setup[S_WM], setup[S_WC], setup[S_WS]}, {0.0, setup[S_FLOOR_C], -INFINITY},
+                       {setup[S_WM], setup[S_WC], setup[S_WS]},
+                       {FLOOR_SLACK, setup[S_FLOOR_C] + FLOOR_SLACK, -INFINITY},
                        {INFINITY, 1.0, 1.0}};
         status = track(&tr, v[0].buf, v[1].buf, v[2].buf, v[11].buf, v[12].buf);
     }

@@ -55,12 +55,16 @@ from .objective import SINGULARITY_CAP, Objective
 
 #: Curvature b of the first tracking step's model (per rad^2).
 INITIAL_CURVATURE = 0.1
+#: Where nothing is feasible within max_step (the feasible range moved away faster), the step
+#: is tried again within this many times max_step: the joint step bounds it as before.
+WIDER = 64.0
 _JOINT_STEP = 0.25  # rad: the step keeps the linearised joint motion within this
 # setup vector layout (csrc/tracking.c)
-_PSI, _CURVATURE, _N_SETUP = 0, 7, 12
+_PSI, _MAX_STEP, _CURVATURE, _N_SETUP = 0, 6, 7, 12
 # output layout after q (csrc/tracking.c)
 _O_PSI, _O_CURVATURE, _O_MARGIN, _O_SINGULARITY = 0, 2, 3, 4
 _O_POS, _O_ORI, _O_EVALS, _O_WITHIN, _N_OUT = 6, 7, 8, 9, 10
+_INFEASIBLE = 3  # ckernels.track_step's status: nothing feasible within the step
 #: Why ckernels.track_step refused, by its status (csrc/tracking.c).
 _REFUSED = {
     1: "no exact solution at the previous psi continues the previous joints",
@@ -117,6 +121,7 @@ class Tracked(NamedTuple):
         solution: The exact solution (configuration: the branch and the new psi).
         margin, clearance, value: M, D and f at its joints.
         curvature: The curvature the next step's model takes.
+        feasible: Within the limits and clear (what the optimiser is given always is).
     """
 
     solution: Solution
@@ -124,6 +129,7 @@ class Tracked(NamedTuple):
     clearance: float
     value: float
     curvature: float
+    feasible: bool = True
 
 
 class Tracker:
@@ -166,6 +172,7 @@ class Tracker:
         )
         # An arm near a family solves through om.near.NearKernel: no compiled tracking step.
         self._kernel = solver.kernel if isinstance(solver.kernel, ckernels.Solver) else None
+        self.max_step = max_step
         # The last step's clearances, at its result's joints: the next step's linearisation.
         # Without obstacles, no pairs.
         self._last = Linearisation(np.zeros(arm.dof), np.zeros(0), np.zeros((0, arm.dof)))
@@ -184,13 +191,32 @@ class Tracker:
         if self._kernel is None:
             return "an arm near a family has no compiled tracking step"
         with self._lock:
-            return self._step(T, signs, psi, q, curvature)
+            step = self._step(T, signs, psi, q, curvature, self.max_step)
+            if step == _REFUSED[_INFEASIBLE]:
+                step = self._step(T, signs, psi, q, curvature, WIDER * self.max_step)
+            if isinstance(step, Tracked) and not step.feasible:
+                # just outside a floor (the pieces' curvature over the step): one step more from
+                # there at the same pose, which the floors' linear models put back inside
+                (psi_out,) = step.solution.configuration.redundancy
+                step = self._step(T, signs, psi_out, step.solution.q, step.curvature, self.max_step)
+            if isinstance(step, Tracked) and not step.feasible:
+                if not step.margin >= 0.0:
+                    return f"the step's joints leave the limits (margin {step.margin:.3g})"
+                return f"the step's joints come within {step.clearance:.4f} m of an obstacle"
+            return step
 
     def _step(
-        self, T: np.ndarray, signs: tuple[int, ...], psi: float, q: np.ndarray, curvature: float
+        self,
+        T: np.ndarray,
+        signs: tuple[int, ...],
+        psi: float,
+        q: np.ndarray,
+        curvature: float,
+        max_step: float,
     ) -> Tracked | str:
         work, objective = self.work, self.objective
         work.setup[_PSI] = psi
+        work.setup[_MAX_STEP] = max_step
         work.setup[_CURVATURE] = curvature if math.isfinite(curvature) else INITIAL_CURVATURE
         linearised = self._linearised_at(q)
         signs_array = self._signs.get(signs)
@@ -213,10 +239,6 @@ class Tracker:
             if clearance >= objective.clearance_reach:  # every pair beyond the reach: D itself, uncapped
                 clearance = objective.clearance.minimum(q_new)
             value += objective.clearance_weight * min(1.0, clearance / objective.clearance_cap)
-        if not margin >= 0.0:
-            return f"the step's joints leave the limits (margin {margin:.3g})"
-        if not clearance >= objective.min_clearance:
-            return f"the step's joints come within {clearance:.4f} m of an obstacle"
         configuration = Configuration(signs, (wrap_psi(out[_O_PSI]),))
         solution = Solution(
             q_new,
@@ -228,7 +250,8 @@ class Tracker:
             int(out[_O_EVALS]),
             bool(out[_O_WITHIN]),
         )
-        return Tracked(solution, margin, clearance, value, out[_O_CURVATURE])
+        feasible = margin >= 0.0 and clearance >= objective.min_clearance
+        return Tracked(solution, margin, clearance, value, out[_O_CURVATURE], feasible)
 
     def _linearised_at(self, q: np.ndarray) -> Linearisation:
         """The clearances at q: the last step's where q is its result's joints and the

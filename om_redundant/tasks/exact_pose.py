@@ -280,20 +280,21 @@ class ExactPoseTask(ArmTask):
     def _pull_to(self, q: np.ndarray, q_target: np.ndarray) -> np.ndarray:
         """What the error pulls the arm's joints to: :math:`\tilde q^*`, or on a joint-space way
         to a choice made afresh, the way's aim: a point of the straight segment from where the
-        arm was to :math:`q^*`, moved on by the joint lead (max-norm) whenever the arm is within
-        half of it (so that mink's steps, clipped by velocity limits joint by joint, keep to the
-        segment whose clearance the optimiser checked)."""
+        arm was to :math:`q^*`, moved on by the joint lead (max-norm) once the arm is as near
+        :math:`q^*` as the aim, give or take half the lead (so that mink's steps, clipped by
+        velocity limits joint by joint, keep near the segment whose clearance the optimiser
+        checked)."""
         if self._way is None:
             return self.joints.nearest_turn(q_target, q)
         start, s = self._way
         delta = q_target - start
-        step = self.lead[2] / max(float(np.abs(delta).max()), self.lead[2])
-        aim = start + s * delta
-        while s < 1.0 and np.abs(q - aim).max() <= 0.5 * self.lead[2]:
+        span = float(np.abs(delta).max())
+        step = self.lead[2] / max(span, self.lead[2])
+        left = float(np.abs(q - q_target).max())
+        while s < 1.0 and left <= (1.0 - s) * span + 0.5 * self.lead[2]:
             s = min(1.0, s + step)
-            aim = start + s * delta
         self._way = None if s >= 1.0 else (start, s)
-        return aim
+        return start + s * delta
 
     def compute_jacobian(self, configuration: MinkConfiguration) -> np.ndarray:
         """The identity in the arm's dof columns, (dof, nv)."""
@@ -361,7 +362,6 @@ class ExactPoseTask(ArmTask):
         if lead and self._leads():
             aim = self._aim_for(T_world, self._data)
             if aim is not T_world:
-                taken = self.choice
                 try:
                     self._solve_at(aim, root_pose, hint, arm_configuration)
                     if not (self.choice.rechosen and not self.choice.way_clear):
@@ -369,21 +369,28 @@ class ExactPoseTask(ArmTask):
                         return
                 except UnreachableTarget:
                     pass
-                self.choice = taken  # (the target itself is chosen from where the lead's was)
-            self._leading = False  # arrived, or the way on from here is blocked: the target itself
+                self.choice = None  # the way on is blocked: the target itself, chosen afresh
+            self._leading = False  # (or arrived: the target tracked from the last aim)
         self._solve_at(T_world, root_pose, hint, arm_configuration)
         self._aim = T_world
 
     def _aim_for(self, T_world: np.ndarray, data: mujoco.MjData) -> np.ndarray:
         """The aim while leading: the first a lead ahead of the hand; the next a lead further
-        along from the last once the hand is within half the lead of it (so that consecutive
-        aims lie a lead apart on the way, and the arm is near each aim's joints when the next
-        is solved: the optimiser tracks from one to the next); meanwhile the last."""
+        along from the last once the hand is as near the target as that aim is, give or take
+        half the lead (the FrameTask pulls the hand past the aim, towards the target, so the
+        hand need not meet the aim itself); meanwhile the last. Consecutive aims lie a lead
+        apart on the way, and the optimiser tracks from one to the next."""
         hand = self.root.frame_pose(data)
         if self._aim is None:
             return lead_pose(hand, T_world, self.lead)
-        distance, angle = pose_gap(hand, self._aim)
-        if distance <= 0.5 * self.lead[0] and angle <= 0.5 * self.lead[1]:
+        (hand_distance, hand_angle), (aim_distance, aim_angle) = (
+            pose_gap(hand, T_world),
+            pose_gap(self._aim, T_world),
+        )
+        if (
+            hand_distance <= aim_distance + 0.5 * self.lead[0]
+            and hand_angle <= aim_angle + 0.5 * self.lead[1]
+        ):
             return lead_pose(self._aim, T_world, self.lead)
         return self._aim
 
@@ -410,12 +417,13 @@ class ExactPoseTask(ArmTask):
         is the target (UnreachableTarget if it has none), the arm going there in joint space."""
         self._stalled, self._patience = 0, STALL_TICKS
         if self.choice is not None and self._tracks_to(T_world, root_pose):
-            self._leading, self._aim = True, None  # the first aim: a lead from the hand
+            self._leading, self._aim, self._way = True, None, None  # the first aim: a lead from the hand
             self._solve(T_world, root_pose, self._q_target, None)
             return
         q_current = self.joints.q(self._data.qpos)
-        self._take(self.optimizer.choose(self._in_root(T_world, root_pose), q_current=q_current), root_pose)
-        self._aim, self._leading, self._way = T_world, False, (q_current, 0.0)
+        choice = self.optimizer.choose(self._in_root(T_world, root_pose), q_current=q_current)
+        self._take(choice, root_pose, fresh=True)
+        self._aim, self._leading = T_world, False
 
     def _tracks_to(self, T_world: np.ndarray, root_pose: np.ndarray) -> bool:
         """Whether the optimiser tracks from its last choice to the target along the hand's
@@ -455,8 +463,9 @@ class ExactPoseTask(ArmTask):
         T_root = self._in_root(T_world, root_pose)
         if arm_configuration is None:
             q_current = None if self._data is None else self.joints.q(self._data.qpos)
-            self._blind = q_current is None
-            self._take(self.optimizer.choose(T_root, previous=self.choice, q_current=q_current), root_pose)
+            self._blind, fresh = q_current is None, self.choice is None
+            choice = self.optimizer.choose(T_root, previous=self.choice, q_current=q_current)
+            self._take(choice, root_pose, fresh)
             return
         self._q_target, self.choice, self._root_pose = (
             self._solve_in(T_root, arm_configuration, hint),
@@ -466,8 +475,10 @@ class ExactPoseTask(ArmTask):
         if self._clearance is not None:
             self._seen = self._clearance.version
 
-    def _take(self, choice: Any, root_pose: np.ndarray) -> None:
-        """Take the optimiser's choice (UnreachableTarget if it is none within the limits)."""
+    def _take(self, choice: Any, root_pose: np.ndarray, fresh: bool = False) -> None:
+        """Take the optimiser's choice (UnreachableTarget if it is none within the limits); one
+        made afresh from the arm's joints (``fresh``, or re-chosen where tracking stopped) is
+        reached along a joint-space way (:meth:`_pull_to`)."""
         if not choice.ok:
             raise UnreachableTarget(
                 f"ExactPoseTask: the optimizer found no configuration for the target: {choice.reason}"
@@ -481,7 +492,7 @@ class ExactPoseTask(ArmTask):
         self._q_target, self.choice, self._root_pose = q, choice, root_pose
         if self._clearance is not None:
             self._seen = self._clearance.version
-        if choice.rechosen and self._data is not None:  # q* jumped: a joint-space way there
+        if (fresh or choice.rechosen) and self._data is not None:  # q* jumped: a joint-space way there
             self._way = (self.joints.q(self._data.qpos), 0.0)
 
     def _live_clearance(self, optimizer: RedundancyOptimizer | None, model: mujoco.MjModel) -> Any:

@@ -19,7 +19,7 @@ import numpy as np
 
 #: Default leads of :class:`~om_redundant.ExactPoseTask`'s aims: of the hand on its straight
 #: way (m, rad), and of the joints on a joint-space way (rad, max-norm).
-DEFAULT_LEAD = (0.05, 0.25, 0.05)
+DEFAULT_LEAD = (0.05, 0.25, 0.1)
 
 
 def pose_gap(A: np.ndarray, B: np.ndarray) -> tuple[float, float]:

@@ -1,0 +1,215 @@
+"""The world moves: obstacles on mocap bodies, a second arm, the arm's own mobile base.
+
+``Clearance.update`` reads them from a ``mujoco.MjData``, and ``ExactPoseTask`` does so every
+tick from its ``mink.Configuration``: at every tick of a mink loop, every pair's distance
+equals MuJoCo's own ``mj_geomDistance`` in the configuration's data to 1e-9 m, and the task's
+choice keeps the optimiser's clearance from the obstacles where they are now.
+"""
+
+from __future__ import annotations
+
+import mink
+import mujoco
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import om_redundant as om
+from tests.conftest import random_q
+
+DT = 0.002
+MIN_CLEARANCE = 0.03
+Q_PANDA = np.array([0.3, -0.4, 0.2, -2.2, 0.3, 1.9, 0.6])
+
+
+@pytest.fixture(scope="module")
+def panda():
+    return om.OMSolver("panda")
+
+
+def mujoco_distances(clearance: om.Clearance, data: mujoco.MjData) -> np.ndarray:
+    """Every pair's distance by MuJoCo in data (its kinematics current), in the pairs' order."""
+    model, fromto = clearance.model, np.empty(6)
+    ids = [(a, o) for arms, obstacles in clearance.geom_pairs for a in arms for o in obstacles]
+    return np.array([mujoco.mj_geomDistance(model, data, a, o, clearance.distmax, fromto) for a, o in ids])
+
+
+def ball_scene(arm: om.Arm) -> mujoco.MjModel:
+    """The arm, a mocap ball and a mocap capsule."""
+    spec = mujoco.MjSpec.from_string(om.scene_mjcf(arm))
+    ball = spec.worldbody.add_body(name="ball", mocap=True, pos=[0.0, 0.8, 1.0])
+    ball.add_geom(name="ball", type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[0.05, 0, 0])
+    rod = spec.worldbody.add_body(name="rod", mocap=True, pos=[0.6, -0.6, 0.2])
+    rod.add_geom(name="rod", type=mujoco.mjtGeom.mjGEOM_CAPSULE, size=[0.03, 0.15, 0])
+    return spec.compile()
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1))
+def test_update_reads_where_mocap_obstacles_are(panda, seed):
+    """Random joints and random mocap poses: after update, the distances are MuJoCo's."""
+    rng = np.random.default_rng(seed)
+    model = ball_scene(panda.arm)
+    clearance = om.Clearance(model, panda.arm, ["ball", "rod"])
+    data = mujoco.MjData(model)
+    q = random_q(panda.arm, 1, rng)[0]
+    data.qpos[:7] = q
+    data.mocap_pos[:] = rng.uniform([0.0, -0.6, 0.0], [0.8, 0.6, 1.0], (2, 3))
+    quat = rng.normal(size=(2, 4))
+    data.mocap_quat[:] = quat / np.linalg.norm(quat, axis=1, keepdims=True)
+    mujoco.mj_kinematics(model, data)
+    version = clearance.version
+    assert clearance.update(data) and clearance.version == version + 1
+    assert not clearance.update(data)  # nothing moved since
+    np.testing.assert_allclose(clearance.distances(q), mujoco_distances(clearance, data), rtol=0.0, atol=1e-9)
+
+
+def test_update_refuses_data_of_another_model(panda):
+    clearance = om.Clearance(ball_scene(panda.arm), panda.arm, ["ball"])
+    with pytest.raises(om.InvalidInput, match="MjData of the clearance's own model"):
+        clearance.update(mujoco.MjData(ball_scene(panda.arm)))
+    with pytest.raises(om.InvalidInput, match="got ndarray"):
+        clearance.update(np.zeros(3))
+
+
+def loop(configuration, tasks, limits, ticks, move, check) -> None:
+    """A mink loop: move the world, then a tick, then check; ticks times."""
+    for k in range(ticks):
+        move(k)
+        mujoco.mj_kinematics(configuration.model, configuration.data)
+        velocity = mink.solve_ik(configuration, tasks, DT, "daqp", damping=1e-6, limits=limits)
+        configuration.integrate_inplace(velocity, DT)
+        check(k)
+
+
+def test_a_ball_moving_into_the_arm_is_seen_every_tick(panda):
+    """A mocap ball moves through the elbow's place while the hand holds its pose: at every
+    tick the task's distances are MuJoCo's in the configuration's data, and the task's
+    choice keeps the optimiser's clearance from the ball where it is now."""
+    model = ball_scene(panda.arm)
+    clearance = om.Clearance(model, panda.arm, ["ball", "rod"])
+    optimizer = om.RedundancyOptimizer(panda, clearance, min_clearance=MIN_CLEARANCE, max_step=0.005)
+    task = om.ExactPoseTask(panda, model, optimizer=optimizer)
+    configuration = mink.Configuration(model)
+    configuration.update(np.concatenate([Q_PANDA, configuration.q[7:]]))
+    data = configuration.data
+    T = panda.arm.fk(Q_PANDA)
+    frame = mink.FrameTask("attachment_site", "site", position_cost=1.0, orientation_cost=1.0)
+    frame.set_target(mink.SE3.from_matrix(T))
+    task.set_target(T)
+    elbow = data.xpos[model.body("link4").id].copy()
+    start = elbow + np.array([0.0, 0.4, 0.0])
+    data.mocap_pos[0] = start
+    limits = [
+        mink.ConfigurationLimit(model),
+        mink.VelocityLimit(model, dict.fromkeys(panda.arm.joint_names, 3.0)),
+    ]
+    seen = []
+
+    def move(k):
+        data.mocap_pos[0] = start + (elbow - start) * min(1.0, k / 400)  # into where the elbow was
+
+    def check(k):
+        task.set_target(T)
+        q = configuration.q[:7]
+        np.testing.assert_allclose(
+            clearance.distances(q), mujoco_distances(clearance, data), rtol=0.0, atol=1e-9
+        )
+        q_star = task.joint_target
+        data_at_star = mujoco.MjData(model)
+        data_at_star.qpos[:], data_at_star.mocap_pos[:] = configuration.q, data.mocap_pos
+        data_at_star.qpos[:7] = q_star
+        mujoco.mj_kinematics(model, data_at_star)
+        seen.append(mujoco_distances(clearance, data_at_star).min())
+
+    loop(configuration, [frame, task], limits, 600, move, check)
+    assert min(seen) >= MIN_CLEARANCE - 1e-9  # every tick's q* clear of the ball where it was
+    assert np.linalg.norm(panda.arm.fk(configuration.q[:7])[:3, 3] - T[:3, 3]) < 1e-6
+    assert clearance.minimum(configuration.q[:7]) >= MIN_CLEARANCE - 2e-3  # the arm made room
+
+
+def two_arms(arm: om.Arm) -> mujoco.MjModel:
+    """Two copies of the arm facing each other 1.1 m apart, joints prefixed l_ and r_."""
+    spec = mujoco.MjSpec()
+    for prefix, x, yaw in (("l_", 0.0, 0.0), ("r_", 1.1, np.pi)):
+        frame = spec.worldbody.add_frame(pos=[x, 0, 0], quat=[np.cos(yaw / 2), 0, 0, np.sin(yaw / 2)])
+        child = mujoco.MjSpec.from_string(om.arm_mjcf(arm))
+        frame.attach_body(child.body("base"), prefix, "")
+    return spec.compile()
+
+
+def test_a_second_arm_moving_toward_the_first_is_seen_every_tick(panda):
+    model = two_arms(panda.arm)
+    other = [model.geom(g).name for g in range(model.ngeom) if model.geom(g).name.startswith("r_")]
+    clearance = om.Clearance(model, panda.arm, other, prefix="l_")
+    optimizer = om.RedundancyOptimizer(panda, clearance, min_clearance=MIN_CLEARANCE, max_step=0.005)
+    task = om.ExactPoseTask(panda, model, optimizer=optimizer, prefix="l_")
+    configuration = mink.Configuration(model)
+    q_other = np.array([0.0, 0.2, 0.0, -1.6, 0.0, 1.8, 0.0])
+    configuration.update(np.concatenate([Q_PANDA, q_other]))
+    data = configuration.data
+    T = task.root.pose(data) @ panda.arm.fk(Q_PANDA)
+    frame = mink.FrameTask("l_attachment_site", "site", position_cost=1.0, orientation_cost=1.0)
+    frame.set_target(mink.SE3.from_matrix(T))
+    task.set_target(T)
+    right = slice(7, 14)
+    reaching = np.array([0.0, 0.9, 0.0, -1.0, 0.0, 1.9, 0.0])  # the right arm reaches across
+    limits = [mink.ConfigurationLimit(model)]
+    errors = []
+
+    def move(k):
+        data.qpos[right] = q_other + (reaching - q_other) * min(1.0, k / 300)
+
+    def check(k):
+        task.set_target(T)
+        q = configuration.q[:7]
+        errors.append(np.abs(clearance.distances(q) - mujoco_distances(clearance, data)).max())
+
+    loop(configuration, [frame, task], limits, 400, move, check)
+    assert max(errors) < 1e-9
+    assert clearance.version > 300  # every move was read
+
+
+def test_the_arms_own_mobile_base_is_followed_by_the_clearance(panda):
+    """The arm on a cart driven around a fixed pole: the distances are MuJoCo's every tick."""
+    spec = mujoco.MjSpec()
+    cart = spec.worldbody.add_body(name="cart", pos=[0, 0, 0.2])
+    for name, kind, axis in (
+        ("cart_x", mujoco.mjtJoint.mjJNT_SLIDE, [1, 0, 0]),
+        ("cart_yaw", mujoco.mjtJoint.mjJNT_HINGE, [0, 0, 1]),
+    ):
+        cart.add_joint(name=name, type=kind, axis=axis)
+    cart.add_geom(size=[0.2, 0.2, 0.05], type=mujoco.mjtGeom.mjGEOM_BOX)
+    cart.add_frame().attach_body(mujoco.MjSpec.from_string(om.arm_mjcf(panda.arm)).body("base"), "arm_", "")
+    spec.worldbody.add_geom(
+        name="pole",
+        type=mujoco.mjtGeom.mjGEOM_CAPSULE,
+        size=[0.04, 0, 0],
+        fromto=[0.9, 0.3, 0, 0.9, 0.3, 1.2],
+    )
+    model = spec.compile()
+    clearance = om.Clearance(model, panda.arm, ["pole"], prefix="arm_")
+    optimizer = om.RedundancyOptimizer(panda, clearance, min_clearance=MIN_CLEARANCE, max_step=0.005)
+    task = om.ExactPoseTask(panda, model, optimizer=optimizer, prefix="arm_")
+    configuration = mink.Configuration(model, np.concatenate([[0.0, 0.0], Q_PANDA]))
+    data = configuration.data
+    T = task.root.pose(data) @ panda.arm.fk(Q_PANDA)
+    frame = mink.FrameTask("arm_attachment_site", "site", position_cost=1.0, orientation_cost=1.0)
+    frame.set_target(mink.SE3.from_matrix(T))
+    task.set_target(T)
+    limits = [mink.ConfigurationLimit(model)]
+    errors, clear = [], []
+
+    def move(k):  # the cart drives on, turning (the hand's target stays in the world)
+        data.qpos[:2] = [0.2 * min(1.0, k / 200), 0.3 * min(1.0, k / 200)]
+
+    def check(k):
+        task.set_target(T)
+        q = configuration.q[2:9]
+        errors.append(np.abs(clearance.distances(q) - mujoco_distances(clearance, data)).max())
+        clear.append(task.choice.clearance)
+
+    loop(configuration, [frame, task], limits, 300, move, check)
+    assert max(errors) < 1e-9
+    assert min(clear) >= MIN_CLEARANCE
