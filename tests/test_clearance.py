@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 
+import mink
 import mujoco
 import numpy as np
 import pytest
@@ -16,7 +17,7 @@ from hypothesis import strategies as st
 import om_redundant as om
 from om_redundant import ckernels
 from om_redundant.exceptions import ModelMismatch
-from tests.conftest import in_threads
+from tests.conftest import in_threads, random_q
 
 KINDS = {
     "sphere": mujoco.mjtGeom.mjGEOM_SPHERE,
@@ -355,3 +356,83 @@ def test_the_kernel_refuses_arrays_of_other_sizes(panda):
         ckernels.arm_geom_poses(*arm, rows, np.empty((2, n_arm, 3)), np.empty((3, n_arm, 9)))
     with pytest.raises(ValueError, match="poses per joint vector"):
         ckernels.arm_geom_poses(*arm, rows, np.empty((3, n_arm, 3)), np.empty((3, n_arm - 1, 9)))
+
+
+# -- along a way, names, errors and mink's pairs ------------------------------------------
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), floor=st.floats(-0.05, 0.15))
+def test_the_clearance_along_a_way_is_bounded_from_below(panda, seed, floor):
+    """minimum_along(q_a, q_b, floor) against 2,001 points of the straight segment: where it
+    says clear (>= floor) every point is at least that far; where not, the segment does come
+    below the floor (to within the 1 mm tolerance and the dense samples' spacing)."""
+    rng = np.random.default_rng(seed)
+    obstacles = [
+        om.Sphere(rng.uniform([0.2, -0.5, 0.1], [0.7, 0.5, 0.9]), 0.08),
+        om.Capsule([0.5, -0.6, 0.3], [0.5, 0.6, 0.3], 0.03),
+    ]
+    clearance = om.Clearance.for_arm(panda.arm, obstacles)
+    q_a, q_b = random_q(panda.arm, 2, rng)
+    along = clearance.minimum_along(q_a, q_b, floor)
+    t = np.linspace(0.0, 1.0, 2001)[:, None]
+    dense = clearance.minima(q_a + t * (q_b - q_a)).min()
+    spacing = float(clearance._lever @ np.abs(q_b - q_a)) / 2000  # a distance's change between samples
+    if along >= floor:
+        assert dense >= along - 1e-12  # certified: no point of the segment is nearer
+    else:
+        assert dense < floor + om.redundancy.clearance.ALONG_TOLERANCE + spacing / 2
+
+
+def test_lever_arms_bound_how_fast_the_geoms_move(panda):
+    """Every geom point's speed per unit joint rate stays below the joint's lever arm
+    (finite differences of the geoms' placements and their bounding radii, random q)."""
+    clearance = om.Clearance.for_arm(panda.arm, [om.Sphere([0.5, 0.0, 0.5], 0.05)])
+    lever = clearance._lever
+    rbound = clearance.model.geom_rbound[clearance._arm_ids]
+    rng, h = np.random.default_rng(5), 1e-6
+    for q in random_q(panda.arm, 50, rng):
+        xpos, xmat = clearance.geom_poses(q)
+        for j in range(7):
+            dq = np.zeros(7)
+            dq[j] = h
+            moved, turned = clearance.geom_poses(q + dq)
+            speed = (
+                np.linalg.norm(moved - xpos, axis=1) / h
+                + rbound * np.abs(turned - xmat).reshape(-1, 9).max(axis=1) / h
+            )
+            assert (speed <= lever[j] + 1e-6).all()
+
+
+def test_an_arm_without_collision_geoms_is_named(panda):
+    """Menagerie models loaded without their meshes have no collision geoms on the arm."""
+    spec = mujoco.MjSpec.from_string(om.scene_mjcf(panda.arm))
+    for geom in list(spec.geoms):
+        if geom.name.startswith("link"):
+            geom.contype, geom.conaffinity = 0, 0
+    spec.worldbody.add_geom(
+        name="ball", type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[0.05, 0, 0], pos=[0.5, 0, 0.5]
+    )
+    with pytest.raises(om.InvalidInput, match=r"carry no collision geoms .* om\.arm_model"):
+        om.Clearance(spec.compile(), panda.arm, ["ball"])
+
+
+def test_unnamed_geoms_are_named_by_their_body_and_pairs_go_to_mink(panda):
+    spec = mujoco.MjSpec.from_string(om.scene_mjcf(panda.arm))
+    spec.body("link4").add_geom(type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[0.04, 0, 0])
+    post = spec.worldbody.add_body(name="post", pos=[0.6, 0.2, 0.0])
+    post.add_geom(type=mujoco.mjtGeom.mjGEOM_CAPSULE, size=[0.03, 0, 0], fromto=[0, 0, 0, 0, 0, 0.8])
+    post.add_geom(name="cap", type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[0.05, 0, 0], pos=[0, 0, 0.8])
+    model = spec.compile()
+    clearance = om.Clearance(model, panda.arm, ["cap"])
+    assert f"link4/geom{len(spec.body('link4').geoms) - 1}" in clearance.arm_geoms  # the sphere added last
+    limit = mink.CollisionAvoidanceLimit(model, clearance.geom_pairs, minimum_distance_from_collisions=0.01)
+    pairs = {tuple(sorted(p)) for p in limit.geom_id_pairs}
+    ours = {
+        tuple(sorted((a, o))) for arms, obstacles in clearance.geom_pairs for a in arms for o in obstacles
+    }
+    # mink keeps every pair but those of the first link (a child of the world's weld, as the post is)
+    first = model.body("link1").id
+    assert pairs <= ours and {p for p in ours if first not in model.geom_bodyid[list(p)]} <= pairs
+    with pytest.raises(om.InvalidInput, match="moves with the arm"):
+        om.Clearance(model, panda.arm, ["link4_capsule0"])

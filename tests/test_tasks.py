@@ -221,10 +221,11 @@ def test_both_jacobians_match_finite_differences(panda, panda_with_hand):
     exact = om.ExactPoseTask(panda, model, arm_configuration=panda.configuration_of(Q_PANDA))
     angle = om.ArmAngleTask(panda, model)
     exact.set_target(panda.arm.fk(Q_PANDA))
-    angle.set_target(0.4)
     rng = np.random.default_rng(2)
     for q in random_joints(panda.arm, 20, rng):
+        q = np.clip(q, angle.joints.lower, angle.joints.upper)  # (the model's limits are tighter)
         configuration.update(np.concatenate([q, rng.uniform(0.0, 0.04, 2)]))
+        angle.set_target_from_configuration(configuration)  # (one the arm can take there)
         for task in (exact, angle):
             J = task.compute_jacobian(configuration)
             assert J.shape == (task.k, model.nv)
@@ -361,6 +362,37 @@ def test_arm_angle_task_swings_the_elbow_while_the_frame_task_holds_the_hand(pan
         step(configuration, [frame, angle], limits)
     assert abs(math.remainder(psi_of(panda, configuration.q) - psi_target, 2 * math.pi)) < 1e-6
     assert max(hand_error(configuration, "attachment_site", panda.arm.fk(Q_PANDA))) < 1e-6
+
+
+def test_an_arm_angle_the_arm_cannot_take_is_refused_not_pulled_to(panda, panda_model):
+    """An arm angle with no exact solution within the Panda's limits at Q_PANDA's hand pose:
+    the elbow cannot go there without pulling the hand off its target (0.6 m in the issue).
+    The task says so at set_target (it has seen the arm) and keeps its target, and at
+    compute_* when it had not."""
+    configuration = mink.Configuration(panda_model, Q_PANDA)
+    T = panda.arm.fk(Q_PANDA)
+    signs = panda.configuration_of(Q_PANDA).signs
+    grid = np.linspace(-np.pi, np.pi, 73)
+    ok = []
+    for psi in grid:
+        s = panda.solve(T, om.Configuration(signs, (psi,)), q_hint=Q_PANDA)
+        ok.append(s.ok and panda.arm.within_limits(s.q))
+    attainable = grid[np.flatnonzero(ok)]
+    gap = [k for k in range(1, len(grid) - 1) if not (ok[k - 1] or ok[k] or ok[k + 1])]
+    assert len(attainable) and gap  # some psi is, some (with its neighbours) is not
+    out = float(grid[gap[len(gap) // 2]])
+    angle = om.ArmAngleTask(panda, panda_model)
+    angle.set_target_from_configuration(configuration)
+    held = angle.target_psi
+    with pytest.raises(om.UnreachableTarget, match=rf"cannot take psi\* = {out:+.4f}"):
+        angle.set_target(out)
+    assert angle.target_psi == held
+    fresh = om.ArmAngleTask(panda, panda_model)
+    fresh.set_target(out)  # not seen the arm yet: checked at the first compute
+    with pytest.raises(om.UnreachableTarget, match="pull the hand off its target"):
+        fresh.compute_error(configuration)
+    fresh.set_target(float(attainable[len(attainable) // 2]))
+    assert np.isfinite(fresh.compute_error(configuration)).all()
 
 
 # ---------------------------------------------------------------------------------------

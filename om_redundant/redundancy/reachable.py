@@ -14,10 +14,11 @@ clearance term of the objective taken along the way,
 :data:`WAY_SAMPLES` points along the straight joint-space segment from :math:`q_0` (every
 candidate's in one batch): of two ways, the one that keeps farther from the obstacles (a
 hand that stays above the table rather than diving to it). Candidates are taken best
-first, and the first whose segment is certified clear (:meth:`~om_redundant.Clearance.minimum_along`, above
-:math:`\min(d_{min}, D(q_0))` less :data:`~om_redundant.redundancy.clearance.ALONG_TOLERANCE`:
-an arm already nearer an obstacle than :math:`d_{min}` may stay as near, never nearer)
-wins; where none is, the best candidate, with the clearance its way has.
+first, and the first whose segment is certified clear
+(:meth:`~om_redundant.Clearance.minimum_along`, above :func:`way_floor`: :data:`WAY_MARGIN`
+more than :math:`d_{min}`, for the arm's steps off the straight way, where the arm starts
+that far; an arm already nearer may stay as near, never nearer) wins; where none is, the
+best candidate, with the clearance its way has.
 """
 
 from __future__ import annotations
@@ -37,8 +38,11 @@ from .probe import Point
 DEFAULT_TRAVEL_WEIGHT = 0.25
 #: Candidates whose way is checked, best first, before the best is taken as it is.
 MAX_WAY_CHECKS = 24
+#: m: a clear way keeps this much more than d_min where it starts farther: mink's steps leave the
+#: straight way by up to about this (its velocity limits clip joint by joint, the FrameTask pulls).
+WAY_MARGIN = 0.01
 #: Points inside a way at which its clearance is sampled for the score.
-WAY_SAMPLES = 7
+WAY_SAMPLES = 15
 #: A candidate's feasibility slack must exceed this: a refined interval end lies on the
 #: boundary (slack ~1e-12), where the next tracking step's rounding leaves the feasible set.
 INTERIOR = 1e-6
@@ -116,11 +120,13 @@ def candidates(
 
 
 def way_floor(objective: Objective, q_from: np.ndarray) -> float:
-    r"""What a clear way from q_from keeps: :math:`\min(d_{min}, D(q_0))` less
-    :data:`~om_redundant.redundancy.clearance.ALONG_TOLERANCE` (-inf without obstacles)."""
+    r"""What a clear way from q_from keeps: :math:`\min(d_{min} + m, D(q_0))` less
+    :data:`~om_redundant.redundancy.clearance.ALONG_TOLERANCE`, m = :data:`WAY_MARGIN` for the
+    arm's deviation from the straight way (-inf without obstacles)."""
     if objective.clearance is None:
         return -math.inf
-    return min(objective.min_clearance, objective.clearance.minimum(q_from)) - ALONG_TOLERANCE
+    floor = min(objective.min_clearance + WAY_MARGIN, objective.clearance.minimum(q_from))
+    return floor - ALONG_TOLERANCE
 
 
 def way_clearance(objective: Objective, q_from: np.ndarray, q_to: np.ndarray, floor: float) -> float:

@@ -8,8 +8,9 @@ import numpy.typing as npt
 from mink import Configuration as MinkConfiguration
 from mink import Task, TaskDefinitionError
 
-from ..exceptions import InvalidInput
+from ..exceptions import InvalidInput, UnreachableTarget
 from ..mujoco_io.arm_in_model import ArmJoints
+from ..om.configuration import Configuration
 from ..om.solver import OMSolver
 from ..validation import as_array, as_instance, as_number
 
@@ -80,3 +81,24 @@ class ArmTask(Task):
         jacobian = np.zeros((self.k, self.joints.model.nv))
         jacobian[:, self.joints.dof_ids] = rows
         return jacobian
+
+    def solve_within_limits(
+        self, T_root: np.ndarray, c: Configuration, hint: np.ndarray | None, who: str
+    ) -> np.ndarray:
+        """The exact solution of pose T_root in configuration c within the joint limits (the
+        tighter of the arm's and the model's), nearest the hint.
+
+        Raises:
+            UnreachableTarget: None; the message says why (``who`` names the task).
+        """
+        solution = self.solver.solve(T_root, c, q_hint=hint)
+        if not solution.ok:
+            raise UnreachableTarget(f"{who}: {solution.status} for the target (configuration {c})")
+        if self.joints.within_limits(solution.q):
+            return solution.q
+        inside = [s.q for s in self.solver.solve_all(T_root, c) if self.joints.within_limits(s.q)]
+        if not inside:
+            raise UnreachableTarget(
+                f"{who}: every solution for the target in configuration {c} breaks a joint limit"
+            )
+        return min(inside, key=lambda q: float(np.linalg.norm(q - solution.q)))

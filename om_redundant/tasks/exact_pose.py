@@ -468,7 +468,7 @@ class ExactPoseTask(ArmTask):
             self._take(choice, root_pose, fresh)
             return
         self._q_target, self.choice, self._root_pose = (
-            self._solve_in(T_root, arm_configuration, hint),
+            self.solve_within_limits(T_root, arm_configuration, hint, "ExactPoseTask"),
             None,
             root_pose,
         )
@@ -509,20 +509,6 @@ class ExactPoseTask(ArmTask):
                 stacklevel=3,
             )
         return None
-
-    def _solve_in(self, T_root: np.ndarray, c: Configuration, hint: np.ndarray | None) -> np.ndarray:
-        """The exact solution in configuration c within the limits, nearest the hint."""
-        solution = self.solver.solve(T_root, c, q_hint=hint)
-        if not solution.ok:
-            raise UnreachableTarget(f"ExactPoseTask: {solution.status} for the target (configuration {c})")
-        if self.joints.within_limits(solution.q):
-            return solution.q
-        inside = [s.q for s in self.solver.solve_all(T_root, c) if self.joints.within_limits(s.q)]
-        if not inside:
-            raise UnreachableTarget(
-                f"ExactPoseTask: every solution for the target in configuration {c} breaks a joint limit"
-            )
-        return min(inside, key=lambda q: float(np.linalg.norm(q - solution.q)))
 
 
 def _as_lead(lead: Any) -> tuple[float, float, float]:
