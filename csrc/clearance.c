@@ -25,6 +25,7 @@
 #include "binding.h"
 
 enum { CORE_MUJOCO = 0, CORE_POINT = 1, CORE_SEGMENT = 2, CORE_BOX = 3 };
+#define CORES_TOUCH 1e-9 /* m: cores nearer than this touch (their pair is MuJoCo's) */
 
 static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
@@ -129,7 +130,9 @@ static double pair_distance(const int64_t *kind, const double *radius, const dou
     }
     double v[3] = {c2[0] - c1[0], c2[1] - c1[1], c2[2] - c1[2]}, length = sqrt(dot3(v, v));
     double dist = length - radius[g1] - radius[g2];
-    if (!(length > 0.0) || (kind[g2] == CORE_BOX && !(dist > 0.0))) return NAN;
+    /* cores within rounding of touching (a nearly parallel pair's nearest points are found to
+     * 1e-12 or so) are touching: MuJoCo's depth */
+    if (!(length > CORES_TOUCH) || (kind[g2] == CORE_BOX && !(dist > 0.0))) return NAN;
     for (int i = 0; i < 3; i++) {
         double n = v[i] / length;
         fromto[i] = c1[i] + radius[g1] * n;
