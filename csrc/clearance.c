@@ -45,12 +45,26 @@ static void segments(const double *p1, const double *q1, const double *p2, const
             s = clamp01(-c / a);
         else {
             double b = dot3(d1, d2), denom = a * e - b * b;
-            s = denom > 1e-14 * a * e ? clamp01((b * f - c * e) / denom) : 0.0; /* parallel: any s */
-            t = (b * s + f) / e;
-            if (t < 0.0)
-                t = 0.0, s = clamp01(-c / a);
-            else if (t > 1.0)
-                t = 1.0, s = clamp01((b - c) / a);
+            if (denom > 1e-14 * a * e) {
+                s = clamp01((b * f - c * e) / denom);
+                t = (b * s + f) / e;
+                if (t < 0.0)
+                    t = 0.0, s = clamp01(-c / a);
+                else if (t > 1.0)
+                    t = 1.0, s = clamp01((b - c) / a);
+            } else { /* (nearly) parallel: the nearest pair has an end of either segment */
+                double ends[4][2] = {{0.0, clamp01(f / e)}, {1.0, clamp01((b + f) / e)},
+                                     {clamp01(-c / a), 0.0}, {clamp01((b - c) / a), 1.0}};
+                double least = INFINITY;
+                for (int k = 0; k < 4; k++) {
+                    double gap = 0.0;
+                    for (int i = 0; i < 3; i++) {
+                        double v = r[i] + ends[k][0] * d1[i] - ends[k][1] * d2[i];
+                        gap += v * v;
+                    }
+                    if (gap < least) least = gap, s = ends[k][0], t = ends[k][1];
+                }
+            }
         }
     }
     for (int i = 0; i < 3; i++) c1[i] = p1[i] + s * d1[i], c2[i] = p2[i] + t * d2[i];
