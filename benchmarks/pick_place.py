@@ -46,6 +46,7 @@ MIN_CLEARANCE = 0.03  # m the optimiser keeps
 #: optimiser's choices)
 MINK_MARGIN = 0.005
 MAX_STEP = 0.005  # rad of psi per tick at 500 Hz
+GAIN = 0.5
 VELOCITY = 2.0  # rad/s, every joint
 BALL = dict(centre=np.array([0.45, 0.0, 0.72]), amplitude=0.3, period=10.0, radius=0.05)
 POLE = ([0.2, 0.45, 0.0], [0.2, 0.45, 0.9], 0.03)
@@ -156,6 +157,7 @@ def run(
             clearance.geom_pairs,
             minimum_distance_from_collisions=MIN_CLEARANCE - MINK_MARGIN,
             collision_detection_distance=0.1,
+            gain=GAIN,
         ),
     ]
     ball, target = model.body("ball").mocapid[0], model.body("target").mocapid[0]

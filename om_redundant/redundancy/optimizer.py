@@ -227,6 +227,11 @@ class RedundancyOptimizer:
         """The obstacles' :class:`~om_redundant.Clearance` (None without obstacles)."""
         return self.objective.clearance
 
+    @property
+    def min_clearance(self) -> float:
+        """d_min (m): the clearance every choice keeps."""
+        return self.objective.min_clearance
+
     def intervals(self, T: Any) -> list[PsiInterval]:
         """The feasible psi intervals of every allowed branch at pose T."""
         T = as_pose(T)

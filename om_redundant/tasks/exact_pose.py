@@ -22,6 +22,7 @@ from ..exceptions import InvalidInput, UnreachableTarget
 from ..mujoco_io.arm_in_model import ArmRoot
 from ..om.configuration import Configuration
 from ..om.solver import OMSolver
+from ..redundancy.reachable import WAY_MARGIN
 from ..validation import as_instance, as_pose, as_vector
 from .arm_task import ArmTask
 from .lead import DEFAULT_LEAD, lead_pose, pose_gap
@@ -48,10 +49,11 @@ class RedundancyOptimizer(Protocol):
     (bool: chosen afresh where tracking could not continue) and ``way_clear`` (bool: the
     joint-space way from ``q_current`` is clear), as a
     :class:`~om_redundant.RedundancyChoice` has them. ``clearance`` is its
-    :class:`~om_redundant.Clearance` or None.
+    :class:`~om_redundant.Clearance` or None, ``min_clearance`` what its choices keep (m).
     """
 
     clearance: Any
+    min_clearance: float
 
     def choose(self, T: np.ndarray, previous: Any = None, *, q_current: Any = None) -> Any: ...
 
@@ -169,6 +171,7 @@ class ExactPoseTask(ArmTask):
         self.lead = None if lead is None else _as_lead(lead)
         self._aim: np.ndarray | None = None  # the world pose q* was solved for: the target or a lead
         self._way: tuple[np.ndarray, float] | None = None  # a joint-space way to q*: start, fraction
+        self._way_checked = -1  # the clearance's version the way was last checked against
         self._leading = False  # a target jumped to: the aim runs ahead of the hand until it is near
         self._blind = False  # the optimiser chose without the arm's joints (none seen yet)
         self._last_q: np.ndarray | None = None  # the arm's joints at the last compute_error
@@ -247,6 +250,16 @@ class ExactPoseTask(ArmTask):
         self.choice = None
         self._leading, self._way = False, None
 
+    def _blocked(self, q: np.ndarray, q_target: np.ndarray) -> bool:
+        """Whether obstacles that moved since the joint-space way was last checked now block
+        its rest (certified below ``min_clearance`` less the way's margin: the arm's own steps
+        off the straight way do not count)."""
+        if self._way is None or self._clearance is None or self._clearance.version == self._way_checked:
+            return False
+        self._way_checked = self._clearance.version
+        floor = self.optimizer.min_clearance - WAY_MARGIN
+        return self._clearance.minimum_along(q, q_target, floor) < floor
+
     def _stall(self, q: np.ndarray, gap: float) -> bool:
         """Whether the arm, far from where the error pulls it, has stood still for
         ``self._patience`` ticks (compute_error calls, one per ``solve_ik``); each fresh
@@ -271,8 +284,10 @@ class ExactPoseTask(ArmTask):
         r"""The joint error :math:`e(q) = q_{arm} - \tilde q^*` (dof,)."""
         q, q_target = self._joint_target(configuration)
         error = q - self._pull_to(q, q_target)
-        if self.optimizer is not None and self._stall(q, float(np.abs(error).max())):
-            self.reset_choice()  # held short of q* (by a collision or joint limit): choose afresh
+        if self.optimizer is not None and (
+            self._stall(q, float(np.abs(error).max())) or self._blocked(q, q_target)
+        ):
+            self.reset_choice()  # held short of q*, or its way blocked: choose afresh
             q, q_target = self._joint_target(configuration, resolve=True)
             error = q - self._pull_to(q, q_target)
         return error
