@@ -7,6 +7,7 @@ shows (:mod:`.sweep`)."""
 
 from .arm_angle import arm_angle_and_gradient
 from .clearance import MAX_EXTENT, Clearance
+from .free_rotation import FreeRotation
 from .intervals import PsiInterval
 from .objective import Evaluation, Objective, joint_margins
 from .optimizer import RedundancyChoice, RedundancyOptimizer
@@ -32,6 +33,7 @@ __all__ = [
     "Choice",
     "Clearance",
     "Evaluation",
+    "FreeRotation",
     "Objective",
     "Obstacle",
     "PoseSweep",

@@ -65,6 +65,7 @@ from ..validation import as_count, as_instance, as_joint_vector, as_number, as_p
 from .arm_angle import wrap_psi
 from .clearance import DEFAULT_DISTMAX, Clearance
 from .climb import maximise
+from .free_rotation import FreeRotation
 from .intervals import PsiInterval, Run, feasible_runs
 from .objective import (
     DEFAULT_CLEARANCE_WEIGHT,
@@ -78,8 +79,10 @@ from .probe import Point, Probe
 from .reachable import DEFAULT_TRAVEL_WEIGHT, Way, candidates, clear_way
 from .shapes import Shape
 from .singularity import Singularity
-from .tracking import Tracked, Tracker
+from .tracking import MAX_CURVATURE, Tracked, Tracker
 
+#: Tracking with a free rotation: a turn is taken where it gains more than this.
+_TURN_GAIN = 1e-9
 #: Global choose: a start whose bound is within this of the best found is not climbed (it can
 #: at most tie).
 _CLIMB_ROUNDING = 1e-12
@@ -118,6 +121,10 @@ class RedundancyChoice:
             without obstacles; nan otherwise (a tracking step moves the joints a step at a
             time, each step's joints clear).
         way_clear: The way is certified clear, or none was checked (``way_clearance`` nan).
+        turn: With a free rotation (``choose(..., free=...)``), the turn R of the target the
+            solution reaches, :meth:`FreeRotation.turned(T, R)
+            <om_redundant.FreeRotation.turned>`; None without.
+        pose: The end-effector pose the solution reaches (T, or T turned); None if not ok.
     """
 
     ok: bool
@@ -134,6 +141,8 @@ class RedundancyChoice:
     travel: float = math.nan
     way_clearance: float = math.nan
     way_clear: bool = True
+    turn: np.ndarray | None = None
+    pose: np.ndarray | None = None
 
 
 class RedundancyOptimizer:
@@ -243,6 +252,7 @@ class RedundancyOptimizer:
         previous: RedundancyChoice | None = None,
         *,
         q_current: Any = None,
+        free: FreeRotation | None = None,
     ) -> RedundancyChoice:
         """The best configuration for pose T; with ``previous``, the best near it; with the
         arm's joints ``q_current``, one the arm can reach from where it is.
@@ -254,6 +264,9 @@ class RedundancyOptimizer:
             q_current: The arm's joints now (dof,), e.g. a mink configuration's: a fresh
                 choice weighs the joint travel from them and wants a clear way from them.
                 Default: a global choice, or the previous choice's joints when tracking.
+            free: Rotations of T left free (a tool axis to point, or a position to reach):
+                the optimiser picks the turn too (:mod:`~om_redundant.redundancy.free_rotation`),
+                reported as the choice's ``turn``.
 
         Returns:
             A :class:`RedundancyChoice`; ``ok`` is False, with the reason, only when no
@@ -269,16 +282,22 @@ class RedundancyOptimizer:
             q_current = as_joint_vector(q_current, self.solver.arm.dof, "q_current", stack=False)
         if previous is not None and not isinstance(previous, RedundancyChoice):
             raise InvalidInput(f"previous must be a RedundancyChoice, got {type(previous).__name__}")
+        if free is not None:
+            as_instance(free, FreeRotation, "free")
         if previous is None or not previous.ok:
-            if q_current is None:
+            if q_current is None and free is None:
                 return self._best_anywhere(T, self.branches)
-            signs = self.solver.configuration_of(q_current).signs
-            return self._from_joints(T, q_current, signs if signs in self.branches else None)
+            signs = None if q_current is None else self.solver.configuration_of(q_current).signs
+            return self._from_joints(T, q_current, signs if signs in self.branches else None, free)
         if previous.configuration.signs not in self.branches:
             raise InvalidInput(
                 f"previous branch {previous.configuration.signs} is not among the allowed branches"
             )
-        return self._track(T, previous, q_current)
+        if (free is None) != (previous.turn is None):
+            raise InvalidInput(
+                "previous was chosen with another free rotation: choose afresh (previous=None)"
+            )
+        return self._track(T, previous, q_current, free)
 
     # -----------------------------------------------------------------------------------
 
@@ -307,11 +326,36 @@ class RedundancyOptimizer:
         return self._result(T, self._climb_all(T, runs), runs)
 
     def _track(
-        self, T: np.ndarray, previous: RedundancyChoice, q_current: np.ndarray | None
+        self,
+        T: np.ndarray,
+        previous: RedundancyChoice,
+        q_current: np.ndarray | None,
+        free: FreeRotation | None,
     ) -> RedundancyChoice:
         signs, (psi,) = previous.configuration.signs, previous.configuration.redundancy
         q_previous = previous.solution.q
-        step = self._tracker.step(T, signs, psi, q_previous, previous.curvature)
+        turn = previous.turn
+        target = T if free is None else free.turned(T, turn)
+        step = self._tracker.step(target, signs, psi, q_previous, previous.curvature)
+        if free is not None:  # a step each way about each free axis: the best feasible that gains on
+            # both this step and the previous choice (a turn back and forth about an optimum is none)
+            for trial in free.trials(turn, self.max_step):
+                turned = free.turned(T, trial)
+                tried = self._tracker.step(turned, signs, psi, q_previous, previous.curvature)
+                least = (
+                    max(step.value if isinstance(step, Tracked) else -math.inf, previous.value) + _TURN_GAIN
+                )
+                if isinstance(tried, Tracked) and (not isinstance(step, Tracked) or tried.value > least):
+                    step, turn, target = tried, trial, turned
+        if (
+            isinstance(step, Tracked)
+            and step.value < previous.value
+            and np.array_equal(target, previous.pose)
+        ):
+            # at the same pose a step may only climb: one that loses (the model's kink or curvature
+            # overshot the optimum, a step back and forth about it) is not taken
+            curvature = min(4.0 * step.curvature, MAX_CURVATURE)
+            return replace(previous, curvature=curvature, reason="", rechosen=False, branch_flipped=False)
         if isinstance(step, Tracked):
             choice = RedundancyChoice(
                 True,
@@ -322,12 +366,14 @@ class RedundancyOptimizer:
                 step.value,
                 (),
                 curvature=step.curvature,
+                turn=turn,
+                pose=target,
             )
             if q_current is not None:
                 choice = replace(choice, travel=float(np.linalg.norm(step.solution.q - q_current)))
             return choice
         start = q_previous if q_current is None else q_current
-        chosen = self._from_joints(T, start, signs)
+        chosen = self._from_joints(T, start, signs, free)
         if not chosen.ok:
             return chosen
         flipped = chosen.configuration.signs != signs
@@ -341,35 +387,58 @@ class RedundancyOptimizer:
         return replace(chosen, rechosen=True, branch_flipped=flipped, reason=reason)
 
     def _from_joints(
-        self, T: np.ndarray, q_from: np.ndarray, signs: tuple[int, ...] | None
+        self,
+        T: np.ndarray,
+        q_from: np.ndarray | None,
+        signs: tuple[int, ...] | None,
+        free: FreeRotation | None,
     ) -> RedundancyChoice:
-        """The fresh choice from the arm's joints (:mod:`~om_redundant.redundancy.reachable`):
-        branch ``signs`` first (None: every allowed branch at once)."""
+        """The fresh choice from the arm's joints (:mod:`~om_redundant.redundancy.reachable`;
+        without them, the best scored): branch ``signs`` first (None: every allowed branch at
+        once); with a free rotation, over the turns it starts from."""
+        hand = None if q_from is None else self.solver.arm.fk(q_from)
+        turns = [None] if free is None else free.starts(T, hand)
+        targets = [T if R is None else free.turned(T, R) for R in turns]
         first = [signs] if signs is not None else self.branches
-        swept = self._sweep(T, first)
-        runs = [run for _, _, branch_runs in swept for run in branch_runs]
-        way = self._way(runs, q_from)
+        swept = [self._sweep(target, first) for target in targets]
+        way = self._way(targets, swept, q_from)
         note = ""
-        if (way is None or not way.clear) and signs is not None:
-            note = f"branch {signs} has no {'clear way' if runs else 'feasible arm angle at this pose'}"
+        if (way is None or not way[0].clear) and signs is not None:
+            ran = any(runs for branch in swept for _, _, runs in branch)
+            note = f"branch {signs} has no {'clear way' if ran else 'feasible arm angle at this pose'}"
             others = [b for b in self.branches if b != signs]
-            more = self._sweep(T, others)
-            runs += [run for _, _, branch_runs in more for run in branch_runs]
-            swept += more
-            way = self._way(runs, q_from)
-        if way is not None and not way.clear:
+            swept = [
+                branch + self._sweep(target, others) for branch, target in zip(swept, targets, strict=True)
+            ]
+            way = self._way(targets, swept, q_from)
+        if way is not None and not way[0].clear:
             note = "; ".join(filter(None, [note, "no candidate has a clear way: the best is taken"]))
         if way is None:
-            why = "; ".join(self._why(s, paths) for s, paths, _ in swept)
+            why = "; ".join(self._why(s, paths) for s, paths, _ in swept[0])
             return _failure((), f"no feasible arm angle: {why}")
-        return self._chosen(T, way, tuple(r.interval for r in runs), note)
+        chosen, k = way
+        intervals = tuple(run.interval for _, _, runs in swept[k] for run in runs)
+        return self._chosen(targets[k], chosen, intervals, note, turns[k])
 
-    def _way(self, runs: list[Run], q_from: np.ndarray) -> Way | None:
-        """The best candidate of the runs with a clear way from q_from (or the best)."""
-        return clear_way(self.objective, candidates(self.objective, runs, q_from, self.travel_weight), q_from)
+    def _way(
+        self,
+        targets: list[np.ndarray],
+        swept: list[list[tuple[Any, Any, list[Run]]]],
+        q_from: np.ndarray | None,
+    ) -> tuple[Way, int] | None:
+        """The best candidate of the targets' runs with a clear way from q_from (or the best),
+        and its target's index."""
+        owner, ranked = {}, []
+        for k, branches in enumerate(swept):
+            runs = [run for _, _, branch_runs in branches for run in branch_runs]
+            owner.update((id(run), k) for run in runs)
+            ranked += candidates(self.objective, runs, q_from, self.travel_weight)
+        ranked.sort(key=lambda c: -c.score)
+        way = clear_way(self.objective, ranked, q_from)
+        return None if way is None else (way, owner[id(way.candidate.run)])
 
     def _chosen(
-        self, T: np.ndarray, way: Way, intervals: tuple[PsiInterval, ...], note: str
+        self, T: np.ndarray, way: Way, intervals: tuple[PsiInterval, ...], note: str, turn: np.ndarray | None
     ) -> RedundancyChoice:
         """The choice of a candidate: its exact solution at its joints."""
         candidate = way.candidate
@@ -394,6 +463,8 @@ class RedundancyOptimizer:
             travel=candidate.travel,
             way_clearance=way.clearance,
             way_clear=way.clear,
+            turn=turn,
+            pose=T,
         )
 
     def _climb_all(self, T: np.ndarray, runs: list[Run]) -> tuple[Run, Point]:
@@ -461,6 +532,7 @@ class RedundancyOptimizer:
             ev.clearance,
             ev.value,
             tuple(r.interval for r in runs),
+            pose=T,
         )
 
     def _why(self, signs: tuple[int, ...], paths: list[Path]) -> str:

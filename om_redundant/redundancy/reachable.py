@@ -89,22 +89,26 @@ def nearest_turns(arm: Arm, q: np.ndarray, q_from: np.ndarray) -> np.ndarray:
 
 
 def candidates(
-    objective: Objective, runs: list[Run], q_from: np.ndarray, travel_weight: float
+    objective: Objective, runs: list[Run], q_from: np.ndarray | None, travel_weight: float
 ) -> list[Candidate]:
     """Every feasible sample of the runs inside the feasible set (slack above
     :data:`INTERIOR`; on its boundary only where no other is) as a :class:`Candidate`, best
-    score first."""
+    score first (without the arm's joints q_from: by the objective alone, travel nan)."""
     found = [(run, p) for run in runs for p in run.points if p.evaluation.slack > INTERIOR]
     found = found or [(run, p) for run in runs for p in run.points if p.evaluation.feasible]
     if not found:
         return []
-    q = nearest_turns(objective.arm, np.array([p.q for _, p in found]), q_from)
+    q = np.array([p.q for _, p in found])
+    if q_from is not None:
+        q = nearest_turns(objective.arm, q, q_from)
     pairs = [p.terms.get_pairs() for _, p in found]
     distances = None if pairs[0] is None else np.array([d for d, _ in pairs])
     evaluations = objective.evaluations(q, distances)  # (the margins of the joints moved by turns)
-    travel = np.linalg.norm(q - q_from, axis=1)
-    score = np.array([ev.value for ev in evaluations]) - travel_weight * travel
-    if objective.clearance is not None:  # the ways' sampled clearance, capped and weighted
+    score = np.array([ev.value for ev in evaluations])
+    travel = np.full(len(q), math.nan) if q_from is None else np.linalg.norm(q - q_from, axis=1)
+    if q_from is not None:
+        score -= travel_weight * travel
+    if objective.clearance is not None and q_from is not None:  # the ways' sampled clearance
         s = np.arange(1, WAY_SAMPLES + 1) / (WAY_SAMPLES + 1)
         ways = q_from + s[None, :, None] * (q - q_from)[:, None, :]  # (K, S, dof)
         along = objective.clearance.minima(ways.reshape(-1, len(q_from))).reshape(len(q), WAY_SAMPLES)
@@ -137,11 +141,14 @@ def way_clearance(objective: Objective, q_from: np.ndarray, q_to: np.ndarray, fl
     return objective.clearance.minimum_along(q_from, q_to, floor)
 
 
-def clear_way(objective: Objective, ranked: list[Candidate], q_from: np.ndarray) -> Way | None:
+def clear_way(objective: Objective, ranked: list[Candidate], q_from: np.ndarray | None) -> Way | None:
     """The first of the ranked candidates whose way from q_from is clear (module docstring);
-    else the first, with its way's clearance; None if there are none."""
+    else the first, with its way's clearance; None if there are none. (Without q_from, the
+    first: no way to check.)"""
     if not ranked:
         return None
+    if q_from is None:
+        return Way(ranked[0], math.nan, True)
     floor = way_floor(objective, q_from)
     first = None
     for candidate in ranked[:MAX_WAY_CHECKS]:

@@ -53,8 +53,8 @@ from ..om.solver import OMSolver, Solution
 from .arm_angle import wrap_psi
 from .objective import SINGULARITY_CAP, Objective
 
-#: Curvature b of the first tracking step's model (per rad^2).
-INITIAL_CURVATURE = 0.1
+#: Curvature b of the first tracking step's model (per rad^2), and its largest (csrc/tracking.c).
+INITIAL_CURVATURE, MAX_CURVATURE = 0.1, 1e3
 #: Where nothing is feasible within max_step (the feasible range moved away faster), the step
 #: is tried again within this many times max_step: the joint step bounds it as before.
 WIDER = 64.0

@@ -22,6 +22,7 @@ from ..exceptions import InvalidInput, UnreachableTarget
 from ..mujoco_io.arm_in_model import ArmRoot
 from ..om.configuration import Configuration
 from ..om.solver import OMSolver
+from ..redundancy.free_rotation import FreeRotation
 from ..redundancy.reachable import WAY_MARGIN
 from ..validation import as_instance, as_pose, as_vector
 from .arm_task import ArmTask
@@ -124,6 +125,14 @@ class ExactPoseTask(ArmTask):
         cost: Cost per joint error (1/rad), one value or one per joint.
         gain: Task gain in [0, 1].
         lm_damping: Levenberg-Marquardt damping (see ``mink.Task``).
+        lead: With an optimiser, how far the aims run ahead on the way to a target that
+            jumped: the hand's (m, rad) and the joints' (rad, max-norm); None: no aims, the
+            target at once.
+        free: With an optimiser, a rotation of the target it may choose:
+            ``"tool_axis"`` (any turn about the frame's z axis: a tool to point, as
+            ``mink.FrameTask(..., orientation_cost=[1, 1, 0])`` asks) or ``"orientation"``
+            (a position to reach: ``orientation_cost=0``); the choice's ``turn`` says which
+            (:class:`~om_redundant.FreeRotation`, about the frame's origin).
 
     Raises:
         TaskDefinitionError: Neither or both of ``arm_configuration`` and ``optimizer``; a bad cost.
@@ -144,6 +153,7 @@ class ExactPoseTask(ArmTask):
         gain: float = 1.0,
         lm_damping: float = 0.0,
         lead: tuple[float, float, float] | None = DEFAULT_LEAD,
+        free: str | None = None,
     ):
         as_instance(solver, OMSolver, "solver")
         if (arm_configuration is None) == (optimizer is None):
@@ -159,6 +169,7 @@ class ExactPoseTask(ArmTask):
         self._tool_to_flange = None if np.array_equal(tool, np.eye(4)) else _inverse(tool)
         self.optimizer = optimizer
         self._clearance = self._live_clearance(optimizer, model)
+        self.free = _free_rotation(free, tool, optimizer)
         self.arm_configuration = arm_configuration
         if arm_configuration is not None:
             solver.check_configuration(arm_configuration)  # raises InvalidInput naming the problem
@@ -423,7 +434,7 @@ class ExactPoseTask(ArmTask):
         if self.transform_target_to_world is None:
             return True
         distance, angle = pose_gap(self.transform_target_to_world.as_matrix(), T_world)
-        return distance > self.lead[0] or angle > self.lead[1]
+        return distance > self.lead[0] or (self.free is None and angle > self.lead[1])
 
     def _jump(self, T_world: np.ndarray, root_pose: np.ndarray) -> None:
         """A target that jumped. Where tracking can follow the hand's straight way there, a
@@ -431,12 +442,12 @@ class ExactPoseTask(ArmTask):
         hand (:meth:`_aim_for`); else the optimiser's fresh choice there from the arm's joints
         is the target (UnreachableTarget if it has none), the arm going there in joint space."""
         self._stalled, self._patience = 0, STALL_TICKS
-        if self.choice is not None and self._tracks_to(T_world, root_pose):
+        if self.choice is not None and self.free is None and self._tracks_to(T_world, root_pose):
             self._leading, self._aim, self._way = True, None, None  # the first aim: a lead from the hand
             self._solve(T_world, root_pose, self._q_target, None)
             return
         q_current = self.joints.q(self._data.qpos)
-        choice = self.optimizer.choose(self._in_root(T_world, root_pose), q_current=q_current)
+        choice = self.optimizer.choose(self._in_root(T_world, root_pose), q_current=q_current, free=self.free)
         self._take(choice, root_pose, fresh=True)
         self._aim, self._leading = T_world, False
 
@@ -479,7 +490,7 @@ class ExactPoseTask(ArmTask):
         if arm_configuration is None:
             q_current = None if self._data is None else self.joints.q(self._data.qpos)
             self._blind, fresh = q_current is None, self.choice is None
-            choice = self.optimizer.choose(T_root, previous=self.choice, q_current=q_current)
+            choice = self.optimizer.choose(T_root, previous=self.choice, q_current=q_current, free=self.free)
             self._take(choice, root_pose, fresh)
             return
         self._q_target, self.choice, self._root_pose = (
@@ -524,6 +535,23 @@ class ExactPoseTask(ArmTask):
                 stacklevel=3,
             )
         return None
+
+
+def _free_rotation(free: str | None, tool: np.ndarray, optimizer: Any) -> FreeRotation | None:
+    """The target's free rotation in the arm's end-effector frame: about the task's frame's
+    z axis (``"tool_axis"``) or any (``"orientation"``), about its origin (the tool offset X)."""
+    if free is None:
+        return None
+    if free not in ("tool_axis", "orientation"):
+        raise TaskDefinitionError(
+            f"ExactPoseTask free must be None, 'tool_axis' or 'orientation', got {free!r}"
+        )
+    if optimizer is None:
+        raise TaskDefinitionError("ExactPoseTask: a free rotation is chosen by an optimizer")
+    R, pivot = tool[:3, :3], tool[:3, 3]
+    if free == "tool_axis":
+        return FreeRotation.tool_axis(R[:, 2], pivot)
+    return FreeRotation(R[:, [2, 0, 1]].T, pivot)
 
 
 def _as_lead(lead: Any) -> tuple[float, float, float]:
