@@ -1,11 +1,15 @@
 r"""The nominal arm: the closed-form structure an arm is NEAR, and the arm in its coordinates.
 
 Arms brought from CAD or from MuJoCo models miss the closed-form families by little:
-twists of 90 deg +- 4e-6 rad from rounded quaternions, a joint whose axis is reversed (a
-twist of 180 deg), fixed rows between joints. The nominal arm is the OM method's *model
-side* of such an arm:
+twists of 90 deg +- 4e-6 rad from rounded quaternions, offsets of 5e-13 m from a URDF's
+11-digit numbers, a joint whose axis is reversed (a twist of 180 deg), fixed rows between
+joints. The nominal arm is the OM method's *model side* of such an arm:
 
 * every twist within :data:`NEAR_TWIST` of 0, +-90 or 180 deg is snapped to that value;
+* every length within rounding of zero (:data:`~om_redundant.om.model.LENGTH_ROUNDING` per
+  metre of reach) is zero, and every joint offset theta within
+  :data:`~om_redundant.om.model.ANGLE_ROUNDING` of a multiple of 90 deg is that multiple:
+  rounding is not geometry, and never changes the method an arm gets;
 * a twist of (about) 180 deg becomes 0 and the next joint flips: since
   :math:`R_x(\pi) R_z(\theta + q) T_z(d) T_x(a) R_x(\alpha) =
   R_z(-\theta - q) T_z(-d) T_x(a) R_x(\alpha + \pi) R_x(\pi)`, the half turn moves past the
@@ -24,6 +28,7 @@ closed-form roots as seeds and corrects the difference on the exact chain.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -31,7 +36,7 @@ import numpy as np
 from ..exceptions import ModelError
 from ..kinematics.arm import Arm
 from ..kinematics.chain import DHRow, JointKind, KinematicChain, row_transform
-from .model import ModelArm, derive_model
+from .model import ANGLE_ROUNDING, ModelArm, derive_model, rounding_length
 
 #: Largest deviation (rad) of a twist from 0, +-90 or 180 deg that the nominal arm snaps.
 NEAR_TWIST = 1e-3
@@ -72,7 +77,7 @@ def nominal_arm(arm: Arm) -> NominalArm:
         or not np.array_equal(nominal.T_root_base, arm.chain.T_root_base)
         or not np.array_equal(nominal.T_flange_tool, arm.chain.T_flange_tool)
     )
-    model = Arm(arm.name, nominal, arm.joint_names, lower, upper, arm.description)
+    model = dataclasses.replace(arm, chain=nominal, lower=lower, upper=upper)
     return NominalArm(arm, model, exact, flip, bool(differs))
 
 
@@ -105,7 +110,8 @@ def _off(alpha: float, nominal: float) -> float:
 
 def _flipped(chain: KinematicChain, snap: bool) -> tuple[KinematicChain, np.ndarray]:
     """Leading fixed rows into the base, half turns moved past the rows that follow them (the
-    joints flipped), twists snapped if ``snap``."""
+    joints flipped), twists and rounding snapped if ``snap``."""
+    eps = rounding_length(chain)
     rows = list(chain.rows)
     base = chain.T_root_base.copy()
     while rows and not rows[0].is_joint:
@@ -124,9 +130,23 @@ def _flipped(chain: KinematicChain, snap: bool) -> tuple[KinematicChain, np.ndar
             alpha = 0.0 if snap else row.alpha - np.pi
         else:
             alpha = nominal if snap and near else row.alpha
+        if snap:
+            a, d, theta = _rounded(row.a, eps), _rounded(row.d, eps), _rounded_angle(row.theta)
+            row = DHRow(a=a, alpha=row.alpha, d=d, theta=theta, kind=row.kind)
         out.append(DHRow(a=row.a, alpha=alpha, d=row.d, theta=row.theta, kind=row.kind))
     tool = _HALF_TURN @ chain.T_flange_tool if half_turn else chain.T_flange_tool
     return KinematicChain(tuple(out), base, tool), np.array(flip)
+
+
+def _rounded(length: float, eps: float) -> float:
+    """0 for a length within rounding of it, else the length."""
+    return 0.0 if abs(length) <= eps else length
+
+
+def _rounded_angle(angle: float) -> float:
+    """The multiple of 90 deg within rounding of the angle, else the angle."""
+    nominal = _nearest_right_angle(angle)
+    return nominal if _off(angle, nominal) <= ANGLE_ROUNDING else angle
 
 
 def _merged(rows: list[DHRow]) -> list[DHRow]:
