@@ -486,7 +486,9 @@ def test_check_model_skips_missing_textures_and_mesh_fitted_geoms(capsys, tmp_pa
     status, _, err = in_process(capsys, "check-model", str(path), "--arm", "ur5e")
     assert status == 2 and err.count("\n") == 1
     assert re.search(
-        r"no_such_joint.*\(with its meshes and textures skipped, which failed first: .*gone", err
+        r"no_such_joint.*\(with its inertial data replaced and its meshes and textures skipped, which failed "
+        r"first: .*gone",
+        err,
     )
 
 

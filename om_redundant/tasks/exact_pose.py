@@ -88,7 +88,8 @@ class ExactPoseTask(ArmTask):
             arm, the arm angle psi).
         optimizer: Instead of c: a redundancy optimiser, asked
             ``optimizer.choose(T_root, previous=<its last choice>)`` at each target.
-        prefix: Prefix of the arm's joint names in the model, e.g. ``"l_"``.
+        prefix: Prefix of the arm's joint names in the model, e.g. ``"l_"``; default the arm's
+            (``arm.prefix``).
         frame_name, frame_type: The arm's end-effector frame in the model (the one
             ``arm.fk`` gives); default the prefix plus the arm's Menagerie frame.
         cost: Cost per joint error (1/rad), one value or one per joint.
@@ -107,7 +108,7 @@ class ExactPoseTask(ArmTask):
         *,
         arm_configuration: Configuration | None = None,
         optimizer: RedundancyOptimizer | None = None,
-        prefix: str = "",
+        prefix: str | None = None,
         frame_name: str | None = None,
         frame_type: str | None = None,
         cost: npt.ArrayLike = EXACT_POSE_COST,
