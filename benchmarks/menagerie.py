@@ -118,7 +118,8 @@ def measure(name: str, n: int, seed: int, entry: Entry | None = None, folder: Pa
     except om.ModelError as error:
         row["solver"] = f"refused: {error}"
         return row
-    row["solver"] = f"accepted ({solver.om.family_name.split(':')[0]})"
+    near = ", near: its nominal arm" if solver.nominal is not None else ""
+    row["solver"] = f"accepted ({solver.om.family_name.split(':')[0]}{near})"
     data = mujoco.MjData(model)
     among = hinted = nearer = wrong = roots_total = 0
     worst_position = worst_orientation = 0.0
@@ -191,16 +192,18 @@ def main() -> None:
             continue
         rows.append(measure(name, args.n, args.seed, *arms[name]))
         print(rows[-1], flush=True)
-    keys = list(dict.fromkeys(k for row in rows for k in row if k not in ("model", "dof")))
-    lines = [
-        f"# Menagerie arms imported and solved ({args.n:,} random q per accepted arm, seed {args.seed})",
-        "",
-        "| " + " | ".join(keys) + " |",
-        "|---" * len(keys) + "|",
-    ]
+    title = f"# Menagerie arms imported and solved ({args.n:,} random q per accepted arm, seed {args.seed})"
+    write_page("menagerie.md", "\n".join([title, "", *table(rows, ("model", "dof"))]) + "\n")
+
+
+def table(rows: list[dict], hidden: tuple[str, ...] = ()) -> list[str]:
+    """The rows as a Markdown table, one column per key any row has (but ``hidden``), "-" where
+    a row has none."""
+    keys = list(dict.fromkeys(k for row in rows for k in row if k not in hidden))
+    lines = ["| " + " | ".join(keys) + " |", "|---" * len(keys) + "|"]
     for row in rows:
         lines.append("| " + " | ".join(str(row.get(k, "-")).replace("|", "\\|") for k in keys) + " |")
-    write_page("menagerie.md", "\n".join(lines) + "\n")
+    return lines
 
 
 if __name__ == "__main__":

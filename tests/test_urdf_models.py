@@ -5,6 +5,7 @@ without the prefix. Each test builds a small URDF that reproduces the problem.""
 from __future__ import annotations
 
 import re
+import sys
 import xml.etree.ElementTree as ET
 
 import mink
@@ -13,6 +14,8 @@ import numpy as np
 import pytest
 
 import om_redundant as om
+from benchmarks import urdf_arms
+from benchmarks.menagerie import Entry
 from om_redundant.cli import main
 from tests.conftest import random_q
 from tests.test_arm_import import UR_JOINTS
@@ -258,3 +261,29 @@ def test_a_chain_with_joints_above_the_arm_is_refused_naming_the_root():
     )
     with pytest.raises(om.ModelError, match=cause):
         om.OMSolver(arm)
+
+
+# ---------------------------------------------------------------------------------------
+# The benchmark of public URDFs
+
+
+def test_the_urdf_benchmark_skips_the_files_its_folder_lacks(tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr(sys, "argv", ["urdf_arms", "--dir", str(tmp_path)])
+    urdf_arms.main()
+    out = capsys.readouterr().out
+    assert "UR3: " in out and "absent, skipped" in out and out.rstrip().endswith("nothing measured")
+
+
+def test_the_urdf_benchmark_row_of_an_arm_on_a_torso(tmp_path, monkeypatch):
+    """A row: imported with its frame, prefix and root, checked, and solved exactly against
+    MuJoCo's pose in the root body's frame; a file that does not load says why."""
+    two_arm_urdf(tmp_path, bad_inertia=True)
+    (tmp_path / "broken.urdf").write_text("<robot name='broken'><joint name='j'/></robot>")
+    monkeypatch.setitem(
+        urdf_arms.URDF_ARMS, "two arms", Entry("two_arms.urdf", "tool0", "body", "l_", "torso")
+    )
+    monkeypatch.setitem(urdf_arms.URDF_ARMS, "broken", Entry("broken.urdf", "tool0", "body"))
+    row = urdf_arms.row("two arms", 5, 0, tmp_path)
+    assert row["import"] == "yes" and row["solver"].startswith("accepted (RRR")
+    assert row["q among solve_all"] == "100.000 %" and row["roots not exact or not in c"] == "0"
+    assert urdf_arms.row("broken", 5, 0, tmp_path)["import"].startswith("failed: cannot load MuJoCo model")
