@@ -15,6 +15,7 @@ not import with its error.
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 import om_redundant as om
@@ -109,10 +110,10 @@ def main() -> None:
         print(f"no URDF of URDF_ARMS under {args.dir}: nothing measured")
         return
     title = f"# Public URDF arms imported and solved ({args.n:,} random q per accepted arm, seed {args.seed})"
+    command = " ".join(["python -m benchmarks.urdf_arms", *sys.argv[1:]])
     sources = ", ".join(f"`{folder}/` {source}" for folder, source in SOURCES.items())
-    write_page(
-        "urdf_arms.md", "\n".join([title, "", f"URDFs: {sources}.", "", *table(rows, ("model",))]) + "\n"
-    )
+    lines = [title, "", f"`{command}`; URDFs: {sources}.", "", *table(rows, ("model",))]
+    write_page("urdf_arms.md", "\n".join(lines) + "\n")
 
 
 if __name__ == "__main__":
