@@ -4,6 +4,7 @@ without the prefix. Each test builds a small URDF that reproduces the problem.""
 
 from __future__ import annotations
 
+import json
 import re
 import sys
 import xml.etree.ElementTree as ET
@@ -147,6 +148,10 @@ def test_prefix_and_root_are_kept_in_the_arm_file_and_used_as_defaults(tmp_path)
     path = two_arm_urdf(tmp_path)
     out = tmp_path / "left.toml"
     assert import_left(path, out, "--prefix", "l_", "--root", "torso", "-q") == 0
+    assert (
+        import_left(path, out, "--prefix", "l_", "--root", "torso", "--json", str(tmp_path / "out.json")) == 0
+    )
+    assert json.loads((tmp_path / "out.json").read_text())["root"] == "torso"
     text = out.read_text()
     assert 'prefix = "l_"' in text and 'root = "torso"' in text and 'frame = "tool0"' in text
     arm = om.load_arm(out)

@@ -63,6 +63,8 @@ def run(args: argparse.Namespace) -> int:
                 "file": args.output,
                 "dof": arm.dof,
                 "joint_names": arm.joint_names,
+                "prefix": arm.prefix,
+                "root": arm.root,
                 "frame": match.frame,
                 "max_position_error": match.max_position_error,
                 "max_orientation_error": match.max_orientation_error,
