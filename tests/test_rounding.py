@@ -112,3 +112,19 @@ def test_refusals_name_the_arms_own_joints(joint, value, cause):
     with pytest.raises(om.ModelError, match=cause) as refused:
         om.OMSolver(arm)
     assert not re.search(r"\bq\d", str(refused.value))
+
+
+def test_rounding_left_by_merging_fixed_rows_is_zero_too():
+    """A fixed row d = 0.2 m before joint 2, whose own row has d = -0.2 + 1e-13 m: merged, the
+    nominal arm's d2 is 1e-13 m of rounding, which it zeroes (else its own model refused it)."""
+    ur5e = om.load_arm("ur5e")
+    rows = list(ur5e.chain.rows)
+    rows[1] = dataclasses.replace(rows[1], d=-0.2 + 1e-13)
+    rows.insert(1, om.DHRow(d=0.2, kind=om.JointKind.FIXED))
+    arm = ur5e.with_chain(
+        om.KinematicChain(tuple(rows), ur5e.chain.T_root_base, ur5e.chain.T_flange_tool), "merged"
+    )
+    solver = om.OMSolver(arm)
+    assert solver.nominal.arm.chain.rows[1].d == 0.0 and method(solver) == method(om.OMSolver("ur5e"))
+    for q in random_q(arm, 8, np.random.default_rng(3)):
+        check_exact(solver, q, well_conditioned(solver, q))

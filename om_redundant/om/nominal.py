@@ -29,6 +29,7 @@ closed-form roots as seeds and corrects the difference on the exact chain.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -68,7 +69,11 @@ def nominal_arm(arm: Arm) -> NominalArm:
     """The nominal arm of a real arm (see the module)."""
     exact, flip = _flipped(arm.chain, snap=False)
     snapped, _ = _flipped(arm.chain, snap=True)
-    nominal = KinematicChain(tuple(_merged(list(snapped.rows))), snapped.T_root_base, snapped.T_flange_tool)
+    # Rounding goes before the merge, which needs exact zeros, and after it, as a merged row
+    # can sum to rounding (d = 0.1 carried into a row with d = -0.1 + 1e-13).
+    eps = rounding_length(arm.chain)
+    rows = _rounded(_merged(_rounded(snapped.rows, eps)), eps)
+    nominal = KinematicChain(tuple(rows), snapped.T_root_base, snapped.T_flange_tool)
     lower = np.where(flip < 0, -arm.upper, arm.lower)
     upper = np.where(flip < 0, -arm.lower, arm.upper)
     differs = (
@@ -110,8 +115,7 @@ def _off(alpha: float, nominal: float) -> float:
 
 def _flipped(chain: KinematicChain, snap: bool) -> tuple[KinematicChain, np.ndarray]:
     """Leading fixed rows into the base, half turns moved past the rows that follow them (the
-    joints flipped), twists and rounding snapped if ``snap``."""
-    eps = rounding_length(chain)
+    joints flipped), twists snapped if ``snap``."""
     rows = list(chain.rows)
     base = chain.T_root_base.copy()
     while rows and not rows[0].is_joint:
@@ -130,21 +134,25 @@ def _flipped(chain: KinematicChain, snap: bool) -> tuple[KinematicChain, np.ndar
             alpha = 0.0 if snap else row.alpha - np.pi
         else:
             alpha = nominal if snap and near else row.alpha
-        if snap:
-            a, d, theta = _rounded(row.a, eps), _rounded(row.d, eps), _rounded_angle(row.theta)
-            row = DHRow(a=a, alpha=row.alpha, d=d, theta=theta, kind=row.kind)
         out.append(DHRow(a=row.a, alpha=alpha, d=row.d, theta=row.theta, kind=row.kind))
     tool = _HALF_TURN @ chain.T_flange_tool if half_turn else chain.T_flange_tool
     return KinematicChain(tuple(out), base, tool), np.array(flip)
 
 
-def _rounded(length: float, eps: float) -> float:
-    """0 for a length within rounding of it, else the length."""
+def _rounded(rows: Sequence[DHRow], eps: float) -> list[DHRow]:
+    """The rows with each length within ``eps`` of 0 zero and each theta within
+    ``ANGLE_ROUNDING`` of a multiple of 90 deg that multiple."""
+    return [
+        DHRow(_length(row.a, eps), row.alpha, _length(row.d, eps), _right_angle(row.theta), row.kind)
+        for row in rows
+    ]
+
+
+def _length(length: float, eps: float) -> float:
     return 0.0 if abs(length) <= eps else length
 
 
-def _rounded_angle(angle: float) -> float:
-    """The multiple of 90 deg within rounding of the angle, else the angle."""
+def _right_angle(angle: float) -> float:
     nominal = _nearest_right_angle(angle)
     return nominal if _off(angle, nominal) <= ANGLE_ROUNDING else angle
 
