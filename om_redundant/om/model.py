@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -192,7 +193,7 @@ def _joint_name(arm: Arm, j: int) -> str:
     return f"joint {j + 1} ('{arm.prefix}{arm.joint_names[j]}')"
 
 
-def _joints_named(arm: Arm, joints) -> str:
+def _joints_named(arm: Arm, joints: Iterable[int]) -> str:
     return ", ".join(_joint_name(arm, j) for j in joints)
 
 
