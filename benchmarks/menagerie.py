@@ -24,6 +24,7 @@ import mujoco
 import numpy as np
 
 import om_redundant as om
+from om_redundant.mujoco_io.frames import arm_frame_names, find_frame
 
 from .report import write_page
 from .robots import joint_distance
@@ -78,14 +79,18 @@ def import_arm(entry: Entry, folder: Path = MENAGERIE) -> tuple[om.Arm, mujoco.M
 
 
 def frame_pose(model: mujoco.MjModel, data: mujoco.MjData, arm: om.Arm, q: np.ndarray) -> np.ndarray:
-    """MuJoCo's own pose of the arm's frame at qpos = q (other joints, e.g. fingers, at qpos0)."""
-    ids = [model.joint(n).id for n in arm.joint_names]
+    """MuJoCo's own pose of the arm's frame at qpos = q (other joints, e.g. fingers, at qpos0), in
+    the frame of the arm's root body (its prefix and root as the arm file keeps them)."""
+    ids = [model.joint(arm.prefix + n).id for n in arm.joint_names]
     data.qpos[:] = model.qpos0
     data.qpos[model.jnt_qposadr[ids]] = q
     mujoco.mj_kinematics(model, data)
-    frame = data.site(arm.frame_name) if arm.frame_type == "site" else data.body(arm.frame_name)
+    frame_id, _ = find_frame(model, arm.frame_type, arm_frame_names(arm.frame_name, arm.prefix))
+    frame = data.site(frame_id) if arm.frame_type == "site" else data.body(frame_id)
+    root = data.body(arm.root or "world")
+    R_root = root.xmat.reshape(3, 3)
     T = np.eye(4)
-    T[:3, :3], T[:3, 3] = frame.xmat.reshape(3, 3), frame.xpos
+    T[:3, :3], T[:3, 3] = R_root.T @ frame.xmat.reshape(3, 3), R_root.T @ (frame.xpos - root.xpos)
     return T
 
 
@@ -113,7 +118,8 @@ def measure(name: str, n: int, seed: int, entry: Entry | None = None, folder: Pa
     except om.ModelError as error:
         row["solver"] = f"refused: {error}"
         return row
-    row["solver"] = f"accepted ({solver.om.family_name.split(':')[0]})"
+    near = ", near: its nominal arm" if solver.nominal is not None else ""
+    row["solver"] = f"accepted ({solver.om.family_name.split(':')[0]}{near})"
     data = mujoco.MjData(model)
     among = hinted = nearer = wrong = roots_total = 0
     worst_position = worst_orientation = 0.0
@@ -186,16 +192,18 @@ def main() -> None:
             continue
         rows.append(measure(name, args.n, args.seed, *arms[name]))
         print(rows[-1], flush=True)
-    keys = list(dict.fromkeys(k for row in rows for k in row if k not in ("model", "dof")))
-    lines = [
-        f"# Menagerie arms imported and solved ({args.n:,} random q per accepted arm, seed {args.seed})",
-        "",
-        "| " + " | ".join(keys) + " |",
-        "|---" * len(keys) + "|",
-    ]
+    title = f"# Menagerie arms imported and solved ({args.n:,} random q per accepted arm, seed {args.seed})"
+    write_page("menagerie.md", "\n".join([title, "", *table(rows, ("model", "dof"))]) + "\n")
+
+
+def table(rows: list[dict], hidden: tuple[str, ...] = ()) -> list[str]:
+    """The rows as a Markdown table, one column per key any row has (but ``hidden``), "-" where
+    a row has none."""
+    keys = list(dict.fromkeys(k for row in rows for k in row if k not in hidden))
+    lines = ["| " + " | ".join(keys) + " |", "|---" * len(keys) + "|"]
     for row in rows:
         lines.append("| " + " | ".join(str(row.get(k, "-")).replace("|", "\\|") for k in keys) + " |")
-    write_page("menagerie.md", "\n".join(lines) + "\n")
+    return lines
 
 
 if __name__ == "__main__":

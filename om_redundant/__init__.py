@@ -33,7 +33,9 @@ from .mujoco_io import (
     without_meshes,
 )
 from .om import (
+    ANGLE_ROUNDING,
     BRANCH_BAND,
+    LENGTH_ROUNDING,
     NEAR_TWIST,
     BatchRoots,
     BatchSolution,
@@ -67,7 +69,9 @@ from .tasks import ArmAngleTask, ExactPoseTask
 __version__ = "0.1.0"
 
 __all__ = [
+    "ANGLE_ROUNDING",
     "BRANCH_BAND",
+    "LENGTH_ROUNDING",
     "MAX_EXTENT",
     "NEAR_TWIST",
     "Arm",

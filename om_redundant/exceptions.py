@@ -71,12 +71,21 @@ class JointNotFound(ModelMismatch):
 class FrameNotFound(ModelMismatch, InvalidFrame):
     """The end-effector frame named for the arm is not in the MuJoCo model.
 
-    Also a ``mink.InvalidFrame``, whose message (listing the model's frames) it keeps.
+    Also a ``mink.InvalidFrame``, whose message (listing the model's frames) it keeps, adding
+    the other names tried (``also``: the name with or without the arm's prefix) and why a
+    URDF's link may be missing.
     """
 
-    def __init__(self, frame_name: str, frame_type: str, model: mujoco.MjModel):
+    def __init__(self, frame_name: str, frame_type: str, model: mujoco.MjModel, also: tuple[str, ...] = ()):
         self.frame_name, self.frame_type = frame_name, frame_type
         InvalidFrame.__init__(self, frame_name, frame_type, model)
+        tried = "".join(f" (nor '{name}')" for name in also)
+        self.args = (
+            self.args[0].replace(f"'{frame_name}'", f"'{frame_name}'{tried}", 1)
+            + ". A URDF's link on a fixed joint (such as tool0) is a body only where the model is compiled "
+            "with fusestatic off, as om.load_mujoco_model does; MuJoCo's URDF loader fuses it into its "
+            "parent by default",
+        )
 
 
 class UnreachableTarget(OMError, InvalidTarget):

@@ -356,7 +356,9 @@ def test_prefix_and_root(tmp_path):
     # Given with its prefix, the frame is found too.
     assert same_arm(om.arm_from_mujoco(path, "l_attachment_site", prefix="l_", root="l_base"), arm)
     with pytest.raises(
-        om.InvalidInput, match=r"is a free joint; an arm has hinge and slide joints \(give a root"
+        om.InvalidInput,
+        match=r"is a free joint; an arm has hinge and slide joints: give the body it moves, 'cart', as the "
+        r"root \(--root cart, root='cart'\)",
     ):
         om.arm_from_mujoco(path, "attachment_site", prefix="l_")
 
@@ -386,7 +388,12 @@ def test_prefix_and_root(tmp_path):
             "not below root body",
         ),
         ({"frame_name": "attachment_site", "root": "link7"}, om.InvalidInput, "no joint moves site"),
-        ({"frame_name": "attachment_site", "prefix": "r_"}, om.FrameNotFound, "r_attachment_site"),
+        ({"frame_name": "nowhere", "prefix": "r_"}, om.FrameNotFound, r"'nowhere' \(nor 'r_nowhere'\)"),
+        (
+            {"frame_name": "attachment_site", "prefix": "r_"},
+            om.InvalidInput,
+            "joint 'joint7' between the root and the frame does not start with the prefix 'r_'$",
+        ),
     ],
 )
 def test_import_errors_name_the_problem(kwargs, error, message):

@@ -332,7 +332,7 @@ def test_arms_lists_every_arm_with_its_model(arm_without_a_model):
     done = command("arms", str(arm_without_a_model), "--json")
     (row,) = json.loads(done.stdout)
     assert not row["solvable"] and row["dp_max"] is None
-    assert row["reason"] == "fixed rows between joints 6 and 7 need a = 0"
+    assert row["reason"] == "fixed rows between joint 6 ('right_j5') and joint 7 ('right_j6') need a = 0"
 
 
 def test_arms_table(capsys, arm_without_a_model):
@@ -341,14 +341,16 @@ def test_arms_table(capsys, arm_without_a_model):
     assert status == 0 and len(lines) == 1 + len(om.arm_names())
     assert "0.0121 m" in out and "not yet solvable" not in out
     status, out, _ = in_process(capsys, "arms", str(arm_without_a_model))
-    assert status == 0 and "not yet solvable: fixed rows between joints 6 and 7 need a = 0" in out
+    reason = "fixed rows between joint 6 ('right_j5') and joint 7 ('right_j6') need a = 0"
+    assert status == 0 and f"not yet solvable: {reason}" in out
 
 
 @pytest.mark.parametrize("subcommand", ["solve", "sweep"])
 def test_an_arm_without_a_model_is_refused_in_one_line(capsys, arm_without_a_model, subcommand):
     status, _, err = in_process(capsys, subcommand, "--arm", str(arm_without_a_model))
     assert status == 2
-    assert err.strip().endswith("arm 'bent': fixed rows between joints 6 and 7 need a = 0")
+    reason = "fixed rows between joint 6 ('right_j5') and joint 7 ('right_j6') need a = 0"
+    assert err.strip().endswith(f"arm 'bent': {reason}")
 
 
 def test_bench_paper_small_run(capsys):
@@ -484,7 +486,9 @@ def test_check_model_skips_missing_textures_and_mesh_fitted_geoms(capsys, tmp_pa
     status, _, err = in_process(capsys, "check-model", str(path), "--arm", "ur5e")
     assert status == 2 and err.count("\n") == 1
     assert re.search(
-        r"no_such_joint.*\(with its meshes and textures skipped, which failed first: .*gone", err
+        r"no_such_joint.*\(with its inertial data replaced and its meshes and textures skipped, which failed "
+        r"first: .*gone",
+        err,
     )
 
 

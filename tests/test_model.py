@@ -25,11 +25,15 @@ def modified(arm: om.Arm, joint: int, **changes) -> om.Arm:
 @pytest.mark.parametrize(
     "joint, changes, message",
     [
-        (3, {"kind": om.JointKind.PRISMATIC}, "joint 4 revolute"),
+        (3, {"kind": om.JointKind.PRISMATIC}, r"joint 4 \('wrist_1_joint'\) revolute"),
         (3, {"alpha": 0.0}, "non-parallel"),
         (4, {"alpha": np.pi}, "non-parallel"),
         (4, {"alpha": np.pi / 3}, "alpha_5 = \\+-90"),
-        (1, {"kind": om.JointKind.PRISMATIC}, "joints 1 and 2 must be revolute"),
+        (
+            1,
+            {"kind": om.JointKind.PRISMATIC},
+            r"joint 1 \('shoulder_pan_joint'\) and joint 2 \('shoulder_lift_joint'\) must be revolute",
+        ),
         (0, {"alpha": 0.0}, "perpendicular"),
         (2, {"kind": om.JointKind.PRISMATIC}, "no closed-form family"),
     ],

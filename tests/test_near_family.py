@@ -111,8 +111,21 @@ def test_solve_all_batch_equals_solve_all_on_a_near_arm():
 @pytest.mark.parametrize(
     ("name", "row", "field", "value", "cause"),
     [
-        ("ur5e", 3, "alpha", np.pi / 2 + 2e-3, r"joints 4 and 5 perpendicular .*\(0.002 rad off\)"),
-        ("panda", 1, "a", 0.01, r"shoulder offset a2 = 0.01 m makes dp depend on q2"),
+        (
+            "ur5e",
+            3,
+            "alpha",
+            np.pi / 2 + 2e-3,
+            r"joint 4 \('wrist_1_joint'\) and joint 5 \('wrist_2_joint'\) perpendicular .*\(0.002 rad off\)",
+        ),
+        (
+            "panda",
+            1,
+            "a",
+            0.01,
+            r"shoulder offset a2 = 0.01 m \(from the axis of joint 2 \('joint2'\) to that of joint 3 "
+            r"\('joint3'\).*\) makes dp depend on joint 2 \('joint2'\)",
+        ),
     ],
 )
 def test_an_arm_that_cannot_be_solved_is_refused_at_construction(name, row, field, value, cause):

@@ -165,7 +165,9 @@ def test_an_arm_that_cannot_solve_is_refused_at_construction(monkeypatch):
     rows[3] = om.DHRow(a=rows[3].a, alpha=rows[3].alpha + 1e-2, d=rows[3].d, theta=rows[3].theta)
     bent = ur5e.with_chain(ur5e.chain.replace_rows(rows), "bent")
     with pytest.raises(
-        om.ModelError, match=r"joints 4 and 5 perpendicular .*got 90.5729578 deg \(0.01 rad off\)"
+        om.ModelError,
+        match=r"joint 4 \('wrist_1_joint'\) and joint 5 \('wrist_2_joint'\) perpendicular .*"
+        r"got 90.5729578 deg \(0.01 rad off\)",
     ):
         om.OMSolver(bent)
     monkeypatch.setattr(model_module, "_RIGHT_ANGLE_EPS", 1e-1)

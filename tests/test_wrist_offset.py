@@ -168,7 +168,11 @@ def test_a_wrist_offset_whose_joint_4_turns_with_joint_2_is_refused():
     puma = with_offsets(om.load_arm("ur5e"), joint2={"alpha": np.pi / 2})
     om.OMSolver(puma)
     offset = with_offsets(puma, joint3={"a": 0.07})
-    cause = r"a4 = 0.07 != 0 makes dp depend on joints 5 and 6.*joint 4's axis turns with q1 alone"
+    cause = (
+        r"a4 = 0.07 != 0 \(the wrist offset from the axis of joint 4 \('wrist_1_joint'\) to that of joint 5 "
+        r"\('wrist_2_joint'\)\) makes dp depend on joint 5 \('wrist_2_joint'\), joint 6 \('wrist_3_joint'\).*"
+        r"joint 4's axis turns with joint 1 \('shoulder_pan_joint'\) alone"
+    )
     with pytest.raises(om.ModelError, match=cause):
         om.derive_model(offset)
     with pytest.raises(om.ModelError, match=cause):

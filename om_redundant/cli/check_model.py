@@ -23,11 +23,16 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--site",
         metavar="NAME",
-        help="end-effector site (or body) in the model, without prefix; default the arm file's frame",
+        help="end-effector site (or body) in the model, as given or with the prefix; default the arm "
+        "file's frame",
     )
-    parser.add_argument("--prefix", default="", help="prefix of the model's joint and frame names")
     parser.add_argument(
-        "--root", metavar="BODY", help="body whose frame is the arm's root frame; default the world"
+        "--prefix", help="prefix of the model's joint (and frame) names; default the arm file's ([mujoco])"
+    )
+    parser.add_argument(
+        "--root",
+        metavar="BODY",
+        help="body whose frame is the arm's root frame; default the arm file's ([mujoco]), else the world",
     )
     parser.add_argument(
         "--samples", type=int, default=100, help="random joint vectors compared (default 100)"

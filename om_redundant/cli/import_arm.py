@@ -30,10 +30,16 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "--frame-type", choices=("site", "body"), default="site", help="what --frame names (default site)"
     )
     parser.add_argument(
-        "--prefix", default="", help="prefix of the model's joint and frame names, left out of the arm file"
+        "--prefix",
+        default="",
+        help="prefix of the model's joint names (and of the frame's, if it has it), left out of the arm's "
+        "names and kept in the file ([mujoco] prefix)",
     )
     parser.add_argument(
-        "--root", metavar="BODY", help="body whose frame is the arm's root frame; default the world"
+        "--root",
+        metavar="BODY",
+        help="body whose frame is the arm's root frame, where its chain starts (below a torso or a mobile "
+        "base); default the world; kept in the file ([mujoco] root)",
     )
     parser.add_argument("--name", help="the arm's name; default the model file's stem")
     parser.add_argument("-o", "--output", required=True, metavar="ARM.toml", help="the arm file to write")
@@ -44,21 +50,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     check_output_path(args.output, "--output", (".toml",))
     arm = arm_from_mujoco(args.model, args.frame, args.frame_type, args.prefix, args.root, name=args.name)
-    match = compare_mujoco_model(
-        arm, load_mujoco_model(args.model), prefix=args.prefix, root=args.root, tolerance=IMPORT_TOLERANCE
-    )
+    match = compare_mujoco_model(arm, load_mujoco_model(args.model), tolerance=IMPORT_TOLERANCE)
     try:
         family, reason = OMSolver(arm).om.family_name, None
     except ModelError as exc:
         family, reason = None, str(exc).removeprefix(f"arm '{arm.name}': ")
-    write_arm_file(
-        arm,
-        args.output,
-        f"Written by om-redundant import-arm from {args.model} ({args.frame_type} '{args.frame}'"
-        + (f", prefix '{args.prefix}'" if args.prefix else "")
-        + (f", root body '{args.root}'" if args.root else "")
-        + ").",
-    )
+    write_arm_file(arm, args.output, f"Written by om-redundant import-arm from {args.model}.")
     if args.json is not None:
         write_json(
             {
@@ -66,6 +63,8 @@ def run(args: argparse.Namespace) -> int:
                 "file": args.output,
                 "dof": arm.dof,
                 "joint_names": arm.joint_names,
+                "prefix": arm.prefix,
+                "root": arm.root,
                 "frame": match.frame,
                 "max_position_error": match.max_position_error,
                 "max_orientation_error": match.max_orientation_error,

@@ -11,6 +11,8 @@ by name or path and :func:`arm_names` lists the built-in ones. The file format::
     model = "universal_robots_ur5e/ur5e.xml"   # path under MuJoCo Menagerie
     frame = "wrist_3_link"
     frame_type = "body"            # "body" or "site"
+    prefix = "l_"                  # optional: of the model's names of the joints (and frame)
+    root = "torso"                 # optional: the body whose frame is the root frame; default the world
 
     [base]                         # pose of DH frame 0 in the arm's root frame
     xyz = [0, 0, 0]
@@ -40,6 +42,7 @@ transforms :func:`exact_angle` and :func:`exact_pose` made (an imported arm's).
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import json
 import math
@@ -70,8 +73,14 @@ class Arm:
         upper: Upper joint limits (dof,); ``+inf`` where unlimited.
         description: Human-readable description.
         mujoco_model: Path of the matching MuJoCo Menagerie model, relative to Menagerie's root.
-        frame_name: Name of the end-effector frame in that model.
+        frame_name: Name of the end-effector frame in that model, without the prefix where it
+            has it.
         frame_type: ``"body"`` or ``"site"``.
+        prefix: Prefix of the model's names of the arm's joints (and of the frame's, where it has
+            it), e.g. ``"l_"``; the defaults of ``check-model``, :class:`~om_redundant.ArmJoints`
+            and the tasks.
+        root: The model's body whose frame is the arm's root frame, the frame of :meth:`fk`
+            and of the poses the solver takes; None for the world.
         source: File the arm was read from.
     """
 
@@ -84,6 +93,8 @@ class Arm:
     mujoco_model: str | None = None
     frame_name: str | None = None
     frame_type: str | None = None
+    prefix: str = ""
+    root: str | None = None
     source: str | None = None
     revolute: np.ndarray = field(init=False, repr=False)
 
@@ -111,19 +122,8 @@ class Arm:
         return bool(inside) if q.ndim == 1 else inside
 
     def with_chain(self, chain: KinematicChain, name: str) -> Arm:
-        """The same arm (names, limits) on another chain, e.g. an offset-modified model."""
-        return Arm(
-            name,
-            chain,
-            self.joint_names,
-            self.lower,
-            self.upper,
-            self.description,
-            self.mujoco_model,
-            self.frame_name,
-            self.frame_type,
-            self.source,
-        )
+        """The same arm (names, limits, model) on another chain, e.g. an offset-modified model."""
+        return dataclasses.replace(self, name=name, chain=chain)
 
 
 def arm_names() -> list[str]:
@@ -226,7 +226,7 @@ def _parse(text: str, path: str) -> Arm:
     mujoco = data.get("mujoco", {})
     if not isinstance(mujoco, dict):
         raise ArmFileError(path, "mujoco", "must be a table")
-    f.no_unknown(mujoco, {"model", "frame", "frame_type"}, "mujoco.")
+    f.no_unknown(mujoco, {"model", "frame", "frame_type", "prefix", "root"}, "mujoco.")
     frame_type = mujoco.get("frame_type")
     if frame_type not in (None, "body", "site"):
         raise ArmFileError(path, "mujoco.frame_type", f"must be 'body' or 'site', got '{frame_type}'")
@@ -241,6 +241,8 @@ def _parse(text: str, path: str) -> Arm:
         mujoco_model=f.string(mujoco, "model", "mujoco.", None),
         frame_name=f.string(mujoco, "frame", "mujoco.", None),
         frame_type=frame_type,
+        prefix=f.string(mujoco, "prefix", "mujoco.", ""),
+        root=f.string(mujoco, "root", "mujoco.", None) or None,  # "" is the world too
         source=path,
     )
 
@@ -354,7 +356,13 @@ def arm_file_text(arm: Arm, comment: str = "") -> str:
     if arm.description:
         lines.append(f"description = {_string(arm.description)}")
     lines.append('convention = "standard"')
-    fields = {"model": arm.mujoco_model, "frame": arm.frame_name, "frame_type": arm.frame_type}
+    fields = {
+        "model": arm.mujoco_model,
+        "frame": arm.frame_name,
+        "frame_type": arm.frame_type,
+        "prefix": arm.prefix,
+        "root": arm.root,
+    }
     if any(fields.values()):
         lines += ["", "[mujoco]"]
         lines += [f"{key} = {_string(value)}" for key, value in fields.items() if value]

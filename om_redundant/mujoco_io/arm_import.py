@@ -49,6 +49,7 @@ import numpy as np
 from ..exceptions import FrameNotFound, InvalidInput, ModelMismatch
 from ..kinematics.arm import Arm, exact_angle, exact_pose
 from ..kinematics.chain import DHRow, JointKind, KinematicChain, row_transform
+from .frames import FRAME_OBJECTS, find_frame, given_frame_names
 from .model_match import compare_mujoco_model, load_mujoco_model
 
 #: Largest length (m) and angle (rad) taken for round-off of 0 or of a multiple of 90 deg.
@@ -61,8 +62,6 @@ NEAR_RIGHT_ANGLE = 1e-3
 FAR_PER_SPAN = 10.0
 #: Largest difference (m, rad) accepted between the derived arm and the model.
 IMPORT_TOLERANCE = 1e-12
-
-_FRAME_OBJECTS = {"site": mujoco.mjtObj.mjOBJ_SITE, "body": mujoco.mjtObj.mjOBJ_BODY}
 
 
 def arm_from_mujoco(
@@ -81,13 +80,15 @@ def arm_from_mujoco(
     Args:
         model: A compiled model, or the path of an MJCF (.xml) or URDF (.urdf) file, loaded
             by :func:`~.model_match.load_mujoco_model` (missing meshes and textures skipped).
-        frame_name: The end-effector site or body, without the prefix.
+        frame_name: The end-effector site or body: its name as given, else with the prefix.
         frame_type: ``"site"`` or ``"body"``.
-        prefix: Prefix of the model's names of the arm's joints and frame (e.g.
-            ``"wx250s/"``); the arm's names are without it, as :func:`compare_mujoco_model`
-            and :class:`~.arm_in_model.ArmJoints` expect.
+        prefix: Prefix of the model's names of the arm's joints (e.g. ``"wx250s/"``), which
+            the frame's name may share; the arm's names are without it, and the arm keeps it
+            (``arm.prefix``), as :func:`compare_mujoco_model` and
+            :class:`~.arm_in_model.ArmJoints` take it.
         root: Body whose frame is the arm's root frame (the frame of ``arm.fk``); default the
-            world. Joints above it (a mobile base) are not the arm's.
+            world. Joints above it (a mobile base, a torso) are not the arm's. The arm keeps
+            it (``arm.root``).
         name: The arm's name; default the file's stem, else the model's name.
         description: Default: where the arm was imported from.
         model_path: The ``[mujoco] model`` of the arm file; default, for a file, its folder
@@ -95,12 +96,13 @@ def arm_from_mujoco(
 
     Returns:
         The arm; its forward kinematics equals the frame's pose in the root frame to 1e-12.
+        Its frame name is the model's, without the prefix where it has it.
 
     Raises:
-        FrameNotFound: No site or body of that name.
+        FrameNotFound: No site or body of that name, with or without the prefix.
         InvalidInput: No joint, or a joint the arm cannot have (ball, free, unnamed, without
-            the prefix) between root and frame; root is not above the frame; a file that
-            does not load.
+            the prefix) between root and frame (the message names the root to give); root is
+            not above the frame; a file that does not load.
         ModelMismatch: The derived arm does not reproduce the model (a bug; the message
             says by how much).
     """
@@ -109,13 +111,12 @@ def arm_from_mujoco(
         model = load_mujoco_model(path)
         name = name or path.stem
         model_path = model_path or f"{path.resolve().parent.name}/{path.name}"
-    if frame_type not in _FRAME_OBJECTS:
+    if frame_type not in ("site", "body"):
         raise InvalidInput(f"frame_type must be 'site' or 'body', got '{frame_type}'")
-    frame_name = _unprefixed_frame(model, frame_name, frame_type, prefix)
-    frame_id = mujoco.mj_name2id(model, _FRAME_OBJECTS[frame_type], prefix + frame_name)
+    frame_id, full_frame_name = _frame(model, frame_name, frame_type, prefix)
     root_id = _body_id(model, root)
     joints = _chain_joints(model, frame_type, frame_id, root_id, root)
-    joint_names = tuple(_unprefixed_joint(model, j, prefix) for j in joints)
+    joint_names = _arm_joint_names(model, joints, prefix)
 
     lines, T_ee = _lines_at_zero(model, joints, frame_type, frame_id, root_id)
     kinds = [
@@ -133,12 +134,14 @@ def arm_from_mujoco(
         lower=np.where(limited, ranges[:, 0], -np.inf),
         upper=np.where(limited, ranges[:, 1], np.inf),
         description=description
-        or f"imported from {model_path or 'a MuJoCo model'} ({frame_type} '{prefix + frame_name}')",
+        or f"imported from {model_path or 'a MuJoCo model'} ({frame_type} '{full_frame_name}')",
         mujoco_model=model_path,
-        frame_name=frame_name,
+        frame_name=full_frame_name.removeprefix(prefix),
         frame_type=frame_type,
+        prefix=prefix,
+        root=root,
     )
-    check = compare_mujoco_model(arm, model, prefix=prefix, root=root, samples=16, tolerance=IMPORT_TOLERANCE)
+    check = compare_mujoco_model(arm, model, samples=16, tolerance=IMPORT_TOLERANCE)
     if not check.ok:
         raise ModelMismatch(f"the arm derived from the model does not reproduce it: {check.differences[0]}")
     return arm
@@ -272,20 +275,20 @@ def _lines_at_zero(
     return lines, T_ee
 
 
-def _unprefixed_frame(model: mujoco.MjModel, frame_name: str, frame_type: str, prefix: str) -> str:
-    """The frame's name without the prefix; given with or without it."""
-    objtype = _FRAME_OBJECTS[frame_type]
-    if mujoco.mj_name2id(model, objtype, prefix + frame_name) >= 0:
-        return frame_name
-    if prefix and frame_name.startswith(prefix) and mujoco.mj_name2id(model, objtype, frame_name) >= 0:
-        return frame_name.removeprefix(prefix)
-    other = "body" if frame_type == "site" else "site"
-    if mujoco.mj_name2id(model, _FRAME_OBJECTS[other], prefix + frame_name) >= 0:
-        raise InvalidInput(
-            f"the model has no {frame_type} '{prefix + frame_name}' but a {other} of that name: give "
-            f"frame_type='{other}' (--frame-type {other})"
-        )
-    raise FrameNotFound(prefix + frame_name, frame_type, model)
+def _frame(model: mujoco.MjModel, frame_name: str, frame_type: str, prefix: str) -> tuple[int, str]:
+    """Id and model's name of the frame: the name as given, else with the prefix."""
+    names = given_frame_names(frame_name, prefix)
+    try:
+        return find_frame(model, frame_type, names)
+    except FrameNotFound:
+        other = "body" if frame_type == "site" else "site"
+        for name in names:
+            if mujoco.mj_name2id(model, FRAME_OBJECTS[other], name) >= 0:
+                raise InvalidInput(
+                    f"the model has no {frame_type} '{name}' but a {other} of that name: give "
+                    f"frame_type='{other}' (--frame-type {other})"
+                ) from None
+        raise
 
 
 def _body_id(model: mujoco.MjModel, root: str | None) -> int:
@@ -314,11 +317,11 @@ def _chain_joints(
     for j in joints:
         kind = mujoco.mjtJoint(model.jnt_type[j])
         if kind not in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE):
-            where = "a root body below it" if kind == mujoco.mjtJoint.mjJNT_FREE else "another frame"
+            where = _root_hint(model, j) if kind == mujoco.mjtJoint.mjJNT_FREE else "give another frame"
             raise InvalidInput(
                 f"joint '{_name(model, 'joint', j)}' between the root and the {frame_type} is a "
-                f"{kind.name.removeprefix('mjJNT_').lower()} joint; an arm has hinge and slide joints "
-                f"(give {where})"
+                f"{kind.name.removeprefix('mjJNT_').lower()} joint; an arm has hinge and slide joints: "
+                + where
             )
     if not joints:
         raise InvalidInput(
@@ -327,16 +330,32 @@ def _chain_joints(
     return joints
 
 
-def _unprefixed_joint(model: mujoco.MjModel, joint: int, prefix: str) -> str:
-    name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, joint)
-    if not name:
+def _arm_joint_names(model: mujoco.MjModel, joints: list[int], prefix: str) -> tuple[str, ...]:
+    """The joints' names without the prefix, which each must have."""
+    names = []
+    for j in joints:
+        name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j)
+        if not name:
+            raise InvalidInput(
+                f"joint {j} (in body '{_name(model, 'body', model.jnt_bodyid[j])}') "
+                "has no name; an arm file names its joints"
+            )
+        names.append(name)
+    outside = [k for k, name in enumerate(names) if not name.startswith(prefix)]
+    if outside:  # the last one: the arm's joints may come after it (below a torso, a mobile base)
+        k = outside[-1]
+        hint = f"; if it is not the arm's, {_root_hint(model, joints[k])}" if k + 1 < len(joints) else ""
         raise InvalidInput(
-            f"joint {joint} (in body '{_name(model, 'body', model.jnt_bodyid[joint])}') "
-            "has no name; an arm file names its joints"
+            f"joint '{names[k]}' between the root and the frame does not start with the prefix "
+            f"'{prefix}'{hint}"
         )
-    if not name.startswith(prefix):
-        raise InvalidInput(f"joint '{name}' does not start with the prefix '{prefix}'")
-    return name.removeprefix(prefix)
+    return tuple(name.removeprefix(prefix) for name in names)
+
+
+def _root_hint(model: mujoco.MjModel, joint: int) -> str:
+    """Advice to start the arm below a joint: the body it moves as the root."""
+    body = _name(model, "body", model.jnt_bodyid[joint])
+    return f"give the body it moves, '{body}', as the root (--root {body}, root='{body}')"
 
 
 def _name(model: mujoco.MjModel, kind: str, index: int) -> str:

@@ -11,12 +11,13 @@ from __future__ import annotations
 
 import mujoco
 import numpy as np
-from mink import FRAME_TO_ENUM, FRAME_TO_POS_ATTR, FRAME_TO_XMAT_ATTR, SUPPORTED_FRAMES, UnsupportedFrame
+from mink import FRAME_TO_POS_ATTR, FRAME_TO_XMAT_ATTR, SUPPORTED_FRAMES, UnsupportedFrame
 from scipy.spatial.transform import Rotation
 
-from ..exceptions import FrameNotFound, JointNotFound, ModelMismatch
+from ..exceptions import JointNotFound, ModelMismatch
 from ..kinematics.arm import Arm
 from ..validation import as_instance
+from .frames import arm_frame_names, find_frame, given_frame_names
 from .mjcf import DEFAULT_SITE
 
 #: Largest disagreement (m, rad) accepted between ``arm.fk`` and the model's end-effector frame.
@@ -31,7 +32,8 @@ class ArmJoints:
     Args:
         arm: The arm.
         model: A MuJoCo model that holds the arm, possibly among other joints.
-        prefix: Prepended to the arm's joint names, e.g. ``"l_"``.
+        prefix: Prepended to the arm's joint names, e.g. ``"l_"``; default the arm's
+            (``arm.prefix``, from its arm file).
 
     Attributes:
         arm: The arm.
@@ -54,10 +56,10 @@ class ArmJoints:
             a string.
     """
 
-    def __init__(self, arm: Arm, model: mujoco.MjModel, prefix: str = ""):
+    def __init__(self, arm: Arm, model: mujoco.MjModel, prefix: str | None = None):
         as_instance(arm, Arm, "arm")
         as_instance(model, mujoco.MjModel, "model", "a mujoco.MjModel")
-        as_instance(prefix, str, "prefix")
+        prefix = arm.prefix if prefix is None else as_instance(prefix, str, "prefix")
         self.arm, self.model, self.prefix = arm, model, prefix
         self.names = tuple(prefix + name for name in arm.joint_names)
         ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name) for name in self.names]
@@ -140,9 +142,9 @@ class ArmRoot:
     Args:
         joints: The arm's joints in the model.
         frame_name: The end-effector frame E in the model: the arm's own (the frame
-            ``arm.fk`` gives) or any frame fixed to its last link. Default: the prefix plus
-            the arm's frame name (``arm.frame_name``, Menagerie's), else
-            ``prefix + "end_effector"``.
+            ``arm.fk`` gives) or any frame fixed to its last link; as given, else with the
+            prefix. Default: the arm's frame name (``arm.frame_name``, Menagerie's, else
+            ``"end_effector"``) with the prefix, else as it is.
         frame_type: ``"site"``, ``"body"`` or ``"geom"``; default the arm's (``"site"`` if it
             names none).
 
@@ -155,7 +157,7 @@ class ArmRoot:
             (the root moves with other joints or a mocap body; see :meth:`pose`).
 
     Raises:
-        FrameNotFound: No frame of that name and type.
+        FrameNotFound: No frame of that name and type, with or without the prefix.
         mink.UnsupportedFrame: frame_type is none of the above.
         ModelMismatch: The frame is not below the arm's joints, or does not move rigidly with
             the arm's end effector.
@@ -167,13 +169,14 @@ class ArmRoot:
             if value is not None:
                 as_instance(value, str, name)
         self.joints = joints
-        self.frame_name = frame_name or joints.prefix + (arm.frame_name or DEFAULT_SITE)
         self.frame_type = frame_type or arm.frame_type or "site"
         if self.frame_type not in SUPPORTED_FRAMES:
             raise UnsupportedFrame(self.frame_type, SUPPORTED_FRAMES)
-        self._frame = mujoco.mj_name2id(model, FRAME_TO_ENUM[self.frame_type], self.frame_name)
-        if self._frame == -1:
-            raise FrameNotFound(self.frame_name, self.frame_type, model)
+        if frame_name:
+            names = given_frame_names(frame_name, joints.prefix)
+        else:
+            names = arm_frame_names(arm.frame_name or DEFAULT_SITE, joints.prefix)
+        self._frame, self.frame_name = find_frame(model, self.frame_type, names)
         self._pos, self._xmat = FRAME_TO_POS_ATTR[self.frame_type], FRAME_TO_XMAT_ATTR[self.frame_type]
         self.body = int(model.body_parentid[model.jnt_bodyid[joints.joint_ids[0]]])
         self._check_path()

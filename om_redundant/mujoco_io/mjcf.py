@@ -15,7 +15,8 @@ other: joints are ``arm.joint_names``; the end-effector frame is a site at :math
 in the last link named ``arm.frame_name`` (``"end_effector"`` for an arm that names none);
 when the Menagerie frame is a body (UR5e's ``wrist_3_link``), that site sits in a jointless
 body of the same name, so body and site lookups both work. Bodies are ``base`` (welded to
-the world) and ``link1`` ... ``link{n}``.
+the world; named after the arm's root body, ``arm.root``, where it has one, as an imported
+arm's) and ``link1`` ... ``link{n}``.
 
 Geometry: capsules of one radius r (default: ``RADIUS_PER_REACH`` times the stretched
 length of the chain, :math:`\sum_k |p_{k+1} - p_k|` over the joint origins and the
@@ -26,7 +27,8 @@ collision geoms, named ``"<body>_capsule<k>"`` and of the default class ``"colli
 (MuJoCo's default density, 1000 kg/m^3). MuJoCo ignores parent-child contacts; the other
 pairs of bodies whose geoms touch in every configuration, because the chain between them
 (e.g. across a spherical wrist) is shorter than 2r, are excluded with ``<exclude>``. Every
-name, class included, starts with ``prefix``.
+name, class included, starts with ``prefix`` (default the arm's, ``arm.prefix``), but the
+root body's.
 """
 
 from __future__ import annotations
@@ -44,12 +46,13 @@ DEFAULT_SITE = "end_effector"
 RADIUS_PER_REACH = 0.03  # default capsule radius over the stretched length of the chain
 
 
-def arm_mjcf(arm: Arm, *, prefix: str = "", radius: float | None = None) -> str:
+def arm_mjcf(arm: Arm, *, prefix: str | None = None, radius: float | None = None) -> str:
     """MJCF text of the arm alone (no floor, no light), its base at the world origin.
 
     Args:
         arm: The arm.
-        prefix: Prepended to every body, joint, geom, site and class name, e.g. ``"l_"``.
+        prefix: Prepended to every body, joint, geom, site and class name, e.g. ``"l_"``;
+            default the arm's (``arm.prefix``).
         radius: Capsule radius in metres; default ``RADIUS_PER_REACH`` times the
             stretched length of the chain (see the module docstring).
 
@@ -63,12 +66,12 @@ def arm_mjcf(arm: Arm, *, prefix: str = "", radius: float | None = None) -> str:
     return _text(_arm_tree(arm, prefix, radius, scene=False))
 
 
-def arm_model(arm: Arm, *, prefix: str = "", radius: float | None = None) -> mujoco.MjModel:
+def arm_model(arm: Arm, *, prefix: str | None = None, radius: float | None = None) -> mujoco.MjModel:
     """The compiled model of :func:`arm_mjcf` (same arguments)."""
     return mujoco.MjModel.from_xml_string(arm_mjcf(arm, prefix=prefix, radius=radius))
 
 
-def scene_mjcf(arm: Arm, *, prefix: str = "", radius: float | None = None) -> str:
+def scene_mjcf(arm: Arm, *, prefix: str | None = None, radius: float | None = None) -> str:
     """:func:`arm_mjcf` plus a light and a floor plane through the base (z = 0).
 
     The world is excluded from contact with the links that touch it in every
@@ -78,9 +81,9 @@ def scene_mjcf(arm: Arm, *, prefix: str = "", radius: float | None = None) -> st
     return _text(_arm_tree(arm, prefix, radius, scene=True))
 
 
-def _arm_tree(arm: Arm, prefix: str, radius: float | None, scene: bool) -> ET.Element:
+def _arm_tree(arm: Arm, prefix: str | None, radius: float | None, scene: bool) -> ET.Element:
     as_instance(arm, Arm, "arm")
-    as_instance(prefix, str, "prefix")
+    prefix = arm.prefix if prefix is None else as_instance(prefix, str, "prefix")
     P, P_tail = arm.chain.joint_placements()
     n = arm.dof
     ends = np.vstack([P[:, :3, 3], P_tail[:3, 3]])  # segment of body k: origin -> ends[k]
@@ -89,7 +92,7 @@ def _arm_tree(arm: Arm, prefix: str, radius: float | None, scene: bool) -> ET.El
         max(round(RADIUS_PER_REACH * lengths.sum(), 4), 1e-4) if radius is None else radius, "radius (m)"
     )
     cls = f"{prefix}collision"
-    names = {-1: "world", 0: f"{prefix}base"} | {k: f"{prefix}link{k}" for k in range(1, n + 1)}
+    names = {-1: "world", 0: arm.root or f"{prefix}base"} | {k: f"{prefix}link{k}" for k in range(1, n + 1)}
     frame = prefix + (arm.frame_name or DEFAULT_SITE)
     for k, name in names.items():
         if arm.frame_type == "body" and name == frame:  # the frame body keeps its model's name

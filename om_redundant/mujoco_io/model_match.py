@@ -12,12 +12,14 @@ arm's joints by name (with an optional prefix) and compares, in this order,
    end-effector frame (a site or a body) against ``arm.fk(q)``.
 
 Poses are compared in the arm's root frame: the world, or a body of the model given as
-``root`` (an arm mounted somewhere in a scene). Every difference is named; the first one is
-the reason a command line gives.
+``root`` (an arm mounted somewhere in a scene; default the arm's own, ``arm.root``). Every
+difference is named; the first one is the reason a command line gives, and where the arm's
+joints lie off their axes because its chain starts at another body, it names that body.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -25,9 +27,10 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from ..exceptions import InvalidInput
+from ..exceptions import FrameNotFound, InvalidInput
 from ..kinematics.arm import Arm
 from ..validation import as_count, as_instance, as_positive
+from .frames import arm_frame_names, find_frame, given_frame_names
 from .mjcf import DEFAULT_SITE
 
 #: Default largest accepted difference: metres for positions and limits, radians for angles.
@@ -65,16 +68,19 @@ class ModelComparison:
 
 
 def load_mujoco_model(path: str | Path) -> mujoco.MjModel:
-    """Compile an MJCF (.xml) or URDF (.urdf) file; if its mesh or texture files are missing,
-    compile it without its meshes and textures.
+    """Compile an MJCF (.xml) or URDF (.urdf) file for its kinematics: as it is if it compiles,
+    else with its inertial data replaced, then also without its meshes and textures.
 
-    Kinematics depend on neither, and copies of models (like the reference Menagerie ones)
-    often come without them. A URDF is read by MuJoCo's own URDF loader, with its bodies
-    kept apart (``fusestatic`` off: a link on a fixed joint, such as ``tool0``, stays a body).
+    Kinematics depend on none of them, and models as they come often miss mesh files (like the
+    reference Menagerie copies) or hold inertias that MuJoCo refuses (URDFs with
+    ``A + B < C`` or negative eigenvalues: PR2, TIAGo, iCub). A URDF is read by MuJoCo's own
+    URDF loader, with its bodies kept apart (``fusestatic`` off: a link on a fixed joint, such
+    as ``tool0``, stays a body, usable as an end-effector frame).
 
     Raises:
         InvalidInput: The file cannot be read or does not compile; the message is one line
-            and names the error that remains once meshes and textures are skipped.
+            and names the error that remains once inertials, meshes and textures are
+            replaced or skipped, and the first one.
     """
     path = Path(path)
     if not path.is_file():
@@ -92,16 +98,39 @@ def load_mujoco_model(path: str | Path) -> mujoco.MjModel:
         spec.compiler.fusestatic = False
     try:
         return spec.compile()
-    except ValueError as first:
-        if not (spec.meshes or spec.textures):
-            raise InvalidInput(f"cannot load MuJoCo model '{path}': {_one_line(first)}") from None
+    except ValueError as exc:
+        first = error = exc
+    # Each step keeps what the previous one changed; the meshes go last, as a model that
+    # compiles without them loses its look.
+    steps = [("its inertial data replaced", _kinematic_inertia)]
+    if spec.meshes or spec.textures:
+        steps.append(("its meshes and textures skipped", without_meshes))
+    done = []
+    for what, change in steps:
+        done.append(what)
         try:
-            return without_meshes(spec).compile()
+            return change(spec).compile()
         except ValueError as exc:
-            raise InvalidInput(
-                f"cannot load MuJoCo model '{path}': {_one_line(exc)} (with its meshes and textures "
-                f"skipped, which failed first: {_one_line(first)})"
-            ) from None
+            error = exc
+    raise InvalidInput(
+        f"cannot load MuJoCo model '{path}': {_one_line(error)} (with {' and '.join(done)}, which "
+        f"failed first: {_one_line(first)})"
+    ) from None
+
+
+def _kinematic_inertia(spec: mujoco.MjSpec) -> mujoco.MjSpec:
+    """Give every body the same valid inertia (in place; returns the spec).
+
+    MuJoCo refuses a model whose inertias break the triangle inequality or are not positive
+    definite, and one whose moving bodies have no mass; the pose of every frame is the same
+    whatever the masses, so the kinematics are the model's.
+    """
+    spec.compiler.inertiafromgeom = mujoco.mjtInertiaFromGeom.mjINERTIAFROMGEOM_FALSE
+    for body in spec.bodies[1:]:  # the world's first
+        body.explicitinertial = True
+        body.mass, body.ipos, body.iquat = 1.0, [0.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0]
+        body.inertia, body.fullinertia = [1e-3] * 3, [math.nan] * 6
+    return spec
 
 
 def without_meshes(spec: mujoco.MjSpec) -> mujoco.MjSpec:
@@ -132,7 +161,7 @@ def compare_mujoco_model(
     model: mujoco.MjModel,
     *,
     frame: str | None = None,
-    prefix: str = "",
+    prefix: str | None = None,
     root: str | None = None,
     samples: int = 100,
     seed: int = 0,
@@ -143,10 +172,13 @@ def compare_mujoco_model(
     Args:
         arm: The arm.
         model: The compiled model, e.g. from :func:`load_mujoco_model`.
-        frame: Name of the end-effector site, or body, in the model (without prefix);
-            default the arm's frame (``arm.frame_name``, else ``"end_effector"``).
-        prefix: Prepended to the arm's joint names and to ``frame``.
-        root: Body of the model whose frame is the arm's root frame; default the world.
+        frame: Name of the end-effector site, or body, in the model: as given, else with the
+            prefix; default the arm's frame (``arm.frame_name``, else ``"end_effector"``) with
+            the prefix, else as it is.
+        prefix: Prepended to the arm's joint names (and tried on the frame's); default the
+            arm's (``arm.prefix``).
+        root: Body of the model whose frame is the arm's root frame; default the arm's
+            (``arm.root``), else the world (``"world"`` names it).
         samples: Random joint vectors for the kinematic comparison.
         seed: Seed of those joint vectors.
         tolerance: Largest accepted difference (m for positions and limits, rad for angles).
@@ -163,6 +195,8 @@ def compare_mujoco_model(
     samples = as_count(samples, "samples", 1, MAX_SAMPLES)
     seed = as_count(seed, "seed", 0, 2**63 - 1)
     tolerance = as_positive(tolerance, "tolerance")
+    prefix = arm.prefix if prefix is None else prefix
+    root = root or arm.root
     root_id = 0
     if root is not None:
         root_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, root)
@@ -179,19 +213,42 @@ def compare_mujoco_model(
     differences += _order(arm, model, ids, frame_kind, frame_id, frame_text)
     if differences:
         return ModelComparison(tuple(differences), frame_text, 0)
-    return _kinematics(arm, model, ids, frame_kind, frame_id, frame_text, root_id, samples, seed, tolerance)
+    frame_at = (ids, frame_kind, frame_id, frame_text)
+    result = _kinematics(arm, model, *frame_at, root_id, samples, seed, tolerance)
+    if result.ok:
+        return result
+    first, *others = result.differences
+    first += _root_hint(arm, model, frame_at, root_id, tolerance)
+    return dataclasses.replace(result, differences=(first, *others))
 
 
 def _frame(arm: Arm, model: mujoco.MjModel, prefix: str, frame: str | None) -> tuple[str, int, str]:
     """Kind ("site" or "body"), id (-1 if absent) and description of the end-effector frame."""
-    name = prefix + (frame or arm.frame_name or DEFAULT_SITE)
-    kinds = ["site", "body"] if frame is not None or arm.frame_type != "body" else ["body", "site"]
+    if frame is None:
+        names = arm_frame_names(arm.frame_name or DEFAULT_SITE, prefix)
+        kinds = ["body", "site"] if arm.frame_type == "body" else ["site", "body"]
+    else:
+        names, kinds = given_frame_names(frame, prefix), ["site", "body"]
     for kind in kinds:
-        objtype = mujoco.mjtObj.mjOBJ_SITE if kind == "site" else mujoco.mjtObj.mjOBJ_BODY
-        frame_id = mujoco.mj_name2id(model, objtype, name)
-        if frame_id >= 0:
-            return kind, frame_id, f"{kind} '{name}'"
-    return kinds[0], -1, f"{kinds[0]} '{name}'"
+        try:
+            frame_id, name = find_frame(model, kind, names)
+        except FrameNotFound:
+            continue
+        return kind, frame_id, f"{kind} '{name}'"
+    return kinds[0], -1, f"{kinds[0]} '{names[0]}'"
+
+
+def _root_hint(arm: Arm, model: mujoco.MjModel, frame_at: tuple, root_id: int, tolerance: float) -> str:
+    """Where the arm matches the model from another root body (one above its first joint's
+    body: the chain starts elsewhere than the root compared), a sentence naming it; else ""."""
+    body = int(model.body_parentid[model.jnt_bodyid[frame_at[0][0]]])
+    while True:
+        if body != root_id and _kinematics(arm, model, *frame_at, body, 8, 0, tolerance).ok:
+            name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, body)
+            return f"; the arm matches the model from root body '{name}' (--root {name}, root='{name}')"
+        if body == 0:
+            return ""
+        body = int(model.body_parentid[body])
 
 
 def _structure(arm: Arm, model: mujoco.MjModel, prefix: str, tolerance: float) -> list[str]:

@@ -4,12 +4,14 @@ search (:mod:`.system`), arms near a family (:mod:`.nominal`, :mod:`.near`), and
 that fronts them (:mod:`.solver`)."""
 
 from .configuration import Configuration
-from .model import ModelArm, derive_model
+from .model import ANGLE_ROUNDING, LENGTH_ROUNDING, ModelArm, derive_model
 from .nominal import NEAR_TWIST, NominalArm, nominal_arm
 from .solver import BRANCH_BAND, BatchRoots, BatchSolution, OMSolver, Solution
 
 __all__ = [
+    "ANGLE_ROUNDING",
     "BRANCH_BAND",
+    "LENGTH_ROUNDING",
     "NEAR_TWIST",
     "BatchRoots",
     "BatchSolution",

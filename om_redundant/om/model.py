@@ -32,6 +32,8 @@ the OM system (9) then lie on a circle (a torus with shoulder offsets) in the ba
 from __future__ import annotations
 
 import dataclasses
+import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -44,9 +46,19 @@ from ..validation import as_instance
 from .families import six_dof, srs
 
 _ANGLE_EPS = 1e-9
-#: Largest deviation (rad) of a twist from +-90 deg that the closed forms, which take it to be
-#: exact, absorb: the hand then moves by well under the solver's 1e-10 m per metre of reach.
+#: Largest deviation (rad) of a twist from +-90 deg (or from 0 between parallel joints) that
+#: the closed forms, which take it to be exact, absorb: the hand then moves by well under the
+#: solver's 1e-10 m per metre of reach.
 _RIGHT_ANGLE_EPS = 1e-11
+#: A DH length within this many metres per metre of the arm's reach of zero, or an angle within
+#: ``ANGLE_ROUNDING`` rad of a multiple of 90 deg, is the rounding of the value it is near, not
+#: geometry (a URDF written to 11 digits leaves offsets of 5e-13 m where the arm has none): it
+#: never changes the method an arm gets. :func:`derive_model` refuses an arm with a nonzero
+#: length within it, so that the arm is solved through its nominal arm
+#: (:func:`~om_redundant.om.nominal.nominal_arm`), which has it zero, while its exact table
+#: verifies every answer.
+LENGTH_ROUNDING = 1e-9
+ANGLE_ROUNDING = 1e-9
 
 
 @dataclass(frozen=True, eq=False)
@@ -99,11 +111,13 @@ def derive_model(arm: Arm) -> ModelArm:
     offsets.
 
     Raises:
-        ModelError: The arm matches no family, or dp depends on more than one joint; the
-            message names the condition.
+        ModelError: The arm matches no family, or dp depends on more than one joint, or a DH
+            length is within rounding of zero (:data:`LENGTH_ROUNDING`; its nominal arm has it
+            zero); the message names the condition and the arm's joints.
         InvalidInput: arm is not an :class:`~om_redundant.Arm`.
     """
     as_instance(arm, Arm, "arm")
+    _refuse_rounding(arm)
     if arm.dof == 6:
         model_chain, family, family_name, params = _six_dof_model(arm)
         shoulderless = arm.chain
@@ -113,14 +127,20 @@ def derive_model(arm: Arm) -> ModelArm:
         family, family_name = srs.SRS, "S-R-S: spherical shoulder, elbow, spherical wrist"
         sign_names, redundancy_names = ("SHOULDER", "ELBOW", "WRIST"), ("psi",)
     else:
-        raise ModelError(f"arm '{arm.name}' has {arm.dof} joints; models exist for 6- and 7-DOF arms")
+        above = (
+            f"; if the arm starts after {_joint_name(arm, arm.dof - 8)} (joints of a torso or a mobile base "
+            "before it), import it from the body that joint moves as the root (import-arm --root BODY)"
+            if arm.dof > 7
+            else ""
+        )
+        raise ModelError(f"arm '{arm.name}' has {arm.dof} joints; models exist for 6- and 7-DOF arms{above}")
     model = arm.with_chain(model_chain, f"{arm.name}-model")
     if arm.dof == 6 and params[six_dof.WRIST_OFFSET] != 0.0:  # dp turns with q1: see _wrist_offset
         a4, d5, a5 = params[six_dof.WRIST_OFFSET : six_dof.WRIST_OFFSET + 3]
         dp_joint, delta, shoulder = 0, np.zeros((3, 3)), np.zeros((3, 3))
         dp_max = float(np.hypot(a4, d5) + abs(a5))
     else:
-        dp_joint = _dp_joint(arm.name, shoulderless, model_chain)
+        dp_joint = _dp_joint(arm, shoulderless, model_chain)
         delta = _circle_fit(
             arm, "dp seen from the flange", dp_joint, lambda q: _delta(shoulderless, model_chain, q)
         )
@@ -148,21 +168,59 @@ def derive_model(arm: Arm) -> ModelArm:
     )
 
 
+def rounding_length(chain: KinematicChain) -> float:
+    """The largest DH length (m) that is rounding of zero in this chain: :data:`LENGTH_ROUNDING`
+    times its reach, the sum of its rows' :math:`|(a, d)|`."""
+    return LENGTH_ROUNDING * sum(math.hypot(row.a, row.d) for row in chain.rows)
+
+
+def _refuse_rounding(arm: Arm) -> None:
+    """Raise :class:`ModelError` at the first nonzero DH length within rounding of zero: the
+    closed forms would take it for geometry (an offset that changes the family or the search)
+    or drop it (an answer off by it); the nominal arm has it zero."""
+    eps = rounding_length(arm.chain)
+    for i, row in enumerate(arm.chain.rows):
+        for key, value in (("a", row.a), ("d", row.d)):
+            if 0.0 < abs(value) <= eps:
+                raise ModelError(
+                    f"arm '{arm.name}': {key} = {value:.3g} m in {_row_name(arm, i)} is rounding of 0 "
+                    f"(within {LENGTH_ROUNDING:g} m per metre of reach, {eps:.2g} m), not geometry"
+                )
+
+
+def _joint_name(arm: Arm, j: int) -> str:
+    """Joint j (0-based) as messages name it: its number on the arm and the model's name."""
+    return f"joint {j + 1} ('{arm.prefix}{arm.joint_names[j]}')"
+
+
+def _joints_named(arm: Arm, joints: Iterable[int]) -> str:
+    return ", ".join(_joint_name(arm, j) for j in joints)
+
+
+def _row_name(arm: Arm, i: int) -> str:
+    """DH row i as messages name it: the row of a joint, or a fixed row after one."""
+    jr = arm.chain.joint_rows
+    if i in jr:
+        return f"the row of {_joint_name(arm, jr.index(i))}"
+    before = [k for k, r in enumerate(jr) if r < i]
+    return f"a fixed row after {_joint_name(arm, before[-1])}" if before else "a fixed row before joint 1"
+
+
 def _six_dof_model(arm: Arm) -> tuple[KinematicChain, int, str, np.ndarray]:
     """Theorem 2: zero a4, a5, d5 for a spherical wrist."""
     rows = list(arm.chain.rows)
     jr = arm.chain.joint_rows
     for j in (3, 4, 5):
         if rows[jr[j]].kind is not JointKind.REVOLUTE:
-            raise ModelError(f"arm '{arm.name}': Theorem 2 C3 needs joint {j + 1} revolute")
-    _refuse_fixed_rows(arm.name, rows, jr, (3, 4, 5))
+            raise ModelError(f"arm '{arm.name}': Theorem 2 C3 needs {_joint_name(arm, j)} revolute")
+    _refuse_fixed_rows(arm, (3, 4, 5))
     for j in (3, 4):
-        _check_right_angle(arm.name, rows[jr[j]], j)
+        _check_right_angle(arm, rows[jr[j]], j)
     offsets = (rows[jr[3]].a, rows[jr[4]].d, rows[jr[4]].a)  # a4, d5, a5 of the real arm
     rows[jr[3]] = dataclasses.replace(rows[jr[3]], a=0.0)
     rows[jr[4]] = dataclasses.replace(rows[jr[4]], a=0.0, d=0.0)
     model_chain = arm.chain.replace_rows(rows)
-    family, family_name, params = _position_family(arm.name, rows, jr)
+    family, family_name, params = _position_family(arm, rows)
     params[six_dof.WRIST_ROW] = jr[3]
     for key, j in ((six_dof.SIGMA4, 3), (six_dof.SIGMA5, 4)):
         params[key] = np.sign(np.sin(rows[jr[j]].alpha))
@@ -212,9 +270,11 @@ def _wrist_offset(
         axis4 = _circle_fit(arm, "joint 4's axis", 0, lambda q: _pose(table[: jr[3]], q[:3])[0][:, 2])
     except ModelError:
         raise ModelError(
-            f"arm '{arm.name}': a4 = {offsets[0]:g} != 0 makes dp depend on joints 5 and 6; the bounded "
-            "search handles a4 != 0 where joint 4's axis turns with q1 alone (parallel to joint 2's, as "
-            "when joints 2, 3 and 4 are parallel): dp then turns with q1"
+            f"arm '{arm.name}': a4 = {offsets[0]:g} != 0 (the wrist offset from the axis of "
+            f"{_joint_name(arm, 3)} to that of {_joint_name(arm, 4)}) makes dp depend on "
+            f"{_joints_named(arm, (4, 5))}; the bounded search handles a4 != 0 where joint 4's axis turns "
+            f"with {_joint_name(arm, 0)} alone (parallel to joint 2's, as when joints 2, 3 and 4 are "
+            "parallel): dp then turns with joint 1"
         ) from None
     axis6 = R_fl.T @ _pose(table[: jr[5]], np.zeros(5))[0][:, 2]  # R_fl: the flange's rotation at q = 0
     params[six_dof.WRIST_OFFSET : six_dof.WRIST_OFFSET + 3] = offsets
@@ -232,7 +292,9 @@ def _wrist_offset(
         z4 = -s4 * s5 * np.sign(np.sin(q[4] + params[six_dof.THETA5])) * n / np.linalg.norm(n)
         dp = -(a4 * s4 * np.cross(z3, z4) + d5 * z4 + a5 * s5 * np.cross(z4, z5))
         if np.abs(dp - (p_model - _pose(arm.chain.table, q)[1])).max() > 1e-12:
-            raise ModelError(f"arm '{arm.name}': the wrist offsets' dp does not turn with q1 alone")
+            raise ModelError(
+                f"arm '{arm.name}': the wrist offsets' dp does not turn with {_joint_name(arm, 0)} alone"
+            )
 
 
 def _srs_model(arm: Arm) -> tuple[KinematicChain, KinematicChain, np.ndarray]:
@@ -254,14 +316,18 @@ def _srs_model(arm: Arm) -> tuple[KinematicChain, KinematicChain, np.ndarray]:
         raise ModelError(f"arm '{arm.name}': the 7-DOF model needs revolute joints")
     if rows[jr[1]].a != 0.0:
         raise ModelError(
-            f"arm '{arm.name}': the shoulder offset a2 = {rows[jr[1]].a:g} m makes dp depend on q2; "
-            "the bounded search handles offsets that turn with q1 or q7 only"
+            f"arm '{arm.name}': the shoulder offset a2 = {rows[jr[1]].a:g} m (from the axis of "
+            f"{_joint_name(arm, 1)} to that of {_joint_name(arm, 2)}, which then miss the shoulder's "
+            f"centre) makes dp depend on {_joint_name(arm, 1)}; the bounded search handles offsets "
+            f"that turn with {_joint_name(arm, 0)} or {_joint_name(arm, 6)} only"
         )
-    _refuse_fixed_rows(arm.name, rows, jr, (0, 1, 2, 3, 4, 5))
+    _refuse_fixed_rows(arm, (0, 1, 2, 3, 4, 5))
     if any(rows[r].a != 0.0 for r in range(jr[5] + 1, jr[6])):
-        raise ModelError(f"arm '{arm.name}': fixed rows between joints 6 and 7 need a = 0")
+        raise ModelError(
+            f"arm '{arm.name}': fixed rows between {_joint_name(arm, 5)} and {_joint_name(arm, 6)} need a = 0"
+        )
     for j in (0, 1, 4, 5):
-        _check_right_angle(arm.name, rows[jr[j]], j)
+        _check_right_angle(arm, rows[jr[j]], j)
     for j, fields in ((0, ("a",)), (1, ("d",))):
         rows[jr[j]] = dataclasses.replace(rows[jr[j]], **dict.fromkeys(fields, 0.0))
     shoulderless = arm.chain.replace_rows(rows)
@@ -279,8 +345,8 @@ def _srs_model(arm: Arm) -> tuple[KinematicChain, KinematicChain, np.ndarray]:
     def frame(k: int, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return _pose(table[: jr[0] + k], q[:k])  # frame k, after joint k's row
 
-    _check_concurrent(arm.name, chain, "shoulder", (0, 1, 2))
-    _check_concurrent(arm.name, chain, "wrist", (4, 5, 6))
+    _check_concurrent(arm, chain, "shoulder", (0, 1, 2))
+    _check_concurrent(arm, chain, "wrist", (4, 5, 6))
     q0 = np.zeros(7)
     (_, S), (R3, o3), (_, W) = (frame(k, q0) for k in (1, 3, 5))
     R_fl, p_fl = _pose(table, q0)
@@ -290,7 +356,9 @@ def _srs_model(arm: Arm) -> tuple[KinematicChain, KinematicChain, np.ndarray]:
     k1 = -2.0 * (s3[0] * u[0] + s3[1] * u[1])
     k2 = -2.0 * (s3[1] * u[0] - s3[0] * u[1])
     if np.hypot(k1, k2) < 1e-9:
-        raise ModelError(f"arm '{arm.name}': joint 4 does not change the shoulder-wrist distance")
+        raise ModelError(
+            f"arm '{arm.name}': {_joint_name(arm, 3)} does not change the shoulder-wrist distance"
+        )
     P = np.zeros(srs.N_PARAMS)
     P[srs.SIGMA1], P[srs.SIGMA2], P[srs.SIGMA5] = (np.sign(np.sin(rows[jr[j]].alpha)) for j in (0, 1, 4))
     P[srs.THETA : srs.THETA + 7] = [rows[r].theta for r in jr]
@@ -319,24 +387,26 @@ def _srs_model(arm: Arm) -> tuple[KinematicChain, KinematicChain, np.ndarray]:
     return chain, shoulderless, P
 
 
-def _check_right_angle(name: str, row: DHRow, j: int) -> None:
+def _check_right_angle(arm: Arm, row: DHRow, j: int) -> None:
     if abs(np.sin(row.alpha)) < _ANGLE_EPS:
         raise ModelError(
-            f"arm '{name}': joints {j + 1} and {j + 2} are parallel; the spherical joint triple "
-            "needs them non-parallel (Theorem 2 C3)"
+            f"arm '{arm.name}': {_joint_name(arm, j)} and {_joint_name(arm, j + 1)} are parallel; the "
+            "spherical joint triple needs them non-parallel (Theorem 2 C3)"
         )
     if _off_right_angle(row.alpha) > _RIGHT_ANGLE_EPS:
         raise ModelError(
-            f"arm '{name}': the closed form needs joints {j + 1} and {j + 2} perpendicular "
+            f"arm '{arm.name}': the closed form needs {_joint_name(arm, j)} and {_joint_name(arm, j + 1)} "
+            "perpendicular "
             f"(alpha_{j + 1} = +-90 deg), got {np.degrees(row.alpha):.10g} deg "
             f"({_off_right_angle(row.alpha):.2g} rad off)"
         )
 
 
-def _refuse_fixed_rows(name: str, rows: list[DHRow], jr: tuple[int, ...], joints: tuple[int, ...]) -> None:
+def _refuse_fixed_rows(arm: Arm, joints: tuple[int, ...]) -> None:
     """Raise :class:`ModelError` if fixed rows lie between these consecutive joints (0-based),
     naming each row and, between joints whose axes it turns nearly parallel or perpendicular,
     by how much."""
+    rows, jr = arm.chain.rows, arm.chain.joint_rows
     found = []
     for k in joints[:-1]:
         between = rows[jr[k] + 1 : jr[k + 1]]
@@ -358,14 +428,13 @@ def _refuse_fixed_rows(name: str, rows: list[DHRow], jr: tuple[int, ...], joints
         nominal = np.pi / 2 * round(angle / (np.pi / 2))
         off = f", {abs(angle - nominal):.2g} rad from {np.degrees(nominal):g} deg" if angle != nominal else ""
         found.append(
-            f"after joint {k + 1} ({', '.join(values) or 'identity'}; axes {k + 1} and {k + 2} "
+            f"after {_joint_name(arm, k)} ({', '.join(values) or 'identity'}; axes {k + 1} and {k + 2} "
             f"{np.degrees(angle):.10g} deg apart{off})"
         )
     if found:
-        shown = ", ".join(str(j + 1) for j in joints)
         raise ModelError(
-            f"arm '{name}': the closed form needs the rows of joints {shown} to follow one another; "
-            f"fixed rows {'; '.join(found)}"
+            f"arm '{arm.name}': the closed form needs the rows of {_joints_named(arm, joints)} to follow "
+            f"one another; fixed rows {'; '.join(found)}"
         )
 
 
@@ -374,7 +443,7 @@ def _off_right_angle(alpha: float) -> float:
     return float(np.arctan2(abs(np.cos(alpha)), abs(np.sin(alpha))))
 
 
-def _check_concurrent(name: str, chain: KinematicChain, what: str, joints: tuple[int, ...]) -> None:
+def _check_concurrent(arm: Arm, chain: KinematicChain, what: str, joints: tuple[int, ...]) -> None:
     """Check that the axes of three consecutive joints pass through one point for any q.
 
     The point is the origin of the first joint's DH frame; joint j turns about the z-axis of
@@ -388,7 +457,10 @@ def _check_concurrent(name: str, chain: KinematicChain, what: str, joints: tuple
         for j in joints:
             R, p = _pose(chain.table[: jr[j]], q[:j])
             if np.linalg.norm(np.cross(point - p, R[:, 2])) > 1e-9:
-                raise ModelError(f"arm '{name}': the model's {what} axes do not meet in one point")
+                raise ModelError(
+                    f"arm '{arm.name}': the model's {what} axes ({_joints_named(arm, joints)}) do not meet "
+                    "in one point"
+                )
 
 
 def _rotx(alpha: float) -> np.ndarray:
@@ -407,17 +479,25 @@ def _tail_rotation(rows: list[DHRow], last: int) -> np.ndarray:
     return _pose(KinematicChain(tuple(tail)).table, np.zeros(0))[0]
 
 
-def _position_family(name: str, rows: list[DHRow], jr: list[int]) -> tuple[int, str, np.ndarray]:
+def _position_family(arm: Arm, rows: list[DHRow]) -> tuple[int, str, np.ndarray]:
+    jr = arm.chain.joint_rows
     r1, r2, r3, r4 = (rows[jr[j]] for j in range(4))
     P = np.zeros(six_dof.N_PARAMS)
     if r1.kind is not JointKind.REVOLUTE or r2.kind is not JointKind.REVOLUTE:
-        raise ModelError(f"arm '{name}': joints 1 and 2 must be revolute for a closed-form model")
+        raise ModelError(
+            f"arm '{arm.name}': {_joint_name(arm, 0)} and {_joint_name(arm, 1)} must be revolute for a "
+            "closed-form model"
+        )
     if jr[0] != 0:
-        raise ModelError(f"arm '{name}': the closed forms need joint 1's row first (no fixed row before it)")
-    _refuse_fixed_rows(name, rows, jr, (0, 1, 2))
+        raise ModelError(
+            f"arm '{arm.name}': the closed forms need the row of {_joint_name(arm, 0)} first (no fixed row "
+            "before it)"
+        )
+    _refuse_fixed_rows(arm, (0, 1, 2))
     if _off_right_angle(r1.alpha) > _RIGHT_ANGLE_EPS:
         raise ModelError(
-            f"arm '{name}': joint 1 must be perpendicular to joint 2 (alpha_1 = +-90 deg), got "
+            f"arm '{arm.name}': {_joint_name(arm, 0)} must be perpendicular to {_joint_name(arm, 1)} "
+            "(alpha_1 = +-90 deg), got "
             f"{np.degrees(r1.alpha):.10g} deg"
         )
     P[six_dof.A1], P[six_dof.D1], P[six_dof.THETA1] = r1.a, r1.d, r1.theta
@@ -425,28 +505,42 @@ def _position_family(name: str, rows: list[DHRow], jr: list[int]) -> tuple[int, 
     P[six_dof.A2], P[six_dof.THETA2] = r2.a, r2.theta
     between = rows[jr[2] + 1 : jr[3]]
     if any(r.a != 0.0 or r.d != 0.0 for r in between):
-        raise ModelError(f"arm '{name}': fixed rows between joints 3 and 4 must be pure rotations")
-    if r3.kind is JointKind.REVOLUTE and abs(np.sin(r2.alpha)) < _ANGLE_EPS and not between:
-        if abs(r2.a) < _ANGLE_EPS:
-            raise ModelError(f"arm '{name}': a2 = 0 leaves joints 2 and 3 without a link")
+        raise ModelError(
+            f"arm '{arm.name}': fixed rows between {_joint_name(arm, 2)} and {_joint_name(arm, 3)} must be "
+            "pure rotations"
+        )
+    # Joints 2 and 3 parallel within what the closed form absorbs (a twist off by more goes
+    # through the nominal arm, which snaps it).
+    if r3.kind is JointKind.REVOLUTE and abs(np.sin(r2.alpha)) <= _RIGHT_ANGLE_EPS and not between:
+        if r2.a == 0.0:  # a nonzero a2 within rounding of 0 was refused first (_refuse_rounding)
+            raise ModelError(
+                f"arm '{arm.name}': a2 = 0 leaves {_joint_name(arm, 1)} and {_joint_name(arm, 2)} "
+                "without a link"
+            )
         P[six_dof.LATERAL] = np.cos(r2.alpha) * r2.d + r3.d + r4.d * np.cos(r3.alpha)
         planar = np.array([r3.a, -r4.d * np.sin(r3.alpha)])
         P[six_dof.ELL3] = np.linalg.norm(planar)
         P[six_dof.BETA] = np.arctan2(planar[1], planar[0])
         P[six_dof.THETA3] = r3.theta
         if np.cos(r2.alpha) < 0.0:
-            raise ModelError(f"arm '{name}': alpha_2 = 180 deg is not supported")
+            raise ModelError(
+                f"arm '{arm.name}': alpha_2 = 180 deg ({_joint_name(arm, 2)} turning against "
+                f"{_joint_name(arm, 1)}) is not supported"
+            )
         return six_dof.RRR_SPHERICAL_WRIST, "RRR + spherical wrist (parallel joints 2, 3)", P
     if r3.kind is JointKind.PRISMATIC and _off_right_angle(r2.alpha) <= _RIGHT_ANGLE_EPS:
         if r3.a != 0.0 or r4.d != 0.0:
-            raise ModelError(f"arm '{name}': RRP family needs a3 = 0 and d4 = 0")
+            raise ModelError(
+                f"arm '{arm.name}': the RRP family needs a3 = 0 and d4 = 0 (the axis of "
+                f"{_joint_name(arm, 3)} through that of {_joint_name(arm, 2)})"
+            )
         P[six_dof.LATERAL] = r2.d
         P[six_dof.SIGMA2] = np.sign(np.sin(r2.alpha))
         P[six_dof.D3] = r3.d
         return six_dof.RRP_SPHERICAL_WRIST, "RRP + spherical wrist", P
     raise ModelError(
-        f"arm '{name}': joints 1-3 match no closed-form family (RRR with parallel joints 2 and 3, "
-        "or RRP); Theorem 2 C2 cannot be used here"
+        f"arm '{arm.name}': {_joints_named(arm, (0, 1, 2))} match no closed-form family (RRR with "
+        "joints 2 and 3 parallel, or RRP); Theorem 2 C2 cannot be used here"
     )
 
 
@@ -462,7 +556,7 @@ def _delta(real: KinematicChain, model: KinematicChain, q: np.ndarray) -> np.nda
     return R.T @ (p_model - p_real)
 
 
-def _dp_joint(name: str, real: KinematicChain, model: KinematicChain) -> int:
+def _dp_joint(arm: Arm, real: KinematicChain, model: KinematicChain) -> int:
     """The joint that delta (dp in the flange frame) depends on; -1 if it is constant."""
     rng = np.random.default_rng(0)
     dependent = set()
@@ -475,9 +569,16 @@ def _dp_joint(name: str, real: KinematicChain, model: KinematicChain) -> int:
             if np.abs(_delta(real, model, moved) - base).max() > 1e-12:
                 dependent.add(j)
     if len(dependent) > 1:
+        zeroed = [
+            f"{key} = {getattr(row, key):g} m in {_row_name(arm, i)}"
+            for i, (row, kept) in enumerate(zip(real.rows, model.rows, strict=True))
+            for key in ("a", "d")
+            if getattr(row, key) != getattr(kept, key)
+        ]
         raise ModelError(
-            f"arm '{name}': dp seen from the flange depends on joints {sorted(d + 1 for d in dependent)}; "
-            "the bounded search handles one"
+            f"arm '{arm.name}': dp seen from the flange (of the offsets the model zeroes: "
+            f"{', '.join(zeroed)}) depends on {_joints_named(arm, sorted(dependent))}; the bounded search "
+            "handles one"
         )
     return dependent.pop() if dependent else -1
 
@@ -498,6 +599,8 @@ def _circle_fit(arm: Arm, what: str, joint: int, f) -> np.ndarray:
     for _ in range(16):
         q = rng.uniform(-np.pi, np.pi, arm.dof)
         w = q[joint] if joint >= 0 else 0.0
-        if np.abs(C[0] + C[1] * np.cos(w) + C[2] * np.sin(w) - f(q)).max() > 1e-13:
-            raise ModelError(f"arm '{arm.name}': {what} is not affine in cos and sin of q{joint + 1}")
+        misfit = np.abs(C[0] + C[1] * np.cos(w) + C[2] * np.sin(w) - f(q)).max()
+        if misfit > 1e-13:
+            shape = "constant" if joint < 0 else f"affine in cos and sin of {_joint_name(arm, joint)}"
+            raise ModelError(f"arm '{arm.name}': {what} is not {shape} (off by {misfit:.2g})")
     return C

@@ -1,11 +1,15 @@
 r"""The nominal arm: the closed-form structure an arm is NEAR, and the arm in its coordinates.
 
 Arms brought from CAD or from MuJoCo models miss the closed-form families by little:
-twists of 90 deg +- 4e-6 rad from rounded quaternions, a joint whose axis is reversed (a
-twist of 180 deg), fixed rows between joints. The nominal arm is the OM method's *model
-side* of such an arm:
+twists of 90 deg +- 4e-6 rad from rounded quaternions, offsets of 5e-13 m from a URDF's
+11-digit numbers, a joint whose axis is reversed (a twist of 180 deg), fixed rows between
+joints. The nominal arm is the OM method's *model side* of such an arm:
 
 * every twist within :data:`NEAR_TWIST` of 0, +-90 or 180 deg is snapped to that value;
+* every length within rounding of zero (:data:`~om_redundant.om.model.LENGTH_ROUNDING` per
+  metre of reach) is zero, and every joint offset theta within
+  :data:`~om_redundant.om.model.ANGLE_ROUNDING` of a multiple of 90 deg is that multiple:
+  rounding is not geometry, and never changes the method an arm gets;
 * a twist of (about) 180 deg becomes 0 and the next joint flips: since
   :math:`R_x(\pi) R_z(\theta + q) T_z(d) T_x(a) R_x(\alpha) =
   R_z(-\theta - q) T_z(-d) T_x(a) R_x(\alpha + \pi) R_x(\pi)`, the half turn moves past the
@@ -24,6 +28,8 @@ closed-form roots as seeds and corrects the difference on the exact chain.
 
 from __future__ import annotations
 
+import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -31,7 +37,7 @@ import numpy as np
 from ..exceptions import ModelError
 from ..kinematics.arm import Arm
 from ..kinematics.chain import DHRow, JointKind, KinematicChain, row_transform
-from .model import ModelArm, derive_model
+from .model import ANGLE_ROUNDING, ModelArm, derive_model, rounding_length
 
 #: Largest deviation (rad) of a twist from 0, +-90 or 180 deg that the nominal arm snaps.
 NEAR_TWIST = 1e-3
@@ -63,7 +69,11 @@ def nominal_arm(arm: Arm) -> NominalArm:
     """The nominal arm of a real arm (see the module)."""
     exact, flip = _flipped(arm.chain, snap=False)
     snapped, _ = _flipped(arm.chain, snap=True)
-    nominal = KinematicChain(tuple(_merged(list(snapped.rows))), snapped.T_root_base, snapped.T_flange_tool)
+    # Rounding goes before the merge, which needs exact zeros, and after it, as a merged row
+    # can sum to rounding (d = 0.1 carried into a row with d = -0.1 + 1e-13).
+    eps = rounding_length(arm.chain)
+    rows = _rounded(_merged(_rounded(snapped.rows, eps)), eps)
+    nominal = KinematicChain(tuple(rows), snapped.T_root_base, snapped.T_flange_tool)
     lower = np.where(flip < 0, -arm.upper, arm.lower)
     upper = np.where(flip < 0, -arm.lower, arm.upper)
     differs = (
@@ -72,7 +82,7 @@ def nominal_arm(arm: Arm) -> NominalArm:
         or not np.array_equal(nominal.T_root_base, arm.chain.T_root_base)
         or not np.array_equal(nominal.T_flange_tool, arm.chain.T_flange_tool)
     )
-    model = Arm(arm.name, nominal, arm.joint_names, lower, upper, arm.description)
+    model = dataclasses.replace(arm, chain=nominal, lower=lower, upper=upper)
     return NominalArm(arm, model, exact, flip, bool(differs))
 
 
@@ -127,6 +137,24 @@ def _flipped(chain: KinematicChain, snap: bool) -> tuple[KinematicChain, np.ndar
         out.append(DHRow(a=row.a, alpha=alpha, d=row.d, theta=row.theta, kind=row.kind))
     tool = _HALF_TURN @ chain.T_flange_tool if half_turn else chain.T_flange_tool
     return KinematicChain(tuple(out), base, tool), np.array(flip)
+
+
+def _rounded(rows: Sequence[DHRow], eps: float) -> list[DHRow]:
+    """The rows with each length within ``eps`` of 0 zero and each theta within
+    ``ANGLE_ROUNDING`` of a multiple of 90 deg that multiple."""
+    return [
+        DHRow(_length(row.a, eps), row.alpha, _length(row.d, eps), _right_angle(row.theta), row.kind)
+        for row in rows
+    ]
+
+
+def _length(length: float, eps: float) -> float:
+    return 0.0 if abs(length) <= eps else length
+
+
+def _right_angle(angle: float) -> float:
+    nominal = _nearest_right_angle(angle)
+    return nominal if _off(angle, nominal) <= ANGLE_ROUNDING else angle
 
 
 def _merged(rows: list[DHRow]) -> list[DHRow]:

@@ -99,7 +99,7 @@ class Clearance:
         model: A MuJoCo model holding the arm and the obstacles, e.g. the user's scene.
         arm: The arm; its joints are found in the model as ``prefix + joint name``.
         obstacle_geoms: Names of the obstacle geoms in the model.
-        prefix: Prepended to the arm's joint names.
+        prefix: Prepended to the arm's joint names; default the arm's (``arm.prefix``).
         distmax: Pairs farther apart than this (m) report ``distmax``.
 
     Attributes:
@@ -130,7 +130,7 @@ class Clearance:
         arm: Arm,
         obstacle_geoms: Sequence[str],
         *,
-        prefix: str = "",
+        prefix: str | None = None,
         distmax: float = DEFAULT_DISTMAX,
     ):
         as_instance(model, mujoco.MjModel, "model", "a mujoco.MjModel")

@@ -42,7 +42,7 @@ class ArmAngleTask(ArmTask):
     Args:
         solver: The OM solver of a 7-DOF arm.
         model: The MuJoCo model that holds the arm.
-        prefix: Prefix of the arm's joint names in the model.
+        prefix: Prefix of the arm's joint names in the model; default the arm's (``arm.prefix``).
         cost: Cost of the arm angle error (1/rad).
         gain: Task gain in [0, 1].
         lm_damping: Levenberg-Marquardt damping (see ``mink.Task``).
@@ -57,7 +57,7 @@ class ArmAngleTask(ArmTask):
         solver: OMSolver,
         model: mujoco.MjModel,
         *,
-        prefix: str = "",
+        prefix: str | None = None,
         cost: npt.ArrayLike = 1.0,
         gain: float = 1.0,
         lm_damping: float = 0.0,

@@ -24,7 +24,7 @@ class ArmTask(Task):
         solver: The OM solver of the arm.
         model: The MuJoCo model that holds the arm (possibly among other joints).
         k: Number of coordinates of the task's error.
-        prefix: Prefix of the arm's joint names in the model.
+        prefix: Prefix of the arm's joint names in the model (None: the arm's).
         cost: Cost, one value for every coordinate of the error or one per coordinate.
         gain: Task gain in [0, 1].
         lm_damping: Levenberg-Marquardt damping (see ``mink.Task``).
@@ -40,7 +40,7 @@ class ArmTask(Task):
         solver: OMSolver,
         model: mujoco.MjModel,
         k: int,
-        prefix: str,
+        prefix: str | None,
         cost: npt.ArrayLike,
         gain: float,
         lm_damping: float,

@@ -118,7 +118,8 @@ class ExactPoseTask(ArmTask):
             arm, the arm angle psi).
         optimizer: Instead of c: a redundancy optimiser, asked ``optimizer.choose(T_root,
             previous=<its last choice>, q_current=<the arm's joints>)`` at each target.
-        prefix: Prefix of the arm's joint names in the model, e.g. ``"l_"``.
+        prefix: Prefix of the arm's joint names in the model, e.g. ``"l_"``; default the arm's
+            (``arm.prefix``).
         frame_name, frame_type: The frame the targets are for: the arm's end-effector frame
             (the one ``arm.fk`` gives) or any frame fixed to its last link (a hand body, a
             TCP site); default the prefix plus the arm's Menagerie frame.
@@ -146,7 +147,7 @@ class ExactPoseTask(ArmTask):
         *,
         arm_configuration: Configuration | None = None,
         optimizer: RedundancyOptimizer | None = None,
-        prefix: str = "",
+        prefix: str | None = None,
         frame_name: str | None = None,
         frame_type: str | None = None,
         cost: npt.ArrayLike = EXACT_POSE_COST,
