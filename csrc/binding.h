@@ -66,8 +66,9 @@ int om_solver_set_types(om_Solver *self, PyObject *solution_type, PyObject *conf
 void om_solver_clear_types(om_Solver *self);
 PyObject *om_solver_solve_pose(om_Solver *self, PyObject *const *args, Py_ssize_t nargs);
 
-/* self_motion.c: dq/dpsi of a 7-DOF arm at q into t (see there); false where psi does not
- * move along the self-motion, |Dpsi . n| <= tol |Dpsi| |n| (or t is not finite). */
+/* self_motion.c: dq/dpsi of a 7-DOF arm at q into t (see there), both in the arm's own joint
+ * coordinates; false where psi does not move along the self-motion, |Dpsi . n| <= tol |Dpsi|
+ * |n| (or t is not finite). */
 bool om_self_motion_tangent(const om_solver_data *s, const double *q, double *t, double tol);
 /* x - 2 pi k in [-pi, pi), as numpy's remainder(x + pi, 2 pi) - pi rounds it (paths.py's _wrap). */
 double om_wrap_angle(double x);

@@ -43,7 +43,7 @@ bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori)
     if (!(nearest < NEAR_BOUNDARY) && !half_line)
         return false;
     om_polish_task t = {s->real_table, s->n_real_rows, s->dof, srs ? s->params : NULL,
-                        srs ? s->model_table : NULL, s->n_model_rows, pb->t.R, pb->p,
+                        srs ? s->model_table : NULL, s->n_model_rows, pb->goal.R, pb->goal_p,
                         srs ? pb->redundancy[0] : 0.0, srs ? (double)pb->signs[ELBOW_SIGN] : 0.0, true};
     double start[OM_MAX_DOF];
     memcpy(start, q, (size_t)s->dof * sizeof(double));
@@ -116,7 +116,8 @@ om_problem om_problem_at(const om_problem *pb, const int64_t *signs, const doubl
     om_problem other = *pb;
     other.signs = signs;
     other.redundancy = redundancy;
-    other.t = om_target_at(s->family, s->params, &pb->t.R, redundancy);
+    other.goal = om_target_at(s->family, s->params, &pb->goal.R, redundancy);
+    other.t = other.goal;
     other.counter = 0;
     return other;
 }

@@ -11,6 +11,11 @@
 #define POLE_NEWTON 8            /* Newton steps to the closest pass of h to zero in a cell */
 #define POLE_ROUNDING 1e-15      /* relative rounding of W - S: of |e| + |u1| + |u2| (DBL_EPSILON 2.2e-16) */
 
+/* An arm near a family scans its nominal arm's g~ and searches G in windows (near.c): G may
+ * cross zero where it is within NEAR_DIFFERENCE times its difference from g~ of it. */
+#define NEAR_DIFFERENCE 4.0
+#define NEAR_WINDOW 5 /* points of a window of G at least (one per scan cell otherwise) */
+
 #define MEMO_POINTS 128 /* a scan of at most this many points shares its samples' model parts (scan_memo) */
 #define MEMO_EDGES 16   /* edges of reach a scan memo keeps */
 #define MEMO_KEY (9 + 3 + 3)
@@ -51,8 +56,12 @@ struct om_scan_memo {
     scan_memo branches[2]; /* ELBOW -1, +1 */
 };
 
-/* Whether the scans of solver s keep a memo: those of an S-R-S arm whose dp turns with q7. */
-static bool _keeps_memo(const om_solver_data *s) { return s->family == OM_SRS && s->mode == OM_CIRCLE && s->dp_joint == 6; }
+/* Whether the scans of solver s keep a memo: those of an S-R-S arm whose dp turns with q7 (not
+ * near a family: its model side moves with the correction at every sample, near.c). */
+static bool _keeps_memo(const om_solver_data *s)
+{
+    return s->family == OM_SRS && s->mode == OM_CIRCLE && s->dp_joint == 6 && !s->nominal_table;
+}
 
 /* (86 kB: allocated only for an arm that keeps one, and not zeroed: a branch's parts are
  * written where its key is.) */
@@ -100,19 +109,34 @@ static double _g_of_parts(om_problem *pb, double w, const om_srs_elbow *e, om_sr
     return om_wrap(q[6] - w);
 }
 
+/* The smallest |branch quantity| of the model at q (every joint). */
+static double _nearest_branch(const om_solver_data *s, const double *q)
+{
+    double values[3], nearest = INFINITY;
+    om_branch_values(s->family, s->params, q, values);
+    for (int i = 0; i < s->n_signs; i++)
+        nearest = py_min(nearest, fabs(values[i]));
+    return nearest;
+}
+
 /* g and the reach margin at the scan's points ws[k] = lo + h k, k < n_pts, into gs and ms as
- * om_g_margin computes them, the parts that the problem's memo holds for them taken from it.
+ * om_g_margin computes them, the parts that the problem's memo holds for them taken from it;
+ * in a near arm's scan of its nominal arm (which keeps no memo), the model's smallest |branch
+ * quantity| there into bs (INFINITY out of reach).
  * Returns that memo's branch, now this scan's (NULL where the problem or the arm keeps
  * none), valid until the memo's next scan. */
 static scan_memo *_sample(om_problem *pb, double lo, double h, int n_pts, double *ws, double *gs, double *ms,
-                          double *q)
+                          double *bs, double *q)
 {
     const om_solver_data *s = pb->s;
     for (int k = 0; k < n_pts; k++)
         ws[k] = lo + h * (double)k;
     if (!pb->memo || n_pts > MEMO_POINTS) { /* (pb->memo: an arm that keeps one, om_scan_memo_new) */
-        for (int k = 0; k < n_pts; k++)
+        for (int k = 0; k < n_pts; k++) {
             gs[k] = om_g_margin(pb, ws[k], q, false, &ms[k]);
+            if (pb->nominal)
+                bs[k] = isnan(gs[k]) ? INFINITY : _nearest_branch(s, q);
+        }
         return NULL;
     }
     double elbow = (double)pb->signs[1];
@@ -172,6 +196,38 @@ static int _put(double *out, int n, int cap, double v)
     return n + 1;
 }
 
+/* An arm near a family's scan of its nominal arm's g~ (pb->nominal) finds the real arm's roots,
+ * the zeros of G, near g~'s own (each refined on G, om_all_roots); where G may cross zero and
+ * g~ does not (near.c), the cells [a, b] are scanned again, on G, in points points (at least
+ * NEAR_WINDOW): their candidates into out[n:]. */
+static int _near_window(om_problem *pb, double a, double b, int points, double *q, double *out, int n, int cap)
+{
+    pb->nominal = false;
+    n += om_circle_candidates(pb, a, b, points > NEAR_WINDOW ? points : NEAR_WINDOW, false, q, out + n, cap - n);
+    pb->nominal = true;
+    return n;
+}
+
+/* Whether G may cross zero next to w, where g~ = gw does not: G at w is out of reach or of the
+ * other sign, or within NEAR_DIFFERENCE times its difference from g~ of zero (the difference,
+ * the correction's effect on g, changes little along a cell). */
+static bool _near_crossing(om_problem *pb, double w, double gw, double *q)
+{
+    pb->nominal = false;
+    double G = om_g(pb, w, q, false);
+    pb->nominal = true;
+    return !(G * gw > 0.0) || fabs(G) < NEAR_DIFFERENCE * fabs(G - gw) + OM_TOUCH;
+}
+
+/* How near to zero a near arm's g~, reach margin or branch quantity comes for G's to reach it. */
+static double _near(const om_problem *pb) { return OM_NEAR_SENSITIVITY * pb->s->near_deviation; }
+
+/* _near_crossing where g~ = gw comes within _near of zero at w. */
+static bool _near_miss(om_problem *pb, double w, double gw, double *q)
+{
+    return fabs(gw) < _near(pb) && _near_crossing(pb, w, gw, q);
+}
+
 /* Add the root of g on [a, b] (both ends reachable) to out[n:]; returns the new count.
  * A sign change is one root; a wrap of g from about +pi to -pi is none. */
 static int _bracket(om_problem *pb, double a, double ga, double b, double gb, double *q, double *out, int n,
@@ -199,6 +255,8 @@ static int _bracket(om_problem *pb, double a, double ga, double b, double gb, do
     }
     if (gb == 0.0)
         return _put(out, n, cap, b);
+    if (pb->nominal && it > 0) /* a steep swing of g~ (a singular wrist): G's may cross where g~'s wraps */
+        return _near_window(pb, a, b, 0, q, out, n, cap);
     /* Bisected to the last bit and still a jump short of a wrap's 2 pi: g crosses zero
      * there, too steeply for floating point (the wrist within about 1e-9 of its
      * singularity, where q_J swings by pi). The candidate goes to the lifted Newton, which
@@ -231,6 +289,9 @@ static int _cell_roots(om_problem *pb, double a, double ga, double b, double gb,
     double m = 0.5 * (a + b), gm = om_g(pb, m, q, false);
     if (isnan(gm)) /* a gap of reach inside */
         return _bracket(pb, a, ga, b, gb, q, out, n, cap);
+    if (pb->nominal && gm * ga > 0.0 && gm * gb > 0.0 && fabs(gm) < py_min(fabs(ga), fabs(gb)) &&
+        _near_miss(pb, m, gm, q)) /* a dip of g~ toward zero */
+        return _near_window(pb, a, b, 0, q, out, n, cap);
     /* A wrap in one half goes to _bracket as that half (the check above): the other half may
      * hold a root that the whole cell's ends hide (g turning by more than pi across the cell,
      * next to psi's half-line: a root and a wrap whose ends differ by less than pi). */
@@ -411,6 +472,8 @@ static int _pair(om_problem *pb, double a, double ga, double x0, double b, doubl
 {
     double gw;
     double w = om_extremum(pb, a, b, x0, -om_sign(ga), false, q, &gw, NULL);
+    if (pb->nominal && !(gw * ga <= 0.0) && _near_miss(pb, w, gw, q))
+        return _near_window(pb, a, b, 0, q, out, n, cap);
     if (isnan(gw) || gw * ga > 0.0) /* no crossing; a touch of zero is a boundary candidate */
         return fabs(gw) < OM_TOUCH ? _put(out, n, cap, w) : n;
     if (gw == 0.0)
@@ -495,6 +558,61 @@ bool om_margin_may_reach(const double *ms, int i, int count, bool cyclic)
     return py_max(ms[i], ms[next]) + change > 0.0;
 }
 
+/* A near arm's window of G (_near_window) where g~'s reach changes between samples i and
+ * i + 1 of ws (count of them, gs and ms their g~ and margins), at the edge w (g~ = gw there),
+ * unless G cannot cross zero next to it. At an edge of reach g turns as the square root of the
+ * distance to it, g ~ g_e + k sqrt(w_e - w) (the elbow at the end of its reach), and G's edge
+ * lies away from g~'s by about its margin at w over the margin's slope, d = |m_G(w)| / m~'
+ * (m~(w) = 0): G may run on by about k sqrt(d) beyond g~'s edge (or end that much short of
+ * it), which the difference G - g~ at w does not show. k and m~' come from the inside sample.
+ * The window takes the samples whose margin is within _near of zero (where G's edge may lie),
+ * and one more each way. */
+static int _near_edge(om_problem *pb, const double *ws, const double *gs, const double *ms, int i, int count,
+                      double w, double gw, double *q, double *out, int n, int cap)
+{
+    int inside = isnan(gs[i]) ? i + 1 : i;
+    double span = fabs(ws[inside] - w), m_edge = 0.0;
+    pb->nominal = false;
+    double G = om_g_margin(pb, w, q, false, &m_edge);
+    pb->nominal = true;
+    double k = span > 0.0 ? fabs(gs[inside] - gw) / sqrt(span) : 0.0;
+    double slope = span > 0.0 ? fabs(ms[inside]) / span : 0.0; /* (the margin is about 0 at the edge) */
+    double run_on = slope > 0.0 ? k * sqrt(fabs(m_edge) / slope) : INFINITY;
+    /* where G is out of reach at w, its edge is inside, and G there within run_on of g~ */
+    double G_edge = isnan(G) ? gw : G, apart = isnan(G) ? 0.0 : fabs(G - gw);
+    if (G_edge * gw > 0.0 && fabs(G_edge) >= NEAR_DIFFERENCE * (apart + run_on) + OM_TOUCH)
+        return n;
+    double near = _near(pb);
+    int lo = i, hi = i + 1;
+    while (lo > 0 && fabs(ms[lo]) < near)
+        lo--;
+    while (hi < count - 1 && fabs(ms[hi]) < near)
+        hi++;
+    return _near_window(pb, ws[lo], ws[hi], hi - lo + 1, q, out, n, cap);
+}
+
+/* A near arm's windows of G about the samples (n of them, h apart) whose model comes within
+ * _near of its singular set (bs: its smallest |branch quantity|): there
+ * the model IK's sensitivity to its target grows as 1 / |b| (the wrist's and shoulder's Euler
+ * angles, the elbow's square root), the correction's effect on g with it, and G's singular swing
+ * may lie cells away from g~'s. A run of such samples takes one window, a cell wider each way.
+ * Their candidates into out[n_out:]; returns the count. */
+static int _near_singular(om_problem *pb, const double *ws, const double *bs, int n, double h, double *q,
+                          double *out, int n_out, int cap)
+{
+    double near = _near(pb);
+    for (int k = 0; k < n; k++) {
+        if (!(bs[k] < near))
+            continue;
+        int last = k;
+        while (last + 1 < n && bs[last + 1] < near)
+            last++;
+        n_out = _near_window(pb, ws[k] - h, ws[last] + h, last - k + 3, q, out, n_out, cap);
+        k = last;
+    }
+    return n_out;
+}
+
 /* Whether the model may reach some point of the cell [ws[i], ws[i + 1]] (both ends out of
  * reach): on an S-R-S arm by a bound (om_srs_reach_possible); otherwise where the margin
  * may (om_margin_may_reach). */
@@ -516,7 +634,7 @@ int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool f
     int count = full_circle ? n_pts + 1 : n_pts;
     /* ws, gs, ms (n_pts + 1 each), their rotations (count each), pw, pg and a run's curvature
      * estimates (count + 2 each) */
-    size_t size = (size_t)(3 * (n_pts + 1) + 3 * count + 3 * (count + 2));
+    size_t size = (size_t)(4 * (n_pts + 1) + 3 * count + 3 * (count + 2));
     double *buffer = malloc(size * sizeof(double));
     int *order = malloc((size_t)count * sizeof(int));
     if (!buffer || !order) {
@@ -526,14 +644,14 @@ int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool f
     }
     double *ws = buffer, *gs = ws + (n_pts + 1), *ms = gs + (n_pts + 1);
     double *rws = ms + (n_pts + 1), *rgs = rws + count, *rms = rgs + count;
-    double *pw = rms + count, *pg = pw + (count + 2), *curvatures = pg + (count + 2);
+    double *pw = rms + count, *pg = pw + (count + 2), *curvatures = pg + (count + 2), *bs = curvatures + (count + 2);
     pole_guard pole = _pole_guard(pb, h);
     int start = -1;
-    scan_memo *memo = _sample(pb, lo, h, n_pts, ws, gs, ms, q);
+    scan_memo *memo = _sample(pb, lo, h, n_pts, ws, gs, ms, bs, q);
+    int n = pb->nominal ? _near_singular(pb, ws, bs, n_pts, h, q, cands, 0, cap) : 0;
     for (int k = 0; k < n_pts && start < 0; k++)
         if (isnan(gs[k]))
             start = k;
-    int n = 0;
     if (full_circle && start < 0) { /* reachable everywhere: one cyclic run */
         n = _run_roots(pb, &pole, POLE_DEPTH, ws, gs, n_pts, true, curvatures, q, cands, n, cap);
         free(buffer);
@@ -561,6 +679,8 @@ int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool f
         if (!isnan(gs[i])) {
             if (L == 0 && i > 0) { /* entering reach */
                 pw[0] = _edge(pb, memo, w, ws[i - 1], q, &pg[0]);
+                if (pb->nominal)
+                    n = _near_edge(pb, ws, gs, ms, i - 1, count, pw[0], pg[0], q, cands, n, cap);
                 L = 1;
             }
             pw[L] = w;
@@ -570,16 +690,23 @@ int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool f
         }
         if (L > 0) { /* leaving reach */
             pw[L] = _edge(pb, memo, pw[L - 1], w, q, &pg[L]);
+            if (pb->nominal)
+                n = _near_edge(pb, ws, gs, ms, i - 1, count, pw[L], pg[L], q, cands, n, cap);
             n = _run_roots(pb, &pole, POLE_DEPTH, pw, pg, L + 1, false, curvatures, q, cands, n, cap);
             L = 0;
         }
         if (i + 1 < count && isnan(gs[i + 1])) {
             /* Both ends of this cell are out of reach: look for an island of reach between
-             * them where the model may reach. */
-            if (_island_possible(pb, &bound, ws, ms, i, count)) {
-                double gc;
-                double c = om_extremum(pb, w, ws[i + 1], 0.5 * (w + ws[i + 1]), 1.0, true, q, &gc, NULL);
-                if (!isnan(gc)) { /* an island of reach around c */
+             * them where the model may reach (for a near arm's G, where g~'s margin peaks
+             * within _near of zero: the cell is searched on G). */
+            double near = _near(pb);
+            if (_island_possible(pb, &bound, ws, ms, i, count) ||
+                (pb->nominal && py_max(ms[i], ms[i + 1]) > -near)) {
+                double gc, mc;
+                double c = om_extremum(pb, w, ws[i + 1], 0.5 * (w + ws[i + 1]), 1.0, true, q, &gc, &mc);
+                if (pb->nominal && mc > -near && mc > py_max(ms[i], ms[i + 1])) { /* inside: not an edge's */
+                    n = _near_window(pb, w, ws[i + 1], 0, q, cands, n, cap);
+                } else if (!isnan(gc)) { /* an island of reach around c */
                     pw[0] = om_reach_edge(pb, c, w, q);
                     pw[1] = c;
                     pg[1] = gc;

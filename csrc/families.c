@@ -21,7 +21,18 @@ double om_model_ik(int family, const double *P, const double *table, const om_ta
 {
     if (family == OM_SRS)
         return om_srs_model_ik(P, t, p, signs, q_prev, q, all_joints);
-    return om_six_dof_model_ik(family, P, table, t, p, signs, q_prev, q);
+    return om_six_dof_model_ik(family, P, table, t, p, signs, q_prev, q, false);
+}
+
+double om_model_ik_nearest(int family, const double *P, const double *table, const om_target *t, vec3 p,
+                           const int64_t *signs, const double *q_prev, double *q)
+{
+    if (family != OM_SRS)
+        return om_six_dof_model_ik(family, P, table, t, p, signs, q_prev, q, true);
+    double x, margin = om_srs_reach(P, t, p, &x);
+    if (margin >= -OM_REACH_SLACK)
+        return om_srs_model_ik(P, t, p, signs, q_prev, q, true);
+    return om_srs_model_ik_at_reach(P, t, p, signs, q_prev, q) ? margin : NAN;
 }
 
 /* The quantities whose signs are the configuration's branch signs at q. */

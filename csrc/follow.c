@@ -93,7 +93,7 @@ static void end_measures(const om_solver_data *s, const int64_t *signs, const do
     double tt = 0.0, b[3];
     for (int i = 0; i < s->dof; i++) tt += t[i] * t[i];
     f[0] = 1.0 / tt;
-    om_branch_values(s->family, s->params, q, b);
+    om_solver_configuration_values(s, q, b, NULL);
     for (int i = 0; i < s->n_signs; i++) f[1 + i] = (double)signs[i] * b[i] + OM_BRANCH_BAND;
 }
 

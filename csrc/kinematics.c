@@ -6,14 +6,12 @@
 #include "om_kernels.h"
 
 /* Right-multiply the frame (R, p) in place by the standard DH row Rz(theta) Tz(d) Tx(a) Rx(alpha),
- * the variable qi added to theta (revolute, kind 0) or d (prismatic, kind 1); cos and sin of
- * theta into *ct_out, *st_out. */
-static inline void apply_row(double *R, double *p, const double *row, double qi, double *ct_out, double *st_out)
+ * the variable qi added to theta (revolute, kind 0) or d (prismatic, kind 1), with ct and st the
+ * cos and sin of theta (apply_row computes them, and gives them into *ct_out, *st_out). */
+static inline void apply_row_cs(double *R, double *p, const double *row, double qi, double ct, double st)
 {
-    double kind = row[5];
-    double theta = kind == 0.0 ? row[2] + qi : row[2];
-    double d = kind == 1.0 ? row[1] + qi : row[1];
-    double ct = cos(theta), st = sin(theta), ca = row[3], sa = row[4], a = row[0];
+    double d = row[5] == 1.0 ? row[1] + qi : row[1];
+    double ca = row[3], sa = row[4], a = row[0];
     double Rl[9] = {R[0], R[1], R[2], R[3], R[4], R[5], R[6], R[7], R[8]}; /* in registers: R, p do not alias */
     for (int i = 0; i < 3; i++) {
         double r0 = Rl[3 * i], r1 = Rl[3 * i + 1], r2 = Rl[3 * i + 2];
@@ -22,6 +20,13 @@ static inline void apply_row(double *R, double *p, const double *row, double qi,
         R[3 * i + 1] = -r0 * st * ca + r1 * ct * ca + r2 * sa;
         R[3 * i + 2] = r0 * st * sa - r1 * ct * sa + r2 * ca;
     }
+}
+
+static inline void apply_row(double *R, double *p, const double *row, double qi, double *ct_out, double *st_out)
+{
+    double theta = row[5] == 0.0 ? row[2] + qi : row[2];
+    double ct = cos(theta), st = sin(theta);
+    apply_row_cs(R, p, row, qi, ct, st);
     *ct_out = ct;
     *st_out = st;
 }
@@ -87,6 +92,29 @@ void om_flange_trig(const double *table, int n_rows, const double *q, double *R,
 {
     set_identity(R, p);
     om_chain(table, n_rows, q, n_rows, R, p, NULL, trig);
+}
+
+void om_flange_pair(const double *first, int n_first, const double *second, int n_second, const double *q,
+                    double *R1, double *p1, double *R2, double *p2)
+{
+    double trig[2 * OM_MAX_DOF], theta[OM_MAX_DOF], cs[2];
+    om_flange_trig(first, n_first, q, R1, p1, trig);
+    for (int k = 0, j = 0; k < n_first; k++)
+        if (first[6 * k + 5] != 2.0)
+            theta[j++] = first[6 * k + 2];
+    set_identity(R2, p2);
+    for (int k = 0, j = 0; k < n_second; k++) {
+        const double *row = second + 6 * k;
+        if (row[5] == 2.0) {
+            apply_row(R2, p2, row, 0.0, &cs[0], &cs[1]);
+        } else {
+            if (memcmp(&row[2], &theta[j], sizeof(double)) == 0) /* the same angle, bit for bit */
+                apply_row_cs(R2, p2, row, q[j], trig[2 * j], trig[2 * j + 1]);
+            else
+                apply_row(R2, p2, row, q[j], &cs[0], &cs[1]);
+            j++;
+        }
+    }
 }
 
 /* out = A @ B for 4x4 row-major matrices (_matmul4). */

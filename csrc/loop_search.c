@@ -54,7 +54,8 @@ typedef struct {
 static loop_search _search(om_problem *pb, double *seen)
 {
     const om_solver_data *s = pb->s;
-    loop_search ls = {pb, {s->real_table, s->n_real_rows, 7, NULL, NULL, 0, pb->t.R, pb->p, 0.0, 0.0, true}, seen, 0, 0};
+    loop_search ls = {pb, {s->real_table, s->n_real_rows, 7, NULL, NULL, 0, pb->goal.R, pb->goal_p, 0.0, 0.0, true},
+                       seen, 0, 0};
     return ls;
 }
 

@@ -55,6 +55,10 @@ void om_apply_row(double *R, double *p, const double *row, double qi);
 /* The pose of the last DH frame in DH frame 0. */
 void om_flange(const double *table, int n_rows, const double *q, double *R, double *p);
 void om_flange_trig(const double *table, int n_rows, const double *q, double *R, double *p, double *trig);
+/* The flange poses of two chains of the same joints at q (a near arm's exact chain and its
+ * nominal arm's), a joint's cos and sin computed once where its rows' theta agree (bit for bit). */
+void om_flange_pair(const double *first, int n_first, const double *second, int n_second, const double *q,
+                    double *R1, double *p1, double *R2, double *p2);
 /* The chain's rows applied to the frame (R, p) in place, up to joint n+1's row (every row for
  * n >= the joints); with frames not NULL, the frame before each joint's row (R row-major, then
  * p: 12 per joint; the joint turns about its z axis, R's column 2, through p); with trig not
@@ -111,9 +115,10 @@ typedef struct {
     double cos_psi, sin_psi;
 } om_target;
 
-/* Returns the reach margin (negative beyond OM_REACH_SLACK: out of reach, q not written). */
+/* Returns the reach margin (negative beyond OM_REACH_SLACK: out of reach, q not written; with
+ * nearest, written: the nearest pose's the model reaches, the reach's square roots at zero). */
 double om_six_dof_model_ik(int family, const double *P, const double *table, const om_target *t, vec3 p,
-                           const int64_t *signs, const double *q_prev, double *q);
+                           const int64_t *signs, const double *q_prev, double *q, bool nearest);
 void om_six_dof_branch_values(int family, const double *P, const double *q, double *out);
 /* q6 given: smooth at the wrist singularity; *residual the wrist's consistency. Returns the margin. */
 double om_six_dof_model_ik_q6(int family, const double *P, const double *table, const om_target *t, vec3 p,
@@ -179,6 +184,11 @@ double om_arm_angle_gradient(const double *P, const double *table, int n_rows, c
 om_target om_target_at(int family, const double *P, const mat3 *R, const double *redundancy);
 double om_model_ik(int family, const double *P, const double *table, const om_target *t, vec3 p,
                    const int64_t *signs, const double *q_prev, double *q, bool all_joints);
+/* om_model_ik of every joint where p is within reach; beyond it, the closed form of the nearest
+ * pose the model reaches (S-R-S: the elbow held at the edge of reach; 6-DOF: the reach's square
+ * roots at zero) into q. Returns the reach margin, NaN where nothing is written (W = S). */
+double om_model_ik_nearest(int family, const double *P, const double *table, const om_target *t, vec3 p,
+                           const int64_t *signs, const double *q_prev, double *q);
 void om_branch_values(int family, const double *P, const double *q, double *out);
 void om_redundancy_values(int family, const double *P, const double *q, double *out);
 
@@ -212,6 +222,18 @@ typedef struct {
     int scan_points;
     double tol_pos, tol_ori;
     bool trig_shared; /* om_trig_shared: verify reuses the real FK's cos and sin in the configuration check */
+    /* An arm NEAR a family (near.c; om/nominal.py): the closed form (params, model_table, D) is
+     * its nominal arm's model's, real_table its own exact chain in the nominal arm's joint
+     * coordinates, lower and upper mapped to them, and nominal_table the nominal arm's chain.
+     * NULL: the arm is in its family exactly (real_table is its chain). */
+    const double *nominal_table; /* n_nominal_rows x 6 */
+    int n_nominal_rows;
+    double near_deviation; /* m: how far the nominal arm's flange frame is from the real one's, a bound */
+    /* +-1 per joint: the kernels' joint coordinates are flip * q, q the arm's own (-1 where a
+     * near arm's axis is reversed, all +1 otherwise); flipped: some is -1. The entry points
+     * (solve.c, the *_at functions below) take and give the arm's own. */
+    double flip[OM_MAX_DOF];
+    bool flipped;
 } om_solver_data;
 
 /* What the circle scans of a batch's problems share (circle.c; om_scan_cache owns it). */
@@ -234,7 +256,50 @@ typedef struct {
     /* the model's parts at the circle scan's samples, which the problem's scans (its own, its
      * neighbours') take from the scans before them and keep for those after (NULL: none) */
     om_scan_memo *memo;
+    /* The real arm's target, the flange pose in DH frame 0 (with the closed form's constants
+     * for its orientation), against which every answer is verified (om_verify) and polished.
+     * t and p above are the model's side of system (9): the goal itself, but for an arm near a
+     * family within one of its model IKs, which moves them to goal C(q) (near.c). */
+    om_target goal;
+    vec3 goal_p;
+    /* An arm near a family scanned on its nominal arm's system: the model IKs skip the
+     * correction (g-tilde of near.c); false for every other evaluation. */
+    bool nominal;
 } om_problem;
+
+/* near.c: an arm near a family (om_solver_data.nominal_table). */
+/* One model IK of system (9) at pb's model side (t, p): the reach margin, q written where it is
+ * not below -OM_REACH_SLACK, and the residual it serves into *residual (g: its size sets how far
+ * a near arm's correction settles; INFINITY: none); with nearest, also where it is out of
+ * reach: the closed form of the nearest pose the model reaches (om_model_ik_nearest; NaN: none
+ * written). */
+typedef double (*om_model_eval)(om_problem *pb, const void *args, double *q, bool nearest, double *residual);
+/* For an arm near a family: eval from pb's goal, then again with pb's model side moved to
+ * goal C(q) until the correction C settles (the fixed point of near.c's (N), to the precision
+ * its residual needs), the model side the goal again at the end. Returns the margin of the last
+ * evaluation, q as it wrote it: a function of eval's arguments and the goal alone. om_near_ik
+ * (om_system.h) is the call for every arm. */
+double om_near_settle(om_problem *pb, om_model_eval eval, const void *args, double *q);
+/* pb's goal (R, p), with the closed form's constants for pb->redundancy, and its model side,
+ * the goal itself (pb->s and pb->redundancy set). */
+void om_set_goal(om_problem *pb, const mat3 *R, vec3 p);
+/* out = flip * in: the arm's own joint coordinates to the kernels' and back (out may be in). */
+void om_flip(const om_solver_data *s, const double *in, double *out);
+/* At q in the arm's own joint coordinates: the real arm's flange Jacobian in DH frame 0 (6 x dof,
+ * rows [v; omega], columns by the arm's joints) and the flange pose (R, p; NULL: not wanted); the
+ * model's arm angle psi (returned) and its gradient by the arm's joints (S-R-S); the model's
+ * branch quantities and redundancy values (NULL: not wanted), which read q's configuration. */
+void om_solver_jacobian(const om_solver_data *s, const double *q, double *J, double *R, double *p);
+double om_solver_psi_gradient(const om_solver_data *s, const double *q, double *grad);
+void om_solver_configuration_values(const om_solver_data *s, const double *q, double *branch, double *redundancy);
+
+/* The deviation (m, om_solver_data.near_deviation) up to which a near arm's bounded search of
+ * the circle scans its nominal arm's g and searches G in windows where it may differ (circle.c);
+ * beyond it, where most of the circle would be windows, the search is of G throughout. */
+#define OM_NEAR_SCAN 1e-4
+/* A bound, with room, on how far the correction moves g (rad), the reach margins and the branch
+ * quantities per metre of the deviation, away from the model's singular set (1 to 20 there). */
+#define OM_NEAR_SENSITIVITY 100.0
 
 /* residual.c */
 vec3 om_delta(const double D[6][3], double w);
@@ -362,7 +427,8 @@ typedef struct {
  * within 1e-2 of zero, or (S-R-S) w_hat within 1e-2 rad of psi's singular half-line (else left
  * as it is); returns whether it now verifies. */
 bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori);
-/* self_motion.c: the null vector of the real 6 x 7 Jacobian at q by cofactors (not normalised) */
+/* self_motion.c: the null vector of the real 6 x 7 Jacobian at q (the kernels' coordinates) by
+ * cofactors (not normalised) */
 void om_self_motion_null(const om_solver_data *s, const double *q, double *n);
 /* det A (n x n row-major, destroyed) into *det (NULL: not wanted) by elimination with partial
  * pivoting and, b not NULL, x of A x = b into b; false where a pivot is zero (*det = 0). */

@@ -13,6 +13,17 @@
 /* Python's a % n for n > 0 (never negative). */
 static inline int py_mod(int a, int n) { int r = a % n; return r < 0 ? r + n : r; }
 
+/* One model IK of system (9), eval's: for an arm near a family, at the fixed point of its
+ * correction (om_near_settle); for an arm in its family, and in a near arm's scan of its
+ * nominal arm (pb->nominal), eval itself (inlined). */
+static inline double om_near_ik(om_problem *pb, om_model_eval eval, const void *args, double *q)
+{
+    double residual;
+    if (!pb->s->nominal_table || pb->nominal)
+        return eval(pb, args, q, false, &residual);
+    return om_near_settle(pb, eval, args, q);
+}
+
 /* A scratch joint vector starts as NaN: a check of joints never written (a local solve whose
  * first point is out of reach) then always fails, never depends on what a previous call left. */
 static inline void nan_fill(double *q, int n) { for (int j = 0; j < n; j++) q[j] = NAN; }

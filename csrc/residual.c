@@ -32,19 +32,65 @@ static vec3 circle_point(om_problem *pb, double w)
     return om_on_circle(pb, w);
 }
 
-/* Model IK for p_m = p_d + R delta(w), one residual evaluation; returns the reach margin
- * (negative beyond OM_REACH_SLACK: out of the model's reach, q not written). all_joints false
- * writes only what g needs: q_J (an S-R-S arm whose dp turns with q7: q7 alone), or more. */
-double om_model_ik_at(om_problem *pb, double w, double *q, bool all_joints)
+/* What om_model_ik_at solves: the circle's point w, and whether for every joint. */
+typedef struct {
+    double w;
+    bool all_joints;
+} circle_ik;
+
+/* The model IK at the circle's point (om_model_eval; its residual g, 0 on a fixed arm). */
+static double _circle_ik(om_problem *pb, const void *args, double *q, bool nearest, double *residual)
 {
     const om_solver_data *data = pb->s;
-    vec3 pm = circle_point(pb, w);
+    const circle_ik *a = args;
+    vec3 pm = circle_point(pb, a->w);
+    *residual = INFINITY;
     if (!isfinite(pm.x)) /* a singular wrist with a4 != 0: no point of the circle */
-        return -1.0;
-    if (!all_joints && data->family == OM_SRS && data->dp_joint == 6)
-        return om_srs_model_q7(data->params, &pb->t, pm, pb->signs, pb->q_prev, q);
-    return om_model_ik(data->family, data->params, data->model_table, &pb->t, pm, pb->signs, pb->q_prev, q,
-                       all_joints);
+        return nearest ? NAN : -1.0;
+    if (nearest)
+        return om_model_ik_nearest(data->family, data->params, data->model_table, &pb->t, pm, pb->signs, pb->q_prev,
+                                   q);
+    double margin;
+    if (!a->all_joints && data->family == OM_SRS && data->dp_joint == 6)
+        margin = om_srs_model_q7(data->params, &pb->t, pm, pb->signs, pb->q_prev, q);
+    else
+        margin = om_model_ik(data->family, data->params, data->model_table, &pb->t, pm, pb->signs, pb->q_prev, q,
+                             a->all_joints);
+    if (margin >= -OM_REACH_SLACK)
+        *residual = data->mode == OM_FIXED ? 0.0 : om_wrap(q[data->dp_joint] - a->w);
+    return margin;
+}
+
+/* Model IK for p_m = p_d + R delta(w), one residual evaluation; returns the reach margin
+ * (negative beyond OM_REACH_SLACK: out of the model's reach, q not written). all_joints false
+ * writes only what g needs: q_J (an S-R-S arm whose dp turns with q7: q7 alone), or more; an
+ * arm near a family, whose correction is the real arm's at every joint, writes them all. */
+double om_model_ik_at(om_problem *pb, double w, double *q, bool all_joints)
+{
+    circle_ik args = {w, all_joints || pb->s->nominal_table}; /* (a near arm's branch quantities: circle.c) */
+    return om_near_ik(pb, _circle_ik, &args, q);
+}
+
+/* What om_wrist_residual solves: the circle's point w = q6, and the residual there (out). */
+typedef struct {
+    double w, residual;
+} wrist_ik;
+
+/* The model IK with q6 = w given at the circle's point (om_model_eval; its residual the wrist's). */
+static double _wrist_ik(om_problem *pb, const void *args, double *q, bool nearest, double *residual)
+{
+    const om_solver_data *data = pb->s;
+    wrist_ik *a = (wrist_ik *)args;
+    vec3 pm = circle_point(pb, a->w);
+    *residual = INFINITY;
+    if (nearest)
+        return om_model_ik_nearest(data->family, data->params, data->model_table, &pb->t, pm, pb->signs, pb->q_prev,
+                                   q);
+    double margin = om_six_dof_model_ik_q6(data->family, data->params, data->model_table, &pb->t, pm, pb->signs,
+                                           pb->q_prev, a->w, q, &a->residual);
+    if (margin >= -OM_REACH_SLACK)
+        *residual = a->residual;
+    return margin;
 }
 
 /* The wrist's consistency at p_m = p_d + R delta(w) with the wrist joint J = w given, for a
@@ -52,14 +98,11 @@ double om_model_ik_at(om_problem *pb, double w, double *q, bool all_joints)
  * Writes q (q_J = w); NaN out of the model's reach, and where w is not q6 (a4 != 0). */
 double om_wrist_residual(om_problem *pb, double w, double *q)
 {
-    const om_solver_data *data = pb->s;
-    if (data->dp_joint != 5) /* a wrist with a4 != 0: w is q1, not q6 (wrist_offset.c) */
+    if (pb->s->dp_joint != 5) /* a wrist with a4 != 0: w is q1, not q6 (wrist_offset.c) */
         return NAN;
-    vec3 pm = circle_point(pb, w);
-    double residual;
-    double margin = om_six_dof_model_ik_q6(data->family, data->params, data->model_table, &pb->t, pm, pb->signs,
-                                           pb->q_prev, w, q, &residual);
-    return margin < -OM_REACH_SLACK ? NAN : residual;
+    wrist_ik args = {w, NAN};
+    double margin = om_near_ik(pb, _wrist_ik, &args, q);
+    return margin < -OM_REACH_SLACK ? NAN : args.residual;
 }
 
 /* Residual g(w) (NaN if unreachable) and the model's reach margin; writes the IK into q. */
@@ -76,11 +119,12 @@ double om_g_margin(om_problem *pb, double w, double *q, bool all_joints, double 
     return om_wrap(q[pb->s->dp_joint] - w);
 }
 
-/* The reach margin of om_g_margin alone: on an S-R-S arm no joint is solved for it (not a
- * residual evaluation, not counted); on the others it is om_g_margin's (q written). */
+/* The reach margin of om_g_margin alone: on an S-R-S arm in its family no joint is solved for
+ * it (not a residual evaluation, not counted); on the others, and near a family (where the
+ * margin is the corrected target's), it is om_g_margin's (q written). */
 double om_reach_margin(om_problem *pb, double w, double *q)
 {
-    if (pb->s->family == OM_SRS) {
+    if (pb->s->family == OM_SRS && !pb->s->nominal_table) {
         double x;
         return om_srs_reach(pb->s->params, &pb->t, om_on_circle(pb, w), &x);
     }
@@ -152,12 +196,19 @@ double om_g(om_problem *pb, double w, double *q, bool all_joints)
     return om_g_margin(pb, w, q, all_joints, NULL);
 }
 
-/* The lifted residual (shoulder, wrist, elbow) at x = (w1, w7, phi4) for
- * p_m = p_d + a(w1) + R delta(w7) (see srs.model_ik_lifted); writes the model IK into q
- * unless q is NULL (the residual alone, cheaper: no joint angles). */
-vec3 om_lifted_residual(om_problem *pb, vec3 x, double *q)
+/* What om_lifted_residual solves: the point x = (w1, w7, phi4), and the residual there (out). */
+typedef struct {
+    vec3 x, F;
+} lifted_ik;
+
+/* The lifted model IK at x for p_m = p_d + a(w1) + R delta(w7) (om_model_eval; q NULL: the
+ * residual alone; its residual the largest of the three). Its margin: 0, NaN where W = S (no
+ * joint written); nearest is never asked. */
+static double _lifted_ik(om_problem *pb, const void *args, double *q, bool nearest, double *residual)
 {
     const om_solver_data *data = pb->s;
+    lifted_ik *a = (lifted_ik *)args;
+    vec3 x = a->x;
     const double(*D)[3] = data->D;
     const mat3 *R = &pb->t.R;
     vec3 p = pb->p;
@@ -167,7 +218,21 @@ vec3 om_lifted_residual(om_problem *pb, vec3 x, double *q)
     vec3 pm = v3(p.x + D[3][0] + D[4][0] * c1 + D[5][0] * s1 + R->r0.x * d.x + R->r0.y * d.y + R->r0.z * d.z,
                  p.y + D[3][1] + D[4][1] * c1 + D[5][1] * s1 + R->r1.x * d.x + R->r1.y * d.y + R->r1.z * d.z,
                  p.z + D[3][2] + D[4][2] * c1 + D[5][2] * s1 + R->r2.x * d.x + R->r2.y * d.y + R->r2.z * d.z);
-    return om_srs_model_ik_lifted(data->params, &pb->t, pm, pb->signs, x.x, x.y, x.z, q);
+    a->F = om_srs_model_ik_lifted(data->params, &pb->t, pm, pb->signs, x.x, x.y, x.z, q);
+    *residual = om_max_norm(a->F);
+    return isnan(a->F.x) ? NAN : 0.0;
+}
+
+/* The lifted residual (shoulder, wrist, elbow) at x = (w1, w7, phi4) for
+ * p_m = p_d + a(w1) + R delta(w7) (see srs.model_ik_lifted); writes the model IK into q
+ * unless q is NULL (the residual alone, cheaper: no joint angles; an arm near a family
+ * solves them for its correction all the same). */
+vec3 om_lifted_residual(om_problem *pb, vec3 x, double *q)
+{
+    double scratch[OM_MAX_DOF];
+    lifted_ik args = {x, v3(NAN, NAN, NAN)};
+    om_near_ik(pb, _lifted_ik, &args, q || !pb->s->nominal_table ? q : scratch);
+    return args.F;
 }
 
 /* The lifted residual times prod_k (1 + 1 / |x - x_k|^2) over the known roots x_k

@@ -76,9 +76,12 @@ int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre
     bool full_circle = radius >= OM_PI;
     double lo = full_circle ? -OM_PI : centre[J] - radius;
     double hi = full_circle ? OM_PI : centre[J] + radius;
+    /* an arm near a family scans its nominal arm's g where it is near enough (near.c) */
+    pb->nominal = data->nominal_table && data->near_deviation <= OM_NEAR_SCAN;
     int n = om_circle_candidates(pb, lo, hi, n_scan, full_circle, q, cands, cap);
     if (data->family != OM_SRS && data->params[SD_WRIST_OFFSET] != 0.0) /* a4 != 0: the singular wrist's bands */
         n += om_wrist_offset_candidates(pb, lo, hi, full_circle, q, cands + n, cap - n);
+    pb->nominal = false;
     int count = _circle_roots(pb, cands, n, q, roots);
     free(cands);
     return count;
@@ -88,7 +91,9 @@ int om_all_roots_cached(om_problem *pb, int n_scan, double *roots, om_scan_cache
 {
     const om_solver_data *data = pb->s;
     double zeros[OM_MAX_DOF] = {0.0};
-    if (!cache || data->mode != OM_CIRCLE || data->family != OM_SRS || data->dp_joint != 6 ||
+    /* (an arm near a family: its model side moves with the correction, which differs between the
+     * SHOULDER signs) */
+    if (!cache || data->mode != OM_CIRCLE || data->family != OM_SRS || data->dp_joint != 6 || data->nominal_table ||
         OM_SCAN_CAPACITY(n_scan) > cache->capacity)
         return om_all_roots(pb, n_scan, roots, zeros, INFINITY);
     double key[OM_SCAN_KEY], q[OM_MAX_DOF];
@@ -108,11 +113,21 @@ int om_all_roots_cached(om_problem *pb, int n_scan, double *roots, om_scan_cache
     return _circle_roots(pb, cache->candidates, cache->count, q, roots);
 }
 
+/* The model IK at the paper's fixed-point start p_m = p_d, every joint (om_model_eval: a start,
+ * no residual). */
+static double _start_ik(om_problem *pb, const void *args, double *q, bool nearest, double *residual)
+{
+    const om_solver_data *s = pb->s;
+    *residual = INFINITY;
+    if (nearest)
+        return om_model_ik_nearest(s->family, s->params, s->model_table, &pb->t, pb->p, pb->signs, pb->q_prev, q);
+    return om_model_ik(s->family, s->params, s->model_table, &pb->t, pb->p, pb->signs, pb->q_prev, q, true);
+}
+
 void om_complete_start(om_problem *pb, double *start, bool *complete)
 {
     const om_solver_data *s = pb->s;
-    if (!*complete && om_model_ik(s->family, s->params, s->model_table, &pb->t, pb->p, pb->signs, pb->q_prev, start,
-                                  true) < -OM_REACH_SLACK)
+    if (!*complete && om_near_ik(pb, _start_ik, NULL, start) < -OM_REACH_SLACK)
         om_srs_model_ik_at_reach(s->params, &pb->t, pb->p, pb->signs, pb->q_prev, start);
     *complete = true;
 }
@@ -121,8 +136,7 @@ bool om_fixed_point_start(om_problem *pb, double *q, double *start)
 {
     const om_solver_data *s = pb->s;
     const int64_t *signs = pb->signs;
-    if (om_model_ik(s->family, s->params, s->model_table, &pb->t, pb->p, signs, pb->q_prev, start, true) >=
-        -OM_REACH_SLACK)
+    if (om_near_ik(pb, _start_ik, NULL, start) >= -OM_REACH_SLACK)
         return true;
     if (s->family == OM_SRS && s->mode != OM_FIXED) /* the elbow held at the edge of reach */
         return om_srs_model_ik_at_reach(s->params, &pb->t, pb->p, signs, pb->q_prev, start);

@@ -66,9 +66,10 @@ void om_self_motion_null(const om_solver_data *s, const double *q, double *n) {
 }
 
 bool om_self_motion_tangent(const om_solver_data *s, const double *q, double *t, double tol) {
-    double grad[7], n[7];
-    om_self_motion_null(s, q, n);
-    om_arm_angle_gradient(s->params, s->model_table, s->n_model_rows, q, grad);
+    double grad[7], n[7], at[7];
+    om_flip(s, q, at); /* (the kernels' coordinates; the tangent back in the arm's own below) */
+    om_self_motion_null(s, at, n);
+    om_arm_angle_gradient(s->params, s->model_table, s->n_model_rows, at, grad);
     double dot = 0.0, gn = 0.0, nn = 0.0;
     for (int i = 0; i < 7; i++) {
         dot += grad[i] * n[i];
@@ -77,7 +78,7 @@ bool om_self_motion_tangent(const om_solver_data *s, const double *q, double *t,
     }
     if (!(fabs(dot) > tol * sqrt(gn * nn)) || !isfinite(dot)) return false;
     for (int i = 0; i < 7; i++) {
-        t[i] = n[i] / dot;
+        t[i] = s->flip[i] * (n[i] / dot);
         if (!isfinite(t[i])) return false;
     }
     return true;

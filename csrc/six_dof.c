@@ -6,17 +6,19 @@
 /* Joints 1-3 for the flange pose (t->R, p) in DH frame 0 and the ARM and ELBOW signs, into q,
  * and the wrist's rotation M = Rz(phi4) Rx(alpha4) Rz(phi5) Rx(alpha5) Rz(phi6) into *M.
  * Returns the reach margin: below -OM_REACH_SLACK the pose is out of reach and neither is
- * written. */
+ * written, unless nearest: then both are, with the square roots of the reach's conditions
+ * held at zero (the shoulder's, the elbow's: the nearest pose the model reaches). */
 static double position_and_wrist(int family, const double *P, const double *table, const om_target *t, vec3 p,
-                                 const int64_t *signs, const double *q_prev, double *q, mat3 *M)
+                                 const int64_t *signs, const double *q_prev, double *q, mat3 *M, bool nearest)
 {
+    double out_of_reach = nearest ? -INFINITY : -OM_REACH_SLACK;
     vec3 pw = v_add(t->wrist, p);
     /* Shoulder. */
     double h = P[SD_LATERAL];
     double r2 = pw.x * pw.x + pw.y * pw.y;
     double k = r2 - h * h;
     double margin = k / py_max(r2, 1.0);
-    if (margin < -OM_REACH_SLACK)
+    if (margin < out_of_reach)
         return margin;
     double rho = (double)signs[0] * sqrt(py_max(k, 0.0));
     double phi1;
@@ -35,7 +37,7 @@ static double position_and_wrist(int family, const double *P, const double *tabl
         double outer = fabs(a2) + l3, inner = fabs(a2) - l3; 
         k = (outer * outer - D) * (D - inner * inner);
         margin = py_min(margin, k / py_max(D * D, 1.0));
-        if (margin < -OM_REACH_SLACK)
+        if (margin < out_of_reach)
             return margin;
         double gamma = atan2((double)signs[1] * sqrt(py_max(k, 0.0)), om_sign(a2) * (D - a2 * a2 - l3 * l3));
         if (D < 1e-24) /* rule 2: wrist centre on joint 2's axis */
@@ -47,7 +49,7 @@ static double position_and_wrist(int family, const double *P, const double *tabl
     } else {
         k = D - a2 * a2;
         margin = py_min(margin, k / py_max(D, 1.0));
-        if (margin < -OM_REACH_SLACK)
+        if (margin < out_of_reach)
             return margin;
         double t = (double)(-signs[1]) * sqrt(py_max(k, 0.0));
         if (D < 1e-24)
@@ -85,13 +87,13 @@ void om_six_dof_target(const double *P, om_target *t)
 
 /* Solve the model arm for the flange pose (t->R, p) in DH frame 0 and the branch signs
  * (ARM, ELBOW, WRIST); write q. Returns the reach margin (model_ik): below -OM_REACH_SLACK the
- * pose is out of reach and q is not written. */
+ * pose is out of reach and q is not written, unless nearest (position_and_wrist's). */
 double om_six_dof_model_ik(int family, const double *P, const double *table, const om_target *t, vec3 p,
-                           const int64_t *signs, const double *q_prev, double *q)
+                           const int64_t *signs, const double *q_prev, double *q, bool nearest)
 {
     mat3 M;
-    double margin = position_and_wrist(family, P, table, t, p, signs, q_prev, q, &M);
-    if (margin < -OM_REACH_SLACK)
+    double margin = position_and_wrist(family, P, table, t, p, signs, q_prev, q, &M, nearest);
+    if (margin < -OM_REACH_SLACK && !nearest)
         return margin;
     vec3 phi = om_euler_zxzxz(M, P[SD_SIGMA4], P[SD_SIGMA5], 0.0, (double)signs[2], q_prev[3] + P[SD_THETA4]);
     q[3] = om_wrap(phi.x - P[SD_THETA4]);
@@ -109,7 +111,7 @@ double om_six_dof_model_ik_q6(int family, const double *P, const double *table, 
                               const int64_t *signs, const double *q_prev, double q6, double *q, double *residual)
 {
     mat3 M;
-    double margin = position_and_wrist(family, P, table, t, p, signs, q_prev, q, &M);
+    double margin = position_and_wrist(family, P, table, t, p, signs, q_prev, q, &M, false);
     if (margin < -OM_REACH_SLACK)
         return margin;
     vec3 neg = om_euler_zxzxz_given_first(m_transpose(M), -P[SD_SIGMA5], 0.0, -P[SD_SIGMA4], -(q6 + P[SD_THETA6]));

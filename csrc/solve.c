@@ -79,15 +79,6 @@ static void _reduce(const om_solver_data *s, const double *redundancy, double *r
         reduced[i] = remainder(redundancy[i], 2.0 * OM_PI);
 }
 
-/* The problem's target: the flange pose for the end-effector pose T, with the per-target
- * constants of the model's closed form (redundancy reduced). */
-static void _set_target(om_problem *pb, const double *T, const double *redundancy)
-{
-    const om_solver_data *s = pb->s;
-    mat3 R;
-    om_flange_target(T, s->T_base_root, s->T_tool_flange, &R, &pb->p);
-    pb->t = om_target_at(s->family, s->params, &R, redundancy);
-}
 
 /* The START_POINTS starts -pi + 2 pi (k + 1/2) / START_POINTS into order, the farthest from
  * w first (w NaN: in order of k). */
@@ -108,21 +99,25 @@ static om_result _result(int status, double pos, double ori, int64_t evaluations
     return result;
 }
 
-/* The problem of one solve: the target T, the branch signs, the redundancy values reduced
- * into reduced (n_redundancy; it must outlive the problem), joints kept at singularities
- * from q_prev. */
+/* The problem of one solve: the target T (with the per-target constants of the model's
+ * closed form), the branch signs, the redundancy values reduced into reduced (n_redundancy;
+ * it must outlive the problem), joints kept at singularities from q_prev. */
 static void _problem(om_problem *pb, const om_solver_data *s, const double *T, const int64_t *signs,
                      const double *redundancy, double *reduced, const double *q_prev)
 {
     pb->s = s;
     _reduce(s, redundancy, reduced);
-    _set_target(pb, T, reduced);
-    pb->signs = signs;
     pb->redundancy = reduced;
+    mat3 R; /* the target: the flange pose for the end-effector pose T */
+    vec3 p;
+    om_flange_target(T, s->T_base_root, s->T_tool_flange, &R, &p);
+    om_set_goal(pb, &R, p);
+    pb->signs = signs;
     pb->q_prev = q_prev;
     pb->counter = 0;
     pb->split_starts = true;
     pb->memo = NULL;
+    pb->nominal = false;
 }
 
 /* A hinted solve's local part (the hint is pb->q_prev, copied into start): the local solve
@@ -180,8 +175,10 @@ static om_result _solve(const om_solver_data *s, const double *T, const int64_t 
     vec3 pd = problem.p;
     double pos = NAN, ori = NAN, outside_w = NAN; /* q_J of a local root out of the limits */
     /* Whether start holds every joint; on an S-R-S circle arm whose dp turns with q7, the
-     * local solve needs q7 alone, and the rest is computed where needed (om_complete_start). */
-    bool start_complete = has_hint || !(mode == OM_CIRCLE && family == OM_SRS && s->dp_joint == 6);
+     * local solve needs q7 alone, and the rest is computed where needed (om_complete_start),
+     * but near a family, where the correction needs them all. */
+    bool start_complete =
+        has_hint || !(mode == OM_CIRCLE && family == OM_SRS && s->dp_joint == 6) || s->nominal_table;
     if (!start_complete) { /* the fixed-point start's q7, at the edge of reach beyond it */
         found = om_srs_model_q7(P, &problem.t, pd, signs, problem.q_prev, start) >= -OM_REACH_SLACK ||
                 om_srs_model_q7_at_reach(P, &problem.t, pd, signs, problem.q_prev, start);
@@ -264,17 +261,51 @@ static om_result _solve(const om_solver_data *s, const double *T, const int64_t 
     return _result(OM_OK, pos, ori, problem.counter, inside);
 }
 
+/* A caller's root test, of the arm's own joint coordinates, asked of the kernels' roots. */
+typedef struct {
+    const om_solver_data *s;
+    om_root_test test;
+    void *context;
+} own_test;
+
+static om_root_verdict _own_test(const double *q, void *context)
+{
+    const own_test *own = context;
+    double q_own[OM_MAX_DOF];
+    om_flip(own->s, q, q_own);
+    return own->test(q_own, own->context);
+}
+
+/* _solve in the arm's own joint coordinates (a near arm's reversed axes, om_solver_data.flip):
+ * the hint in, q_out out, and the roots that as_is judges, flipped. */
+static om_result _solve_own(const om_solver_data *s, const double *T, const int64_t *signs,
+                            const double *redundancy, const double *hint, double *q_out, om_root_test as_is,
+                            void *context, bool search)
+{
+    if (!s->flipped)
+        return _solve(s, T, signs, redundancy, hint, q_out, as_is, context, search);
+    double flipped[OM_MAX_DOF];
+    if (hint) {
+        om_flip(s, hint, flipped);
+        hint = flipped;
+    }
+    own_test own = {s, as_is, context};
+    om_result r = _solve(s, T, signs, redundancy, hint, q_out, as_is ? _own_test : NULL, &own, search);
+    om_flip(s, q_out, q_out);
+    return r;
+}
+
 om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
                        const double *hint, double *q_out, om_root_test as_is, void *context)
 {
-    return _solve(s, T, signs, redundancy, hint, q_out, as_is, context, true);
+    return _solve_own(s, T, signs, redundancy, hint, q_out, as_is, context, true);
 }
 
 /* The hinted solve's local part alone (see om_solve_near in om_kernels.h). */
 bool om_solve_near(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
                    const double *hint, double *q_out, om_root_test as_is, void *context, om_result *result)
 {
-    om_result r = _solve(s, T, signs, redundancy, hint, q_out, as_is, context, false);
+    om_result r = _solve_own(s, T, signs, redundancy, hint, q_out, as_is, context, false);
     if (r.status == OM_OK && result)
         *result = r;
     return r.status == OM_OK;
@@ -311,6 +342,8 @@ int om_solve_all(const om_solver_data *s, const double *T, const int64_t *signs,
         om_verify(&problem, root, &info[3 * r], &info[3 * r + 1]);
         bool inside = _finish(&problem, root, zeros, false, roots + r * dof, &info[3 * r], &info[3 * r + 1]);
         info[3 * r + 2] = inside ? 1.0 : 0.0;
+        if (s->flipped)
+            om_flip(s, roots + r * dof, roots + r * dof);
     }
     if (evaluations)
         *evaluations = problem.counter;

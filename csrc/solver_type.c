@@ -57,31 +57,41 @@ static int Solver_init(Solver *self, PyObject *args, PyObject *kwds) {
     long family, mode, dp_joint, scan_points;
     if (attr_long(d, "family", &family) || attr_long(d, "mode", &mode) || attr_long(d, "dp_joint", &dp_joint) ||
         attr_long(d, "scan_points", &scan_points) || attr_double(d, "position_tolerance", &s->tol_pos) ||
-        attr_double(d, "orientation_tolerance", &s->tol_ori))
+        attr_double(d, "orientation_tolerance", &s->tol_ori) || attr_double(d, "near_deviation", &s->near_deviation))
         return -1;
     Py_ssize_t n_params = attr_copy(d, "params", NULL, -1);
     Py_ssize_t n_model = attr_copy(d, "model_table", NULL, -1);
     Py_ssize_t n_real = attr_copy(d, "real_table", NULL, -1);
+    Py_ssize_t n_nominal = attr_copy(d, "nominal_table", NULL, -1);
     Py_ssize_t dof = attr_copy(d, "lower", NULL, -1);
-    if (n_params < 0 || n_model < 0 || n_real < 0 || dof < 0) return -1;
-    if (dof < 1 || dof > OM_MAX_DOF || n_model % 6 || n_real % 6) {
+    if (n_params < 0 || n_model < 0 || n_real < 0 || n_nominal < 0 || dof < 0) return -1;
+    if (dof < 1 || dof > OM_MAX_DOF || n_model % 6 || n_real % 6 || n_nominal % 6) {
         PyErr_SetString(PyExc_ValueError, "malformed solver data (dof or table shape)");
         return -1;
     }
     PyMem_Free(self->storage);
-    self->storage = PyMem_Malloc(sizeof(double) * (n_params + n_model + n_real + 2 * dof));
+    self->storage = PyMem_Malloc(sizeof(double) * (n_params + n_model + n_real + n_nominal + 2 * dof));
     if (!self->storage) {
         PyErr_NoMemory();
         return -1;
     }
     double *params = self->storage, *model = params + n_params, *real = model + n_model;
-    double *lower = real + n_real, *upper = lower + dof;
+    double *nominal = real + n_real, *lower = nominal + n_nominal, *upper = lower + dof;
     double D[18];
     if (attr_copy(d, "params", params, n_params) < 0 || attr_copy(d, "model_table", model, n_model) < 0 ||
-        attr_copy(d, "real_table", real, n_real) < 0 || attr_copy(d, "lower", lower, dof) < 0 ||
-        attr_copy(d, "upper", upper, dof) < 0 || attr_copy(d, "dp_coefficients", D, 18) < 0 ||
+        attr_copy(d, "real_table", real, n_real) < 0 || attr_copy(d, "nominal_table", nominal, n_nominal) < 0 ||
+        attr_copy(d, "lower", lower, dof) < 0 || attr_copy(d, "upper", upper, dof) < 0 ||
+        attr_copy(d, "flip", s->flip, dof) < 0 || attr_copy(d, "dp_coefficients", D, 18) < 0 ||
         attr_copy(d, "T_base_root", s->T_base_root, 16) < 0 || attr_copy(d, "T_tool_flange", s->T_tool_flange, 16) < 0)
         return -1;
+    s->flipped = false;
+    for (Py_ssize_t j = 0; j < dof; j++) {
+        if (s->flip[j] != 1.0 && s->flip[j] != -1.0) {
+            PyErr_SetString(PyExc_ValueError, "malformed solver data (flip: +-1 per joint)");
+            return -1;
+        }
+        s->flipped = s->flipped || s->flip[j] < 0.0;
+    }
     PyObject *rev = PyObject_GetAttrString(d, "revolute");
     if (!rev) return -1;
     Py_buffer view;
@@ -102,6 +112,8 @@ static int Solver_init(Solver *self, PyObject *args, PyObject *kwds) {
     s->n_model_rows = (int)(n_model / 6);
     s->real_table = real;
     s->n_real_rows = (int)(n_real / 6);
+    s->nominal_table = n_nominal ? nominal : NULL;
+    s->n_nominal_rows = (int)(n_nominal / 6);
     s->revolute = self->revolute;
     s->lower = lower;
     s->upper = upper;
@@ -278,8 +290,7 @@ static PyObject *Solver_configuration_values(Solver *self, PyObject *const *args
                             {F64, s->n_redundancy, 1, "redundancy"}};
     Py_buffer v[3];
     if (get_buffers(args, v, specs, 3) < 0) return NULL;
-    om_branch_values(s->family, s->params, v[0].buf, v[1].buf);
-    om_redundancy_values(s->family, s->params, v[0].buf, v[2].buf);
+    om_solver_configuration_values(s, v[0].buf, v[1].buf, v[2].buf);
     release_buffers(v, 3);
     Py_RETURN_NONE;
 }
@@ -291,7 +302,9 @@ static PyObject *Solver_holds(Solver *self, PyObject *const *args, Py_ssize_t na
     if (get_call(s, args, nargs, 3, "holds", &c) < 0) return NULL;
     Py_buffer q;
     if (get_buffer(args[0], &q, F64, s->dof, 0, "q") < 0) return NULL;
-    bool in = om_in_configuration(s, q.buf, c.signs, c.redundancy);
+    double at[OM_MAX_DOF]; /* the kernels' coordinates */
+    om_flip(s, q.buf, at);
+    bool in = om_in_configuration(s, at, c.signs, c.redundancy);
     PyBuffer_Release(&q);
     return PyBool_FromLong(in);
 }

@@ -168,10 +168,9 @@ static om_root_verdict on_step(const double *x, void *context) {
  * rotation vector of E to first order (all in DH frame 0, as om_self_motion_null's J). False
  * where the 7 x 7 system is singular (a zero pivot, or dq not finite): no prediction, the scan decides. */
 static bool pose_motion(const om_solver_data *s, const double *T, const double *q, double *dq) {
-    static const double eye[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
     double A[7 * 7], R[9], p[3];
-    om_jacobian(s->real_table, s->n_real_rows, eye, eye, q, 7, A, R, p); /* rows 0-5 of A; the flange (R, p) */
-    om_arm_angle_gradient(s->params, s->model_table, s->n_model_rows, q, A + 6 * 7);
+    om_solver_jacobian(s, q, A, R, p); /* rows 0-5 of A; the flange (R, p) */
+    om_solver_psi_gradient(s, q, A + 6 * 7);
     mat3 Rd;
     vec3 pd;
     om_flange_target(T, s->T_base_root, s->T_tool_flange, &Rd, &pd);

@@ -82,9 +82,9 @@ bool om_verify(om_problem *pb, const double *q, double *pos, double *ori)
     const om_solver_data *data = pb->s;
     double Rr[9], pr[3], trig[2 * OM_MAX_DOF];
     om_flange_trig(data->real_table, data->n_real_rows, q, Rr, pr, trig);
-    vec3 d = v3(pr[0] - pb->p.x, pr[1] - pb->p.y, pr[2] - pb->p.z);
+    vec3 d = v3(pr[0] - pb->goal_p.x, pr[1] - pb->goal_p.y, pr[2] - pb->goal_p.z);
     double position = sqrt(v_dot(d, d));
-    mat3 E = m_mtm(pb->t.R, m_load(Rr, 0));
+    mat3 E = m_mtm(pb->goal.R, m_load(Rr, 0));
     double e0 = E.r2.y - E.r1.z, e1 = E.r0.z - E.r2.x, e2 = E.r1.x - E.r0.y;
     double s = 0.5 * sqrt(e0 * e0 + e1 * e1 + e2 * e2);
     double orientation = atan2(s, 0.5 * (E.r0.x + E.r1.y + E.r2.z - 1.0));

@@ -1,6 +1,6 @@
 """Arms NEAR a closed-form family (issue 17, item 2): twists off 0/90/180 deg by 1e-8 ... 1e-3
 rad, reversed axes, fixed rows between joints; solved exactly through the nominal arm
-(om/nominal.py, om/near.py), or refused at construction with a ModelError naming the cause."""
+(om/nominal.py, csrc/near.c), or refused at construction with a ModelError naming the cause."""
 
 from __future__ import annotations
 
@@ -168,8 +168,8 @@ def test_arm_angle_and_singularities_of_a_reversed_joint(joint):
     ids=lambda a: a.name,
 )
 def test_the_redundancy_optimizer_tracks_on_a_near_arm(arm):
-    """The optimiser's global choice and its tracking steps (no compiled tracking kernel for
-    a near arm: the windowed search) give exact answers in their configuration."""
+    """The optimiser's global choice and its tracking steps (the compiled ones, as for every
+    arm) give exact answers in their configuration."""
     solver = om.OMSolver(arm)
     optimizer = om.RedundancyOptimizer(solver, [om.Sphere([0.4, 0.2, 0.5], 0.05)])
     T = arm.fk(np.array([0.1, -0.3, 0.2, -2.0, 0.1, 1.8, 0.5]))
@@ -199,8 +199,8 @@ def test_targets_at_a_branch_boundary_of_a_near_arm(branch, q):
     Doosan M1013): the ARM's (the wrist centre at the cylinder of the lateral offset about
     joint 1's axis), the ELBOW's (a folded elbow, an inner edge of reach). c may hold two real
     roots where the nominal arm has one in c and one in the neighbouring configuration, one
-    far away, or none at all (near.BOUNDARY seeds, the PUSH and SHIFT targets on every solve,
-    the fold partners). Each of these q was missed before."""
+    far away, or none at all: the corrected system's roots in c are the real ones (csrc/near.c).
+    Each of these q was missed by the first near-family solver."""
     solver = bent_solver("ur5e", np.log10(2e-4), 0)
     q = np.array(q)
     values = np.empty(3)
@@ -269,12 +269,13 @@ def test_targets_at_a_branch_boundary_of_a_near_arm(branch, q):
         ),
     ],
 )
-def test_a_polish_that_stalls_beside_a_fold(name, q):
-    """benchmarks.near_family's arms (seed 0) at q it missed: no seed polishes to q, those
-    nearest it stall where the exact chain's Jacobian is nearly singular (a fold of the real
-    arm's roots that the nominal arm lacks, as on the Doosan M1013 at the shoulder's). The
-    roots of the fold's quadratic from the stalled point (NearKernel._fold_partners) seed both
-    roots of the pair; before, q was not among solve_all."""
+def test_targets_beside_a_fold_of_the_real_arms_roots(name, q):
+    """benchmarks.near_family's arms (seed 0) at q the first near-family solver missed: no
+    nominal root polishes to q, those nearest it stall where the exact chain's Jacobian is
+    nearly singular (a fold of the real arm's roots that the nominal arm lacks, as on the
+    Doosan M1013 at the shoulder's): a close
+    pair of zeros of the corrected system's residual, found by its search (csrc/near.c); the
+    first near-family solver missed q."""
     arm = next(arm for arm in cases(0) if arm.name == name)
     solver = om.OMSolver(arm)
     assert solver.nominal is not None

@@ -5,13 +5,14 @@ that fronts them (:mod:`.solver`)."""
 
 from .configuration import Configuration
 from .model import ANGLE_ROUNDING, LENGTH_ROUNDING, ModelArm, derive_model
-from .nominal import NEAR_TWIST, NominalArm, nominal_arm
+from .nominal import NEAR_LENGTH, NEAR_TWIST, NominalArm, nominal_arm
 from .solver import BRANCH_BAND, BatchRoots, BatchSolution, OMSolver, Solution
 
 __all__ = [
     "ANGLE_ROUNDING",
     "BRANCH_BAND",
     "LENGTH_ROUNDING",
+    "NEAR_LENGTH",
     "NEAR_TWIST",
     "BatchRoots",
     "BatchSolution",

@@ -4,23 +4,26 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kinematics.arm import Arm
 from . import system
 from .model import ModelArm
+from .nominal import NominalArm
 
 
 def kernel_data(
-    arm: Arm, om: ModelArm, tolerances: tuple[float, float], scan_points: int
+    om: ModelArm, tolerances: tuple[float, float], scan_points: int, nominal: NominalArm | None = None
 ) -> system.SolverData:
-    """The :class:`~om_redundant.om.system.SolverData` of ``ckernels.Solver`` for an arm
-    (``om.real``) and its closed-form model.
+    """The :class:`~om_redundant.om.system.SolverData` of ``ckernels.Solver`` for an arm and
+    its closed-form model.
 
     Args:
-        arm: The arm whose FK verifies every answer (``om.real``).
-        om: Its closed-form model (:func:`~om_redundant.om.model.derive_model`).
+        om: The closed-form model (:func:`~om_redundant.om.model.derive_model`) of the arm, or
+            of its nominal arm (``om.real``) for an arm near a family.
         tolerances: Accepted position and orientation errors (m, rad).
         scan_points: Grid points of the bounded search.
+        nominal: The nominal arm of an arm near a family (None: ``om.real`` is the arm): every
+            answer is verified with the arm's exact chain, in the nominal joint coordinates.
     """
+    arm = om.real
     chain = arm.chain
     if om.shoulder.any():  # dp turns with q1 and q7: the torus (q1, q7)
         mode, dp_joint = system.TORUS, 0
@@ -34,7 +37,7 @@ def kernel_data(
         mode=mode,
         params=c(om.params),
         model_table=c(om.model.chain.table),
-        real_table=c(chain.table),
+        real_table=c((chain if nominal is None else nominal.exact).table),
         dp_joint=int(dp_joint),
         dp_coefficients=c(np.vstack([om.delta, om.shoulder])),
         T_base_root=c(np.linalg.inv(chain.T_root_base)),
@@ -45,4 +48,7 @@ def kernel_data(
         scan_points=scan_points,
         position_tolerance=tolerances[0],
         orientation_tolerance=tolerances[1],
+        nominal_table=c(np.empty((0, 6)) if nominal is None else chain.table),
+        flip=c(np.ones(arm.dof) if nominal is None else nominal.flip),
+        near_deviation=0.0 if nominal is None else nominal.deviation,
     )

@@ -168,10 +168,15 @@ def derive_model(arm: Arm) -> ModelArm:
     )
 
 
+def reach(chain: KinematicChain) -> float:
+    """The chain's reach (m), the sum of its rows' :math:`|(a, d)|`: the scale of its lengths."""
+    return sum(math.hypot(row.a, row.d) for row in chain.rows)
+
+
 def rounding_length(chain: KinematicChain) -> float:
     """The largest DH length (m) that is rounding of zero in this chain: :data:`LENGTH_ROUNDING`
-    times its reach, the sum of its rows' :math:`|(a, d)|`."""
-    return LENGTH_ROUNDING * sum(math.hypot(row.a, row.d) for row in chain.rows)
+    times its reach."""
+    return LENGTH_ROUNDING * reach(chain)
 
 
 def _refuse_rounding(arm: Arm) -> None:

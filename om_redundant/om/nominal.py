@@ -6,8 +6,9 @@ twists of 90 deg +- 4e-6 rad from rounded quaternions, offsets of 5e-13 m from a
 joints. The nominal arm is the OM method's *model side* of such an arm:
 
 * every twist within :data:`NEAR_TWIST` of 0, +-90 or 180 deg is snapped to that value;
-* every length within rounding of zero (:data:`~om_redundant.om.model.LENGTH_ROUNDING` per
-  metre of reach) is zero, and every joint offset theta within
+* every length within :data:`NEAR_LENGTH` per metre of reach of zero (rounding of zero,
+  :data:`~om_redundant.om.model.LENGTH_ROUNDING`, and the micrometres a rounded twist moves a
+  common normal by) is zero, and every joint offset theta within
   :data:`~om_redundant.om.model.ANGLE_ROUNDING` of a multiple of 90 deg is that multiple:
   rounding is not geometry, and never changes the method an arm gets;
 * a twist of (about) 180 deg becomes 0 and the next joint flips: since
@@ -22,8 +23,8 @@ joints. The nominal arm is the OM method's *model side* of such an arm:
 The real arm keeps its exact table: :attr:`NominalArm.exact` is the same chain as the real
 arm's, only re-expressed in the nominal joint coordinates :math:`q_n = f \odot q`
 (:attr:`NominalArm.flip`, the half turns moved but not snapped), so its FK at :math:`q_n`
-is the real arm's at q. The solver (:mod:`om_redundant.om.near`) takes the nominal arm's
-closed-form roots as seeds and corrects the difference on the exact chain.
+is the real arm's at q. The solver solves the OM system with the nominal arm as the model's
+side, the exact chain's difference from it corrected at every model IK (``csrc/near.c``).
 """
 
 from __future__ import annotations
@@ -37,10 +38,17 @@ import numpy as np
 from ..exceptions import ModelError
 from ..kinematics.arm import Arm
 from ..kinematics.chain import DHRow, JointKind, KinematicChain, row_transform
-from .model import ANGLE_ROUNDING, ModelArm, derive_model, rounding_length
+from .model import ANGLE_ROUNDING, ModelArm, derive_model, reach
 
 #: Largest deviation (rad) of a twist from 0, +-90 or 180 deg that the nominal arm snaps.
 NEAR_TWIST = 1e-3
+#: A DH length within this many metres per metre of the arm's reach of zero is zero in the
+#: nominal arm: rounding, and the common normal's shift by a twist rounded in the arm's source
+#: (an xArm7 URDF's rpy 1.5708 is 3.7e-6 rad off 90 deg and leaves d = 1.1e-6 m over 0.29 m),
+#: which the correction of ``csrc/near.c`` absorbs like the twist; it would otherwise make the
+#: nominal arm another family's (the shoulder offset d2 of the torus). Genuine offsets are
+#: millimetres (the Piper's d5 = 1.4e-3 m, 1.8e-3 per metre of its reach, is kept).
+NEAR_LENGTH = 1e-5
 
 _HALF_TURN = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, -1.0, 0.0, 0.0], [0.0, 0.0, -1.0, 0.0], [0, 0, 0, 1.0]])
 
@@ -56,6 +64,10 @@ class NominalArm:
             the real arm's at q).
         flip: (dof,) +1, or -1 where a joint's axis is reversed.
         differs: Whether the nominal arm's table differs from the real one.
+        deviation: A bound (m, to first order) on how far the nominal arm's flange frame is
+            from the real one's at any q, over the points within reach: the snapped angles'
+            changes times the reach plus the zeroed lengths, summed (``csrc/near.c``'s scale
+            of the correction).
     """
 
     real: Arm
@@ -63,6 +75,7 @@ class NominalArm:
     exact: KinematicChain
     flip: np.ndarray
     differs: bool
+    deviation: float
 
 
 def nominal_arm(arm: Arm) -> NominalArm:
@@ -71,9 +84,15 @@ def nominal_arm(arm: Arm) -> NominalArm:
     snapped, _ = _flipped(arm.chain, snap=True)
     # Rounding goes before the merge, which needs exact zeros, and after it, as a merged row
     # can sum to rounding (d = 0.1 carried into a row with d = -0.1 + 1e-13).
-    eps = rounding_length(arm.chain)
-    rows = _rounded(_merged(_rounded(snapped.rows, eps)), eps)
+    scale = reach(arm.chain)
+    eps = NEAR_LENGTH * scale
+    rounded = _rounded(snapped.rows, eps)
+    merged = _merged(rounded)
+    rows = _rounded(merged, eps)
     nominal = KinematicChain(tuple(rows), snapped.T_root_base, snapped.T_flange_tool)
+    # each change is a small rotation or translation of the frames after it (merges are exact)
+    changes = [_change(exact.rows, snapped.rows), _change(snapped.rows, rounded), _change(merged, rows)]
+    deviation = sum(angles * scale + lengths for angles, lengths in changes)
     lower = np.where(flip < 0, -arm.upper, arm.lower)
     upper = np.where(flip < 0, -arm.lower, arm.upper)
     differs = (
@@ -83,7 +102,7 @@ def nominal_arm(arm: Arm) -> NominalArm:
         or not np.array_equal(nominal.T_flange_tool, arm.chain.T_flange_tool)
     )
     model = dataclasses.replace(arm, chain=nominal, lower=lower, upper=upper)
-    return NominalArm(arm, model, exact, flip, bool(differs))
+    return NominalArm(arm, model, exact, flip, bool(differs), float(deviation))
 
 
 def closed_form(arm: Arm) -> tuple[ModelArm, NominalArm | None]:
@@ -146,6 +165,13 @@ def _rounded(rows: Sequence[DHRow], eps: float) -> list[DHRow]:
         DHRow(_length(row.a, eps), row.alpha, _length(row.d, eps), _right_angle(row.theta), row.kind)
         for row in rows
     ]
+
+
+def _change(before: Sequence[DHRow], after: Sequence[DHRow]) -> tuple[float, float]:
+    """The rows' total change of angle (twists, thetas: rad) and of length (m)."""
+    angles = sum(_off(b.alpha, a.alpha) + _off(b.theta, a.theta) for b, a in zip(before, after, strict=True))
+    lengths = sum(abs(b.a - a.a) + abs(b.d - a.d) for b, a in zip(before, after, strict=True))
+    return angles, lengths
 
 
 def _length(length: float, eps: float) -> float:

@@ -26,7 +26,6 @@ from . import system
 from .configuration import Configuration
 from .kernel_data import kernel_data
 from .model import ModelArm
-from .near import NearKernel
 from .nominal import NominalArm, closed_form
 
 DEFAULT_POSITION_TOLERANCE = 1e-10
@@ -177,22 +176,18 @@ class OMSolver:
         self.om, self.nominal = closed_form(self.arm)
         self._flip = np.ones(self.arm.dof) if self.nominal is None else self.nominal.flip
         types = {"solution_type": Solution, "configuration_type": Configuration}
-        if self.nominal is not None:  # near a family: the nominal arm's roots seed the exact ones
-            self._kernel = NearKernel(self.nominal, self.om, self.solver_data(), **types)
-        else:
-            self._kernel = ckernels.Solver(self.solver_data(), **types)
+        self._kernel = ckernels.Solver(self.solver_data(), **types)
         self._check_solves_itself()
 
     def solver_data(self) -> system.SolverData:
         """The fixed data of the compiled kernel (see :class:`~om_redundant.om.system.SolverData`):
-        of the arm, or of its nominal arm for an arm near a family (:attr:`nominal`)."""
-        arm = self.arm if self.nominal is None else self.nominal.arm
-        return kernel_data(arm, self.om, self.tolerances, self.scan_points)
+        of the arm, or, for an arm near a family (:attr:`nominal`), of its nominal arm's model with
+        the arm's exact chain (``csrc/near.c``)."""
+        return kernel_data(self.om, self.tolerances, self.scan_points, self.nominal)
 
     @property
-    def kernel(self) -> ckernels.Solver | NearKernel:
-        """The compiled solver, for kernels that solve with it (``ckernels.track_step``); a
-        :class:`~om_redundant.om.near.NearKernel` for an arm near a family."""
+    def kernel(self) -> ckernels.Solver:
+        """The compiled solver, for kernels that solve with it (``ckernels.track_step``)."""
         return self._kernel
 
     @property
@@ -389,8 +384,7 @@ class OMSolver:
 
         Args:
             T, signs, redundancy, threads: As :meth:`solve_all_batch` takes them.
-            band: (M,) bool, or None: every row searches as :meth:`solve_all` does. (An arm
-                near a closed-form family always does: its roots are its nominal arm's.)
+            band: (M,) bool, or None: every row searches as :meth:`solve_all` does.
 
         Returns:
             A :class:`BatchRoots` with M rows.

@@ -93,6 +93,14 @@ class SolverData(NamedTuple):
         lower, upper: (dof,) joint limits.
         scan_points: Grid points of the bounded search.
         position_tolerance, orientation_tolerance: Accepted errors (m, rad).
+        nominal_table: For an arm near a family, its nominal arm's DH table (the model side of
+            system (9), whose correction ``csrc/near.c`` solves); real_table is then the arm's
+            exact chain and lower, upper its limits, in the nominal joint coordinates
+            ``flip * q``. Empty (0 rows) for an arm in its family.
+        flip: (dof,) +-1: the kernels' joint coordinates are ``flip * q`` (all +1 but a near
+            arm's reversed axes); joint vectors cross the kernels' entry points in the arm's own.
+        near_deviation: A bound (m) on how far the nominal arm's flange frame is from the
+            arm's (:attr:`~om_redundant.om.nominal.NominalArm.deviation`); 0 in its family.
     """
 
     family: int
@@ -110,6 +118,9 @@ class SolverData(NamedTuple):
     scan_points: int
     position_tolerance: float
     orientation_tolerance: float
+    nominal_table: np.ndarray
+    flip: np.ndarray
+    near_deviation: float
 
 
 def flange_target(

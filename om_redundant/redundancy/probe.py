@@ -180,8 +180,8 @@ class Probe:
         solver, objective, T, signs: The solver, the objective, the pose and the branch.
         wrapped: Revolute joints modulo 2 pi, at the representative nearest mid-range (for
             the feasible intervals); False keeps them as solved (for tracking).
-        compiled: Follow paths with ``ckernels.follow`` where the solver is a 7-DOF arm's
-            compiled one; False: always the Python loop (the reference it is tested against).
+        compiled: Follow paths with ``ckernels.follow`` where the arm has 7 joints; False:
+            always the Python loop (the reference it is tested against).
     """
 
     def __init__(
@@ -202,8 +202,8 @@ class Probe:
         self._centre = (lower + upper) / 2.0
         # (where every joint is cyclic, or centred, no np.where picks between the two)
         self._all_cyclic, self._all_centred = all(self._cyclic.tolist()), all(self._centred.tolist())
-        self._work = None  # the compiled follow's arrays: a 7-DOF arm's compiled solver only
-        if compiled and isinstance(solver.kernel, ckernels.Solver) and arm.dof == 7:
+        self._work = None  # the compiled follow's arrays: a 7-DOF arm's only
+        if compiled and arm.dof == 7:
             self._work = FollowWork(
                 solver.kernel,
                 np.ascontiguousarray(T, dtype=float),

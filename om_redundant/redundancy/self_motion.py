@@ -67,14 +67,13 @@ def self_motion_tangent(solver: OMSolver, q: np.ndarray) -> np.ndarray:
 def self_motion_tangents(solver: OMSolver, q: np.ndarray, compiled: bool = True) -> np.ndarray:
     r"""dq/dpsi of a 7-DOF arm (one redundancy variable) at every row of q, as
     :func:`self_motion_tangent` computes it (the same operations per row, the 6x6 minors of
-    all rows in one batch; with a compiled solver by :func:`compiled_tangents`), NaN rows
-    where psi does not move along the self-motion.
+    all rows in one batch; compiled, by :func:`compiled_tangents`), NaN rows where psi does not
+    move along the self-motion.
 
     Args:
         solver: The solver of a 7-DOF arm.
         q: (M, 7) joint vectors.
-        compiled: With a compiled solver, its kernel; False: always numpy (the reference
-            it is tested against).
+        compiled: The solver's kernel; False: numpy (the reference it is tested against).
 
     Returns:
         (M, 7, 1) tangents.
@@ -84,7 +83,7 @@ def self_motion_tangents(solver: OMSolver, q: np.ndarray, compiled: bool = True)
     """
     check_arm_angle(solver)
     q = as_joint_vector(q, solver.arm.dof).reshape(-1, solver.arm.dof)
-    if compiled and isinstance(solver.kernel, ckernels.Solver) and solver.arm.dof == 7:
+    if compiled and solver.arm.dof == 7:
         return compiled_tangents(solver.kernel, q)
     chain, model, flip = solver.arm.chain, solver.model.chain, solver.flip
     jacobians = np.empty((len(q), 6, 7))

@@ -170,8 +170,7 @@ class Tracker:
             np.zeros(arm.dof),
             np.zeros(_N_OUT),
         )
-        # An arm near a family solves through om.near.NearKernel: no compiled tracking step.
-        self._kernel = solver.kernel if isinstance(solver.kernel, ckernels.Solver) else None
+        self._kernel = solver.kernel
         self.max_step = max_step
         # The last step's clearances, at its result's joints: the next step's linearisation.
         # Without obstacles, no pairs.
@@ -188,8 +187,6 @@ class Tracker:
             The step at the new psi, or why it cannot be taken or lands on an infeasible
             point (module docstring).
         """
-        if self._kernel is None:
-            return "an arm near a family has no compiled tracking step"
         with self._lock:
             step = self._step(T, signs, psi, q, curvature, self.max_step)
             if step == _REFUSED[_INFEASIBLE]:

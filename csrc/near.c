@@ -1,0 +1,212 @@
+/* Arms NEAR a closed-form family: the OM system (9) with the nominal arm as the model's side,
+ * its orientation difference included (om_redundant/om/nominal.py builds the nominal arm).
+ *
+ * The real arm's exact chain (in the nominal joint coordinates q) and its nominal arm (twists
+ * snapped to right angles, reversed axes flipped, fixed rows merged, small lengths zeroed)
+ * differ at the flange by a small rigid motion, the correction
+ *
+ *     C(q) = T_real(q)^-1 T_nom(q),   |C(q) - I| <= delta (om_solver_data.near_deviation, m at
+ *                                     the hand: the snapped angles times the reach and the
+ *                                     zeroed lengths, summed),
+ *
+ * so T_real(q) = T_d exactly where T_nom(q) = T_d C(q): q is a root of the nominal arm, an
+ * exact-family arm, for the target T_d C(q). The nominal arm's own OM system reduces, for a
+ * target T, to the circle (torus) of its model: with X_T(w) the model's target at the circle's
+ * point w (p_d + R delta(w); on the torus also a(w1)) and IK_m(X, c) the model's closed form in
+ * configuration c, its roots are the zeros of g_T(w) = wrap(IK_m(X_T(w), c)_J - w). For the real
+ * arm the target itself moves with q: at the circle's point w,
+ *
+ *     q = Phi_w(q) := IK_m(X_{T_d C(q)}(w), c),       G(w) = wrap(q_J - w)  at that fixed point,   (N)
+ *
+ * and every model IK of its search (om_near_ik, om_near_settle) iterates Phi_w until C settles.
+ *
+ * Exactness. At a zero of G with its fixed point q: q_J = w, so X_{T_d C(q)}(q_J) is the model's
+ * pose at q (IK_m inverts the model's FK), which is T_nom(q) moved by dp(q) (the construction of
+ * the exact family's system), so T_nom(q) = T_d C(q) and T_real(q) = T_d. Conversely a real root
+ * q* in c is the fixed point of Phi_{w*}, w* = q*_J (IK_m is one-to-one in c off the model's
+ * singular set, the paper's condition C2), with G(w*) = 0: the real roots in c are the zeros of
+ * G. c is read by the model's branch quantities at q (om_verify), whose signs IK_m gives by
+ * construction: no neighbouring configuration holds a root of c that G lacks, and a target that
+ * the nominal arm does not reach but the real arm does is reached by the corrected target.
+ *
+ * The fixed point. |dPhi_w/dq| <= L = |dIK_m/dX| |dC/dq|, with |dC/dq| <= delta per radian.
+ * Where L < 1 -- the model IK well conditioned against delta: all of the circle but within
+ * about delta |dIK_m/dX| of the model's singular set, where |dIK_m/dX| grows as 1 / |b| (b the
+ * branch quantities: a wrist's or shoulder's Euler angle, the elbow's square root at the edge
+ * of reach) -- Phi_w is a contraction: the fixed point is unique near q and the iteration
+ * converges to it at rate L (from C = I at every evaluation: G is then a function of w alone,
+ * as the exact family's g is), and G is as continuous in w as g (its Lipschitz constant grows
+ * by 1 / (1 - L)).
+ *
+ * The search (circle.c). Over the circle G differs from the nominal arm's own g~ = g_{T_d} by
+ * |G - g~| <= |dg/dX| delta: small where the model is well conditioned. The bounded search runs
+ * on g~ (the exact family's scan at the target, at its cost), every candidate it finds refined
+ * on G (om_all_roots), and G is searched -- by the same bounded search, in windows of the circle
+ * -- wherever it may cross zero and g~ does not: where g~ comes within a multiple of delta of
+ * zero without crossing it (a local minimum, a dip seen by a cell's halving) and G, evaluated
+ * there, is of the other sign or within four times its difference from g~ of zero (the
+ * difference changes little along a cell: the real arm's folds, a double zero of G, lie there);
+ * where g~ swings steeply (a singular wrist, which the correction may move); at each edge of
+ * reach, where g turns as a square root and G's edge lies about |m_G| / m' away (m the reach
+ * margin), unless G at g~'s edge stays clear of zero by four times its difference and that
+ * square root's run-on; between samples out of reach whose margin peaks within a multiple of
+ * delta of zero; and about the samples whose model comes within a multiple of delta of its
+ * singular set. The multiples (OM_NEAR_SENSITIVITY) bound the sensitivity of g, the margins and
+ * the branch quantities to the target with room (1 to 20 per metre away from the singular set).
+ * So the zeros of G are those of the search of G itself, the exact family's argument (sign
+ * changes bracket roots, extremum searches find close pairs, edges and islands of reach are
+ * searched), with G read as g~ where both are far from zero. Above OM_NEAR_SCAN (where the
+ * windows would take most of the circle) and on the torus the search is of G throughout. What
+ * the argument does not cover: within about delta |dIK_m/dX| >= 1 of the model's singular set
+ * the iteration need not contract (it stops after NEAR_STEPS), and a root whose fixed point
+ * exists only there is a candidate like any other, polished on the real arm near the boundary
+ * (om_polish_candidate) and verified, or missed: on a set of targets of measure O(delta).
+ *
+ * Out of the model's reach there is no q to correct from; where the margin is within
+ * OM_NEAR_SENSITIVITY times delta of it, the nearest pose the model reaches gives one
+ * (om_model_ik_nearest), so that a target which only the corrected system reaches (beyond the
+ * nominal arm's shoulder, a real arm reaching a little farther) is reached. */
+#include "om_system.h"
+
+#define NEAR_STEPS 16      /* fixed-point steps of the correction per model IK, at most */
+#define NEAR_SETTLED 1e-14 /* a correction moving by at most this (R, p in m: ten of their rounding) has settled */
+#define NEAR_RATE 0.1      /* a convergence rate below which the next move is predicted from the last two */
+/* Where the evaluation's residual r is not near zero, the correction settles to NEAR_RELATIVE |r|
+ * (at most NEAR_COARSE): r is then off by about that times the model IK's sensitivity to its
+ * target (some units), relative 1e-8, which its sign and the search's steps do not notice; at
+ * a root, r -> 0, to NEAR_SETTLED */
+#define NEAR_RELATIVE 1e-9
+#define NEAR_COARSE 1e-10
+
+/* C(q) = T_real(q)^-1 T_nom(q) into (*R, *p) (q in the kernels' coordinates). */
+static void _correction(const om_solver_data *s, const double *q, mat3 *R, vec3 *p)
+{
+    double Rr[9], pr[3], Rn[9], pn[3];
+    om_flange_pair(s->real_table, s->n_real_rows, s->nominal_table, s->n_nominal_rows, q, Rr, pr, Rn, pn);
+    mat3 real = m_load(Rr, 0);
+    *R = m_mtm(real, m_load(Rn, 0));
+    *p = m_mv(m_transpose(real), v_sub(v_load(pn, 0), v_load(pr, 0)));
+}
+
+/* The largest entry of |A - B| and |a - b|. */
+static double _moved(mat3 A, vec3 a, mat3 B, vec3 b)
+{
+    const vec3 d[4] = {v_sub(A.r0, B.r0), v_sub(A.r1, B.r1), v_sub(A.r2, B.r2), v_sub(a, b)};
+    double most = 0.0;
+    for (int i = 0; i < 4; i++)
+        most = py_max(most, py_max(py_max(fabs(d[i].x), fabs(d[i].y)), fabs(d[i].z)));
+    return most;
+}
+
+void om_set_goal(om_problem *pb, const mat3 *R, vec3 p)
+{
+    const om_solver_data *s = pb->s;
+    pb->goal = om_target_at(s->family, s->params, R, pb->redundancy);
+    pb->goal_p = p;
+    pb->t = pb->goal;
+    pb->p = p;
+}
+
+/* pb's model side moved to goal C(q), C into (*R, *p). Returns how far C moved from them. */
+static double _retarget(om_problem *pb, const double *q, mat3 *R, vec3 *p)
+{
+    const om_solver_data *s = pb->s;
+    mat3 C_R;
+    vec3 C_p;
+    _correction(s, q, &C_R, &C_p);
+    double moved = _moved(C_R, C_p, *R, *p);
+    *R = C_R;
+    *p = C_p;
+    mat3 target = m_mm(pb->goal.R, C_R);
+    pb->p = v_add(pb->goal_p, m_mv(pb->goal.R, C_p));
+    pb->t = om_target_at(s->family, s->params, &target, pb->redundancy);
+    return moved;
+}
+
+/* Each evaluation starts from the goal (C = I), not from the last one's correction: the
+ * evaluation is then a function of its arguments, as the exact family's is -- the same w
+ * evaluated twice is in reach both times or neither (an edge of reach found by bisection
+ * stays inside), and the search's brackets and extremum searches see one function. */
+/* How far a correction must settle for an evaluation whose residual is r (see NEAR_RELATIVE). */
+static double _settled(double r)
+{
+    return py_max(NEAR_SETTLED, py_min(NEAR_COARSE, NEAR_RELATIVE * fabs(r))); /* (NaN r: NEAR_COARSE) */
+}
+
+double om_near_settle(om_problem *pb, om_model_eval eval, const void *args, double *q)
+{
+    mat3 C_R = {v3(1.0, 0.0, 0.0), v3(0.0, 1.0, 0.0), v3(0.0, 0.0, 1.0)};
+    vec3 C_p = v3(0.0, 0.0, 0.0);
+    double nearest[OM_MAX_DOF], residual, ignored, last = INFINITY;
+    double margin = eval(pb, args, q, false, &residual);
+    for (int k = 0; k < NEAR_STEPS; k++) {
+        const double *at = q;
+        if (!(margin >= -OM_REACH_SLACK)) { /* out of reach: correct from the nearest pose, if near */
+            if (!(margin >= -OM_NEAR_SENSITIVITY * pb->s->near_deviation) ||
+                !(eval(pb, args, nearest, true, &ignored) >= -INFINITY))
+                break;
+            at = nearest;
+        }
+        double moved = _retarget(pb, at, &C_R, &C_p), settled = _settled(residual);
+        if (moved <= settled)
+            break;
+        margin = eval(pb, args, q, false, &residual);
+        settled = _settled(residual);
+        /* converging at the rate moved / last: the next move would be below settled */
+        if (last < INFINITY && moved < NEAR_RATE * last && moved * moved <= settled * last &&
+            margin >= -OM_REACH_SLACK)
+            break;
+        last = moved;
+    }
+    pb->t = pb->goal;
+    pb->p = pb->goal_p;
+    return margin;
+}
+
+/* ------------------------------------------------------------------------------------ */
+/* The arm's own joint coordinates: q = flip * q_n, q_n the kernels' (a near arm's reversed
+ * axes turn the other way in its nominal arm). */
+
+void om_flip(const om_solver_data *s, const double *in, double *out)
+{
+    for (int j = 0; j < s->dof; j++)
+        out[j] = s->flip[j] * in[j];
+}
+
+/* q in the kernels' coordinates into scratch, returned (q itself where nothing is flipped). */
+static const double *_kernels(const om_solver_data *s, const double *q, double *scratch)
+{
+    if (!s->flipped)
+        return q;
+    om_flip(s, q, scratch);
+    return scratch;
+}
+
+void om_solver_jacobian(const om_solver_data *s, const double *q, double *J, double *R, double *p)
+{
+    static const double eye[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    double scratch[OM_MAX_DOF];
+    int dof = s->dof;
+    om_jacobian(s->real_table, s->n_real_rows, eye, eye, _kernels(s, q, scratch), dof, J, R, p);
+    for (int i = 0; i < 6 && s->flipped; i++)
+        for (int j = 0; j < dof; j++)
+            J[i * dof + j] *= s->flip[j];
+}
+
+double om_solver_psi_gradient(const om_solver_data *s, const double *q, double *grad)
+{
+    double scratch[OM_MAX_DOF];
+    double psi = om_arm_angle_gradient(s->params, s->model_table, s->n_model_rows, _kernels(s, q, scratch), grad);
+    if (s->flipped)
+        om_flip(s, grad, grad);
+    return psi;
+}
+
+void om_solver_configuration_values(const om_solver_data *s, const double *q, double *branch, double *redundancy)
+{
+    double scratch[OM_MAX_DOF];
+    const double *at = _kernels(s, q, scratch);
+    om_branch_values(s->family, s->params, at, branch);
+    if (redundancy)
+        om_redundancy_values(s->family, s->params, at, redundancy);
+}
