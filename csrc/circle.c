@@ -15,6 +15,8 @@
  * cross zero where it is within NEAR_DIFFERENCE times its difference from g~ of it. */
 #define NEAR_DIFFERENCE 4.0
 #define NEAR_WINDOW 5 /* points of a window of G at least (one per scan cell otherwise) */
+#define WRIST_SAMPLES 4 /* samples of the wrist residual per scan cell of a near arm's singular window */
+#define WRIST_CONTRACTION 10.0 /* per metre of the deviation: |sin q5| of such a window (_near_singular) */
 
 #define MEMO_POINTS 128 /* a scan of at most this many points shares its samples' model parts (scan_memo) */
 #define MEMO_EDGES 16   /* edges of reach a scan memo keeps */
@@ -109,20 +111,24 @@ static double _g_of_parts(om_problem *pb, double w, const om_srs_elbow *e, om_sr
     return om_wrap(q[6] - w);
 }
 
-/* The smallest |branch quantity| of the model at q (every joint). */
-static double _nearest_branch(const om_solver_data *s, const double *q)
+/* The smallest |branch quantity| of the model at q (every joint; NULL: out of reach, INFINITY)
+ * into *nearest, its WRIST quantity's into *wrist. */
+static void _near_branches(const om_solver_data *s, const double *q, double *nearest, double *wrist)
 {
-    double values[3], nearest = INFINITY;
+    double values[3];
+    *nearest = *wrist = INFINITY;
+    if (!q)
+        return;
     om_branch_values(s->family, s->params, q, values);
     for (int i = 0; i < s->n_signs; i++)
-        nearest = py_min(nearest, fabs(values[i]));
-    return nearest;
+        *nearest = py_min(*nearest, fabs(values[i]));
+    *wrist = fabs(values[2]);
 }
 
 /* g and the reach margin at the scan's points ws[k] = lo + h k, k < n_pts, into gs and ms as
  * om_g_margin computes them, the parts that the problem's memo holds for them taken from it;
- * in a near arm's scan of its nominal arm (which keeps no memo), the model's smallest |branch
- * quantity| there into bs (INFINITY out of reach).
+ * for an arm near a family (which keeps no memo), the model's smallest |branch quantity| there
+ * into bs[k], its |WRIST quantity| into bs[n_pts + k] (INFINITY out of reach).
  * Returns that memo's branch, now this scan's (NULL where the problem or the arm keeps
  * none), valid until the memo's next scan. */
 static scan_memo *_sample(om_problem *pb, double lo, double h, int n_pts, double *ws, double *gs, double *ms,
@@ -134,8 +140,8 @@ static scan_memo *_sample(om_problem *pb, double lo, double h, int n_pts, double
     if (!pb->memo || n_pts > MEMO_POINTS) { /* (pb->memo: an arm that keeps one, om_scan_memo_new) */
         for (int k = 0; k < n_pts; k++) {
             gs[k] = om_g_margin(pb, ws[k], q, false, &ms[k]);
-            if (pb->nominal)
-                bs[k] = isnan(gs[k]) ? INFINITY : _nearest_branch(s, q);
+            if (s->nominal_table)
+                _near_branches(s, isnan(gs[k]) ? NULL : q, &bs[k], &bs[n_pts + k]);
         }
         return NULL;
     }
@@ -591,25 +597,55 @@ static int _near_edge(om_problem *pb, const double *ws, const double *gs, const 
     return _near_window(pb, ws[lo], ws[hi], hi - lo + 1, q, out, n, cap);
 }
 
-/* A near arm's windows of G about the samples (n of them, h apart) whose model comes within
- * _near of its singular set (bs: its smallest |branch quantity|): there
- * the model IK's sensitivity to its target grows as 1 / |b| (the wrist's and shoulder's Euler
- * angles, the elbow's square root), the correction's effect on g with it, and G's singular swing
- * may lie cells away from g~'s. A run of such samples takes one window, a cell wider each way.
- * Their candidates into out[n_out:]; returns the count. */
-static int _near_singular(om_problem *pb, const double *ws, const double *bs, int n, double h, double *q,
-                          double *out, int n_out, int cap)
+/* A near arm's windows about the runs of samples ws (n of them, h apart) whose values bs come
+ * below near, each a cell wider each way, searched by search (a scan of g~'s: on G, _near_window;
+ * on the wrist residual, _wrist_window). Candidates into out[n_out:]; returns the count. */
+static int _near_runs(om_problem *pb, const double *ws, const double *bs, int n, double h, double near,
+                      int (*search)(om_problem *, double, double, int, double *, double *, int, int), double *q,
+                      double *out, int n_out, int cap)
 {
-    double near = _near(pb);
     for (int k = 0; k < n; k++) {
         if (!(bs[k] < near))
             continue;
         int last = k;
         while (last + 1 < n && bs[last + 1] < near)
             last++;
-        n_out = _near_window(pb, ws[k] - h, ws[last] + h, last - k + 3, q, out, n_out, cap);
+        n_out = search(pb, ws[k] - h, ws[last] + h, last - k + 3, q, out, n_out, cap);
         k = last;
     }
+    return n_out;
+}
+
+/* The cells [a, b] of a 6-DOF near arm searched on its wrist residual (om_wrist_residual: q6 = w
+ * given, smooth at the singular wrist; its zeros, close pairs at the edge of reach included, by
+ * the same search, in WRIST_SAMPLES points per cell of the points - 1): candidates into out[n:]. */
+static int _wrist_window(om_problem *pb, double a, double b, int points, double *q, double *out, int n, int cap)
+{
+    bool nominal = pb->nominal;
+    pb->nominal = false, pb->wrist = true;
+    n += om_circle_candidates(pb, a, b, WRIST_SAMPLES * (points - 1) + 1, false, q, out + n, cap - n);
+    pb->nominal = nominal, pb->wrist = false;
+    return n;
+}
+
+/* A near arm's windows about the samples ws (n of them, h apart) whose model comes near its
+ * singular set (bs: the smallest |branch quantity| of each, then the |WRIST quantity|). Within
+ * _near of it the model IK's sensitivity to its target grows as 1 / |b| (the wrist's and the
+ * shoulder's Euler angles, the elbow's square root), and the correction's effect on g with it:
+ * G's singular swing may lie cells away from g~'s, so where the scan was of g~ the window is
+ * searched on G. Within WRIST_CONTRACTION times the deviation of a 6-DOF arm's aligned wrist
+ * (the model splits it by q_prev, the real arm does not, and the correction at the split moves
+ * by about the deviation over |sin q5|), the correction's fixed point need not contract: G's q6
+ * need not be the real root's where there is one, and the window is searched on the wrist
+ * residual. Candidates into out[n_out:]; returns the count. */
+static int _near_singular(om_problem *pb, const double *ws, const double *bs, int n, double h, double *q,
+                          double *out, int n_out, int cap)
+{
+    if (pb->nominal)
+        n_out = _near_runs(pb, ws, bs, n, h, _near(pb), _near_window, q, out, n_out, cap);
+    if (pb->s->family != OM_SRS && pb->s->dp_joint == 5)
+        n_out = _near_runs(pb, ws, bs + n, n, h, WRIST_CONTRACTION * pb->s->near_deviation, _wrist_window, q, out,
+                           n_out, cap);
     return n_out;
 }
 
@@ -634,7 +670,7 @@ int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool f
     int count = full_circle ? n_pts + 1 : n_pts;
     /* ws, gs, ms (n_pts + 1 each), their rotations (count each), pw, pg and a run's curvature
      * estimates (count + 2 each) */
-    size_t size = (size_t)(4 * (n_pts + 1) + 3 * count + 3 * (count + 2));
+    size_t size = (size_t)(5 * (n_pts + 1) + 3 * count + 3 * (count + 2));
     double *buffer = malloc(size * sizeof(double));
     int *order = malloc((size_t)count * sizeof(int));
     if (!buffer || !order) {
@@ -648,12 +684,17 @@ int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool f
     pole_guard pole = _pole_guard(pb, h);
     int start = -1;
     scan_memo *memo = _sample(pb, lo, h, n_pts, ws, gs, ms, bs, q);
-    int n = pb->nominal ? _near_singular(pb, ws, bs, n_pts, h, q, cands, 0, cap) : 0;
+    /* a near arm's windows about its singular set, after the runs' candidates (near ones first:
+     * a candidate's secant may run to another root, which then is one found) */
+    const double *samples = ws;
+    int n = 0;
     for (int k = 0; k < n_pts && start < 0; k++)
         if (isnan(gs[k]))
             start = k;
     if (full_circle && start < 0) { /* reachable everywhere: one cyclic run */
         n = _run_roots(pb, &pole, POLE_DEPTH, ws, gs, n_pts, true, curvatures, q, cands, n, cap);
+        if (pb->s->nominal_table && !pb->wrist)
+            n = _near_singular(pb, samples, bs, n_pts, h, q, cands, n, cap);
         free(buffer);
         free(order);
         return n;
@@ -720,6 +761,8 @@ int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool f
     }
     if (L > 0) /* a run that reaches the end of the window */
         n = _run_roots(pb, &pole, POLE_DEPTH, pw, pg, L, false, curvatures, q, cands, n, cap);
+    if (pb->s->nominal_table && !pb->wrist)
+        n = _near_singular(pb, samples, bs, n_pts, h, q, cands, n, cap);
     free(buffer);
     free(order);
     return n;

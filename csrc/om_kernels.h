@@ -265,6 +265,9 @@ typedef struct {
     /* An arm near a family scanned on its nominal arm's system: the model IKs skip the
      * correction (g-tilde of near.c); false for every other evaluation. */
     bool nominal;
+    /* A 6-DOF arm near a family scanned on its wrist residual (om_wrist_residual: om_g is it,
+     * circle.c's windows at the singular wrist); false for every other evaluation. */
+    bool wrist;
 } om_problem;
 
 /* near.c: an arm near a family (om_solver_data.nominal_table). */

@@ -24,6 +24,13 @@ static inline double om_near_ik(om_problem *pb, om_model_eval eval, const void *
     return om_near_settle(pb, eval, args, q);
 }
 
+/* Whether solver s is an arm near a family whose searches take its nominal arm's residual g~
+ * first, and the real arm's G where they may differ (near.c): up to OM_NEAR_SCAN. */
+static inline bool om_scans_nominal(const om_solver_data *s)
+{
+    return s->nominal_table && s->near_deviation <= OM_NEAR_SCAN;
+}
+
 /* A scratch joint vector starts as NaN: a check of joints never written (a local solve whose
  * first point is out of reach) then always fails, never depends on what a previous call left. */
 static inline void nan_fill(double *q, int n) { for (int j = 0; j < n; j++) q[j] = NAN; }

@@ -93,6 +93,16 @@ static double _wrist_ik(om_problem *pb, const void *args, double *q, bool neares
     return margin;
 }
 
+/* om_wrist_residual, its reach margin into *margin (NULL: not wanted). */
+static double _wrist_residual(om_problem *pb, double w, double *q, double *margin)
+{
+    wrist_ik args = {w, NAN};
+    double m = om_near_ik(pb, _wrist_ik, &args, q);
+    if (margin)
+        *margin = m;
+    return m < -OM_REACH_SLACK ? NAN : args.residual;
+}
+
 /* The wrist's consistency at p_m = p_d + R delta(w) with the wrist joint J = w given, for a
  * 6-DOF circle arm (om_six_dof_model_ik_q6): smooth where g is steep at a singular wrist.
  * Writes q (q_J = w); NaN out of the model's reach, and where w is not q6 (a4 != 0). */
@@ -100,14 +110,15 @@ double om_wrist_residual(om_problem *pb, double w, double *q)
 {
     if (pb->s->dp_joint != 5) /* a wrist with a4 != 0: w is q1, not q6 (wrist_offset.c) */
         return NAN;
-    wrist_ik args = {w, NAN};
-    double margin = om_near_ik(pb, _wrist_ik, &args, q);
-    return margin < -OM_REACH_SLACK ? NAN : args.residual;
+    return _wrist_residual(pb, w, q, NULL);
 }
 
-/* Residual g(w) (NaN if unreachable) and the model's reach margin; writes the IK into q. */
+/* Residual g(w) (NaN if unreachable) and the model's reach margin; writes the IK into q. In a
+ * near arm's scan of its wrist residual (pb->wrist), that residual and the IK with q6 = w. */
 double om_g_margin(om_problem *pb, double w, double *q, bool all_joints, double *margin)
 {
+    if (pb->wrist)
+        return _wrist_residual(pb, w, q, margin);
     bool fixed = pb->s->mode == OM_FIXED;
     double m = om_model_ik_at(pb, w, q, all_joints || fixed);
     if (margin)

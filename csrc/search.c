@@ -19,7 +19,9 @@ static int _circle_roots(om_problem *pb, const double *cands, int n, double *q, 
             om_secant(pb, cands[i], q);
         int before = count;
         count = om_add_root(pb, q, roots, count);
-        if (count == before && !isnan(om_g(pb, cands[i], q, true))) {
+        /* (an arm near a family's wrist residual may reach where G does not: its correction's) */
+        bool wrist = data->nominal_table && !lifted && data->dp_joint == 5;
+        if (count == before && (!isnan(om_g(pb, cands[i], q, true)) || wrist)) {
             /* A steep crossing at a singular wrist: solved where it is smooth, from the
              * crossing itself (q_J = w; the model's q_J is off by the jump of g there). */
             double at_candidate[OM_MAX_DOF];
@@ -76,8 +78,7 @@ int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre
     bool full_circle = radius >= OM_PI;
     double lo = full_circle ? -OM_PI : centre[J] - radius;
     double hi = full_circle ? OM_PI : centre[J] + radius;
-    /* an arm near a family scans its nominal arm's g where it is near enough (near.c) */
-    pb->nominal = data->nominal_table && data->near_deviation <= OM_NEAR_SCAN;
+    pb->nominal = om_scans_nominal(data); /* an arm near a family: its nominal arm's g~ first (near.c) */
     int n = om_circle_candidates(pb, lo, hi, n_scan, full_circle, q, cands, cap);
     if (data->family != OM_SRS && data->params[SD_WRIST_OFFSET] != 0.0) /* a4 != 0: the singular wrist's bands */
         n += om_wrist_offset_candidates(pb, lo, hi, full_circle, q, cands + n, cap - n);
@@ -124,10 +125,20 @@ static double _start_ik(om_problem *pb, const void *args, double *q, bool neares
     return om_model_ik(s->family, s->params, s->model_table, &pb->t, pb->p, pb->signs, pb->q_prev, q, true);
 }
 
+/* The start's model IK (_start_ik): an arm near a family that scans its nominal arm starts
+ * from the nominal arm's. */
+static double _start_at(om_problem *pb, double *start)
+{
+    pb->nominal = om_scans_nominal(pb->s);
+    double margin = om_near_ik(pb, _start_ik, NULL, start);
+    pb->nominal = false;
+    return margin;
+}
+
 void om_complete_start(om_problem *pb, double *start, bool *complete)
 {
     const om_solver_data *s = pb->s;
-    if (!*complete && om_near_ik(pb, _start_ik, NULL, start) < -OM_REACH_SLACK)
+    if (!*complete && _start_at(pb, start) < -OM_REACH_SLACK)
         om_srs_model_ik_at_reach(s->params, &pb->t, pb->p, pb->signs, pb->q_prev, start);
     *complete = true;
 }
@@ -136,7 +147,7 @@ bool om_fixed_point_start(om_problem *pb, double *q, double *start)
 {
     const om_solver_data *s = pb->s;
     const int64_t *signs = pb->signs;
-    if (om_near_ik(pb, _start_ik, NULL, start) >= -OM_REACH_SLACK)
+    if (_start_at(pb, start) >= -OM_REACH_SLACK)
         return true;
     if (s->family == OM_SRS && s->mode != OM_FIXED) /* the elbow held at the edge of reach */
         return om_srs_model_ik_at_reach(s->params, &pb->t, pb->p, signs, pb->q_prev, start);
@@ -166,7 +177,14 @@ bool om_local_solve(om_problem *pb, double *start, bool *start_complete, double 
         om_lifted_solve(pb, start, q);
         return om_verify(pb, q, pos, ori);
     }
-    om_secant_in_reach(pb, data->mode == OM_CIRCLE ? start[data->dp_joint] : 0.0, q);
+    double w = data->mode == OM_CIRCLE ? start[data->dp_joint] : 0.0;
+    if (om_scans_nominal(data) && data->mode == OM_CIRCLE) { /* the nominal arm's root first, G's from it */
+        pb->nominal = true;
+        if (om_secant_in_reach(pb, w, q) < OM_TOUCH)
+            w = q[data->dp_joint];
+        pb->nominal = false;
+    }
+    om_secant_in_reach(pb, w, q);
     bool accepted = om_verify(pb, q, pos, ori);
     if (!accepted && data->family == OM_SRS && data->mode == OM_CIRCLE) {
         om_complete_start(pb, start, start_complete);

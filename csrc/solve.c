@@ -118,6 +118,7 @@ static void _problem(om_problem *pb, const om_solver_data *s, const double *T, c
     pb->split_starts = true;
     pb->memo = NULL;
     pb->nominal = false;
+    pb->wrist = false;
 }
 
 /* A hinted solve's local part (the hint is pb->q_prev, copied into start): the local solve
