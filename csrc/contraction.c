@@ -264,31 +264,15 @@ static bool _empty(const om_solver_data *s, torus_cell c, om_torus_bound b, cons
     return fabs(om_wrap(q[0] - c.w1)) > (1.0 + b.g1 * rho) * c.h || fabs(om_wrap(q[6] - c.w7)) > (1.0 + b.g7 * rho) * c.h;
 }
 
-bool om_torus_certified_roots(om_problem *pb, double *roots, int *count)
+/* Every root in the cells (a stack of n, room for CELL_STACK) into roots (*count of them): each
+ * cell proved empty (_empty, or beyond reach), or holding one root in the C' about it (found,
+ * verified), or split, down to CELL_DEPTH halvings of the first cell's width. Returns whether
+ * every cell was decided (false: a cell left undecided, examined more than CELL_BUDGET, or a
+ * fixed point that does not verify on the real arm). */
+static bool _decide_cells(om_problem *pb, torus_cell *cells, int n, double *roots, int *count)
 {
     const om_solver_data *s = pb->s;
-    const double *P = s->params;
-    if (!(_rate_a(s) + _rate_d(s) < CERTIFIABLE * sqrt(P[SRS_K0] + fabs(P[SRS_K]))))
-        return false;
-    double q[OM_MAX_DOF];
-    nan_fill(q, OM_MAX_DOF);
-    om_torus_bound whole = om_torus_cell_bound(pb, 0.0, 0.0, OM_PI, q);
-    *count = 0;
-    if (whole.unreachable)
-        return true;
-    double c1 = q[0], c7 = q[6]; /* G at the ball's centre: a point of the torus to start from */
-    if (_lipschitz(s, whole) < 1.0 && _map(pb, c1, c7, q)) {
-        fixed_point_outcome outcome = _fixed_point(pb, c1, c7, OM_PI, whole, q, roots, count);
-        if (outcome != FIXED_POINT_UNDECIDED) /* unverified: the search decides */
-            return outcome == FIXED_POINT_ROOT;
-    }
-    torus_cell cells[CELL_STACK];
-    int n = 0;
-    for (int i = 0; i < FIRST_CELLS; i++)
-        for (int j = 0; j < FIRST_CELLS; j++)
-            cells[n++] = (torus_cell){-OM_PI + (i + 0.5) * 2.0 * OM_PI / FIRST_CELLS,
-                                      -OM_PI + (j + 0.5) * 2.0 * OM_PI / FIRST_CELLS, OM_PI / FIRST_CELLS};
-    double smallest = OM_PI / FIRST_CELLS / (double)(1 << CELL_DEPTH);
+    double q[OM_MAX_DOF], smallest = cells[0].h / (double)(1 << CELL_DEPTH);
     for (int examined = 0; n > 0; examined++) {
         torus_cell c = cells[--n];
         nan_fill(q, OM_MAX_DOF);
@@ -309,4 +293,36 @@ bool om_torus_certified_roots(om_problem *pb, double *roots, int *count)
             cells[n++] = (torus_cell){c.w1 + (k & 1 ? h : -h), c.w7 + (k & 2 ? h : -h), h};
     }
     return true;
+}
+
+bool om_torus_certified_roots(om_problem *pb, double *roots, int *count, const double *centre, double radius)
+{
+    const om_solver_data *s = pb->s;
+    const double *P = s->params;
+    if (!(_rate_a(s) + _rate_d(s) < CERTIFIABLE * sqrt(P[SRS_K0] + fabs(P[SRS_K]))))
+        return false;
+    torus_cell cells[CELL_STACK];
+    *count = 0;
+    if (radius < OM_PI / FIRST_CELLS) { /* a window about the centre's (q1, q7): its one cell */
+        cells[0] = (torus_cell){centre[0], centre[6], radius};
+        return _decide_cells(pb, cells, 1, roots, count);
+    }
+    /* the whole torus (a superset of a wider window's roots) */
+    double q[OM_MAX_DOF];
+    nan_fill(q, OM_MAX_DOF);
+    om_torus_bound whole = om_torus_cell_bound(pb, 0.0, 0.0, OM_PI, q);
+    if (whole.unreachable)
+        return true;
+    double c1 = q[0], c7 = q[6]; /* G at the ball's centre: a point of the torus to start from */
+    if (_lipschitz(s, whole) < 1.0 && _map(pb, c1, c7, q)) {
+        fixed_point_outcome outcome = _fixed_point(pb, c1, c7, OM_PI, whole, q, roots, count);
+        if (outcome != FIXED_POINT_UNDECIDED) /* unverified: the search decides */
+            return outcome == FIXED_POINT_ROOT;
+    }
+    int n = 0;
+    for (int i = 0; i < FIRST_CELLS; i++)
+        for (int j = 0; j < FIRST_CELLS; j++)
+            cells[n++] = (torus_cell){-OM_PI + (i + 0.5) * 2.0 * OM_PI / FIRST_CELLS,
+                                      -OM_PI + (j + 0.5) * 2.0 * OM_PI / FIRST_CELLS, OM_PI / FIRST_CELLS};
+    return _decide_cells(pb, cells, n, roots, count);
 }

@@ -317,10 +317,12 @@ om_torus_bound om_torus_bound_on(om_problem *pb, vec3 p, double rho, double *q);
  * q: the model IK there, G's value); h >= pi: on the whole torus (the ball of radius r_a + r_d
  * that holds it; q: the model IK at its centre). */
 om_torus_bound om_torus_cell_bound(om_problem *pb, double w1, double w7, double h, double *q);
-/* Where the bounds prove the roots (none beyond reach; where G contracts, its one fixed point,
- * verified; cells of the torus without a root or with exactly one): every root of the configuration into roots, the count into *count; returns
- * whether it did (false: the bounded search decides). */
-bool om_torus_certified_roots(om_problem *pb, double *roots, int *count);
+/* Where the bounds prove them (cells of the torus without a root, or with exactly one, where G
+ * contracts: found and verified), every root of the configuration whose (q1, q7) lies within
+ * radius of the centre's (radius >= pi / 4: on the whole torus, a superset) into roots, the
+ * count into *count, on an arm whose offsets are small against it; returns whether it did
+ * (false: the grid search decides). */
+bool om_torus_certified_roots(om_problem *pb, double *roots, int *count, const double *centre, double radius);
 /* x = W - S of the model on the torus less its parts that turn with w1 and w7:
  * p_d + R w_F - S + D3 + R D0 (x = it + D4 cos w1 + D5 sin w1 + R (D1 cos w7 + D2 sin w7)). */
 vec3 om_shoulder_wrist_centre(const om_problem *pb);

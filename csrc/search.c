@@ -67,7 +67,7 @@ int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre
     }
     if (data->mode == OM_TORUS) {
         int count;
-        if (radius >= OM_PI && pb->certify && om_torus_certified_roots(pb, roots, &count))
+        if (pb->certify && om_torus_certified_roots(pb, roots, &count, centre, radius))
             return count;
         int side = (int)(TORUS_SIDE * (double)n_scan);
         return om_torus_roots(pb, side > 4 ? side : 4, roots, centre, radius);

@@ -117,3 +117,19 @@ def test_certificate_finds_every_root_of_the_grid_search(name):
                 assert solver.holds(root, c)
                 assert np.linalg.norm(solver.arm.fk(root)[:3, 3] - T[:3, 3]) < EXACT
     assert decided >= DECIDED[name] * 2 * len(random)
+
+
+@pytest.mark.parametrize("name", TORUS_ARMS)
+def test_hinted_solve_is_at_least_as_near_as_every_grid_root(name):
+    """The hinted solve's window search (certified where it decides) returns a root at least
+    as near the hint as every root of the grid search over the whole torus."""
+    solver = solver_of(name)
+    rng = np.random.default_rng(5)
+    for q in random_q(solver.arm, 40, rng):
+        T, c = solver.arm.fk(q), solver.configuration_of(q)
+        hint = q + rng.uniform(-0.05, 0.05, 7)
+        solution = solver.solve(T, c, q_hint=hint)
+        assert solution.ok
+        grid, _ = _roots(solver, T, c, False)
+        nearest = min(np.linalg.norm(wrap(root - hint)) for root in grid)
+        assert np.linalg.norm(wrap(solution.q - hint)) <= nearest + 1e-9
