@@ -300,7 +300,13 @@ int om_wrist_offset_candidates(om_problem *pb, double lo, double hi, bool full_c
 /* torus.c */
 double om_newton(om_problem *pb, vec3 x, double *q, const double *known, int n_known, vec3 *x_end);
 double om_lifted_solve(om_problem *pb, const double *start, double *q);
-int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, double radius);
+/* The candidates a torus search hands to verification, in order: q (dof each) of the first cap
+ * of them, count in all (beyond cap: not all kept). */
+typedef struct {
+    double *q;
+    int cap, count;
+} om_candidate_log;
+int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, double radius, om_candidate_log *log);
 /* contraction.c: bounds g1, g7 on the rates of q1 and q7 of the model IK per unit of the
  * shoulder-wrist vector x over the ball of radius rho about that of the hand position p (inf
  * where there is none: a singular shoulder or wrist, the edge of reach, psi's half-line), so
@@ -368,12 +374,14 @@ double om_polish(const om_polish_task *t, int iterations, double *q);
  * memo (circle.c), for the next scan of the same pose in the same ELBOW sign. On an S-R-S arm
  * whose dp turns with q7 the circle residual g(w) is the model's q7 less w, and q7 does not
  * depend on the SHOULDER sign (srs.c, q7_with_elbow): the scan, its brackets and refinements
- * are the same, only the joints that each candidate becomes differ. The gate depends on the
+ * are the same, only the joints that each candidate becomes differ. On the torus the grid
+ * search's candidates (joint vectors, dof each) are shared by the problems that differ in the
+ * SHOULDER and WRIST signs alone (the lifted residual reads neither). The gate depends on the
  * pose alone. */
 typedef struct {
     bool valid;
     double key[OM_SCAN_KEY];  /* the target, psi, the other signs, q_prev, the scan points */
-    int count;                /* candidates */
+    int count;                /* candidates (on the torus: joint vectors) */
     int64_t evaluations;      /* the residual evaluations they took */
     double q[OM_MAX_DOF];     /* the scratch joints as the search left them */
     double *candidates;       /* capacity of them */
