@@ -11,6 +11,7 @@ from om_redundant import ckernels
 from om_redundant.om.families import srs
 from om_redundant.om.system import MAX_ROOTS, flange_target
 from tests.conftest import EXACT, random_q, solver_of, wrap
+from tests.test_kernels import _assert_rows_are_solve_all
 
 TORUS_ARMS = ["gen3", "sawyer"]
 #: The share of the random problems below that the certificate decides, at least: the Gen3's offsets
@@ -133,3 +134,18 @@ def test_hinted_solve_is_at_least_as_near_as_every_grid_root(name):
         grid, _ = _roots(solver, T, c, False)
         nearest = min(np.linalg.norm(wrap(root - hint)) for root in grid)
         assert np.linalg.norm(wrap(solution.q - hint)) <= nearest + 1e-9
+
+
+@pytest.mark.parametrize("name", TORUS_ARMS)
+def test_rows_that_share_the_grid_search_are_solve_all(name):
+    """A batch's rows in the sweep's order (the four SHOULDER and WRIST signs of an ELBOW sign
+    next to each other, which share the torus grid search's candidates, om_scan_cache) are
+    solve_all's row by row: the same roots in the same order, bit for bit, and evaluations."""
+    solver = solver_of(name)
+    T = solver.arm.fk(random_q(solver.arm, 2, np.random.default_rng(8)))
+    branches = sorted((c.signs for c in solver.configurations()), key=lambda s: (s[1:], s[0]))
+    rows = [(t, s, x) for t in T for x in np.linspace(-np.pi, np.pi, 6, endpoint=False) for s in branches]
+    Ts, signs, redundancy = (np.array(column) for column in zip(*rows, strict=True))
+    batch = solver.solve_all_batch(Ts, signs, redundancy, threads=1)
+    assert (batch.count > 0).any()
+    _assert_rows_are_solve_all(solver, Ts, signs, redundancy, batch)
