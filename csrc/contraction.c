@@ -23,7 +23,7 @@
  * - the arm angle's reference frame A0 = (x_hat, n, x_hat x n), n = R(up -> x_hat) ref, turns at
  *   |d x_hat| / cos(theta / 2) (theta: the angle of x_hat from up; tight), |d x_hat| = |dx_t| /
  *   L, 2 cos^2(theta / 2) = 1 + up . x_hat >= 1 + up . x_hat_c - 2 rho / L_c: at a_t |dx_t|;
- *   A, A0 turned by psi about x_hat, turns with it. So R03 turns at most at a_t |dx_t| + turn3
+ *   A, which is A0 turned by psi about x_hat, turns with it. So R03 turns at most at a_t |dx_t| + turn3
  *   e4 |dL| <= w03 |dx|, w03 = hypot(a_t, turn3 e4) (Cauchy-Schwarz), and R04 at w04 |dx|, w04 =
  *   hypot(a_t, turn4 e4);
  * - an Euler triple Rz(phi_a) Rx(alpha_a) Rz(phi_b) Rx(beta) Rz(phi_c), alpha_a = +-90 deg, of a
@@ -39,6 +39,8 @@
  *
  * on any square whose points map into the ball (a segment between two of them does), and F(w) =
  * w - G(w) has |F_i(w) - F_i(c)| <= (1 + g_i rho) h on the cell of half-width h about c.
+ * A cell's bound is taken on the ball about x(c) of radius rho min(2 h, 2), which holds the
+ * square C' of half-width 2 h about c (the whole torus: the ball about c0 of radius rho).
  * - A cell where some |F_i(c)| exceeds that holds no root.
  * - Where lambda < 1 on a convex region, G has at most one fixed point there (|w - w'|_g <=
  *   lambda |w - w'|_g), and a square S of |.|_g-radius k about a point z lying in the region
