@@ -152,22 +152,28 @@ double om_g(om_problem *pb, double w, double *q, bool all_joints)
     return om_g_margin(pb, w, q, all_joints, NULL);
 }
 
+/* The model's hand position on the torus, p_m = p_d + a(w1) + R delta(w7) (not counted as an
+ * evaluation). */
+vec3 om_torus_point(const om_problem *pb, double w1, double w7)
+{
+    const double(*D)[3] = pb->s->D;
+    const mat3 *R = &pb->t.R;
+    vec3 p = pb->p;
+    double c1 = cos(w1), s1 = sin(w1);
+    vec3 d = om_delta(D, w7);
+    return v3(p.x + D[3][0] + D[4][0] * c1 + D[5][0] * s1 + R->r0.x * d.x + R->r0.y * d.y + R->r0.z * d.z,
+              p.y + D[3][1] + D[4][1] * c1 + D[5][1] * s1 + R->r1.x * d.x + R->r1.y * d.y + R->r1.z * d.z,
+              p.z + D[3][2] + D[4][2] * c1 + D[5][2] * s1 + R->r2.x * d.x + R->r2.y * d.y + R->r2.z * d.z);
+}
+
 /* The lifted residual (shoulder, wrist, elbow) at x = (w1, w7, phi4) for
  * p_m = p_d + a(w1) + R delta(w7) (see srs.model_ik_lifted); writes the model IK into q
  * unless q is NULL (the residual alone, cheaper: no joint angles). */
 vec3 om_lifted_residual(om_problem *pb, vec3 x, double *q)
 {
-    const om_solver_data *data = pb->s;
-    const double(*D)[3] = data->D;
-    const mat3 *R = &pb->t.R;
-    vec3 p = pb->p;
     pb->counter++;
-    double c1 = cos(x.x), s1 = sin(x.x);
-    vec3 d = om_delta(data->D, x.y);
-    vec3 pm = v3(p.x + D[3][0] + D[4][0] * c1 + D[5][0] * s1 + R->r0.x * d.x + R->r0.y * d.y + R->r0.z * d.z,
-                 p.y + D[3][1] + D[4][1] * c1 + D[5][1] * s1 + R->r1.x * d.x + R->r1.y * d.y + R->r1.z * d.z,
-                 p.z + D[3][2] + D[4][2] * c1 + D[5][2] * s1 + R->r2.x * d.x + R->r2.y * d.y + R->r2.z * d.z);
-    return om_srs_model_ik_lifted(data->params, &pb->t, pm, pb->signs, x.x, x.y, x.z, q);
+    vec3 pm = om_torus_point(pb, x.x, x.y);
+    return om_srs_model_ik_lifted(pb->s->params, &pb->t, pm, pb->signs, x.x, x.y, x.z, q);
 }
 
 /* The lifted residual times prod_k (1 + 1 / |x - x_k|^2) over the known roots x_k

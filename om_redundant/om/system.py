@@ -36,8 +36,14 @@ singularities, which is where roots crowd; lifted, Newton's method converges the
   small islands of reach, where roots come in close pairs, 1-D extremum searches find
   them. On the torus, a grid of the lifted residual seeds Newton's method, with deflation
   and a search along each root's fold direction for close pairs (``csrc/torus.c``);
-  this is a thorough search rather than a proof. Every candidate is verified with the REAL
-  arm's forward kinematics.
+  this is a thorough search rather than a proof. Before it, a certificate
+  (``csrc/contraction.c``) bounds how fast the model's q1 and q7 turn as the wrist centre
+  moves over the ball that holds the torus: where the map w -> (q1, q7) contracts (in a
+  weighted max norm), on the whole torus or on cells of it, Banach's theorem proves each
+  cell's root unique, found by iterating the map, and cells where the residual cannot
+  vanish are proved empty; only where it decides nothing (singular shoulder or wrist, the
+  edge of reach, psi's half-line, most Sawyer poses) does the grid search run. Every
+  candidate is verified with the REAL arm's forward kinematics.
 
 The kernels are C (``csrc/``, one file per idea: ``residual.c``, ``scalar.c`` (secant,
 regula falsi, Brent), ``circle.c``, ``torus.c``, ``verify.c``, ``search.c``, ``solve.c``),
