@@ -183,6 +183,12 @@ class OMSolver:
             self._kernel = ckernels.Solver(self.solver_data(), **types)
         self._check_solves_itself()
 
+    def __reduce__(self) -> tuple[Any, tuple[Any, ...]]:
+        """Pickled as its arm and options (the compiled kernel is rebuilt): for spawned
+        workers, Dask, Ray."""
+        position, orientation = self.tolerances
+        return (_rebuilt, (self.arm, position, orientation, self.scan_points))
+
     def solver_data(self) -> system.SolverData:
         """The fixed data of the compiled kernel (see :class:`~om_redundant.om.system.SolverData`):
         of the arm, or of its nominal arm for an arm near a family (:attr:`nominal`)."""
@@ -493,3 +499,13 @@ class OMSolver:
         if q_hint is None:
             return None
         return as_joint_vector(q_hint, self.arm.dof, "q_hint", stack=False)
+
+
+def _rebuilt(arm: Arm, position_tolerance: float, orientation_tolerance: float, scan_points: int) -> OMSolver:
+    """An :class:`OMSolver` unpickled (:meth:`OMSolver.__reduce__`)."""
+    return OMSolver(
+        arm,
+        position_tolerance=position_tolerance,
+        orientation_tolerance=orientation_tolerance,
+        scan_points=scan_points,
+    )

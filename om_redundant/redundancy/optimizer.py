@@ -233,6 +233,22 @@ class RedundancyOptimizer:
         # shoulder offsets (the torus): a batch's branches share their grid search
         self._shared_search = bool(np.any(solver.om.shoulder))
 
+    def __reduce__(self) -> tuple[Any, tuple[Any, ...]]:
+        """Pickled as its solver, clearance and options (the tracking step's state is rebuilt)."""
+        objective = self.objective
+        options = {
+            "margin_weight": objective.margin_weight,
+            "clearance_weight": objective.clearance_weight,
+            "singularity_weight": objective.singularity_weight,
+            "clearance_cap": objective.clearance_cap,
+            "min_clearance": objective.min_clearance,
+            "branches": self.branches,
+            "grid_points": self.grid_points,
+            "max_step": self.max_step,
+            "travel_weight": self.travel_weight,
+        }
+        return (_rebuilt, (self.solver, objective.clearance, options))
+
     @property
     def clearance(self) -> Clearance | None:
         """The obstacles' :class:`~om_redundant.Clearance` (None without obstacles)."""
@@ -647,6 +663,11 @@ class _StartBounds:
         for column in terms.T:
             total = total + column
         return np.minimum(values[:, 0], total)
+
+
+def _rebuilt(solver: OMSolver, clearance: Clearance | None, options: dict[str, Any]) -> RedundancyOptimizer:
+    """A :class:`RedundancyOptimizer` unpickled (:meth:`RedundancyOptimizer.__reduce__`)."""
+    return RedundancyOptimizer(solver, clearance, **options)
 
 
 def _failure(intervals: tuple[PsiInterval, ...], reason: str) -> RedundancyChoice:
