@@ -230,8 +230,8 @@ class Clearance:
         return self._evaluate(q, self.distmax, gradient=False)[0]
 
     def minimum(self, q: np.ndarray) -> float:
-        """The clearance D(q) = min_k d_k(q) in metres."""
-        return float(self.distances(q).min())
+        """The clearance D(q) = min_k d_k(q) in metres, of a joint vector q (dof,)."""
+        return float(self.distances(as_joint_vector(q, self._dof, stack=False)).min())
 
     def distances_and_gradients(self, q: np.ndarray, near: float = math.inf) -> tuple[np.ndarray, np.ndarray]:
         """d_k(q) and their gradients dd_k/dq (module docstring): (P,) and (P, dof) for a
