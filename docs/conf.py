@@ -2,6 +2,11 @@
 
 from __future__ import annotations
 
+import os
+from pathlib import Path
+
+from sphinx import addnodes
+
 import om_redundant
 
 project = "om_redundant"
@@ -34,3 +39,35 @@ autodoc_default_options = {"members": True, "show-inheritance": True}
 
 html_theme = "furo"
 html_title = f"om_redundant {release}"
+
+
+def _files_outside_the_site(app, doctree):
+    """A Markdown link to a file beside the site (``../benchmarks/results/paper.md``) is a
+    link to that file, as on GitHub, not to a page of the site: MyST would take it for a
+    missing page, so it becomes a download of the file, as links to other files do."""
+    env = app.env
+    here = Path(env.doc2path(env.docname)).parent
+    for node in list(doctree.findall(addnodes.pending_xref)):
+        target = node.get("reftarget", "")
+        if node.get("reftype") != "myst" or node.get("refdomain") != "doc" or target in env.found_docs:
+            continue
+        path = Path(target + ".md")
+        if not (path.is_absolute() and path.is_file()):
+            continue
+        link = addnodes.download_reference(
+            "",
+            "",
+            *node.children,
+            refdomain=None,
+            reftype="myst",
+            refexplicit=True,
+            reftarget=os.path.relpath(path, here),
+            refdoc=env.docname,
+            classes=["xref", "download", "myst"],
+        )
+        node.replace_self(link)
+
+
+def setup(app):
+    # Before Sphinx's collector of downloads reads the page (priority 500).
+    app.connect("doctree-read", _files_outside_the_site, priority=100)
