@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import os
+import sys
 from pathlib import Path
 
 from sphinx import addnodes
+from sphinx.pycode import ModuleAnalyzer, PycodeError
 
 import om_redundant
 
@@ -68,6 +70,23 @@ def _files_outside_the_site(app, doctree):
         node.replace_self(link)
 
 
+def _constant_docs(app, what, name, obj, options, lines):
+    """A constant the package root re-exports (``om_redundant.BRANCH_BAND``) takes the ``#:``
+    comment of the module that defines it, not the docstring of ``float``."""
+    if what != "data" or not name.startswith("om_redundant."):
+        return
+    short = name.rsplit(".", 1)[1]
+    for module in sorted(m for m in sys.modules if m.startswith("om_redundant.")):
+        try:
+            docs = ModuleAnalyzer.for_module(module).find_attr_docs()
+        except PycodeError:
+            continue
+        if ("", short) in docs:
+            lines[:] = [line for line in docs[("", short)] if line]
+            return
+
+
 def setup(app):
+    app.connect("autodoc-process-docstring", _constant_docs)
     # Before Sphinx's collector of downloads reads the page (priority 500).
     app.connect("doctree-read", _files_outside_the_site, priority=100)

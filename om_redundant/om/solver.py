@@ -32,7 +32,7 @@ from .nominal import NominalArm, closed_form
 DEFAULT_POSITION_TOLERANCE = 1e-10
 DEFAULT_ORIENTATION_TOLERANCE = 1e-10
 DEFAULT_SCAN_POINTS = 64
-#: |branch quantity| within which a joint vector belongs to both neighbouring configurations
+#: ``|branch quantity|`` within which a joint vector belongs to both neighbouring configurations
 #: (the singular boundary's band; see :meth:`OMSolver.holds`).
 BRANCH_BAND: float = ckernels.BRANCH_BAND
 #: Seeded random joint vectors within the limits whose poses a new solver must solve.
