@@ -256,7 +256,7 @@ class RedundancyOptimizer:
 
     @property
     def min_clearance(self) -> float:
-        """d_min (m): the clearance every choice keeps."""
+        """The clearance every choice keeps, d_min (m)."""
         return self.objective.min_clearance
 
     def intervals(self, T: Any) -> list[PsiInterval]:
