@@ -55,7 +55,10 @@ def run(name: str, count: int, poses: int, seed: int) -> tuple[list[dict], np.nd
     solver = om.OMSolver(name)
     rng = np.random.default_rng(seed)
     choices, cpus, walls = [], [], []
-    for q in rng.uniform(solver.arm.lower, solver.arm.upper, (poses, solver.arm.dof)):
+    span = np.where(solver.arm.revolute, np.pi, 1.0)  # an unlimited joint (the Gen3's) within +-pi
+    lower = np.where(np.isfinite(solver.arm.lower), solver.arm.lower, -span)
+    upper = np.where(np.isfinite(solver.arm.upper), solver.arm.upper, span)
+    for q in rng.uniform(lower, upper, (poses, solver.arm.dof)):
         T = solver.arm.fk(q)
         optimizer = om.RedundancyOptimizer(
             solver, obstacles(T[:3, 3], count) or None, min_clearance=MIN_CLEARANCE

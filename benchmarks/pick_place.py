@@ -50,9 +50,9 @@ GAIN = 0.5
 VELOCITY = 2.0  # rad/s, every joint
 BALL = dict(centre=np.array([0.45, 0.0, 0.72]), amplitude=0.3, period=10.0, radius=0.05)
 POLE = ([0.2, 0.45, 0.0], [0.2, 0.45, 0.9], 0.03)
-TABLE = dict(pos=[0.6, 0.0, -0.025], size=[0.3, 0.6, 0.025])
+TABLE = dict(pos=[0.6, 0.0, -0.02], size=[0.3, 0.6, 0.04])  # its top 2 cm above the floor
 GRASP, ABOVE = 0.15, 0.32  # m: flange heights at and above a pick or place
-CAMERA = dict(lookat=[0.45, 0.0, 0.3], distance=2.0, azimuth=140.0, elevation=-20.0)
+CAMERA = dict(lookat=[0.4, 0.0, 0.35], distance=1.7, azimuth=145.0, elevation=-22.0)
 
 
 def scene(arm: om.Arm) -> mujoco.MjModel:
@@ -292,7 +292,7 @@ def video(name: str, poses: list[np.ndarray], q_start: np.ndarray, file: Path, f
     ball, target = model.body("ball").mocapid[0], model.body("target").mocapid[0]
     every = max(1, round(RATE / fps))
     file.parent.mkdir(parents=True, exist_ok=True)
-    with mujoco.Renderer(model, 360, 480) as renderer, imageio.get_writer(file, fps=fps) as writer:
+    with mujoco.Renderer(model, 480, 640) as renderer, imageio.get_writer(file, fps=fps) as writer:
         for q, T, centre in log[::every]:
             data.qpos[: len(q)] = q
             data.mocap_pos[ball], data.mocap_pos[target] = centre, T[:3, 3]

@@ -253,6 +253,9 @@ typedef struct {
      * singular joint pair where that split is arbitrary (false: the hinted local part alone,
      * om_solve_near, whose model takes the split from its hint) */
     bool split_starts;
+    /* whether the torus search takes the certificate's roots where it proves them
+     * (contraction.c; false: the grid search, always) */
+    bool certify;
     /* the model's parts at the circle scan's samples, which the problem's scans (its own, its
      * neighbours') take from the scans before them and keep for those after (NULL: none) */
     om_scan_memo *memo;
@@ -328,6 +331,8 @@ bool om_srs_reach_possible(om_problem *pb, om_reach_bound *bound, double a, doub
 /* S-R-S: W(w) - S = e + u1 cos w + u2 sin w on the circle. */
 void om_srs_wrist_circle(const om_problem *pb, vec3 *e, vec3 *u1, vec3 *u2);
 bool om_margin_may_reach(const double *ms, int i, int count, bool cyclic);
+/* The model's hand position at the torus point (w1, w7) (not counted as an evaluation). */
+vec3 om_torus_point(const om_problem *pb, double w1, double w7);
 vec3 om_lifted_residual(om_problem *pb, vec3 x, double *q);
 vec3 om_deflated_residual(om_problem *pb, vec3 x, double *q, const double *known, int n_known); /* known: n x 3 */
 double om_max_norm(vec3 F);
@@ -363,7 +368,35 @@ int om_wrist_offset_candidates(om_problem *pb, double lo, double hi, bool full_c
 /* torus.c */
 double om_newton(om_problem *pb, vec3 x, double *q, const double *known, int n_known, vec3 *x_end);
 double om_lifted_solve(om_problem *pb, const double *start, double *q);
-int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, double radius);
+/* The candidates a torus search hands to verification, in order: q (dof each) of the first cap
+ * of them, count in all (beyond cap: not all kept). */
+typedef struct {
+    double *q;
+    int cap, count;
+} om_candidate_log;
+int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, double radius, om_candidate_log *log);
+/* contraction.c: bounds g1, g7 on the rates of q1 and q7 of the model IK per unit of the
+ * shoulder-wrist vector x over the ball of radius rho about that of the hand position p (inf
+ * where there is none: a singular shoulder or wrist, the edge of reach, psi's half-line), so
+ * that G(w) = (q1, q7) at the torus points w whose x lies in the ball has |dG_i| <= g_i |dx|;
+ * and whether the model reaches no point of that ball. q gets the model IK at p where the
+ * elbow can be bounded (else NaN as it was). */
+typedef struct {
+    double g1, g7;
+    bool unreachable;
+} om_torus_bound;
+om_torus_bound om_torus_bound_on(om_problem *pb, vec3 p, double rho, double *q);
+/* The bound on the square C' of half-width 2 h about the torus point (w1, w7), which holds
+ * the cell of half-width h there (its ball: radius (r_a + r_d) min(2 h, 2) about x(w1, w7);
+ * q: the model IK there, G's value); h >= pi: on the whole torus (the ball of radius r_a + r_d
+ * that holds it; q: the model IK at its centre). */
+om_torus_bound om_torus_cell_bound(om_problem *pb, double w1, double w7, double h, double *q);
+/* Where the bounds prove them (cells of the torus without a root, or with exactly one, where G
+ * contracts: found and verified), every root of the configuration whose (q1, q7) lies within
+ * radius of the centre's (radius >= pi / 4: on the whole torus, a superset) into roots, the
+ * count into *count, on an arm whose offsets are small against it; returns whether it did
+ * (false: the grid search decides). */
+bool om_torus_certified_roots(om_problem *pb, double *roots, int *count, const double *centre, double radius);
 /* x = W - S of the model on the torus less its parts that turn with w1 and w7:
  * p_d + R w_F - S + D3 + R D0 (x = it + D4 cos w1 + D5 sin w1 + R (D1 cos w7 + D2 sin w7)). */
 vec3 om_shoulder_wrist_centre(const om_problem *pb);
@@ -409,12 +442,14 @@ double om_polish(const om_polish_task *t, int iterations, double *q);
  * memo (circle.c), for the next scan of the same pose in the same ELBOW sign. On an S-R-S arm
  * whose dp turns with q7 the circle residual g(w) is the model's q7 less w, and q7 does not
  * depend on the SHOULDER sign (srs.c, q7_with_elbow): the scan, its brackets and refinements
- * are the same, only the joints that each candidate becomes differ. The gate depends on the
+ * are the same, only the joints that each candidate becomes differ. On the torus the grid
+ * search's candidates (joint vectors, dof each) are shared by the problems that differ in the
+ * SHOULDER and WRIST signs alone (the lifted residual reads neither). The gate depends on the
  * pose alone. */
 typedef struct {
     bool valid;
     double key[OM_SCAN_KEY];  /* the target, psi, the other signs, q_prev, the scan points */
-    int count;                /* candidates */
+    int count;                /* candidates (on the torus: joint vectors) */
     int64_t evaluations;      /* the residual evaluations they took */
     double q[OM_MAX_DOF];     /* the scratch joints as the search left them */
     double *candidates;       /* capacity of them */
@@ -486,6 +521,11 @@ typedef struct {
 } om_result;
 
 void om_flange_target(const double *T, const double *T_base_root, const double *T_tool_flange, mat3 *R, vec3 *p);
+/* The problem of one solve: the target T, the branch signs, the redundancy values reduced
+ * into reduced (n_redundancy; it must outlive the problem), joints kept at singularities
+ * from q_prev. */
+void om_problem_init(om_problem *pb, const om_solver_data *s, const double *T, const int64_t *signs,
+                     const double *redundancy, double *reduced, const double *q_prev);
 /* What a caller makes of a root: scan for a nearer one, take it as it is, or reject it and
  * every root at most as near the hint. */
 typedef enum { OM_ROOT_SCAN = 0, OM_ROOT_TAKE = 1, OM_ROOT_REJECT = 2 } om_root_verdict;

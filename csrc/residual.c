@@ -207,6 +207,20 @@ double om_g(om_problem *pb, double w, double *q, bool all_joints)
     return om_g_margin(pb, w, q, all_joints, NULL);
 }
 
+/* The model's hand position on the torus, p_m = p_d + a(w1) + R delta(w7) (not counted as an
+ * evaluation). */
+vec3 om_torus_point(const om_problem *pb, double w1, double w7)
+{
+    const double(*D)[3] = pb->s->D;
+    const mat3 *R = &pb->t.R;
+    vec3 p = pb->p;
+    double c1 = cos(w1), s1 = sin(w1);
+    vec3 d = om_delta(D, w7);
+    return v3(p.x + D[3][0] + D[4][0] * c1 + D[5][0] * s1 + R->r0.x * d.x + R->r0.y * d.y + R->r0.z * d.z,
+              p.y + D[3][1] + D[4][1] * c1 + D[5][1] * s1 + R->r1.x * d.x + R->r1.y * d.y + R->r1.z * d.z,
+              p.z + D[3][2] + D[4][2] * c1 + D[5][2] * s1 + R->r2.x * d.x + R->r2.y * d.y + R->r2.z * d.z);
+}
+
 /* What om_lifted_residual solves: the point x = (w1, w7, phi4), and the residual there (out). */
 typedef struct {
     vec3 x, F;
@@ -217,19 +231,11 @@ typedef struct {
  * joint written); nearest is never asked. */
 static double _lifted_ik(om_problem *pb, const void *args, double *q, bool nearest, double *residual)
 {
-    const om_solver_data *data = pb->s;
     lifted_ik *a = (lifted_ik *)args;
     vec3 x = a->x;
-    const double(*D)[3] = data->D;
-    const mat3 *R = &pb->t.R;
-    vec3 p = pb->p;
     pb->counter++;
-    double c1 = cos(x.x), s1 = sin(x.x);
-    vec3 d = om_delta(data->D, x.y);
-    vec3 pm = v3(p.x + D[3][0] + D[4][0] * c1 + D[5][0] * s1 + R->r0.x * d.x + R->r0.y * d.y + R->r0.z * d.z,
-                 p.y + D[3][1] + D[4][1] * c1 + D[5][1] * s1 + R->r1.x * d.x + R->r1.y * d.y + R->r1.z * d.z,
-                 p.z + D[3][2] + D[4][2] * c1 + D[5][2] * s1 + R->r2.x * d.x + R->r2.y * d.y + R->r2.z * d.z);
-    a->F = om_srs_model_ik_lifted(data->params, &pb->t, pm, pb->signs, x.x, x.y, x.z, q);
+    vec3 pm = om_torus_point(pb, x.x, x.y);
+    a->F = om_srs_model_ik_lifted(pb->s->params, &pb->t, pm, pb->signs, x.x, x.y, x.z, q);
     *residual = om_max_norm(a->F);
     return isnan(a->F.x) ? NAN : 0.0;
 }

@@ -39,8 +39,9 @@ static int _circle_roots(om_problem *pb, const double *cands, int n, double *q, 
     return count;
 }
 
-/* What the circle's candidates of the problem depend on, but for its SHOULDER sign (om_scan_cache). */
-static void _scan_key(const om_problem *pb, int n_scan, double *key)
+/* What the circle's candidates of the problem depend on, but for its SHOULDER sign (and, with
+ * wrist false, its WRIST sign: the torus search's; om_scan_cache). */
+static void _scan_key(const om_problem *pb, int n_scan, bool wrist, double *key)
 {
     const mat3 *R = &pb->t.R;
     const vec3 rows[3] = {R->r0, R->r1, R->r2};
@@ -49,10 +50,46 @@ static void _scan_key(const om_problem *pb, int n_scan, double *key)
     for (int i = 0; i < 3; i++)
         *k++ = rows[i].x, *k++ = rows[i].y, *k++ = rows[i].z;
     *k++ = pb->t.psi;
-    *k++ = (double)pb->signs[1], *k++ = (double)pb->signs[2];
+    *k++ = (double)pb->signs[1], *k++ = wrist ? (double)pb->signs[2] : 0.0;
     for (int j = 0; j < OM_MAX_DOF; j++)
         *k++ = j < pb->s->dof ? pb->q_prev[j] : 0.0;
     *k = (double)n_scan;
+}
+
+/* The torus grid's nodes a side for n_scan scan points. */
+static int _torus_side(int n_scan)
+{
+    int side = (int)(TORUS_SIDE * (double)n_scan);
+    return side > 4 ? side : 4;
+}
+
+/* The torus grid search of the whole torus (om_torus_roots), its candidates taken from cache
+ * where it holds this problem's, else searched and kept there: they are those of every
+ * problem that differs in the SHOULDER and WRIST signs alone (torus.c, _candidate), and only
+ * their verification, which refines and filters each in the problem's configuration, is the
+ * problem's own. The same roots, in the same order, and evaluations, as the search. */
+static int _torus_roots_cached(om_problem *pb, int n_scan, double *roots, om_scan_cache *cache)
+{
+    int dof = pb->s->dof, count = 0;
+    double key[OM_SCAN_KEY], zeros[OM_MAX_DOF] = {0.0};
+    _scan_key(pb, n_scan, false, key);
+    if (cache->valid && memcmp(key, cache->key, sizeof key) == 0) {
+        pb->counter += cache->evaluations;
+        for (int k = 0; k < cache->count; k++) {
+            double q[OM_MAX_DOF];
+            memcpy(q, cache->candidates + (size_t)dof * (size_t)k, (size_t)dof * sizeof(double));
+            count = om_add_candidate(pb, q, roots, count);
+        }
+        return count;
+    }
+    om_candidate_log log = {cache->candidates, cache->capacity / dof, 0};
+    int64_t before = pb->counter;
+    count = om_torus_roots(pb, _torus_side(n_scan), roots, zeros, INFINITY, &log);
+    cache->valid = log.count <= log.cap; /* else not all kept */
+    cache->count = log.count;
+    cache->evaluations = pb->counter - before;
+    memcpy(cache->key, key, sizeof key);
+    return count;
 }
 
 /* Bounded search: every verified solution in this configuration into roots (OM_MAX_ROOTS x
@@ -68,8 +105,10 @@ int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre
         return isnan(gw) ? 0 : om_add_candidate(pb, q, roots, 0);
     }
     if (data->mode == OM_TORUS) {
-        int side = (int)(TORUS_SIDE * (double)n_scan);
-        return om_torus_roots(pb, side > 4 ? side : 4, roots, centre, radius);
+        int count;
+        if (pb->certify && om_torus_certified_roots(pb, roots, &count, centre, radius))
+            return count;
+        return om_torus_roots(pb, _torus_side(n_scan), roots, centre, radius, NULL);
     }
     int J = data->dp_joint, cap = OM_SCAN_CAPACITY(n_scan);
     double *cands = malloc((size_t)cap * sizeof(double));
@@ -92,13 +131,18 @@ int om_all_roots_cached(om_problem *pb, int n_scan, double *roots, om_scan_cache
 {
     const om_solver_data *data = pb->s;
     double zeros[OM_MAX_DOF] = {0.0};
-    /* (an arm near a family: its model side moves with the correction, which differs between the
-     * SHOULDER signs) */
+    int count;
+    /* (an arm near a family shares no search between signs: its corrected target moves with
+     * the joints the signs choose) */
+    if (cache && data->mode == OM_TORUS && !data->nominal_table)
+        return pb->certify && om_torus_certified_roots(pb, roots, &count, zeros, INFINITY)
+                   ? count
+                   : _torus_roots_cached(pb, n_scan, roots, cache);
     if (!cache || data->mode != OM_CIRCLE || data->family != OM_SRS || data->dp_joint != 6 || data->nominal_table ||
         OM_SCAN_CAPACITY(n_scan) > cache->capacity)
         return om_all_roots(pb, n_scan, roots, zeros, INFINITY);
     double key[OM_SCAN_KEY], q[OM_MAX_DOF];
-    _scan_key(pb, n_scan, key);
+    _scan_key(pb, n_scan, true, key);
     if (cache->valid && memcmp(key, cache->key, sizeof key) == 0) {
         pb->counter += cache->evaluations;
         memcpy(q, cache->q, sizeof q);

@@ -99,10 +99,8 @@ static om_result _result(int status, double pos, double ori, int64_t evaluations
     return result;
 }
 
-/* The problem of one solve: the target T (with the per-target constants of the model's
- * closed form), the branch signs, the redundancy values reduced into reduced (n_redundancy;
- * it must outlive the problem), joints kept at singularities from q_prev. */
-static void _problem(om_problem *pb, const om_solver_data *s, const double *T, const int64_t *signs,
+/* (om_kernels.h) */
+void om_problem_init(om_problem *pb, const om_solver_data *s, const double *T, const int64_t *signs,
                      const double *redundancy, double *reduced, const double *q_prev)
 {
     pb->s = s;
@@ -116,6 +114,7 @@ static void _problem(om_problem *pb, const om_solver_data *s, const double *T, c
     pb->q_prev = q_prev;
     pb->counter = 0;
     pb->split_starts = true;
+    pb->certify = !s->nominal_table; /* (the certificate's bounds are the model's at the target, not G's) */
     pb->memo = NULL;
     pb->nominal = false;
     pb->wrist = false;
@@ -164,7 +163,7 @@ static om_result _solve(const om_solver_data *s, const double *T, const int64_t 
     hint = has_hint ? usable : zeros; /* zeros: what the Python side passes without a hint */
     om_problem problem;
     double psi[1];
-    _problem(&problem, s, T, signs, redundancy, psi, hint);
+    om_problem_init(&problem, s, T, signs, redundancy, psi, hint);
     problem.split_starts = search;
     om_problem *pb = &problem;
     double q[OM_MAX_DOF], start[OM_MAX_DOF];
@@ -326,7 +325,7 @@ int om_solve_all(const om_solver_data *s, const double *T, const int64_t *signs,
     int dof = s->dof;
     double psi[1];
     om_problem problem;
-    _problem(&problem, s, T, signs, redundancy, psi, zeros);
+    om_problem_init(&problem, s, T, signs, redundancy, psi, zeros);
     problem.memo = cache ? cache->memo : NULL;
     int n = om_all_roots_cached(&problem, s->scan_points, roots, cache);
     bool neighbour_reached, complete = true;

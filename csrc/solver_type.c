@@ -282,6 +282,56 @@ static PyObject *Solver_solve_all(Solver *self, PyObject *const *args, Py_ssize_
     return Py_BuildValue("(iL)", n, (long long)evaluations);
 }
 
+/* bounded_search(T, signs, redundancy, roots, certify) -> (count, evaluations): the bounded
+ * search's roots of a configuration (om_all_roots on the whole circle or torus; roots
+ * (MAX_ROOTS, dof), as found, in the arm's own joints), with the torus certificate where it
+ * proves them (certify) or the grid search alone: what the tests compare. */
+static PyObject *Solver_bounded_search(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
+    const om_solver_data *s = &self->data;
+    configuration c;
+    if (get_call(s, args, nargs, 5, "bounded_search", &c) < 0) return NULL;
+    int certify = PyObject_IsTrue(args[4]);
+    if (certify < 0) return NULL;
+    PyObject *objs[2] = {args[0], args[3]};
+    buffer_spec specs[2] = {{F64, 16, 0, "T"}, {F64, OM_MAX_ROOTS * s->dof, 1, "roots"}};
+    Py_buffer v[2];
+    if (get_buffers(objs, v, specs, 2) < 0) return NULL;
+    double zeros[OM_MAX_DOF] = {0.0}, psi[1];
+    om_problem pb;
+    int n;
+    Py_BEGIN_ALLOW_THREADS om_problem_init(&pb, s, v[0].buf, c.signs, c.redundancy, psi, zeros);
+    pb.certify = certify && pb.certify; /* (never for an arm near a family: om_problem_init) */
+    n = om_all_roots(&pb, s->scan_points, v[1].buf, zeros, INFINITY);
+    for (int r = 0; r < n && s->flipped; r++)
+        om_flip(s, (double *)v[1].buf + r * s->dof, (double *)v[1].buf + r * s->dof);
+    Py_END_ALLOW_THREADS release_buffers(v, 2);
+    return Py_BuildValue("(iL)", n, (long long)pb.counter);
+}
+
+/* torus_bound(T, signs, redundancy, w1, w7, h) -> (g1, g7, unreachable, (q1, q7)):
+ * om_torus_cell_bound for the configuration (an arm whose search is on the torus), what its
+ * tests check against the map itself. */
+static PyObject *Solver_torus_bound(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
+    const om_solver_data *s = &self->data;
+    configuration c;
+    if (get_call(s, args, nargs, 6, "torus_bound", &c) < 0) return NULL;
+    double w1 = PyFloat_AsDouble(args[3]), w7 = PyFloat_AsDouble(args[4]), h = PyFloat_AsDouble(args[5]);
+    if (PyErr_Occurred()) return NULL;
+    if (s->mode != OM_TORUS) {
+        PyErr_SetString(PyExc_ValueError, "torus_bound: the arm's search is not on the torus");
+        return NULL;
+    }
+    Py_buffer T;
+    if (get_buffer(args[0], &T, F64, 16, 0, "T") < 0) return NULL;
+    double zeros[OM_MAX_DOF] = {0.0}, q[OM_MAX_DOF] = {NAN}, psi[1];
+    q[6] = NAN;
+    om_problem pb;
+    om_problem_init(&pb, s, T.buf, c.signs, c.redundancy, psi, zeros);
+    om_torus_bound b = om_torus_cell_bound(&pb, w1, w7, h, q);
+    PyBuffer_Release(&T);
+    return Py_BuildValue("(ddO(dd))", b.g1, b.g7, b.unreachable ? Py_True : Py_False, q[0], q[6]);
+}
+
 /* configuration_values(q, branch, redundancy): the branch quantities and redundancy values at q. */
 static PyObject *Solver_configuration_values(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
     if (check_nargs(nargs, 3, "configuration_values") < 0) return NULL;
@@ -319,6 +369,10 @@ static PyMethodDef Solver_methods[] = {
     {"solve_all", (PyCFunction)(void (*)(void))Solver_solve_all, METH_FASTCALL, "Every root in a configuration."},
     {"configuration_values", (PyCFunction)(void (*)(void))Solver_configuration_values, METH_FASTCALL,
      "Branch quantities and redundancy values at q."},
+    {"bounded_search", (PyCFunction)(void (*)(void))Solver_bounded_search, METH_FASTCALL,
+     "The bounded search's roots of a configuration, with or without the torus certificate."},
+    {"torus_bound", (PyCFunction)(void (*)(void))Solver_torus_bound, METH_FASTCALL,
+     "The torus map's rate bounds on a cell (om_torus_cell_bound)."},
     {"holds", (PyCFunction)(void (*)(void))Solver_holds, METH_FASTCALL, "Whether q is in a configuration (band)."},
     {NULL, NULL, 0, NULL},
 };

@@ -327,12 +327,29 @@ static int _half_line_points(om_problem *pb, double lo1, double lo7, double step
     return count;
 }
 
+/* om_add_candidate of a copy of q, logged (log not NULL): the search's q stays as Newton left
+ * it, whatever the verification's refinement, which depends on the configuration's signs,
+ * makes of the copy. So the candidates, in order, are those of every configuration that
+ * differs in the SHOULDER and WRIST signs alone (om_srs_model_ik_lifted does not read them). */
+static int _candidate(om_problem *pb, const double *q, double *roots, int count, om_candidate_log *log)
+{
+    double candidate[OM_MAX_DOF];
+    memcpy(candidate, q, sizeof candidate);
+    if (log) {
+        int dof = pb->s->dof;
+        if (log->count < log->cap)
+            memcpy(log->q + (size_t)dof * (size_t)log->count, q, (size_t)dof * sizeof(double));
+        log->count++;
+    }
+    return om_add_candidate(pb, candidate, roots, count);
+}
+
 /* Roots next to the points of psi's half-line in the grid's square (_half_line_points):
  * Newton in each point's chart from LINE_SEEDS directions at r = LINE_START; an end whose
  * lifted residual is below LINE_ROOT (its rounding there is about 1e-16 / rho) is a candidate,
- * refined on the real arm and verified (om_add_candidate). Returns the root count. */
+ * refined on the real arm and verified (_candidate). Returns the root count. */
 static int _half_line_roots(om_problem *pb, double lo1, double lo7, double step, int m, double *q, double *roots,
-                            int count)
+                            int count, om_candidate_log *log)
 {
     half_line_chart charts[LINE_POINTS];
     int n = _half_line_points(pb, lo1, lo7, step, m, charts);
@@ -351,7 +368,7 @@ static int _half_line_roots(om_problem *pb, double lo1, double lo7, double step,
             if (seen)
                 continue;
             ends[n_ends++] = end;
-            count = om_add_candidate(pb, q, roots, count);
+            count = _candidate(pb, q, roots, count, log);
         }
     }
     return count;
@@ -362,8 +379,9 @@ static int _half_line_roots(om_problem *pb, double lo1, double lo7, double step,
  * the centre's (q1, q7) when radius < pi); Newton starts from local minima of its norm and
  * from cells where the shoulder and wrist residuals change sign, with deflation and fold
  * partners; and around the points of psi's singular half-line, where the lifted residual
- * turns about a point, in their charts (_half_line_roots). */
-int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, double radius)
+ * turns about a point, in their charts (_half_line_roots). The candidates go to verification
+ * in order, into log too (NULL: none). */
+int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, double radius, om_candidate_log *log)
 {
     double q[OM_MAX_DOF];
     nan_fill(q, OM_MAX_DOF); /* read as E where W = S at the first node: NaN */
@@ -432,13 +450,13 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
                 }
                 if (n_known == first)
                     continue;
-                count = om_add_candidate(pb, q, roots, count);
+                count = _candidate(pb, q, roots, count, log);
                 while (n_known < MAX_KNOWN) { /* deflated, from the same start */
                     int found = n_known;
                     n_known = _new_root(pb, x, true, &known, n_known, q);
                     if (n_known == found)
                         break;
-                    count = om_add_candidate(pb, q, roots, count);
+                    count = _candidate(pb, q, roots, count, log);
                 }
                 int k = first;
                 while (k < n_known && n_known < MAX_KNOWN) {
@@ -453,13 +471,13 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
                             n_known = _new_root(pb, halfway, true, &known, n_known, q);
                         }
                         if (n_known > found)
-                            count = om_add_candidate(pb, q, roots, count);
+                            count = _candidate(pb, q, roots, count, log);
                     }
                 }
             }
         }
     }
-    count = _half_line_roots(pb, lo1, lo7, step, m, q, roots, count);
+    count = _half_line_roots(pb, lo1, lo7, step, m, q, roots, count, log);
     free(S);
     free(known.x);
     return count;

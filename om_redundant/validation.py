@@ -304,7 +304,7 @@ def as_redundancy(
     """
     if values is None and rows is not None and not names:
         return np.zeros((rows, 0))
-    if rows is None and _plain(values, _REALS) and all(math.isfinite(x) for x in values):
+    if rows is None and _plain(values, _REALS) and all(_finite(x) for x in values):
         return np.array(values, dtype=np.float64)  # the common case, fast: a tuple of finite floats
     if rows is None:
         expected = "a sequence of real numbers"
@@ -338,6 +338,14 @@ def as_redundancy(
         row, col = np.argwhere(bad)[0]
         raise InvalidInput(f"{name} value {names[col]} is {array[row, col]} in row {row}")
     return array
+
+
+def _finite(x: int | float) -> bool:
+    """Whether a real number is finite as a float (an int beyond the float range is not)."""
+    try:
+        return math.isfinite(x)
+    except OverflowError:
+        return False
 
 
 def as_vector(value: Any, size: int, name: str) -> np.ndarray:

@@ -24,7 +24,7 @@ from om_redundant.redundancy.objective import Group
 
 # The suite's property tests draw the same examples on every run, so that CI answers for the
 # code and not for the draw; HYPOTHESIS_PROFILE=explore draws new ones (run it to hunt bugs:
-# the known gaps it can find are listed under "Status" in the README).
+# the known gaps it can find are listed in docs/status.md).
 settings.register_profile("repeatable", derandomize=True)
 settings.register_profile("explore", derandomize=False)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "repeatable"))

@@ -48,7 +48,7 @@ def test_the_two_variable_step_is_the_models_maximiser(seed, pieces, curvature, 
     """A delta within the box and (to OSQP's tolerance) the floors, whose model value no point
     of a 401 x 401 grid of the box that keeps the floors beats (where OSQP certifies its
     solution: about 1 % of random problems end at its iteration limit, a known gap listed in
-    the README's Status); the gain it reports is the model's from delta = 0; multipliers >= 0
+    docs/status.md); the gain it reports is the model's from delta = 0; multipliers >= 0
     that sum to w_g per group where neither its floor nor its cap holds it."""
     rng = np.random.default_rng(seed)
     groups = _groups(rng, pieces, 2)

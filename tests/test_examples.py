@@ -1,4 +1,5 @@
-"""The examples, the README's snippets and the paper's experiment run as a user would run them."""
+"""The examples, the snippets of the README and the documentation, and the paper's experiment run as
+a user would run them."""
 
 from __future__ import annotations
 
@@ -18,12 +19,58 @@ def test_paper_benchmark_small_run():
     assert "| converged | 100.000 % | 100 % |" in result.table()
 
 
-def test_readme_snippets_run():
-    text = (ROOT / "README.md").read_text()
-    blocks = re.findall(r"```python\n(.*?)```", text, flags=re.S)
-    assert blocks
-    for block in blocks:
-        exec(compile(block, "README.md", "exec"), {})
+#: The pages whose ```python blocks run as tests: the README and the documentation site's.
+PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+#: A block the tests do not run carries this comment on the line above its fence, with the
+#: reason: <!-- not run: needs a display -->.
+NOT_RUN = re.compile(r"<!--\s*not run:\s*(.*?)\s*-->")
+
+
+def python_blocks(page):
+    """The page's ```python blocks: (first line, code, the reason it is not run or None)."""
+    lines = page.read_text().splitlines()
+    blocks, i = [], 0
+    while i < len(lines):
+        if lines[i].strip() == "```python":
+            start = i
+            end = lines.index("```", i + 1)
+            above = NOT_RUN.fullmatch(lines[start - 1].strip()) if start else None
+            blocks.append((start + 1, "\n".join(lines[start + 1 : end]) + "\n", above and above.group(1)))
+            i = end
+        i += 1
+    return blocks
+
+
+BLOCKS = [(page, *block) for page in PAGES for block in python_blocks(page)]
+
+
+def test_the_readme_and_the_guide_have_snippets():
+    pages = {page.name for page, *_ in BLOCKS}
+    assert {"README.md", "getting-started.md", "mink.md", "arm-angle.md", "arms.md"} <= pages
+
+
+@pytest.mark.parametrize(
+    "page, line, code, not_run", BLOCKS, ids=[f"{p.relative_to(ROOT)}:{n}" for p, n, *_ in BLOCKS]
+)
+def test_page_snippet_runs(page, line, code, not_run):
+    """Every ```python block of the README and of docs/ runs as written, each on its own."""
+    if not_run:
+        pytest.skip(not_run)
+    exec(compile("\n" * line + code, str(page.relative_to(ROOT)), "exec"), {"__name__": "__snippet__"})
+
+
+def test_readme_is_short():
+    """The README is the front page (what, install, a first example, the mink loop, where to
+    read on); the rest lives in docs/."""
+    assert len((ROOT / "README.md").read_text().splitlines()) <= 300
+
+
+def test_the_api_reference_names_every_public_name():
+    import om_redundant
+
+    text = (ROOT / "docs" / "api.md").read_text()
+    documented = set(re.findall(r"^\.\. auto\w+:: om_redundant\.(\w+)$", text, flags=re.M))
+    assert documented == set(om_redundant.__all__)
 
 
 SCRIPTS = sorted(p for p in (ROOT / "examples").glob("*.py") if not p.name.startswith("_"))

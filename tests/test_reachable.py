@@ -109,3 +109,23 @@ def test_nearest_turns_are_whole_turns_within_the_limits(seed):
     for other in (moved - 2.0 * math.pi, moved + 2.0 * math.pi):
         inside = (other >= arm.lower) & (other <= arm.upper)
         assert (np.abs(moved - q_from) <= np.abs(other - q_from) + 1e-9)[inside].all()
+
+
+def test_a_grid_sample_at_a_fold_ends_the_paths_beside_it():
+    """A Sawyer pose whose sweep of branch (1, -1, -1) meets a solution exactly where psi does
+    not move along the self-motion (its elbow folded at q4 = -pi, at a grid psi): the sample
+    is left out, as a fold between samples is, and the fresh choice is made (it raised
+    SingularSelfMotion out of the task's tick before)."""
+    sawyer = om.OMSolver("sawyer")
+    optimizer = om.RedundancyOptimizer(sawyer, OBSTACLES, min_clearance=MIN_CLEARANCE, max_step=0.005)
+    T = sawyer.arm.fk(np.array([1.1668707874753528, 1.7442127842504407, 1.9643459663071914,
+                                -1.9538021705322535, 1.4774805301385858, -2.4601554285576186,
+                                -0.6987901064769053]))  # fmt: skip
+    q_now = np.array([1.3362565136768723, -2.1003733675248952, -0.11754343633286402, -0.5780018957777315,
+                      0.5117865081418325, 0.6578403675600484, 1.584364297195715])  # fmt: skip
+    previous = optimizer.choose(sawyer.arm.fk(q_now), q_current=q_now)
+    assert previous.ok and previous.configuration.signs == (1, -1, -1)
+    choice = optimizer.choose(T, previous, q_current=q_now)
+    assert choice.ok == bool(optimizer.intervals(T))
+    if choice.ok:
+        assert exact(sawyer, choice.solution.q, T)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import mink
@@ -465,3 +466,24 @@ def test_any_malformed_number_raises_invalid_input(value):
             continue
         number = isinstance(value, int | float | np.integer) and not isinstance(value, bool)
         assert number and math.isfinite(value)
+
+
+def test_stray_exceptions_of_odd_values_are_named():
+    """Values that reached numpy or MuJoCo unchecked: each now an InvalidInput naming it."""
+    arm = om.load_arm("panda")
+    with pytest.raises(om.InvalidInput, match="configuration redundancy"):
+        om.Configuration((1, 1, 1), (10**400,))
+    for radius in (1e300, 1e-300):
+        with pytest.raises(om.InvalidInput, match="radius must be from"):
+            om.Clearance.for_arm(arm, [om.Sphere([0.5, 0.0, 0.5], 0.05)], radius=radius)
+    clearance = om.Clearance.for_arm(arm, [om.Sphere([0.5, 0.0, 0.5], 0.05)])
+    with pytest.raises(om.InvalidInput, match=r"q must have shape \(7,\)"):
+        clearance.minimum(np.zeros((0, 7)))
+    lower, upper = arm.lower.copy(), arm.upper.copy()
+    lower[2], upper[3] = np.nan, -3.5
+    with pytest.raises(om.InvalidInput, match="lower limits must be 7 numbers"):
+        dataclasses.replace(arm, lower=lower)
+    with pytest.raises(om.InvalidInput, match=r"joint 'joint4' has its lower limit -3\.0718 above"):
+        dataclasses.replace(arm, upper=upper)
+    with pytest.raises(om.InvalidInput, match="upper limits must be 7 numbers"):
+        dataclasses.replace(arm, upper=arm.upper[:3])

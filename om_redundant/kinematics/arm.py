@@ -57,7 +57,7 @@ import mujoco
 import numpy as np
 
 from ..exceptions import ArmFileError, InvalidInput, UnknownArm
-from ..validation import as_instance, as_joint_vector, as_number, as_quaternion, as_vector
+from ..validation import as_array, as_instance, as_joint_vector, as_number, as_quaternion, as_vector
 from .chain import DHRow, JointKind, KinematicChain, standard_rows_from_modified
 
 
@@ -101,6 +101,21 @@ class Arm:
     def __post_init__(self) -> None:
         kinds = [self.chain.rows[i].kind for i in self.chain.joint_rows]
         object.__setattr__(self, "revolute", np.array([k is JointKind.REVOLUTE for k in kinds]))
+        for side in ("lower", "upper"):  # one real number per joint, -inf or +inf for none
+            limit = as_array(getattr(self, side), f"arm '{self.name}' {side} limits", "numbers")
+            if limit.shape != (self.dof,) or np.isnan(limit).any():
+                raise InvalidInput(
+                    f"arm '{self.name}' {side} limits must be {self.dof} numbers (+-inf for none), "
+                    f"got {limit.tolist() if limit.ndim == 1 else limit.shape}"
+                )
+            object.__setattr__(self, side, limit)
+        inverted = np.flatnonzero(~(self.lower <= self.upper))
+        if len(inverted):
+            j = int(inverted[0])
+            raise InvalidInput(
+                f"arm '{self.name}' joint '{self.joint_names[j]}' has its lower limit {self.lower[j]} "
+                f"above its upper limit {self.upper[j]}"
+            )
 
     @property
     def dof(self) -> int:

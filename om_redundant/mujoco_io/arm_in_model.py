@@ -200,6 +200,21 @@ class ArmRoot:
         self.fixed_pose: np.ndarray | None = None
         if model.body_weldid[self.body] == 0:
             self.fixed_pose = self.pose(data)
+        self._world_to_fixed = None if self.fixed_pose is None else inverse(self.fixed_pose)
+        self._at_origin = self.fixed_pose is not None and np.array_equal(self.fixed_pose, np.eye(4))
+        self._to_flange = None if np.array_equal(self.tool, np.eye(4)) else inverse(self.tool)
+
+    def in_root(self, T_world: np.ndarray, root_pose: np.ndarray) -> np.ndarray:
+        """The pose of the arm's end-effector frame in its root frame, for the frame E at
+        world pose T_world with the root at root_pose: :math:`T_{root}^{-1} T_{world} X^{-1}`."""
+        if root_pose is self.fixed_pose:
+            T_root = T_world if self._at_origin else self._world_to_fixed @ T_world
+        else:
+            R, p = root_pose[:3, :3], root_pose[:3, 3]
+            T_root = np.eye(4)
+            T_root[:3, :3] = R.T @ T_world[:3, :3]
+            T_root[:3, 3] = R.T @ (T_world[:3, 3] - p)
+        return T_root if self._to_flange is None else T_root @ self._to_flange
 
     def pose(self, data: mujoco.MjData) -> np.ndarray:
         """World pose (4, 4) of the arm's root frame: :attr:`fixed_pose`, or from data's
@@ -264,6 +279,14 @@ def _tool_offset(flange: np.ndarray, seen: np.ndarray) -> np.ndarray:
     X = np.eye(4)
     X[:3, :3], X[:3, 3] = R, np.linalg.lstsq(lhs, rhs, rcond=None)[0]
     return X
+
+
+def inverse(pose: np.ndarray) -> np.ndarray:
+    """The inverse of a homogeneous transform, [[R^T, -R^T p], [0, 1]]."""
+    out = np.eye(4)
+    out[:3, :3] = pose[:3, :3].T
+    out[:3, 3] = -pose[:3, :3].T @ pose[:3, 3]
+    return out
 
 
 def _distance(A: np.ndarray, B: np.ndarray) -> tuple[float, float]:

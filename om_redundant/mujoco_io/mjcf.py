@@ -39,11 +39,13 @@ import xml.etree.ElementTree as ET
 import mujoco
 import numpy as np
 
+from ..exceptions import InvalidInput
 from ..kinematics.arm import Arm
 from ..validation import as_instance, as_positive
 
 DEFAULT_SITE = "end_effector"
 RADIUS_PER_REACH = 0.03  # default capsule radius over the stretched length of the chain
+MIN_RADIUS, MAX_RADIUS = 1e-4, 10.0  # m: the capsules' radius
 
 
 def arm_mjcf(arm: Arm, *, prefix: str | None = None, radius: float | None = None) -> str:
@@ -61,7 +63,7 @@ def arm_mjcf(arm: Arm, *, prefix: str | None = None, radius: float | None = None
 
     Raises:
         InvalidInput: arm is not an :class:`~om_redundant.Arm`, prefix not a string, or radius
-            not a positive finite number.
+            not a number from :data:`MIN_RADIUS` to :data:`MAX_RADIUS` m.
     """
     return _text(_arm_tree(arm, prefix, radius, scene=False))
 
@@ -91,6 +93,8 @@ def _arm_tree(arm: Arm, prefix: str | None, radius: float | None, scene: bool) -
     r = as_positive(
         max(round(RADIUS_PER_REACH * lengths.sum(), 4), 1e-4) if radius is None else radius, "radius (m)"
     )
+    if not MIN_RADIUS <= r <= MAX_RADIUS:  # (MuJoCo refuses the geoms and bodies beyond them)
+        raise InvalidInput(f"radius must be from {MIN_RADIUS} to {MAX_RADIUS} m, got {r:g}")
     cls = f"{prefix}collision"
     names = {-1: "world", 0: arm.root or f"{prefix}base"} | {k: f"{prefix}link{k}" for k in range(1, n + 1)}
     frame = prefix + (arm.frame_name or DEFAULT_SITE)

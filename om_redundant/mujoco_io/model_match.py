@@ -50,7 +50,7 @@ class ModelComparison:
         samples: Random joint vectors compared (0 when a structural difference prevents it).
         max_axis_error: Largest angle between a model joint axis and the arm's (rad).
         max_anchor_error: Largest distance of a model hinge anchor from the arm's axis (m).
-        max_position_error: Largest |p_model - p_arm| of the frame (m).
+        max_position_error: Largest ``|p_model - p_arm|`` of the frame (m).
         max_orientation_error: Largest rotation angle between the frames (rad).
     """
 

@@ -58,6 +58,8 @@ _RIGHT_ANGLE_EPS = 1e-11
 #: (:func:`~om_redundant.om.nominal.nominal_arm`), which has it zero, while its exact table
 #: verifies every answer.
 LENGTH_ROUNDING = 1e-9
+#: An angle (rad) within this of a multiple of 90 deg is the rounding of that multiple (see
+#: :data:`LENGTH_ROUNDING`).
 ANGLE_ROUNDING = 1e-9
 
 

@@ -31,7 +31,7 @@ from .nominal import NominalArm, closed_form
 DEFAULT_POSITION_TOLERANCE = 1e-10
 DEFAULT_ORIENTATION_TOLERANCE = 1e-10
 DEFAULT_SCAN_POINTS = 64
-#: |branch quantity| within which a joint vector belongs to both neighbouring configurations
+#: ``|branch quantity|`` within which a joint vector belongs to both neighbouring configurations
 #: (the singular boundary's band; see :meth:`OMSolver.holds`).
 BRANCH_BAND: float = ckernels.BRANCH_BAND
 #: Seeded random joint vectors within the limits whose poses a new solver must solve.
@@ -60,7 +60,7 @@ class Solution:
         status: ``"ok"``, ``"unreachable"`` (no configuration reaches the pose) or
             ``"no solution in this configuration"``.
         configuration: The configuration asked for.
-        position_error: |p_real(q) - p_d| in metres.
+        position_error: ``|p_real(q) - p_d|`` in metres.
         orientation_error: Angle of R_d^T R_real(q) in radians.
         iterations: Residual evaluations spent.
         within_limits: Whether q is within the joint limits.
@@ -179,6 +179,12 @@ class OMSolver:
         self._kernel = ckernels.Solver(self.solver_data(), **types)
         self._check_solves_itself()
 
+    def __reduce__(self) -> tuple[Any, tuple[Any, ...]]:
+        """Pickled as its arm and options (the compiled kernel is rebuilt): for spawned
+        workers, Dask, Ray."""
+        position, orientation = self.tolerances
+        return (_rebuilt, (self.arm, position, orientation, self.scan_points))
+
     def solver_data(self) -> system.SolverData:
         """The fixed data of the compiled kernel (see :class:`~om_redundant.om.system.SolverData`):
         of the arm, or, for an arm near a family (:attr:`nominal`), of its nominal arm's model with
@@ -198,8 +204,8 @@ class OMSolver:
 
     @property
     def flip(self) -> np.ndarray:
-        """(dof,) +-1: the model's joint coordinates are ``flip * q`` (-1 where an arm near a
-        family has a reversed axis, see :mod:`~om_redundant.om.nominal`)."""
+        """The (dof,) signs (+-1) that give the model's joint coordinates ``flip * q`` (-1 where
+        an arm near a family has a reversed axis, see :mod:`~om_redundant.om.nominal`)."""
         return self._flip
 
     @property
@@ -214,7 +220,7 @@ class OMSolver:
 
     @property
     def redundancy_names(self) -> tuple[str, ...]:
-        """Names of the configuration's redundancy values: ``("psi",)`` for 7-DOF arms."""
+        """Names of the configuration's redundancy values (``("psi",)`` for 7-DOF arms)."""
         return self.om.redundancy_names
 
     def configurations(self, redundancy: Any = ()) -> list[Configuration]:
@@ -237,15 +243,15 @@ class OMSolver:
     def holds(self, q: np.ndarray, configuration: Configuration) -> bool:
         """Whether joint vector q is in the configuration, by the boundary contract.
 
-        Each branch quantity b_i(q) (the values whose signs :meth:`configuration_of` reads)
-        must have the requested sign s_i, or lie in the band |b_i(q)| <= :data:`BRANCH_BAND`,
-        where q belongs to both neighbouring configurations: s_i b_i(q) >= 0 or
-        |b_i(q)| <= 1e-7. A 7-DOF arm's arm angle psi(q) must equal the requested one within
-        1e-9 rad modulo 2 pi, or within its own rounding at q, |d psi / dq|_1 2^-51 (psi's
+        Each branch quantity ``b_i(q)`` (the values whose signs :meth:`configuration_of` reads)
+        must have the requested sign ``s_i``, or lie in the band ``|b_i(q)|`` <= :data:`BRANCH_BAND`,
+        where q belongs to both neighbouring configurations: ``s_i b_i(q) >= 0`` or
+        ``|b_i(q)| <= 1e-7``. A 7-DOF arm's arm angle psi(q) must equal the requested one within
+        1e-9 rad modulo 2 pi, or within its own rounding at q, ``|d psi / dq|_1 2^-51`` (psi's
         change when each joint moves by an ulp of pi: larger than 1e-9 only within about
         1e-7 rad of psi's singular half-line, the wrist centre straight below the shoulder,
-        where |d psi / dq| grows as 1 / rho, and where the model's wrist centre is at its
-        shoulder, where it grows as 1 / |W - S|: the folded elbow of a model with equal upper
+        where ``|d psi / dq|`` grows as 1 / rho, and where the model's wrist centre is at its
+        shoulder, where it grows as ``1 / |W - S|``: the folded elbow of a model with equal upper
         arm and forearm, the Sawyer's at q4 = +-pi, beyond its limits), psi read in the
         requested ELBOW branch (the
         elbow plane's normal flips with the branch, so at a straight elbow psi is the
@@ -487,3 +493,13 @@ class OMSolver:
         if q_hint is None:
             return None
         return as_joint_vector(q_hint, self.arm.dof, "q_hint", stack=False)
+
+
+def _rebuilt(arm: Arm, position_tolerance: float, orientation_tolerance: float, scan_points: int) -> OMSolver:
+    """An :class:`OMSolver` unpickled (:meth:`OMSolver.__reduce__`)."""
+    return OMSolver(
+        arm,
+        position_tolerance=position_tolerance,
+        orientation_tolerance=orientation_tolerance,
+        scan_points=scan_points,
+    )

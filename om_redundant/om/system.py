@@ -36,8 +36,14 @@ singularities, which is where roots crowd; lifted, Newton's method converges the
   small islands of reach, where roots come in close pairs, 1-D extremum searches find
   them. On the torus, a grid of the lifted residual seeds Newton's method, with deflation
   and a search along each root's fold direction for close pairs (``csrc/torus.c``);
-  this is a thorough search rather than a proof. Every candidate is verified with the REAL
-  arm's forward kinematics.
+  this is a thorough search rather than a proof. Before it, a certificate
+  (``csrc/contraction.c``) bounds how fast the model's q1 and q7 turn as the wrist centre
+  moves over the ball that holds the torus: where the map w -> (q1, q7) contracts (in a
+  weighted max norm), on the whole torus or on cells of it, Banach's theorem proves each
+  cell's root unique, found by iterating the map, and cells where the residual cannot
+  vanish are proved empty; only where it decides nothing (singular shoulder or wrist, the
+  edge of reach, psi's half-line, most Sawyer poses) does the grid search run. Every
+  candidate is verified with the REAL arm's forward kinematics.
 
 The kernels are C (``csrc/``, one file per idea: ``residual.c``, ``scalar.c`` (secant,
 regula falsi, Brent), ``circle.c``, ``torus.c``, ``verify.c``, ``search.c``, ``solve.c``),
@@ -148,6 +154,16 @@ _pool_lock = threading.Lock()
 _CORES = os.cpu_count() or 1  # read once: os.cpu_count() reads a file (~30 us a call on Linux)
 
 
+def _forget_the_pool() -> None:
+    """In a forked child: the parent's pool threads do not exist there (a batch would wait for
+    them forever); the child makes its own when it needs one."""
+    global _pool, _pool_lock
+    _pool, _pool_lock = None, threading.Lock()
+
+
+os.register_at_fork(after_in_child=_forget_the_pool)
+
+
 def run_rows(solve_range: Callable[[int, int], None], rows: int, threads: int | None = None) -> None:
     """Run ``solve_range(start, stop)`` over ``range(rows)`` in chunks, on ``threads`` threads.
 
@@ -155,7 +171,9 @@ def run_rows(solve_range: Callable[[int, int], None], rows: int, threads: int | 
     chunk as it comes free, which balances targets of unequal cost. The calling thread is one
     of them (it would only wait otherwise; on a busy machine a pool thread may be slow to
     wake, and then the caller takes its chunks). ``threads`` None: one per core (at most that
-    many in any case); 1: every row on the calling thread, in one call.
+    many in any case); 1: every row on the calling thread, in one call. An exception in the
+    calling thread (Ctrl-C: KeyboardInterrupt, raised between its chunks) stops every thread
+    after its current chunk, and is raised at once.
     """
     global _pool
     cores = _CORES
@@ -167,10 +185,10 @@ def run_rows(solve_range: Callable[[int, int], None], rows: int, threads: int | 
         if _pool is None:
             _pool = ThreadPoolExecutor(cores, thread_name_prefix="om_redundant")
     chunk = max(1, min(BATCH_CHUNK, -(-rows // workers)))
-    starts, lock = iter(range(0, rows, chunk)), threading.Lock()
+    starts, lock, stop = iter(range(0, rows, chunk)), threading.Lock(), threading.Event()
 
     def drain() -> None:
-        while True:
+        while not stop.is_set():
             with lock:
                 start = next(starts, None)
             if start is None:
@@ -180,6 +198,8 @@ def run_rows(solve_range: Callable[[int, int], None], rows: int, threads: int | 
     helpers = [_pool.submit(drain) for _ in range(workers - 1)]
     try:
         drain()
-    finally:
         for future in helpers:
             future.result()
+    except BaseException:
+        stop.set()  # (the helpers finish the chunk they are in, into the abandoned batch's arrays)
+        raise

@@ -54,6 +54,7 @@ from __future__ import annotations
 import math
 import threading
 from collections.abc import Sequence
+from typing import Any
 
 import mujoco
 import numpy as np
@@ -140,6 +141,7 @@ class Clearance:
             raise InvalidInput(f"obstacle_geoms must be a sequence of geom names, got {obstacle_geoms!r}")
         self.model, self.arm, self._dof = model, arm, arm.dof
         self.distmax = as_positive(distmax, "distmax")
+        self._given = (tuple(obstacle_geoms), prefix)
         joints = ArmJoints(arm, model, prefix)
         first_body = model.jnt_bodyid[joints.joint_ids[0]]
         moving = subtree(model, first_body)
@@ -216,14 +218,20 @@ class Clearance:
             spec.worldbody.add_geom(name=g.name, type=g.type, size=g.size, pos=g.pos, quat=g.quat)
         return cls(spec.compile(), arm, [g.name for g in geoms], distmax=distmax)
 
+    def __reduce__(self) -> tuple[Any, tuple[Any, ...]]:
+        """Pickled as what it was built from, with the poses :meth:`update` last read."""
+        cores = self._cores
+        moved = (cores.start, cores.obstacle_pos, cores.obstacle_mat, self.version)
+        return (_restored, (self.model, self.arm, *self._given, self.distmax, moved))
+
     def distances(self, q: np.ndarray) -> np.ndarray:
         """Signed distance d_k(q) of every pair (m), in the order of :attr:`pairs`: (P,) for
         a joint vector q (dof,), (M, P) for the rows of q (M, dof)."""
         return self._evaluate(q, self.distmax, gradient=False)[0]
 
     def minimum(self, q: np.ndarray) -> float:
-        """The clearance D(q) = min_k d_k(q) in metres."""
-        return float(self.distances(q).min())
+        """The clearance D(q) = min_k d_k(q) in metres, of a joint vector q (dof,)."""
+        return float(self.distances(as_joint_vector(q, self._dof, stack=False)).min())
 
     def distances_and_gradients(self, q: np.ndarray, near: float = math.inf) -> tuple[np.ndarray, np.ndarray]:
         """d_k(q) and their gradients dd_k/dq (module docstring): (P,) and (P, dof) for a
@@ -463,3 +471,19 @@ def _check_extent(model: mujoco.MjModel, obstacles: list[int], position: np.ndar
                 f"obstacle geom '{geom_label(model, o)}': its position and sizes must be within "
                 f"{MAX_EXTENT:g} m, got {extent:.3g} m"
             )
+
+
+def _restored(
+    model: mujoco.MjModel,
+    arm: Arm,
+    obstacle_geoms: tuple[str, ...],
+    prefix: str | None,
+    distmax: float,
+    moved: tuple[np.ndarray, np.ndarray, np.ndarray, int],
+) -> Clearance:
+    """A :class:`Clearance` unpickled (:meth:`Clearance.__reduce__`), the world as it was read."""
+    clearance = Clearance(model, arm, list(obstacle_geoms), prefix=prefix, distmax=distmax)
+    start, position, rotation, version = moved
+    clearance._cores = clearance._cores._replace(start=start, obstacle_pos=position, obstacle_mat=rotation)
+    clearance.version = version
+    return clearance

@@ -64,6 +64,21 @@ class FreeRotation:
         """Any orientation: the target is the pivot's position only (the tool axis z first)."""
         return cls([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], pivot)
 
+    @classmethod
+    def of_frame(cls, kind: str, tool: np.ndarray) -> FreeRotation:
+        """``"tool_axis"`` or ``"orientation"`` for a frame E at pose ``tool`` (X) in the
+        end-effector frame: turns about E's z axis, or any, about E's origin.
+
+        Raises:
+            InvalidInput: Another kind.
+        """
+        R, pivot = tool[:3, :3], tool[:3, 3]
+        if kind == "tool_axis":
+            return cls.tool_axis(R[:, 2], pivot)
+        if kind == "orientation":
+            return cls(R[:, [2, 0, 1]].T, pivot)
+        raise InvalidInput(f"a free rotation is 'tool_axis' or 'orientation', got {kind!r}")
+
     def turned(self, T: np.ndarray, R: np.ndarray) -> np.ndarray:
         """T(R): the pose T turned by R about the pivot (module docstring)."""
         turn = np.eye(4)

@@ -163,7 +163,7 @@ class Evaluation(NamedTuple):
         margin: M(q), the smallest normalised joint-limit margin (inf if no joint is limited).
         clearance: D(q) in metres (inf without obstacles).
         slack: The smallest of M(q) and (D(q) - d_min) / d_cap; q is feasible iff >= 0.
-        singularity: S(q), the smallest |sin| of the model's singular angles (inf without
+        singularity: S(q), the smallest ``|sin|`` of the model's singular angles (inf without
             the term).
     """
 
@@ -223,7 +223,8 @@ class Objective:
         self.margin_weight, self.clearance_weight = float(margin_weight), float(clearance_weight)
         self.singularity_weight = float(singularity_weight)
         self.clearance_cap, self.min_clearance = float(clearance_cap), float(min_clearance)
-        #: 2 d_cap: pairs farther apart change neither the capped term nor the slack's minimum.
+        #: Twice d_cap (m), the distance beyond which a pair changes neither the capped term nor the
+        #: slack's minimum.
         self.clearance_reach = 2.0 * self.clearance_cap
         self._limited = np.flatnonzero(np.isfinite(arm.lower) & np.isfinite(arm.upper))
         self._lower, self._upper = arm.lower[self._limited], arm.upper[self._limited]

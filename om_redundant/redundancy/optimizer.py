@@ -230,6 +230,24 @@ class RedundancyOptimizer:
         if not self.travel_weight >= 0.0:
             raise InvalidInput(f"travel_weight must be >= 0, got {travel_weight}")
         self._tracker = Tracker(solver, self.objective, self.max_step)
+        # shoulder offsets (the torus): a batch's branches share their grid search
+        self._shared_search = bool(np.any(solver.om.shoulder))
+
+    def __reduce__(self) -> tuple[Any, tuple[Any, ...]]:
+        """Pickled as its solver, clearance and options (the tracking step's state is rebuilt)."""
+        objective = self.objective
+        options = {
+            "margin_weight": objective.margin_weight,
+            "clearance_weight": objective.clearance_weight,
+            "singularity_weight": objective.singularity_weight,
+            "clearance_cap": objective.clearance_cap,
+            "min_clearance": objective.min_clearance,
+            "branches": self.branches,
+            "grid_points": self.grid_points,
+            "max_step": self.max_step,
+            "travel_weight": self.travel_weight,
+        }
+        return (_rebuilt, (self.solver, objective.clearance, options))
 
     @property
     def clearance(self) -> Clearance | None:
@@ -238,7 +256,7 @@ class RedundancyOptimizer:
 
     @property
     def min_clearance(self) -> float:
-        """d_min (m): the clearance every choice keeps."""
+        """The clearance every choice keeps, d_min (m)."""
         return self.objective.min_clearance
 
     def intervals(self, T: Any) -> list[PsiInterval]:
@@ -395,21 +413,25 @@ class RedundancyOptimizer:
     ) -> RedundancyChoice:
         """The fresh choice from the arm's joints (:mod:`~om_redundant.redundancy.reachable`;
         without them, the best scored): branch ``signs`` first (None: every allowed branch at
-        once); with a free rotation, over the turns it starts from."""
+        once); with a free rotation, over the turns it starts from. An arm whose branches share
+        their grid search in one batch (shoulder offsets: the torus) sweeps them all at once."""
         hand = None if q_from is None else self.solver.arm.fk(q_from)
         turns = [None] if free is None else free.starts(T, hand)
         targets = [T if R is None else free.turned(T, R) for R in turns]
-        first = [signs] if signs is not None else self.branches
+        at_once = signs is None or self._shared_search
+        first = self.branches if at_once else [signs]
         swept = [self._sweep(target, first) for target in targets]
-        way = self._way(targets, swept, q_from)
+        way = self._way(targets, swept, q_from, signs)
         note = ""
         if (way is None or not way[0].clear) and signs is not None:
-            ran = any(runs for branch in swept for _, _, runs in branch)
+            ran = any(runs for branch in swept for s, _, runs in branch if s == signs)
             note = f"branch {signs} has no {'clear way' if ran else 'feasible arm angle at this pose'}"
-            others = [b for b in self.branches if b != signs]
-            swept = [
-                branch + self._sweep(target, others) for branch, target in zip(swept, targets, strict=True)
-            ]
+            if not at_once:
+                others = [b for b in self.branches if b != signs]
+                swept = [
+                    branch + self._sweep(target, others)
+                    for branch, target in zip(swept, targets, strict=True)
+                ]
             way = self._way(targets, swept, q_from)
         if way is not None and not way[0].clear:
             note = "; ".join(filter(None, [note, "no candidate has a clear way: the best is taken"]))
@@ -425,12 +447,13 @@ class RedundancyOptimizer:
         targets: list[np.ndarray],
         swept: list[list[tuple[Any, Any, list[Run]]]],
         q_from: np.ndarray | None,
+        signs: tuple[int, ...] | None = None,
     ) -> tuple[Way, int] | None:
-        """The best candidate of the targets' runs with a clear way from q_from (or the best),
-        and its target's index."""
+        """The best candidate of the targets' runs (branch ``signs``' only, if given) with a
+        clear way from q_from (or the best), and its target's index."""
         owner, ranked = {}, []
         for k, branches in enumerate(swept):
-            runs = [run for _, _, branch_runs in branches for run in branch_runs]
+            runs = [run for s, _, branch_runs in branches if signs in (None, s) for run in branch_runs]
             owner.update((id(run), k) for run in runs)
             ranked += candidates(self.objective, runs, q_from, self.travel_weight)
         ranked.sort(key=lambda c: -c.score)
@@ -640,6 +663,11 @@ class _StartBounds:
         for column in terms.T:
             total = total + column
         return np.minimum(values[:, 0], total)
+
+
+def _rebuilt(solver: OMSolver, clearance: Clearance | None, options: dict[str, Any]) -> RedundancyOptimizer:
+    """A :class:`RedundancyOptimizer` unpickled (:meth:`RedundancyOptimizer.__reduce__`)."""
+    return RedundancyOptimizer(solver, clearance, **options)
 
 
 def _failure(intervals: tuple[PsiInterval, ...], reason: str) -> RedundancyChoice:

@@ -96,7 +96,8 @@ def sweep_circle(probes: list[Probe], n: int) -> list[list[Path]]:
         roots: list[list[Point]] = [[] for _ in range(n)]
         if len(grid):
             for k, point in zip(grid.tolist(), probe.points(psi[grid], distinct), strict=True):
-                roots[k].append(point)
+                if point is not None:
+                    roots[k].append(point)
         swept.append([(probe, path) for path in _link(probe, psi, roots)])
     filled = iter(_with_hidden([path for paths in swept for path in paths]))  # (every branch's at once)
     return [[next(filled) for _ in paths] for paths in swept]

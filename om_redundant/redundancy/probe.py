@@ -243,19 +243,35 @@ class Probe:
         tangent = self_motion_tangent(self.solver, q)
         return Point(psi, q, tangent, _Terms(self.objective, q, tangent), solution)
 
-    def points(self, psi: np.ndarray, q: np.ndarray) -> list[Point]:
+    def points(self, psi: np.ndarray, q: np.ndarray) -> list[Point | None]:
         """:meth:`point` for every psi and row of q (M, dof) of a 7-DOF arm, the tangents and
-        the objective (:func:`evaluate_points`) computed for all rows at once."""
+        the objective (:func:`evaluate_points`) computed for all rows at once; None for a row
+        exactly where psi does not move along the self-motion (a fold met by the grid itself,
+        a straight or folded elbow): the paths end beside it, as at any fold.
+
+        Raises:
+            SingularSelfMotion: psi moves along the self-motion at none of the rows (the arm
+                stretched along psi's axis: no arm angle to choose).
+        """
         q = self._represent(q)
         tangents = self_motion_tangents(self.solver, q)
-        bad = ~np.isfinite(tangents).all(axis=(1, 2))
-        if bad.any():
-            self_motion_tangent(self.solver, q[np.argmax(bad)])  # raises SingularSelfMotion
-        rows, rates = list(q), list(tangents)  # (each row's views, shared by its point and terms)
-        terms = map(
-            _Terms, itertools.repeat(self.objective), rows, rates, *_evaluated(self.objective, q, tangents)
-        )
-        return list(map(Point, psi.tolist(), rows, rates, terms))
+        good = np.isfinite(tangents).all(axis=(1, 2))
+        if len(q) and not good.any():
+            self_motion_tangent(self.solver, q[0])  # raises SingularSelfMotion
+        points: list[Point | None] = [None] * len(q)
+        if good.any():
+            q, tangents, at = q[good], tangents[good], np.flatnonzero(good).tolist()
+            rows, rates = list(q), list(tangents)  # (each row's views, shared by its point and terms)
+            terms = map(
+                _Terms,
+                itertools.repeat(self.objective),
+                rows,
+                rates,
+                *_evaluated(self.objective, q, tangents),
+            )
+            for k, point in zip(at, map(Point, psi[good].tolist(), rows, rates, terms), strict=True):
+                points[k] = point
+        return points
 
     def at(self, psi: float | np.ndarray, hint: np.ndarray) -> Point | None:
         """The solution at psi nearest ``hint``, if there is one."""

@@ -6,7 +6,7 @@ and pulls the arm's joints there; :class:`ArmAngleTask` only steers a 7-DOF arm'
 leaving the hand to mink's ``FrameTask``. Both are ``mink.Task``\ s: add them to the task
 list of ``mink.solve_ik``, whose limits (joint, velocity, collision) keep every step safe.
 
-Typical use (see the README, "Using it with mink")::
+Typical use (see docs/mink.md, "Using it with mink")::
 
     solver = om.OMSolver("panda")
     frame_task = mink.FrameTask("attachment_site", "site", position_cost=1.0, orientation_cost=1.0)

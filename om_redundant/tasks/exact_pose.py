@@ -24,14 +24,9 @@ from ..om.configuration import Configuration
 from ..om.solver import OMSolver
 from ..redundancy.free_rotation import FreeRotation
 from ..redundancy.reachable import WAY_MARGIN
-from ..validation import as_instance, as_pose, as_vector
+from ..validation import as_instance, as_pose
+from .approach import DEFAULT_LEAD, JointWay, Patience, as_lead, lead_pose, next_aim, pose_gap
 from .arm_task import ArmTask
-from .lead import DEFAULT_LEAD, lead_pose, pose_gap
-
-#: An arm held short of :math:`q^*` (farther than :data:`_NEAR` rad) whose joints move less than
-#: :data:`_STILL` rad per tick for this many ticks is stalled: the optimiser chooses afresh.
-STALL_TICKS = 50
-_NEAR, _STILL = 1e-3, 1e-4
 
 #: Default cost of :class:`ExactPoseTask`, per radian (metre for prismatic joints). With
 #: mink's usual ``FrameTask`` costs of 1 it makes the exact target dominate far from it,
@@ -163,14 +158,14 @@ class ExactPoseTask(ArmTask):
             )
         super().__init__(solver, model, solver.arm.dof, prefix, cost, gain, lm_damping)
         self.root = ArmRoot(self.joints, frame_name, frame_type)
-        fixed = self.root.fixed_pose
-        self._root_at_origin = fixed is not None and np.array_equal(fixed, np.eye(4))
-        self._world_to_fixed_root = None if fixed is None else _inverse(fixed)
-        tool = self.root.tool
-        self._tool_to_flange = None if np.array_equal(tool, np.eye(4)) else _inverse(tool)
         self.optimizer = optimizer
         self._clearance = self._live_clearance(optimizer, model)
-        self.free = _free_rotation(free, tool, optimizer)
+        if free is not None and optimizer is None:
+            raise TaskDefinitionError("ExactPoseTask: a free rotation is chosen by an optimizer")
+        try:
+            self.free = None if free is None else FreeRotation.of_frame(free, self.root.tool)
+        except InvalidInput as exc:
+            raise TaskDefinitionError(f"ExactPoseTask: {exc}") from None
         self.arm_configuration = arm_configuration
         if arm_configuration is not None:
             solver.check_configuration(arm_configuration)  # raises InvalidInput naming the problem
@@ -180,14 +175,12 @@ class ExactPoseTask(ArmTask):
         self._root_pose: np.ndarray | None = None
         self._data: mujoco.MjData | None = None  # of the configuration last seen: where the world is
         self._seen = -1  # the clearance's version the target was solved for
-        self.lead = None if lead is None else _as_lead(lead)
+        self.lead = None if lead is None else as_lead(lead)
         self._aim: np.ndarray | None = None  # the world pose q* was solved for: the target or a lead
-        self._way: tuple[np.ndarray, float] | None = None  # a joint-space way to q*: start, fraction
-        self._way_checked = -1  # the clearance's version the way was last checked against
+        self._way: JointWay | None = None  # the joint-space way to q* chosen afresh
         self._leading = False  # a target jumped to: the aim runs ahead of the hand until it is near
         self._blind = False  # the optimiser chose without the arm's joints (none seen yet)
-        self._last_q: np.ndarray | None = None  # the arm's joints at the last compute_error
-        self._stalled, self._patience = 0, STALL_TICKS  # ticks without progress; how many to bear
+        self._patience = Patience()
         self._unsolved_fallback: tuple[SE3 | None, Configuration | None] | None = None
         self._jacobian = self.scatter(np.eye(self.k))
         self._jacobian.setflags(write=False)
@@ -266,25 +259,12 @@ class ExactPoseTask(ArmTask):
         """Whether obstacles that moved since the joint-space way was last checked now block
         its rest (certified below ``min_clearance`` less the way's margin: the arm's own steps
         off the straight way do not count)."""
-        if self._way is None or self._clearance is None or self._clearance.version == self._way_checked:
+        way, clearance = self._way, self._clearance
+        if way is None or clearance is None or clearance.version == way.checked:
             return False
-        self._way_checked = self._clearance.version
+        way.checked = clearance.version
         floor = self.optimizer.min_clearance - WAY_MARGIN
-        return self._clearance.minimum_along(q, q_target, floor) < floor
-
-    def _stall(self, q: np.ndarray, gap: float) -> bool:
-        """Whether the arm, far from where the error pulls it, has stood still for
-        ``self._patience`` ticks (compute_error calls, one per ``solve_ik``); each fresh
-        choice that leaves it stalled doubles the patience, arriving resets it."""
-        still = self._last_q is not None and float(np.abs(q - self._last_q).max()) < _STILL
-        self._last_q = q
-        if gap <= _NEAR:
-            self._stalled, self._patience = 0, STALL_TICKS
-        self._stalled = self._stalled + 1 if still and gap > _NEAR else 0
-        if self._stalled < self._patience:
-            return False
-        self._stalled, self._patience = 0, 2 * self._patience
-        return True
+        return clearance.minimum_along(q, q_target, floor) < floor
 
     def seed(self, configuration: MinkConfiguration) -> None:
         """Put the arm's joints of ``configuration`` at :math:`q^*` of the target itself (not of
@@ -297,7 +277,7 @@ class ExactPoseTask(ArmTask):
         q, q_target = self._joint_target(configuration)
         error = q - self._pull_to(q, q_target)
         if self.optimizer is not None and (
-            self._stall(q, float(np.abs(error).max())) or self._blocked(q, q_target)
+            self._patience.run_out(q, float(np.abs(error).max())) or self._blocked(q, q_target)
         ):
             self.reset_choice()  # held short of q*, or its way blocked: choose afresh
             q, q_target = self._joint_target(configuration, resolve=True)
@@ -306,22 +286,13 @@ class ExactPoseTask(ArmTask):
 
     def _pull_to(self, q: np.ndarray, q_target: np.ndarray) -> np.ndarray:
         """What the error pulls the arm's joints to: :math:`\tilde q^*`, or on a joint-space way
-        to a choice made afresh, the way's aim: a point of the straight segment from where the
-        arm was to :math:`q^*`, moved on by the joint lead (max-norm) once the arm is as near
-        :math:`q^*` as the aim, give or take half the lead (so that mink's steps, clipped by
-        velocity limits joint by joint, keep near the segment whose clearance the optimiser
-        checked)."""
+        to a choice made afresh, the way's aim (:class:`~om_redundant.tasks.approach.JointWay`)."""
         if self._way is None:
             return self.joints.nearest_turn(q_target, q)
-        start, s = self._way
-        delta = q_target - start
-        span = float(np.abs(delta).max())
-        step = self.lead[2] / max(span, self.lead[2])
-        left = float(np.abs(q - q_target).max())
-        while s < 1.0 and left <= (1.0 - s) * span + 0.5 * self.lead[2]:
-            s = min(1.0, s + step)
-        self._way = None if s >= 1.0 else (start, s)
-        return start + s * delta
+        aim = self._way.aim(q, q_target, self.lead[2])
+        if self._way.done:
+            self._way = None
+        return aim
 
     def compute_jacobian(self, configuration: MinkConfiguration) -> np.ndarray:
         """The identity in the arm's dof columns, (dof, nv)."""
@@ -402,24 +373,8 @@ class ExactPoseTask(ArmTask):
         self._aim = T_world
 
     def _aim_for(self, T_world: np.ndarray, data: mujoco.MjData) -> np.ndarray:
-        """The aim while leading: the first a lead ahead of the hand; the next a lead further
-        along from the last once the hand is as near the target as that aim is, give or take
-        half the lead (the FrameTask pulls the hand past the aim, towards the target, so the
-        hand need not meet the aim itself); meanwhile the last. Consecutive aims lie a lead
-        apart on the way, and the optimiser tracks from one to the next."""
-        hand = self.root.frame_pose(data)
-        if self._aim is None:
-            return lead_pose(hand, T_world, self.lead)
-        (hand_distance, hand_angle), (aim_distance, aim_angle) = (
-            pose_gap(hand, T_world),
-            pose_gap(self._aim, T_world),
-        )
-        if (
-            hand_distance <= aim_distance + 0.5 * self.lead[0]
-            and hand_angle <= aim_angle + 0.5 * self.lead[1]
-        ):
-            return lead_pose(self._aim, T_world, self.lead)
-        return self._aim
+        """The aim while leading (:func:`~om_redundant.tasks.approach.next_aim`)."""
+        return next_aim(self.root.frame_pose(data), T_world, self._aim, self.lead)
 
     def _leads(self) -> bool:
         """Whether the task aims a lead ahead of the hand: after a jump of the target (with an
@@ -442,13 +397,15 @@ class ExactPoseTask(ArmTask):
         lead at a time (:meth:`_tracks_to`: then the target is reachable), the task leads the
         hand (:meth:`_aim_for`); else the optimiser's fresh choice there from the arm's joints
         is the target (UnreachableTarget if it has none), the arm going there in joint space."""
-        self._stalled, self._patience = 0, STALL_TICKS
+        self._patience.reset()
         if self.choice is not None and self.free is None and self._tracks_to(T_world, root_pose):
             self._leading, self._aim, self._way = True, None, None  # the first aim: a lead from the hand
             self._solve(T_world, root_pose, self._q_target, None)
             return
         q_current = self.joints.q(self._data.qpos)
-        choice = self.optimizer.choose(self._in_root(T_world, root_pose), q_current=q_current, free=self.free)
+        choice = self.optimizer.choose(
+            self.root.in_root(T_world, root_pose), q_current=q_current, free=self.free
+        )
         self._take(choice, root_pose, fresh=True)
         self._aim, self._leading = T_world, False
 
@@ -460,23 +417,12 @@ class ExactPoseTask(ArmTask):
         while aim is not T_world:
             aim = lead_pose(aim, T_world, self.lead)
             q = previous.solution.q
-            previous = self.optimizer.choose(self._in_root(aim, root_pose), previous=previous, q_current=q)
+            previous = self.optimizer.choose(
+                self.root.in_root(aim, root_pose), previous=previous, q_current=q
+            )
             if not (previous.ok and not previous.rechosen and previous.way_clear):
                 return False
         return True
-
-    def _in_root(self, T_world: np.ndarray, root_pose: np.ndarray) -> np.ndarray:
-        """A target frame's world pose as the pose of the arm's end-effector frame in its root."""
-        if root_pose is self.root.fixed_pose:
-            T_root = T_world if self._root_at_origin else self._world_to_fixed_root @ T_world
-        else:
-            R, p = root_pose[:3, :3], root_pose[:3, 3]
-            T_root = np.eye(4)
-            T_root[:3, :3] = R.T @ T_world[:3, :3]
-            T_root[:3, 3] = R.T @ (T_world[:3, 3] - p)
-        if self._tool_to_flange is not None:
-            T_root = T_root @ self._tool_to_flange
-        return T_root
 
     def _solve_at(
         self,
@@ -487,7 +433,7 @@ class ExactPoseTask(ArmTask):
     ) -> None:
         """Solve the world pose T_world for the root at root_pose and, only if that succeeds,
         take it."""
-        T_root = self._in_root(T_world, root_pose)
+        T_root = self.root.in_root(T_world, root_pose)
         if arm_configuration is None:
             q_current = None if self._data is None else self.joints.q(self._data.qpos)
             self._blind, fresh = q_current is None, self.choice is None
@@ -520,7 +466,7 @@ class ExactPoseTask(ArmTask):
         if self._clearance is not None:
             self._seen = self._clearance.version
         if (fresh or choice.rechosen) and self._data is not None:  # q* jumped: a joint-space way there
-            self._way = (self.joints.q(self._data.qpos), 0.0)
+            self._way = JointWay(self.joints.q(self._data.qpos))
 
     def _live_clearance(self, optimizer: RedundancyOptimizer | None, model: mujoco.MjModel) -> Any:
         """The optimiser's clearance where the task reads its obstacles from the model (the
@@ -536,35 +482,3 @@ class ExactPoseTask(ArmTask):
                 stacklevel=3,
             )
         return None
-
-
-def _free_rotation(free: str | None, tool: np.ndarray, optimizer: Any) -> FreeRotation | None:
-    """The target's free rotation in the arm's end-effector frame: about the task's frame's
-    z axis (``"tool_axis"``) or any (``"orientation"``), about its origin (the tool offset X)."""
-    if free is None:
-        return None
-    if free not in ("tool_axis", "orientation"):
-        raise TaskDefinitionError(
-            f"ExactPoseTask free must be None, 'tool_axis' or 'orientation', got {free!r}"
-        )
-    if optimizer is None:
-        raise TaskDefinitionError("ExactPoseTask: a free rotation is chosen by an optimizer")
-    R, pivot = tool[:3, :3], tool[:3, 3]
-    if free == "tool_axis":
-        return FreeRotation.tool_axis(R[:, 2], pivot)
-    return FreeRotation(R[:, [2, 0, 1]].T, pivot)
-
-
-def _as_lead(lead: Any) -> tuple[float, float, float]:
-    distance, angle, joints = as_vector(lead, 3, "lead").tolist()
-    if not (distance > 0.0 and angle > 0.0 and joints > 0.0):
-        raise InvalidInput(f"lead must be (metres, radians, radians), all positive, got {lead!r}")
-    return distance, angle, joints
-
-
-def _inverse(pose: np.ndarray) -> np.ndarray:
-    """The inverse of a homogeneous transform, [[R^T, -R^T p], [0, 1]]."""
-    inverse = np.eye(4)
-    inverse[:3, :3] = pose[:3, :3].T
-    inverse[:3, 3] = -pose[:3, :3].T @ pose[:3, 3]
-    return inverse

@@ -1,0 +1,152 @@
+r"""How :class:`~om_redundant.ExactPoseTask` takes the arm to a target that jumped.
+
+**The hand's way** (:func:`lead_pose`, :func:`next_aim`). With hand pose :math:`H` and target
+:math:`T`, position gap :math:`d = |p_T - p_H|` and rotation gap :math:`\theta` (the angle of
+:math:`R_H^T R_T`), an aim is the pose a fraction
+
+.. math::  s = \min\big(1,\ \ell_p / d,\ \ell_r / \theta\big)
+
+of the way from H to T: the position on the straight line, the rotation turned about the
+fixed axis of :math:`R_H^T R_T` (spherical interpolation); the target itself where
+:math:`s = 1`. The optimiser tracks from one aim to the next.
+
+**The joints' way** (:class:`JointWay`): the straight segment from where the arm was to a
+choice made afresh, whose clearance the optimiser certified; the error pulls to a point of
+it a joint lead ahead, so that mink's steps, clipped joint by joint by its velocity limits,
+keep near the segment.
+
+**A stall** (:class:`Patience`): an arm held short of where the error pulls it (a collision
+or joint limit holds it) makes the optimiser choose afresh.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..exceptions import InvalidInput
+from ..validation import as_vector
+
+#: An arm held short of its aim (farther than :data:`NEAR` rad) whose joints move less than
+#: :data:`STILL` rad per tick for this many ticks is stalled.
+STALL_TICKS = 50
+NEAR, STILL = 1e-3, 1e-4
+
+#: Default leads of :class:`~om_redundant.ExactPoseTask`'s aims: of the hand on its straight
+#: way (m, rad), and of the joints on a joint-space way (rad, max-norm).
+DEFAULT_LEAD = (0.05, 0.25, 0.1)
+
+
+def pose_gap(A: np.ndarray, B: np.ndarray) -> tuple[float, float]:
+    """Position (m) and rotation angle (rad) between two poses."""
+    cos = (np.trace(A[:3, :3].T @ B[:3, :3]) - 1.0) / 2.0
+    return float(np.linalg.norm(B[:3, 3] - A[:3, 3])), math.acos(min(1.0, max(-1.0, cos)))
+
+
+def lead_pose(hand: np.ndarray, target: np.ndarray, lead: tuple[float, ...]) -> np.ndarray:
+    """The aim (module docstring): ``target`` itself (the same object) when it lies within
+    the lead of the hand, else the pose a fraction s of the way there."""
+    distance, angle = pose_gap(hand, target)
+    s = min(1.0, lead[0] / distance if distance > 0.0 else 1.0, lead[1] / angle if angle > 0.0 else 1.0)
+    if s >= 1.0:
+        return target
+    aim = np.eye(4)
+    aim[:3, :3] = hand[:3, :3] @ _turned(hand[:3, :3].T @ target[:3, :3], angle, s)
+    aim[:3, 3] = hand[:3, 3] + s * (target[:3, 3] - hand[:3, 3])
+    return aim
+
+
+def _turned(R: np.ndarray, angle: float, s: float) -> np.ndarray:
+    """The rotation by s times the angle of R about R's axis (Rodrigues' formula)."""
+    if angle == 0.0:
+        return np.eye(3)
+    if angle < math.pi - 1e-6:
+        axis = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]]) / (2.0 * math.sin(angle))
+    else:  # a half turn: the axis from R + I, whose columns are multiples of it
+        column = R + np.eye(3)
+        axis = column[:, int(np.argmax(np.linalg.norm(column, axis=0)))]
+    axis = axis / np.linalg.norm(axis)
+    K = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    t = s * angle
+    return np.eye(3) + math.sin(t) * K + (1.0 - math.cos(t)) * (K @ K)
+
+
+def as_lead(lead: Any) -> tuple[float, float, float]:
+    """The leads (m, rad, rad), each positive, or InvalidInput."""
+    distance, angle, joints = as_vector(lead, 3, "lead").tolist()
+    if not (distance > 0.0 and angle > 0.0 and joints > 0.0):
+        raise InvalidInput(f"lead must be (metres, radians, radians), all positive, got {lead!r}")
+    return distance, angle, joints
+
+
+def next_aim(
+    hand: np.ndarray, target: np.ndarray, aim: np.ndarray | None, lead: tuple[float, ...]
+) -> np.ndarray:
+    """The aim on the hand's way: the first a lead ahead of the hand; the next a lead further
+    along from the last once the hand is as near the target as that aim is, give or take half
+    the lead (the FrameTask pulls the hand past the aim, towards the target, so the hand need
+    not meet the aim itself); meanwhile the last."""
+    if aim is None:
+        return lead_pose(hand, target, lead)
+    (hand_distance, hand_angle), (aim_distance, aim_angle) = pose_gap(hand, target), pose_gap(aim, target)
+    if hand_distance <= aim_distance + 0.5 * lead[0] and hand_angle <= aim_angle + 0.5 * lead[1]:
+        return lead_pose(aim, target, lead)
+    return aim
+
+
+@dataclass
+class JointWay:
+    """A joint-space way from ``start`` to q* (module docstring).
+
+    Attributes:
+        start: Where the arm was when the choice was made.
+        s: The aim's fraction of the way.
+        checked: The clearance's version the way's rest was last checked against.
+    """
+
+    start: np.ndarray
+    s: float = 0.0
+    checked: int = -1
+
+    def aim(self, q: np.ndarray, q_target: np.ndarray, lead: float) -> np.ndarray:
+        """The way's aim: moved on by ``lead`` (max-norm) while the arm is as near q_target
+        as the aim, give or take half of it (:attr:`done` once it reaches q_target)."""
+        delta = q_target - self.start
+        span = float(np.abs(delta).max())
+        step = lead / max(span, lead)
+        left = float(np.abs(q - q_target).max())
+        while self.s < 1.0 and left <= (1.0 - self.s) * span + 0.5 * lead:
+            self.s = min(1.0, self.s + step)
+        return self.start + self.s * delta
+
+    @property
+    def done(self) -> bool:
+        return self.s >= 1.0
+
+
+class Patience:
+    """Counts the ticks an arm stands still short of its aim (module docstring); each stall
+    doubles the patience, arriving resets it."""
+
+    def __init__(self) -> None:
+        self.stalled, self.patience = 0, STALL_TICKS
+        self._last: np.ndarray | None = None
+
+    def reset(self) -> None:
+        self.stalled, self.patience = 0, STALL_TICKS
+
+    def run_out(self, q: np.ndarray, gap: float) -> bool:
+        """Whether the arm at q, ``gap`` (rad, max-norm) short of its aim, has stood still
+        for as many ticks as the patience (one call per tick)."""
+        still = self._last is not None and float(np.abs(q - self._last).max()) < STILL
+        self._last = q
+        if gap <= NEAR:
+            self.reset()
+        self.stalled = self.stalled + 1 if still and gap > NEAR else 0
+        if self.stalled < self.patience:
+            return False
+        self.stalled, self.patience = 0, 2 * self.patience
+        return True
