@@ -111,14 +111,22 @@ static double _g_of_parts(om_problem *pb, double w, const om_srs_elbow *e, om_sr
     return om_wrap(q[6] - w);
 }
 
-/* The smallest |branch quantity| of the model at q (every joint; NULL: out of reach, INFINITY)
- * into *nearest, its WRIST quantity's into *wrist. */
-static void _near_branches(const om_solver_data *s, const double *q, double *nearest, double *wrist)
+/* The smallest |branch quantity| of the model at q (margin its reach margin; q NULL: out of
+ * reach, INFINITY) into *nearest, its WRIST quantity's into *wrist. On an S-R-S arm, whose scan
+ * of its nominal arm solves q7 alone, the ELBOW quantity's alone, |sin(phi4 - phi*)| =
+ * sqrt(margin) (the SHOULDER's and the WRIST's singular swings show in g~ itself, and the
+ * scan searches G there: _bracket), and no WRIST quantity (its wrist residual is not searched:
+ * _near_singular). */
+static void _near_branches(const om_solver_data *s, const double *q, double margin, double *nearest, double *wrist)
 {
     double values[3];
     *nearest = *wrist = INFINITY;
     if (!q)
         return;
+    if (s->family == OM_SRS) {
+        *nearest = sqrt(py_max(margin, 0.0));
+        return;
+    }
     om_branch_values(s->family, s->params, q, values);
     for (int i = 0; i < s->n_signs; i++)
         *nearest = py_min(*nearest, fabs(values[i]));
@@ -141,7 +149,7 @@ static scan_memo *_sample(om_problem *pb, double lo, double h, int n_pts, double
         for (int k = 0; k < n_pts; k++) {
             gs[k] = om_g_margin(pb, ws[k], q, false, &ms[k]);
             if (s->nominal_table)
-                _near_branches(s, isnan(gs[k]) ? NULL : q, &bs[k], &bs[n_pts + k]);
+                _near_branches(s, isnan(gs[k]) ? NULL : q, ms[k], &bs[k], &bs[n_pts + k]);
         }
         return NULL;
     }

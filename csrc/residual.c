@@ -64,10 +64,11 @@ static double _circle_ik(om_problem *pb, const void *args, double *q, bool neare
 /* Model IK for p_m = p_d + R delta(w), one residual evaluation; returns the reach margin
  * (negative beyond OM_REACH_SLACK: out of the model's reach, q not written). all_joints false
  * writes only what g needs: q_J (an S-R-S arm whose dp turns with q7: q7 alone), or more; an
- * arm near a family, whose correction is the real arm's at every joint, writes them all. */
+ * arm near a family, whose correction is the real arm's at every joint, writes them all (but
+ * in its scan of its nominal arm: pb->nominal). */
 double om_model_ik_at(om_problem *pb, double w, double *q, bool all_joints)
 {
-    circle_ik args = {w, all_joints || pb->s->nominal_table}; /* (a near arm's branch quantities: circle.c) */
+    circle_ik args = {w, all_joints || (pb->s->nominal_table && !pb->nominal)};
     return om_near_ik(pb, _circle_ik, &args, q);
 }
 
