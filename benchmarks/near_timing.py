@@ -8,14 +8,15 @@ call at a time from Python. The arms: UR5e, Panda and iiwa14 with every joint ro
 by +-eps (``benchmarks.near_family.bent``, seed 0), eps = 1e-6 ... 1e-3; the Menagerie near arms
 (Piper, Lite6); with ``--dir`` the URDF arms that go through their nominal arm
 (``benchmarks.urdf_arms``); and the shipped arms they are near, for reference. ``--json`` keeps
-the medians; ``--before`` takes such a file (the same command run on another commit, e.g.
-``PYTHONPATH=<checkout>``) as the table's "before" column.
+the medians; ``--before`` takes such a file (the same command run in a checkout of another
+commit) as the table's "before" column; ``--note`` adds a line on the runs.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -88,6 +89,7 @@ def main() -> None:
     parser.add_argument("--dir", type=Path, help="folder of the URDFs (benchmarks.urdf_arms)")
     parser.add_argument("--json", type=Path, help="write the medians here")
     parser.add_argument("--before", type=Path, help="medians of another run: the 'before' column")
+    parser.add_argument("--note", default="", help="a line on the runs (commits, load) for the page")
     args = parser.parse_args()
     before = json.loads(args.before.read_text()) if args.before else {}
     rows = {}
@@ -102,6 +104,9 @@ def main() -> None:
         f"# Time per solve near a closed-form family ({args.n} random targets per arm, seed 1)",
         "",
         f"Median (90th percentile) wall time in microseconds, one call at a time from Python{arrow}.",
+        *([args.note] if args.note else []),
+        "",
+        "`" + " ".join(["python -m benchmarks.near_timing", *sys.argv[1:]]) + "`",
         "",
         "| arm | through the nominal arm | solve | hinted solve | solve_all |",
         "|---|---|---|---|---|",
