@@ -31,6 +31,16 @@ static double nearest_branch(const om_solver_data *s, const double *q, int *inde
     return nearest;
 }
 
+om_polish_task om_problem_polish_task(const om_problem *pb)
+{
+    const om_solver_data *s = pb->s;
+    bool srs = s->family == OM_SRS;
+    om_polish_task t = {s->real_table, s->n_real_rows, s->dof, srs ? s->params : NULL,
+                        srs ? s->model_table : NULL, s->n_model_rows, pb->goal.R, pb->goal_p,
+                        srs ? pb->redundancy[0] : 0.0, srs ? (double)pb->signs[ELBOW_SIGN] : 0.0, true};
+    return t;
+}
+
 bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori)
 {
     const om_solver_data *s = pb->s;
@@ -40,11 +50,11 @@ bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori)
     /* Next to psi's singular half-line the circle's root holds q to a few digits only: g turns
      * by 2 pi within 1e-16 / rho of w there, the model's reference n by 1e-16 / rho rad */
     bool half_line = srs && om_srs_half_line_angle(s->params, q) < NEAR_BOUNDARY;
-    if (!(nearest < NEAR_BOUNDARY) && !half_line)
-        return false;
-    om_polish_task t = {s->real_table, s->n_real_rows, s->dof, srs ? s->params : NULL,
-                        srs ? s->model_table : NULL, s->n_model_rows, pb->goal.R, pb->goal_p,
-                        srs ? pb->redundancy[0] : 0.0, srs ? (double)pb->signs[ELBOW_SIGN] : 0.0, true};
+    /* An arm near a family's root of G holds q to the correction's settling (near.c) */
+    bool near_root = s->nominal_table && om_near_polish(pb, q, pos, ori);
+    if (near_root || (!(nearest < NEAR_BOUNDARY) && !half_line))
+        return near_root;
+    om_polish_task t = om_problem_polish_task(pb);
     double start[OM_MAX_DOF];
     memcpy(start, q, (size_t)s->dof * sizeof(double));
     om_polish(&t, POLISH_STEPS, q);

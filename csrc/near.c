@@ -77,6 +77,9 @@
  * a root, r -> 0, to NEAR_SETTLED */
 #define NEAR_RELATIVE 1e-9
 #define NEAR_COARSE 1e-10
+#define NEAR_POLISH 3         /* Gauss-Newton steps of a root's polish on the exact chain */
+#define NEAR_POLISH_FROM 1e-8 /* m + rad: the pose errors of a root polished, from ... */
+#define NEAR_POLISHED 1e-14   /* ... down to (rounding: left as it is) */
 
 /* C(q) = T_real(q)^-1 T_nom(q) into (*R, *p) (q in the kernels' coordinates). */
 static void _correction(const om_solver_data *s, const double *q, mat3 *R, vec3 *p)
@@ -161,6 +164,32 @@ double om_near_settle(om_problem *pb, om_model_eval eval, const void *args, doub
     pb->t = pb->goal;
     pb->p = pb->goal_p;
     return margin;
+}
+
+/* The correction's fixed point settles to NEAR_SETTLED and the search's root of G to
+ * OM_ROOT_TOL: their effect on the pose, times the model IK's sensitivity, is 1e-14 to 1e-11
+ * (m, rad); NEAR_POLISH Gauss-Newton steps on the exact chain take a root within
+ * NEAR_POLISH_FROM of the pose (quadratically) to its rounding. The polish's minimum-norm
+ * steps keep it at that root. */
+bool om_near_polish(om_problem *pb, double *q, double *pos, double *ori)
+{
+    double p0, o0, polished[OM_MAX_DOF], p1, o1;
+    bool verified = om_verify(pb, q, &p0, &o0);
+    if (!(p0 + o0 > NEAR_POLISHED && p0 + o0 < NEAR_POLISH_FROM)) {
+        if (pos)
+            *pos = p0, *ori = o0;
+        return verified;
+    }
+    om_polish_task t = om_problem_polish_task(pb);
+    memcpy(polished, q, (size_t)pb->s->dof * sizeof(double));
+    om_polish(&t, NEAR_POLISH, polished);
+    if (om_verify(pb, polished, &p1, &o1) && p1 + o1 < p0 + o0) {
+        memcpy(q, polished, (size_t)pb->s->dof * sizeof(double));
+        p0 = p1, o0 = o1, verified = true;
+    }
+    if (pos)
+        *pos = p0, *ori = o0;
+    return verified;
 }
 
 /* ------------------------------------------------------------------------------------ */

@@ -289,6 +289,11 @@ double om_near_settle(om_problem *pb, om_model_eval eval, const void *args, doub
 /* pb's goal (R, p), with the closed form's constants for pb->redundancy, and its model side,
  * the goal itself (pb->s and pb->redundancy set). */
 void om_set_goal(om_problem *pb, const mat3 *R, vec3 p);
+/* An arm near a family's root q (the kernels' coordinates) to its last digits: a few Gauss-Newton
+ * steps on its exact chain (near.c: NEAR_POLISH), where q is within NEAR_POLISH_FROM of the
+ * pose; q replaced, and its errors into *pos, *ori (NULL: not wanted), only where the polished
+ * one verifies with smaller errors. Returns whether q verifies at the end. */
+bool om_near_polish(om_problem *pb, double *q, double *pos, double *ori);
 /* out = flip * in: the arm's own joint coordinates to the kernels' and back (out may be in). */
 void om_flip(const om_solver_data *s, const double *in, double *out);
 /* At q in the arm's own joint coordinates: the real arm's flange Jacobian in DH frame 0 (6 x dof,
@@ -462,9 +467,13 @@ typedef struct {
 
 /* boundary.c */
 /* A candidate q that failed verification, refined on the real arm where a branch quantity is
- * within 1e-2 of zero, or (S-R-S) w_hat within 1e-2 rad of psi's singular half-line (else left
- * as it is); returns whether it now verifies. */
+ * within 1e-2 of zero, or (S-R-S) w_hat within 1e-2 rad of psi's singular half-line, or (an
+ * arm near a family) where it is within NEAR_POLISH_FROM of the pose (om_near_polish; else
+ * left as it is); returns whether it now verifies. */
 bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori);
+/* The refinement on the real arm toward pb's goal (with psi, S-R-S: in the requested ELBOW
+ * branch), giving up a crawl far from a root (om_polish). */
+om_polish_task om_problem_polish_task(const om_problem *pb);
 /* self_motion.c: the null vector of the real 6 x 7 Jacobian at q (the kernels' coordinates) by
  * cofactors (not normalised) */
 void om_self_motion_null(const om_solver_data *s, const double *q, double *n);

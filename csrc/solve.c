@@ -38,9 +38,9 @@ static bool _shifted(const double *a, const double *b, int dof)
     return false;
 }
 
-/* Write the verified root q into q_out, revolute joints shifted by whole turns into the
- * limits, nearest the hint (has_hint) or zero; *pos and *ori hold q's errors on entry and the
- * returned vector's on exit. Shifting toward a huge hint is inexact in floating point (a turn
+/* Write the verified root q into q_out (an arm near a family's polished first, om_near_polish),
+ * revolute joints shifted by whole turns into the limits, nearest the hint (has_hint) or zero;
+ * *pos and *ori hold q's errors on entry and the returned vector's on exit. Shifting toward a huge hint is inexact in floating point (a turn
  * is not representable at 1e8 rad to 1e-10): where the shifted vector no longer verifies,
  * the shift nearest zero is taken, and where that fails too, q itself. So the vector
  * returned always verifies. Returns whether it is within the limits. */
@@ -49,6 +49,12 @@ static bool _finish(om_problem *pb, const double *q, const double *hint, bool ha
 {
     const om_solver_data *s = pb->s;
     int dof = s->dof;
+    double polished[OM_MAX_DOF];
+    if (s->nominal_table) { /* an arm near a family's root to its last digits */
+        memcpy(polished, q, (size_t)dof * sizeof(double));
+        om_near_polish(pb, polished, pos, ori);
+        q = polished;
+    }
     double q_pos = *pos, q_ori = *ori;
     for (int toward_hint = has_hint; toward_hint >= 0; toward_hint--) {
         memcpy(q_out, q, (size_t)dof * sizeof(double));
