@@ -51,16 +51,23 @@
  * margin), unless G at g~'s edge stays clear of zero by four times its difference and that
  * square root's run-on; between samples out of reach whose margin peaks within a multiple of
  * delta of zero; and about the samples whose model comes within a multiple of delta of its
- * singular set. The multiples (OM_NEAR_SENSITIVITY) bound the sensitivity of g, the margins and
- * the branch quantities to the target with room (1 to 20 per metre away from the singular set).
- * So the zeros of G are those of the search of G itself, the exact family's argument (sign
- * changes bracket roots, extremum searches find close pairs, edges and islands of reach are
- * searched), with G read as g~ where both are far from zero. Above OM_NEAR_SCAN (where the
- * windows would take most of the circle) and on the torus the search is of G throughout. What
- * the argument does not cover: within about delta |dIK_m/dX| >= 1 of the model's singular set
- * the iteration need not contract (it stops after NEAR_STEPS), and a root whose fixed point
- * exists only there is a candidate like any other, polished on the real arm near the boundary
- * (om_polish_candidate) and verified, or missed: on a set of targets of measure O(delta).
+ * singular set (an S-R-S arm's scan solves q7 alone, as the exact family's does: there the
+ * ELBOW quantity sqrt(margin); its SHOULDER's and WRIST's singular swings show in g~ itself).
+ * The multiples (OM_NEAR_SENSITIVITY) bound the sensitivity of g, the margins and the branch
+ * quantities to the target with room (1 to 20 per metre away from the singular set). So the
+ * zeros of G are those of the search of G itself, the exact family's argument (sign changes
+ * bracket roots, extremum searches find close pairs, edges and islands of reach are searched),
+ * with G read as g~ where both are far from zero. Above OM_NEAR_SCAN (where the windows would
+ * take most of the circle) and on the torus the search is of G throughout. At a 6-DOF arm's
+ * aligned wrist the fixed point need not contract (the model splits the wrist by q_prev, the
+ * real arm does not; the correction at the split moves by about delta / |sin q5|), and G's q6
+ * need not be the real root's: within a multiple of delta of it the window is searched on the
+ * wrist's residual with q6 = w given (om_wrist_residual, smooth there), whose zeros are the
+ * real roots as G's are. What the argument does not cover: within about delta |dIK_m/dX| >= 1
+ * of the rest of the model's singular set the iteration need not contract (it stops after
+ * NEAR_STEPS), and a root whose fixed point exists only there is a candidate like any other,
+ * polished on the real arm and verified, or missed: on a set of targets of measure O(delta).
+ * Every answer is polished on the exact chain to its last digits (om_near_polish).
  *
  * Out of the model's reach there is no q to correct from; where the margin is within
  * OM_NEAR_SENSITIVITY times delta of it, the nearest pose the model reaches gives one
