@@ -692,8 +692,9 @@ int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool f
     pole_guard pole = _pole_guard(pb, h);
     int start = -1;
     scan_memo *memo = _sample(pb, lo, h, n_pts, ws, gs, ms, bs, q);
-    /* a near arm's windows about its singular set, after the runs' candidates (near ones first:
-     * a candidate's secant may run to another root, which then is one found) */
+    /* (the samples in order, for a near arm's windows about its singular set: ws may be rotated
+     * below. Its candidates come after the runs': one whose secant runs to another root finds
+     * that root found already, and takes the wrist's secant, om_all_roots) */
     const double *samples = ws;
     int n = 0;
     for (int k = 0; k < n_pts && start < 0; k++)

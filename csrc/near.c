@@ -133,16 +133,16 @@ static double _retarget(om_problem *pb, const double *q, mat3 *R, vec3 *p)
     return moved;
 }
 
-/* Each evaluation starts from the goal (C = I), not from the last one's correction: the
- * evaluation is then a function of its arguments, as the exact family's is -- the same w
- * evaluated twice is in reach both times or neither (an edge of reach found by bisection
- * stays inside), and the search's brackets and extremum searches see one function. */
 /* How far a correction must settle for an evaluation whose residual is r (see NEAR_RELATIVE). */
 static double _settled(double r)
 {
     return py_max(NEAR_SETTLED, py_min(NEAR_COARSE, NEAR_RELATIVE * fabs(r))); /* (NaN r: NEAR_COARSE) */
 }
 
+/* Each evaluation starts from the goal (C = I), not from the last one's correction: the
+ * evaluation is then a function of its arguments, as the exact family's is -- the same w
+ * evaluated twice is in reach both times or neither (an edge of reach found by bisection
+ * stays inside), and the search's brackets and extremum searches see one function. */
 double om_near_settle(om_problem *pb, om_model_eval eval, const void *args, double *q)
 {
     mat3 C_R = {v3(1.0, 0.0, 0.0), v3(0.0, 1.0, 0.0), v3(0.0, 0.0, 1.0)};

@@ -231,7 +231,8 @@ typedef struct {
     double near_deviation; /* m: how far the nominal arm's flange frame is from the real one's, a bound */
     /* +-1 per joint: the kernels' joint coordinates are flip * q, q the arm's own (-1 where a
      * near arm's axis is reversed, all +1 otherwise); flipped: some is -1. The entry points
-     * (solve.c, the *_at functions below) take and give the arm's own. */
+     * (solve.c's om_solve_*, near.c's om_solver_*, om_self_motion_tangent) take and give the
+     * arm's own. */
     double flip[OM_MAX_DOF];
     bool flipped;
 } om_solver_data;

@@ -40,7 +40,8 @@ static bool _shifted(const double *a, const double *b, int dof)
 
 /* Write the verified root q into q_out (an arm near a family's polished first, om_near_polish),
  * revolute joints shifted by whole turns into the limits, nearest the hint (has_hint) or zero;
- * *pos and *ori hold q's errors on entry and the returned vector's on exit. Shifting toward a huge hint is inexact in floating point (a turn
+ * *pos and *ori hold q's errors on entry and the returned vector's on exit. Shifting toward a
+ * huge hint is inexact in floating point (a turn
  * is not representable at 1e8 rad to 1e-10): where the shifted vector no longer verifies,
  * the shift nearest zero is taken, and where that fails too, q itself. So the vector
  * returned always verifies. Returns whether it is within the limits. */
@@ -84,7 +85,6 @@ static void _reduce(const om_solver_data *s, const double *redundancy, double *r
     for (int i = 0; i < s->n_redundancy; i++)
         reduced[i] = remainder(redundancy[i], 2.0 * OM_PI);
 }
-
 
 /* The START_POINTS starts -pi + 2 pi (k + 1/2) / START_POINTS into order, the farthest from
  * w first (w NaN: in order of k). */
