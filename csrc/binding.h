@@ -91,12 +91,22 @@ double om_largest_joint_step(int dof, const double *q0, const double *q1, const 
 #define OM_END_TOLERANCE 1e-9
 #define OM_PATH_SAME 1e-6
 /* follow.c: what om_follow_path answers. */
-enum { OM_FOLLOW_ARRIVED = 0, OM_FOLLOW_ENDED = 1, OM_FOLLOW_SINGULAR = 2 };
+enum { OM_FOLLOW_ARRIVED = 0, OM_FOLLOW_ENDED = 1, OM_FOLLOW_SINGULAR = 2, OM_FOLLOW_STALLED = 3 };
+/* A path that runs within rounding of a singular set (the Panda's self-motion through
+ * q2 = q6 = 0 at the pose of its q = 0) is accepted only in steps of ~1e-6 rad, millions of
+ * them, each a windowed scan: a follow stalls (is not followed further) after
+ * OM_FOLLOW_CRAWL_STEPS accepted steps in a row shorter than OM_FOLLOW_CRAWL (rad; an end
+ * approached by aimed steps takes two or three), or after OM_FOLLOW_MAX_ATTEMPTS attempts (the
+ * most seen in 2,000 global choices on 6 arms: 58). */
+#define OM_FOLLOW_CRAWL 1e-5
+#define OM_FOLLOW_CRAWL_STEPS 16
+#define OM_FOLLOW_MAX_ATTEMPTS 256
 /* A 7-DOF branch's solution path followed from (*psi, q, t) (t = dq/dpsi) towards target
  * (probe.py's Probe.follow), *psi, q and t updated in place to the point reached, *steps the
  * accepted steps: OM_FOLLOW_ARRIVED there, OM_FOLLOW_ENDED where the step fell below min_step
  * (the path ended on the way), OM_FOLLOW_SINGULAR where an accepted point has no tangent (a
- * fold met exactly; the point reached is then the last one that has). Revolute joints are
+ * fold met exactly; the point reached is then the last one that has), OM_FOLLOW_STALLED after
+ * OM_FOLLOW_MAX_ATTEMPTS attempts (the point reached: the last accepted). Revolute joints are
  * compared modulo 2 pi where cyclic, and taken nearest mid-range centre where centred. */
 int om_follow_path(const om_solver_data *s, const double *T, const int64_t *signs, const uint8_t *cyclic,
                    const uint8_t *centred, const double *centre, double *psi, double *q, double *t, double target,

@@ -122,8 +122,9 @@ int om_follow_path(const om_solver_data *s, const double *T, const int64_t *sign
     double ends[4], ends_prev[4], moved = 0.0; /* moved: psi from the point before (0: none yet) */
     end_measures(s, signs, q, t, ends);
     *steps = 0;
-    while (*psi != target) {
+    for (int attempts = 0, crawled = 0; *psi != target; attempts++) {
         if (fabs(step) < min_step) return OM_FOLLOW_ENDED;
+        if (attempts == OM_FOLLOW_MAX_ATTEMPTS || crawled == OM_FOLLOW_CRAWL_STEPS) return OM_FOLLOW_STALLED;
         double x = fabs(target - *psi) <= fabs(step) ? target : *psi + step;
         double aim = moved > 0.0 ? fmax(AIM * predicted_end(n_ends, ends_prev, ends, moved), 1.5 * min_step) : INFINITY;
         if (aim < fabs(x - *psi)) x = *psi + copysign(aim, step);
@@ -139,6 +140,7 @@ int om_follow_path(const om_solver_data *s, const double *T, const int64_t *sign
         }
         if (!om_self_motion_tangent(s, x_q, x_t, 0.0)) return OM_FOLLOW_SINGULAR;
         moved = fabs(x - *psi);
+        crawled = moved < OM_FOLLOW_CRAWL ? crawled + 1 : 0;
         step = 2.0 * (x - *psi);
         *psi = x;
         memcpy(q, x_q, (size_t)dof * sizeof(double));

@@ -211,7 +211,7 @@ static int link_roots(linker *l, int64_t n, const double *grid, const int64_t *c
  * within a turn); the rows that following adds into psi_out (R), q_out and t_out (R, 7); each
  * path's rows, in order, into members (M + R, 2: the row, and the turns of psi it is taken
  * at), and into paths (M + R, 2) where its members end and its turns (a loop's, else 0); out =
- * (status: 0 done, 1 a follow met a fold exactly, 2 more than R rows added; the rows added,
+ * (status: 0 done, 1 a follow met a fold exactly or stalled, 2 more than R rows added; the rows added,
  * the paths). The caller's loop decides where the status is not 0. */
 static PyObject *om_link_paths(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
     if (check_nargs(nargs, 16, "link_paths") < 0) return NULL;

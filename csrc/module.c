@@ -40,6 +40,9 @@ PyMODINIT_FUNC PyInit_ckernels(void) {
         {"RRR_SPHERICAL_WRIST", OM_RRR_SPHERICAL_WRIST}, {"RRP_SPHERICAL_WRIST", OM_RRP_SPHERICAL_WRIST},
         {"SRS", OM_SRS}, {"FIXED", OM_FIXED}, {"CIRCLE", OM_CIRCLE}, {"TORUS", OM_TORUS}, {"OK", OM_OK},
         {"UNREACHABLE", OM_UNREACHABLE}, {"NO_SOLUTION_IN_CONFIGURATION", OM_NO_SOLUTION_IN_CONFIGURATION},
+        {"FOLLOW_ARRIVED", OM_FOLLOW_ARRIVED}, {"FOLLOW_SINGULAR", OM_FOLLOW_SINGULAR},
+        {"FOLLOW_STALLED", OM_FOLLOW_STALLED}, {"FOLLOW_MAX_ATTEMPTS", OM_FOLLOW_MAX_ATTEMPTS},
+        {"FOLLOW_CRAWL_STEPS", OM_FOLLOW_CRAWL_STEPS},
     };
     if (PyModule_AddObjectRef(m, "Solver", (PyObject *)&om_SolverType) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_tracking_functions) < 0) goto fail;
@@ -58,7 +61,8 @@ PyMODINIT_FUNC PyInit_ckernels(void) {
         double value;
     } floats[] = {
         {"REACH_SLACK", OM_REACH_SLACK}, {"BRANCH_BAND", OM_BRANCH_BAND}, {"ORTHONORMALITY_TOLERANCE", OM_ORTHONORMALITY_TOL},
-        {"END_TOLERANCE", OM_END_TOLERANCE}, {"PATH_SAME", OM_PATH_SAME}};
+        {"END_TOLERANCE", OM_END_TOLERANCE}, {"PATH_SAME", OM_PATH_SAME},
+        {"FOLLOW_CRAWL", OM_FOLLOW_CRAWL}};
     for (size_t i = 0; i < sizeof floats / sizeof floats[0]; i++) {
         PyObject *v = PyFloat_FromDouble(floats[i].value);
         if (!v || PyModule_AddObject(m, floats[i].name, v) < 0) {

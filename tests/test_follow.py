@@ -172,3 +172,34 @@ def test_link_paths_puts_every_row_on_one_path_and_says_when_it_has_no_room():
             added_somewhere = True
             assert link_rows(probe, psi, flat, counts, 0)[0] == [2, 0, 0]
     assert added_somewhere
+
+
+# The Panda's hand at its q = 0 as an ExactPoseTask on MuJoCo's model saw it (root pose and
+# site composed: 1e-16 off the arm's own FK), bit for bit.
+_HEX = """
+    -0x1.6a09e73c0e1efp-1 -0x1.6a09e593d95a1p-1 0x1.38e98a512f0d3p-53 0x1.6872b020c49bbp-4
+    -0x1.6a09e593d959bp-1 0x1.6a09e73c0e1f1p-1 -0x1.6e419b7b26038p-51 0x1.ae77e7d024800p-53
+    0x1.f0d5d466b28cfp-52 -0x1.2f09b938723fdp-51 -0x1.ffffffffffffcp-1 0x1.da1cac0831269p-1
+    0x0p+0 0x0p+0 0x0p+0 0x1p+0"""
+T_PANDA_ZERO_ROUNDED = np.array([float.fromhex(x) for x in _HEX.split()]).reshape(4, 4)
+
+
+def test_a_path_within_rounding_of_a_singular_set_stalls_rather_than_crawls():
+    """Within rounding of the Panda's q = 0 pose, the branch of q = 0 has a solution path
+    along q2 = q4 = q6 = 0 that is accepted only in steps of ~1e-6 rad (before the bound: hours
+    in one ``link_paths`` call, the GIL released). The follow stalls with SingularSelfMotion;
+    the optimiser sweeps that branch alone and answers from the others, saying so, the
+    intervals those of the other branches."""
+    solver = solver_of("panda")
+    optimizer = om.RedundancyOptimizer(solver)
+    alone = [optimizer._sweep_alone(T_PANDA_ZERO_ROUNDED, signs) for signs in optimizer.branches]
+    stalled = [branch.signs for branch in alone if branch.stalled]
+    assert stalled and all("the self-motion crawls" in b.stalled for b in alone if b.stalled)
+    for q_current in (np.zeros(7), None):
+        choice = optimizer.choose(T_PANDA_ZERO_ROUNDED, q_current=q_current)
+        assert choice.ok and choice.configuration.signs not in stalled
+        assert np.abs(solver.arm.fk(choice.solution.q) - T_PANDA_ZERO_ROUNDED).max() < 1e-10
+        assert choice.intervals == tuple(optimizer.intervals(T_PANDA_ZERO_ROUNDED))
+        assert all(interval.signs not in stalled for interval in choice.intervals)
+    with pytest.raises(om.SingularSelfMotion, match="crawls"):  # (the branch alone: nothing else answers)
+        om.RedundancyOptimizer(solver, branches=[stalled[0]]).choose(T_PANDA_ZERO_ROUNDED)

@@ -131,6 +131,42 @@ def test_optimizer_choice_is_reached(panda, panda_model):
     assert optimizer.previous[0] is None and optimizer.previous[1] is not None
 
 
+@pytest.mark.parametrize("with_frame_task", [False, True])
+def test_a_fresh_choice_is_reached_along_its_joint_space_way(panda, panda_model, with_frame_task):
+    """A choice made afresh is reached along the straight joint-space way the optimiser
+    certified, not a diagonal cut by mink's velocity limits (the old 0.1 rad lead left the
+    way by 0.05 rad), also while a FrameTask pulls the hand straight to the target."""
+    optimizer = om.RedundancyOptimizer(panda)
+    task = om.ExactPoseTask(panda, panda_model, optimizer=optimizer)
+    frame = frame_task()
+    limits = [
+        mink.ConfigurationLimit(panda_model),
+        mink.VelocityLimit(panda_model, dict.fromkeys(panda.arm.joint_names, 2.0)),
+    ]
+    tasks = [frame, task] if with_frame_task else [task]
+    rng = np.random.default_rng(4)
+    configuration = mink.Configuration(panda_model, Q_PANDA)
+    task.set_target_from_configuration(configuration)  # (the task sees the configuration)
+    for q_from, q_to in zip(random_joints(panda.arm, 6, rng), random_joints(panda.arm, 6, rng), strict=True):
+        configuration.update(q_from)
+        T = panda.arm.fk(q_to)
+        task.reset_choice()
+        task.set_target(T)
+        frame.set_target(mink.SE3.from_matrix(T))
+        deviation = 0.0
+        for _ in range(3000):
+            way = task._way
+            step(configuration, tasks, limits, dt=0.002)
+            if way is not None:  # the distance (max-norm) of q from the way's segment
+                delta = task.joint_target - way.start
+                s = np.clip((configuration.q - way.start) @ delta / (delta @ delta), 0.0, 1.0)
+                deviation = max(deviation, float(np.abs(configuration.q - way.start - s * delta).max()))
+            if max(hand_error(configuration, "attachment_site", T)) < 1e-9:
+                break
+        assert max(hand_error(configuration, "attachment_site", T)) < 1e-9
+        assert deviation < 0.01
+
+
 def test_the_redundancy_optimizers_choice_is_reached_clear_of_an_obstacle(panda, panda_model):
     """The real optimiser behind the task: a sphere at the elbow of the psi = 0 solution. The
     target set before the task has seen the arm is chosen globally; at the first step the

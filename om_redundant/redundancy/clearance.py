@@ -82,7 +82,7 @@ from .shapes import Shape, model_geoms, shape_geoms
 
 DEFAULT_DISTMAX = 1.0  # m: pairs farther apart report this distance
 #: m: :meth:`Clearance.minimum_along` stops splitting a segment whose bound is this close to its ends'.
-ALONG_TOLERANCE = 1e-3
+ALONG_TOLERANCE = 2e-4
 
 #: The largest coordinate or size (m) of an obstacle geom: distances are computed in doubles to
 #: about 1e-16 of the largest coordinates, 1e-10 m at this extent; beyond about 1e154 their

@@ -59,6 +59,16 @@ class PsiInterval:
         return self.closed or (psi - self.lo) % (2.0 * math.pi) <= self.width
 
 
+class BranchRuns(NamedTuple):
+    """A branch's solution paths swept over the circle and their feasible runs; ``stalled``:
+    why it has none (:attr:`Probe.stalled`), else ""."""
+
+    signs: tuple[int, ...]
+    paths: list[Path]
+    runs: list[Run]
+    stalled: str = ""
+
+
 @dataclass(frozen=True, eq=False)
 class Run:
     """A feasible interval with its feasible samples and refined ends, ordered by psi."""

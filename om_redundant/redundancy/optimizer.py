@@ -58,7 +58,7 @@ import mujoco
 import numpy as np
 
 from .. import ckernels
-from ..exceptions import InvalidInput
+from ..exceptions import InvalidInput, SingularSelfMotion
 from ..om.configuration import Configuration
 from ..om.solver import OMSolver, Solution
 from ..validation import as_count, as_instance, as_joint_vector, as_number, as_pose, as_signs
@@ -66,7 +66,7 @@ from .arm_angle import wrap_psi
 from .clearance import DEFAULT_DISTMAX, Clearance
 from .climb import maximise
 from .free_rotation import FreeRotation
-from .intervals import PsiInterval, Run, feasible_runs
+from .intervals import BranchRuns, PsiInterval, Run, feasible_runs
 from .objective import (
     DEFAULT_CLEARANCE_WEIGHT,
     DEFAULT_MARGIN_WEIGHT,
@@ -74,7 +74,7 @@ from .objective import (
     Objective,
     check_weights,
 )
-from .paths import Path, sweep_circle
+from .paths import sweep_circle
 from .probe import Point, Probe
 from .reachable import DEFAULT_TRAVEL_WEIGHT, Way, candidates, clear_way
 from .shapes import Shape
@@ -262,7 +262,7 @@ class RedundancyOptimizer:
     def intervals(self, T: Any) -> list[PsiInterval]:
         """The feasible psi intervals of every allowed branch at pose T."""
         T = as_pose(T)
-        return [run.interval for _, _, runs in self._sweep(T, self.branches) for run in runs]
+        return [run.interval for branch in self._sweep(T, self.branches) for run in branch.runs]
 
     def choose(
         self,
@@ -319,27 +319,45 @@ class RedundancyOptimizer:
 
     # -----------------------------------------------------------------------------------
 
-    def _sweep(
-        self, T: np.ndarray, branches: list[tuple[int, ...]]
-    ) -> list[tuple[tuple[int, ...], list[Path], list[Run]]]:
-        """Every branch's solution paths and feasible runs."""
+    def _sweep(self, T: np.ndarray, branches: list[tuple[int, ...]]) -> list[BranchRuns]:
+        """Every branch's solution paths and feasible runs. Where a path runs within rounding
+        of a singular set (SingularSelfMotion), the branches are swept one by one and those
+        that raise have none, the reason in their ``stalled``.
+
+        Raises:
+            SingularSelfMotion: Every branch raised.
+        """
         probes = [self._probe(T, signs) for signs in branches]
-        swept = sweep_circle(probes, self.grid_points)
+        try:
+            swept = sweep_circle(probes, self.grid_points)
+        except SingularSelfMotion as singular:
+            if len(branches) == 1:
+                raise
+            alone = [self._sweep_alone(T, signs) for signs in branches]
+            if all(branch.stalled for branch in alone):
+                raise singular
+            return alone
         paths = [(probe, path) for probe, paths in zip(probes, swept, strict=True) for path in paths]
         runs = iter(feasible_runs(paths))
         return [
-            (signs, paths, [run for _ in paths for run in next(runs)])
+            BranchRuns(signs, paths, [run for _ in paths for run in next(runs)])
             for signs, paths in zip(branches, swept, strict=True)
         ]
+
+    def _sweep_alone(self, T: np.ndarray, signs: tuple[int, ...]) -> BranchRuns:
+        try:
+            return self._sweep(T, [signs])[0]
+        except SingularSelfMotion as singular:
+            return BranchRuns(signs, [], [], str(singular))
 
     def _probe(self, T: np.ndarray, signs: tuple[int, ...]) -> Probe:
         return Probe(self.solver, self.objective, T, signs)
 
     def _best_anywhere(self, T: np.ndarray, branches: list[tuple[int, ...]]) -> RedundancyChoice:
         swept = self._sweep(T, branches)
-        runs = [run for _, _, branch_runs in swept for run in branch_runs]
+        runs = [run for branch in swept for run in branch.runs]
         if not runs:
-            why = "; ".join(self._why(signs, paths) for signs, paths, _ in swept)
+            why = "; ".join(self._why(branch) for branch in swept)
             return _failure((), f"no feasible arm angle: {why}")
         return self._result(T, self._climb_all(T, runs), runs)
 
@@ -424,8 +442,11 @@ class RedundancyOptimizer:
         way = self._way(targets, swept, q_from, signs)
         note = ""
         if (way is None or not way[0].clear) and signs is not None:
-            ran = any(runs for branch in swept for s, _, runs in branch if s == signs)
+            own = [b for branches in swept for b in branches if b.signs == signs]
+            stalled = next((b.stalled for b in own if b.stalled), "")
+            ran = any(b.runs for b in own)
             note = f"branch {signs} has no {'clear way' if ran else 'feasible arm angle at this pose'}"
+            note = f"branch {signs} was not swept: {stalled}" if stalled else note
             if not at_once:
                 others = [b for b in self.branches if b != signs]
                 swept = [
@@ -436,16 +457,16 @@ class RedundancyOptimizer:
         if way is not None and not way[0].clear:
             note = "; ".join(filter(None, [note, "no candidate has a clear way: the best is taken"]))
         if way is None:
-            why = "; ".join(self._why(s, paths) for s, paths, _ in swept[0])
+            why = "; ".join(self._why(branch) for branch in swept[0])
             return _failure((), f"no feasible arm angle: {why}")
         chosen, k = way
-        intervals = tuple(run.interval for _, _, runs in swept[k] for run in runs)
+        intervals = tuple(run.interval for branch in swept[k] for run in branch.runs)
         return self._chosen(targets[k], chosen, intervals, note, turns[k])
 
     def _way(
         self,
         targets: list[np.ndarray],
-        swept: list[list[tuple[Any, Any, list[Run]]]],
+        swept: list[list[BranchRuns]],
         q_from: np.ndarray | None,
         signs: tuple[int, ...] | None = None,
     ) -> tuple[Way, int] | None:
@@ -453,7 +474,7 @@ class RedundancyOptimizer:
         clear way from q_from (or the best), and its target's index."""
         owner, ranked = {}, []
         for k, branches in enumerate(swept):
-            runs = [run for s, _, branch_runs in branches if signs in (None, s) for run in branch_runs]
+            runs = [run for b in branches if signs in (None, b.signs) for run in b.runs]
             owner.update((id(run), k) for run in runs)
             ranked += candidates(self.objective, runs, q_from, self.travel_weight)
         ranked.sort(key=lambda c: -c.score)
@@ -558,9 +579,12 @@ class RedundancyOptimizer:
             pose=T,
         )
 
-    def _why(self, signs: tuple[int, ...], paths: list[Path]) -> str:
+    def _why(self, branch: BranchRuns) -> str:
         """Why a branch's solution paths hold nothing feasible."""
-        points = [p for path in paths for p in path.points]
+        signs = branch.signs
+        if branch.stalled:
+            return f"branch {signs}: not swept ({branch.stalled})"
+        points = [p for path in branch.paths for p in path.points]
         if not points:
             return f"branch {signs}: no solution at any of {self.grid_points} arm angles"
         within = [p for p in points if p.evaluation.margin >= 0.0]

@@ -29,6 +29,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from .. import ckernels
+from ..exceptions import SingularSelfMotion
 from ..om.configuration import Configuration
 from ..om.solver import BRANCH_BAND, OMSolver, Solution
 from .objective import Evaluation, Group, Objective
@@ -41,7 +42,12 @@ END_TOLERANCE = ckernels.END_TOLERANCE
 SAME = ckernels.PATH_SAME
 _AIM = 63.0 / 64.0  # of the distance to a path's predicted end, a step aimed there goes (csrc/follow.c)
 _TURN = 2.0 * math.pi
-_ARRIVED, _SINGULAR = 0, 2  # ckernels.follow's status
+_ARRIVED, _SINGULAR, _STALLED = ckernels.FOLLOW_ARRIVED, ckernels.FOLLOW_SINGULAR, ckernels.FOLLOW_STALLED
+# A follow stalls (csrc/binding.h: a path within rounding of a singular set advances by
+# ~1e-6 rad a step) after CRAWL_STEPS accepted steps in a row shorter than CRAWL, or after
+# MAX_ATTEMPTS attempts: then SingularSelfMotion.
+CRAWL, CRAWL_STEPS = ckernels.FOLLOW_CRAWL, ckernels.FOLLOW_CRAWL_STEPS
+MAX_ATTEMPTS = ckernels.FOLLOW_MAX_ATTEMPTS
 _LINKED = 0  # ckernels.link_paths' status where it linked the paths
 
 
@@ -323,9 +329,14 @@ class Probe:
                 return reached
         point, step = start, psi - start.psi
         ends, behind = self._end_measures(point), None  # behind: (psi, end measures) of the point before
-        while point.psi != psi:
+        crawled = 0  # accepted steps in a row shorter than CRAWL
+        for attempts in itertools.count():
+            if point.psi == psi:
+                break
             if abs(step) < END_TOLERANCE:
                 return point, False
+            if attempts == MAX_ATTEMPTS or crawled == CRAWL_STEPS:
+                _stalled(point.psi, point.q)
             x = psi if abs(psi - point.psi) <= abs(step) else point.psi + step
             aim = math.inf
             if behind is not None:
@@ -337,6 +348,7 @@ class Probe:
             if nxt is None:  # (halved from x, not from step: psi nearer than step is not tried again)
                 step = 0.5 * (x - point.psi)
             else:
+                crawled = crawled + 1 if abs(x - point.psi) < CRAWL else 0
                 step = 2.0 * (x - point.psi)
                 behind, point = (point.psi, ends), nxt
                 ends = self._end_measures(point)
@@ -368,6 +380,8 @@ class Probe:
         reached, status, steps = work.out.tolist()
         if status == _SINGULAR:
             return None
+        if status == _STALLED:
+            _stalled(reached, work.q)
         if steps == 0:
             return start, status == _ARRIVED
         q, tangent = work.q.copy(), work.t.copy()[:, None]
@@ -432,6 +446,16 @@ class FollowWork(NamedTuple):
     q: np.ndarray
     t: np.ndarray
     out: np.ndarray
+
+
+def _stalled(psi: float, q: np.ndarray) -> None:
+    """Raise for a follow that stalled (:data:`CRAWL_STEPS`, :data:`MAX_ATTEMPTS`): the
+    path runs within rounding of a singular set, where it is accepted only in steps of ~1e-6
+    rad."""
+    raise SingularSelfMotion(
+        f"the self-motion crawls at psi = {psi:+.6f}, q = {np.round(q, 6).tolist()}: the pose is "
+        "within rounding of one where the arm's joint axes align (e.g. q2 = q6 = 0)"
+    )
 
 
 def _predicted_end(before: list[float], now: list[float], moved: float) -> float:

@@ -22,8 +22,8 @@ from ..exceptions import InvalidInput, UnreachableTarget
 from ..mujoco_io.arm_in_model import ArmRoot
 from ..om.configuration import Configuration
 from ..om.solver import OMSolver
+from ..redundancy.clearance import ALONG_TOLERANCE
 from ..redundancy.free_rotation import FreeRotation
-from ..redundancy.reachable import WAY_MARGIN
 from ..validation import as_instance, as_pose
 from .approach import DEFAULT_LEAD, JointWay, Patience, as_lead, lead_pose, next_aim, pose_gap
 from .arm_task import ArmTask
@@ -95,7 +95,10 @@ class ExactPoseTask(ArmTask):
     feasible range that moves away, an obstacle moved onto the way), the optimiser chooses
     afresh from where the arm is, weighing the joint travel and wanting a clear way
     (:attr:`choice` says so: ``rechosen``, ``reason``). :meth:`reset_choice` forces a fresh
-    choice at the next target.
+    choice at the next target. The arm goes to a fresh choice along the straight joint-space
+    way the optimiser certified clear, the error pulling a step at a time along it (and
+    scaled to keep the task's weight, :mod:`~om_redundant.tasks.approach`); obstacles that
+    move onto the rest of the way make it choose afresh from where the arm is.
 
     Failure is never silent: if the pose is out of reach, has no solution in c, or only
     solutions that break a joint limit (with an optimiser: no feasible arm angle on any
@@ -257,13 +260,14 @@ class ExactPoseTask(ArmTask):
 
     def _blocked(self, q: np.ndarray, q_target: np.ndarray) -> bool:
         """Whether obstacles that moved since the joint-space way was last checked now block
-        its rest (certified below ``min_clearance`` less the way's margin: the arm's own steps
-        off the straight way do not count)."""
+        its rest from q: below the way's floor by more than the certificate's tolerance (the
+        arm's own way, certified above the floor to that tolerance, never blocks itself: a
+        way chosen afresh from each near miss would sink by the tolerance each time)."""
         way, clearance = self._way, self._clearance
         if way is None or clearance is None or clearance.version == way.checked:
             return False
         way.checked = clearance.version
-        floor = self.optimizer.min_clearance - WAY_MARGIN
+        floor = way.floor - ALONG_TOLERANCE
         return clearance.minimum_along(q, q_target, floor) < floor
 
     def seed(self, configuration: MinkConfiguration) -> None:
@@ -275,29 +279,35 @@ class ExactPoseTask(ArmTask):
     def compute_error(self, configuration: MinkConfiguration) -> np.ndarray:
         r"""The joint error :math:`e(q) = q_{arm} - \tilde q^*` (dof,)."""
         q, q_target = self._joint_target(configuration)
-        error = q - self._pull_to(q, q_target)
+        aim, weight = self._pull_to(q, q_target)
         if self.optimizer is not None and (
-            self._patience.run_out(q, float(np.abs(error).max())) or self._blocked(q, q_target)
+            self._patience.run_out(q, float(np.abs(q - self.joints.nearest_turn(q_target, q)).max()))
+            or self._blocked(q, q_target)
         ):
             self.reset_choice()  # held short of q*, or its way blocked: choose afresh
             q, q_target = self._joint_target(configuration, resolve=True)
-            error = q - self._pull_to(q, q_target)
-        return error
+            aim, weight = self._pull_to(q, q_target)
+        return weight * (q - aim)
 
-    def _pull_to(self, q: np.ndarray, q_target: np.ndarray) -> np.ndarray:
-        """What the error pulls the arm's joints to: :math:`\tilde q^*`, or on a joint-space way
-        to a choice made afresh, the way's aim (:class:`~om_redundant.tasks.approach.JointWay`)."""
-        if self._way is None:
-            return self.joints.nearest_turn(q_target, q)
-        aim = self._way.aim(q, q_target, self.lead[2])
-        if self._way.done:
+    def _pull_to(self, q: np.ndarray, q_target: np.ndarray) -> tuple[np.ndarray, float]:
+        """What the error pulls the arm's joints to, and the error's scale: :math:`\tilde q^*`
+        and 1, or on a joint-space way to a choice made afresh, the way's aim and weight
+        (:class:`~om_redundant.tasks.approach.JointWay`) until the aim is q* itself."""
+        way = self._way
+        if way is not None:
+            way.follow(q, q_target, self.lead[2])
+            aim = way.aim(q_target)
+            if aim is not q_target:
+                return aim, way.weight(self.lead[2])
             self._way = None
-        return aim
+        return self.joints.nearest_turn(q_target, q), 1.0
 
     def compute_jacobian(self, configuration: MinkConfiguration) -> np.ndarray:
-        """The identity in the arm's dof columns, (dof, nv)."""
-        self._joint_target(configuration)
-        return self._jacobian
+        """The identity in the arm's dof columns (on a joint-space way, scaled as the error),
+        (dof, nv)."""
+        q, q_target = self._joint_target(configuration)
+        _, weight = self._pull_to(q, q_target)
+        return self._jacobian if weight == 1.0 else weight * self._jacobian
 
     # -----------------------------------------------------------------------------------
 
@@ -466,7 +476,11 @@ class ExactPoseTask(ArmTask):
         if self._clearance is not None:
             self._seen = self._clearance.version
         if (fresh or choice.rechosen) and self._data is not None:  # q* jumped: a joint-space way there
-            self._way = JointWay(self.joints.q(self._data.qpos))
+            start = self.joints.q(self._data.qpos)
+            floor = -np.inf
+            if self._clearance is not None:
+                floor = min(self.optimizer.min_clearance, self._clearance.minimum(start)) - ALONG_TOLERANCE
+            self._way = JointWay(start, floor, lead=self.lead[2])
 
     def _live_clearance(self, optimizer: RedundancyOptimizer | None, model: mujoco.MjModel) -> Any:
         """The optimiser's clearance where the task reads its obstacles from the model (the
