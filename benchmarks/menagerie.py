@@ -106,8 +106,29 @@ def _angle(R: np.ndarray, S: np.ndarray) -> float:
     return float(np.arctan2(s, 0.5 * (np.trace(E) - 1.0)))
 
 
-def measure(name: str, n: int, seed: int, entry: Entry | None = None, folder: Path = MENAGERIE) -> dict:
-    """One arm's row: import, check-model, acceptance and the exact solves."""
+def measure(
+    name: str,
+    n: int,
+    seed: int,
+    entry: Entry | None = None,
+    folder: Path = MENAGERIE,
+    *,
+    times: bool = False,
+) -> dict:
+    """One arm's row: import, check-model, acceptance and the exact solves.
+
+    Args:
+        name: The arm's name in the row (and its key in ``REFERENCE`` without ``entry``).
+        n: Random in-limit joint vectors solved.
+        seed: Seed of those joint vectors.
+        entry: Where the arm is; default ``REFERENCE[name]``.
+        folder: The folder ``entry.path`` is under.
+        times: Also the median wall time of one ``solve_all(T, c)`` and of one hinted
+            ``solve(T, c, q_hint=q)`` over the n targets.
+
+    Returns:
+        The row: a column per quantity measured; an arm OMSolver refuses has its ModelError.
+    """
     entry = entry or REFERENCE[name]
     arm, model = import_arm(entry, folder)
     row: dict = {"arm": name, "model": entry.path, "dof": arm.dof}
@@ -123,11 +144,14 @@ def measure(name: str, n: int, seed: int, entry: Entry | None = None, folder: Pa
     data = mujoco.MjData(model)
     among = hinted = nearer = wrong = roots_total = 0
     worst_position = worst_orientation = 0.0
+    all_times, solve_times = [], []
     start = time.perf_counter()
     for q in _random_q(arm, n, np.random.default_rng(seed)):
         T = frame_pose(model, data, arm, q)
         c = solver.configuration_of(q)
+        tic = time.perf_counter()
         roots = solver.solve_all(T, c)
+        all_times.append(time.perf_counter() - tic)
         roots_total += len(roots)
         among += any(joint_distance(arm, r.q, q) < 1e-7 for r in roots)
         for root in roots:
@@ -139,7 +163,9 @@ def measure(name: str, n: int, seed: int, entry: Entry | None = None, folder: Pa
                 max(worst_orientation, orientation),
             )
             wrong += position > 1e-10 or orientation > 1e-10 or not solver.configuration_of(root.q).isclose(c)
+        tic = time.perf_counter()
         sol = solver.solve(T, c, q_hint=q)
+        solve_times.append(time.perf_counter() - tic)
         if sol.ok and joint_distance(arm, sol.q, q) < 1e-7:
             hinted += 1
         elif sol.ok:
@@ -158,7 +184,48 @@ def measure(name: str, n: int, seed: int, entry: Entry | None = None, folder: Pa
             "s": f"{time.perf_counter() - start:.0f}",
         }
     )
+    if times:
+        row["solve (hinted), median"] = _duration(float(np.median(solve_times)))
+        row["solve_all, median"] = _duration(float(np.median(all_times)))
     return row
+
+
+def _duration(seconds: float) -> str:
+    return f"{1e6 * seconds:.0f} µs" if seconds < 1e-3 else f"{1e3 * seconds:.1f} ms"
+
+
+def import_row(name: str, entry: Entry, n: int, seed: int, folder: Path, **options: bool) -> dict:
+    """The arm's row of :func:`measure` after an ``import`` column, or where the arm does not
+    import (its file does not load, a frame or joint the importer refuses), why.
+
+    Args:
+        name: The arm's name in the row.
+        entry: Where the arm is under ``folder``.
+        n: Random in-limit joint vectors solved.
+        seed: Seed of those joint vectors.
+        folder: The folder ``entry.path`` is under.
+        **options: Keyword options of :func:`measure` (``times``).
+
+    Returns:
+        The row.
+    """
+    try:
+        measured = measure(name, n, seed, entry, folder, **options)
+    except om.OMError as error:
+        return {"arm": name, "import": f"failed: {error}"}
+    return {"arm": name, "import": "yes", **measured}
+
+
+def present(arms: dict[str, Entry], folder: Path, names: list[str] | None = None) -> list[str]:
+    """The names (of ``names``, default every arm) whose model file ``folder`` holds; each other
+    one is skipped with a note, so a benchmark runs where the models are not at hand (CI)."""
+    kept = []
+    for name in names or list(arms):
+        if (folder / arms[name].path).is_file():
+            kept.append(name)
+        else:
+            print(f"{name}: {folder / arms[name].path} absent, skipped", flush=True)
+    return kept
 
 
 def available(extra: Path | None = None) -> dict[str, tuple[Entry, Path]]:
@@ -169,11 +236,7 @@ def available(extra: Path | None = None) -> dict[str, tuple[Entry, Path]]:
     """
     arms = {name: (entry, MENAGERIE) for name, entry in REFERENCE.items()}
     if extra is not None:
-        for name, entry in EXTRA.items():
-            if (extra / entry.path).is_file():
-                arms[name] = (entry, extra)
-            else:
-                print(f"{name}: {extra / entry.path} absent, skipped", flush=True)
+        arms.update({name: (EXTRA[name], extra) for name in present(EXTRA, extra)})
     return arms
 
 

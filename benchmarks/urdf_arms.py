@@ -18,9 +18,7 @@ import argparse
 import sys
 from pathlib import Path
 
-import om_redundant as om
-
-from .menagerie import Entry, measure, table
+from .menagerie import Entry, import_row, present, table
 from .report import write_page
 
 #: The repositories the URDFs come from, as folders of DIR, and the commit they were read at.
@@ -85,11 +83,7 @@ URDF_ARMS = {
 
 def row(name: str, n: int, seed: int, folder: Path) -> dict:
     """The arm's row of :func:`benchmarks.menagerie.measure`, or where it does not import, why."""
-    try:
-        measured = measure(name, n, seed, URDF_ARMS[name], folder)
-    except om.OMError as error:
-        return {"arm": name, "import": f"failed: {error}"}
-    return {"arm": name, "import": "yes", **measured}
+    return import_row(name, URDF_ARMS[name], n, seed, folder)
 
 
 def main() -> None:
@@ -100,10 +94,7 @@ def main() -> None:
     parser.add_argument("--arms", nargs="+", choices=list(URDF_ARMS))
     args = parser.parse_args()
     rows = []
-    for name in args.arms or list(URDF_ARMS):
-        if not (args.dir / URDF_ARMS[name].path).is_file():
-            print(f"{name}: {args.dir / URDF_ARMS[name].path} absent, skipped", flush=True)
-            continue
+    for name in present(URDF_ARMS, args.dir, args.arms):
         rows.append(row(name, args.n, args.seed, args.dir))
         print(rows[-1], flush=True)
     if not rows:
