@@ -382,6 +382,16 @@ def test_the_clearance_along_a_way_is_bounded_from_below(panda, seed, floor):
         assert dense >= along - 1e-12  # certified: no point of the segment is nearer
     else:
         assert dense < floor + om.redundancy.clearance.ALONG_TOLERANCE + spacing / 2
+    # with a budget of samples: the same answer where it suffices, else undecided (NaN) and
+    # only where the unbounded check needed more; never a wrong "clear"
+    for budget in (0, 1, 8, 64):
+        bounded = clearance.minimum_along(q_a, q_b, floor, max_samples=budget)
+        if math.isnan(bounded):
+            continue
+        assert bounded == along
+    assert clearance.minimum_along(q_a, q_b, floor, max_samples=10**6) == along
+    with pytest.raises(om.InvalidInput, match="max_samples"):
+        clearance.minimum_along(q_a, q_b, floor, max_samples=-1)
 
 
 def test_lever_arms_bound_how_fast_the_geoms_move(panda):

@@ -8,6 +8,8 @@ choice keeps the optimiser's clearance from the obstacles where they are now.
 
 from __future__ import annotations
 
+import dataclasses
+
 import mink
 import mujoco
 import numpy as np
@@ -83,13 +85,28 @@ def loop(configuration, tasks, limits, ticks, move, check) -> None:
         check(k)
 
 
-def test_a_ball_moving_into_the_arm_is_seen_every_tick(panda):
+@pytest.mark.parametrize("unclear_ways", [False, True])
+def test_a_ball_moving_into_the_arm_is_seen_every_tick(panda, unclear_ways, monkeypatch):
     """A mocap ball moves through the elbow's place while the hand holds its pose: at every
     tick the task's distances are MuJoCo's in the configuration's data, and the task's
-    choice keeps the optimiser's clearance from the ball where it is now."""
+    choice keeps the optimiser's clearance from the ball where it is now. Also where every
+    fresh choice's joint-space way is reported not clear (the best taken): such a way has no
+    floor and is not re-checked (else it blocks itself, tick after tick)."""
     model = ball_scene(panda.arm)
     clearance = om.Clearance(model, panda.arm, ["ball", "rod"])
     optimizer = om.RedundancyOptimizer(panda, clearance, min_clearance=MIN_CLEARANCE, max_step=0.005)
+    fresh = []
+    if unclear_ways:
+        choose = optimizer.choose
+
+        def unclear(*args, **kwargs):
+            choice = choose(*args, **kwargs)
+            if choice.rechosen or kwargs.get("previous") is None:
+                fresh.append(choice)
+                return dataclasses.replace(choice, way_clear=False)
+            return choice
+
+        monkeypatch.setattr(optimizer, "choose", unclear)
     task = om.ExactPoseTask(panda, model, optimizer=optimizer)
     configuration = mink.Configuration(model)
     configuration.update(np.concatenate([Q_PANDA, configuration.q[7:]]))
@@ -109,6 +126,8 @@ def test_a_ball_moving_into_the_arm_is_seen_every_tick(panda):
 
     def move(k):
         data.mocap_pos[0] = start + (elbow - start) * min(1.0, k / 400)  # into where the elbow was
+        if k in (100, 300):
+            task.reset_choice()  # (a fresh choice from the arm's joints: a way, re-checked as the ball moves)
 
     def check(k):
         task.set_target(T)
@@ -124,6 +143,7 @@ def test_a_ball_moving_into_the_arm_is_seen_every_tick(panda):
         seen.append(mujoco_distances(clearance, data_at_star).min())
 
     loop(configuration, [frame, task], limits, 600, move, check)
+    assert len(fresh) >= 3 if unclear_ways else not fresh  # (the first choice, and the two afresh)
     assert min(seen) >= MIN_CLEARANCE - 1e-9  # every tick's q* clear of the ball where it was
     assert np.linalg.norm(panda.arm.fk(configuration.q[:7])[:3, 3] - T[:3, 3]) < 1e-6
     assert clearance.minimum(configuration.q[:7]) >= MIN_CLEARANCE - 2e-3  # the arm made room

@@ -757,3 +757,23 @@ def test_task_arguments_of_the_wrong_type_are_named(panda, panda_model):
         task.set_target("pose")
     with pytest.raises(mink.InvalidTarget, match="finite angle"):
         om.ArmAngleTask(panda, panda_model).set_target("0.5")
+
+
+@settings(max_examples=50, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), s=st.floats(0.0, 1.0), horizon=st.floats(1e-3, 3.0))
+def test_a_ways_part_ahead_lies_on_its_rest_within_the_horizon(seed, s, horizon):
+    """JointWay.ahead: from the arm's projection (fraction s of the way) along the way's rest,
+    at most ``horizon`` (max-norm) further, the whole rest where it is nearer."""
+    from om_redundant.tasks.approach import JointWay
+
+    rng = np.random.default_rng(seed)
+    start, q_target = rng.uniform(-3.0, 3.0, (2, 7))
+    way = JointWay(start, s=s)
+    here, ahead = way.ahead(q_target, horizon)
+    delta = q_target - start
+    np.testing.assert_allclose(here, start + s * delta, atol=1e-12)
+    rest = float(np.abs(q_target - here).max())
+    assert float(np.abs(ahead - here).max()) == pytest.approx(min(rest, horizon), abs=1e-12)
+    u = (ahead - start) @ delta / (delta @ delta)  # on the segment, not before here
+    np.testing.assert_allclose(ahead, start + u * delta, atol=1e-9)
+    assert s - 1e-12 <= u <= 1.0 + 1e-12

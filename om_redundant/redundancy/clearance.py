@@ -64,7 +64,7 @@ from ..exceptions import InvalidInput
 from ..kinematics.arm import Arm
 from ..mujoco_io.arm_in_model import ArmJoints
 from ..mujoco_io.mjcf import arm_mjcf
-from ..validation import as_instance, as_joint_vector, as_number, as_positive
+from ..validation import as_count, as_instance, as_joint_vector, as_number, as_positive
 from .arm_geoms import (
     BOX,
     POINT,
@@ -338,7 +338,9 @@ class Clearance:
         self.version += 1
         return True
 
-    def minimum_along(self, q_from: np.ndarray, q_to: np.ndarray, floor: float) -> float:
+    def minimum_along(
+        self, q_from: np.ndarray, q_to: np.ndarray, floor: float, max_samples: int | None = None
+    ) -> float:
         r"""The clearance along the straight joint-space segment from q_from to q_to, as far
         as it matters against ``floor``.
 
@@ -349,14 +351,24 @@ class Clearance:
         the midpoints of a round in one call) until one's end falls below ``floor`` or the
         piece is within :data:`ALONG_TOLERANCE` of its ends.
 
+        Args:
+            q_from, q_to: The segment's ends (dof,).
+            floor: The clearance (m) it is checked against.
+            max_samples: The most joint vectors sampled inside the segment (None: as many
+                as the tolerance takes, up to ~1/ALONG_TOLERANCE per metre of lever): a
+                round of halving that would exceed it is not made.
+
         Returns:
             At least ``floor`` only if the whole segment is clear of ``floor`` (a certified
             lower bound); else a sampled clearance below ``floor``, or a bound within
-            :data:`ALONG_TOLERANCE` of the segment's true clearance.
+            :data:`ALONG_TOLERANCE` of the segment's true clearance; NaN where ``max_samples``
+            ran out before either (undecided: no sample below ``floor``, some piece's bound
+            below it).
         """
         q_from = as_joint_vector(q_from, self._dof, stack=False)
         q_to = as_joint_vector(q_to, self._dof, stack=False)
         floor = as_number(floor, "floor")
+        budget = math.inf if max_samples is None else as_count(max_samples, "max_samples", 0, 2**31)
         lipschitz = float(self._lever @ np.abs(q_to - q_from))
         t = np.array([0.0, 1.0])
         ends = self.distances(np.array([q_from, q_to])).min(axis=1)
@@ -375,6 +387,9 @@ class Clearance:
                     split.append((t0, t1, d0, d1))
             if not split:
                 break
+            if len(split) > budget:
+                return math.nan
+            budget -= len(split)
             t = np.array([0.5 * (t0 + t1) for t0, t1, _, _ in split])
             middle = self.distances(q_from + t[:, None] * (q_to - q_from)).min(axis=1).tolist()
             pieces = [

@@ -48,6 +48,10 @@ NEAR, STILL = 1e-3, 1e-4
 #: Default leads of :class:`~om_redundant.ExactPoseTask`'s aims: of the hand on its straight
 #: way (m, rad), and of the joints on a joint-space way (rad, max-norm).
 DEFAULT_LEAD = (0.05, 0.25, 0.1)
+#: rad (max-norm): how far ahead of the arm a joint-space way is re-checked against obstacles
+#: that moved, about a quarter second of an arm at 2 rad/s. (Farther parts are re-checked as the
+#: arm comes within it: tracking moves q* meanwhile, so they are not yet the arm's path.)
+WAY_HORIZON = 0.5
 #: rad: the smallest lead on a joint-space way (an arm standing still), so the task's weight
 #: grows at most by the joint lead over this.
 MIN_WAY_LEAD = 1e-3
@@ -144,6 +148,13 @@ class JointWay:
         length = float(delta @ delta)
         if length > 0.0:
             self.s = max(self.s, min(1.0, float((q - self.start) @ delta) / length))
+
+    def ahead(self, q_target: np.ndarray, horizon: float) -> tuple[np.ndarray, np.ndarray]:
+        """The part of the way's rest within ``horizon`` (rad, max-norm) of the arm's
+        projection on it: its first and last points."""
+        here = self.start + self.s * (q_target - self.start)
+        span = float(np.abs(q_target - here).max())
+        return here, (q_target if span <= horizon else here + (horizon / span) * (q_target - here))
 
     def aim(self, q_target: np.ndarray) -> np.ndarray:
         """The point of the way the lead past the arm's fraction (q_target itself at the end)."""

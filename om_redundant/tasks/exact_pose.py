@@ -9,6 +9,7 @@ model (:class:`~om_redundant.ArmRoot`).
 
 from __future__ import annotations
 
+import math
 import warnings
 from typing import Any, Protocol
 
@@ -25,13 +26,17 @@ from ..om.solver import OMSolver
 from ..redundancy.clearance import ALONG_TOLERANCE
 from ..redundancy.free_rotation import FreeRotation
 from ..validation import as_instance, as_pose
-from .approach import DEFAULT_LEAD, JointWay, Patience, as_lead, lead_pose, next_aim, pose_gap
+from .approach import DEFAULT_LEAD, WAY_HORIZON, JointWay, Patience, as_lead, lead_pose, next_aim, pose_gap
 from .arm_task import ArmTask
 
 #: Default cost of :class:`ExactPoseTask`, per radian (metre for prismatic joints). With
 #: mink's usual ``FrameTask`` costs of 1 it makes the exact target dominate far from it,
 #: which removes the spurious stationary points of the sum (see :class:`ExactPoseTask`).
 EXACT_POSE_COST = 10.0
+#: The most joint vectors one tick samples to re-check a way's rest against moved obstacles
+#: (:meth:`~om_redundant.redundancy.clearance.Clearance.minimum_along`): a way whose clearance
+#: nears its floor needs thousands to decide, ~10 us each, past a 2 ms tick.
+WAY_CHECK_SAMPLES = 128
 
 
 class RedundancyOptimizer(Protocol):
@@ -258,17 +263,22 @@ class ExactPoseTask(ArmTask):
         self.choice = None
         self._leading, self._way = False, None
 
-    def _blocked(self, q: np.ndarray, q_target: np.ndarray) -> bool:
+    def _blocked(self, q_target: np.ndarray) -> bool:
         """Whether obstacles that moved since the joint-space way was last checked now block
-        its rest from q: below the way's floor by more than the certificate's tolerance (the
-        arm's own way, certified above the floor to that tolerance, never blocks itself: a
-        way chosen afresh from each near miss would sink by the tolerance each time)."""
+        its rest ahead (from the arm's projection on it, which the optimiser certified, the
+        arm's own deviation its margin's, to :data:`~om_redundant.tasks.approach.WAY_HORIZON`
+        further): below the way's floor by more than the certificate's tolerance (the arm's
+        own way, certified above the floor to that tolerance, never blocks itself: a way
+        chosen afresh from each near miss would sink by the tolerance each time)."""
         way, clearance = self._way, self._clearance
-        if way is None or clearance is None or clearance.version == way.checked:
-            return False
+        if way is None or way.floor == -math.inf or clearance.version == way.checked:
+            return False  # (no floor: no obstacles, or a way the optimiser could not find clear)
         way.checked = clearance.version
+        q, q_ahead = way.ahead(q_target, WAY_HORIZON)
         floor = way.floor - ALONG_TOLERANCE
-        return clearance.minimum_along(q, q_target, floor) < floor
+        # (undecided within the samples, NaN: kept; the obstacle that nears the way is sampled
+        # below its floor in a later tick, or moves off)
+        return clearance.minimum_along(q, q_ahead, floor, WAY_CHECK_SAMPLES) < floor
 
     def seed(self, configuration: MinkConfiguration) -> None:
         """Put the arm's joints of ``configuration`` at :math:`q^*` of the target itself (not of
@@ -282,7 +292,7 @@ class ExactPoseTask(ArmTask):
         aim, weight = self._pull_to(q, q_target)
         if self.optimizer is not None and (
             self._patience.run_out(q, float(np.abs(q - self.joints.nearest_turn(q_target, q)).max()))
-            or self._blocked(q, q_target)
+            or self._blocked(q_target)
         ):
             self.reset_choice()  # held short of q*, or its way blocked: choose afresh
             q, q_target = self._joint_target(configuration, resolve=True)
@@ -477,8 +487,9 @@ class ExactPoseTask(ArmTask):
             self._seen = self._clearance.version
         if (fresh or choice.rechosen) and self._data is not None:  # q* jumped: a joint-space way there
             start = self.joints.q(self._data.qpos)
-            floor = -np.inf
-            if self._clearance is not None:
+            floor = -np.inf  # (a way the optimiser could not find clear is not re-checked: it
+            # would be "blocked" by what it already passes, and chosen again, tick after tick)
+            if self._clearance is not None and choice.way_clear:
                 floor = min(self.optimizer.min_clearance, self._clearance.minimum(start)) - ALONG_TOLERANCE
             self._way = JointWay(start, floor, lead=self.lead[2])
 
