@@ -1,7 +1,7 @@
 """Redundancy resolution at control rate (issue 16): the optimiser's tracking step inside a
 500 Hz mink loop, against plain mink's tick in the same run; writes results/control_rate.md.
 
-For the Panda and the iiwa14, with 0, 1 and 3 obstacles (a sphere, a capsule, a box), a
+For every shipped 7-DOF arm (``--arms``), with 0, 1 and 3 obstacles (a sphere, a capsule, a box), a
 target moves along a figure eight around the hand (TICKS ticks of dt = 2 ms, one lap).
 Every tick, interleaved:
 
@@ -42,6 +42,7 @@ from om_redundant.redundancy.optimizer import RedundancyChoice
 from om_redundant.redundancy.probe import Probe
 
 from .report import cpu_model, write_page
+from .robots import random_joints
 
 TICKS = 2000
 DT = 0.002
@@ -53,6 +54,15 @@ GLOBAL_POSES = 10
 HOMES = {
     "panda": np.array([0.0, -0.3, 0.0, -2.2, 0.0, 1.9, 0.785]),
     "iiwa14": np.array([0.0, 0.6, 0.0, -1.4, 0.0, 1.0, 0.0]),
+}
+# The other shipped 7-DOF arms' homes (bent elbow and wrist, inside every range): measured with
+# --arms, not sampled by the tests that read HOMES.
+ARM_HOMES = {
+    **HOMES,
+    "fr3": HOMES["panda"],
+    "gen3": np.array([0.0, 0.26, 3.14, -2.27, 0.0, 0.96, 1.57]),
+    "xarm7": np.array([0.0, -0.3, 0.0, 0.9, 0.0, 1.2, 0.0]),
+    "sawyer": np.array([0.0, -1.18, 0.0, 2.18, 0.0, 0.57, 1.57]),
 }
 EXACT = 1e-10  # m: the hand on the choice's target
 CONVERGED = 1e-12  # rad: tracking at one pose has converged when psi moves less
@@ -108,7 +118,7 @@ class Run:
 def run(name: str, count: int, ticks: int) -> Run:
     solver = om.OMSolver(name)
     arm = solver.arm
-    T_home = arm.fk(HOMES[name])
+    T_home = arm.fk(ARM_HOMES[name])
     shapes = obstacles(T_home[:3, 3], count)
 
     def optimizer() -> om.RedundancyOptimizer:
@@ -139,7 +149,7 @@ def run(name: str, count: int, ticks: int) -> Run:
 
     # the mink loops, interleaved tick by tick
     plain_conf, om_conf = mink.Configuration(model), mink.Configuration(model)
-    home = HOMES[name]
+    home = ARM_HOMES[name]
     plain_conf.update(home.copy())
     om_conf.update(home.copy())
     plain_hand = mink.FrameTask(frame, "site", position_cost=1.0, orientation_cost=1.0, lm_damping=1.0)
@@ -189,7 +199,7 @@ def run(name: str, count: int, ticks: int) -> Run:
 def global_times(name: str, poses: int, ticks: int) -> tuple[np.ndarray, np.ndarray]:
     """Wall and CPU times (ms) of the global choose(T) with 3 obstacles on poses of the path."""
     solver = om.OMSolver(name)
-    T_home = solver.arm.fk(HOMES[name])
+    T_home = solver.arm.fk(ARM_HOMES[name])
     optimizer = om.RedundancyOptimizer(solver, obstacles(T_home[:3, 3], 3), min_clearance=MIN_CLEARANCE)
     walls, cpus = [], []
     for k in np.linspace(0, ticks, poses, endpoint=False).astype(int):
@@ -236,12 +246,12 @@ def turned(a: RedundancyChoice, b: RedundancyChoice) -> float:
 def quality(name: str, n: int, seed: int) -> tuple[int, int, float, float]:
     """(poses checked, poses failing both bars, worst psi gap, worst value gain)."""
     solver = om.OMSolver(name)
-    T_home = solver.arm.fk(HOMES[name])
+    T_home = solver.arm.fk(ARM_HOMES[name])
     optimizer = om.RedundancyOptimizer(solver, obstacles(T_home[:3, 3], 3), min_clearance=MIN_CLEARANCE)
     rng = np.random.default_rng(seed)
     checked = bad = 0
     worst_gap = worst_gain = 0.0
-    for q in rng.uniform(solver.arm.lower, solver.arm.upper, (n, solver.arm.dof)):
+    for q in random_joints(solver.arm, n, rng):
         result = converged_gap(optimizer, q)
         if result is None:
             continue
@@ -263,10 +273,10 @@ def global_row(name: str, poses: int, ticks: int) -> str:
     return row
 
 
-def global_page(poses: int, ticks: int) -> str:
+def global_page(arms: list[str], poses: int, ticks: int) -> str:
     """The global choose alone (``--global-only``): its table, with the load."""
     load = os.getloadavg()
-    rows = [global_row(name, poses, ticks) for name in HOMES]
+    rows = [global_row(name, poses, ticks) for name in arms]
     return "\n".join(
         [
             "# Redundancy resolution at control rate: the global choose",
@@ -294,17 +304,18 @@ def main() -> None:
     )
     parser.add_argument("--globals", type=int, default=GLOBAL_POSES, help="poses timed for the global choose")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--arms", nargs="+", choices=list(ARM_HOMES), default=list(ARM_HOMES))
     parser.add_argument("--quality-only", action="store_true", help="only the convergence check")
     parser.add_argument(
         "--global-only", action="store_true", help="only the global choose (writes control_rate_global.md)"
     )
     args = parser.parse_args()
     if args.global_only:
-        write_page("control_rate_global.md", global_page(args.globals, args.ticks))
+        write_page("control_rate_global.md", global_page(args.arms, args.globals, args.ticks))
         return
     load = os.getloadavg()
     rows, global_rows, quality_rows = [], [], []
-    for name in HOMES:
+    for name in args.arms:
         for count in () if args.quality_only else (0, 1, 3):
             r = run(name, count, args.ticks)
             ratio_wall = np.median(r.om_wall) / np.median(r.mink_wall)

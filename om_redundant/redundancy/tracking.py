@@ -58,13 +58,18 @@ INITIAL_CURVATURE, MAX_CURVATURE = 0.1, 1e3
 #: Where nothing is feasible within max_step (the feasible range moved away faster), the step
 #: is tried again within this many times max_step: the joint step bounds it as before.
 WIDER = 64.0
+#: Where a step, and one more from it, land outside a floor, or it leaves the solution path, the
+#: step is tried again within max_step halved, at most this many times (a maximum on a floor is
+#: reached to rounding, and its step lands outside by that; one at a fold, where the path ends,
+#: is approached in steps that halve).
+SHRINKS = 4
 _JOINT_STEP = 0.25  # rad: the step keeps the linearised joint motion within this
 # setup vector layout (csrc/tracking.c)
 _PSI, _MAX_STEP, _CURVATURE, _N_SETUP = 0, 6, 7, 12
 # output layout after q (csrc/tracking.c)
 _O_PSI, _O_CURVATURE, _O_MARGIN, _O_SINGULARITY = 0, 2, 3, 4
 _O_POS, _O_ORI, _O_EVALS, _O_WITHIN, _N_OUT = 6, 7, 8, 9, 10
-_INFEASIBLE = 3  # ckernels.track_step's status: nothing feasible within the step
+_INFEASIBLE, _LEFT = 3, 4  # ckernels.track_step's status: nothing feasible within the step; off the path
 #: Why ckernels.track_step refused, by its status (csrc/tracking.c).
 _REFUSED = {
     1: "no exact solution at the previous psi continues the previous joints",
@@ -196,6 +201,14 @@ class Tracker:
                 # there at the same pose, which the floors' linear models put back inside
                 (psi_out,) = step.solution.configuration.redundancy
                 step = self._step(T, signs, psi_out, step.solution.q, step.curvature, self.max_step)
+            reach = self.max_step
+            for _ in range(SHRINKS):
+                # (a maximum on a floor: the step lands on it, rounded outside; at a fold, where
+                # the path ends: the step leaves the path beyond it)
+                if not ((isinstance(step, Tracked) and not step.feasible) or step == _REFUSED[_LEFT]):
+                    break
+                reach /= 2.0
+                step = self._step(T, signs, psi, q, curvature, reach)
             if isinstance(step, Tracked) and not step.feasible:
                 if not step.margin >= 0.0:
                     return f"the step's joints leave the limits (margin {step.margin:.3g})"
