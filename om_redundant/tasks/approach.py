@@ -122,6 +122,8 @@ class JointWay:
         start: Where the arm was when the choice was made.
         floor: The clearance the way's rest keeps (m): the optimiser's ``min_clearance``, or
             the clearance at ``start`` where that was less; below it the way is blocked.
+            -inf where there is nothing to keep (no obstacles, or a way the optimiser could
+            not find clear: it is not re-checked).
         s: The fraction of the way the arm has come (its projection's, never going back).
         lead: The aim's current lead past the arm (rad, max-norm): at first the full lead (a
             first step clipped off the way is one tick's), then from the arm's steps.
