@@ -15,6 +15,7 @@ from hypothesis import strategies as st
 
 import om_redundant as om
 from benchmarks.control_rate import (
+    ARM_HOMES,
     HOMES,
     MIN_CLEARANCE,
     PSI_GAP,
@@ -247,5 +248,18 @@ def test_tracking_reaches_a_maximum_on_a_joint_limit():
     T_home = solver.arm.fk(HOMES["panda"])
     optimizer = om.RedundancyOptimizer(solver, obstacles(T_home[:3, 3], 3), min_clearance=MIN_CLEARANCE)
     q = np.array([-0.98568561, 1.56423033, -1.74244584, -1.53425468, -2.75815311, 0.5983977, 2.22175819])
+    gap, gain = converged_gap(optimizer, q)
+    assert gap < 1e-6 and gain < 1e-6
+
+
+def test_tracking_holds_a_maximum_where_the_path_ends():
+    """The xArm7, three obstacles: the objective rises along psi to where the solution path
+    ends (a fold). Steps past it leave the path; shorter ones approach it and the last try,
+    at psi itself, holds it (before: refused, the optimiser chose afresh 0.016 rad back and
+    tracked up to the fold again, every five calls, for ever)."""
+    solver = om.OMSolver("xarm7")
+    T_home = solver.arm.fk(ARM_HOMES["xarm7"])
+    optimizer = om.RedundancyOptimizer(solver, obstacles(T_home[:3, 3], 3), min_clearance=MIN_CLEARANCE)
+    q = np.array([2.88593761, -1.32943195, 4.56384435, 2.03828794, -2.51689649, 0.35053673, -5.92731425])
     gap, gain = converged_gap(optimizer, q)
     assert gap < 1e-6 and gain < 1e-6

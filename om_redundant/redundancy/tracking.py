@@ -59,10 +59,11 @@ INITIAL_CURVATURE, MAX_CURVATURE = 0.1, 1e3
 #: is tried again within this many times max_step: the joint step bounds it as before.
 WIDER = 64.0
 #: Where a step, and one more from it, land outside a floor, or it leaves the solution path, the
-#: step is tried again within max_step halved, at most this many times (a maximum on a floor is
-#: reached to rounding, and its step lands outside by that; one at a fold, where the path ends,
-#: is approached in steps that halve).
-SHRINKS = 4
+#: step is tried again within a quarter of the last reach, at most this many times (to
+#: max_step / 4^8, 8e-8 rad at 0.005), and then at psi itself: a maximum on a floor is reached
+#: to rounding, and its step lands outside by that; one at a fold, where the path ends, is
+#: approached in shorter steps, and then held.
+SHRINKS = 8
 _JOINT_STEP = 0.25  # rad: the step keeps the linearised joint motion within this
 # setup vector layout (csrc/tracking.c)
 _PSI, _MAX_STEP, _CURVATURE, _N_SETUP = 0, 6, 7, 12
@@ -202,12 +203,12 @@ class Tracker:
                 (psi_out,) = step.solution.configuration.redundancy
                 step = self._step(T, signs, psi_out, step.solution.q, step.curvature, self.max_step)
             reach = self.max_step
-            for _ in range(SHRINKS):
+            for k in range(SHRINKS + 1):
                 # (a maximum on a floor: the step lands on it, rounded outside; at a fold, where
-                # the path ends: the step leaves the path beyond it)
+                # the path ends: the step leaves the path beyond it; the last try stays at psi)
                 if not ((isinstance(step, Tracked) and not step.feasible) or step == _REFUSED[_LEFT]):
                     break
-                reach /= 2.0
+                reach = reach / 4.0 if k < SHRINKS else 0.0
                 step = self._step(T, signs, psi, q, curvature, reach)
             if isinstance(step, Tracked) and not step.feasible:
                 if not step.margin >= 0.0:
