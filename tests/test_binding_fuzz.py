@@ -85,8 +85,16 @@ def recorded_calls() -> dict[str, tuple[Callable[..., Any], tuple[Any, ...]]]:
     ur5e = om.OMSolver("ur5e").solver_data()
     written = {
         "arm_angle_gradient": (data.params, data.model_table, q, np.zeros(7)),
-        "box_overlap": (np.zeros(3), np.eye(3).ravel(), np.array([0, 0, 0.1]), 0.05, np.ones(3), np.eye(3).ravel(),
-                        np.full(3, 0.2), np.zeros(6)),
+        "box_overlap": (
+            np.zeros(3),
+            R,
+            np.array([0, 0, 0.1]),
+            0.05,
+            np.ones(3),
+            R,
+            np.full(3, 0.2),
+            np.zeros(6),
+        ),
         "branch_values": (2, data.params, q, np.zeros(3)),
         "redundancy_values": (2, data.params, q, np.zeros(1)),
         "jacobian": (data.real_table, np.eye(4), np.eye(4), q, np.zeros((6, 7))),
@@ -105,15 +113,25 @@ def recorded_calls() -> dict[str, tuple[Callable[..., Any], tuple[Any, ...]]]:
         "solve": (T, c.signs, c.redundancy, None, np.zeros(7)),
         "solve_pose": (T, c),
         "solve_rows": (Ts, rows, psis, None, 0, m, np.zeros((m, 7)), np.zeros((m, 5))),
-        "solve_all_rows": (Ts, rows, psis, 0, m, np.zeros((m, roots, 7)), np.zeros((m, roots, 3)),
-                           np.zeros((m, 2), dtype=np.int64), np.ones(m, dtype=bool)),
+        "solve_all_rows": (
+            Ts,
+            rows,
+            psis,
+            0,
+            m,
+            np.zeros((m, roots, 7)),
+            np.zeros((m, roots, 3)),
+            np.zeros((m, 2), dtype=np.int64),
+            np.ones(m, dtype=bool),
+        ),
         "solve_all": (T, c.signs, c.redundancy, np.zeros((roots, 7)), np.zeros((roots, 3))),
         "configuration_values": (q, np.zeros(3), np.zeros(1)),
         "bounded_search": (T, c.signs, c.redundancy, np.zeros((roots, 7)), False),
         "holds": (q, c.signs, c.redundancy),
     }
     # (unbound, the Solver first: swapped as other solver arguments are)
-    calls |= {f"Solver.{name}": (getattr(ckernels.Solver, name), (kernel, *args)) for name, args in methods.items()}
+    for name, args in methods.items():
+        calls[f"Solver.{name}"] = (getattr(ckernels.Solver, name), (kernel, *args))
     gen3 = om.OMSolver("gen3")
     torus = (gen3.kernel, gen3.arm.fk(np.zeros(7)), (1, 1, 1), (0.0,), 0.1, 0.1, 0.05)
     calls["Solver.torus_bound"] = (ckernels.Solver.torus_bound, torus)
@@ -153,8 +171,10 @@ class _Clearing:
 def _array(rng: np.random.Generator, like: np.ndarray | None = None) -> np.ndarray:
     """An array of a random dtype and shape, or like's shape, of random and special entries."""
     dtype = rng.choice(["float64", "int64", "bool", "float32", "int32", "uint8", "complex128"])
-    shape = like.shape if like is not None and rng.random() < 0.5 else tuple(rng.integers(0, 5, rng.integers(0, 4)))
-    values = rng.choice(SPECIAL + [0.0, 1.0, -1.0, 0.5], size=shape) if shape else rng.choice(SPECIAL)
+    shape = tuple(rng.integers(0, 5, rng.integers(0, 4)))
+    if like is not None and rng.random() < 0.5:
+        shape = like.shape
+    values = rng.choice([*SPECIAL, 0.0, 1.0, -1.0, 0.5], size=shape) if shape else rng.choice(SPECIAL)
     with np.errstate(all="ignore"):
         return np.asarray(values).astype(dtype)
 
@@ -240,7 +260,10 @@ def fuzz(examples: int = EXAMPLES) -> None:
     counts = dict.fromkeys(names, 0)
     returned = {}
     # what a solver argument may become: a bare Solver, a 6-DOF arm's, a torus arm's
-    others = [ckernels.Solver.__new__(ckernels.Solver), om.OMSolver("ur5e").kernel, om.OMSolver("gen3").kernel]
+    others = [
+        ckernels.Solver.__new__(ckernels.Solver),
+        *(om.OMSolver(name).kernel for name in ("ur5e", "gen3")),
+    ]
 
     @settings(
         max_examples=examples,
@@ -254,7 +277,8 @@ def fuzz(examples: int = EXAMPLES) -> None:
         function, args = calls[name]
         if name.startswith("Solver") and not name.startswith("Solver."):  # the data's fields
             data = args[0]
-            args = (data._replace(**{f: _changed(rng, getattr(data, f)) for f in rng.choice(data._fields, 2)}),)
+            fields = rng.choice(data._fields, 2)
+            args = (data._replace(**{f: _changed(rng, getattr(data, f)) for f in fields}),)
         else:
             args = _mutated(rng, args)
             swap = rng.random() < 0.2
@@ -271,7 +295,9 @@ def fuzz(examples: int = EXAMPLES) -> None:
 
 
 def test_the_binding_returns_or_raises_for_any_arguments():
-    script = f"import faulthandler; faulthandler.dump_traceback_later(280, exit=True)\n" \
-             f"from tests.test_binding_fuzz import fuzz; fuzz({EXAMPLES})"
+    script = (
+        f"import faulthandler; faulthandler.dump_traceback_later(280, exit=True)\n"
+        f"from tests.test_binding_fuzz import fuzz; fuzz({EXAMPLES})"
+    )
     done = run_python("-c", script, timeout=300)
     assert done.returncode == 0, f"exit {done.returncode}\n{done.stdout[-2000:]}\n{done.stderr[-6000:]}"

@@ -114,7 +114,7 @@ def test_malformed_solver_data_is_refused():
         ur5e = om.OMSolver("ur5e").solver_data()
         wrist_row = ckernels.SD_WRIST_ROW
         bad = [
-            dict(scan_points=3), dict(scan_points=2**31), dict(scan_points=ckernels.MAX_SCAN_POINTS + 1),
+            dict(scan_points=3), dict(scan_points=2**30), dict(scan_points=ckernels.MAX_SCAN_POINTS + 1),
             dict(dp_joint=-1), dict(dp_joint=7), dict(mode=5), dict(family=9), dict(params=np.zeros(5)),
             dict(model_table=data.model_table[:3]), dict(real_table=data.real_table[:2]),
             dict(nominal_table=data.real_table[:1]), dict(flip=np.zeros(7)), dict(position_tolerance=np.nan),
