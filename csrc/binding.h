@@ -35,6 +35,12 @@ bool indices_within(const int64_t *index, Py_ssize_t n, Py_ssize_t stride, int64
 /* A family's parameters P and the joints dof checked against it (and its model's DH table, if
  * not NULL: the family's joints, and a 6-DOF one's wrist row within it); -1 with a ValueError. */
 int check_family(long family, const Py_buffer *P, Py_ssize_t dof, const Py_buffer *table);
+/* Copy n signs into out, each -1 or +1 (the kernels take a sign's value as given); -1 with a
+ * ValueError. */
+int copy_signs(const int64_t *signs, Py_ssize_t n, int64_t *out);
+/* A call's pose T (16 float64) and k signs copied out of their buffers (copy_signs): what the
+ * kernels read while the GIL is released stays as it was checked. -1 with a ValueError. */
+int copy_pose_and_signs(const Py_buffer *pose, const Py_buffer *signs, int k, double *T, int64_t *out);
 /* A tuple of the sequence obj's k items (k < 0: any number; a new reference), NULL with a
  * TypeError or ValueError naming the argument. A tuple, not the sequence itself: an item's
  * __index__ or __float__ may change a list while it is read, never the tuple. */

@@ -69,6 +69,22 @@ void release_buffers(Py_buffer *views, int n) {
     for (int i = 0; i < n; i++) PyBuffer_Release(&views[i]);
 }
 
+int copy_signs(const int64_t *signs, Py_ssize_t n, int64_t *out) {
+    for (Py_ssize_t i = 0; i < n; i++) {
+        if (signs[i] != 1 && signs[i] != -1) {
+            PyErr_SetString(PyExc_ValueError, "signs must be -1 or +1");
+            return -1;
+        }
+        out[i] = signs[i];
+    }
+    return 0;
+}
+
+int copy_pose_and_signs(const Py_buffer *pose, const Py_buffer *signs, int k, double *T, int64_t *out) {
+    memcpy(T, pose->buf, 16 * sizeof(double));
+    return copy_signs(signs->buf, k, out);
+}
+
 Py_ssize_t table_joints(const Py_buffer *table) {
     const double *t = table->buf;
     Py_ssize_t joints = 0;

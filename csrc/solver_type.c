@@ -243,11 +243,8 @@ static Py_ssize_t get_rows(const om_solver_data *s, PyObject *const *args, PyObj
     Py_ssize_t n = (*stop - *start) * s->n_signs;
     const int64_t *given = (const int64_t *)v[1].buf + *start * s->n_signs;
     *signs = PyMem_Malloc((size_t)(n + 1) * sizeof(int64_t));
-    bool ok = *signs != NULL;
-    for (Py_ssize_t i = 0; i < n && ok; i++) ok = ((*signs)[i] = given[i]) == 1 || given[i] == -1;
-    if (!ok) {
-        if (*signs) PyErr_SetString(PyExc_ValueError, "signs must be -1 or +1");
-        else PyErr_NoMemory();
+    if (!*signs || copy_signs(given, n, *signs) < 0) {
+        if (!*signs) PyErr_NoMemory();
         PyMem_Free(*signs);
         release_buffers(v, 3 + n_out);
         return -1;

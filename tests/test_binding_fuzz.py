@@ -30,6 +30,7 @@ EXAMPLES = int(os.environ.get("OM_FUZZ_EXAMPLES", "3000"))
 #: Special floats an array entry or a number may take.
 SPECIAL = [np.nan, np.inf, -np.inf, 1e308, -1e16, 1e16, 5e-324, -0.0, 1e-300, 2.0**53]
 INTS = [0, 1, -1, 2, 7, 16, 255, 2**31, -(2**31), 2**63 - 1, -(2**63), 2**64, -(2**70)]
+INT64S = INTS[:11]  # (those an int64 entry holds)
 
 
 def _snapshot(value: Any) -> Any:
@@ -207,7 +208,7 @@ def _changed(rng: np.random.Generator, value: Any) -> Any:
             flat = array.reshape(-1)
             at = rng.integers(0, flat.size, rng.integers(1, 4))
             with np.errstate(all="ignore"):
-                flat[at] = rng.choice(SPECIAL if array.dtype.kind == "f" else INTS[:10], at.size)
+                flat[at] = rng.choice(SPECIAL if array.dtype.kind == "f" else INT64S, at.size)
             return array
         if how == 5:
             with np.errstate(all="ignore"):

@@ -185,6 +185,9 @@ def test_a_follow_with_a_nan_target_returns():
                 ckernels.follow(kernel, T, SIGNS, cyclic, centred, np.zeros(7), *walk)
             except ValueError:
                 pass
+        walk = (Q.copy(), t[0].copy(), np.zeros(3), psi, psi + 1, 1e-9)
+        for signs in [np.array([1, 5, 1]), np.array([1, -(2**63), 1])]:  # (copied and checked)
+            raises(ValueError, ckernels.follow, kernel, T, signs, cyclic, centred, np.zeros(7), *walk)
     """,
         timeout=60,
     )
