@@ -68,7 +68,7 @@ static int check_data(const om_solver_data *s, long family, long mode, long dp_j
         problem = "tables: rows of 6, one joint per joint of the arm";
     else if (!(s->tol_pos > 0.0 && s->tol_ori > 0.0 && isfinite(s->tol_pos) && isfinite(s->tol_ori)) ||
              !(s->near_deviation >= 0.0 && isfinite(s->near_deviation)))
-        problem = "tolerances and near deviation: finite, positive";
+        problem = "tolerances: finite, > 0; near deviation: finite, >= 0";
     for (int j = 0; j < s->dof && !problem; j++)
         if (s->flip[j] != 1.0 && s->flip[j] != -1.0) problem = "flip: +-1 per joint";
     if (problem) PyErr_Format(PyExc_ValueError, "malformed solver data (%s)", problem);
@@ -270,7 +270,8 @@ static PyObject *Solver_solve_rows(Solver *self, PyObject *const *args, Py_ssize
     const double *Tb = v[0].buf, *rb = v[2].buf, *hb = n_out == 3 ? v[5].buf : NULL;
     double *qb = v[3].buf, *ib = v[4].buf;
     Py_BEGIN_ALLOW_THREADS for (Py_ssize_t i = start; i < stop; i++) {
-        om_result r = om_solve_one(s, Tb + 16 * i, signs + k * (i - start), rb + nr * i, hb ? hb + dof * i : NULL, qb + dof * i, NULL, NULL);
+        om_result r = om_solve_one(s, Tb + 16 * i, signs + k * (i - start), rb + nr * i, hb ? hb + dof * i : NULL,
+                                   qb + dof * i, NULL, NULL);
         double *row = ib + 5 * i;
         row[0] = r.status;
         row[1] = r.position_error;
@@ -312,8 +313,8 @@ static PyObject *Solver_solve_all_rows(Solver *self, PyObject *const *args, Py_s
     cache.memo = om_scan_memo_new(s);
     for (Py_ssize_t i = start; i < stop; i++) {
         int64_t evaluations;
-        counts[2 * i] = om_solve_all(s, Tb + 16 * i, signs + k * (i - start), rb + nr * i, roots + OM_MAX_ROOTS * dof * i,
-                                     info + OM_MAX_ROOTS * 3 * i, &evaluations, band[i],
+        counts[2 * i] = om_solve_all(s, Tb + 16 * i, signs + k * (i - start), rb + nr * i,
+                                     roots + OM_MAX_ROOTS * dof * i, info + OM_MAX_ROOTS * 3 * i, &evaluations, band[i],
                                      cache.candidates ? &cache : NULL);
         counts[2 * i + 1] = evaluations;
     }
