@@ -4,7 +4,7 @@
 /* ------------------------------------------------------------------------------------ */
 /* Module functions: kinematics and the families' closed forms.                           */
 
-static Py_ssize_t table_rows(Py_buffer *table) {
+static Py_ssize_t table_rows(const Py_buffer *table) {
     return table->len / (6 * 8);
 }
 
