@@ -26,7 +26,7 @@ pytestmark = pytest.mark.sanitize
 
 #: What a call may raise: a malformed argument, a Solver's state, an allocation refused.
 ACCEPTED = (TypeError, ValueError, OverflowError, RuntimeError, MemoryError)
-#: Draws per run (about 4 ms each; OM_FUZZ_EXAMPLES sets another number).
+#: Draws per run (about 1 ms each, under ASan too; OM_FUZZ_EXAMPLES sets another number).
 EXAMPLES = int(os.environ.get("OM_FUZZ_EXAMPLES", "3000"))
 #: Special floats an array entry or a number may take.
 SPECIAL = [np.nan, np.inf, -np.inf, 1e308, -1e16, 1e16, 5e-324, -0.0, 1e-300, 2.0**53]
