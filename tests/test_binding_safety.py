@@ -41,8 +41,9 @@ def solves(call=kernel.solve):
 
 
 def run_case(body: str, timeout: float = 120) -> None:
-    """Run PREAMBLE and body in a fresh interpreter, which must finish within timeout (s) and
-    print what the body's last line prints."""
+    """Run PREAMBLE and body in a fresh interpreter, which must reach the body's end (where it
+    prints "finished") within timeout (s) and exit 0: a crash, a hang or a failed assertion
+    there fails the test."""
     done = run_python("-c", PREAMBLE + textwrap.dedent(body) + "\nprint('finished')", timeout=timeout)
     assert done.returncode == 0 and done.stdout.rstrip().endswith("finished"), (
         f"exit {done.returncode}\n{done.stdout[-2000:]}\n{done.stderr[-4000:]}"
