@@ -27,9 +27,24 @@ typedef struct {
 int get_buffers(PyObject *const *objs, Py_buffer *views, const buffer_spec *specs, int n);
 /* Release views[0:n]. */
 void release_buffers(Py_buffer *views, int n);
+/* The joints (rows of kind 0 or 1, not 2: fixed) of a DH table's buffer (rows of 6 float64). */
+Py_ssize_t table_joints(const Py_buffer *table);
 /* Whether index[k * stride] lies in [lo, hi) for every k < n (a binding's check of the
  * joint or geom indices it is given, before it reads arrays at them). */
 bool indices_within(const int64_t *index, Py_ssize_t n, Py_ssize_t stride, int64_t lo, int64_t hi);
+/* A family's parameters P and the joints dof checked against it (and its model's DH table, if
+ * not NULL: the family's joints, and a 6-DOF one's wrist row within it); -1 with a ValueError. */
+int check_family(long family, const Py_buffer *P, Py_ssize_t dof, const Py_buffer *table);
+/* Copy n signs into out, each -1 or +1 (the kernels take a sign's value as given); -1 with a
+ * ValueError. */
+int copy_signs(const int64_t *signs, Py_ssize_t n, int64_t *out);
+/* A call's pose T (16 float64) and k signs copied out of their buffers (copy_signs): what the
+ * kernels read while the GIL is released stays as it was checked. -1 with a ValueError. */
+int copy_pose_and_signs(const Py_buffer *pose, const Py_buffer *signs, int k, double *T, int64_t *out);
+/* A tuple of the sequence obj's k items (k < 0: any number; a new reference), NULL with a
+ * TypeError or ValueError naming the argument. A tuple, not the sequence itself: an item's
+ * __index__ or __float__ may change a list while it is read, never the tuple. */
+PyObject *get_tuple(PyObject *obj, Py_ssize_t k, const char *name);
 /* A sequence of k signs, each -1 or +1, into out. */
 int get_signs(PyObject *obj, int64_t *out, int k);
 /* A sequence of k numbers into out. */
@@ -40,6 +55,11 @@ int get_doubles(PyObject *obj, double *out, int k, const char *name);
 #define OM_ORTHONORMALITY_TOL 1e-9
 /* T (16 float64, row-major 4x4): finite, last row [0 0 0 1], max|R^T R - I| <= tol, det R > 0. */
 int om_pose_is_valid(const double *T, double tol);
+
+/* The bounded search's grid points a Solver takes (ckernels.MIN_SCAN_POINTS, MAX_SCAN_POINTS;
+ * om_redundant.om.solver takes its bounds from here). */
+#define OM_MIN_SCAN_POINTS 8
+#define OM_MAX_SCAN_POINTS 1024
 
 /* The status names by status code (ckernels.STATUS_NAMES), made at import (module.c). */
 extern PyObject *om_status_names;
@@ -61,6 +81,8 @@ typedef struct {
     PyObject *empty;                                 /* numpy.empty */
 } om_Solver;
 
+/* solver_type.c: the Solver's data, or NULL with a RuntimeError where it was never initialised. */
+const om_solver_data *om_solver_ready(const om_Solver *self);
 /* solve_pose.c: Solver(..., solution_type=, configuration_type=) and Solver.solve_pose. */
 int om_solver_set_types(om_Solver *self, PyObject *solution_type, PyObject *configuration_type);
 void om_solver_clear_types(om_Solver *self);

@@ -69,23 +69,58 @@ void release_buffers(Py_buffer *views, int n) {
     for (int i = 0; i < n; i++) PyBuffer_Release(&views[i]);
 }
 
+int copy_signs(const int64_t *signs, Py_ssize_t n, int64_t *out) {
+    for (Py_ssize_t i = 0; i < n; i++) {
+        if (signs[i] != 1 && signs[i] != -1) {
+            PyErr_SetString(PyExc_ValueError, "signs must be -1 or +1");
+            return -1;
+        }
+        out[i] = signs[i];
+    }
+    return 0;
+}
+
+int copy_pose_and_signs(const Py_buffer *pose, const Py_buffer *signs, int k, double *T, int64_t *out) {
+    memcpy(T, pose->buf, 16 * sizeof(double));
+    return copy_signs(signs->buf, k, out);
+}
+
+Py_ssize_t table_joints(const Py_buffer *table) {
+    const double *t = table->buf;
+    Py_ssize_t joints = 0;
+    for (Py_ssize_t i = 0; i < table->len / 48; i++) joints += t[6 * i + 5] != 2.0;
+    return joints;
+}
+
 bool indices_within(const int64_t *index, Py_ssize_t n, Py_ssize_t stride, int64_t lo, int64_t hi) {
     for (Py_ssize_t k = 0; k < n; k++)
         if (index[k * stride] < lo || index[k * stride] >= hi) return false;
     return true;
 }
 
-/* Parse a sequence of k numbers (ints for signs) into out. */
-int get_signs(PyObject *obj, int64_t *out, int k) {
-    PyObject *seq = PySequence_Fast(obj, "signs must be a sequence");
-    if (!seq) return -1;
-    if (PySequence_Fast_GET_SIZE(seq) != k) {
-        PyErr_Format(PyExc_ValueError, "signs must have %d entries, got %zd", k, PySequence_Fast_GET_SIZE(seq));
-        Py_DECREF(seq);
-        return -1;
+PyObject *get_tuple(PyObject *obj, Py_ssize_t k, const char *name) {
+    PyObject *seq = PySequence_Check(obj) ? PySequence_Tuple(obj) : NULL;
+    if (!seq) {
+        if (!PyErr_Occurred() || PyErr_ExceptionMatches(PyExc_TypeError)) {
+            PyErr_Clear();
+            PyErr_Format(PyExc_TypeError, "%s must be a sequence", name);
+        }
+        return NULL;
     }
+    if (k >= 0 && PyTuple_GET_SIZE(seq) != k) {
+        PyErr_Format(PyExc_ValueError, "%s must have %zd entries, got %zd", name, k, PyTuple_GET_SIZE(seq));
+        Py_DECREF(seq);
+        return NULL;
+    }
+    return seq;
+}
+
+/* Parse a sequence of k signs into out. */
+int get_signs(PyObject *obj, int64_t *out, int k) {
+    PyObject *seq = get_tuple(obj, k, "signs");
+    if (!seq) return -1;
     for (int i = 0; i < k; i++) {
-        long long v = PyLong_AsLongLong(PySequence_Fast_GET_ITEM(seq, i));
+        long long v = PyLong_AsLongLong(PyTuple_GET_ITEM(seq, i));
         if (v == -1 && PyErr_Occurred()) {
             Py_DECREF(seq);
             return -1;
@@ -102,15 +137,10 @@ int get_signs(PyObject *obj, int64_t *out, int k) {
 }
 
 int get_doubles(PyObject *obj, double *out, int k, const char *name) {
-    PyObject *seq = PySequence_Fast(obj, "redundancy must be a sequence");
+    PyObject *seq = get_tuple(obj, k, name);
     if (!seq) return -1;
-    if (PySequence_Fast_GET_SIZE(seq) != k) {
-        PyErr_Format(PyExc_ValueError, "%s must have %d entries, got %zd", name, k, PySequence_Fast_GET_SIZE(seq));
-        Py_DECREF(seq);
-        return -1;
-    }
     for (int i = 0; i < k; i++) {
-        out[i] = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(seq, i));
+        out[i] = PyFloat_AsDouble(PyTuple_GET_ITEM(seq, i));
         if (out[i] == -1.0 && PyErr_Occurred()) {
             Py_DECREF(seq);
             return -1;

@@ -216,17 +216,17 @@ typedef struct {
 static int _samples(PyObject *const *lists, Py_ssize_t M, Py_ssize_t dof, Py_ssize_t n, samples *s)
 {
     for (Py_ssize_t m = 0; m < M; m++) {
-        PyObject *pieces = PySequence_Fast_GET_ITEM(lists[2], m);
+        PyObject *pieces = PyTuple_GET_ITEM(lists[2], m);
         if (!PyTuple_Check(pieces) || PyTuple_GET_SIZE(pieces) != 2) {
             PyErr_SetString(PyExc_TypeError, "cell_looks: each pieces item must be a tuple (g, dg)");
             return -1;
         }
-        if (_row(PySequence_Fast_GET_ITEM(lists[0], m), s->q, m, dof, "q") < 0 ||
+        if (_row(PyTuple_GET_ITEM(lists[0], m), s->q, m, dof, "q") < 0 ||
             _row(PyTuple_GET_ITEM(pieces, 0), s->g, m, n, "g") < 0 ||
             _row(PyTuple_GET_ITEM(pieces, 1), s->dg, m, n, "dg") < 0)
             return -1;
-        s->psi[m] = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(lists[1], m));
-        int f = PyObject_IsTrue(PySequence_Fast_GET_ITEM(lists[3], m));
+        s->psi[m] = PyFloat_AsDouble(PyTuple_GET_ITEM(lists[1], m));
+        int f = PyObject_IsTrue(PyTuple_GET_ITEM(lists[3], m));
         if (f < 0 || PyErr_Occurred()) return -1;
         s->feasible[m] = (uint8_t)f;
     }
@@ -281,16 +281,16 @@ static PyObject *om_cell_looks(PyObject *mod, PyObject *const *args, Py_ssize_t 
         {I64, -1, 0, "bounds"}, {U8, -1, 0, "cyclic"}, {F64, -1, 0, "hermite"}, {F64, -1, 1, "first"}};
     PyObject *const objs[4] = {args[4], args[5], args[8], args[9]};
     for (int i = 0; i < 4; i++) {
-        lists[i] = PySequence_Fast(args[i], "cell_looks: q, psi, pieces and feasible must be sequences");
+        lists[i] = get_tuple(args[i], -1, "cell_looks: q, psi, pieces and feasible each");
         if (!lists[i]) goto lists_fail;
     }
     if (get_buffers(objs, v, sp, 4) < 0) goto lists_fail;
-    Py_ssize_t M = PySequence_Fast_GET_SIZE(lists[0]), P = v[0].len / 8 - 1, N = v[2].len / 32;
+    Py_ssize_t M = PyTuple_GET_SIZE(lists[0]), P = v[0].len / 8 - 1, N = v[2].len / 32;
     const int64_t *bounds = v[0].buf;
     Py_ssize_t dof = P > 0 ? v[1].len / P : 0, n = 0;
     int bad = P < 0 || v[1].len != P * dof || v[2].len != N * 32 || v[3].len != M * 8 ||
               (P > 0 && (dof < 1 || dof > OM_MAX_DOF));
-    for (int i = 1; i < 4; i++) bad = bad || PySequence_Fast_GET_SIZE(lists[i]) != M;
+    for (int i = 1; i < 4; i++) bad = bad || PyTuple_GET_SIZE(lists[i]) != M;
     bad = bad || bounds[0] != 0 || bounds[P] != M; /* each path's first sample, from 0 to M, increasing */
     for (Py_ssize_t p = 1; p <= P && !bad; p++) bad = bounds[p] < bounds[p - 1];
     if (bad) {
@@ -298,7 +298,7 @@ static PyObject *om_cell_looks(PyObject *mod, PyObject *const *args, Py_ssize_t 
         goto fail;
     }
     if (M) { /* the pieces' count from the first sample's */
-        PyObject *pieces = PySequence_Fast_GET_ITEM(lists[2], 0);
+        PyObject *pieces = PyTuple_GET_ITEM(lists[2], 0);
         if (PyTuple_Check(pieces) && PyTuple_GET_SIZE(pieces) == 2) n = PyObject_Length(PyTuple_GET_ITEM(pieces, 0));
         if (n < 0) goto fail;
     }

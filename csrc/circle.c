@@ -8,6 +8,9 @@
 #define POLE_SPLITS 3            /* split points on either side of a close pass: azimuth steps of pi / 8 */
 #define POLE_SPREAD 60           /* then offsets doubling out to the cell's ends (g's own slope beside the turn) */
 #define POLE_DEPTH 64            /* nested splits of a cell at psi's half-line: to the last bit */
+#define POLE_BUDGET 65536        /* evaluations after which a scan splits no more cells (a pose far from
+                                  * orthonormal splits every cell to POLE_DEPTH: exponential); the most
+                                  * a whole solve takes on random poses is ~1,400 at 1,024 scan points */
 #define POLE_NEWTON 8            /* Newton steps to the closest pass of h to zero in a cell */
 #define POLE_ROUNDING 1e-15      /* relative rounding of W - S: of |e| + |u1| + |u2| (DBL_EPSILON 2.2e-16) */
 
@@ -330,6 +333,7 @@ typedef struct {
     double sigma;   /* bounds |h'| and |h''| */
     double sigma_z; /* bounds |z''| */
     double slack;   /* rounding of x(w) (m) */
+    int64_t until;  /* pb->counter from which no cell is split (POLE_BUDGET) */
 } pole_guard;
 
 /* The part of x across up. */
@@ -345,6 +349,7 @@ static vec3 _across(const pole_guard *pole, vec3 x)
 static pole_guard _pole_guard(om_problem *pb, double L)
 {
     pole_guard pole = {false};
+    pole.until = pb->counter + POLE_BUDGET;
     if (pb->s->family != OM_SRS)
         return pole;
     pole.up = v_load(pb->s->params, SRS_UP);
@@ -502,7 +507,8 @@ static int _pair(om_problem *pb, double a, double ga, double x0, double b, doubl
  * Sign changes bracket roots; local minima of |g| are searched for close pairs; a touch of
  * zero (|g| < OM_TOUCH without a crossing, also at an edge of reach) is a candidate for the
  * singular boundary, where the closed form's last digits are lost. A cell where w_hat passes
- * close by psi's half-line is split first (_pole_splits, at most depth times nested). A
+ * close by psi's half-line is split first (_pole_splits, at most depth times nested, and not
+ * once the scan has taken POLE_BUDGET evaluations). A
  * cyclic run covers the whole circle. curvatures: scratch for L doubles. */
 static int _run_roots(om_problem *pb, const pole_guard *pole, int depth, const double *pw, const double *pg, int L,
                       bool cyclic, double *curvatures, double *q, double *out, int n, int cap)
@@ -529,7 +535,7 @@ static int _run_roots(om_problem *pb, const pole_guard *pole, int depth, const d
         memmove(near, near + 1, 3 * sizeof(double));
         near[3] = _curvature_near(curvatures, L, cyclic, i + 3);
         double split[2 * (POLE_SPLITS + POLE_SPREAD) + 1];
-        int k = pole->active && depth > 0 ? _pole_splits(pole, pw[i], wj, split) : 0;
+        int k = pole->active && depth > 0 && pb->counter < pole->until ? _pole_splits(pole, pw[i], wj, split) : 0;
         if (k)
             n = _split_roots(pb, pole, depth - 1, pw[i], pg[i], split, k, wj, pg[j], q, out, n, cap);
         else

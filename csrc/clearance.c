@@ -289,9 +289,7 @@ static const buffer_spec arm_spec[N_ARM] = {
 /* Check the arm's arguments (table rows of 6, offsets of 12 per geom, links within 0..dof,
  * q rows of dof); the number of rows of q into *M, dof into *dof. */
 static int check_arm(Py_buffer *v, Py_ssize_t A, Py_ssize_t *M, int *dof, const char *what) {
-    Py_ssize_t n_rows = v[0].len / 48, joints = 0;
-    const double *table = v[0].buf;
-    for (Py_ssize_t k = 0; k < n_rows; k++) joints += table[6 * k + 5] != 2.0;
+    Py_ssize_t n_rows = v[0].len / 48, joints = table_joints(&v[0]);
     const int64_t *link = v[2].buf;
     int bad = v[0].len != n_rows * 48 || joints < 1 || joints > OM_MAX_DOF || v[2].len != A * 8 ||
               v[3].len != A * 96 || v[4].len != joints || v[5].len % (joints * 8) != 0;
@@ -381,15 +379,21 @@ static PyObject *om_arm_clearance(PyObject *mod, PyObject *const *args, Py_ssize
         return NULL;
     }
     const double *table = v[0].buf, *start = v[1].buf, *offset = v[3].buf, *q = v[5].buf;
-    const int64_t *link = v[2].buf, *kind = v[8].buf;
+    const int64_t *kind = v[8].buf;
     const uint8_t *slide = v[4].buf;
     const double *radius = v[9].buf, *half = v[10].buf, *bounds = v[12].buf;
     double *dist = v[13].buf, *fromto = v[14].buf, *grad = with_grad ? v[15].buf : NULL;
-    double *xpos = PyMem_RawMalloc((size_t)G * 12 * sizeof(double)), *xmat = xpos + 3 * G; /* poses, all geoms */
+    /* the poses of all geoms; the pairs and links, checked above with the GIL held, copied: the
+     * kernels index by them with the GIL released, while the caller's arrays may change */
+    double *xpos = PyMem_RawMalloc(((size_t)G * 12 + (size_t)(2 * P + A)) * sizeof(double)), *xmat = xpos + 3 * G;
     if (!xpos) {
         release_buffers(v, n_views);
         return PyErr_NoMemory();
     }
+    int64_t *pairs_copy = (int64_t *)(xmat + 9 * G), *link = pairs_copy + 2 * P;
+    memcpy(pairs_copy, pairs, (size_t)(2 * P) * sizeof(int64_t));
+    memcpy(link, v[2].buf, (size_t)A * sizeof(int64_t));
+    pairs = pairs_copy;
     memcpy(xpos + 3 * A, v[6].buf, (size_t)(G - A) * 3 * sizeof(double));
     memcpy(xmat + 9 * A, v[7].buf, (size_t)(G - A) * 9 * sizeof(double));
     int n_rows = (int)(v[0].len / 48);

@@ -165,8 +165,14 @@ static PyObject *om_follow(PyObject *mod, PyObject *const *args, Py_ssize_t narg
                                {U8, 7, 0, "centred"}, {F64, 7, 0, "centre"}, {F64, 7, 1, "q"},
                                {F64, 7, 1, "t"}, {F64, F_N, 1, "out"}};
     if (get_buffers(args + 1, v, sp, 8) < 0) return NULL;
+    double T[16];
+    int64_t signs[3];
+    if (copy_pose_and_signs(&v[0], &v[1], s->n_signs, T, signs) < 0) {
+        release_buffers(v, 8);
+        return NULL;
+    }
     int steps = 0, status;
-    Py_BEGIN_ALLOW_THREADS status = om_follow_path(s, v[0].buf, v[1].buf, v[2].buf, v[3].buf, v[4].buf, &psi,
+    Py_BEGIN_ALLOW_THREADS status = om_follow_path(s, T, signs, v[2].buf, v[3].buf, v[4].buf, &psi,
                                                    v[5].buf, v[6].buf, target, min_step, &steps);
     Py_END_ALLOW_THREADS double *out = v[7].buf;
     out[F_PSI] = psi, out[F_STATUS] = status, out[F_STEPS] = steps;

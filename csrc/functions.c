@@ -4,7 +4,7 @@
 /* ------------------------------------------------------------------------------------ */
 /* Module functions: kinematics and the families' closed forms.                           */
 
-static Py_ssize_t table_rows(Py_buffer *table) {
+static Py_ssize_t table_rows(const Py_buffer *table) {
     return table->len / (6 * 8);
 }
 
@@ -15,9 +15,8 @@ static PyObject *k_fk(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
     buffer_spec sp[5] = {{F64, -1, 0, "table"}, {F64, 16, 0, "base"}, {F64, 16, 0, "tool"}, {F64, -1, 0, "Q"},
                          {F64, -1, 1, "out"}};
     if (get_buffers(args, v, sp, 5) < 0) return NULL;
-    Py_ssize_t rows = table_rows(&v[0]), dof = 0;
+    Py_ssize_t rows = table_rows(&v[0]), dof = table_joints(&v[0]);
     const double *t = v[0].buf;
-    for (Py_ssize_t i = 0; i < rows; i++) dof += t[6 * i + 5] != 2.0;
     Py_ssize_t m = dof ? v[3].len / (8 * dof) : v[4].len / 128; /* no joints: one pose per out */
     if (v[0].len != rows * 48 || v[3].len != m * dof * 8 || v[4].len != m * 128) {
         release_buffers(v, 5);
@@ -39,9 +38,9 @@ static PyObject *k_jacobian(PyObject *mod, PyObject *const *args, Py_ssize_t nar
                          {F64, -1, 1, "J"}};
     if (get_buffers(args, v, sp, 5) < 0) return NULL;
     Py_ssize_t rows = table_rows(&v[0]), dof = v[3].len / 8;
-    if (dof > OM_MAX_DOF || v[4].len != 6 * dof * 8) {
+    if (v[0].len != rows * 48 || dof > OM_MAX_DOF || table_joints(&v[0]) != dof || v[4].len != 6 * dof * 8) {
         release_buffers(v, 5);
-        PyErr_SetString(PyExc_ValueError, "jacobian: shapes of q and J disagree");
+        PyErr_SetString(PyExc_ValueError, "jacobian: shapes of the table, q and J disagree");
         return NULL;
     }
     om_jacobian(v[0].buf, (int)rows, v[1].buf, v[2].buf, v[3].buf, (int)dof, v[4].buf, NULL, NULL);
@@ -55,6 +54,11 @@ static PyObject *k_flange(PyObject *mod, PyObject *const *args, Py_ssize_t nargs
     Py_buffer v[4];
     buffer_spec sp[4] = {{F64, -1, 0, "table"}, {F64, -1, 0, "q"}, {F64, 9, 1, "R"}, {F64, 3, 1, "p"}};
     if (get_buffers(args, v, sp, 4) < 0) return NULL;
+    if (v[0].len != table_rows(&v[0]) * 48 || table_joints(&v[0]) != v[1].len / 8) {
+        release_buffers(v, 4);
+        PyErr_SetString(PyExc_ValueError, "flange: shapes of the table and q disagree");
+        return NULL;
+    }
     om_flange(v[0].buf, (int)table_rows(&v[0]), v[1].buf, v[2].buf, v[3].buf);
     release_buffers(v, 4);
     Py_RETURN_NONE;
@@ -92,8 +96,7 @@ static vec3 load_vec(const double *p) {
     return v_load(p, 0);
 }
 
-/* Families' arguments are checked against the parameter vector's length and q's size. */
-static int check_family(long family, Py_buffer *P, Py_ssize_t dof) {
+int check_family(long family, const Py_buffer *P, Py_ssize_t dof, const Py_buffer *table) {
     Py_ssize_t need = family == OM_SRS ? SRS_N_PARAMS : SD_N_PARAMS;
     Py_ssize_t want_dof = family == OM_SRS ? 7 : 6;
     if (family < 0 || family > OM_SRS) {
@@ -102,6 +105,16 @@ static int check_family(long family, Py_buffer *P, Py_ssize_t dof) {
     }
     if (P->len != need * 8 || dof != want_dof) {
         PyErr_Format(PyExc_ValueError, "family %ld takes %zd parameters and %zd joints", family, need, want_dof);
+        return -1;
+    }
+    if (!table) return 0;
+    /* the 6-DOF closed form applies the rows before the wrist's, P[SD_WRIST_ROW] of them */
+    Py_ssize_t rows = table_rows(table);
+    double wrist_row = family == OM_SRS ? 0.0 : ((const double *)P->buf)[SD_WRIST_ROW];
+    if (table->len != rows * 48 || table_joints(table) != want_dof ||
+        !(wrist_row >= 0.0 && wrist_row <= (double)rows && wrist_row == floor(wrist_row))) {
+        PyErr_Format(PyExc_ValueError, "family %ld: the model table must hold %zd joints (and the wrist's row)",
+                     family, want_dof);
         return -1;
     }
     return 0;
@@ -117,7 +130,7 @@ static PyObject *k_model_ik(PyObject *mod, PyObject *const *args, Py_ssize_t nar
     buffer_spec sp[8] = {{F64, -1, 0, "P"}, {F64, -1, 0, "table"}, {F64, 9, 0, "R"}, {F64, 3, 0, "p"},
                          {I64, 3, 0, "signs"}, {F64, -1, 0, "redundancy"}, {F64, -1, 0, "q_prev"}, {F64, -1, 1, "q"}};
     if (get_buffers(args + 1, v, sp, 8) < 0) return NULL;
-    if (check_family(family, &v[0], v[7].len / 8) < 0 || v[6].len != v[7].len ||
+    if (check_family(family, &v[0], v[7].len / 8, &v[1]) < 0 || v[6].len != v[7].len ||
         v[5].len != (family == OM_SRS ? 8 : 0)) {
         if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "model_ik: shapes disagree");
         release_buffers(v, 8);
@@ -186,7 +199,7 @@ static PyObject *configuration_values(PyObject *const *args, Py_ssize_t nargs, i
     buffer_spec sp[3] = {{F64, -1, 0, "P"}, {F64, -1, 0, "q"}, {F64, -1, 1, "out"}};
     if (get_buffers(args + 1, v, sp, 3) < 0) return NULL;
     Py_ssize_t want = redundancy ? (family == OM_SRS ? 1 : 0) : 3;
-    if (check_family(family, &v[0], v[1].len / 8) < 0 || v[2].len < want * 8) {
+    if (check_family(family, &v[0], v[1].len / 8, NULL) < 0 || v[2].len < want * 8) {
         if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "out is too short");
         release_buffers(v, 3);
         return NULL;
@@ -213,6 +226,10 @@ static PyObject *k_arm_angle_gradient(PyObject *mod, PyObject *const *args, Py_s
     Py_buffer v[4];
     buffer_spec sp[4] = {{F64, SRS_N_PARAMS, 0, "P"}, {F64, -1, 0, "table"}, {F64, 7, 0, "q"}, {F64, 7, 1, "grad"}};
     if (get_buffers(args, v, sp, 4) < 0) return NULL;
+    if (check_family(OM_SRS, &v[0], 7, &v[1]) < 0) {
+        release_buffers(v, 4);
+        return NULL;
+    }
     double psi = om_arm_angle_gradient(v[0].buf, v[1].buf, (int)table_rows(&v[1]), v[2].buf, v[3].buf);
     release_buffers(v, 4);
     return PyFloat_FromDouble(psi);
@@ -271,6 +288,9 @@ static PyObject *k_all_finite(PyObject *mod, PyObject *const *args, Py_ssize_t n
     return PyBool_FromLong(ok);
 }
 
+/* The most Gauss-Newton steps a polish call takes (each a few microseconds, the GIL released). */
+#define MAX_POLISH_ITERATIONS 10000
+
 /* polish(table, R, p, q, iterations, P, model_table, psi) -> residual: om_polish of q in place
  * toward the flange pose (R (9), p (3)) in DH frame 0 of the chain `table`; P and model_table
  * None: no arm-angle row, else an S-R-S model's parameters and table with target psi. */
@@ -279,6 +299,10 @@ static PyObject *k_polish(PyObject *mod, PyObject *const *args, Py_ssize_t nargs
     long iterations = PyLong_AsLong(args[4]);
     double psi = PyFloat_AsDouble(args[7]);
     if (PyErr_Occurred()) return NULL;
+    if (iterations < 0 || iterations > MAX_POLISH_ITERATIONS) {
+        PyErr_Format(PyExc_ValueError, "polish: iterations must be 0 ... %d", MAX_POLISH_ITERATIONS);
+        return NULL;
+    }
     int with_psi = args[5] != Py_None;
     PyObject *const a[6] = {args[0], args[1], args[2], args[3], args[5], args[6]};
     Py_buffer v[6];
@@ -289,9 +313,8 @@ static PyObject *k_polish(PyObject *mod, PyObject *const *args, Py_ssize_t nargs
     t.table = v[0].buf;
     t.n_rows = (int)table_rows(&v[0]);
     t.dof = (int)(v[3].len / 8);
-    Py_ssize_t dof = 0;
-    for (Py_ssize_t i = 0; i < t.n_rows; i++) dof += ((const double *)v[0].buf)[6 * i + 5] != 2.0;
-    if (v[0].len != t.n_rows * 48 || dof != t.dof || t.dof > OM_MAX_DOF || (with_psi && t.dof != 7)) {
+    if (v[0].len != t.n_rows * 48 || table_joints(&v[0]) != t.dof || t.dof > OM_MAX_DOF || (with_psi && t.dof != 7) ||
+        (with_psi && check_family(OM_SRS, &v[4], 7, &v[5]) < 0)) {
         release_buffers(v, with_psi ? 6 : 4);
         PyErr_SetString(PyExc_ValueError, "polish: table, q (and a 7-joint arm for psi) disagree");
         return NULL;

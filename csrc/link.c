@@ -225,31 +225,34 @@ static PyObject *om_link_paths(PyObject *mod, PyObject *const *args, Py_ssize_t 
         {I64, -1, 1, "members"}, {I64, -1, 1, "paths"},        {I64, L_N, 1, "out"},
     };
     if (get_buffers(args + 1, v, sp, 15) < 0) return NULL;
-    const double *grid = v[5].buf;
-    const int64_t *counts = v[6].buf;
     Py_ssize_t n = v[6].len / 8, m = v[7].len / 8 / 7, capacity = v[9].len / 8, rows = m + capacity, total = 0;
     bool ok = n >= 1 && v[5].len / 8 == n && v[7].len == 8 * 7 * m && v[8].len == v[7].len;
     ok = ok && v[10].len == 8 * 7 * capacity && v[11].len == v[10].len && v[12].len == 8 * 2 * rows &&
          v[13].len == v[12].len;
+    double T[16];
+    int64_t signs[3], *work = NULL, *counts;
+    double *root_psi = NULL, *grid;
+    if (!ok) goto refuse;
+    work = malloc(sizeof(int64_t) * (size_t)(12 * rows + n + 1));
+    root_psi = malloc(sizeof(double) * (size_t)(m + n + 1));
+    if (!work || !root_psi) {
+        PyErr_NoMemory();
+        goto fail;
+    }
+    /* the pose, signs, grid and counts copied, then checked: the kernels read them with the GIL
+     * released, while the caller's arrays may change */
+    counts = work + 12 * rows, grid = root_psi + m;
+    memcpy(counts, v[6].buf, (size_t)n * sizeof(int64_t));
+    memcpy(grid, v[5].buf, (size_t)n * sizeof(double));
+    if (copy_pose_and_signs(&v[0], &v[1], s->n_signs, T, signs) < 0) goto fail;
     for (Py_ssize_t k = 0; ok && k < n; k++) {
         ok = counts[k] >= 0 && counts[k] <= m && isfinite(grid[k]) && (k == 0 || grid[k] > grid[k - 1]);
         total += ok ? counts[k] : 0;
     }
-    if (!ok || total != m || !(grid[n - 1] - grid[0] < TURN)) {
-        release_buffers(v, 15);
-        PyErr_SetString(PyExc_ValueError, "link_paths: sizes of the grid, counts, roots and outputs disagree, or "
-                                          "the grid is not increasing within a turn");
-        return NULL;
-    }
-    int64_t *work = malloc(sizeof(int64_t) * (size_t)(12 * rows + 1));
-    double *root_psi = malloc(sizeof(double) * (size_t)(m + 1));
-    if (!work || !root_psi) {
-        free(work), free(root_psi), release_buffers(v, 15);
-        return PyErr_NoMemory();
-    }
+    if (!ok || total != m || !(grid[n - 1] - grid[0] < TURN)) goto refuse;
     for (Py_ssize_t k = 0, r = 0; k < n; k++)
         for (int64_t c = 0; c < counts[k]; c++) root_psi[r++] = grid[k];
-    linker l = {.s = s, .T = v[0].buf, .signs = v[1].buf, .cyclic = v[2].buf, .centred = v[3].buf,
+    linker l = {.s = s, .T = T, .signs = signs, .cyclic = v[2].buf, .centred = v[3].buf,
                 .centre = v[4].buf, .n_roots = m, .n_rows = m, .capacity = capacity, .root_psi = root_psi,
                 .root_q = v[7].buf, .root_t = v[8].buf, .new_psi = v[9].buf, .new_q = v[10].buf, .new_t = v[11].buf,
                 .next = work, .n_paths = 0, .head = work + rows, .tail = work + 2 * rows, .first = work + 3 * rows};
@@ -262,6 +265,12 @@ static PyObject *om_link_paths(PyObject *mod, PyObject *const *args, Py_ssize_t 
     free(work), free(root_psi);
     release_buffers(v, 15);
     Py_RETURN_NONE;
+refuse:
+    PyErr_SetString(PyExc_ValueError, "link_paths: sizes of the grid, counts, roots and outputs disagree, or "
+                                      "the grid is not increasing within a turn");
+fail:
+    free(work), free(root_psi), release_buffers(v, 15);
+    return NULL;
 }
 
 PyMethodDef om_link_functions[] = {

@@ -23,6 +23,7 @@ PyMODINIT_FUNC PyInit_ckernels(void) {
         int value;
     } constants[] = {
         {"MAX_ROOTS", OM_MAX_ROOTS}, {"MAX_DOF", OM_MAX_DOF},
+        {"MIN_SCAN_POINTS", OM_MIN_SCAN_POINTS}, {"MAX_SCAN_POINTS", OM_MAX_SCAN_POINTS},
         {"SD_A1", SD_A1}, {"SD_D1", SD_D1}, {"SD_SIGMA1", SD_SIGMA1}, {"SD_THETA1", SD_THETA1},
         {"SD_LATERAL", SD_LATERAL}, {"SD_A2", SD_A2}, {"SD_THETA2", SD_THETA2}, {"SD_ELL3", SD_ELL3},
         {"SD_BETA", SD_BETA}, {"SD_THETA3", SD_THETA3}, {"SD_SIGMA2", SD_SIGMA2}, {"SD_D3", SD_D3},

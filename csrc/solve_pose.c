@@ -75,19 +75,22 @@ static int read_configuration(const om_Solver *self, PyObject *configuration, in
     return ok;
 }
 
-/* T as a valid pose (C-contiguous float64 4x4, om_pose_is_valid): 1 with the view held; 0 if
- * not (no exception set, no view held). */
-static int read_pose(PyObject *T, Py_buffer *view) {
-    if (PyObject_GetBuffer(T, view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
+/* T, a C-contiguous float64 4x4, copied into pose (the caller's array may change while the GIL
+ * is released: the copy is what is checked and solved): 1 if it is valid (om_pose_is_valid);
+ * 0 if not (no exception set). */
+static int read_pose(PyObject *T, double *pose) {
+    Py_buffer view;
+    if (PyObject_GetBuffer(T, &view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
         PyErr_Clear();
         return 0;
     }
-    const char *f = view->format ? view->format : "B";
+    const char *f = view.format ? view.format : "B";
     if (*f == '<' || *f == '=' || *f == '@') f++;
-    int ok = view->ndim == 2 && view->shape[0] == 4 && view->shape[1] == 4 && view->itemsize == 8 && f[0] == 'd' &&
-             f[1] == 0 && om_pose_is_valid(view->buf, OM_ORTHONORMALITY_TOL);
-    if (!ok) PyBuffer_Release(view);
-    return ok;
+    int ok = view.ndim == 2 && view.shape[0] == 4 && view.shape[1] == 4 && view.itemsize == 8 && f[0] == 'd' &&
+             f[1] == 0;
+    if (ok) memcpy(pose, view.buf, 16 * sizeof(double));
+    PyBuffer_Release(&view);
+    return ok && om_pose_is_valid(pose, OM_ORTHONORMALITY_TOL);
 }
 
 /* A new solution_type object with its fields set to values (references stolen). */
@@ -123,18 +126,18 @@ static PyObject *new_vector(const om_Solver *self, const double *q) {
 
 /* solve_pose(T, configuration) -> Solution, or None (see the top of this file). */
 PyObject *om_solver_solve_pose(om_Solver *self, PyObject *const *args, Py_ssize_t nargs) {
+    if (!om_solver_ready(self)) return NULL;
     if (nargs != 2) {
         PyErr_SetString(PyExc_TypeError, "solve_pose takes (T, configuration)");
         return NULL;
     }
     int64_t signs[3];
-    double redundancy[1], q[OM_MAX_DOF];
-    Py_buffer T;
-    if (!self->solution_type || !read_configuration(self, args[1], signs, redundancy) || !read_pose(args[0], &T))
+    double redundancy[1], q[OM_MAX_DOF], T[16];
+    if (!self->solution_type || !read_configuration(self, args[1], signs, redundancy) || !read_pose(args[0], T))
         Py_RETURN_NONE;
     om_result r;
-    Py_BEGIN_ALLOW_THREADS r = om_solve_one(&self->data, T.buf, signs, redundancy, NULL, q, NULL, NULL);
-    Py_END_ALLOW_THREADS PyBuffer_Release(&T);
+    Py_BEGIN_ALLOW_THREADS r = om_solve_one(&self->data, T, signs, redundancy, NULL, q, NULL, NULL);
+    Py_END_ALLOW_THREADS
     PyObject *values[OM_N_SOLUTION_FIELDS] = {
         new_vector(self, q),
         PyBool_FromLong(r.status == OM_OK),

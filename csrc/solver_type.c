@@ -30,100 +30,145 @@ static int attr_double(PyObject *obj, const char *name, double *out) {
     return (*out == -1.0 && PyErr_Occurred()) ? -1 : 0;
 }
 
-/* Copy the float64 array attribute `name` (n entries, or any size if n < 0) into dst (if
- * not NULL); returns its entry count, -1 on error. */
-static Py_ssize_t attr_copy(PyObject *obj, const char *name, double *dst, Py_ssize_t n) {
+/* The array attribute `name` of obj, of the given kind, into view (n entries; any if n < 0), held until
+ * released; -1 with an error. */
+static int attr_buffer(PyObject *obj, const char *name, Py_buffer *view, int kind, Py_ssize_t n) {
     PyObject *v = PyObject_GetAttrString(obj, name);
     if (!v) return -1;
-    Py_buffer view;
-    int rc = get_buffer(v, &view, F64, n, 0, name);
+    int rc = get_buffer(v, view, kind, n, 0, name);
     Py_DECREF(v);
-    if (rc < 0) return -1;
-    Py_ssize_t count = view.len / 8;
-    if (dst) memcpy(dst, view.buf, view.len);
+    return rc;
+}
+
+/* Copy the float64 array attribute `name` (n entries) into dst; -1 on error. */
+static int attr_copy(PyObject *obj, const char *name, double *dst, Py_ssize_t n) {
+    Py_buffer view;
+    if (attr_buffer(obj, name, &view, F64, n) < 0) return -1;
+    memcpy(dst, view.buf, (size_t)view.len);
     PyBuffer_Release(&view);
-    return count;
+    return 0;
+}
+
+/* The data's checks beyond their buffers' sizes: what the kernels index or loop by (the
+ * family's parameters and tables, the modes, dp_joint, the scan points, flip), so that no
+ * SolverData makes them read outside their arrays. -1 with a ValueError. */
+static int check_data(const om_solver_data *s, long family, long mode, long dp_joint, long scan_points,
+                      const Py_buffer *params, const Py_buffer *model_table, const Py_buffer *real_table,
+                      const Py_buffer *nominal_table) {
+    const char *problem = NULL;
+    if (check_family(family, params, s->dof, model_table) < 0) return -1;
+    if (mode != OM_FIXED && mode != OM_CIRCLE && mode != OM_TORUS)
+        problem = "mode: FIXED, CIRCLE or TORUS";
+    else if (dp_joint < 0 || dp_joint >= s->dof)
+        problem = "dp joint: a joint's index";
+    else if (scan_points < OM_MIN_SCAN_POINTS || scan_points > OM_MAX_SCAN_POINTS)
+        problem = "scan points: MIN_SCAN_POINTS ... MAX_SCAN_POINTS";
+    else if (real_table->len % 48 || table_joints(real_table) != s->dof || nominal_table->len % 48 ||
+             (nominal_table->len && table_joints(nominal_table) != s->dof))
+        problem = "tables: rows of 6, one joint per joint of the arm";
+    else if (!(s->tol_pos > 0.0 && s->tol_ori > 0.0 && isfinite(s->tol_pos) && isfinite(s->tol_ori)) ||
+             !(s->near_deviation >= 0.0 && isfinite(s->near_deviation)))
+        problem = "tolerances: finite, > 0; near deviation: finite, >= 0";
+    for (int j = 0; j < s->dof && !problem; j++)
+        if (s->flip[j] != 1.0 && s->flip[j] != -1.0) problem = "flip: +-1 per joint";
+    if (problem) PyErr_Format(PyExc_ValueError, "malformed solver data (%s)", problem);
+    return problem ? -1 : 0;
 }
 
 /* Solver(data, solution_type=None, configuration_type=None): data is an om_redundant
- * SolverData named tuple; the two types (Solution, Configuration) let solve_pose answer. */
+ * SolverData named tuple; the two types (Solution, Configuration) let solve_pose answer.
+ * Initialised once: the data is read and checked into a new store, kept only if all of it is
+ * good (calls on other threads may be reading the store, the GIL released). */
 static int Solver_init(Solver *self, PyObject *args, PyObject *kwds) {
     PyObject *d, *solution_type = Py_None, *configuration_type = Py_None;
     static char *kwlist[] = {"data", "solution_type", "configuration_type", NULL};
     if (!PyArg_ParseTupleAndKeywords(args, kwds, "O|$OO", kwlist, &d, &solution_type, &configuration_type))
         return -1;
-    if (om_solver_set_types(self, solution_type, configuration_type) < 0) return -1;
-    om_solver_data *s = &self->data;
+    if (self->storage) {
+        PyErr_SetString(PyExc_RuntimeError, "a Solver is initialised once");
+        return -1;
+    }
+    om_solver_data s = {0};
+    uint8_t revolute[OM_MAX_DOF];
     long family, mode, dp_joint, scan_points;
     if (attr_long(d, "family", &family) || attr_long(d, "mode", &mode) || attr_long(d, "dp_joint", &dp_joint) ||
-        attr_long(d, "scan_points", &scan_points) || attr_double(d, "position_tolerance", &s->tol_pos) ||
-        attr_double(d, "orientation_tolerance", &s->tol_ori) || attr_double(d, "near_deviation", &s->near_deviation))
+        attr_long(d, "scan_points", &scan_points) || attr_double(d, "position_tolerance", &s.tol_pos) ||
+        attr_double(d, "orientation_tolerance", &s.tol_ori) || attr_double(d, "near_deviation", &s.near_deviation))
         return -1;
-    Py_ssize_t n_params = attr_copy(d, "params", NULL, -1);
-    Py_ssize_t n_model = attr_copy(d, "model_table", NULL, -1);
-    Py_ssize_t n_real = attr_copy(d, "real_table", NULL, -1);
-    Py_ssize_t n_nominal = attr_copy(d, "nominal_table", NULL, -1);
-    Py_ssize_t dof = attr_copy(d, "lower", NULL, -1);
-    if (n_params < 0 || n_model < 0 || n_real < 0 || n_nominal < 0 || dof < 0) return -1;
-    if (dof < 1 || dof > OM_MAX_DOF || n_model % 6 || n_real % 6 || n_nominal % 6) {
-        PyErr_SetString(PyExc_ValueError, "malformed solver data (dof or table shape)");
-        return -1;
+    /* the arrays, held while they are checked and copied: params, the three tables, lower, upper */
+    enum { N_ARRAYS = 6 };
+    static const char *const names[N_ARRAYS] = {"params", "model_table", "real_table", "nominal_table", "lower",
+                                                "upper"};
+    Py_buffer v[N_ARRAYS];
+    int held = 0;
+    double *storage = NULL;
+    for (; held < N_ARRAYS; held++)
+        if (attr_buffer(d, names[held], &v[held], F64, held == 5 ? v[4].len / 8 : -1) < 0) goto fail;
+    s.dof = (int)(v[4].len / 8);
+    if (s.dof < 1 || s.dof > OM_MAX_DOF) {
+        PyErr_Format(PyExc_ValueError, "malformed solver data (dof: 1 ... %d)", OM_MAX_DOF);
+        goto fail;
     }
-    PyMem_Free(self->storage);
-    self->storage = PyMem_Malloc(sizeof(double) * (n_params + n_model + n_real + n_nominal + 2 * dof));
-    if (!self->storage) {
+    Py_buffer rev;
+    if (attr_copy(d, "flip", s.flip, s.dof) < 0 || attr_copy(d, "dp_coefficients", &s.D[0][0], 18) < 0 ||
+        attr_copy(d, "T_base_root", s.T_base_root, 16) < 0 || attr_copy(d, "T_tool_flange", s.T_tool_flange, 16) < 0 ||
+        attr_buffer(d, "revolute", &rev, U8, s.dof) < 0)
+        goto fail;
+    for (int j = 0; j < s.dof; j++) revolute[j] = ((const uint8_t *)rev.buf)[j] != 0;
+    PyBuffer_Release(&rev);
+    if (check_data(&s, family, mode, dp_joint, scan_points, &v[0], &v[1], &v[2], &v[3]) < 0) goto fail;
+    Py_ssize_t total = 0;
+    for (int i = 0; i < N_ARRAYS; i++) total += v[i].len;
+    if (!(storage = PyMem_Malloc((size_t)total))) {
         PyErr_NoMemory();
-        return -1;
+        goto fail;
     }
-    double *params = self->storage, *model = params + n_params, *real = model + n_model;
-    double *nominal = real + n_real, *lower = nominal + n_nominal, *upper = lower + dof;
-    double D[18];
-    if (attr_copy(d, "params", params, n_params) < 0 || attr_copy(d, "model_table", model, n_model) < 0 ||
-        attr_copy(d, "real_table", real, n_real) < 0 || attr_copy(d, "nominal_table", nominal, n_nominal) < 0 ||
-        attr_copy(d, "lower", lower, dof) < 0 || attr_copy(d, "upper", upper, dof) < 0 ||
-        attr_copy(d, "flip", s->flip, dof) < 0 || attr_copy(d, "dp_coefficients", D, 18) < 0 ||
-        attr_copy(d, "T_base_root", s->T_base_root, 16) < 0 || attr_copy(d, "T_tool_flange", s->T_tool_flange, 16) < 0)
-        return -1;
-    s->flipped = false;
-    for (Py_ssize_t j = 0; j < dof; j++) {
-        if (s->flip[j] != 1.0 && s->flip[j] != -1.0) {
-            PyErr_SetString(PyExc_ValueError, "malformed solver data (flip: +-1 per joint)");
-            return -1;
-        }
-        s->flipped = s->flipped || s->flip[j] < 0.0;
+    const double *arrays[N_ARRAYS];
+    double *at = storage;
+    for (int i = 0; i < N_ARRAYS; at += v[i].len / 8, i++) {
+        memcpy(at, v[i].buf, (size_t)v[i].len);
+        arrays[i] = at;
     }
-    PyObject *rev = PyObject_GetAttrString(d, "revolute");
-    if (!rev) return -1;
-    Py_buffer view;
-    int rc = get_buffer(rev, &view, U8, dof, 0, "revolute");
-    Py_DECREF(rev);
-    if (rc < 0) return -1;
-    for (Py_ssize_t j = 0; j < dof; j++) self->revolute[j] = ((const uint8_t *)view.buf)[j] != 0;
-    PyBuffer_Release(&view);
-    memcpy(s->D, D, sizeof D);
-    s->family = (int)family;
-    s->mode = (int)mode;
-    s->dof = (int)dof;
-    s->n_signs = 3;
-    s->n_redundancy = family == OM_SRS ? 1 : 0;
-    s->dp_joint = (int)dp_joint;
-    s->params = params;
-    s->model_table = model;
-    s->n_model_rows = (int)(n_model / 6);
-    s->real_table = real;
-    s->n_real_rows = (int)(n_real / 6);
-    s->nominal_table = n_nominal ? nominal : NULL;
-    s->n_nominal_rows = (int)(n_nominal / 6);
-    s->revolute = self->revolute;
-    s->lower = lower;
-    s->upper = upper;
-    s->scan_points = (int)scan_points;
-    s->trig_shared = om_trig_shared(s);
-    if (s->scan_points < 8 || (s->mode == OM_CIRCLE && (dp_joint < 0 || dp_joint >= dof))) {
-        PyErr_SetString(PyExc_ValueError, "malformed solver data (scan points or dp joint)");
-        return -1;
+    s.family = (int)family;
+    s.mode = (int)mode;
+    s.n_signs = 3;
+    s.n_redundancy = family == OM_SRS ? 1 : 0;
+    s.dp_joint = (int)dp_joint;
+    s.params = arrays[0];
+    s.model_table = arrays[1];
+    s.n_model_rows = (int)(v[1].len / 48);
+    s.real_table = arrays[2];
+    s.n_real_rows = (int)(v[2].len / 48);
+    s.nominal_table = v[3].len ? arrays[3] : NULL;
+    s.n_nominal_rows = (int)(v[3].len / 48);
+    s.lower = arrays[4];
+    s.upper = arrays[5];
+    s.scan_points = (int)scan_points;
+    for (int j = 0; j < s.dof; j++) s.flipped = s.flipped || s.flip[j] < 0.0;
+    release_buffers(v, held);
+    held = 0;
+    /* (the types' attributes run Python code, which might initialise this Solver meanwhile) */
+    if (om_solver_set_types(self, solution_type, configuration_type) < 0) goto fail;
+    if (self->storage) {
+        PyErr_SetString(PyExc_RuntimeError, "a Solver is initialised once");
+        goto fail;
     }
+    memcpy(self->revolute, revolute, sizeof revolute);
+    s.revolute = self->revolute;
+    s.trig_shared = om_trig_shared(&s);
+    self->data = s;
+    self->storage = storage;
     return 0;
+fail:
+    release_buffers(v, held);
+    PyMem_Free(storage);
+    return -1;
+}
+
+const om_solver_data *om_solver_ready(const om_Solver *self) {
+    if (self->storage) return &self->data;
+    PyErr_SetString(PyExc_RuntimeError, "the Solver is not initialised");
+    return NULL;
 }
 
 static PyObject *result_tuple(om_result r) {
@@ -149,16 +194,18 @@ static int get_call(const om_solver_data *s, PyObject *const *args, Py_ssize_t n
 /* solve(T, signs, redundancy, hint, q_out) -> (status, position error, orientation error,
  * evaluations, within limits). hint None: no hint. */
 static PyObject *Solver_solve(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
-    const om_solver_data *s = &self->data;
+    const om_solver_data *s = om_solver_ready(self);
     configuration c;
-    if (get_call(s, args, nargs, 5, "solve", &c) < 0) return NULL;
+    if (!s || get_call(s, args, nargs, 5, "solve", &c) < 0) return NULL;
     int n = args[3] != Py_None ? 3 : 2; /* the hint last, if there is one */
     PyObject *objs[3] = {args[0], args[4], args[3]};
     buffer_spec specs[3] = {{F64, 16, 0, "T"}, {F64, s->dof, 1, "q_out"}, {F64, s->dof, 0, "q_hint"}};
     Py_buffer v[3];
     if (get_buffers(objs, v, specs, n) < 0) return NULL;
+    double T[16]; /* (the caller's array may change while the GIL is released: a copy) */
+    memcpy(T, v[0].buf, sizeof T);
     om_result r;
-    Py_BEGIN_ALLOW_THREADS r = om_solve_one(s, v[0].buf, c.signs, c.redundancy, n == 3 ? v[2].buf : NULL, v[1].buf, NULL, NULL);
+    Py_BEGIN_ALLOW_THREADS r = om_solve_one(s, T, c.signs, c.redundancy, n == 3 ? v[2].buf : NULL, v[1].buf, NULL, NULL);
     Py_END_ALLOW_THREADS release_buffers(v, n);
     return result_tuple(r);
 }
@@ -166,9 +213,13 @@ static PyObject *Solver_solve(Solver *self, PyObject *const *args, Py_ssize_t na
 /* A batch call's rows start:stop (args[3], args[4]) and inputs: Ts (M, 4, 4) from args[0] into
  * v[0], signs (M, k) int64 and redundancy (M, r) from args[1], args[2] into v[1], v[2], and
  * the outputs outs[i] by specs[i] (n_out of them; entries given per row, times M here) into
- * v[3 + i]. Returns M, or -1 with a TypeError or ValueError (nothing acquired). */
+ * v[3 + i]; the rows' signs, each -1 or +1, copied into *signs (k per row from row start on;
+ * PyMem_Free it), for the caller's array may change while the GIL is released and the kernels
+ * take a sign's value as given. Returns M, or -1 with a TypeError or ValueError (nothing
+ * acquired). */
 static Py_ssize_t get_rows(const om_solver_data *s, PyObject *const *args, PyObject *const *outs,
-                           const buffer_spec *specs, int n_out, Py_buffer *v, Py_ssize_t *start, Py_ssize_t *stop) {
+                           const buffer_spec *specs, int n_out, Py_buffer *v, Py_ssize_t *start, Py_ssize_t *stop,
+                           int64_t **signs) {
     *start = PyLong_AsSsize_t(args[3]), *stop = PyLong_AsSsize_t(args[4]);
     if (PyErr_Occurred()) return -1;
     if (get_buffer(args[0], &v[0], F64, -1, 0, "Ts") < 0) return -1;
@@ -189,6 +240,15 @@ static Py_ssize_t get_rows(const om_solver_data *s, PyObject *const *args, PyObj
         release_buffers(v, 1);
         return -1;
     }
+    Py_ssize_t n = (*stop - *start) * s->n_signs;
+    const int64_t *given = (const int64_t *)v[1].buf + *start * s->n_signs;
+    *signs = PyMem_Malloc((size_t)(n + 1) * sizeof(int64_t));
+    if (!*signs || copy_signs(given, n, *signs) < 0) {
+        if (!*signs) PyErr_NoMemory();
+        PyMem_Free(*signs);
+        release_buffers(v, 3 + n_out);
+        return -1;
+    }
     return m;
 }
 
@@ -197,21 +257,21 @@ static Py_ssize_t get_rows(const om_solver_data *s, PyObject *const *args, PyObj
  * q_out (M, dof), info (M, 5) gets (status, position error, orientation error,
  * evaluations, within limits). */
 static PyObject *Solver_solve_rows(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
-    if (check_nargs(nargs, 8, "solve_rows") < 0)
-        return NULL;
-    const om_solver_data *s = &self->data;
+    const om_solver_data *s = om_solver_ready(self);
+    if (!s || check_nargs(nargs, 8, "solve_rows") < 0) return NULL;
     int dof = s->dof, k = s->n_signs, nr = s->n_redundancy, n_out = args[3] != Py_None ? 3 : 2;
     PyObject *rows[5] = {args[0], args[1], args[2], args[4], args[5]};
     PyObject *outs[3] = {args[6], args[7], args[3]};
     const buffer_spec specs[3] = {{F64, dof, 1, "q_out"}, {F64, 5, 1, "info"}, {F64, dof, 0, "q_hint"}};
     Py_buffer v[6]; /* Ts, signs, redundancy, q_out, info and the hints last */
     Py_ssize_t start, stop;
-    if (get_rows(s, rows, outs, specs, n_out, v, &start, &stop) < 0) return NULL;
+    int64_t *signs;
+    if (get_rows(s, rows, outs, specs, n_out, v, &start, &stop, &signs) < 0) return NULL;
     const double *Tb = v[0].buf, *rb = v[2].buf, *hb = n_out == 3 ? v[5].buf : NULL;
-    const int64_t *sb = v[1].buf;
     double *qb = v[3].buf, *ib = v[4].buf;
     Py_BEGIN_ALLOW_THREADS for (Py_ssize_t i = start; i < stop; i++) {
-        om_result r = om_solve_one(s, Tb + 16 * i, sb + k * i, rb + nr * i, hb ? hb + dof * i : NULL, qb + dof * i, NULL, NULL);
+        om_result r = om_solve_one(s, Tb + 16 * i, signs + k * (i - start), rb + nr * i, hb ? hb + dof * i : NULL,
+                                   qb + dof * i, NULL, NULL);
         double *row = ib + 5 * i;
         row[0] = r.status;
         row[1] = r.position_error;
@@ -220,6 +280,7 @@ static PyObject *Solver_solve_rows(Solver *self, PyObject *const *args, Py_ssize
         row[4] = r.within_limits;
     }
     Py_END_ALLOW_THREADS release_buffers(v, 3 + n_out);
+    PyMem_Free(signs);
     Py_RETURN_NONE;
 }
 
@@ -229,9 +290,8 @@ static PyObject *Solver_solve_rows(Solver *self, PyObject *const *args, Py_ssize
  * MAX_ROOTS, dof) and info (M, MAX_ROOTS, 3) get each row's as solve_all's, counts (M, 2)
  * int64 its (count, evaluations). */
 static PyObject *Solver_solve_all_rows(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
-    if (check_nargs(nargs, 9, "solve_all_rows") < 0)
-        return NULL;
-    const om_solver_data *s = &self->data;
+    const om_solver_data *s = om_solver_ready(self);
+    if (!s || check_nargs(nargs, 9, "solve_all_rows") < 0) return NULL;
     int dof = s->dof, k = s->n_signs, nr = s->n_redundancy;
     PyObject *outs[4] = {args[5], args[6], args[7], args[8]};
     const buffer_spec specs[4] = {{F64, OM_MAX_ROOTS * dof, 1, "roots"},
@@ -240,9 +300,9 @@ static PyObject *Solver_solve_all_rows(Solver *self, PyObject *const *args, Py_s
                                   {U8, 1, 0, "band"}};
     Py_buffer v[7];
     Py_ssize_t start, stop;
-    if (get_rows(s, args, outs, specs, 4, v, &start, &stop) < 0) return NULL;
+    int64_t *signs;
+    if (get_rows(s, args, outs, specs, 4, v, &start, &stop, &signs) < 0) return NULL;
     const double *Tb = v[0].buf, *rb = v[2].buf;
-    const int64_t *sb = v[1].buf;
     double *roots = v[3].buf, *info = v[4].buf;
     int64_t *counts = v[5].buf;
     const uint8_t *band = v[6].buf;
@@ -253,31 +313,34 @@ static PyObject *Solver_solve_all_rows(Solver *self, PyObject *const *args, Py_s
     cache.memo = om_scan_memo_new(s);
     for (Py_ssize_t i = start; i < stop; i++) {
         int64_t evaluations;
-        counts[2 * i] = om_solve_all(s, Tb + 16 * i, sb + k * i, rb + nr * i, roots + OM_MAX_ROOTS * dof * i,
-                                     info + OM_MAX_ROOTS * 3 * i, &evaluations, band[i],
+        counts[2 * i] = om_solve_all(s, Tb + 16 * i, signs + k * (i - start), rb + nr * i,
+                                     roots + OM_MAX_ROOTS * dof * i, info + OM_MAX_ROOTS * 3 * i, &evaluations, band[i],
                                      cache.candidates ? &cache : NULL);
         counts[2 * i + 1] = evaluations;
     }
     free(cache.candidates);
     om_scan_memo_free(cache.memo);
     Py_END_ALLOW_THREADS release_buffers(v, 7);
+    PyMem_Free(signs);
     Py_RETURN_NONE;
 }
 
 /* solve_all(T, signs, redundancy, roots, info) -> (count, evaluations); roots (MAX_ROOTS,
  * dof), info (MAX_ROOTS, 3) gets (position error, orientation error, within limits). */
 static PyObject *Solver_solve_all(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
-    const om_solver_data *s = &self->data;
+    const om_solver_data *s = om_solver_ready(self);
     configuration c;
-    if (get_call(s, args, nargs, 5, "solve_all", &c) < 0) return NULL;
+    if (!s || get_call(s, args, nargs, 5, "solve_all", &c) < 0) return NULL;
     PyObject *objs[3] = {args[0], args[3], args[4]};
     buffer_spec specs[3] = {{F64, 16, 0, "T"}, {F64, OM_MAX_ROOTS * s->dof, 1, "roots"},
                             {F64, OM_MAX_ROOTS * 3, 1, "info"}};
     Py_buffer v[3];
     if (get_buffers(objs, v, specs, 3) < 0) return NULL;
+    double T[16]; /* (a copy, as solve's) */
+    memcpy(T, v[0].buf, sizeof T);
     int n;
     int64_t evaluations;
-    Py_BEGIN_ALLOW_THREADS n = om_solve_all(s, v[0].buf, c.signs, c.redundancy, v[1].buf, v[2].buf, &evaluations, true, NULL);
+    Py_BEGIN_ALLOW_THREADS n = om_solve_all(s, T, c.signs, c.redundancy, v[1].buf, v[2].buf, &evaluations, true, NULL);
     Py_END_ALLOW_THREADS release_buffers(v, 3);
     return Py_BuildValue("(iL)", n, (long long)evaluations);
 }
@@ -287,19 +350,20 @@ static PyObject *Solver_solve_all(Solver *self, PyObject *const *args, Py_ssize_
  * (MAX_ROOTS, dof), as found, in the arm's own joints), with the torus certificate where it
  * proves them (certify) or the grid search alone: what the tests compare. */
 static PyObject *Solver_bounded_search(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
-    const om_solver_data *s = &self->data;
+    const om_solver_data *s = om_solver_ready(self);
     configuration c;
-    if (get_call(s, args, nargs, 5, "bounded_search", &c) < 0) return NULL;
+    if (!s || get_call(s, args, nargs, 5, "bounded_search", &c) < 0) return NULL;
     int certify = PyObject_IsTrue(args[4]);
     if (certify < 0) return NULL;
     PyObject *objs[2] = {args[0], args[3]};
     buffer_spec specs[2] = {{F64, 16, 0, "T"}, {F64, OM_MAX_ROOTS * s->dof, 1, "roots"}};
     Py_buffer v[2];
     if (get_buffers(objs, v, specs, 2) < 0) return NULL;
-    double zeros[OM_MAX_DOF] = {0.0}, psi[1];
+    double zeros[OM_MAX_DOF] = {0.0}, psi[1], T[16]; /* (T: a copy, as solve's) */
+    memcpy(T, v[0].buf, sizeof T);
     om_problem pb;
     int n;
-    Py_BEGIN_ALLOW_THREADS om_problem_init(&pb, s, v[0].buf, c.signs, c.redundancy, psi, zeros);
+    Py_BEGIN_ALLOW_THREADS om_problem_init(&pb, s, T, c.signs, c.redundancy, psi, zeros);
     pb.certify = certify && pb.certify; /* (never for an arm near a family: om_problem_init) */
     n = om_all_roots(&pb, s->scan_points, v[1].buf, zeros, INFINITY);
     for (int r = 0; r < n && s->flipped; r++)
@@ -312,9 +376,9 @@ static PyObject *Solver_bounded_search(Solver *self, PyObject *const *args, Py_s
  * om_torus_cell_bound for the configuration (an arm whose search is on the torus), what its
  * tests check against the map itself. */
 static PyObject *Solver_torus_bound(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
-    const om_solver_data *s = &self->data;
+    const om_solver_data *s = om_solver_ready(self);
     configuration c;
-    if (get_call(s, args, nargs, 6, "torus_bound", &c) < 0) return NULL;
+    if (!s || get_call(s, args, nargs, 6, "torus_bound", &c) < 0) return NULL;
     double w1 = PyFloat_AsDouble(args[3]), w7 = PyFloat_AsDouble(args[4]), h = PyFloat_AsDouble(args[5]);
     if (PyErr_Occurred()) return NULL;
     if (s->mode != OM_TORUS) {
@@ -334,8 +398,8 @@ static PyObject *Solver_torus_bound(Solver *self, PyObject *const *args, Py_ssiz
 
 /* configuration_values(q, branch, redundancy): the branch quantities and redundancy values at q. */
 static PyObject *Solver_configuration_values(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
-    if (check_nargs(nargs, 3, "configuration_values") < 0) return NULL;
-    const om_solver_data *s = &self->data;
+    const om_solver_data *s = om_solver_ready(self);
+    if (!s || check_nargs(nargs, 3, "configuration_values") < 0) return NULL;
     buffer_spec specs[3] = {{F64, s->dof, 0, "q"}, {F64, s->n_signs, 1, "branch"},
                             {F64, s->n_redundancy, 1, "redundancy"}};
     Py_buffer v[3];
@@ -347,9 +411,9 @@ static PyObject *Solver_configuration_values(Solver *self, PyObject *const *args
 
 /* holds(q, signs, redundancy) -> bool: om_in_configuration (the band contract). */
 static PyObject *Solver_holds(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
-    const om_solver_data *s = &self->data;
+    const om_solver_data *s = om_solver_ready(self);
     configuration c;
-    if (get_call(s, args, nargs, 3, "holds", &c) < 0) return NULL;
+    if (!s || get_call(s, args, nargs, 3, "holds", &c) < 0) return NULL;
     Py_buffer q;
     if (get_buffer(args[0], &q, F64, s->dof, 0, "q") < 0) return NULL;
     double at[OM_MAX_DOF]; /* the kernels' coordinates */
@@ -384,7 +448,8 @@ const om_solver_data *om_srs7_solver(PyObject *obj, const char *what) {
         PyErr_Format(PyExc_TypeError, "%s: solver must be a ckernels.Solver", what);
         return NULL;
     }
-    const om_solver_data *s = &((om_Solver *)obj)->data;
+    const om_solver_data *s = om_solver_ready((om_Solver *)obj);
+    if (!s) return NULL;
     if (s->family != OM_SRS || s->dof != 7) {
         PyErr_Format(PyExc_ValueError, "%s: the solver must be a 7-DOF arm's (S-R-S model)", what);
         return NULL;

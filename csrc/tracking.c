@@ -240,6 +240,12 @@ PyObject *om_track_step(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) 
                 {F64, O_N, 1, "out"}};
     if (get_buffers(args + 1, v, sp, 13) < 0)
         return NULL;
+    double T[16];
+    int64_t signs[3];
+    if (copy_pose_and_signs(&v[0], &v[1], s->n_signs, T, signs) < 0) {
+        release_buffers(v, 13);
+        return NULL;
+    }
     int status = -1;
     const double *setup = v[3].buf;
     Py_ssize_t n_sing = v[6].len / 8, n_clear = v[9].len / 8;
@@ -257,7 +263,7 @@ PyObject *om_track_step(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) 
                        {setup[S_WM], setup[S_WC], setup[S_WS]},
                        {FLOOR_SLACK, setup[S_FLOOR_C] + FLOOR_SLACK, -INFINITY},
                        {INFINITY, 1.0, 1.0}};
-        status = track(&tr, v[0].buf, v[1].buf, v[2].buf, v[11].buf, v[12].buf);
+        status = track(&tr, T, signs, v[2].buf, v[11].buf, v[12].buf);
     }
     release_buffers(v, 13);
     return status < 0 ? NULL : PyLong_FromLong(status);

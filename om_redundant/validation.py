@@ -168,7 +168,9 @@ def as_poses(T: Any, name: str = "T") -> np.ndarray:
 
     Takes an (M, 4, 4) array or a sequence of M (4, 4) arrays. An empty batch and
     ``mink.SE3`` (one, or a sequence of them) are refused with the fix in the message:
-    ``solve`` takes one SE3, and the stack of matrices is one ``np.stack`` away.
+    ``solve`` takes one SE3, and the stack of matrices is one ``np.stack`` away. Always a
+    copy: what is checked is what the kernels solve, whatever another thread writes into the
+    caller's array meanwhile.
     """
     expected = "(M, 4, 4) poses"
     if _is_se3(T) or (isinstance(T, list | tuple) and any(_is_se3(x) for x in T)):
@@ -182,7 +184,7 @@ def as_poses(T: Any, name: str = "T") -> np.ndarray:
         raise InvalidInput(f"{name} holds no poses (shape {T.shape}): a batch needs at least one")
     if T.ndim != 3 or T.shape[1:] != (4, 4):
         raise InvalidInput(f"{name} must have shape (M, 4, 4), got {T.shape}")
-    T = np.ascontiguousarray(T)
+    T = np.array(T, order="C")
     _check_poses(T, name)
     return T
 

@@ -17,6 +17,8 @@ from om_redundant.redundancy.self_motion import self_motion_tangent
 from tests.conftest import random_q
 from tests.test_reliability import BOUNDARY_CASES
 
+pytestmark = pytest.mark.sanitize  # also run under ASan and UBSan (.ci/sanitize)
+
 
 @pytest.fixture(scope="module")
 def panda() -> om.OMSolver:

@@ -14,6 +14,8 @@ import om_redundant as om
 from om_redundant import ckernels
 from tests.conftest import random_q
 
+pytestmark = pytest.mark.sanitize  # also run under ASan and UBSan (.ci/sanitize)
+
 ARMS = ("panda", "iiwa14", "gen3", "ur5e", "spherical")
 
 

@@ -12,6 +12,8 @@ from om_redundant.om import model as model_module
 from tests.conftest import random_q, wrap
 from tests.ur_closed_form import ur_ik
 
+pytestmark = pytest.mark.sanitize  # also run under ASan and UBSan (.ci/sanitize)
+
 
 @pytest.fixture(scope="module")
 def spherical():

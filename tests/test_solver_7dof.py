@@ -12,6 +12,8 @@ from om_redundant.om.families import REACH_SLACK, model_ik
 from om_redundant.om.system import flange_target
 from tests.conftest import random_q, wrap
 
+pytestmark = pytest.mark.sanitize  # also run under ASan and UBSan (.ci/sanitize)
+
 ARMS = ["panda", "fr3", "iiwa14", "gen3", "xarm7", "sawyer"]
 
 

@@ -43,7 +43,7 @@ _SELF_CHECKED: weakref.WeakKeyDictionary[Arm, set[tuple]] = weakref.WeakKeyDicti
 #: Bounds of ``scan_points``. The bounded search of an arm whose dp turns with two joints
 #: (the Gen3's torus) costs the square of it: one ``solve_all`` takes 0.7 s at 1024 points
 #: (11 s at 4096), 6 ms at the default 64.
-MIN_SCAN_POINTS, MAX_SCAN_POINTS = 8, 1024
+MIN_SCAN_POINTS, MAX_SCAN_POINTS = ckernels.MIN_SCAN_POINTS, ckernels.MAX_SCAN_POINTS
 #: Most worker threads ``solve_batch`` accepts (it uses at most one per core).
 MAX_THREADS = 1024
 

@@ -1,0 +1,257 @@
+"""The compiled kernels' entry points are safe for any Python input: a Solver initialised
+once, an uninitialised one, lists changed while they are read, malformed solver data, sizes,
+signs and indices out of range, tables shorter than q, NaN targets, rotations far from
+orthonormal, and a pose written by another thread during a batch. Each case runs in a fresh
+interpreter (``run_case``): a crash or a hang fails its test instead of the whole run."""
+
+from __future__ import annotations
+
+import textwrap
+
+import pytest
+
+from tests.conftest import run_python
+
+pytestmark = pytest.mark.sanitize
+
+PREAMBLE = """
+import threading
+import numpy as np
+import om_redundant as om
+from om_redundant import ckernels
+
+solver = om.OMSolver("panda")
+kernel, data = solver.kernel, solver.solver_data()
+Q = np.array([0.3, -0.4, 0.2, -2.2, 0.3, 1.9, 0.6])
+T, c = solver.arm.fk(Q), solver.configuration_of(Q)
+SIGNS = np.array(c.signs, dtype=np.int64)
+
+
+def raises(kind, call, *args):
+    try:
+        call(*args)
+    except kind:
+        return
+    raise AssertionError(f"{call} {args!r:.200} did not raise {kind.__name__}")
+
+
+def solves(call=kernel.solve):
+    assert call(T, c.signs, c.redundancy, None, np.zeros(7))[0] == ckernels.OK
+"""
+
+
+def run_case(body: str, timeout: float = 120) -> None:
+    """Run PREAMBLE and body in a fresh interpreter, which must reach the body's end (where it
+    prints "finished") within timeout (s) and exit 0: a crash, a hang or a failed assertion
+    there fails the test."""
+    done = run_python("-c", PREAMBLE + textwrap.dedent(body) + "\nprint('finished')", timeout=timeout)
+    assert done.returncode == 0 and done.stdout.rstrip().endswith("finished"), (
+        f"exit {done.returncode}\n{done.stdout[-2000:]}\n{done.stderr[-4000:]}"
+    )
+
+
+def test_a_solver_is_initialised_once():
+    run_case("""
+        raises(RuntimeError, kernel.__init__, data._replace(flip=np.ones(3)))  # was a use after free
+        raises(RuntimeError, kernel.__init__, data)
+        solves()
+        fresh = ckernels.Solver.__new__(ckernels.Solver)
+        raises(ValueError, fresh.__init__, data._replace(flip=np.ones(3)))
+        raises(ValueError, fresh.__init__, data._replace(scan_points=3))
+        raises(RuntimeError, fresh.solve, T, c.signs, c.redundancy, None, np.zeros(7))
+        fresh.__init__(data)
+        solves(fresh.solve)
+    """)
+
+
+def test_an_uninitialised_solver_raises():
+    run_case("""
+        bare = ckernels.Solver.__new__(ckernels.Solver)
+        methods = ["solve", "solve_pose", "solve_rows", "solve_all_rows", "solve_all", "configuration_values",
+                   "bounded_search", "torus_bound", "holds"]
+        for name in methods:
+            raises(RuntimeError, getattr(bare, name))
+        raises(RuntimeError, bare.solve, T, (), (), None, np.zeros(0))
+        walks = [("follow", 12), ("link_paths", 16), ("track_step", 14), ("self_motion_tangents", 3)]
+        for name, arity in walks:
+            raises(RuntimeError, getattr(ckernels, name), bare, *[None] * (arity - 1))
+    """)
+
+
+def test_lists_emptied_while_they_are_read():
+    run_case("""
+        class Clears:
+            def __init__(self, items, value):
+                self.items, self.value = items, value
+            def __index__(self):
+                self.items.clear()
+                return self.value
+            def __float__(self):
+                self.items.clear()
+                return float(self.value)
+            def __bool__(self):
+                self.items.clear()
+                return True
+
+        signs = []
+        signs += [Clears(signs, s) for s in c.signs]
+        redundancy = []
+        redundancy.append(Clears(redundancy, c.redundancy[0]))
+        assert kernel.solve(T, signs, redundancy, None, np.zeros(7))[0] == ckernels.OK
+        assert kernel.holds(Q, signs[:] or [Clears(signs, s) for s in c.signs], c.redundancy)
+        psi, feasible = [], []
+        psi += [Clears(psi, 0.0), 0.1, 0.2]
+        feasible += [True, Clears(feasible, True), True]
+        q = [Q.copy() for _ in range(3)]
+        pieces = [(np.ones(1), np.zeros(1))] * 3
+        first = np.zeros(3)
+        ckernels.cell_looks(q, psi, pieces, feasible, np.array([0, 3]), np.zeros(7, dtype=bool), 1.0, 0.0,
+                            np.zeros((4, 3)), first)
+    """)
+
+
+def test_malformed_solver_data_is_refused():
+    run_case("""
+        ur5e = om.OMSolver("ur5e").solver_data()
+        wrist_row = ckernels.SD_WRIST_ROW
+        bad = [
+            dict(scan_points=3), dict(scan_points=2**30), dict(scan_points=ckernels.MAX_SCAN_POINTS + 1),
+            dict(dp_joint=-1), dict(dp_joint=7), dict(mode=5), dict(family=9), dict(params=np.zeros(5)),
+            dict(model_table=data.model_table[:3]), dict(real_table=data.real_table[:2]),
+            dict(nominal_table=data.real_table[:1]), dict(flip=np.zeros(7)), dict(position_tolerance=np.nan),
+            dict(orientation_tolerance=0.0), dict(near_deviation=np.inf), dict(lower=np.zeros(9)),
+            dict(upper=np.zeros(6)), dict(lower=np.zeros(0)),
+        ]
+        for change in bad:
+            raises(ValueError, ckernels.Solver, data._replace(**change))
+        raises(OverflowError, ckernels.Solver, data._replace(dp_joint=2**70))
+        raises(TypeError, ckernels.Solver, data._replace(params=list(data.params)))
+        for row in [np.nan, 1e9, -1.0, 2.5]:
+            params = ur5e.params.copy()
+            params[wrist_row] = row
+            raises(ValueError, ckernels.Solver, ur5e._replace(params=params))
+            raises(ValueError, ckernels.model_ik, 0, params, ur5e.model_table, np.eye(3), np.zeros(3),
+                   np.ones(3, dtype=np.int64), np.zeros(0), np.zeros(6), np.zeros(6), False)
+    """)
+
+
+def test_batch_rows_refuse_signs_and_rows_out_of_range():
+    run_case("""
+        Ts = np.stack([T, T])
+        q, info = np.zeros((2, 7)), np.zeros((2, 5))
+        psi = np.full((2, 1), c.redundancy[0])
+        for sign in [5, 0, -2**63]:
+            signs = np.array([c.signs, c.signs], dtype=np.int64)
+            signs[1, 1] = sign
+            raises(ValueError, kernel.solve_rows, Ts, signs, psi, None, 0, 2, q, info)
+            roots, root_info = np.zeros((2, ckernels.MAX_ROOTS, 7)), np.zeros((2, ckernels.MAX_ROOTS, 3))
+            raises(ValueError, kernel.solve_all_rows, Ts, signs, psi, 0, 2, roots, root_info,
+                   np.zeros((2, 2), dtype=np.int64), np.ones(2, dtype=bool))
+            kernel.solve_rows(Ts, signs, psi, None, 0, 1, q, info)  # the rows asked for are checked
+        signs = np.array([c.signs, c.signs], dtype=np.int64)
+        for start, stop in [(-1, 1), (0, 3), (2, 1), (2**62, 2**62 + 1)]:
+            raises(ValueError, kernel.solve_rows, Ts, signs, psi, None, start, stop, q, info)
+        raises(OverflowError, kernel.solve_rows, Ts, signs, psi, None, 0, 2**70, q, info)
+        raises(ValueError, kernel.solve, T, (1, 2, 1), c.redundancy, None, np.zeros(7))
+    """)
+
+
+def test_tables_shorter_than_q_are_refused():
+    run_case("""
+        table = data.real_table
+        raises(ValueError, ckernels.jacobian, table[:2], np.eye(4), np.eye(4), Q, np.zeros((6, 7)))
+        raises(ValueError, ckernels.flange, table[:2], Q, np.zeros(9), np.zeros(3))
+        raises(ValueError, ckernels.flange, table, Q[:3], np.zeros(9), np.zeros(3))
+        raises(ValueError, ckernels.arm_angle_gradient, data.params, data.model_table[:2], Q, np.zeros(7))
+        raises(ValueError, ckernels.polish, table, np.eye(3), np.zeros(3), Q, 5, data.params,
+               data.model_table[:2], 0.0)
+        raises(ValueError, ckernels.polish, table, np.eye(3), np.zeros(3), Q, 2**40, None, None, 0.0)
+        J = np.zeros((6, 7))
+        ckernels.jacobian(table, np.eye(4), np.eye(4), Q, J)
+        assert np.isfinite(J).all()
+    """)
+
+
+def test_a_follow_with_a_nan_target_returns():
+    run_case(
+        """
+        t = np.zeros((1, 7))
+        ckernels.self_motion_tangents(kernel, Q[None], t)
+        cyclic, centred = np.zeros(7, dtype=bool), np.zeros(7, dtype=bool)
+        psi = c.redundancy[0]
+        for target, min_step, start in [(np.nan, 1e-9, psi), (psi + 1, np.nan, psi), (psi + 1, 0.0, psi),
+                                        (np.inf, 1e-9, psi), (psi + 1, 1e-9, np.nan), (1e300, -1.0, psi)]:
+            walk = (Q.copy(), t[0].copy(), np.zeros(3), start, target, min_step)
+            try:
+                ckernels.follow(kernel, T, SIGNS, cyclic, centred, np.zeros(7), *walk)
+            except ValueError:
+                pass
+        walk = (Q.copy(), t[0].copy(), np.zeros(3), psi, psi + 1, 1e-9)
+        for signs in [np.array([1, 5, 1]), np.array([1, -(2**63), 1])]:  # (copied and checked)
+            raises(ValueError, ckernels.follow, kernel, T, signs, cyclic, centred, np.zeros(7), *walk)
+    """,
+        timeout=60,
+    )
+
+
+@pytest.mark.parametrize("name", ["panda", "ur5e", "gen3", "iiwa14", "sawyer", "xarm7", "spherical"])
+def test_a_rotation_far_from_orthonormal_returns(name):
+    run_case(
+        f"""
+        solver = om.OMSolver({name!r})
+        kernel, dof = solver.kernel, solver.arm.dof
+        arm = solver.arm
+        q0 = np.random.default_rng(0).uniform(np.maximum(arm.lower, -3), np.minimum(arm.upper, 3))
+        T, c = solver.arm.fk(q0), solver.configuration_of(q0)
+        for i in range(3):
+            for j in range(4):
+                for value in [-1e16, 1e300, np.nan]:
+                    bad = T.copy()
+                    bad[i, j] = value
+                    kernel.solve(bad, c.signs, c.redundancy, None, np.zeros(dof))
+                    roots, info = np.zeros((ckernels.MAX_ROOTS, dof)), np.zeros((ckernels.MAX_ROOTS, 3))
+                    kernel.solve_all(bad, c.signs, c.redundancy, roots, info)
+                    kernel.bounded_search(bad, c.signs, c.redundancy, roots, True)
+                    if j < 3 or not np.isfinite(value):  # (a finite position is a pose, out of reach)
+                        raises(om.InvalidInput, solver.solve, bad, c)
+        for psi in [np.nan, np.inf, 1e300] if dof == 7 else []:
+            kernel.solve(T, c.signs, (psi,), None, np.zeros(dof))
+    """,
+        timeout=240,
+    )
+
+
+def test_a_pose_written_during_a_batch_is_solved_as_checked():
+    run_case(
+        """
+        rng = np.random.default_rng(1)
+        q = rng.uniform(solver.arm.lower, solver.arm.upper, (400, 7))
+        Ts, configurations = solver.arm.fk(q), [solver.configuration_of(row) for row in q]
+        signs, psi = [x.signs for x in configurations], [x.redundancy for x in configurations]
+        Ts[:, :3, 3] *= 0.5  # poses nearer the base: mostly reachable, none on the edge of reach
+        reference = solver.solve_batch(Ts, signs, psi, threads=2)
+        stop, good = threading.Event(), Ts.copy()
+
+        def write():  # the rotations' first entries far from orthonormal, and back
+            while not stop.is_set():
+                Ts[:, 0, 1] = -1e16
+                Ts[:, 0, 1] = good[:, 0, 1]
+
+        writer = threading.Thread(target=write)
+        writer.start()
+        try:
+            answered = 0
+            for _ in range(20):
+                try:
+                    batch = solver.solve_batch(Ts, signs, psi, threads=2)
+                except om.InvalidInput:
+                    continue
+                answered += 1
+                np.testing.assert_array_equal(batch.status, reference.status)
+        finally:
+            stop.set()
+            writer.join()
+        print("answered", answered)
+    """,
+        timeout=300,
+    )
