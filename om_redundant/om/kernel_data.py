@@ -51,4 +51,5 @@ def kernel_data(
         nominal_table=c(np.empty((0, 6)) if nominal is None else chain.table),
         flip=c(np.ones(arm.dof) if nominal is None else nominal.flip),
         near_deviation=0.0 if nominal is None else nominal.deviation,
+        near_left=nominal is not None and nominal.shoulder_offset != 0.0,
     )

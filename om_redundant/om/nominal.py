@@ -18,7 +18,15 @@ joints. The nominal arm is the OM method's *model side* of such an arm:
   nominal coordinate is :math:`q_n = -q`;
 * fixed rows before joint 1 go into the base; a fixed row that is a pure :math:`R_z T_z`
   merges into the next row (:math:`\theta, d` add, they commute with the joint's motion),
-  one that is a pure :math:`T_x R_x` into the previous row (:math:`a, \alpha` add).
+  one that is a pure :math:`T_x R_x` into the previous row (:math:`a, \alpha` add);
+* a 7-DOF arm's shoulder offset :math:`a_2` (the common normal of joints 2 and 3: Unitree
+  G1 6.24 mm, TIAGo Pro 20 mm), which is geometry, not rounding, is zero: it moves the joints
+  after it by :math:`a_2 x_2(q_1, q_2)`, so the S-R-S model's dp would turn with q1, q2 and
+  q7, three joints where its bounded searches take a circle or a torus; with it zeroed the
+  nominal arm is a circle or torus arm, and the correction (below) is that translation, the
+  OM system (9) itself: :math:`C(q)` moves the hand by :math:`\Delta p`, the model's target by
+  it, solved at every model IK by the fixed point of ``csrc/near.c``, which contracts at rate
+  about :math:`a_2 / |W - S|` away from the model's singular set.
 
 The real arm keeps its exact table: :attr:`NominalArm.exact` is the same chain as the real
 arm's, only re-expressed in the nominal joint coordinates :math:`q_n = f \odot q`
@@ -68,6 +76,12 @@ class NominalArm:
             from the real one's at any q, over the points within reach: the snapped angles'
             changes times the reach plus the zeroed lengths, summed (``csrc/near.c``'s scale
             of the correction).
+        shoulder_offset: The 7-DOF shoulder offset a2 (m) the nominal arm zeroes; 0 if none.
+            Where nonzero, the correction is taken on the left, in DH frame 0
+            (``csrc/near.c``): :math:`T_{nom}(q) = L(q)\,T_{real}(q)` with :math:`L` the
+            translation by :math:`\Delta p(q_1, q_2)`, so that the model's target is the OM
+            system's :math:`p_d + \Delta p` and the fixed point, with :math:`q_1` given on the
+            torus, turns with :math:`q_2` alone.
     """
 
     real: Arm
@@ -76,6 +90,7 @@ class NominalArm:
     flip: np.ndarray
     differs: bool
     deviation: float
+    shoulder_offset: float = 0.0
 
 
 def nominal_arm(arm: Arm) -> NominalArm:
@@ -89,6 +104,7 @@ def nominal_arm(arm: Arm) -> NominalArm:
     rounded = _rounded(snapped.rows, eps)
     merged = _merged(rounded)
     rows = _rounded(merged, eps)
+    shoulder_offset, rows = _shoulder_offset_zeroed(rows)
     nominal = KinematicChain(tuple(rows), snapped.T_root_base, snapped.T_flange_tool)
     # each change is a small rotation or translation of the frames after it (merges are exact)
     changes = [_change(exact.rows, snapped.rows), _change(snapped.rows, rounded), _change(merged, rows)]
@@ -102,7 +118,7 @@ def nominal_arm(arm: Arm) -> NominalArm:
         or not np.array_equal(nominal.T_flange_tool, arm.chain.T_flange_tool)
     )
     model = dataclasses.replace(arm, chain=nominal, lower=lower, upper=upper)
-    return NominalArm(arm, model, exact, flip, bool(differs), float(deviation))
+    return NominalArm(arm, model, exact, flip, bool(differs), float(deviation), shoulder_offset)
 
 
 def closed_form(arm: Arm) -> tuple[ModelArm, NominalArm | None]:
@@ -181,6 +197,17 @@ def _length(length: float, eps: float) -> float:
 def _right_angle(angle: float) -> float:
     nominal = _nearest_right_angle(angle)
     return nominal if _off(angle, nominal) <= ANGLE_ROUNDING else angle
+
+
+def _shoulder_offset_zeroed(rows: list[DHRow]) -> tuple[float, list[DHRow]]:
+    """A 7-DOF arm's shoulder offset a2 (in the row of joint 2; 0 for other arms), and the rows
+    with it zero (see the module)."""
+    joints = [i for i, row in enumerate(rows) if row.is_joint]
+    if len(joints) != 7:
+        return 0.0, rows
+    a2 = rows[joints[1]].a
+    rows[joints[1]] = dataclasses.replace(rows[joints[1]], a=0.0)
+    return a2, rows
 
 
 def _merged(rows: list[DHRow]) -> list[DHRow]:
