@@ -69,6 +69,16 @@
  * polished on the real arm and verified, or missed: on a set of targets of measure O(delta).
  * Every answer is polished on the exact chain to its last digits (om_near_polish).
  *
+ * The correction on the left (om_solver_data.near_left): a 7-DOF arm's shoulder offset a2,
+ * which the nominal arm zeroes (nominal.py), moves the joints after it by a2 x2(q1, q2), so
+ * L(q) = T_nom(q) T_real(q)^-1 is the translation by dp(q1, q2) in DH frame 0 and (N) reads
+ * q = IK_m(X_{L(q) T_d}(w), c): the model's target p_d + dp(q), the OM system (9) itself. On
+ * the torus q1 = w1 is given, so the fixed point turns with q2 alone, at the rate
+ * |dq2/dp| a2, about a2 / |W - S| but growing as 1 / (angle from psi's half-line) near it,
+ * where the translation is mixed from the last two steps (_mixed). On the right the same
+ * translation, seen from the flange through the iterate's orientation, turned with every
+ * joint, and crept (rate 0.95 on the Unitree G1 at a2 = 20 mm, 16 steps short of settling).
+ *
  * Out of the model's reach there is no q to correct from; where the margin is within
  * OM_NEAR_SENSITIVITY times delta of it, the nearest pose the model reaches gives one
  * (om_model_ik_nearest), so that a target which only the corrected system reaches (beyond the

@@ -25,7 +25,10 @@ def kernel_data(
     """
     arm = om.real
     chain = arm.chain
-    if om.shoulder.any():  # dp turns with q1 and q7: the torus (q1, q7)
+    left = nominal is not None and nominal.shoulder_offset != 0.0
+    # dp turns with q1 and q7: the torus (q1, q7); with a shoulder offset a2 zeroed by the nominal
+    # arm, q1 is given on the torus and the correction's fixed point turns with q2 alone
+    if om.shoulder.any() or left:
         mode, dp_joint = system.TORUS, 0
     elif om.dp_joint >= 0:
         mode, dp_joint = system.CIRCLE, om.dp_joint
@@ -51,5 +54,5 @@ def kernel_data(
         nominal_table=c(np.empty((0, 6)) if nominal is None else chain.table),
         flip=c(np.ones(arm.dof) if nominal is None else nominal.flip),
         near_deviation=0.0 if nominal is None else nominal.deviation,
-        near_left=nominal is not None and nominal.shoulder_offset != 0.0,
+        near_left=left,
     )

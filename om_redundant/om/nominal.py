@@ -63,7 +63,7 @@ _HALF_TURN = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, -1.0, 0.0, 0.0], [0.0, 0.0, -
 
 @dataclass(frozen=True, eq=False)
 class NominalArm:
-    """An arm and the closed-form structure it is near.
+    r"""An arm and the closed-form structure it is near.
 
     Attributes:
         real: The real arm.
@@ -78,7 +78,7 @@ class NominalArm:
             of the correction).
         shoulder_offset: The 7-DOF shoulder offset a2 (m) the nominal arm zeroes; 0 if none.
             Where nonzero, the correction is taken on the left, in DH frame 0
-            (``csrc/near.c``): :math:`T_{nom}(q) = L(q)\,T_{real}(q)` with :math:`L` the
+            (``csrc/near.c``): :math:`T_{nom}(q) = L(q) T_{real}(q)` with :math:`L` the
             translation by :math:`\Delta p(q_1, q_2)`, so that the model's target is the OM
             system's :math:`p_d + \Delta p` and the fixed point, with :math:`q_1` given on the
             torus, turns with :math:`q_2` alone.
