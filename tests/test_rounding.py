@@ -88,13 +88,6 @@ def test_derive_model_names_the_rounding_it_leaves_to_the_nominal_arm():
 @pytest.mark.parametrize(
     "joint, value, cause",
     [
-        # TIAGo Pro's and G1's shoulder: a2 = 0.02 m, geometry, not rounding.
-        (
-            1,
-            {"a": 0.02},
-            r"the shoulder offset a2 = 0.02 m \(from the axis of joint 2 \('arm_left_joint2'\) to that of "
-            r"joint 3 \('arm_left_joint3'\), .*\) makes dp depend on joint 2 \('arm_left_joint2'\)",
-        ),
         # Baxter's wrist: a5 = 0.01 m makes dp turn with joints 6 and 7.
         (
             4,
