@@ -78,6 +78,12 @@
  * where the translation is mixed from the last two steps (_mixed). On the right the same
  * translation, seen from the flange through the iterate's orientation, turned with every
  * joint, and crept (rate 0.95 on the Unitree G1 at a2 = 20 mm, 16 steps short of settling).
+ * A 7-DOF wrist offset a5 (the common normal of joints 5 and 6, Baxter's), which the nominal
+ * arm zeroes too, moves the flange by a5 x5, which seen from the flange turns with q6 and q7:
+ * there the correction stays on the right, and with q7 given on the torus its fixed point
+ * turns with q6 alone, mixed as well (om_solver_data.near_mixed); of an arm with both, the
+ * larger offset's side is taken, the other's translation turning with the fixed point's
+ * other joints at its own (small) rate.
  *
  * Out of the model's reach there is no q to correct from; where the margin is within
  * OM_NEAR_SENSITIVITY times delta of it, the nearest pose the model reaches gives one
@@ -148,13 +154,14 @@ static void _apply(om_problem *pb, mat3 R, vec3 p)
     pb->t = om_target_at(s->family, s->params, &target, pb->redundancy);
 }
 
-/* A left correction's translation, the fixed point's variable, mixed from its last two steps
+/* The correction's translation, the fixed point's variable, mixed from its last two steps
  * (Anderson's): the translation next tried is g - gamma (g - g_prev), g = Phi(x) the step's
  * image of its variable x, f = g - x, gamma = f . (f - f_prev) / |f - f_prev|^2, the root of
- * the secant through the two steps' f. With q1 given (the torus) the translation turns with q2
- * alone, a curve: the mixed iteration converges where the plain one creeps or diverges, near
- * psi's half-line, where q2 turns fast with the target (rate a2 / |W - S| over the distance
- * from the line, above 1 within about a2 / |W - S| rad of it). */
+ * the secant through the two steps' f. With q1 and q7 given (the torus) a shoulder offset's
+ * translation turns with q2 alone, a wrist offset's with q6, a curve: the mixed iteration
+ * converges where the plain one creeps or diverges, near psi's half-line, where q2 turns fast
+ * with the target (rate a2 / |W - S| over the distance from the line, above 1 within about
+ * a2 / |W - S| rad of it). */
 typedef struct {
     bool known;
     vec3 g, f; /* the last step's image and f */
@@ -212,7 +219,7 @@ double om_near_settle(om_problem *pb, om_model_eval eval, const void *args, doub
                 break;
             at = nearest;
         }
-        double moved = _retarget(pb, at, &C_R, &C_p, pb->s->near_left ? &mix : NULL), settled = _settled(residual);
+        double moved = _retarget(pb, at, &C_R, &C_p, pb->s->near_mixed ? &mix : NULL), settled = _settled(residual);
         if (moved <= settled)
             break;
         margin = eval(pb, args, q, false, &residual);

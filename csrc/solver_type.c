@@ -54,9 +54,10 @@ static int Solver_init(Solver *self, PyObject *args, PyObject *kwds) {
         return -1;
     if (om_solver_set_types(self, solution_type, configuration_type) < 0) return -1;
     om_solver_data *s = &self->data;
-    long family, mode, dp_joint, scan_points, near_left;
+    long family, mode, dp_joint, scan_points, near_left, near_mixed;
     if (attr_long(d, "family", &family) || attr_long(d, "mode", &mode) || attr_long(d, "dp_joint", &dp_joint) ||
         attr_long(d, "scan_points", &scan_points) || attr_long(d, "near_left", &near_left) ||
+        attr_long(d, "near_mixed", &near_mixed) ||
         attr_double(d, "position_tolerance", &s->tol_pos) ||
         attr_double(d, "orientation_tolerance", &s->tol_ori) || attr_double(d, "near_deviation", &s->near_deviation))
         return -1;
@@ -109,6 +110,7 @@ static int Solver_init(Solver *self, PyObject *args, PyObject *kwds) {
     s->n_redundancy = family == OM_SRS ? 1 : 0;
     s->dp_joint = (int)dp_joint;
     s->near_left = near_left != 0;
+    s->near_mixed = near_mixed != 0;
     s->params = params;
     s->model_table = model;
     s->n_model_rows = (int)(n_model / 6);
