@@ -69,6 +69,22 @@
  * polished on the real arm and verified, or missed: on a set of targets of measure O(delta).
  * Every answer is polished on the exact chain to its last digits (om_near_polish).
  *
+ * The correction on the left (om_solver_data.near_left): a 7-DOF arm's shoulder offset a2,
+ * which the nominal arm zeroes (nominal.py), moves the joints after it by a2 x2(q1, q2), so
+ * L(q) = T_nom(q) T_real(q)^-1 is the translation by dp(q1, q2) in DH frame 0 and (N) reads
+ * q = IK_m(X_{L(q) T_d}(w), c): the model's target p_d + dp(q), the OM system (9) itself. On
+ * the torus q1 = w1 is given, so the fixed point turns with q2 alone, at the rate
+ * |dq2/dp| a2, about a2 / |W - S| but growing as 1 / (angle from psi's half-line) near it,
+ * where the translation is mixed from the last two steps (_mixed). On the right the same
+ * translation, seen from the flange through the iterate's orientation, turned with every
+ * joint, and crept (rate 0.95 on the Unitree G1 at a2 = 20 mm, 16 steps short of settling).
+ * A 7-DOF wrist offset a5 (the common normal of joints 5 and 6, Baxter's), which the nominal
+ * arm zeroes too, moves the flange by a5 x5, which seen from the flange turns with q6 and q7:
+ * there the correction stays on the right, and with q7 given on the torus its fixed point
+ * turns with q6 alone, mixed as well (om_solver_data.near_mixed); of an arm with both, the
+ * larger offset's side is taken, the other's translation turning with the fixed point's
+ * other joints at its own (small) rate.
+ *
  * Out of the model's reach there is no q to correct from; where the margin is within
  * OM_NEAR_SENSITIVITY times delta of it, the nearest pose the model reaches gives one
  * (om_model_ik_nearest), so that a target which only the corrected system reaches (beyond the
@@ -88,12 +104,18 @@
 #define NEAR_POLISH_FROM 1e-8 /* m + rad: the pose errors of a root polished, from ... */
 #define NEAR_POLISHED 1e-14   /* ... down to (rounding: left as it is) */
 
-/* C(q) = T_real(q)^-1 T_nom(q) into (*R, *p) (q in the kernels' coordinates). */
+/* C(q) = T_real(q)^-1 T_nom(q), or on the left (s->near_left) L(q) = T_nom(q) T_real(q)^-1, into
+ * (*R, *p) (q in the kernels' coordinates). */
 static void _correction(const om_solver_data *s, const double *q, mat3 *R, vec3 *p)
 {
     double Rr[9], pr[3], Rn[9], pn[3];
     om_flange_pair(s->real_table, s->n_real_rows, s->nominal_table, s->n_nominal_rows, q, Rr, pr, Rn, pn);
     mat3 real = m_load(Rr, 0);
+    if (s->near_left) {
+        *R = m_mmt(m_load(Rn, 0), real);
+        *p = v_sub(v_load(pn, 0), m_mv(*R, v_load(pr, 0)));
+        return;
+    }
     *R = m_mtm(real, m_load(Rn, 0));
     *p = m_mv(m_transpose(real), v_sub(v_load(pn, 0), v_load(pr, 0)));
 }
@@ -117,19 +139,58 @@ void om_set_goal(om_problem *pb, const mat3 *R, vec3 p)
     pb->p = p;
 }
 
-/* pb's model side moved to goal C(q), C into (*R, *p). Returns how far C moved from them. */
-static double _retarget(om_problem *pb, const double *q, mat3 *R, vec3 *p)
+/* pb's model side moved to goal C (or L goal, s->near_left) for the correction (R, p). */
+static void _apply(om_problem *pb, mat3 R, vec3 p)
 {
     const om_solver_data *s = pb->s;
+    mat3 target;
+    if (s->near_left) {
+        target = m_mm(R, pb->goal.R);
+        pb->p = v_add(m_mv(R, pb->goal_p), p);
+    } else {
+        target = m_mm(pb->goal.R, R);
+        pb->p = v_add(pb->goal_p, m_mv(pb->goal.R, p));
+    }
+    pb->t = om_target_at(s->family, s->params, &target, pb->redundancy);
+}
+
+/* The correction's translation, the fixed point's variable, mixed from its last two steps
+ * (Anderson's): the translation next tried is g - gamma (g - g_prev), g = Phi(x) the step's
+ * image of its variable x, f = g - x, gamma = f . (f - f_prev) / |f - f_prev|^2, the root of
+ * the secant through the two steps' f. With q1 and q7 given (the torus) a shoulder offset's
+ * translation turns with q2 alone, a wrist offset's with q6, a curve: the mixed iteration
+ * converges where the plain one creeps or diverges, near psi's half-line, where q2 turns fast
+ * with the target (rate a2 / |W - S| over the distance from the line, above 1 within about
+ * a2 / |W - S| rad of it). */
+typedef struct {
+    bool known;
+    vec3 g, f; /* the last step's image and f */
+} near_mix;
+
+static vec3 _mixed(near_mix *mix, vec3 x, vec3 g)
+{
+    vec3 f = v_sub(g, x), next = g;
+    if (mix->known) {
+        vec3 df = v_sub(f, mix->f);
+        double dd = v_dot(df, df), gamma = dd > 0.0 ? v_dot(f, df) / dd : NAN;
+        if (isfinite(gamma))
+            next = v_sub(g, v_scale(gamma, v_sub(g, mix->g)));
+    }
+    mix->known = true, mix->g = g, mix->f = f;
+    return next;
+}
+
+/* pb's model side moved to goal C(q) (or L(q) goal), the correction into (*R, *p): C(q) itself,
+ * or a left one's translation mixed (mix not NULL, _mixed). Returns how far C(q) is from them. */
+static double _retarget(om_problem *pb, const double *q, mat3 *R, vec3 *p, near_mix *mix)
+{
     mat3 C_R;
     vec3 C_p;
-    _correction(s, q, &C_R, &C_p);
+    _correction(pb->s, q, &C_R, &C_p);
     double moved = _moved(C_R, C_p, *R, *p);
     *R = C_R;
-    *p = C_p;
-    mat3 target = m_mm(pb->goal.R, C_R);
-    pb->p = v_add(pb->goal_p, m_mv(pb->goal.R, C_p));
-    pb->t = om_target_at(s->family, s->params, &target, pb->redundancy);
+    *p = mix ? _mixed(mix, *p, C_p) : C_p;
+    _apply(pb, *R, *p);
     return moved;
 }
 
@@ -148,6 +209,7 @@ double om_near_settle(om_problem *pb, om_model_eval eval, const void *args, doub
     mat3 C_R = {v3(1.0, 0.0, 0.0), v3(0.0, 1.0, 0.0), v3(0.0, 0.0, 1.0)};
     vec3 C_p = v3(0.0, 0.0, 0.0);
     double nearest[OM_MAX_DOF], residual, ignored, last = INFINITY;
+    near_mix mix = {false, v3(0.0, 0.0, 0.0), v3(0.0, 0.0, 0.0)};
     double margin = eval(pb, args, q, false, &residual);
     for (int k = 0; k < NEAR_STEPS; k++) {
         const double *at = q;
@@ -157,7 +219,7 @@ double om_near_settle(om_problem *pb, om_model_eval eval, const void *args, doub
                 break;
             at = nearest;
         }
-        double moved = _retarget(pb, at, &C_R, &C_p), settled = _settled(residual);
+        double moved = _retarget(pb, at, &C_R, &C_p, pb->s->near_mixed ? &mix : NULL), settled = _settled(residual);
         if (moved <= settled)
             break;
         margin = eval(pb, args, q, false, &residual);

@@ -229,6 +229,10 @@ typedef struct {
     const double *nominal_table; /* n_nominal_rows x 6 */
     int n_nominal_rows;
     double near_deviation; /* m: how far the nominal arm's flange frame is from the real one's, a bound */
+    /* The correction on the left, in DH frame 0: T_nom(q) = L(q) T_real(q) (near.c); false: on
+     * the right, in the flange frame, T_nom(q) = T_real(q) C(q). */
+    bool near_left;
+    bool near_mixed; /* the correction's translation mixed from its last two steps (near.c: _mixed) */
     /* +-1 per joint: the kernels' joint coordinates are flip * q, q the arm's own (-1 where a
      * near arm's axis is reversed, all +1 otherwise); flipped: some is -1. The entry points
      * (solve.c's om_solve_*, near.c's om_solver_*, om_self_motion_tangent) take and give the

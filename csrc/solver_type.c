@@ -90,9 +90,10 @@ static int Solver_init(Solver *self, PyObject *args, PyObject *kwds) {
     }
     om_solver_data s = {0};
     uint8_t revolute[OM_MAX_DOF];
-    long family, mode, dp_joint, scan_points;
+    long family, mode, dp_joint, scan_points, near_left, near_mixed;
     if (attr_long(d, "family", &family) || attr_long(d, "mode", &mode) || attr_long(d, "dp_joint", &dp_joint) ||
-        attr_long(d, "scan_points", &scan_points) || attr_double(d, "position_tolerance", &s.tol_pos) ||
+        attr_long(d, "scan_points", &scan_points) || attr_long(d, "near_left", &near_left) ||
+        attr_long(d, "near_mixed", &near_mixed) || attr_double(d, "position_tolerance", &s.tol_pos) ||
         attr_double(d, "orientation_tolerance", &s.tol_ori) || attr_double(d, "near_deviation", &s.near_deviation))
         return -1;
     /* the arrays, held while they are checked and copied: params, the three tables, lower, upper */
@@ -144,6 +145,8 @@ static int Solver_init(Solver *self, PyObject *args, PyObject *kwds) {
     s.lower = arrays[4];
     s.upper = arrays[5];
     s.scan_points = (int)scan_points;
+    s.near_left = near_left != 0;
+    s.near_mixed = near_mixed != 0;
     for (int j = 0; j < s.dof; j++) s.flipped = s.flipped || s.flip[j] < 0.0;
     release_buffers(v, held);
     held = 0;

@@ -118,19 +118,12 @@ def test_solve_all_batch_equals_solve_all_on_a_near_arm():
             np.pi / 2 + 2e-3,
             r"joint 4 \('wrist_1_joint'\) and joint 5 \('wrist_2_joint'\) perpendicular .*\(0.002 rad off\)",
         ),
-        (
-            "panda",
-            1,
-            "a",
-            0.01,
-            r"shoulder offset a2 = 0.01 m \(from the axis of joint 2 \('joint2'\) to that of joint 3 "
-            r"\('joint3'\).*\) makes dp depend on joint 2 \('joint2'\)",
-        ),
     ],
 )
 def test_an_arm_that_cannot_be_solved_is_refused_at_construction(name, row, field, value, cause):
-    """Beyond what the nominal arm absorbs (a twist 2e-3 rad off, twice NEAR_TWIST), a2 != 0 on
-    a 7-DOF arm: a ModelError naming the cause (a4 != 0: tests/test_wrist_offset.py)."""
+    """Beyond what the nominal arm absorbs (a twist 2e-3 rad off, twice NEAR_TWIST): a ModelError
+    naming the cause (a4 != 0: tests/test_wrist_offset.py; a 7-DOF shoulder offset a2, which the
+    nominal arm zeroes: tests/test_shoulder_offset.py)."""
     arm = om.load_arm(name)
     rows = list(arm.chain.rows)
     old = rows[row]

@@ -25,7 +25,11 @@ def kernel_data(
     """
     arm = om.real
     chain = arm.chain
-    if om.shoulder.any():  # dp turns with q1 and q7: the torus (q1, q7)
+    shoulder, wrist = (0.0, 0.0) if nominal is None else (nominal.shoulder_offset, nominal.wrist_offset)
+    # dp turns with q1 and q7: the torus (q1, q7); with a shoulder offset a2 or a wrist offset a5
+    # zeroed by the nominal arm, q1 and q7 are given on the torus and the correction's fixed
+    # point turns with q2 (on the left) or q6 (on the right) alone
+    if om.shoulder.any() or shoulder or wrist:
         mode, dp_joint = system.TORUS, 0
     elif om.dp_joint >= 0:
         mode, dp_joint = system.CIRCLE, om.dp_joint
@@ -51,4 +55,6 @@ def kernel_data(
         nominal_table=c(np.empty((0, 6)) if nominal is None else chain.table),
         flip=c(np.ones(arm.dof) if nominal is None else nominal.flip),
         near_deviation=0.0 if nominal is None else nominal.deviation,
+        near_left=shoulder != 0.0 and abs(shoulder) >= abs(wrist),
+        near_mixed=shoulder != 0.0 or wrist != 0.0,
     )

@@ -311,7 +311,8 @@ def _srs_model(arm: Arm) -> tuple[KinematicChain, KinematicChain, np.ndarray]:
     (at S = :math:`o_1`) iff :math:`a_1 = 0`; axis 3 passes through S iff :math:`d_2 = a_2 = 0`;
     likewise :math:`a_5 = 0` and :math:`d_6 = a_6 = 0` put axes 5-7 through W = :math:`o_5`.
     The elbow's offsets (:math:`a_3, d_4, a_4`) are kept. :math:`a_2` would make dp depend on
-    q2 as well and is refused.
+    q2 as well and is refused here; the arm's nominal arm zeroes it
+    (:mod:`~om_redundant.om.nominal`), whose correction solves it.
 
     Returns:
         The model chain, the real chain with only its shoulder offsets zeroed, and the
@@ -325,8 +326,9 @@ def _srs_model(arm: Arm) -> tuple[KinematicChain, KinematicChain, np.ndarray]:
         raise ModelError(
             f"arm '{arm.name}': the shoulder offset a2 = {rows[jr[1]].a:g} m (from the axis of "
             f"{_joint_name(arm, 1)} to that of {_joint_name(arm, 2)}, which then miss the shoulder's "
-            f"centre) makes dp depend on {_joint_name(arm, 1)}; the bounded search handles offsets "
-            f"that turn with {_joint_name(arm, 0)} or {_joint_name(arm, 6)} only"
+            f"centre) makes dp depend on {_joint_name(arm, 1)}; the model's bounded searches take offsets "
+            f"that turn with {_joint_name(arm, 0)} or {_joint_name(arm, 6)} only (OMSolver solves the "
+            "arm through its nominal arm, which zeroes a2: om.nominal_arm)"
         )
     _refuse_fixed_rows(arm, (0, 1, 2, 3, 4, 5))
     if any(rows[r].a != 0.0 for r in range(jr[5] + 1, jr[6])):

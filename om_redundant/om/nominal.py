@@ -18,7 +18,18 @@ joints. The nominal arm is the OM method's *model side* of such an arm:
   nominal coordinate is :math:`q_n = -q`;
 * fixed rows before joint 1 go into the base; a fixed row that is a pure :math:`R_z T_z`
   merges into the next row (:math:`\theta, d` add, they commute with the joint's motion),
-  one that is a pure :math:`T_x R_x` into the previous row (:math:`a, \alpha` add).
+  one that is a pure :math:`T_x R_x` into the previous row (:math:`a, \alpha` add);
+* a 7-DOF arm's shoulder offset :math:`a_2` (the common normal of joints 2 and 3: Unitree
+  G1 6.24 mm, TIAGo Pro 20 mm) and wrist offset :math:`a_5` (of joints 5 and 6: Baxter
+  10 mm), which are geometry, not rounding, are zero: :math:`a_2` moves the joints after it by
+  :math:`a_2 x_2(q_1, q_2)` in DH frame 0, :math:`a_5` the flange by :math:`a_5 x_5`, which
+  seen from the flange turns with q6 and q7, so the S-R-S model's dp would turn with q2 or q6
+  besides q1 and q7, where its bounded searches take a circle or a torus; with them zeroed
+  the nominal arm is searched on the torus :math:`(q_1, q_7)`, and the correction (below) is
+  that translation, the OM system (9) itself, solved at every model IK by the fixed point of
+  ``csrc/near.c``: with q1 and q7 given, it turns with q2 alone (taken on the left, in DH frame
+  0) or q6 alone (on the right, in the flange frame), at a rate of about
+  :math:`a / |W - S|` away from the model's singular set.
 
 The real arm keeps its exact table: :attr:`NominalArm.exact` is the same chain as the real
 arm's, only re-expressed in the nominal joint coordinates :math:`q_n = f \odot q`
@@ -55,7 +66,7 @@ _HALF_TURN = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, -1.0, 0.0, 0.0], [0.0, 0.0, -
 
 @dataclass(frozen=True, eq=False)
 class NominalArm:
-    """An arm and the closed-form structure it is near.
+    r"""An arm and the closed-form structure it is near.
 
     Attributes:
         real: The real arm.
@@ -68,6 +79,15 @@ class NominalArm:
             from the real one's at any q, over the points within reach: the snapped angles'
             changes times the reach plus the zeroed lengths, summed (``csrc/near.c``'s scale
             of the correction).
+        shoulder_offset: The 7-DOF shoulder offset a2 (m) the nominal arm zeroes; 0 if none.
+            Where it is the larger of the two, the correction is taken on the left, in DH frame
+            0 (``csrc/near.c``): :math:`T_{nom}(q) = L(q) T_{real}(q)` with :math:`L` the
+            translation by :math:`\Delta p(q_1, q_2)`, so that the model's target is the OM
+            system's :math:`p_d + \Delta p` and the fixed point, with :math:`q_1` given on the
+            torus, turns with :math:`q_2` alone.
+        wrist_offset: The 7-DOF wrist offset a5 (m) the nominal arm zeroes; 0 if none. Where
+            it is the larger, the correction is on the right, in the flange frame, a
+            translation that turns with q6 and q7 (q7 given on the torus).
     """
 
     real: Arm
@@ -76,6 +96,8 @@ class NominalArm:
     flip: np.ndarray
     differs: bool
     deviation: float
+    shoulder_offset: float = 0.0
+    wrist_offset: float = 0.0
 
 
 def nominal_arm(arm: Arm) -> NominalArm:
@@ -89,6 +111,7 @@ def nominal_arm(arm: Arm) -> NominalArm:
     rounded = _rounded(snapped.rows, eps)
     merged = _merged(rounded)
     rows = _rounded(merged, eps)
+    shoulder_offset, wrist_offset, rows = _offsets_zeroed(rows)
     nominal = KinematicChain(tuple(rows), snapped.T_root_base, snapped.T_flange_tool)
     # each change is a small rotation or translation of the frames after it (merges are exact)
     changes = [_change(exact.rows, snapped.rows), _change(snapped.rows, rounded), _change(merged, rows)]
@@ -102,7 +125,7 @@ def nominal_arm(arm: Arm) -> NominalArm:
         or not np.array_equal(nominal.T_flange_tool, arm.chain.T_flange_tool)
     )
     model = dataclasses.replace(arm, chain=nominal, lower=lower, upper=upper)
-    return NominalArm(arm, model, exact, flip, bool(differs), float(deviation))
+    return NominalArm(arm, model, exact, flip, bool(differs), float(deviation), shoulder_offset, wrist_offset)
 
 
 def closed_form(arm: Arm) -> tuple[ModelArm, NominalArm | None]:
@@ -181,6 +204,18 @@ def _length(length: float, eps: float) -> float:
 def _right_angle(angle: float) -> float:
     nominal = _nearest_right_angle(angle)
     return nominal if _off(angle, nominal) <= ANGLE_ROUNDING else angle
+
+
+def _offsets_zeroed(rows: list[DHRow]) -> tuple[float, float, list[DHRow]]:
+    """A 7-DOF arm's shoulder offset a2 and wrist offset a5 (in the rows of joints 2 and 5; 0 for
+    other arms), and the rows with them zero (see the module)."""
+    joints = [i for i, row in enumerate(rows) if row.is_joint]
+    if len(joints) != 7:
+        return 0.0, 0.0, rows
+    offsets = [rows[joints[j]].a for j in (1, 4)]
+    for j in (1, 4):
+        rows[joints[j]] = dataclasses.replace(rows[joints[j]], a=0.0)
+    return offsets[0], offsets[1], rows
 
 
 def _merged(rows: list[DHRow]) -> list[DHRow]:

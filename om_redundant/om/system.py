@@ -107,6 +107,11 @@ class SolverData(NamedTuple):
             arm's reversed axes); joint vectors cross the kernels' entry points in the arm's own.
         near_deviation: A bound (m) on how far the nominal arm's flange frame is from the
             arm's (:attr:`~om_redundant.om.nominal.NominalArm.deviation`); 0 in its family.
+        near_left: The correction on the left, in DH frame 0 (an arm whose nominal arm zeroes a
+            shoulder offset, :attr:`~om_redundant.om.nominal.NominalArm.shoulder_offset`, larger
+            than its wrist offset); False: on the right, in the flange frame (``csrc/near.c``).
+        near_mixed: The correction's translation mixed from its last two steps (an arm whose
+            nominal arm zeroes a shoulder or wrist offset; ``csrc/near.c``).
     """
 
     family: int
@@ -127,6 +132,8 @@ class SolverData(NamedTuple):
     nominal_table: np.ndarray
     flip: np.ndarray
     near_deviation: float
+    near_left: bool
+    near_mixed: bool
 
 
 def flange_target(
