@@ -1,21 +1,14 @@
 """Panda at 500 Hz: the optimiser picks the arm angle every tick of a mink loop, around a pole and a ball.
 
-A mocap target moves along a scripted figure eight in front of the arm (or, with --mouse,
-wherever you drag it in the viewer: double-click it, then Ctrl + right-drag). Every tick,
-as in mink's own examples, the target goes to a FrameTask and to om.ExactPoseTask, whose
-RedundancyOptimizer tracks the branch and arm angle that keep the joints far from their
-limits, the arm 3 cm clear of the pole and the ball, and the wrist away from singularities;
-mink.solve_ik then gives the velocity, limited by ConfigurationLimit and VelocityLimit, and
-a RateLimiter holds the loop at 500 Hz when the tick takes less than 2 ms.
-
-It prints the achieved rate and the ticks' median, p99 and worst time; the last line is a
-JSON summary. Headless (--headless, or no display) it writes an mp4 (MuJoCo's renderer; set
-MUJOCO_GL=egl) and a plot of tick time, clearance, hand error and arm angle to --out.
+A mocap target moves along a figure eight (with --mouse, where you drag it in the viewer:
+double-click it, then Ctrl + right-drag). Every tick it goes to a FrameTask and to
+om.ExactPoseTask, whose RedundancyOptimizer keeps the joints far from their limits, the arm
+3 cm clear of the obstacles and the wrist away from singularities; a RateLimiter holds the
+loop at 500 Hz. It prints the rate and the ticks' times, then a JSON summary; headless
+(--headless or no display; MUJOCO_GL=egl) it writes an mp4 and a plot to --out.
 
 Run: python examples/realtime_panda.py [--headless] [--mouse] [--seconds 8] [--out examples_out]
 """
-
-from __future__ import annotations
 
 import argparse
 import json
@@ -25,98 +18,82 @@ from pathlib import Path
 
 import mink
 import mujoco
+import mujoco.viewer
 import numpy as np
-from _common import scene
+from _report import Recording, plot, print_runs, render_video, timing
+from _scene import scene
 from loop_rate_limiters import RateLimiter
 
 import om_redundant as om
 
 RATE = 500.0  # Hz, the control loop
 MARGIN = 0.03  # m of clearance the optimiser keeps
-# rad: psi moves at most this per tick, 2.5 rad/s at 500 Hz, which the joints can follow
-# within the velocity limit (the optimiser's default 0.05 suits 100 Hz; at 500 Hz psi would
-# chase the optimum at 25 rad/s and the joints lag, the hand 3 cm off its target)
+# rad per tick that psi moves at most: 2.5 rad/s, which the joints follow within the velocity
+# limit (the default 0.05 suits 100 Hz; at 500 Hz the hand would lag 3 cm behind its target)
 MAX_STEP = 0.005
 PERIOD = 8.0  # s, one figure eight
-FPS = 30  # frames per second of the video
 HOME = np.array([0.0, -0.3, 0.0, -2.2, 0.0, 1.9, 0.785])  # hand down in front, elbow up
+CAPSULE, SPHERE = mujoco.mjtGeom.mjGEOM_CAPSULE, mujoco.mjtGeom.mjGEOM_SPHERE
 OBSTACLES = {
-    "pole": dict(
-        type=mujoco.mjtGeom.mjGEOM_CAPSULE, size=[0.03, 0, 0], fromto=[0.08, -0.6, 0.72, 0.08, 0.6, 0.72]
-    ),
-    "ball": dict(type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[0.06, 0, 0], pos=[0.3, 0.35, 0.5]),
+    "pole": dict(type=CAPSULE, size=[0.03, 0, 0], fromto=[0.08, -0.6, 0.72, 0.08, 0.6, 0.72]),
+    "ball": dict(type=SPHERE, size=[0.06, 0, 0], pos=[0.3, 0.35, 0.5]),
 }
 CAMERA = dict(lookat=[0.3, 0.0, 0.45], distance=1.9, azimuth=150.0, elevation=-15.0)
 
 
-def parse_args() -> argparse.Namespace:
+def figure_eight(t: float) -> np.ndarray:
+    """The scripted target's position: 0.45 m high, a figure eight in x and y."""
+    phase = 2.0 * np.pi * t / PERIOD
+    return np.array([0.5 + 0.1 * np.sin(2.0 * phase), 0.3 * np.sin(phase), 0.45])
+
+
+if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--headless", action="store_true", help="write a video and a plot, no viewer")
     parser.add_argument("--mouse", action="store_true", help="drag the target (needs a display)")
     parser.add_argument("--seconds", type=float, default=PERIOD, help="simulated time when headless")
     parser.add_argument("--out", default="examples_out", help="directory for the video and the plot")
     args = parser.parse_args()
-    args.headless = args.headless or not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
-    if args.mouse and args.headless:
+    show = not args.headless and bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+    if args.mouse and not show:
         parser.error("--mouse needs the viewer: a display, without --headless")
-    return args
 
-
-def figure_eight(t: float, T_home: np.ndarray) -> np.ndarray:
-    """The scripted target: hand pointing down at 0.45 m height, a figure eight in x and y."""
-    phase = 2.0 * np.pi * t / PERIOD
-    T = T_home.copy()
-    T[:3, 3] = [0.5 + 0.1 * np.sin(2.0 * phase), 0.3 * np.sin(phase), 0.45]
-    return T
-
-
-def place(data: mujoco.MjData, mocap: int, T: np.ndarray) -> None:
-    """Put the mocap target at pose T."""
-    data.mocap_pos[mocap] = T[:3, 3]
-    mujoco.mju_mat2Quat(data.mocap_quat[mocap], T[:3, :3].ravel())
-
-
-def main() -> dict:
-    args = parse_args()
     solver = om.OMSolver("panda")
-    arm = solver.arm
-    model = scene(arm, OBSTACLES)
+    model = scene(solver.arm, OBSTACLES)
     configuration = mink.Configuration(model)
     data = configuration.data
-    clearance = om.Clearance(model, arm, list(OBSTACLES))
+    clearance = om.Clearance(model, solver.arm, list(OBSTACLES))
+
     optimizer = om.RedundancyOptimizer(solver, clearance, min_clearance=MARGIN, max_step=MAX_STEP)
-    hand = mink.FrameTask(arm.frame_name, "site", position_cost=1.0, orientation_cost=1.0)
-    exact = om.ExactPoseTask(solver, model, optimizer=optimizer)
-    tasks = [hand, exact]
+    tasks = [
+        hand := mink.FrameTask(solver.arm.frame_name, "site", position_cost=1.0, orientation_cost=1.0),
+        exact := om.ExactPoseTask(solver, model, optimizer=optimizer),
+    ]
     limits = [
         mink.ConfigurationLimit(model),
-        mink.VelocityLimit(model, {name: np.pi for name in arm.joint_names}),
+        mink.VelocityLimit(model, {name: np.pi for name in solver.arm.joint_names}),
     ]
 
-    T_home = arm.fk(HOME)
-    T = figure_eight(0.0, T_home)
-    exact.set_target(T)  # the global choice of branch and arm angle for the first pose
-    exact.seed(configuration)  # start there, the hand on the target
-    mocap = model.body("target").mocapid[0]
-    place(data, mocap, T)
+    # Start on the figure eight's first pose (the hand pointing down, as at home), in the
+    # optimiser's global choice of branch and arm angle, the mocap target on the hand.
+    T_start = solver.arm.fk(HOME)
+    T_start[:3, 3] = figure_eight(0.0)
+    exact.set_target(T_start)
+    exact.seed(configuration)
+    mink.move_mocap_to_frame(model, data, "target", solver.arm.frame_name, "site")
 
-    rate = RateLimiter(frequency=RATE, warn=False)
-    log: dict[str, list] = {key: [] for key in ("t", "tick", "q", "target", "clearance", "error", "psi")}
-    unreachable = 0
     viewer = None
-    if not args.headless:
-        import mujoco.viewer
-
+    if show:
         viewer = mujoco.viewer.launch_passive(model, data, show_left_ui=False, show_right_ui=False)
-    start = time.perf_counter()
-    k = 0
+    rate = RateLimiter(frequency=RATE, warn=False)
+    run = Recording("OM + mink", solver.arm, clearance)
+    unreachable = 0
+    k, start = 0, time.perf_counter()
     while viewer.is_running() if viewer else k * rate.dt < args.seconds:
-        t = k * rate.dt
         if not args.mouse:  # the script moves the mocap target; with --mouse, you do
-            T = figure_eight(t, T_home)
-            place(data, mocap, T)
+            data.mocap_pos[0] = figure_eight(k * rate.dt)
         tick = time.perf_counter()
-        target = mink.SE3.from_mocap_id(data, mocap)
+        target = mink.SE3.from_mocap_name(model, data, "target")
         hand.set_target(target)
         try:
             exact.set_target(target)  # the optimiser tracks psi from the previous tick
@@ -124,16 +101,9 @@ def main() -> dict:
             unreachable += 1  # (a dragged target out of reach) keeps the previous one
         velocity = mink.solve_ik(configuration, tasks, rate.dt, "daqp", damping=1e-6, limits=limits)
         configuration.integrate_inplace(velocity, rate.dt)
-        log["tick"].append(time.perf_counter() - tick)
-        q = configuration.q[: arm.dof].copy()
-        log["t"].append(t)
-        log["q"].append(q)
-        log["target"].append(target.as_matrix())
-        log["clearance"].append(clearance.minimum(q))
-        log["error"].append(float(np.linalg.norm(arm.fk(q)[:3, 3] - target.translation())))
-        log["psi"].append(exact.choice.configuration.redundancy[0] if exact.choice else np.nan)
+        psi = exact.choice.configuration.redundancy[0] if exact.choice else np.nan
+        run.add(k * rate.dt, configuration.q, target, tick=time.perf_counter() - tick, psi=psi)
         if viewer:
-            mujoco.mj_camlight(model, data)
             viewer.sync()
         rate.sleep()
         k += 1
@@ -141,95 +111,14 @@ def main() -> dict:
     if viewer:
         viewer.close()
 
-    summary = report(log, elapsed, unreachable)
-    if args.headless:
+    summary = {"example": "realtime_panda", **timing(run, elapsed, RATE), "margin": MARGIN, **run.summary()}
+    summary["unreachable"] = unreachable
+    print_runs([run], MARGIN)
+    if not show:
         out = Path(args.out)
-        out.mkdir(parents=True, exist_ok=True)
-        print("wrote", render(model, log, out / "realtime_panda.mp4"))
-        print("wrote", plot(log, out / "realtime_panda.png"))
+        print("wrote", render_video(model, run, CAMERA, out / "realtime_panda.mp4", RATE, fps=30))
+        keys = ["tick", "clearance", "error", "psi"]
+        budget, margin = (1.0 / RATE, f"{RATE:.0f} Hz budget"), (MARGIN, "margin")
+        title = "Panda at 500 Hz: OM's optimiser choosing psi every tick"
+        print("wrote", plot([run], keys, title, out / "realtime_panda.png", tick=budget, clearance=margin))
     print(json.dumps(summary))
-    return summary
-
-
-def report(log: dict[str, list], elapsed: float, unreachable: int) -> dict:
-    """Print the rate and tick times; the summary."""
-    ticks = np.array(log["tick"]) * 1000.0
-    worst = int(np.argmax(ticks))
-    summary = {
-        "example": "realtime_panda",
-        "ticks": len(ticks),
-        "rate_hz": round(len(ticks) / elapsed, 1),
-        "target_hz": RATE,
-        "tick_ms": {
-            "median": round(float(np.median(ticks)), 3),
-            "p99": round(float(np.percentile(ticks, 99)), 3),
-            "worst": round(float(ticks[worst]), 3),
-            "worst_at_s": round(log["t"][worst], 3),
-        },
-        "margin": MARGIN,
-        "min_clearance": round(min(log["clearance"]), 5),
-        "max_error": float(f"{max(log['error']):.3e}"),
-        "final_error": float(f"{log['error'][-1]:.3e}"),
-        "unreachable": unreachable,
-    }
-    tick_ms = summary["tick_ms"]
-    print(
-        f"{summary['ticks']} ticks at {summary['rate_hz']:.0f} Hz (target {RATE:.0f} Hz): tick median "
-        f"{tick_ms['median']:.2f} ms, p99 {tick_ms['p99']:.2f} ms, worst {tick_ms['worst']:.2f} ms "
-        f"at t = {tick_ms['worst_at_s']:.2f} s"
-    )
-    print(
-        f"min clearance {summary['min_clearance'] * 1000:.1f} mm (margin {MARGIN * 1000:.0f} mm), "
-        f"max hand error {summary['max_error']:.1e} m"
-    )
-    return summary
-
-
-def render(model: mujoco.MjModel, log: dict[str, list], file: Path) -> Path:
-    """The run as an mp4 at FPS frames per second of simulated time (after the loop, so that
-    rendering takes no time from the ticks)."""
-    import imageio
-
-    data = mujoco.MjData(model)
-    camera = mujoco.MjvCamera()
-    camera.lookat[:], camera.distance, camera.azimuth, camera.elevation = CAMERA.values()
-    every = max(1, round(RATE / FPS))
-    with mujoco.Renderer(model, 480, 640) as renderer, imageio.get_writer(file, fps=FPS) as video:
-        for q, target in zip(log["q"][::every], log["target"][::every], strict=True):
-            data.qpos[: len(q)] = q
-            data.mocap_pos[0] = target[:3, 3]
-            mujoco.mj_forward(model, data)
-            renderer.update_scene(data, camera)
-            video.append_data(renderer.render())
-    return file
-
-
-def plot(log: dict[str, list], file: Path) -> Path:
-    """Tick time, clearance, hand error and arm angle over time."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    t = np.array(log["t"])
-    fig, axes = plt.subplots(1, 4, figsize=(15, 3.2), constrained_layout=True)
-    axes[0].plot(t, np.array(log["tick"]) * 1000.0, lw=0.6)
-    axes[0].axhline(1000.0 / RATE, color="k", ls="--", lw=0.8, label=f"{RATE:.0f} Hz budget")
-    axes[1].plot(t, np.array(log["clearance"]) * 1000.0)
-    axes[1].axhline(MARGIN * 1000.0, color="k", ls="--", lw=0.8, label="margin")
-    axes[2].semilogy(t, np.maximum(log["error"], 1e-12))
-    axes[3].plot(t, log["psi"])
-    labels = ["tick (ms)", "clearance to pole and ball (mm)", "hand error (m)", "arm angle psi (rad)"]
-    for ax, label in zip(axes, labels, strict=True):
-        ax.set_xlabel("t (s)")
-        ax.set_ylabel(label)
-    axes[0].legend()
-    axes[1].legend()
-    fig.suptitle("Panda at 500 Hz: OM's optimiser choosing psi every tick")
-    fig.savefig(file, dpi=80)
-    plt.close(fig)
-    return file
-
-
-if __name__ == "__main__":
-    main()
