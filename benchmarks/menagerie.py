@@ -216,6 +216,18 @@ def import_row(name: str, entry: Entry, n: int, seed: int, folder: Path, **optio
     return {"arm": name, "import": "yes", **measured}
 
 
+def files_arguments(doc: str, arms: dict[str, Entry], folder: str, n: int) -> argparse.Namespace:
+    """The command line of a benchmark over arms' model files kept outside the project: --dir
+    (the folder holding ``folder``), --n (random joint vectors per accepted arm, default n),
+    --seed, --arms (some of ``arms``)."""
+    parser = argparse.ArgumentParser(description=doc.splitlines()[0])
+    parser.add_argument("--dir", type=Path, required=True, help=f"folder holding {folder}")
+    parser.add_argument("--n", type=int, default=n, help="random joint vectors per accepted arm")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--arms", nargs="+", choices=list(arms))
+    return parser.parse_args()
+
+
 def present(arms: dict[str, Entry], folder: Path, names: list[str] | None = None) -> list[str]:
     """The names (of ``names``, default every arm) whose model file ``folder`` holds; each other
     one is skipped with a note, so a benchmark runs where the models are not at hand (CI)."""

@@ -20,9 +20,8 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-from pathlib import Path
 
-from .menagerie import Entry, import_row, present, table
+from .menagerie import Entry, files_arguments, import_row, present, table
 from .report import write_page
 
 #: The arms: model file, end-effector body or site, the prefix of the arm's joint names and the
@@ -96,12 +95,7 @@ NOT_SERIAL = {
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--dir", type=Path, required=True, help="folder holding Menagerie's model files")
-    parser.add_argument("--n", type=int, default=10_000, help="random joint vectors per accepted arm")
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--arms", nargs="+", choices=list(ARMS))
-    args = parser.parse_args()
+    args = files_arguments(__doc__, ARMS, "Menagerie's model files", 10_000)
     rows, loads = [], [os.getloadavg()[0]]
     for name in present(ARMS, args.dir, args.arms):
         entry = ARMS[name]

@@ -14,11 +14,10 @@ not import with its error.
 
 from __future__ import annotations
 
-import argparse
 import sys
 from pathlib import Path
 
-from .menagerie import Entry, import_row, present, table
+from .menagerie import Entry, files_arguments, import_row, present, table
 from .report import write_page
 
 #: The repositories the URDFs come from, as folders of DIR, and the commit they were read at.
@@ -87,12 +86,7 @@ def row(name: str, n: int, seed: int, folder: Path) -> dict:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--dir", type=Path, required=True, help="folder holding the repositories' URDFs")
-    parser.add_argument("--n", type=int, default=1000, help="random joint vectors per accepted arm")
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--arms", nargs="+", choices=list(URDF_ARMS))
-    args = parser.parse_args()
+    args = files_arguments(__doc__, URDF_ARMS, "the repositories' URDFs", 1000)
     rows = []
     for name in present(URDF_ARMS, args.dir, args.arms):
         rows.append(row(name, args.n, args.seed, args.dir))
