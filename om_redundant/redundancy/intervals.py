@@ -61,7 +61,8 @@ class PsiInterval:
 
 class BranchRuns(NamedTuple):
     """A branch's solution paths swept over the circle and their feasible runs; ``stalled``:
-    why it has none (:attr:`Probe.stalled`), else ""."""
+    why it has none, where its sweep stalled (the SingularSelfMotion of a path within rounding
+    of a singular set), else ""."""
 
     signs: tuple[int, ...]
     paths: list[Path]

@@ -121,7 +121,9 @@ class JointWay:
     Attributes:
         start: Where the arm was when the choice was made.
         floor: The clearance the way's rest keeps (m): the optimiser's ``min_clearance``, or
-            the clearance at ``start`` where that was less; below it the way is blocked.
+            the clearance at ``start`` where that was less, less the certificate's
+            tolerance (what the optimiser certified the way above); below it, by more than
+            that tolerance again (a re-check's bound), the way is blocked.
             -inf where there is nothing to keep (no obstacles, or a way the optimiser could
             not find clear: it is not re-checked).
         s: The fraction of the way the arm has come (its projection's, never going back).
