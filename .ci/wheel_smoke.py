@@ -26,7 +26,7 @@ def main(project: Path) -> None:
         work = Path(scratch)
         check = (
             "import sys, numpy as np, om_redundant as om\n"
-            "from om_redundant import ckernels\n"
+            "from om_redundant._core import ckernels\n"
             f"assert ckernels.__file__.startswith({sysconfig.get_paths()['purelib']!r}), ckernels.__file__\n"
             "solver = om.OMSolver('panda')\n"
             "q = np.array([0.3, -0.4, 0.2, -2.2, 0.3, 1.9, 0.6])\n"

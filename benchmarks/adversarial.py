@@ -68,7 +68,7 @@ import mujoco
 import numpy as np
 
 import om_redundant as om
-from om_redundant import ckernels
+from om_redundant import _core
 from om_redundant.mujoco_io.mjcf import DEFAULT_SITE
 from om_redundant.om import system
 from om_redundant.om.families import branch_values, redundancy_values
@@ -619,11 +619,11 @@ class ArmRun:
         all in DH frame 0 (where the kernels' up, shoulder and flange-frame wrist offset are;
         the model's FK is in the root frame, turned on the Gen3: z down)."""
         model, P, data = self.solver.om.model, self.solver.om.params, self.solver.solver_data()
-        up = P[ckernels.SRS_UP : ckernels.SRS_UP + 3]
+        up = P[_core.SRS_UP : _core.SRS_UP + 3]
         e1 = np.cross(up, [1.0, 0.0, 0.0] if abs(up[0]) < 0.9 else [0.0, 1.0, 0.0])
         e1 /= np.linalg.norm(e1)
-        wrist = P[ckernels.SRS_WRIST : ckernels.SRS_WRIST + 3]
-        shoulder = P[ckernels.SRS_SHOULDER : ckernels.SRS_SHOULDER + 3]
+        wrist = P[_core.SRS_WRIST : _core.SRS_WRIST + 3]
+        shoulder = P[_core.SRS_SHOULDER : _core.SRS_SHOULDER + 3]
 
         def w(Q: np.ndarray) -> np.ndarray:
             T = data.T_base_root @ model.fk(Q) @ data.T_tool_flange  # the flange in DH frame 0

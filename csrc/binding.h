@@ -14,6 +14,25 @@ enum { F64, I64, U8 }; /* buffer kinds: float64, int64, bool */
 int get_buffer(PyObject *obj, Py_buffer *view, int kind, Py_ssize_t n, int writable, const char *name);
 /* A TypeError naming what takes `want` arguments where nargs came; -1 then. */
 int check_nargs(Py_ssize_t nargs, Py_ssize_t want, const char *what);
+/* A kernel function's arguments: names[0:n] in order, the first `positional` (<= 6) of them
+ * by position or by name, the rest by name only (`f(a, b, *, c, d)`). */
+typedef struct {
+    const char *function;
+    const char *const *names;
+    int n, positional;
+} arg_spec;
+/* The arguments of a METH_FASTCALL | METH_KEYWORDS call into out[0:spec->n] (borrowed
+ * references), every one required; -1 with a TypeError naming the function and the argument
+ * that is missing, unknown, repeated or given by position beyond spec->positional. */
+int bind_args(PyObject *const *args, Py_ssize_t nargs, PyObject *kwnames, const arg_spec *spec, PyObject **out);
+/* The fields names[0:n] of a record (a NamedTuple of om_redundant._core) into out[0:n] (new
+ * references: release_fields), read by name; -1 with a TypeError naming what and the field. */
+int get_fields(PyObject *record, const char *const *names, int n, PyObject **out, const char *what);
+/* A new result record of a PyStructSequence type (named fields) from items[0:n], whose
+ * references it steals (NULL items: a failed conversion; NULL then, every item released). */
+PyObject *new_record(PyTypeObject *type, PyObject **items, int n);
+/* Release get_fields' references out[0:n]. */
+void release_fields(PyObject **out, int n);
 /* An arm's joint count from obj into *dof, 1 ... OM_MAX_DOF; -1 with an error naming what. */
 int get_dof(PyObject *obj, Py_ssize_t *dof, const char *what);
 /* What get_buffers asks of one argument: kind, entries (n < 0: any), writable, name. */
@@ -141,6 +160,7 @@ extern PyMethodDef om_kernel_functions[]; /* functions.c: kinematics and closed 
 extern PyMethodDef om_tracking_functions[]; /* tracking.c: the redundancy optimiser's tracking step */
 extern PyMethodDef om_clearance_functions[]; /* clearance.c: distances of arm and obstacle geoms */
 extern PyMethodDef om_follow_functions[];    /* follow.c: a solution path followed along psi */
+int om_follow_init(PyObject *module);         /* follow.c: its result type, ckernels.Followed */
 extern PyMethodDef om_link_functions[];      /* link.c: a branch's solution paths through its grid roots */
 extern PyMethodDef om_tangent_functions[];   /* tangents.c: self-motion tangents of many rows */
 extern PyMethodDef om_objective_functions[]; /* objective.c: the redundancy optimiser's objective */

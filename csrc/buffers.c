@@ -45,6 +45,66 @@ int check_nargs(Py_ssize_t nargs, Py_ssize_t want, const char *what) {
     return 0;
 }
 
+int bind_args(PyObject *const *args, Py_ssize_t nargs, PyObject *kwnames, const arg_spec *spec, PyObject **out) {
+    if (nargs > spec->positional) {
+        PyErr_Format(PyExc_TypeError, "%s takes at most %d positional arguments, got %zd", spec->function,
+                     spec->positional, nargs);
+        return -1;
+    }
+    for (int i = 0; i < spec->n; i++) out[i] = i < nargs ? args[i] : NULL;
+    Py_ssize_t nkw = kwnames ? PyTuple_GET_SIZE(kwnames) : 0;
+    for (Py_ssize_t k = 0; k < nkw; k++) {
+        const char *key = PyUnicode_AsUTF8(PyTuple_GET_ITEM(kwnames, k));
+        if (!key) return -1;
+        int i = 0;
+        while (i < spec->n && strcmp(key, spec->names[i]) != 0) i++;
+        if (i == spec->n) {
+            PyErr_Format(PyExc_TypeError, "%s got an unknown argument '%s'", spec->function, key);
+            return -1;
+        }
+        if (out[i]) {
+            PyErr_Format(PyExc_TypeError, "%s got argument '%s' twice", spec->function, key);
+            return -1;
+        }
+        out[i] = args[nargs + k];
+    }
+    for (int i = 0; i < spec->n; i++)
+        if (!out[i]) {
+            PyErr_Format(PyExc_TypeError, "%s missing argument '%s'", spec->function, spec->names[i]);
+            return -1;
+        }
+    return 0;
+}
+
+int get_fields(PyObject *record, const char *const *names, int n, PyObject **out, const char *what) {
+    for (int i = 0; i < n; i++) {
+        out[i] = PyObject_GetAttrString(record, names[i]);
+        if (!out[i]) {
+            PyErr_Clear();
+            PyErr_Format(PyExc_TypeError, "%s must have a field '%s'", what, names[i]);
+            release_fields(out, i);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+PyObject *new_record(PyTypeObject *type, PyObject **items, int n) {
+    PyObject *record = PyStructSequence_New(type);
+    for (int i = 0; i < n; i++)
+        if (!items[i]) Py_CLEAR(record);
+    if (!record) {
+        release_fields(items, n);
+        return NULL;
+    }
+    for (int i = 0; i < n; i++) PyStructSequence_SET_ITEM(record, i, items[i]);
+    return record;
+}
+
+void release_fields(PyObject **out, int n) {
+    for (int i = 0; i < n; i++) Py_CLEAR(out[i]);
+}
+
 int get_dof(PyObject *obj, Py_ssize_t *dof, const char *what) {
     *dof = PyLong_AsSsize_t(obj);
     if (*dof == -1 && PyErr_Occurred()) return -1;

@@ -48,7 +48,7 @@ PyMODINIT_FUNC PyInit_ckernels(void) {
     if (PyModule_AddObjectRef(m, "Solver", (PyObject *)&om_SolverType) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_tracking_functions) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_clearance_functions) < 0) goto fail;
-    if (PyModule_AddFunctions(m, om_follow_functions) < 0) goto fail;
+    if (PyModule_AddFunctions(m, om_follow_functions) < 0 || om_follow_init(m) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_link_functions) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_tangent_functions) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_objective_functions) < 0) goto fail;

@@ -28,12 +28,12 @@ import mink
 import mujoco
 import numpy as np
 
-from . import ckernels
+from . import _core
 from .exceptions import InvalidInput
 
 #: Largest accepted deviation max|R^T R - I| of a pose's rotation block (1e-9; defined in
 #: csrc/binding.h, where ``OMSolver.solve``'s one-call path checks poses too).
-ORTHONORMALITY_TOLERANCE: float = ckernels.ORTHONORMALITY_TOLERANCE
+ORTHONORMALITY_TOLERANCE: float = _core.ORTHONORMALITY_TOLERANCE
 #: A quaternion whose norm is below this is refused as zero (it has no direction to keep).
 MIN_QUATERNION_NORM = 1e-9
 
@@ -157,7 +157,7 @@ def as_pose(T: Any, name: str = "T") -> np.ndarray:
     if T.shape != (4, 4):
         raise InvalidInput(f"{name} must be a (4, 4) homogeneous transform, got shape {T.shape}")
     T = np.ascontiguousarray(T)
-    if ckernels.pose_is_valid(T, ORTHONORMALITY_TOLERANCE):  # fast path; the full check names the problem
+    if _core.pose_is_valid(T, ORTHONORMALITY_TOLERANCE):  # fast path; the full check names the problem
         return T
     _check_poses(T[None], name)
     raise AssertionError("unreachable: pose_is_valid and _check_poses disagree")
@@ -210,7 +210,7 @@ def _se3_matrix(T: Any) -> np.ndarray:
 
 
 def _check_poses(T: np.ndarray, name: str) -> None:
-    if ckernels.pose_is_valid(T, ORTHONORMALITY_TOLERANCE):  # fast path
+    if _core.pose_is_valid(T, ORTHONORMALITY_TOLERANCE):  # fast path
         return
     bad = ~np.isfinite(T).all(axis=(1, 2))
     if bad.any():
@@ -244,7 +244,7 @@ def as_joint_vector(q: Any, dof: int, name: str = "q", *, stack: bool = True) ->
         if q.ndim not in ((1, 2) if stack else (1,)) or q.shape[-1] != dof:
             raise InvalidInput(f"{name} must have shape {shapes}, got {q.shape}")
         q = np.ascontiguousarray(q)
-    if not ckernels.all_finite(q):
+    if not _core.all_finite(q):
         raise InvalidInput(f"{name} contains NaN or inf")
     return q
 

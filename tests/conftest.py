@@ -18,7 +18,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
-from om_redundant import ckernels
+from om_redundant import _core
 from om_redundant.mujoco_io.model_match import load_mujoco_model
 from om_redundant.redundancy.objective import Group
 
@@ -118,7 +118,7 @@ def random_groups(rng: np.random.Generator, r: int, values) -> list[Group]:
 
 
 def steps_numpy(cyclic: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """The reference of the largest joint step (``ckernels.joint_step``, ``Probe.step``) between
+    """The reference of the largest joint step (``_core.joint_step``, ``Probe.step``) between
     the rows of a and b (M, dof): max_i |b_i - a_i|, the differences of the cyclic joints taken
     to [-pi, pi) by np.remainder; numpy's maximum, so a NaN difference gives NaN."""
     d = b - a
@@ -167,7 +167,7 @@ def well_conditioned(solver: om.OMSolver, q: np.ndarray) -> bool:
     two roots of (T, c) meet), the pose map on a 6-DOF arm, and every branch quantity (of the
     model, at ``solver.flip * q``)."""
     values = np.empty(len(solver.sign_names))
-    ckernels.branch_values(solver.om.family, solver.om.params, solver.flip * q, values)
+    _core.branch_values(solver.om.family, solver.om.params, solver.flip * q, values)
     jacobian = solver.arm.jacobian(q)
     if solver.arm.dof == 7:
         jacobian = np.vstack([jacobian, om.arm_angle_and_gradient(solver, q)[1]])

@@ -11,6 +11,7 @@ the test instead of the whole run."""
 from __future__ import annotations
 
 import os
+import types
 import warnings
 from collections.abc import Callable
 from typing import Any
@@ -38,6 +39,8 @@ def _snapshot(value: Any) -> Any:
     """value with its arrays copied (lists and tuples followed), the rest as it is."""
     if isinstance(value, np.ndarray):
         return value.copy()
+    if hasattr(value, "_fields"):  # (a record of om_redundant._core)
+        return type(value)(*(_snapshot(x) for x in value))
     if isinstance(value, list | tuple):
         return type(value)(_snapshot(x) for x in value)
     return value
@@ -49,12 +52,12 @@ def recorded_calls() -> dict[str, tuple[Callable[..., Any], tuple[Any, ...]]]:
     there), the rest and the Solver's methods written out here."""
     import om_redundant as om
     from benchmarks.control_rate import HOMES, MIN_CLEARANCE, figure_eight, obstacles
-    from om_redundant import ckernels
+    from om_redundant import _core
 
     functions = {
-        name: getattr(ckernels, name)
-        for name in dir(ckernels)
-        if not name.startswith("_") and callable(getattr(ckernels, name)) and name != "Solver"
+        name: getattr(_core, name)
+        for name in dir(_core)
+        if isinstance(getattr(_core, name), types.BuiltinFunctionType)  # (the kernels: C functions)
     }
     seen: dict[str, tuple[Any, ...]] = {}
 
@@ -66,7 +69,7 @@ def recorded_calls() -> dict[str, tuple[Callable[..., Any], tuple[Any, ...]]]:
         return call
 
     for name, function in functions.items():
-        setattr(ckernels, name, recorder(name, function))
+        setattr(_core, name, recorder(name, function))
     try:
         solver = om.OMSolver("panda")
         T_home = solver.arm.fk(HOMES["panda"])
@@ -77,12 +80,12 @@ def recorded_calls() -> dict[str, tuple[Callable[..., Any], tuple[Any, ...]]]:
         optimizer.choose(figure_eight(T_home, 1, 200), choice)
     finally:
         for name, function in functions.items():
-            setattr(ckernels, name, function)
+            setattr(_core, name, function)
 
     data, kernel, q = solver.solver_data(), solver.kernel, HOMES["panda"]
     T, c = solver.arm.fk(q), solver.configuration_of(q)
     R, p = np.zeros(9), np.zeros(3)
-    ckernels.flange_target(T, data.T_base_root, data.T_tool_flange, R, p)
+    _core.flange_target(T, data.T_base_root, data.T_tool_flange, R, p)
     signs, psi = np.array(c.signs, dtype=np.int64), np.array(c.redundancy)
     ur5e = om.OMSolver("ur5e").solver_data()
     written = {
@@ -109,7 +112,7 @@ def recorded_calls() -> dict[str, tuple[Callable[..., Any], tuple[Any, ...]]]:
         "polish": (data.real_table, R, p, q.copy(), 20, data.params, data.model_table, psi[0]),
     }
     calls = {name: (functions[name], seen.get(name, written.get(name))) for name in functions}
-    m, roots = 3, ckernels.MAX_ROOTS
+    m, roots = 3, _core.MAX_ROOTS
     Ts, rows, psis = np.stack([T] * m), np.stack([signs] * m), np.stack([psi] * m)
     methods = {
         "solve": (T, c.signs, c.redundancy, None, np.zeros(7)),
@@ -133,12 +136,12 @@ def recorded_calls() -> dict[str, tuple[Callable[..., Any], tuple[Any, ...]]]:
     }
     # (unbound, the Solver first: swapped as other solver arguments are)
     for name, args in methods.items():
-        calls[f"Solver.{name}"] = (getattr(ckernels.Solver, name), (kernel, *args))
+        calls[f"Solver.{name}"] = (getattr(_core.Solver, name), (kernel, *args))
     gen3 = om.OMSolver("gen3")
     torus = (gen3.kernel, gen3.arm.fk(np.zeros(7)), (1, 1, 1), (0.0,), 0.1, 0.1, 0.05)
-    calls["Solver.torus_bound"] = (ckernels.Solver.torus_bound, torus)
-    calls["Solver"] = (ckernels.Solver, (data,))
-    calls["Solver (6-DOF)"] = (ckernels.Solver, (ur5e,))
+    calls["Solver.torus_bound"] = (_core.Solver.torus_bound, torus)
+    calls["Solver"] = (_core.Solver, (data,))
+    calls["Solver (6-DOF)"] = (_core.Solver, (ur5e,))
     missing = [name for name, (_, args) in calls.items() if args is None]
     assert not missing, f"no arguments for {missing}"
     return calls
@@ -250,12 +253,21 @@ def _mutated(rng: np.random.Generator, args: tuple[Any, ...]) -> tuple[Any, ...]
     return tuple(args)
 
 
+def _swapped(value: Any, other: Any) -> Any:
+    """value, or a record's fields, with a Solver (other's type) replaced by other."""
+    if type(value) is type(other):
+        return other
+    if hasattr(value, "_fields"):
+        return type(value)(*(other if type(x) is type(other) else x for x in value))
+    return value
+
+
 def fuzz(examples: int = EXAMPLES) -> None:
     """Draw `examples` calls (tests/test_binding_fuzz.py's docstring); an exception other than
     ACCEPTED fails, a crash ends the interpreter. Prints, per entry point, the calls that
     returned and the calls made."""
     import om_redundant as om
-    from om_redundant import ckernels
+    from om_redundant import _core
 
     calls = recorded_calls()
     names = sorted(calls)
@@ -263,7 +275,7 @@ def fuzz(examples: int = EXAMPLES) -> None:
     returned = {}
     # what a solver argument may become: a bare Solver, a 6-DOF arm's, a torus arm's
     others = [
-        ckernels.Solver.__new__(ckernels.Solver),
+        _core.Solver.__new__(_core.Solver),
         *(om.OMSolver(name).kernel for name in ("ur5e", "gen3")),
     ]
 
@@ -284,7 +296,7 @@ def fuzz(examples: int = EXAMPLES) -> None:
         else:
             args = _mutated(rng, args)
             swap = rng.random() < 0.2
-            args = tuple(others[rng.integers(3)] if swap and type(a) is ckernels.Solver else a for a in args)
+            args = tuple(_swapped(a, others[rng.integers(3)]) if swap else a for a in args)
         counts[name] += 1
         try:
             function(*args)

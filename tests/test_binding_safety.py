@@ -18,7 +18,7 @@ PREAMBLE = """
 import threading
 import numpy as np
 import om_redundant as om
-from om_redundant import ckernels
+from om_redundant import _core
 
 solver = om.OMSolver("panda")
 kernel, data = solver.kernel, solver.solver_data()
@@ -36,7 +36,7 @@ def raises(kind, call, *args):
 
 
 def solves(call=kernel.solve):
-    assert call(T, c.signs, c.redundancy, None, np.zeros(7))[0] == ckernels.OK
+    assert call(T, c.signs, c.redundancy, None, np.zeros(7))[0] == _core.OK
 """
 
 
@@ -55,7 +55,7 @@ def test_a_solver_is_initialised_once():
         raises(RuntimeError, kernel.__init__, data._replace(flip=np.ones(3)))  # was a use after free
         raises(RuntimeError, kernel.__init__, data)
         solves()
-        fresh = ckernels.Solver.__new__(ckernels.Solver)
+        fresh = _core.Solver.__new__(_core.Solver)
         raises(ValueError, fresh.__init__, data._replace(flip=np.ones(3)))
         raises(ValueError, fresh.__init__, data._replace(scan_points=3))
         raises(RuntimeError, fresh.solve, T, c.signs, c.redundancy, None, np.zeros(7))
@@ -66,15 +66,16 @@ def test_a_solver_is_initialised_once():
 
 def test_an_uninitialised_solver_raises():
     run_case("""
-        bare = ckernels.Solver.__new__(ckernels.Solver)
+        bare = _core.Solver.__new__(_core.Solver)
         methods = ["solve", "solve_pose", "solve_rows", "solve_all_rows", "solve_all", "configuration_values",
                    "bounded_search", "torus_bound", "holds"]
         for name in methods:
             raises(RuntimeError, getattr(bare, name))
         raises(RuntimeError, bare.solve, T, (), (), None, np.zeros(0))
-        walks = [("follow", 12), ("link_paths", 16), ("track_step", 14), ("self_motion_tangents", 3)]
+        raises(RuntimeError, _core.follow, _core.FollowWork(bare, *[None] * 7), 0.0, 0.0, 0.0)
+        walks = [("link_paths", 16), ("track_step", 14), ("self_motion_tangents", 3)]
         for name, arity in walks:
-            raises(RuntimeError, getattr(ckernels, name), bare, *[None] * (arity - 1))
+            raises(RuntimeError, getattr(_core, name), bare, *[None] * (arity - 1))
     """)
 
 
@@ -97,7 +98,7 @@ def test_lists_emptied_while_they_are_read():
         signs += [Clears(signs, s) for s in c.signs]
         redundancy = []
         redundancy.append(Clears(redundancy, c.redundancy[0]))
-        assert kernel.solve(T, signs, redundancy, None, np.zeros(7))[0] == ckernels.OK
+        assert kernel.solve(T, signs, redundancy, None, np.zeros(7))[0] == _core.OK
         assert kernel.holds(Q, signs[:] or [Clears(signs, s) for s in c.signs], c.redundancy)
         psi, feasible = [], []
         psi += [Clears(psi, 0.0), 0.1, 0.2]
@@ -105,7 +106,7 @@ def test_lists_emptied_while_they_are_read():
         q = [Q.copy() for _ in range(3)]
         pieces = [(np.ones(1), np.zeros(1))] * 3
         first = np.zeros(3)
-        ckernels.cell_looks(q, psi, pieces, feasible, np.array([0, 3]), np.zeros(7, dtype=bool), 1.0, 0.0,
+        _core.cell_looks(q, psi, pieces, feasible, np.array([0, 3]), np.zeros(7, dtype=bool), 1.0, 0.0,
                             np.zeros((4, 3)), first)
     """)
 
@@ -113,9 +114,9 @@ def test_lists_emptied_while_they_are_read():
 def test_malformed_solver_data_is_refused():
     run_case("""
         ur5e = om.OMSolver("ur5e").solver_data()
-        wrist_row = ckernels.SD_WRIST_ROW
+        wrist_row = _core.SD_WRIST_ROW
         bad = [
-            dict(scan_points=3), dict(scan_points=2**30), dict(scan_points=ckernels.MAX_SCAN_POINTS + 1),
+            dict(scan_points=3), dict(scan_points=2**30), dict(scan_points=_core.MAX_SCAN_POINTS + 1),
             dict(dp_joint=-1), dict(dp_joint=7), dict(mode=5), dict(family=9), dict(params=np.zeros(5)),
             dict(model_table=data.model_table[:3]), dict(real_table=data.real_table[:2]),
             dict(nominal_table=data.real_table[:1]), dict(flip=np.zeros(7)), dict(position_tolerance=np.nan),
@@ -123,14 +124,14 @@ def test_malformed_solver_data_is_refused():
             dict(upper=np.zeros(6)), dict(lower=np.zeros(0)),
         ]
         for change in bad:
-            raises(ValueError, ckernels.Solver, data._replace(**change))
-        raises(OverflowError, ckernels.Solver, data._replace(dp_joint=2**70))
-        raises(TypeError, ckernels.Solver, data._replace(params=list(data.params)))
+            raises(ValueError, _core.Solver, data._replace(**change))
+        raises(OverflowError, _core.Solver, data._replace(dp_joint=2**70))
+        raises(TypeError, _core.Solver, data._replace(params=list(data.params)))
         for row in [np.nan, 1e9, -1.0, 2.5]:
             params = ur5e.params.copy()
             params[wrist_row] = row
-            raises(ValueError, ckernels.Solver, ur5e._replace(params=params))
-            raises(ValueError, ckernels.model_ik, 0, params, ur5e.model_table, np.eye(3), np.zeros(3),
+            raises(ValueError, _core.Solver, ur5e._replace(params=params))
+            raises(ValueError, _core.model_ik, 0, params, ur5e.model_table, np.eye(3), np.zeros(3),
                    np.ones(3, dtype=np.int64), np.zeros(0), np.zeros(6), np.zeros(6), False)
     """)
 
@@ -144,7 +145,7 @@ def test_batch_rows_refuse_signs_and_rows_out_of_range():
             signs = np.array([c.signs, c.signs], dtype=np.int64)
             signs[1, 1] = sign
             raises(ValueError, kernel.solve_rows, Ts, signs, psi, None, 0, 2, q, info)
-            roots, root_info = np.zeros((2, ckernels.MAX_ROOTS, 7)), np.zeros((2, ckernels.MAX_ROOTS, 3))
+            roots, root_info = np.zeros((2, _core.MAX_ROOTS, 7)), np.zeros((2, _core.MAX_ROOTS, 3))
             raises(ValueError, kernel.solve_all_rows, Ts, signs, psi, 0, 2, roots, root_info,
                    np.zeros((2, 2), dtype=np.int64), np.ones(2, dtype=bool))
             kernel.solve_rows(Ts, signs, psi, None, 0, 1, q, info)  # the rows asked for are checked
@@ -159,15 +160,15 @@ def test_batch_rows_refuse_signs_and_rows_out_of_range():
 def test_tables_shorter_than_q_are_refused():
     run_case("""
         table = data.real_table
-        raises(ValueError, ckernels.jacobian, table[:2], np.eye(4), np.eye(4), Q, np.zeros((6, 7)))
-        raises(ValueError, ckernels.flange, table[:2], Q, np.zeros(9), np.zeros(3))
-        raises(ValueError, ckernels.flange, table, Q[:3], np.zeros(9), np.zeros(3))
-        raises(ValueError, ckernels.arm_angle_gradient, data.params, data.model_table[:2], Q, np.zeros(7))
-        raises(ValueError, ckernels.polish, table, np.eye(3), np.zeros(3), Q, 5, data.params,
+        raises(ValueError, _core.jacobian, table[:2], np.eye(4), np.eye(4), Q, np.zeros((6, 7)))
+        raises(ValueError, _core.flange, table[:2], Q, np.zeros(9), np.zeros(3))
+        raises(ValueError, _core.flange, table, Q[:3], np.zeros(9), np.zeros(3))
+        raises(ValueError, _core.arm_angle_gradient, data.params, data.model_table[:2], Q, np.zeros(7))
+        raises(ValueError, _core.polish, table, np.eye(3), np.zeros(3), Q, 5, data.params,
                data.model_table[:2], 0.0)
-        raises(ValueError, ckernels.polish, table, np.eye(3), np.zeros(3), Q, 2**40, None, None, 0.0)
+        raises(ValueError, _core.polish, table, np.eye(3), np.zeros(3), Q, 2**40, None, None, 0.0)
         J = np.zeros((6, 7))
-        ckernels.jacobian(table, np.eye(4), np.eye(4), Q, J)
+        _core.jacobian(table, np.eye(4), np.eye(4), Q, J)
         assert np.isfinite(J).all()
     """)
 
@@ -176,19 +177,19 @@ def test_a_follow_with_a_nan_target_returns():
     run_case(
         """
         t = np.zeros((1, 7))
-        ckernels.self_motion_tangents(kernel, Q[None], t)
+        _core.self_motion_tangents(kernel, Q[None], t)
         cyclic, centred = np.zeros(7, dtype=bool), np.zeros(7, dtype=bool)
         psi = c.redundancy[0]
         for target, min_step, start in [(np.nan, 1e-9, psi), (psi + 1, np.nan, psi), (psi + 1, 0.0, psi),
                                         (np.inf, 1e-9, psi), (psi + 1, 1e-9, np.nan), (1e300, -1.0, psi)]:
-            walk = (Q.copy(), t[0].copy(), np.zeros(3), start, target, min_step)
+            work = _core.FollowWork(kernel, T, SIGNS, cyclic, centred, np.zeros(7), Q.copy(), t[0].copy())
             try:
-                ckernels.follow(kernel, T, SIGNS, cyclic, centred, np.zeros(7), *walk)
+                _core.follow(work, start, target, min_step)
             except ValueError:
                 pass
-        walk = (Q.copy(), t[0].copy(), np.zeros(3), psi, psi + 1, 1e-9)
         for signs in [np.array([1, 5, 1]), np.array([1, -(2**63), 1])]:  # (copied and checked)
-            raises(ValueError, ckernels.follow, kernel, T, signs, cyclic, centred, np.zeros(7), *walk)
+            work = _core.FollowWork(kernel, T, signs, cyclic, centred, np.zeros(7), Q.copy(), t[0].copy())
+            raises(ValueError, _core.follow, work, psi, psi + 1, 1e-9)
     """,
         timeout=60,
     )
@@ -209,7 +210,7 @@ def test_a_rotation_far_from_orthonormal_returns(name):
                     bad = T.copy()
                     bad[i, j] = value
                     kernel.solve(bad, c.signs, c.redundancy, None, np.zeros(dof))
-                    roots, info = np.zeros((ckernels.MAX_ROOTS, dof)), np.zeros((ckernels.MAX_ROOTS, 3))
+                    roots, info = np.zeros((_core.MAX_ROOTS, dof)), np.zeros((_core.MAX_ROOTS, 3))
                     kernel.solve_all(bad, c.signs, c.redundancy, roots, info)
                     kernel.bounded_search(bad, c.signs, c.redundancy, roots, True)
                     if j < 3 or not np.isfinite(value):  # (a finite position is a pose, out of reach)

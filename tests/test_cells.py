@@ -1,5 +1,5 @@
-"""The compiled cell test of the global choose's solution paths (``ckernels.pieces``,
-``ckernels.surprise``, ``ckernels.joint_step`` and ``ckernels.cell_looks``, csrc/cells.c)
+"""The compiled cell test of the global choose's solution paths (``_core.pieces``,
+``_core.surprise``, ``_core.joint_step`` and ``_core.cell_looks``, csrc/cells.c)
 against the numpy it replaces: the feasibility functions of the margin and clearance groups
 and their rates, where the cubic Hermite models of a cell predict a feasibility its ends do
 not explain, the largest joint step, and the first tests of every cell of a path."""
@@ -14,7 +14,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from benchmarks.control_rate import HOMES
-from om_redundant import ckernels
+from om_redundant import _core
 from om_redundant.redundancy.paths import _BOUND_SLACK, _HERMITE, FINE_STEP
 from om_redundant.redundancy.self_motion import self_motion_tangents
 from tests.conftest import steps_numpy
@@ -55,14 +55,14 @@ def surprise_numpy(ga, da, gb, db, span, feasible_a, feasible_b):
 @settings(max_examples=300, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1), pieces=st.integers(1, 12), span=st.floats(1e-6, 1.0))
 def test_surprise_is_numpys(seed, pieces, span):
-    """ckernels.surprise gives the numpy models' answer (pieces whose bound keeps them
+    """_core.surprise gives the numpy models' answer (pieces whose bound keeps them
     positive skipped), for ends feasible or not as their values say, with dips and islands
     between them (slopes large against the values)."""
     rng = np.random.default_rng(seed)
     ga, gb = rng.normal(0.3, 0.5, (2, pieces))
     da, db = rng.normal(0.0, 3.0 / span, (2, pieces))
     fa, fb = bool((ga >= 0).all()), bool((gb >= 0).all())
-    got = ckernels.surprise(ga, da, gb, db, span, _HERMITE, fa, fb, _BOUND_SLACK)
+    got = _core.surprise(ga, da, gb, db, span, _HERMITE, fa, fb, _BOUND_SLACK)
     assert got == surprise_numpy(ga, da, gb, db, span, fa, fb)
 
 
@@ -84,13 +84,13 @@ def crossing_numpy(ga, da, gb, db, span):
 @settings(max_examples=300, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1), pieces=st.integers(1, 12), span=st.floats(-1.0, 1.0))
 def test_crossing_is_numpys(seed, pieces, span):
-    """ckernels.crossing gives the numpy models' first zero, to rounding (pieces whose bound
+    """_core.crossing gives the numpy models' first zero, to rounding (pieces whose bound
     keeps them positive skipped), from a feasible end towards either side (span < 0: the
     cell lies below the feasible end), with dips and islands between."""
     rng = np.random.default_rng(seed)
     ga, gb = np.abs(rng.normal(0.3, 0.5, pieces)), rng.normal(0.3, 0.5, pieces)
     da, db = rng.normal(0.0, 3.0 / max(abs(span), 1e-6), (2, pieces))
-    got, want = ckernels.crossing(ga, da, gb, db, span, _HERMITE), crossing_numpy(ga, da, gb, db, span)
+    got, want = _core.crossing(ga, da, gb, db, span, _HERMITE), crossing_numpy(ga, da, gb, db, span)
     assert (got is None) == (want is None)
     if want is not None:
         assert 0.0 <= got <= 1.0 and abs(got - want) <= 1e-12
@@ -126,7 +126,7 @@ def looks_numpy(q, psi, g, dg, feasible, cyclic):
 
 
 def cell_looks(paths):
-    """ckernels.cell_looks of paths [(q, psi, g, dg, feasible, cyclic)], given as lists of
+    """_core.cell_looks of paths [(q, psi, g, dg, feasible, cyclic)], given as lists of
     samples; each path's looks."""
     lengths = [len(psi) for _, psi, *_ in paths]
     q, psi, pieces, feasible = [], [], [], []
@@ -138,14 +138,14 @@ def cell_looks(paths):
     bounds = np.cumsum([0, *lengths])
     cyclic = np.array([c for *_, c in paths], dtype=bool).reshape(-1, 7)
     first = np.full(len(psi), -7.0)
-    ckernels.cell_looks(q, psi, pieces, feasible, bounds, cyclic, FINE_STEP, _BOUND_SLACK, _HERMITE, first)
+    _core.cell_looks(q, psi, pieces, feasible, bounds, cyclic, FINE_STEP, _BOUND_SLACK, _HERMITE, first)
     return np.split(first, bounds[1:-1]) if paths else []
 
 
 @settings(max_examples=300, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1), pieces=st.integers(1, 12), span=st.floats(-1.0, 1.0))
 def test_a_quiet_cell_has_no_surprise(seed, pieces, span):
-    """cell_looks' bounds: where they call a cell quiet, ckernels.surprise finds no change
+    """cell_looks' bounds: where they call a cell quiet, _core.surprise finds no change
     that its ends do not explain (so skipping its look changes no sample); cells drawn near
     the bounds' edge (values small against the slopes), ends feasible or not as they say;
     and the bounds are numpy's (quiet_numpy)."""
@@ -161,7 +161,7 @@ def test_a_quiet_cell_has_no_surprise(seed, pieces, span):
     quiet = quiet_numpy(
         np.array([span]), ga[None], da[None], gb[None], db[None], np.array([fa]), np.array([fb])
     )
-    surprise = ckernels.surprise(ga, da, gb, db, span, _HERMITE, fa, fb, _BOUND_SLACK)
+    surprise = _core.surprise(ga, da, gb, db, span, _HERMITE, fa, fb, _BOUND_SLACK)
     assert np.isnan(first[0]) == (quiet[0] or surprise is None)
     if quiet[0]:
         assert surprise is None
@@ -170,7 +170,7 @@ def test_a_quiet_cell_has_no_surprise(seed, pieces, span):
 @settings(max_examples=300, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1), dof=st.integers(1, 7), scale=st.sampled_from([0.1, 1.0, 10.0, 1e3]))
 def test_joint_step_is_the_numpy_step(seed, dof, scale):
-    """ckernels.joint_step is the numpy reference (steps_numpy) to the bit: joints drawn far
+    """_core.joint_step is the numpy reference (steps_numpy) to the bit: joints drawn far
     apart (turns of the cyclic ones) and at exact multiples of pi apart, where the remainder's
     sign rule decides."""
     rng = np.random.default_rng(seed)
@@ -179,7 +179,7 @@ def test_joint_step_is_the_numpy_step(seed, dof, scale):
     b = a + rng.normal(0.0, scale, (8, dof))
     b[-2:] = a[-2:] + math.pi * rng.integers(-4, 5, (2, dof))  # (rounded: near the turn's edge)
     want = steps_numpy(cyclic, a, b)
-    got = [ckernels.joint_step(cyclic, x, y) for x, y in zip(a, b, strict=True)]
+    got = [_core.joint_step(cyclic, x, y) for x, y in zip(a, b, strict=True)]
     assert np.array_equal(got, want)
 
 
@@ -188,7 +188,7 @@ def test_joint_step_is_the_numpy_step(seed, dof, scale):
     seed=st.integers(0, 2**32 - 1), paths=st.lists(st.integers(1, 12), max_size=4), pieces=st.integers(0, 9)
 )
 def test_cell_looks_are_numpys(seed, paths, pieces):
-    """ckernels.cell_looks gives each cell's first look as the reference (calm: NaN; a step
+    """_core.cell_looks gives each cell's first look as the reference (calm: NaN; a step
     above FINE_STEP: 1/2; else the numpy surprise), path by path with each path's cyclic
     joints: samples close and far apart in the joints, values small against the slopes
     (dips and islands), ends feasible or not as they say, no pieces at all, no paths."""
@@ -210,16 +210,14 @@ def test_cell_looks_refuses_what_it_cannot_read():
     q, pieces, feasible = [np.zeros(7)] * 2, [(np.zeros(3), np.zeros(3))] * 2, [True, True]
     bounds, cyclic, first = np.array([0, 2]), np.ones((1, 7), dtype=bool), np.empty(2)
     rest = (FINE_STEP, _BOUND_SLACK, _HERMITE, first)
-    ckernels.cell_looks(q, [0.0, 0.1], pieces, feasible, bounds, cyclic, *rest)
+    _core.cell_looks(q, [0.0, 0.1], pieces, feasible, bounds, cyclic, *rest)
     assert first[0] == 0.5 or np.isnan(first[0])
     wider = [pieces[0], (np.zeros(4), np.zeros(4))]
     with pytest.raises(ValueError, match="g must have 3 entries"):
-        ckernels.cell_looks(q, [0.0, 0.1], wider, feasible, bounds, cyclic, *rest)
+        _core.cell_looks(q, [0.0, 0.1], wider, feasible, bounds, cyclic, *rest)
     with pytest.raises(TypeError, match="q must be float64"):
-        ckernels.cell_looks(
-            [q[0], np.zeros(7, np.float32)], [0.0, 0.1], pieces, feasible, bounds, cyclic, *rest
-        )
+        _core.cell_looks([q[0], np.zeros(7, np.float32)], [0.0, 0.1], pieces, feasible, bounds, cyclic, *rest)
     with pytest.raises(ValueError, match="disagree"):
-        ckernels.cell_looks(q, [0.0, 0.1], pieces, feasible, np.array([0, 3]), cyclic, *rest)
+        _core.cell_looks(q, [0.0, 0.1], pieces, feasible, np.array([0, 3]), cyclic, *rest)
     with pytest.raises(ValueError, match="disagree"):
-        ckernels.cell_looks(q, [0.0], pieces, feasible, bounds, cyclic, *rest)
+        _core.cell_looks(q, [0.0], pieces, feasible, bounds, cyclic, *rest)

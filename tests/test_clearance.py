@@ -1,4 +1,4 @@
-"""The clearance's compiled kernel (``ckernels.arm_clearance``): the arm geoms placed by the arm's
+"""The clearance's compiled kernel (``_core.arm_clearance``): the arm geoms placed by the arm's
 DH chain against MuJoCo's ``mj_kinematics``, the distances (sphere and capsule arm geoms against
 sphere, capsule and box obstacles) against MuJoCo's ``mj_geomDistance``, and their gradients
 against finite differences."""
@@ -15,7 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
-from om_redundant import ckernels
+from om_redundant import _core
 from om_redundant.exceptions import ModelMismatch
 from tests.conftest import in_threads, random_q
 
@@ -151,7 +151,7 @@ def test_a_capsule_through_a_thin_box_overlaps(panda):
     ],
 )
 def test_box_overlap_is_the_exact_signed_distance(pos, half, distance, arm_point, box_point):
-    """ckernels.box_overlap (the pairs whose overlap MuJoCo contradicts) on shapes whose answer
+    """_core.box_overlap (the pairs whose overlap MuJoCo contradicts) on shapes whose answer
     is known, rotated and moved together: a sphere whose centre is 0.1 inside a face (radius
     0.05), a capsule along a face 0.02 outside it, a capsule through the box (its core leaves
     by 1 along x or y, its depth 1 + the radius); wrong sizes are named."""
@@ -160,7 +160,7 @@ def test_box_overlap_is_the_exact_signed_distance(pos, half, distance, arm_point
     )
     shift = np.array([0.3, -0.2, 0.5])
     fromto = np.empty(6)
-    found = ckernels.box_overlap(
+    found = _core.box_overlap(
         turn @ pos + shift, turn.ravel(), np.array(half), 0.05, shift, turn.ravel(), np.ones(3), fromto
     )
     assert found == pytest.approx(distance, abs=1e-15)
@@ -169,9 +169,7 @@ def test_box_overlap_is_the_exact_signed_distance(pos, half, distance, arm_point
             fromto, np.concatenate([turn @ arm_point, turn @ box_point]) + np.tile(shift, 2), atol=1e-15
         )
     with pytest.raises(ValueError, match="box_half"):
-        ckernels.box_overlap(
-            shift, turn.ravel(), np.array(half), 0.05, shift, turn.ravel(), np.ones(2), fromto
-        )
+        _core.box_overlap(shift, turn.ravel(), np.array(half), 0.05, shift, turn.ravel(), np.ones(2), fromto)
 
 
 def test_threads_sharing_a_clearance_get_its_answers():
@@ -284,7 +282,7 @@ def test_gradients_near_are_the_full_ones_where_the_objective_reads_them(name):
     """distances_and_gradients(q, near): the same distances, and in a row with a pair nearer
     than near the gradients of those pairs (the others zero), else all; also in the rows
     whose pairs MuJoCo computed (the overlapping sphere and the box touched). The arm geoms'
-    poses of many rows in one ckernels.arm_geom_poses call are each row's."""
+    poses of many rows in one _core.arm_geom_poses call are each row's."""
     arm = om.load_arm(name)
     clearance = mounted(arm)
     rng = np.random.default_rng(3)
@@ -292,7 +290,7 @@ def test_gradients_near_are_the_full_ones_where_the_objective_reads_them(name):
     every, full = clearance.distances_and_gradients(Q)
     arm_args, geoms = clearance._cores.links, clearance._cores.geoms
     left = np.empty(every.shape)  # which pairs the kernel leaves to MuJoCo
-    ckernels.arm_clearance(
+    _core.arm_clearance(
         *arm_args, Q, *geoms, clearance.distmax, math.inf, left, np.empty((*every.shape, 6)), None, False
     )
     assert np.isnan(left).any()
@@ -315,7 +313,7 @@ def test_gradients_near_are_the_full_ones_where_the_objective_reads_them(name):
         np.empty((len(Q), len(clearance.arm_geoms), 3)),
         np.empty((len(Q), len(clearance.arm_geoms), 9)),
     )
-    ckernels.arm_geom_poses(*arm_args, Q, xpos, xmat)
+    _core.arm_geom_poses(*arm_args, Q, xpos, xmat)
     for q, x, m in zip(Q, xpos, xmat, strict=True):
         single = clearance.geom_poses(q)
         np.testing.assert_array_equal(x, single[0])
@@ -332,13 +330,13 @@ def test_a_model_whose_links_are_not_the_arms_is_refused(panda):
 
 
 def test_the_kernel_refuses_arrays_of_other_sizes(panda):
-    """ckernels.arm_clearance and arm_geom_poses check every array's size against the others: a
+    """_core.arm_clearance and arm_geom_poses check every array's size against the others: a
     ValueError, never a read past an end."""
     clearance = om.Clearance.for_arm(panda.arm, [om.Sphere([0.4, 0.1, 0.5], 0.05)])
     arm, geoms = clearance._cores.links, clearance._cores.geoms
     q, n_pairs = np.zeros(7), len(clearance.pairs)
     dist, fromto, grad = np.empty(n_pairs), np.empty((n_pairs, 6)), np.empty((n_pairs, 7))
-    assert ckernels.arm_clearance(*arm, q, *geoms, 1.0, math.inf, dist, fromto, grad, False) == 0
+    assert _core.arm_clearance(*arm, q, *geoms, 1.0, math.inf, dist, fromto, grad, False) == 0
     short = [
         (arm, q[:6], geoms),
         (arm, q, (geoms[0][:0], *geoms[1:])),
@@ -346,16 +344,16 @@ def test_the_kernel_refuses_arrays_of_other_sizes(panda):
     ]
     for a, x, g in short:
         with pytest.raises(ValueError, match="disagree"):
-            ckernels.arm_clearance(*a, x, *g, 1.0, math.inf, dist, fromto, grad, False)
+            _core.arm_clearance(*a, x, *g, 1.0, math.inf, dist, fromto, grad, False)
     with pytest.raises(ValueError, match="disagree"):
-        ckernels.arm_clearance(*arm, q, *geoms, 1.0, math.inf, dist[:-1], fromto, grad, False)
+        _core.arm_clearance(*arm, q, *geoms, 1.0, math.inf, dist[:-1], fromto, grad, False)
     # arm_geom_poses: A poses for each of the M rows of q
     rows, n_arm = np.zeros((3, 7)), len(clearance.arm_geoms)
-    ckernels.arm_geom_poses(*arm, rows, np.empty((3, n_arm, 3)), np.empty((3, n_arm, 9)))
+    _core.arm_geom_poses(*arm, rows, np.empty((3, n_arm, 3)), np.empty((3, n_arm, 9)))
     with pytest.raises(ValueError, match="poses per joint vector"):
-        ckernels.arm_geom_poses(*arm, rows, np.empty((2, n_arm, 3)), np.empty((3, n_arm, 9)))
+        _core.arm_geom_poses(*arm, rows, np.empty((2, n_arm, 3)), np.empty((3, n_arm, 9)))
     with pytest.raises(ValueError, match="poses per joint vector"):
-        ckernels.arm_geom_poses(*arm, rows, np.empty((3, n_arm, 3)), np.empty((3, n_arm - 1, 9)))
+        _core.arm_geom_poses(*arm, rows, np.empty((3, n_arm, 3)), np.empty((3, n_arm - 1, 9)))
 
 
 # -- along a way, names, errors and mink's pairs ------------------------------------------

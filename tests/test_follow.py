@@ -1,7 +1,7 @@
-"""The compiled path following (``ckernels.follow``, csrc/follow.c) against the Python loop
+"""The compiled path following (``_core.follow``, csrc/follow.c) against the Python loop
 it replaces (``Probe(..., compiled=False).follow``): the same point reached, the same answer
 whether it arrived, on random poses and steps of both 7-DOF arms; and the compiled linking of
-a branch's grid roots into paths (``ckernels.link_paths``, csrc/link.c) against the Python
+a branch's grid roots into paths (``_core.link_paths``, csrc/link.c) against the Python
 loop (``paths._link(..., compiled=False)``): the same paths, to the bit."""
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 
 import om_redundant as om
 from benchmarks.control_rate import MIN_CLEARANCE, obstacles
-from om_redundant import ckernels
+from om_redundant import _core
 from om_redundant.redundancy import paths
 from om_redundant.redundancy.probe import END_TOLERANCE, Point, Probe
 from tests.conftest import solver_of
@@ -138,7 +138,7 @@ def test_compiled_link_makes_the_python_loops_paths(seed, name):
 
 
 def link_rows(probe: Probe, psi: np.ndarray, flat: list[Point], counts: np.ndarray, capacity: int):
-    """``ckernels.link_paths`` of the roots ``flat`` (counts[k] at psi[k]) with room for
+    """``_core.link_paths`` of the roots ``flat`` (counts[k] at psi[k]) with room for
     ``capacity`` added rows: (status, rows added, paths), members, the paths' (end, turns),
     the added rows' psi."""
     q = np.array([p.q for p in flat], dtype=float).reshape(-1, 7)
@@ -146,7 +146,7 @@ def link_rows(probe: Probe, psi: np.ndarray, flat: list[Point], counts: np.ndarr
     members, ends = np.empty((2, len(flat) + capacity, 2), dtype=np.int64)
     out = np.empty(3, dtype=np.int64)
     rows = np.empty(capacity), np.empty((capacity, 7)), np.empty((capacity, 7))
-    ckernels.link_paths(*probe._work[:6], psi, counts, q, t, *rows, members, ends, out)
+    _core.link_paths(*probe._work[:6], psi, counts, q, t, *rows, members, ends, out)
     return out.tolist(), members, ends, rows[0]
 
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import om_redundant as om
-from om_redundant import ckernels
+from om_redundant import _core
 from om_redundant.om.families import six_dof, srs
 from om_redundant.om.system import MAX_ROOTS, SolverData
 from om_redundant.redundancy.self_motion import self_motion_tangent
@@ -208,7 +208,7 @@ def test_threads_sharing_one_solver_agree_with_serial_calls(panda):
 
 def test_the_binding_rejects_malformed_buffers_with_a_named_error(panda):
     _, T, c = _target(panda, 0)
-    kernel = ckernels.Solver(panda.solver_data())
+    kernel = _core.Solver(panda.solver_data())
     out = np.empty(7)
     with pytest.raises(TypeError, match="T must be float64"):
         kernel.solve(T.astype(np.float32), c.signs, c.redundancy, None, out)
@@ -249,9 +249,9 @@ def test_the_binding_rejects_malformed_buffers_with_a_named_error(panda):
             np.empty((3, 5))[:, :0].copy(),
         )
     with pytest.raises(ValueError, match="malformed solver data"):
-        ckernels.Solver(panda.solver_data()._replace(scan_points=2))
+        _core.Solver(panda.solver_data()._replace(scan_points=2))
     with pytest.raises(AttributeError):
-        ckernels.Solver(object())
+        _core.Solver(object())
 
 
 def test_the_bindings_refuse_indices_out_of_range(panda):
@@ -264,14 +264,14 @@ def test_the_bindings_refuse_indices_out_of_range(panda):
         q, g = np.zeros((1, 7)), np.empty((1, 1))
         half, numbers = np.full(1, 0.5), np.array([0.2, 0.1, 0.5])
         lower, upper = np.zeros(1), np.ones(1)
-        ckernels.pieces(
+        _core.pieces(
             7, q, q, np.empty((1, 0)), np.empty((1, 0, 7)), limited, lower, upper, half, numbers, g, g
         )
 
     def evaluate(limited, joints):
         q, out, one = np.zeros((1, 7)), np.empty((1, 5)), np.ones(1)
         numbers = np.array([1.0, 1.0, 1.0, 0.1, 0.03, 0.1])
-        ckernels.evaluate(7, q, np.empty((1, 0)), limited, one - 1.0, one, one, joints, one, numbers, out)
+        _core.evaluate(7, q, np.empty((1, 0)), limited, one - 1.0, one, one, joints, one, numbers, out)
 
     clearance = om.Clearance.for_arm(panda.arm, [om.Sphere([0.4, 0.1, 0.5], 0.05)])
     arm, geoms = clearance._cores.links, clearance._cores.geoms
@@ -280,10 +280,10 @@ def test_the_bindings_refuse_indices_out_of_range(panda):
 
     def poses(link):
         xpos, xmat = np.empty((n_arm, 3)), np.empty((n_arm, 9))
-        ckernels.arm_geom_poses(*arm[:2], link, *arm[3:], q, xpos, xmat)
+        _core.arm_geom_poses(*arm[:2], link, *arm[3:], q, xpos, xmat)
 
     def clear(link, pairs):
-        ckernels.arm_clearance(
+        _core.arm_clearance(
             *arm[:2], link, *arm[3:], q, *geoms[:5], pairs, geoms[6], 1.0, 1.0, dist, fromto, grad, False
         )
 
@@ -336,7 +336,7 @@ def test_the_climb_bindings_refuse_groups_and_indices_out_of_range():
     one, none = np.ones(1), np.empty(0)
 
     def groups(ends, w=one, n=5):
-        for kernel in (ckernels.maximise_1d, ckernels.step_1d):
+        for kernel in (_core.maximise_1d, _core.step_1d):
             kernel(v[:n], a[:n], np.array(ends, dtype=np.int64), w, -w, w, 1.0, -1.0, 1.0, z[:n])
 
     groups([0, 5])
@@ -350,9 +350,7 @@ def test_the_climb_bindings_refuse_groups_and_indices_out_of_range():
     def bound(k, first, last, reach=0.5, columns=(1, 2)):
         group_columns = np.array(columns, dtype=np.int64)
         weights = np.ones(len(columns))
-        return ckernels.start_bound(
-            psi, values, slopes, group_columns, weights, weights, k, first, last, reach
-        )
+        return _core.start_bound(psi, values, slopes, group_columns, weights, weights, k, first, last, reach)
 
     assert all(bound(k, 0, 3) >= values[k, 0] for k in range(4))  # (at least f_k, read at either end)
     for k, first, last, reach, columns in (
@@ -392,7 +390,7 @@ def test_link_paths_refuses_grids_counts_and_outputs_that_disagree(panda):
         grid=(0.0, 0.1, 0.2), counts=(1, 0, 0), roots=1, tangents=1, room=8, q_out=8, members=9, paths=9
     ):
         out = np.empty(3, dtype=np.int64)
-        ckernels.link_paths(
+        _core.link_paths(
             *work,
             psi0 + np.array(grid),
             np.array(counts, dtype=np.int64),
@@ -440,8 +438,8 @@ def test_the_c_layouts_equal_the_python_ones():
         names = [n for n in dir(module) if n.isupper() and isinstance(getattr(module, n), int)]
         for name in names:
             c_name = name if name in ("RRR_SPHERICAL_WRIST", "RRP_SPHERICAL_WRIST", "SRS") else prefix + name
-            assert getattr(ckernels, c_name) == getattr(module, name), name
-    assert MAX_ROOTS == ckernels.MAX_ROOTS
+            assert getattr(_core, c_name) == getattr(module, name), name
+    assert MAX_ROOTS == _core.MAX_ROOTS
     for name in ("FIXED", "CIRCLE", "TORUS", "OK", "UNREACHABLE", "NO_SOLUTION_IN_CONFIGURATION"):
-        assert getattr(om.om.system, name) == getattr(ckernels, name), name
+        assert getattr(om.om.system, name) == getattr(_core, name), name
     assert set(SolverData._fields) >= {"family", "mode", "params", "dp_coefficients"}

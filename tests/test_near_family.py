@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 
 import om_redundant as om
 from benchmarks.near_family import bent, cases, fixed_row_between, reversed_joint
-from om_redundant import ckernels
+from om_redundant import _core
 from om_redundant.om.nominal import NEAR_TWIST, nominal_arm
 from tests.conftest import EXACT, check_exact, random_q, well_conditioned, wrap
 
@@ -197,7 +197,7 @@ def test_targets_at_a_branch_boundary_of_a_near_arm(branch, q):
     solver = bent_solver("ur5e", np.log10(2e-4), 0)
     q = np.array(q)
     values = np.empty(3)
-    ckernels.branch_values(solver.om.family, solver.om.params, solver.flip * q, values)
+    _core.branch_values(solver.om.family, solver.om.params, solver.flip * q, values)
     assert abs(values[branch]) < 5e-3
     check_exact(solver, q, strict=True)
 

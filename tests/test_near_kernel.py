@@ -11,7 +11,7 @@ import pytest
 
 import om_redundant as om
 from benchmarks.near_family import bent, reversed_joint
-from om_redundant import ckernels
+from om_redundant import _core
 from om_redundant.om import system
 from tests.conftest import EXACT, distance, random_q
 
@@ -32,7 +32,7 @@ def polished_roots(solver: om.OMSolver, T: np.ndarray, psi: float, rng: np.rando
     roots: list[np.ndarray] = []
     for start in rng.uniform(-np.pi, np.pi, (STARTS, solver.arm.dof)):
         q = np.ascontiguousarray(start)
-        if ckernels.polish(exact.table, R, p, q, 100, P, model, psi) > 1e-13:
+        if _core.polish(exact.table, R, p, q, 100, P, model, psi) > 1e-13:
             continue
         q = nominal.flip * q
         if not any(distance(solver.arm, q, r) < 1e-7 for r in roots):
@@ -75,7 +75,7 @@ def test_a_reversed_axis_answers_as_the_arm_itself(name, joint):
     """solve, the hinted solve, solve_all, the batches, configuration_of and holds of the
     reversed arm are the arm's with q_joint negated."""
     plain, turned = reversed_pair(name, joint)
-    assert isinstance(turned.kernel, ckernels.Solver) and turned.flip[joint] == -1
+    assert isinstance(turned.kernel, _core.Solver) and turned.flip[joint] == -1
     flip = turned.flip
     qs = random_q(plain.arm, 12, np.random.default_rng(3))
     for q in qs:
@@ -119,11 +119,11 @@ def test_the_optimiser_of_a_reversed_axis_chooses_and_tracks_as_the_arm_itself()
 
 
 def test_a_near_arm_tracks_with_the_compiled_step():
-    """A Panda with twists bent by 1e-5: its kernel is a ckernels.Solver, so the optimiser's
+    """A Panda with twists bent by 1e-5: its kernel is a _core.Solver, so the optimiser's
     tracking steps are the compiled ones, not fresh choices (before, every tracking call of a
     near arm was refused: "an arm near a family has no compiled tracking step")."""
     solver = om.OMSolver(bent(om.load_arm("panda"), 1e-5, np.random.default_rng(0)))
-    assert solver.nominal is not None and isinstance(solver.kernel, ckernels.Solver)
+    assert solver.nominal is not None and isinstance(solver.kernel, _core.Solver)
     optimizer = om.RedundancyOptimizer(solver, [om.Sphere([0.4, 0.2, 0.5], 0.05)], max_step=0.01)
     T = solver.arm.fk(np.array([0.1, -0.3, 0.2, -2.0, 0.1, 1.8, 0.5]))
     choice = optimizer.choose(T)

@@ -15,7 +15,7 @@ from hypothesis import example, settings
 
 import om_redundant as om
 from benchmarks.control_rate import MIN_CLEARANCE, obstacles
-from om_redundant import ckernels
+from om_redundant import _core
 from om_redundant.redundancy import paths
 from om_redundant.redundancy.paths import _TURN, FINE_STEP, sweep_circle
 from tests.conftest import random_pose, random_scenes, solver_of
@@ -63,7 +63,7 @@ def test_every_traced_cell_is_finer_than_fine_step(seed, name, count):
     for probe, branch in zip(probes, found, strict=True):
         for path in branch:
             for a, b in cells(path):
-                step = ckernels.joint_step(probe.cyclic, a.q, b.q)
+                step = _core.joint_step(probe.cyclic, a.q, b.q)
                 assert step <= FINE_STEP or not traced(probe, a, b), (probe.signs, a.psi, b.psi, step)
 
 

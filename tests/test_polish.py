@@ -1,4 +1,4 @@
-"""The damped Gauss-Newton refinement on the real arm's chain (``ckernels.polish``)."""
+"""The damped Gauss-Newton refinement on the real arm's chain (``_core.polish``)."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
-from om_redundant import ckernels
+from om_redundant import _core
 from tests.conftest import random_q
 
 _SOLVERS: dict[str, om.OMSolver] = {}
@@ -26,10 +26,10 @@ def _polish(solver: om.OMSolver, T: np.ndarray, psi: float | None, q: np.ndarray
     """polish q in place toward T (and psi) on the solver's real chain; the residual returned."""
     data = solver.solver_data()
     R, p = np.empty(9), np.empty(3)
-    ckernels.flange_target(np.ascontiguousarray(T), data.T_base_root, data.T_tool_flange, R, p)
+    _core.flange_target(np.ascontiguousarray(T), data.T_base_root, data.T_tool_flange, R, p)
     if psi is None:
-        return ckernels.polish(data.real_table, R, p, q, 20, None, None, 0.0)
-    return ckernels.polish(data.real_table, R, p, q, 20, data.params, data.model_table, psi)
+        return _core.polish(data.real_table, R, p, q, 20, None, None, 0.0)
+    return _core.polish(data.real_table, R, p, q, 20, data.params, data.model_table, psi)
 
 
 def _psi_distance(solver: om.OMSolver, q: np.ndarray, psi: float) -> float:

@@ -9,8 +9,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
-from om_redundant.ckernels import flange as flange_kernel
-from om_redundant.ckernels import srs_model_q7
+from om_redundant._core import flange as flange_kernel
+from om_redundant._core import srs_model_q7
 from om_redundant.om.families import REACH_SLACK, branch_values, model_ik, redundancy_values, srs
 from tests.conftest import random_q, wrap
 

@@ -1,4 +1,4 @@
-"""OMSolver.solve's one-call path (``ckernels.Solver.solve_pose``): the same answers and the
+"""OMSolver.solve's one-call path (``_core.Solver.solve_pose``): the same answers and the
 same errors as the general path it short-cuts."""
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
-from om_redundant import ckernels
+from om_redundant import _core
 from tests.conftest import random_q
 
 pytestmark = pytest.mark.sanitize  # also run under ASan and UBSan (.ci/sanitize)
@@ -92,7 +92,7 @@ def test_the_one_call_path_raises_what_the_general_path_raises(solvers):
 
 def test_orthonormality_is_checked_with_the_one_tolerance(solvers):
     """The one-call path and validation.py take the same tolerance, defined once in C."""
-    assert om.validation.ORTHONORMALITY_TOLERANCE == ckernels.ORTHONORMALITY_TOLERANCE == 1e-9
+    assert om.validation.ORTHONORMALITY_TOLERANCE == _core.ORTHONORMALITY_TOLERANCE == 1e-9
     solver = solvers["iiwa14"]
     q = random_q(solver.arm, 1, np.random.default_rng(1))[0]
     T, c = solver.arm.fk(q), solver.configuration_of(q)
@@ -107,18 +107,16 @@ def test_orthonormality_is_checked_with_the_one_tolerance(solvers):
 
 
 def test_a_solver_without_result_types_answers_none(solvers):
-    """ckernels.Solver(data) alone (as other wrappers build it) leaves every solve to the
+    """_core.Solver(data) alone (as other wrappers build it) leaves every solve to the
     caller; with the result types it answers a Solution, and None for a layout it does not take."""
     solver = solvers["panda"]
     q = random_q(solver.arm, 1, np.random.default_rng(2))[0]
     T, c = solver.arm.fk(q), solver.configuration_of(q)
-    assert ckernels.Solver(solver.solver_data()).solve_pose(T, c) is None
-    typed = ckernels.Solver(
-        solver.solver_data(), solution_type=om.Solution, configuration_type=om.Configuration
-    )
+    assert _core.Solver(solver.solver_data()).solve_pose(T, c) is None
+    typed = _core.Solver(solver.solver_data(), solution_type=om.Solution, configuration_type=om.Configuration)
     assert type(typed.solve_pose(T, c)) is om.Solution
     assert typed.solve_pose(np.asfortranarray(T), c) is None  # the general path's
     with pytest.raises(TypeError, match="both be types"):
-        ckernels.Solver(solver.solver_data(), solution_type=om.Solution)
+        _core.Solver(solver.solver_data(), solution_type=om.Solution)
     with pytest.raises(TypeError, match="slot 'q'"):
-        ckernels.Solver(solver.solver_data(), solution_type=int, configuration_type=om.Configuration)
+        _core.Solver(solver.solver_data(), solution_type=int, configuration_type=om.Configuration)

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from om_redundant import ckernels
+from om_redundant import _core
 from om_redundant.om.families import srs
 from om_redundant.om.system import MAX_ROOTS, flange_target
 from tests.conftest import EXACT, random_q, solver_of, wrap
@@ -30,7 +30,7 @@ def _map(solver, T, signs, psi, w):
         delta = D[0] + D[1] * np.cos(w7) + D[2] * np.sin(w7)
         pm = p + D[3] + D[4] * np.cos(w1) + D[5] * np.sin(w1) + R @ delta
         args = (data.family, data.params, data.model_table, R, pm, np.array(signs), np.array([psi]))
-        margin = ckernels.model_ik(*args, np.zeros(7), q, True)
+        margin = _core.model_ik(*args, np.zeros(7), q, True)
         if margin >= -1e-12:
             out[k] = q[0], q[6]
     return out

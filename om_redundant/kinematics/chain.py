@@ -27,7 +27,7 @@ from functools import cached_property
 
 import numpy as np
 
-from .. import ckernels
+from .. import _core
 from ..validation import as_joint_vector
 
 
@@ -157,7 +157,7 @@ class KinematicChain:
         """
         q = np.ascontiguousarray(as_joint_vector(q, self.dof))
         out = np.empty((*q.shape[:-1], 4, 4))
-        ckernels.fk(self.table, self.T_root_base, self.T_flange_tool, q, out)
+        _core.fk(self.table, self.T_root_base, self.T_flange_tool, q, out)
         return out
 
     def jacobian(self, q: np.ndarray) -> np.ndarray:
@@ -175,7 +175,7 @@ class KinematicChain:
         """
         q = as_joint_vector(q, self.dof, stack=False)
         J = np.empty((6, self.dof))
-        ckernels.jacobian(self.table, self.T_root_base, self.T_flange_tool, np.ascontiguousarray(q), J)
+        _core.jacobian(self.table, self.T_root_base, self.T_flange_tool, np.ascontiguousarray(q), J)
         return J
 
 

@@ -38,7 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import ckernels
+from .. import _core
 from ..exceptions import ModelError
 from ..kinematics.arm import Arm
 from ..kinematics.chain import DHRow, JointKind, KinematicChain
@@ -555,7 +555,7 @@ def _position_family(arm: Arm, rows: list[DHRow]) -> tuple[int, str, np.ndarray]
 
 def _pose(table: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     R, p = np.empty((3, 3)), np.empty(3)
-    ckernels.flange(np.ascontiguousarray(table), np.ascontiguousarray(q, dtype=np.float64), R, p)
+    _core.flange(np.ascontiguousarray(table), np.ascontiguousarray(q, dtype=np.float64), R, p)
     return R, p
 
 

@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from .. import ckernels
+from .. import _core
 from ..exceptions import InvalidInput, ModelError
 from ..kinematics.arm import Arm, load_arm
 from ..validation import (
@@ -33,7 +33,7 @@ DEFAULT_ORIENTATION_TOLERANCE = 1e-10
 DEFAULT_SCAN_POINTS = 64
 #: ``|branch quantity|`` within which a joint vector belongs to both neighbouring configurations
 #: (the singular boundary's band; see :meth:`OMSolver.holds`).
-BRANCH_BAND: float = ckernels.BRANCH_BAND
+BRANCH_BAND: float = _core.BRANCH_BAND
 #: Seeded random joint vectors within the limits whose poses a new solver must solve.
 SELF_CHECK_SAMPLES = 12
 
@@ -43,7 +43,7 @@ _SELF_CHECKED: weakref.WeakKeyDictionary[Arm, set[tuple]] = weakref.WeakKeyDicti
 #: Bounds of ``scan_points``. The bounded search of an arm whose dp turns with two joints
 #: (the Gen3's torus) costs the square of it: one ``solve_all`` takes 0.7 s at 1024 points
 #: (11 s at 4096), 6 ms at the default 64.
-MIN_SCAN_POINTS, MAX_SCAN_POINTS = ckernels.MIN_SCAN_POINTS, ckernels.MAX_SCAN_POINTS
+MIN_SCAN_POINTS, MAX_SCAN_POINTS = _core.MIN_SCAN_POINTS, _core.MAX_SCAN_POINTS
 #: Most worker threads ``solve_batch`` accepts (it uses at most one per core).
 MAX_THREADS = 1024
 
@@ -176,7 +176,7 @@ class OMSolver:
         self.om, self.nominal = closed_form(self.arm)
         self._flip = np.ones(self.arm.dof) if self.nominal is None else self.nominal.flip
         types = {"solution_type": Solution, "configuration_type": Configuration}
-        self._kernel = ckernels.Solver(self.solver_data(), **types)
+        self._kernel = _core.Solver(self.solver_data(), **types)
         self._check_solves_itself()
 
     def __reduce__(self) -> tuple[Any, tuple[Any, ...]]:
@@ -192,8 +192,8 @@ class OMSolver:
         return kernel_data(self.om, self.tolerances, self.scan_points, self.nominal)
 
     @property
-    def kernel(self) -> ckernels.Solver:
-        """The compiled solver, for kernels that solve with it (``ckernels.track_step``)."""
+    def kernel(self) -> _core.Solver:
+        """The compiled solver, for kernels that solve with it (``_core.track_step``)."""
         return self._kernel
 
     @property

@@ -49,7 +49,7 @@ The kernels are C (``csrc/``, one file per idea: ``residual.c``, ``scalar.c`` (s
 regula falsi, Brent), ``circle.c``, ``torus.c``, ``verify.c``, ``search.c``, ``solve.c``),
 compiled when the package is installed: no compile at run time. They work in DH frame 0
 with the flange pose. What crosses into them is :class:`SolverData`, copied once per solver
-into :class:`om_redundant.ckernels.Solver`, and per call the pose, the configuration's
+into :class:`om_redundant._core.Solver`, and per call the pose, the configuration's
 tuples and C-contiguous float64 arrays.
 """
 
@@ -63,21 +63,21 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .. import ckernels
+from .. import _core
 
 # Status codes of a solve, and their names by code (defined in csrc/: om_kernels.h, module.c).
-OK = ckernels.OK
-UNREACHABLE = ckernels.UNREACHABLE
-NO_SOLUTION_IN_CONFIGURATION = ckernels.NO_SOLUTION_IN_CONFIGURATION
-STATUS_NAMES: tuple[str, ...] = ckernels.STATUS_NAMES
+OK = _core.OK
+UNREACHABLE = _core.UNREACHABLE
+NO_SOLUTION_IN_CONFIGURATION = _core.NO_SOLUTION_IN_CONFIGURATION
+STATUS_NAMES: tuple[str, ...] = _core.STATUS_NAMES
 
 # How the solutions of system (9) are searched (SolverData.mode; csrc/om_kernels.h).
-FIXED = ckernels.FIXED  # dp = 0: the model is the real arm, one evaluation of the closed form
-CIRCLE = ckernels.CIRCLE  # dp depends on one wrist joint w = q_J: a circle
-TORUS = ckernels.TORUS  # shoulder offsets too: dp depends on (q_1, q_7), a torus
+FIXED = _core.FIXED  # dp = 0: the model is the real arm, one evaluation of the closed form
+CIRCLE = _core.CIRCLE  # dp depends on one wrist joint w = q_J: a circle
+TORUS = _core.TORUS  # shoulder offsets too: dp depends on (q_1, q_7), a torus
 
 #: Roots kept per configuration.
-MAX_ROOTS = ckernels.MAX_ROOTS
+MAX_ROOTS = _core.MAX_ROOTS
 
 
 class SolverData(NamedTuple):
@@ -142,7 +142,7 @@ def flange_target(
     """The flange pose (R, p) in DH frame 0 for an end-effector pose T in the root frame:
     ``T_base_root @ T @ T_tool_flange``, as the kernels compute it."""
     R, p = np.empty((3, 3)), np.empty(3)
-    ckernels.flange_target(
+    _core.flange_target(
         as_kernel_array(T), as_kernel_array(T_base_root), as_kernel_array(T_tool_flange), R, p
     )
     return R, p

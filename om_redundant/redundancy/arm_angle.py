@@ -42,7 +42,7 @@ import math
 
 import numpy as np
 
-from .. import ckernels
+from .. import _core
 from ..exceptions import InvalidInput
 from ..om.solver import OMSolver
 from ..validation import as_instance, as_joint_vector
@@ -81,7 +81,7 @@ def arm_angle_and_gradient(solver: OMSolver, q: np.ndarray) -> tuple[float, np.n
     q = as_joint_vector(q, solver.arm.dof, stack=False)
     grad = np.empty(solver.arm.dof)
     flip = solver.flip  # the model's joint coordinates are flip * q
-    psi = ckernels.arm_angle_gradient(
+    psi = _core.arm_angle_gradient(
         solver.om.params, solver.model.chain.table, np.ascontiguousarray(flip * q), grad
     )
     return float(psi), flip * grad

@@ -1,5 +1,5 @@
 r"""Where an arm's collision geoms sit on its DH chain, and the obstacles' cores: what
-``ckernels.arm_clearance`` reads (:class:`ArmCores`), set up once from a MuJoCo model.
+``_core.arm_clearance`` reads (:class:`ArmCores`), set up once from a MuJoCo model.
 
 A geom moved by joints 1..l sits at a fixed offset :math:`G` in link l's frame
 :math:`F_l(q)` (the chain's frame before joint l+1's row), :math:`X(q) = K F_l(q) G`, with
@@ -16,16 +16,16 @@ from typing import NamedTuple
 import mujoco
 import numpy as np
 
-from .. import ckernels
+from .. import _core
 from ..exceptions import ModelMismatch
 from ..mujoco_io.arm_in_model import MATCH_TOLERANCE, ArmJoints
 
-POINT, SEGMENT, BOX = 1, 2, 3  # ArmCores.kind: the cores that ckernels.arm_clearance computes
+POINT, SEGMENT, BOX = 1, 2, 3  # ArmCores.kind: the cores that _core.arm_clearance computes
 _CHECKS = 3  # random joint vectors at which the geoms' placement is checked against MuJoCo's
 
 
 class ArmCores(NamedTuple):
-    """What ``ckernels.arm_clearance`` reads, in its order: the arm's links (its DH chain
+    """What ``_core.arm_clearance`` reads, in its order: the arm's links (its DH chain
     placed in the world) with the arm geoms' offsets in them, and the geoms as cores, the
     arm's A geoms first, then the O obstacles (G = A + O).
 
@@ -60,12 +60,12 @@ class ArmCores(NamedTuple):
 
     @property
     def links(self) -> tuple[np.ndarray, ...]:
-        """The arguments of ``ckernels.arm_geom_poses`` and ``arm_clearance`` before q."""
+        """The arguments of ``_core.arm_geom_poses`` and ``arm_clearance`` before q."""
         return self[:5]
 
     @property
     def geoms(self) -> tuple[np.ndarray, ...]:
-        """The arguments of ``ckernels.arm_clearance`` after q."""
+        """The arguments of ``_core.arm_clearance`` after q."""
         return self[5:]
 
 
@@ -159,11 +159,11 @@ def lever_arms(model: mujoco.MjModel, cores: ArmCores, arm_geoms: list[int], joi
 
 def _link_frames(table: np.ndarray, start: np.ndarray, slide: np.ndarray, q: np.ndarray) -> np.ndarray:
     """The (dof + 1, 4, 4) poses of links 0..dof at q, DH frame 0 at ``start`` (csrc/clearance.c):
-    ``ckernels.arm_geom_poses`` of a geom at the origin of every link."""
+    ``_core.arm_geom_poses`` of a geom at the origin of every link."""
     links = np.arange(len(q) + 1, dtype=np.int64)
     identity = np.tile(np.concatenate([np.eye(3).ravel(), np.zeros(3)]), (len(links), 1))
     xpos, xmat = np.empty((len(links), 3)), np.empty((len(links), 9))
-    ckernels.arm_geom_poses(table, start, links, identity, slide, q, xpos, xmat)
+    _core.arm_geom_poses(table, start, links, identity, slide, q, xpos, xmat)
     frames = np.tile(np.eye(4), (len(links), 1, 1))
     frames[:, :3, :3], frames[:, :3, 3] = xmat.reshape(-1, 3, 3), xpos
     return frames

@@ -23,14 +23,14 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .. import ckernels
+from .. import _core
 from .objective import Group
 
 _TIE = 1e-12  # pieces within this of their group's minimum meet there
 
 
 class Pieces(NamedTuple):
-    """Groups of one variable concatenated, as ``ckernels.maximise_1d`` reads them: group g's
+    """Groups of one variable concatenated, as ``_core.maximise_1d`` reads them: group g's
     pieces are ``ends[g]`` to ``ends[g + 1] - 1``, each group has at least one.
 
     Attributes:
@@ -83,10 +83,10 @@ class Pieces(NamedTuple):
 
 
 def solve_1d(pieces: Pieces, curvature: float, lower: float, upper: float) -> tuple[float, np.ndarray] | None:
-    """:func:`maximise_1d` of the pieces by ``ckernels.maximise_1d``: (delta, the pieces'
+    """:func:`maximise_1d` of the pieces by ``_core.maximise_1d``: (delta, the pieces'
     multipliers (n,)), or None when the floors leave no delta."""
     z = np.empty(len(pieces.values))
-    delta = ckernels.maximise_1d(*pieces, curvature, lower, upper, z)
+    delta = _core.maximise_1d(*pieces, curvature, lower, upper, z)
     return None if delta is None else (delta, z)
 
 
@@ -107,7 +107,7 @@ def step_1d(
         pieces: The groups' pieces.
         curvature: b > 0.
         lower, upper: Bounds of delta, lower <= 0 <= upper.
-        compiled: By ``ckernels.step_1d`` (``csrc/box_qp.c``, the same operations); False:
+        compiled: By ``_core.step_1d`` (``csrc/box_qp.c``, the same operations); False:
             numpy, the reference it is tested against.
 
     Returns:
@@ -117,7 +117,7 @@ def step_1d(
     """
     if compiled:
         z = np.empty(len(pieces.values))
-        found = ckernels.step_1d(*pieces, curvature, lower, upper, z)
+        found = _core.step_1d(*pieces, curvature, lower, upper, z)
         return None if found is None else (*found, z)
     reach = max(-lower, upper)
     change = np.abs(pieces.rates) * reach
@@ -142,7 +142,7 @@ def maximise_1d(
         groups: Groups with jacobians (p_g, 1) by the redundancy variable, each with a piece.
         curvature: b > 0.
         lower, upper: Bounds of delta, lower <= 0 <= upper.
-        compiled: By ``ckernels.maximise_1d`` (``csrc/box_qp.c``, the same operations;
+        compiled: By ``_core.maximise_1d`` (``csrc/box_qp.c``, the same operations;
             :func:`solve_1d`); False: numpy, the reference it is tested against.
 
     Returns:

@@ -8,7 +8,7 @@ geoms and the obstacle geoms,
 over the pairs k of (arm geom :math:`A_k`, obstacle geom :math:`O_k`), negative when the
 geoms overlap, capped at ``distmax``. The arm geoms are placed by the arm's DH chain
 (:mod:`~om_redundant.redundancy.arm_geoms`: each at its offset in its link, checked against
-MuJoCo's ``mj_kinematics`` at set-up). One compiled call (``ckernels.arm_clearance``,
+MuJoCo's ``mj_kinematics`` at set-up). One compiled call (``_core.arm_clearance``,
 ``csrc/clearance.c``) places the geoms for every row of a batch of joint vectors and computes
 the pairs of a sphere or capsule arm geom and a sphere, capsule or box obstacle exactly
 (closest points of segments, and of a segment and a box, in closed form; overlapping where
@@ -17,7 +17,7 @@ touching, boxes touched), the arm geoms placed as the kernel places them;
 ``tests/test_clearance.py`` checks both against MuJoCo. Where MuJoCo says a sphere or capsule
 is apart from a box that its core overlaps (its box-capsule distance is positive for about
 0.3 % of such pairs, up to 0.09 m, a capsule through a thin box), the exact signed distance is
-taken instead (``ckernels.box_overlap``). With :math:`p_A, p_O` the nearest points and
+taken instead (``_core.box_overlap``). With :math:`p_A, p_O` the nearest points and
 :math:`n_k = (p_O - p_A)/d_k` the unit direction from the arm geom to the obstacle (the
 division by the signed distance keeps it pointing that way when the geoms overlap), moving
 the arm point by :math:`dp` changes the distance by :math:`-n_k \cdot dp`, so
@@ -59,7 +59,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from .. import ckernels
+from .. import _core
 from ..exceptions import InvalidInput
 from ..kinematics.arm import Arm
 from ..mujoco_io.arm_in_model import ArmJoints
@@ -236,7 +236,7 @@ class Clearance:
     def distances_and_gradients(self, q: np.ndarray, near: float = math.inf) -> tuple[np.ndarray, np.ndarray]:
         """d_k(q) and their gradients dd_k/dq (module docstring): (P,) and (P, dof) for a
         joint vector q (dof,), (M, P) and (M, P, dof) for the rows of q (M, dof), all rows
-        in one ``ckernels.arm_clearance`` call.
+        in one ``_core.arm_clearance`` call.
 
         Args:
             q: (dof,) joint vector, or (M, dof) rows.
@@ -290,7 +290,7 @@ class Clearance:
         """
         q = as_joint_vector(q, self._dof, stack=False)
         xpos, xmat = np.empty((len(self.arm_geoms), 3)), np.empty((len(self.arm_geoms), 9))
-        ckernels.arm_geom_poses(*self._cores.links, q, xpos, xmat)
+        _core.arm_geom_poses(*self._cores.links, q, xpos, xmat)
         return xpos, xmat.reshape(-1, 3, 3)
 
     def update(self, data: mujoco.MjData) -> bool:
@@ -404,14 +404,14 @@ class Clearance:
     ) -> tuple[np.ndarray, np.ndarray | None]:
         """Distances capped at reach and, if asked (else None), their gradients (only the
         pairs nearer than ``near`` where one is: :meth:`distances_and_gradients`) at a joint
-        vector or the rows of q: one ``ckernels.arm_clearance`` call, then
+        vector or the rows of q: one ``_core.arm_clearance`` call, then
         ``mj_geomDistance`` for the pairs it leaves (:meth:`_by_mujoco`)."""
         q = as_joint_vector(q, self._dof)
         shape = (*q.shape[:-1], self._n_pairs)
         dist, fromto = np.empty(shape), np.empty((*shape, 6))
         grad = np.empty((*shape, self._dof)) if gradient else None
         cores = self._cores
-        if ckernels.arm_clearance(*cores.links, q, *cores.geoms, reach, near, dist, fromto, grad, False):
+        if _core.arm_clearance(*cores.links, q, *cores.geoms, reach, near, dist, fromto, grad, False):
             self._by_mujoco(
                 cores, q.reshape(-1, self._dof), reach, near, dist.reshape(-1, self._n_pairs), fromto, grad
             )
@@ -427,7 +427,7 @@ class Clearance:
         fromto: np.ndarray,
         grad: np.ndarray | None,
     ) -> None:
-        """The pairs ``ckernels.arm_clearance`` left (nan: kinds it does not compute, cores
+        """The pairs ``_core.arm_clearance`` left (nan: kinds it does not compute, cores
         touching, boxes touched) by ``mj_geomDistance``, the arm geoms placed as it places
         them (all those rows' in one call), and those rows' gradients (in one call)."""
         m, d, n_pairs = self.model, self._data, self._n_pairs
@@ -436,7 +436,7 @@ class Clearance:
         rows = np.flatnonzero(left.any(axis=1))
         n_arm = len(self._arm_ids)
         xpos, xmat = np.empty((len(rows), n_arm, 3)), np.empty((len(rows), n_arm, 9))
-        ckernels.arm_geom_poses(*cores.links, q[rows], xpos, xmat)
+        _core.arm_geom_poses(*cores.links, q[rows], xpos, xmat)
         at, placed = rows.tolist(), self._placed
         kind, radius, half = cores.kind, cores.radius, cores.half
         for r, k in np.argwhere(left[rows]).tolist():  # (only the pair's geoms placed: the ones read)
@@ -451,7 +451,7 @@ class Clearance:
                 # The kernel leaves such a pair where the cores say it overlaps; MuJoCo's
                 # box-capsule distance can be positive for a capsule whose core pierces a
                 # thin box (0.3 % of such pairs, up to 0.09 m): the exact depth instead.
-                found = ckernels.box_overlap(
+                found = _core.box_overlap(
                     xpos[r, i],
                     xmat[r, i],
                     half[i],
@@ -464,7 +464,7 @@ class Clearance:
             dist[at[r], k] = found
         if grad is not None:
             given = np.empty((len(rows), n_pairs, self._dof))
-            ckernels.arm_clearance(
+            _core.arm_clearance(
                 *cores.links, q[rows], *cores.geoms, reach, near, dist[rows], fromto[rows], given, True
             )
             grad.reshape(-1, n_pairs, self._dof)[rows] = given

@@ -24,7 +24,7 @@ from collections.abc import Generator, Sequence
 from dataclasses import dataclass
 from typing import NamedTuple
 
-from .. import ckernels
+from .. import _core
 from .arm_angle import wrap_psi
 from .paths import _HERMITE, Follow, Path, lockstep
 from .probe import END_TOLERANCE, Point, Probe
@@ -250,10 +250,10 @@ def _newton(point: Point) -> float | None:
 
 def _modelled_end(inside: Point, outside: Point) -> float | None:
     """Where the first of the feasibility functions' cubic Hermite models between inside
-    (s = 0) and outside (s = 1) reaches zero (``ckernels.crossing``, ``csrc/cells.c``): the
+    (s = 0) and outside (s = 1) reaches zero (``_core.crossing``, ``csrc/cells.c``): the
     first of the _MODEL_POINTS points of the cell where one is negative, refined by that
     model's secant from the point before; None where none is negative there."""
     (ga, da), (gb, db) = inside.pieces(), outside.pieces()
     span = outside.psi - inside.psi
-    s = ckernels.crossing(ga, da, gb, db, span, _HERMITE) if len(ga) else None
+    s = _core.crossing(ga, da, gb, db, span, _HERMITE) if len(ga) else None
     return None if s is None else inside.psi + span * s

@@ -47,7 +47,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from .. import ckernels
+from .. import _core
 from ..exceptions import InvalidInput
 from ..kinematics.arm import Arm
 from ..validation import as_instance, as_joint_vector, as_number
@@ -178,7 +178,7 @@ class Evaluation(NamedTuple):
         return self.slack >= 0.0
 
 
-#: An :class:`Evaluation` of a row of ``ckernels.evaluate``'s five numbers: ``Evaluation._make``
+#: An :class:`Evaluation` of a row of ``_core.evaluate``'s five numbers: ``Evaluation._make``
 #: without its length check (the kernel writes five), the cheapest way to build hundreds.
 _evaluation_of_row = functools.partial(tuple.__new__, Evaluation)
 
@@ -232,12 +232,12 @@ class Objective:
         singular = (np.zeros(0, dtype=np.int64), np.zeros(0)) if singularity is None else singularity.rows()
         numbers = (self.margin_weight, self.clearance_weight, self.singularity_weight)
         numbers += (self.clearance_cap, self.min_clearance, SINGULARITY_CAP)
-        # what ckernels.pieces reads: 2 d_cap, d_cap, d_min / d_cap
+        # what _core.pieces reads: 2 d_cap, d_cap, d_min / d_cap
         self._clearance_numbers = np.array(
             [self.clearance_reach, self.clearance_cap, self.min_clearance / self.clearance_cap]
         )
-        self._no_distances = np.zeros(0)  # ckernels.evaluate's without obstacles
-        # what ckernels.pieces reads of the limits, and ckernels.evaluate of every term (csrc/objective.c)
+        self._no_distances = np.zeros(0)  # _core.evaluate's without obstacles
+        # what _core.pieces reads of the limits, and _core.evaluate of every term (csrc/objective.c)
         self._limits = (self._limited, self._lower, self._upper, self._half)
         self._terms = (*self._limits, *singular, np.array(numbers))
         eye = np.eye(self._dof)[self._limited] / self._half[:, None]
@@ -303,7 +303,7 @@ class Objective:
     def evaluate(self, q: np.ndarray, distances: np.ndarray | None = None) -> Evaluation:
         """f(q), M(q), D(q), the feasibility slack and S(q): each group's minimum
         (the smallest of its pieces, :meth:`groups`) capped and weighted, summed in the
-        groups' order (``ckernels.evaluate``, ``csrc/objective.c``).
+        groups' order (``_core.evaluate``, ``csrc/objective.c``).
 
         Args:
             q: (dof,) joint vector.
@@ -322,14 +322,14 @@ class Objective:
         return list(map(_evaluation_of_row, self._evaluated(q, distances).tolist()))
 
     def _evaluated(self, q: np.ndarray, distances: np.ndarray | None) -> np.ndarray:
-        """``ckernels.evaluate`` at q, (dof,) or (M, dof): (5,) or (M, 5) the fields of
+        """``_core.evaluate`` at q, (dof,) or (M, dof): (5,) or (M, 5) the fields of
         :class:`Evaluation`."""
         if self.clearance is None:
             distances = self._no_distances
         elif distances is None:
             distances = self.clearance.distances(q)
         out = np.empty((*q.shape[:-1], 5))
-        ckernels.evaluate(self._dof, q, np.ascontiguousarray(distances, dtype=float), *self._terms, out)
+        _core.evaluate(self._dof, q, np.ascontiguousarray(distances, dtype=float), *self._terms, out)
         return out
 
     def pieces(
@@ -337,7 +337,7 @@ class Objective:
     ) -> tuple[np.ndarray, np.ndarray]:
         """The feasibility functions g_j at q (>= 0 iff feasible) and dg_j/dpsi: the
         :meth:`Group.constraints` of the margin and clearance groups chained through the
-        tangent (``ckernels.pieces``, ``csrc/cells.c``; the same numbers to rounding), at one
+        tangent (``_core.pieces``, ``csrc/cells.c``; the same numbers to rounding), at one
         joint vector or at every row of q in one call.
 
         Args:
@@ -355,9 +355,7 @@ class Objective:
         distances, gradients = np.ascontiguousarray(pairs[0], float), np.ascontiguousarray(pairs[1], float)
         g, dg = np.empty((2, *rows, len(self._limited) + distances.shape[-1]))
         q, rate = np.ascontiguousarray(q, float), np.ascontiguousarray(tangent[..., 0], float)
-        ckernels.pieces(
-            self._dof, q, rate, distances, gradients, *self._limits, self._clearance_numbers, g, dg
-        )
+        _core.pieces(self._dof, q, rate, distances, gradients, *self._limits, self._clearance_numbers, g, dg)
         return g, dg
 
     def term_functions(

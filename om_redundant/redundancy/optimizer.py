@@ -57,7 +57,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from .. import ckernels
+from .. import _core
 from ..exceptions import InvalidInput, SingularSelfMotion
 from ..om.configuration import Configuration
 from ..om.solver import OMSolver, Solution
@@ -654,13 +654,13 @@ class _StartBounds:
         Args:
             k: The start's sample.
             reach: R >= 0.
-            compiled: By ``ckernels.start_bound`` (``csrc/start_bounds.c``, the same
+            compiled: By ``_core.start_bound`` (``csrc/start_bounds.c``, the same
                 operations); False: numpy, the reference it is tested against.
         """
         a, b = int(self.first[k]), int(self.last[k])
         if compiled:
             numbers = (self._groups, self._weights, self._caps)
-            return ckernels.start_bound(self.psi, self._values, self._slopes, *numbers, int(k), a, b, reach)
+            return _core.start_bound(self.psi, self._values, self._slopes, *numbers, int(k), a, b, reach)
         at = self.psi.tolist()
         x = at[k]
         lo = bisect.bisect_left(at, x - reach, a, b + 1)  # the samples within reach: lo..hi

@@ -39,7 +39,7 @@ from typing import Any
 
 import numpy as np
 
-from .. import ckernels
+from .. import _core
 from .probe import END_TOLERANCE, SAME, Point, Probe, evaluate_points
 
 FINE_STEP = 0.25  # rad: cells in which a joint moves further get samples in between
@@ -263,12 +263,12 @@ def _with_hidden(paths: list[tuple[Probe, Path]]) -> list[Path]:
         ends_of.append(list(path.points) + closing)
     flat = [p for ends in ends_of for p in ends]
     evaluate_points(paths[0][0].objective, flat)  # (the path ends that the following found)
-    # every cell's first tests at once (ckernels.cell_looks, which reads the samples' lists)
+    # every cell's first tests at once (_core.cell_looks, which reads the samples' lists)
     lengths = [len(ends) for ends in ends_of]
     owner = np.repeat(np.arange(len(paths)), lengths).tolist()  # each end's path
     start = np.cumsum([0, *lengths]).tolist()  # each path's first end in flat
     first = np.empty(len(flat))  # cell a: between ends a, a + 1
-    ckernels.cell_looks(
+    _core.cell_looks(
         [p.q for p in flat],
         [p.psi for p in flat],
         [p.pieces() for p in flat],
@@ -295,7 +295,7 @@ def _with_hidden(paths: list[tuple[Probe, Path]]) -> list[Path]:
 
 def _hidden(probe: Probe, a: Point, b: Point, t: float) -> Generator[Follow, tuple[Point, bool], list[Point]]:
     r"""Exact samples inserted between neighbours a and b of a path, in order, the first at
-    the fraction t of the cell (where :func:`_look` would look; ``ckernels.cell_looks``):
+    the fraction t of the cell (where :func:`_look` would look; ``_core.cell_looks``):
     halving until no joint moves more than :data:`FINE_STEP` in a sub-cell, then until the
     Hermite models of every sub-cell agree with its ends (module docstring). A process of
     :func:`lockstep`, which asks for each inserted sample's follow: from the sub-cell's left
@@ -334,18 +334,18 @@ def _look(cyclic: np.ndarray, a: Point, b: Point) -> float | None:
     """Where, as a fraction of the cell between a and b, :func:`_hidden` samples it: the
     middle where a joint moves more than :data:`FINE_STEP` (``cyclic``: the probe's joints
     compared modulo 2 pi, :meth:`Probe.step`), else :func:`_surprise`'s."""
-    return 0.5 if ckernels.joint_step(cyclic, a.q, b.q) > FINE_STEP else _surprise(a, b)
+    return 0.5 if _core.joint_step(cyclic, a.q, b.q) > FINE_STEP else _surprise(a, b)
 
 
 def _surprise(a: Point, b: Point) -> float | None:
     """Where, as a fraction of the cell, the pieces' cubic models predict a feasibility that
     the ends do not explain: more changes between feasible and infeasible than the ends'
     (none if alike, one if not), at the _MODEL_POINTS points of the cell. Returns the middle
-    of the first unexplained stretch. (``ckernels.surprise``, ``csrc/cells.c``; a piece
-    that the bound of ``ckernels.cell_looks`` keeps positive cannot change the pattern and
+    of the first unexplained stretch. (``_core.surprise``, ``csrc/cells.c``; a piece
+    that the bound of ``_core.cell_looks`` keeps positive cannot change the pattern and
     is skipped.)"""
     (ga, da), (gb, db) = a.pieces(), b.pieces()
     if len(ga) == 0:
         return None
     feasible = a.evaluation.feasible, b.evaluation.feasible
-    return ckernels.surprise(ga, da, gb, db, b.psi - a.psi, _HERMITE, *feasible, _BOUND_SLACK)
+    return _core.surprise(ga, da, gb, db, b.psi - a.psi, _HERMITE, *feasible, _BOUND_SLACK)

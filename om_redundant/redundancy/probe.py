@@ -8,14 +8,14 @@ halved (near a singular shoulder or wrist two joints turn fast), and doubled aga
 success; where the last two points predict the path's end short of the next step, the step
 aims just short of it (:meth:`Probe.follow`). Below :data:`END_TOLERANCE` the path has *ended*: it folded
 back in psi, or left the branch or the reach. With a compiled solver the loop runs in one
-call (``ckernels.follow``, ``csrc/follow.c``: the same steps and tests, the tangents of
+call (``_core.follow``, ``csrc/follow.c``: the same steps and tests, the tangents of
 ``csrc/self_motion.c``; its solves are the hinted solve's local part, so a failed local solve
 is a failed step without the bounded search, a root within a quarter of its step of the
 first-order prediction is taken without the scan for a nearer one, and a step whose
 prediction moves a joint farther than any root as near as the local one could continue
 fails without it, as it would with it); Python builds only the point reached. The linking of
 a branch's grid roots into paths runs in one call too (:meth:`Probe.link`,
-``ckernels.link_paths``, ``csrc/link.c``: those follows and the decisions of
+``_core.link_paths``, ``csrc/link.c``: those follows and the decisions of
 :func:`~om_redundant.redundancy.paths._link`'s loop).
 """
 
@@ -24,11 +24,11 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import dataclass
-from typing import Any, NamedTuple
+from typing import Any
 
 import numpy as np
 
-from .. import ckernels
+from .. import _core
 from ..exceptions import SingularSelfMotion
 from ..om.configuration import Configuration
 from ..om.solver import BRANCH_BAND, OMSolver, Solution
@@ -37,24 +37,24 @@ from .self_motion import self_motion_tangent, self_motion_tangents
 
 JUMP = 1.0  # rad, max-norm joint step between neighbouring solutions of one path
 #: rad: a path whose following step falls below this has ended (one value with csrc/binding.h's).
-END_TOLERANCE = ckernels.END_TOLERANCE
+END_TOLERANCE = _core.END_TOLERANCE
 #: rad, max-norm: two solutions at one psi this close are one (csrc/link.c reads it there too).
-SAME = ckernels.PATH_SAME
+SAME = _core.PATH_SAME
 _AIM = 63.0 / 64.0  # of the distance to a path's predicted end, a step aimed there goes (csrc/follow.c)
 _TURN = 2.0 * math.pi
-_ARRIVED, _SINGULAR, _STALLED = ckernels.FOLLOW_ARRIVED, ckernels.FOLLOW_SINGULAR, ckernels.FOLLOW_STALLED
+_ARRIVED, _SINGULAR, _STALLED = _core.FOLLOW_ARRIVED, _core.FOLLOW_SINGULAR, _core.FOLLOW_STALLED
 # A follow stalls (csrc/binding.h: a path within rounding of a singular set advances by
 # ~1e-6 rad a step) after CRAWL_STEPS accepted steps in a row shorter than CRAWL, or after
 # MAX_ATTEMPTS attempts: then SingularSelfMotion.
-CRAWL, CRAWL_STEPS = ckernels.FOLLOW_CRAWL, ckernels.FOLLOW_CRAWL_STEPS
-MAX_ATTEMPTS = ckernels.FOLLOW_MAX_ATTEMPTS
-_LINKED = 0  # ckernels.link_paths' status where it linked the paths
+CRAWL, CRAWL_STEPS = _core.FOLLOW_CRAWL, _core.FOLLOW_CRAWL_STEPS
+MAX_ATTEMPTS = _core.FOLLOW_MAX_ATTEMPTS
+_LINKED = 0  # _core.link_paths' status where it linked the paths
 
 
 class _Terms:
     """The objective at a point, computed when first asked for (a path's following steps
     need only the joints and the tangent), or given by a batch (:func:`evaluate_points`):
-    the clearance's pair distances and gradients (one ``ckernels.arm_clearance`` call), from
+    the clearance's pair distances and gradients (one ``_core.arm_clearance`` call), from
     which the groups with their rates, the evaluation and the feasibility functions. Shared
     by the copies of a point at other representatives of psi. (Slots, the arrays of a pair
     each in its own: the sweep keeps hundreds of terms per pose, and each container they
@@ -186,7 +186,7 @@ class Probe:
         solver, objective, T, signs: The solver, the objective, the pose and the branch.
         wrapped: Revolute joints modulo 2 pi, at the representative nearest mid-range (for
             the feasible intervals); False keeps them as solved (for tracking).
-        compiled: Follow paths with ``ckernels.follow`` where the arm has 7 joints; False:
+        compiled: Follow paths with ``_core.follow`` where the arm has 7 joints; False:
             always the Python loop (the reference it is tested against).
     """
 
@@ -210,7 +210,7 @@ class Probe:
         self._all_cyclic, self._all_centred = all(self._cyclic.tolist()), all(self._centred.tolist())
         self._work = None  # the compiled follow's arrays: a 7-DOF arm's only
         if compiled and arm.dof == 7:
-            self._work = FollowWork(
+            self._work = _core.FollowWork(
                 solver.kernel,
                 np.ascontiguousarray(T, dtype=float),
                 np.array(signs, dtype=np.int64),
@@ -219,14 +219,13 @@ class Probe:
                 np.ascontiguousarray(self._centre, dtype=float),
                 np.empty(7),
                 np.empty(7),
-                np.empty(3),
             )
 
     def step(self, a: np.ndarray, b: np.ndarray) -> float:
         """The largest joint step max_i |b_i - a_i| between joint vectors a and b (float64,
         (dof,)), the :attr:`cyclic` joints' differences taken to [-pi, pi); NaN where a
-        joint's is (``ckernels.joint_step``)."""
-        return ckernels.joint_step(self._cyclic, a, b)
+        joint's is (``_core.joint_step``)."""
+        return _core.joint_step(self._cyclic, a, b)
 
     @property
     def cyclic(self) -> np.ndarray:
@@ -370,14 +369,13 @@ class Probe:
     def _follow_compiled(
         self, start: Point, psi: float, min_step: float = END_TOLERANCE
     ) -> tuple[Point, bool] | None:
-        """:meth:`follow` in one ``ckernels.follow`` call, ending where the step falls below
+        """:meth:`follow` in one ``_core.follow`` call, ending where the step falls below
         ``min_step``; None where it met a point without a tangent (a fold met exactly: the
         Python loop then decides)."""
         work = self._work
         work.q[:] = start.q
         work.t[:] = start.tangent[:, 0]
-        ckernels.follow(*work, float(start.psi), float(psi), float(min_step))
-        reached, status, steps = work.out.tolist()
+        reached, status, steps = _core.follow(work, float(start.psi), float(psi), float(min_step))
         if status == _SINGULAR:
             return None
         if status == _STALLED:
@@ -390,7 +388,7 @@ class Probe:
     def link(self, psi: np.ndarray, roots: list[list[Point]]) -> list[tuple[list[Point], int]] | None:
         """The paths through the solutions ``roots[k]`` at the increasing grid psi[k] (within a
         turn) that :func:`~om_redundant.redundancy.paths._link`'s loop finds, in one
-        ``ckernels.link_paths`` call (``csrc/link.c``: the same follows, in the same order, and
+        ``_core.link_paths`` call (``csrc/link.c``: the same follows, in the same order, and
         the same decisions): each path's points and turns. Python builds only the points that
         following added. None where the solver is not a 7-DOF arm's compiled one, where a
         follow met a fold exactly (:meth:`_follow_compiled`) or where following added more
@@ -408,7 +406,7 @@ class Probe:
         new_psi, new_q, new_t = np.empty(capacity), np.empty((capacity, 7)), np.empty((capacity, 7))
         members, paths = np.empty((2, len(flat) + capacity, 2), dtype=np.int64)
         out = np.empty(3, dtype=np.int64)
-        ckernels.link_paths(*work[:6], psi, counts, q, t, new_psi, new_q, new_t, members, paths, out)
+        _core.link_paths(*work[:6], psi, counts, q, t, new_psi, new_q, new_t, members, paths, out)
         status, added, n_paths = out.tolist()
         if status != _LINKED:
             return None
@@ -420,32 +418,6 @@ class Probe:
             linked.append(([flat[r].at(flat[r].psi + _TURN * k) if k else flat[r] for r, k in rows], turns))
             begin = end
         return linked
-
-
-class FollowWork(NamedTuple):
-    """The arrays ``ckernels.follow`` reads and writes, set up once per :class:`Probe` (the
-    first six: the branch that ``ckernels.link_paths`` links).
-
-    Attributes:
-        kernel: The compiled solver.
-        T: (4, 4) the pose.
-        signs: The branch signs (int64).
-        cyclic: (7,) joints compared modulo 2 pi (uint8).
-        centred: (7,) joints taken at the turn nearest mid-range (uint8).
-        centre: (7,) the mid-ranges (0 where not centred).
-        q, t: (7,) the start's joints and tangent on entry, the point reached's on return.
-        out: (psi reached, status (0 arrived, 1 the path ended, 2 no tangent), steps taken).
-    """
-
-    kernel: ckernels.Solver
-    T: np.ndarray
-    signs: np.ndarray
-    cyclic: np.ndarray
-    centred: np.ndarray
-    centre: np.ndarray
-    q: np.ndarray
-    t: np.ndarray
-    out: np.ndarray
 
 
 def _stalled(psi: float, q: np.ndarray) -> None:

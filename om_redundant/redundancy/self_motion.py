@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import ckernels
+from .. import _core
 from ..exceptions import SingularSelfMotion
 from ..om.solver import OMSolver
 from ..validation import as_joint_vector
@@ -89,8 +89,8 @@ def self_motion_tangents(solver: OMSolver, q: np.ndarray, compiled: bool = True)
     jacobians = np.empty((len(q), 6, 7))
     gradients = np.empty((len(q), 7))
     for row, J, grad in zip(q, jacobians, gradients, strict=True):
-        ckernels.jacobian(chain.table, chain.T_root_base, chain.T_flange_tool, row, J)
-        ckernels.arm_angle_gradient(solver.om.params, model.table, flip * row, grad)
+        _core.jacobian(chain.table, chain.T_root_base, chain.T_flange_tool, row, J)
+        _core.arm_angle_gradient(solver.om.params, model.table, flip * row, grad)
     gradients *= flip
     null = _COFACTOR_SIGNS * np.linalg.det(jacobians[:, :, _MINORS].transpose(0, 2, 1, 3))
     change = np.array([g @ n for g, n in zip(gradients, null, strict=True)])
@@ -100,10 +100,10 @@ def self_motion_tangents(solver: OMSolver, q: np.ndarray, compiled: bool = True)
     return tangent[:, :, None]
 
 
-def compiled_tangents(kernel: ckernels.Solver, q: np.ndarray) -> np.ndarray:
+def compiled_tangents(kernel: _core.Solver, q: np.ndarray) -> np.ndarray:
     """:func:`self_motion_tangents` by a 7-DOF arm's compiled solver
-    (``ckernels.self_motion_tangents``, ``csrc/tangents.c``: the cofactors of the real arm's
-    Jacobian in its base frame, the same null vector, and the tangents of ``ckernels.follow``).
+    (``_core.self_motion_tangents``, ``csrc/tangents.c``: the cofactors of the real arm's
+    Jacobian in its base frame, the same null vector, and the tangents of ``_core.follow``).
 
     Args:
         kernel: The compiled solver.
@@ -113,5 +113,5 @@ def compiled_tangents(kernel: ckernels.Solver, q: np.ndarray) -> np.ndarray:
         (M, 7, 1) tangents, NaN rows where psi does not move along the self-motion.
     """
     tangent = np.empty((len(q), 7))
-    ckernels.self_motion_tangents(kernel, q, tangent)
+    _core.self_motion_tangents(kernel, q, tangent)
     return tangent[:, :, None]

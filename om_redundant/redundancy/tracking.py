@@ -1,6 +1,6 @@
 r"""The tracking step: the optimiser's choice for the next pose of a path in one compiled call.
 
-From the previous choice (branch signs, psi, joints q'), :func:`ckernels.track_step
+From the previous choice (branch signs, psi, joints q'), :func:`_core.track_step
 <om_redundant.ckernels>` (``csrc/tracking.c``) does, for the new pose T:
 
 1. the exact solution :math:`q_0` at the previous psi, hinted by :math:`q'`;
@@ -24,7 +24,7 @@ From the previous choice (branch signs, psi, joints q'), :func:`ckernels.track_s
 
 Each exact solve's local root is taken without the windowed scan for a nearer root where it
 continues its path from the hint beyond doubt (within a quarter of its joint step of the
-first-order prediction, as ``ckernels.follow`` takes its roots): the first solve's along the
+first-order prediction, as ``_core.follow`` takes its roots): the first solve's along the
 hand's motion at fixed psi, :math:`[J; D\psi](q')\,\Delta q = [\Delta p; \omega; 0]` for the
 flange's move from :math:`\mathrm{fk}(q')` to T, the second's along the self-motion,
 :math:`t\,\delta`. Else the scan decides, as in :meth:`~om_redundant.OMSolver.solve`.
@@ -47,7 +47,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .. import ckernels
+from .. import _core
 from ..om.configuration import Configuration
 from ..om.solver import OMSolver, Solution
 from .arm_angle import wrap_psi
@@ -70,8 +70,8 @@ _PSI, _MAX_STEP, _CURVATURE, _N_SETUP = 0, 6, 7, 12
 # output layout after q (csrc/tracking.c)
 _O_PSI, _O_CURVATURE, _O_MARGIN, _O_SINGULARITY = 0, 2, 3, 4
 _O_POS, _O_ORI, _O_EVALS, _O_WITHIN, _N_OUT = 6, 7, 8, 9, 10
-_INFEASIBLE, _LEFT = 3, 4  # ckernels.track_step's status: nothing feasible within the step; off the path
-#: Why ckernels.track_step refused, by its status (csrc/tracking.c).
+_INFEASIBLE, _LEFT = 3, 4  # _core.track_step's status: nothing feasible within the step; off the path
+#: Why _core.track_step refused, by its status (csrc/tracking.c).
 _REFUSED = {
     1: "no exact solution at the previous psi continues the previous joints",
     2: "the self-motion folds there (psi does not move along it)",
@@ -81,7 +81,7 @@ _REFUSED = {
 
 
 class TrackingWork(NamedTuple):
-    """The arrays ``ckernels.track_step`` reads and writes, set up once per optimiser (the
+    """The arrays ``_core.track_step`` reads and writes, set up once per optimiser (the
     clearances it linearises, a :class:`Linearisation`, are passed as they are).
 
     Attributes:
@@ -233,7 +233,7 @@ class Tracker:
         signs_array = self._signs.get(signs)
         if signs_array is None:
             signs_array = self._signs[signs] = np.array(signs, dtype=np.int64)
-        status = ckernels.track_step(
+        status = _core.track_step(
             self._kernel, T, signs_array, q, *work[:-2], *linearised[:3], work.q, work.out
         )
         if status != 0:

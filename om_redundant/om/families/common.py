@@ -21,7 +21,7 @@ their rounding errors cancel in the product even near the singularity
 :math:`\varphi_a` keeps a given value.
 """
 
-from ... import ckernels
+from ... import _core
 
 #: Relative slack under a square root before a target counts as outside the model's reach.
-REACH_SLACK = ckernels.REACH_SLACK
+REACH_SLACK = _core.REACH_SLACK

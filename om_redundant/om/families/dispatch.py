@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ... import ckernels
+from ... import _core
 
 
 def model_ik(
@@ -42,7 +42,7 @@ def model_ik(
         The reach margin: negative (beyond ``REACH_SLACK``) when the pose is out of the
         model's reach, in which case q is not written; it measures how far.
     """
-    return ckernels.model_ik(
+    return _core.model_ik(
         int(family),
         f64(P),
         f64(table),
@@ -58,12 +58,12 @@ def model_ik(
 
 def branch_values(family: int, P: np.ndarray, q: np.ndarray, out: np.ndarray) -> None:
     """Write the quantities whose signs are the configuration's branch signs at q."""
-    ckernels.branch_values(int(family), f64(P), f64(q), out)
+    _core.branch_values(int(family), f64(P), f64(q), out)
 
 
 def redundancy_values(family: int, P: np.ndarray, q: np.ndarray, out: np.ndarray) -> None:
     """Write the redundancy values of the configuration at q (the arm angle for 7-DOF)."""
-    ckernels.redundancy_values(int(family), f64(P), f64(q), out)
+    _core.redundancy_values(int(family), f64(P), f64(q), out)
 
 
 def f64(values: np.ndarray) -> np.ndarray:

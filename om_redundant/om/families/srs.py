@@ -57,7 +57,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ... import ckernels
+from ... import _core
 from .dispatch import f64, i64
 
 SRS = 2
@@ -105,7 +105,7 @@ def model_ik_lifted(
     angles are ill-conditioned. Its roots are the model's IK in every SHOULDER and WRIST
     branch at once (each angle pair's branch follows from q1 or q7).
     """
-    return ckernels.model_ik_lifted(f64(P), f64(R), f64(p), i64(signs), psi, q1, q7, phi4, q)
+    return _core.model_ik_lifted(f64(P), f64(R), f64(p), i64(signs), psi, q1, q7, phi4, q)
 
 
 def model_ik_at_reach(
@@ -120,4 +120,4 @@ def model_ik_at_reach(
     """The closed form, but where the wrist centre lies beyond the model's reach the elbow is
     held at the edge (straight or folded): a start for :func:`model_ik_lifted`, which is
     smooth across that edge. Returns False, and leaves q, only where W = S."""
-    return ckernels.model_ik_at_reach(f64(P), f64(R), f64(p), i64(signs), psi, f64(q_prev), q)
+    return _core.model_ik_at_reach(f64(P), f64(R), f64(p), i64(signs), psi, f64(q_prev), q)
