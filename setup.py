@@ -35,9 +35,9 @@ setup(
     ext_modules=[
         Extension(
             "om_redundant.ckernels",
-            sources=sorted(str(path) for path in Path("csrc").glob("*.c")),
-            include_dirs=["csrc"],
-            depends=sorted(str(path) for path in Path("csrc").glob("*.h")),
+            sources=sorted(str(path) for path in Path("csrc").rglob("*.c")),
+            include_dirs=["csrc", "csrc/binding"],
+            depends=sorted(str(path) for path in Path("csrc").rglob("*.h")),
         )
     ],
     cmdclass={"build_ext": BuildExt},
