@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import om_redundant as om
-from om_redundant.kinematics.arm import pose_from_xyz_quat
+from om_redundant.kinematics import pose_from_xyz_quat
 from tests.conftest import random_q
 
 UR5E_ROWS = """

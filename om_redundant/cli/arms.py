@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ..exceptions import ModelError
-from ..kinematics.arm import arm_names, load_arm
+from ..kinematics import arm_names, load_arm
 from ..om.solver import OMSolver
 from .common import add_output_options, table_wanted, write_json
 

@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from ..exceptions import InvalidInput, OMError
-from ..kinematics.arm import Arm, arm_names, pose_from_xyz_quat
+from ..kinematics import Arm, arm_names, pose_from_xyz_quat
 from ..om.solver import OMSolver
 from ..validation import as_pose, as_signs, numbers_text
 
@@ -115,7 +115,7 @@ def target_pose(args: argparse.Namespace, arm: Arm) -> np.ndarray:
 
 
 def pose_from_text(xyz, quat, xyz_name: str, quat_name: str) -> np.ndarray:
-    """:func:`~om_redundant.kinematics.arm.pose_from_xyz_quat` of numbers read from the command line or a
+    """:func:`~om_redundant.kinematics.poses.pose_from_xyz_quat` of numbers read from the command line or a
     file, an error naming them and the problem (a quaternion that is not finite, has zero norm,
     ...: :func:`~om_redundant.validation.as_quaternion`)."""
     xyz = np.asarray(xyz, dtype=np.float64)

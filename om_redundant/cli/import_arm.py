@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ..exceptions import ModelError
-from ..kinematics.arm import write_arm_file
+from ..kinematics import write_arm_file
 from ..mujoco_io.arm_import import IMPORT_TOLERANCE, arm_from_mujoco
 from ..mujoco_io.model_match import compare_mujoco_model, load_mujoco_model
 from ..om.solver import OMSolver

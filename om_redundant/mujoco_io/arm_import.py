@@ -34,7 +34,7 @@ y) turned perpendicular to the axis: the base transform. The last row keeps only
 the rest. Lengths below ``SNAP`` metres become 0 and angles within ``SNAP`` radians of a
 multiple of 90 deg become that multiple (round-off of the model's own numbers; the arm's
 pose moves by less than 1e-13 m), every angle and transform is one that an arm file's
-numbers give exactly (:func:`~om_redundant.kinematics.arm.exact_angle`), and the result is
+numbers give exactly (:func:`~om_redundant.kinematics.poses.exact_angle`), and the result is
 checked against the model with :func:`~.model_match.compare_mujoco_model` at 1e-12.
 """
 
@@ -47,8 +47,9 @@ import mujoco
 import numpy as np
 
 from ..exceptions import FrameNotFound, InvalidInput, ModelMismatch
-from ..kinematics.arm import Arm, exact_angle, exact_pose
+from ..kinematics.arm import Arm
 from ..kinematics.chain import DHRow, JointKind, KinematicChain, row_transform
+from ..kinematics.poses import exact_angle, exact_pose
 from .frames import FRAME_OBJECTS, find_frame, given_frame_names
 from .model_match import compare_mujoco_model, load_mujoco_model
 

@@ -11,7 +11,7 @@ import numpy as np
 
 from .. import _core
 from ..exceptions import InvalidInput, ModelError
-from ..kinematics.arm import Arm, load_arm
+from ..kinematics import Arm, load_arm
 from ..validation import (
     as_count,
     as_instance,
