@@ -19,7 +19,7 @@ from hypothesis import strategies as st
 
 import om_redundant as om
 from om_redundant import _core
-from om_redundant.mujoco_io.model_match import load_mujoco_model
+from om_redundant.mujoco_io.loading import load_mujoco_model
 from om_redundant.redundancy.objective import Group
 
 # The suite's property tests draw the same examples on every run, so that CI answers for the

@@ -5,7 +5,8 @@ from __future__ import annotations
 import argparse
 
 from ..kinematics import load_arm
-from ..mujoco_io.model_match import DEFAULT_TOLERANCE, compare_mujoco_model, load_mujoco_model
+from ..mujoco_io.loading import load_mujoco_model
+from ..mujoco_io.model_match import DEFAULT_TOLERANCE, compare_mujoco_model
 from .common import Failed, add_arm_option, add_output_options, table_wanted, write_json
 
 

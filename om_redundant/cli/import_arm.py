@@ -7,7 +7,8 @@ import argparse
 from ..exceptions import ModelError
 from ..kinematics import write_arm_file
 from ..mujoco_io.arm_import import IMPORT_TOLERANCE, arm_from_mujoco
-from ..mujoco_io.model_match import compare_mujoco_model, load_mujoco_model
+from ..mujoco_io.loading import load_mujoco_model
+from ..mujoco_io.model_match import compare_mujoco_model
 from ..om.solver import OMSolver
 from .common import add_output_options, check_output_path, table_wanted, write_json
 

@@ -19,7 +19,7 @@ import sys
 
 import numpy as np
 
-from ..mujoco_io.model_match import load_mujoco_model
+from ..mujoco_io.loading import load_mujoco_model
 from ..om.configuration import Configuration
 from ..om.solver import OMSolver
 from ..redundancy.objective import DEFAULT_SINGULARITY_WEIGHT

@@ -4,8 +4,9 @@ larger model (:mod:`.arm_in_model`), the check of a model against an arm file
 
 from .arm_import import arm_from_mujoco
 from .arm_in_model import ArmJoints, ArmRoot
+from .loading import load_mujoco_model, without_meshes
 from .mjcf import DEFAULT_SITE, arm_mjcf, arm_model, scene_mjcf
-from .model_match import ModelComparison, compare_mujoco_model, load_mujoco_model, without_meshes
+from .model_match import ModelComparison, compare_mujoco_model
 
 __all__ = [
     "DEFAULT_SITE",

@@ -51,7 +51,8 @@ from ..kinematics.arm import Arm
 from ..kinematics.chain import DHRow, JointKind, KinematicChain, row_transform
 from ..kinematics.poses import exact_angle, exact_pose
 from .frames import FRAME_OBJECTS, find_frame, given_frame_names
-from .model_match import compare_mujoco_model, load_mujoco_model
+from .loading import load_mujoco_model
+from .model_match import compare_mujoco_model
 
 #: Largest length (m) and angle (rad) taken for round-off of 0 or of a multiple of 90 deg.
 SNAP = 1e-14
@@ -80,7 +81,7 @@ def arm_from_mujoco(
 
     Args:
         model: A compiled model, or the path of an MJCF (.xml) or URDF (.urdf) file, loaded
-            by :func:`~.model_match.load_mujoco_model` (missing meshes and textures skipped).
+            by :func:`~.loading.load_mujoco_model` (missing meshes and textures skipped).
         frame_name: The end-effector site or body: its name as given, else with the prefix.
         frame_type: ``"site"`` or ``"body"``.
         prefix: Prefix of the model's names of the arm's joints (e.g. ``"wx250s/"``), which
