@@ -35,9 +35,11 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
+import mujoco
 import numpy as np
 
-from ..exceptions import InvalidInput
+from ..exceptions import InvalidInput, UnreachableTarget
+from ..redundancy.clearance import ALONG_TOLERANCE
 from ..validation import as_vector
 
 #: An arm held short of its aim (farther than :data:`NEAR` rad) whose joints move less than
@@ -55,6 +57,10 @@ WAY_HORIZON = 0.5
 #: rad: the smallest lead on a joint-space way (an arm standing still), so the task's weight
 #: grows at most by the joint lead over this.
 MIN_WAY_LEAD = 1e-3
+#: The most joint vectors one tick samples to re-check a way's rest against moved obstacles
+#: (:meth:`~om_redundant.Clearance.minimum_along`): a way whose clearance
+#: nears its floor needs thousands to decide, ~10 us each, past a 2 ms tick.
+WAY_CHECK_SAMPLES = 128
 
 
 def pose_gap(A: np.ndarray, B: np.ndarray) -> tuple[float, float]:
@@ -168,6 +174,23 @@ class JointWay:
             return q_target
         return self.start + (self.s + self.lead / span) * delta
 
+    def blocked(self, clearance: Any, q_target: np.ndarray) -> bool:
+        """Whether obstacles that moved since the way was last checked now block its rest
+        ahead (from the arm's projection on it, which the optimiser certified, the arm's own
+        deviation its margin's, to :data:`WAY_HORIZON` further): below the way's floor by more
+        than the certificate's tolerance (the arm's own way, certified above the floor to that
+        tolerance, never blocks itself: a way chosen afresh from each near miss would sink by
+        the tolerance each time). ``clearance``: the optimiser's live
+        :class:`~om_redundant.Clearance`."""
+        if self.floor == -math.inf or clearance.version == self.checked:
+            return False  # (no floor: no obstacles, or a way the optimiser could not find clear)
+        self.checked = clearance.version
+        q, q_ahead = self.ahead(q_target, WAY_HORIZON)
+        floor = self.floor - ALONG_TOLERANCE
+        # (undecided within the samples, NaN: kept; the obstacle that nears the way is sampled
+        # below its floor in a later tick, or moves off)
+        return clearance.minimum_along(q, q_ahead, floor, WAY_CHECK_SAMPLES) < floor
+
     def weight(self, max_lead: float) -> float:
         """The error's scale, the full lead over the current one."""
         return max_lead / self.lead
@@ -196,3 +219,87 @@ class Patience:
             return False
         self.stalled, self.patience = 0, 2 * self.patience
         return True
+
+
+class LeadsToJumpedTargets:
+    """:class:`~om_redundant.ExactPoseTask`'s approach to a target that jumped: an aim that
+    leads the hand along its straight way while tracking can follow it, else the optimiser's
+    fresh choice reached along a joint-space way. (The task's own state: ``optimizer``,
+    ``lead``, ``free``, ``choice``, ``root``, ``joints`` and the world last seen.)"""
+
+    def _aim_for(self, T_world: np.ndarray, data: mujoco.MjData) -> np.ndarray:
+        """The aim while leading (:func:`~om_redundant.tasks.approach.next_aim`)."""
+        return next_aim(self.root.frame_pose(data), T_world, self._aim, self.lead)
+
+    def _leads(self) -> bool:
+        """Whether the task aims a lead ahead of the hand: after a jump of the target (with an
+        optimiser and a lead), until the hand is near it or the lead's way is blocked."""
+        return self._leading and self._data is not None
+
+    def _jumped(self, T_world: np.ndarray) -> bool:
+        """Whether a new target lies farther than the lead from the last one (or there is none),
+        with an optimiser, a lead and the hand seen: then the aim leads the hand, and the
+        target is chosen at once (:meth:`_jump`)."""
+        if self.optimizer is None or self.lead is None or self._data is None:
+            return False
+        if self.transform_target_to_world is None:
+            return True
+        distance, angle = pose_gap(self.transform_target_to_world.as_matrix(), T_world)
+        return distance > self.lead[0] or (self.free is None and angle > self.lead[1])
+
+    def _jump(self, T_world: np.ndarray, root_pose: np.ndarray) -> None:
+        """A target that jumped. Where tracking can follow the hand's straight way there, a
+        lead at a time (:meth:`_tracks_to`: then the target is reachable), the task leads the
+        hand (:meth:`_aim_for`); else the optimiser's fresh choice there from the arm's joints
+        is the target (UnreachableTarget if it has none), the arm going there in joint space."""
+        self._patience.reset()
+        if self.choice is not None and self.free is None and self._tracks_to(T_world, root_pose):
+            self._leading, self._aim, self._way = True, None, None  # the first aim: a lead from the hand
+            self._solve(T_world, root_pose, self._q_target, None)
+            return
+        q_current = self.joints.q(self._data.qpos)
+        choice = self.optimizer.choose(
+            self.root.in_root(T_world, root_pose), q_current=q_current, free=self.free
+        )
+        self._take(choice, root_pose, fresh=True)
+        self._aim, self._leading = T_world, False
+
+    def _tracks_to(self, T_world: np.ndarray, root_pose: np.ndarray) -> bool:
+        """Whether the optimiser tracks from its last choice to the target along the hand's
+        straight way there, a lead at a time (the aims :meth:`_aim_for` will take, the arm
+        taken to follow each), without choosing afresh or losing a clear way."""
+        previous, aim = self.choice, self.root.frame_pose(self._data)
+        while aim is not T_world:
+            aim = lead_pose(aim, T_world, self.lead)
+            q = previous.solution.q
+            previous = self.optimizer.choose(
+                self.root.in_root(aim, root_pose), previous=previous, q_current=q
+            )
+            if not (previous.ok and not previous.rechosen and previous.way_clear):
+                return False
+        return True
+
+    def _take(self, choice: Any, root_pose: np.ndarray, fresh: bool = False) -> None:
+        """Take the optimiser's choice (UnreachableTarget if it is none within the limits); one
+        made afresh from the arm's joints (``fresh``, or re-chosen where tracking stopped) is
+        reached along a joint-space way (:meth:`_pull_to`)."""
+        if not choice.ok:
+            raise UnreachableTarget(
+                f"ExactPoseTask: the optimizer found no configuration for the target: {choice.reason}"
+            )
+        q = np.asarray(choice.solution.q, dtype=np.float64)
+        if not (choice.solution.ok and self.joints.within_limits(q)):
+            raise UnreachableTarget(
+                f"ExactPoseTask: the optimizer's solution {np.round(q, 4).tolist()} "
+                f"({choice.solution.status}) does not reach the target within the joint limits"
+            )
+        self._q_target, self.choice, self._root_pose = q, choice, root_pose
+        if self._clearance is not None:
+            self._seen = self._clearance.version
+        if (fresh or choice.rechosen) and self._data is not None:  # q* jumped: a joint-space way there
+            start = self.joints.q(self._data.qpos)
+            floor = -np.inf  # (a way the optimiser could not find clear is not re-checked: it
+            # would be "blocked" by what it already passes, and chosen again, tick after tick)
+            if self._clearance is not None and choice.way_clear:
+                floor = min(self.optimizer.min_clearance, self._clearance.minimum(start)) - ALONG_TOLERANCE
+            self._way = JointWay(start, floor, lead=self.lead[2])

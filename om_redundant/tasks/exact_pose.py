@@ -9,9 +9,7 @@ model (:class:`~om_redundant.ArmRoot`).
 
 from __future__ import annotations
 
-import math
-import warnings
-from typing import Any, Protocol
+from typing import Any
 
 import mujoco
 import numpy as np
@@ -23,43 +21,19 @@ from ..exceptions import InvalidInput, UnreachableTarget
 from ..mujoco_io.arm_in_model import ArmRoot
 from ..om.configuration import Configuration
 from ..om.solver import OMSolver
-from ..redundancy.clearance import ALONG_TOLERANCE
 from ..redundancy.free_rotation import FreeRotation
 from ..validation import as_instance, as_pose
-from .approach import DEFAULT_LEAD, WAY_HORIZON, JointWay, Patience, as_lead, lead_pose, next_aim, pose_gap
+from .approach import DEFAULT_LEAD, JointWay, LeadsToJumpedTargets, Patience, as_lead
 from .arm_task import ArmTask
+from .chooser import Chooser, live_clearance
 
 #: Default cost of :class:`ExactPoseTask`, per radian (metre for prismatic joints). With
 #: mink's usual ``FrameTask`` costs of 1 it makes the exact target dominate far from it,
 #: which removes the spurious stationary points of the sum (see :class:`ExactPoseTask`).
 EXACT_POSE_COST = 10.0
-#: The most joint vectors one tick samples to re-check a way's rest against moved obstacles
-#: (:meth:`~om_redundant.redundancy.clearance.Clearance.minimum_along`): a way whose clearance
-#: nears its floor needs thousands to decide, ~10 us each, past a 2 ms tick.
-WAY_CHECK_SAMPLES = 128
 
 
-class RedundancyOptimizer(Protocol):
-    """What :class:`ExactPoseTask` needs of a redundancy optimiser (duck-typed, as
-    :class:`~om_redundant.RedundancyOptimizer`).
-
-    ``choose(T, previous, q_current=q)`` takes a pose in the arm's root frame, the previous
-    choice (or None) and the arm's joints now (or None), and returns an object with ``ok``
-    (bool), ``solution`` (an om :class:`~om_redundant.Solution`), ``configuration`` (its
-    :class:`~om_redundant.Configuration`), ``reason`` (str, why when not ok), ``rechosen``
-    (bool: chosen afresh where tracking could not continue) and ``way_clear`` (bool: the
-    joint-space way from ``q_current`` is clear), as a
-    :class:`~om_redundant.RedundancyChoice` has them. ``clearance`` is its
-    :class:`~om_redundant.Clearance` or None, ``min_clearance`` what its choices keep (m).
-    """
-
-    clearance: Any
-    min_clearance: float
-
-    def choose(self, T: np.ndarray, previous: Any = None, *, q_current: Any = None) -> Any: ...
-
-
-class ExactPoseTask(ArmTask):
+class ExactPoseTask(ArmTask, LeadsToJumpedTargets):
     r"""Pull the arm's joints to the exact solution of a hand pose in a chosen configuration.
 
     On :meth:`set_target` the OM solver gives :math:`q^*` with :math:`\mathrm{fk}(q^*) =
@@ -149,7 +123,7 @@ class ExactPoseTask(ArmTask):
         model: mujoco.MjModel,
         *,
         arm_configuration: Configuration | None = None,
-        optimizer: RedundancyOptimizer | None = None,
+        optimizer: Chooser | None = None,
         prefix: str | None = None,
         frame_name: str | None = None,
         frame_type: str | None = None,
@@ -167,7 +141,7 @@ class ExactPoseTask(ArmTask):
         super().__init__(solver, model, solver.arm.dof, prefix, cost, gain, lm_damping)
         self.root = ArmRoot(self.joints, frame_name, frame_type)
         self.optimizer = optimizer
-        self._clearance = self._live_clearance(optimizer, model)
+        self._clearance = live_clearance(optimizer, model, self.root)
         if free is not None and optimizer is None:
             raise TaskDefinitionError("ExactPoseTask: a free rotation is chosen by an optimizer")
         try:
@@ -265,20 +239,8 @@ class ExactPoseTask(ArmTask):
 
     def _blocked(self, q_target: np.ndarray) -> bool:
         """Whether obstacles that moved since the joint-space way was last checked now block
-        its rest ahead (from the arm's projection on it, which the optimiser certified, the
-        arm's own deviation its margin's, to :data:`~om_redundant.tasks.approach.WAY_HORIZON`
-        further): below the way's floor by more than the certificate's tolerance (the arm's
-        own way, certified above the floor to that tolerance, never blocks itself: a way
-        chosen afresh from each near miss would sink by the tolerance each time)."""
-        way, clearance = self._way, self._clearance
-        if way is None or way.floor == -math.inf or clearance.version == way.checked:
-            return False  # (no floor: no obstacles, or a way the optimiser could not find clear)
-        way.checked = clearance.version
-        q, q_ahead = way.ahead(q_target, WAY_HORIZON)
-        floor = way.floor - ALONG_TOLERANCE
-        # (undecided within the samples, NaN: kept; the obstacle that nears the way is sampled
-        # below its floor in a later tick, or moves off)
-        return clearance.minimum_along(q, q_ahead, floor, WAY_CHECK_SAMPLES) < floor
+        its rest ahead (:meth:`~om_redundant.tasks.approach.JointWay.blocked`)."""
+        return self._way is not None and self._way.blocked(self._clearance, q_target)
 
     def seed(self, configuration: MinkConfiguration) -> None:
         """Put the arm's joints of ``configuration`` at :math:`q^*` of the target itself (not of
@@ -392,58 +354,6 @@ class ExactPoseTask(ArmTask):
         self._solve_at(T_world, root_pose, hint, arm_configuration)
         self._aim = T_world
 
-    def _aim_for(self, T_world: np.ndarray, data: mujoco.MjData) -> np.ndarray:
-        """The aim while leading (:func:`~om_redundant.tasks.approach.next_aim`)."""
-        return next_aim(self.root.frame_pose(data), T_world, self._aim, self.lead)
-
-    def _leads(self) -> bool:
-        """Whether the task aims a lead ahead of the hand: after a jump of the target (with an
-        optimiser and a lead), until the hand is near it or the lead's way is blocked."""
-        return self._leading and self._data is not None
-
-    def _jumped(self, T_world: np.ndarray) -> bool:
-        """Whether a new target lies farther than the lead from the last one (or there is none),
-        with an optimiser, a lead and the hand seen: then the aim leads the hand, and the
-        target is chosen at once (:meth:`_jump`)."""
-        if self.optimizer is None or self.lead is None or self._data is None:
-            return False
-        if self.transform_target_to_world is None:
-            return True
-        distance, angle = pose_gap(self.transform_target_to_world.as_matrix(), T_world)
-        return distance > self.lead[0] or (self.free is None and angle > self.lead[1])
-
-    def _jump(self, T_world: np.ndarray, root_pose: np.ndarray) -> None:
-        """A target that jumped. Where tracking can follow the hand's straight way there, a
-        lead at a time (:meth:`_tracks_to`: then the target is reachable), the task leads the
-        hand (:meth:`_aim_for`); else the optimiser's fresh choice there from the arm's joints
-        is the target (UnreachableTarget if it has none), the arm going there in joint space."""
-        self._patience.reset()
-        if self.choice is not None and self.free is None and self._tracks_to(T_world, root_pose):
-            self._leading, self._aim, self._way = True, None, None  # the first aim: a lead from the hand
-            self._solve(T_world, root_pose, self._q_target, None)
-            return
-        q_current = self.joints.q(self._data.qpos)
-        choice = self.optimizer.choose(
-            self.root.in_root(T_world, root_pose), q_current=q_current, free=self.free
-        )
-        self._take(choice, root_pose, fresh=True)
-        self._aim, self._leading = T_world, False
-
-    def _tracks_to(self, T_world: np.ndarray, root_pose: np.ndarray) -> bool:
-        """Whether the optimiser tracks from its last choice to the target along the hand's
-        straight way there, a lead at a time (the aims :meth:`_aim_for` will take, the arm
-        taken to follow each), without choosing afresh or losing a clear way."""
-        previous, aim = self.choice, self.root.frame_pose(self._data)
-        while aim is not T_world:
-            aim = lead_pose(aim, T_world, self.lead)
-            q = previous.solution.q
-            previous = self.optimizer.choose(
-                self.root.in_root(aim, root_pose), previous=previous, q_current=q
-            )
-            if not (previous.ok and not previous.rechosen and previous.way_clear):
-                return False
-        return True
-
     def _solve_at(
         self,
         T_world: np.ndarray,
@@ -467,43 +377,3 @@ class ExactPoseTask(ArmTask):
         )
         if self._clearance is not None:
             self._seen = self._clearance.version
-
-    def _take(self, choice: Any, root_pose: np.ndarray, fresh: bool = False) -> None:
-        """Take the optimiser's choice (UnreachableTarget if it is none within the limits); one
-        made afresh from the arm's joints (``fresh``, or re-chosen where tracking stopped) is
-        reached along a joint-space way (:meth:`_pull_to`)."""
-        if not choice.ok:
-            raise UnreachableTarget(
-                f"ExactPoseTask: the optimizer found no configuration for the target: {choice.reason}"
-            )
-        q = np.asarray(choice.solution.q, dtype=np.float64)
-        if not (choice.solution.ok and self.joints.within_limits(q)):
-            raise UnreachableTarget(
-                f"ExactPoseTask: the optimizer's solution {np.round(q, 4).tolist()} "
-                f"({choice.solution.status}) does not reach the target within the joint limits"
-            )
-        self._q_target, self.choice, self._root_pose = q, choice, root_pose
-        if self._clearance is not None:
-            self._seen = self._clearance.version
-        if (fresh or choice.rechosen) and self._data is not None:  # q* jumped: a joint-space way there
-            start = self.joints.q(self._data.qpos)
-            floor = -np.inf  # (a way the optimiser could not find clear is not re-checked: it
-            # would be "blocked" by what it already passes, and chosen again, tick after tick)
-            if self._clearance is not None and choice.way_clear:
-                floor = min(self.optimizer.min_clearance, self._clearance.minimum(start)) - ALONG_TOLERANCE
-            self._way = JointWay(start, floor, lead=self.lead[2])
-
-    def _live_clearance(self, optimizer: RedundancyOptimizer | None, model: mujoco.MjModel) -> Any:
-        """The optimiser's clearance where the task reads its obstacles from the model (the
-        clearance is of this model), else None."""
-        clearance = getattr(optimizer, "clearance", None)
-        if clearance is None or clearance.model is model:
-            return clearance
-        if self.root.fixed_pose is None:
-            warnings.warn(
-                "ExactPoseTask: the optimizer's obstacles are not in this task's model, so they stay in "
-                "the arm's root frame and move with its root; for obstacles that stay in the world, build "
-                "the optimizer's Clearance on this model",
-                stacklevel=3,
-            )
-        return None
