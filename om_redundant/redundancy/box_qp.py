@@ -19,7 +19,6 @@ that the slope balances :math:`b\delta`.
 from __future__ import annotations
 
 import itertools
-from typing import NamedTuple
 
 import numpy as np
 
@@ -29,23 +28,12 @@ from .objective import Group
 _TIE = 1e-12  # pieces within this of their group's minimum meet there
 
 
-class Pieces(NamedTuple):
-    """Groups of one variable concatenated, as ``_core.maximise_1d`` reads them: group g's
-    pieces are ``ends[g]`` to ``ends[g + 1] - 1``, each group has at least one.
+class Pieces(_core.Pieces):
+    """Groups of one variable concatenated, as ``_core.maximise_1d`` reads them
+    (``_core.Pieces``: values, rates, ends, weights, floors, caps), with what the climb does
+    with them."""
 
-    Attributes:
-        values: (n,) the pieces v_j.
-        rates: (n,) their rates a_j.
-        ends: (G + 1,) int64, from 0 to n.
-        weights, floors, caps: (G,) per group.
-    """
-
-    values: np.ndarray
-    rates: np.ndarray
-    ends: np.ndarray
-    weights: np.ndarray
-    floors: np.ndarray
-    caps: np.ndarray
+    __slots__ = ()
 
     @classmethod
     def of(cls, groups: list[Group]) -> Pieces:
@@ -86,7 +74,7 @@ def solve_1d(pieces: Pieces, curvature: float, lower: float, upper: float) -> tu
     """:func:`maximise_1d` of the pieces by ``_core.maximise_1d``: (delta, the pieces'
     multipliers (n,)), or None when the floors leave no delta."""
     z = np.empty(len(pieces.values))
-    delta = _core.maximise_1d(*pieces, curvature, lower, upper, z)
+    delta = _core.maximise_1d(pieces, curvature, lower, upper, z)
     return None if delta is None else (delta, z)
 
 
@@ -117,8 +105,8 @@ def step_1d(
     """
     if compiled:
         z = np.empty(len(pieces.values))
-        found = _core.step_1d(*pieces, curvature, lower, upper, z)
-        return None if found is None else (*found, z)
+        found = _core.step_1d(pieces, curvature, lower, upper, z)
+        return None if found is None else (found.delta, found.gain, z)
     reach = max(-lower, upper)
     change = np.abs(pieces.rates) * reach
     least = pieces.least(pieces.values + change)

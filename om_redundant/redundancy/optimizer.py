@@ -637,6 +637,9 @@ class _StartBounds:
         self._groups = np.cumsum([1] + [v.shape[1] for _, _, v in terms[:-1]], dtype=np.int64)[: len(terms)]
         self._weights = np.array([w for w, _, _ in terms])
         self._caps = np.array([cap for _, cap, _ in terms])
+        self._samples = _core.StartSamples(
+            self.psi, self._values, self._slopes, self._groups, self._weights, self._caps
+        )
 
     def cone(self, k: np.ndarray, reach: np.ndarray) -> np.ndarray:
         r"""(K,) the bounds from the starts' own cones: the smaller of :math:`f_k + L R` and
@@ -659,8 +662,7 @@ class _StartBounds:
         """
         a, b = int(self.first[k]), int(self.last[k])
         if compiled:
-            numbers = (self._groups, self._weights, self._caps)
-            return _core.start_bound(self.psi, self._values, self._slopes, *numbers, int(k), a, b, reach)
+            return _core.start_bound(self._samples, int(k), a, b, reach)
         at = self.psi.tolist()
         x = at[k]
         lo = bisect.bisect_left(at, x - reach, a, b + 1)  # the samples within reach: lo..hi
