@@ -15,12 +15,13 @@ import om_redundant as om
 from benchmarks.control_rate import HOMES, MIN_CLEARANCE, obstacles
 from om_redundant import _core
 from om_redundant.redundancy.box_qp import Pieces, step_1d
-from om_redundant.redundancy.objective import Group
+from om_redundant.redundancy.objective import Evaluation, Group
 from om_redundant.redundancy.optimizer import _StartBounds
 from om_redundant.redundancy.probe import Probe
 from om_redundant.redundancy.self_motion import self_motion_tangents
 from tests.conftest import random_groups, steps_numpy
 from tests.reference import box_qp as box_qp_numpy
+from tests.reference import objective as objective_numpy
 from tests.reference import start_bounds as start_bounds_numpy
 
 
@@ -54,6 +55,12 @@ def joints(optimizer, seed, n=40):
     return np.random.default_rng(seed).uniform(arm.lower - 0.3, arm.upper + 0.3, (n, arm.dof))
 
 
+def test_the_kernels_evaluations_are_read_by_their_names():
+    """_core.evaluate writes each field of Evaluation into the array of that name
+    (_core.Evaluations), whose rows Objective.evaluations reads in Evaluation's order."""
+    assert _core.Evaluations._fields == Evaluation._fields
+
+
 @settings(max_examples=6, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1), name=st.sampled_from(list(HOMES)), count=st.sampled_from([0, 1, 3]))
 def test_batched_evaluations_equal_the_single_ones(seed, name, count):
@@ -65,9 +72,10 @@ def test_batched_evaluations_equal_the_single_ones(seed, name, count):
     assert objective.evaluations(q) == [objective.evaluate(row) for row in q]
     for row in q[:5]:  # the groups' minima, capped, weighted and summed (C's sin or numpy's)
         evaluation, groups = objective.evaluate(row), {g.kind: g for g in objective.groups(row)}
-        assert evaluation.value == pytest.approx(sum(g.term() for g in groups.values()), rel=0, abs=1e-15)
+        terms = [objective_numpy.term(g) for g in groups.values()]
+        assert evaluation.value == pytest.approx(sum(terms), rel=0, abs=1e-15)
         assert evaluation.margin == groups["margin"].values.min()
-        assert evaluation.slack == min(g.slack() for g in groups.values())
+        assert evaluation.slack == min(objective_numpy.slack(g) for g in groups.values())
         if "clearance" in groups:
             assert evaluation.clearance == groups["clearance"].values.min() * objective.clearance_cap
         if "singularity" in groups:

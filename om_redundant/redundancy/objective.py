@@ -131,12 +131,6 @@ class Group:
     values: np.ndarray
     jacobian: np.ndarray | None = None
 
-    def term(self) -> float:
-        return self.weight * min(self.cap, float(self.values.min()))
-
-    def slack(self) -> float:
-        return float(self.values.min()) - self.floor
-
     def constraints(self) -> tuple[np.ndarray, np.ndarray]:
         """The group's feasibility functions, >= 0 where feasible, and their derivatives
         (by the first variable of the jacobian). A joint's two margin pieces count as one
