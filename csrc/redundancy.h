@@ -123,7 +123,7 @@ typedef struct {
     const double *q_ref, *clear_d, *clear_g; /* (7,), (n_clear,) metres, (n_clear, 7) */
     int n_clear;
     double clearance_cap, singularity_cap, joint_step;
-    double weight[3], floor[3], cap[3]; /* of the groups margin, clearance, singularity (om_tracking_init) */
+    double weight[3], floor[3], cap[3]; /* of the groups margin, clearance, singularity (om_tracking_groups) */
 } om_tracking;
 
 /* The groups' weights (w_m, w_c, w_s), floors (0, clearance_floor = d_min / d_cap) and caps. */
