@@ -45,6 +45,9 @@ typedef struct {
     ptrdiff_t columns, G;
 } om_start_samples;
 
+/* The bound of a start k from its own cones, the smaller of f_k + L R and sum_g w_g min(cap_g,
+ * min_j (v_jk + L_j R)); row: scratch (columns). */
+double om_start_cone(const om_start_samples *s, ptrdiff_t k, double reach, double *row);
 /* The bound of start k (its run's samples first .. last) within reach; row: scratch (columns). */
 double om_start_bound(const om_start_samples *s, ptrdiff_t k, ptrdiff_t first, ptrdiff_t last, double reach,
                       double *row);

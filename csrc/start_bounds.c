@@ -40,6 +40,12 @@ static double beyond(const start_bounds *s, ptrdiff_t e, double x, double reach,
     return bound(s, row);
 }
 
+double om_start_cone(const om_start_samples *s, ptrdiff_t k, double reach, double *row) {
+    const double *u = s->values + k * s->columns;
+    for (ptrdiff_t j = 0; j < s->columns; j++) row[j] = u[j] + s->slopes[j] * reach;
+    return bound(s, row);
+}
+
 /* Every whole cell within reach, and the cells reach cuts (or the run's ends) each the smaller
  * of its bound and the cut end's; the largest, at least f_k. */
 double om_start_bound(const om_start_samples *s, ptrdiff_t k, ptrdiff_t a, ptrdiff_t b, double reach, double *row) {

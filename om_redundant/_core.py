@@ -121,6 +121,7 @@ from .ckernels import (
     self_motion_tangents,
     srs_model_q7,
     start_bound,
+    start_cones,
     step_1d,
     surprise,
     track_step,
@@ -252,6 +253,7 @@ __all__ = [
     "self_motion_tangents",
     "srs_model_q7",
     "start_bound",
+    "start_cones",
     "step_1d",
     "surprise",
     "track_step",
@@ -495,7 +497,7 @@ class Pieces(NamedTuple):
 
 
 class StartSamples(NamedTuple):
-    """The samples of runs, as ``start_bound`` reads them.
+    """The samples of runs, as ``start_bound`` and ``start_cones`` read them.
 
     Attributes:
         psi: (M,) the runs' samples, a run's in increasing psi.

@@ -331,7 +331,8 @@ def test_the_climb_bindings_refuse_groups_and_indices_out_of_range():
     """maximise_1d and step_1d read the pieces of each group between its ends: ends that do not
     start at 0, end at the pieces' count and increase are a ValueError, with no groups too;
     start_bound reads the samples a..b of its start k: k, a and b out of order or out of
-    range, a group column out of range, or a reach that is not >= 0, are a ValueError."""
+    range, a group column out of range, or a reach that is not >= 0, are a ValueError; start_cones
+    reads the samples of its starts: a start out of range is a ValueError."""
     v, a, z = np.arange(5.0), np.ones(5), np.empty(5)
     one, none = np.ones(1), np.empty(0)
 
@@ -355,6 +356,12 @@ def test_the_climb_bindings_refuse_groups_and_indices_out_of_range():
         return _core.start_bound(samples, k, first, last, reach)
 
     assert all(bound(k, 0, 3) >= values[k, 0] for k in range(4))  # (at least f_k, read at either end)
+    samples = _core.StartSamples(psi, values, slopes, np.array([1, 2]), np.ones(2), np.ones(2))
+    out = np.empty(2)
+    _core.start_cones(samples, np.array([0, 3]), np.ones(2), out)  # (read at either end)
+    for starts, reach in (([-1, 0], np.ones(2)), ([0, 4], np.ones(2)), ([0, 1], np.ones(3))):
+        with pytest.raises(ValueError, match="start_cones: sizes or indices of the starts disagree"):
+            _core.start_cones(samples, np.array(starts), reach, out)
     for k, first, last, reach, columns in (
         (-1, 0, 3, 0.5, (1, 2)),
         (2, 3, 3, 0.5, (1, 2)),

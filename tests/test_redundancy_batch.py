@@ -311,7 +311,9 @@ def test_the_climbs_start_bounds_hold_for_functions_within_their_slopes(seed, ru
     bounds = _StartBounds(psi, f, terms, first, last, slope, slopes)
     reach = rng.uniform(0.0, 1.0, len(psi))
     cones = bounds.cone(np.arange(len(psi)), reach)
+    np.testing.assert_array_equal(cones, start_bounds_numpy.cone(bounds, np.arange(len(psi)), reach))
     bare = _StartBounds(psi, f, [], first, last, slope, [])
+    np.testing.assert_array_equal(bare.cone(first, reach), start_bounds_numpy.cone(bare, first, reach))
     columns = np.column_stack([f] + [v for _, _, v in terms])
     pairs = [(i, i + 1) for i in range(len(psi) - 1) if first[i] == first[i + 1]]  # neighbours on a run
     sampled = [
@@ -331,5 +333,9 @@ def test_the_climbs_start_bounds_hold_for_functions_within_their_slopes(seed, ru
     holed = terms[0][2].copy()
     holed[rng.integers(len(psi)), 0] = np.nan  # (a function that is not a number at one sample)
     nan_bounds = _StartBounds(psi, f, [(*terms[0][:2], holed), *terms[1:]], first, last, slope, slopes)
+    everyone = np.arange(len(psi))
+    np.testing.assert_equal(
+        nan_bounds.cone(everyone, reach), start_bounds_numpy.cone(nan_bounds, everyone, reach)
+    )
     for k, r in enumerate(reach.tolist()):  # NaN where numpy's is (then no start is skipped for it)
         np.testing.assert_equal(nan_bounds.within(k, r), start_bounds_numpy.within(nan_bounds, k, r))

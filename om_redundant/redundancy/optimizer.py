@@ -642,8 +642,12 @@ class _StartBounds:
 
     def cone(self, k: np.ndarray, reach: np.ndarray) -> np.ndarray:
         r"""(K,) the bounds from the starts' own cones: the smaller of :math:`f_k + L R` and
-        :math:`\sum_g w_g \min(cap_g, \min_j (v_{jk} + L_j R))`."""
-        return self._bound(self._values[k] + self._slopes * reach[:, None])
+        :math:`\sum_g w_g \min(cap_g, \min_j (v_{jk} + L_j R))`, the groups summed in their
+        order (``_core.start_cones``, ``csrc/start_bounds.c``; its numpy oracle is
+        ``tests/reference/start_bounds.py``)."""
+        bounds, reach = np.empty(len(k)), np.ascontiguousarray(reach, dtype=float)
+        _core.start_cones(self._samples, np.ascontiguousarray(k, dtype=np.int64), reach, bounds)
+        return bounds
 
     def within(self, k: int, reach: float) -> float:
         r"""The bound of start k from every sample of its run within its reach R (never
@@ -660,17 +664,6 @@ class _StartBounds:
             reach: R >= 0.
         """
         return _core.start_bound(self._samples, int(k), int(self.first[k]), int(self.last[k]), reach)
-
-    def _bound(self, values: np.ndarray) -> np.ndarray:
-        """(N,) the smaller of f's bound and sum_g w_g min(cap_g, min_j bound_j), from bounds
-        (N, 1 + n) of f and of each group's functions, the groups summed in their order."""
-        if not len(self._weights):  # no terms: f = 0
-            return np.minimum(values[:, 0], 0.0)
-        terms = self._weights * np.minimum(self._caps, np.minimum.reduceat(values, self._groups, axis=1))
-        total = 0.0
-        for column in terms.T:
-            total = total + column
-        return np.minimum(values[:, 0], total)
 
 
 def _rebuilt(solver: OMSolver, clearance: Clearance | None, options: dict[str, Any]) -> RedundancyOptimizer:
