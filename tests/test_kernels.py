@@ -5,6 +5,8 @@ from __future__ import annotations
 import math
 import re
 import threading
+import types
+from typing import NamedTuple
 
 import numpy as np
 import pytest
@@ -374,6 +376,51 @@ def test_the_climb_bindings_refuse_groups_and_indices_out_of_range():
     ):
         with pytest.raises(ValueError, match="start_bound: sizes or indices of the samples disagree"):
             bound(k, first, last, reach, columns)
+
+
+class _Reordered(NamedTuple):
+    """_core.StartSamples' fields in another order."""
+
+    caps: np.ndarray
+    weights: np.ndarray
+    groups: np.ndarray
+    slopes: np.ndarray
+    values: np.ndarray
+    psi: np.ndarray
+
+
+class _Overridden(_core.StartSamples):
+    """_core.StartSamples whose caps getattr does not read from the tuple."""
+
+    __slots__ = ()
+
+    @property
+    def caps(self) -> np.ndarray:
+        return np.zeros(len(self.weights))
+
+
+def test_records_are_read_by_their_fields_names():
+    """The kernels read a record's fields by name (the record's field indices resolved from its
+    type's _fields, else getattr): the same answer from a NamedTuple of the fields in another
+    order and from an object with those attributes; a subclass's property is what is read; a
+    record without a field is a TypeError naming it."""
+    psi, values = np.linspace(0.0, 1.0, 4), np.arange(12.0).reshape(4, 3)
+    fields = dict(psi=psi, values=values, slopes=np.ones(3), groups=np.array([1, 2]), weights=np.ones(2))
+    samples = _core.StartSamples(**fields, caps=np.full(2, 0.5))
+    want = [_core.start_bound(samples, k, 0, 3, 0.4) for k in range(4)]
+    for record in (
+        _Reordered(**fields, caps=samples.caps),
+        types.SimpleNamespace(**fields, caps=samples.caps),
+    ):
+        for _ in range(2):  # (the second read: by the indices resolved at the first)
+            assert [_core.start_bound(record, k, 0, 3, 0.4) for k in range(4)] == want
+    overridden = _Overridden(*samples)
+    capped = [_core.start_bound(overridden, k, 0, 3, 0.4) for k in range(4)]
+    assert capped != want and capped == [
+        _core.start_bound(samples._replace(caps=np.zeros(2)), k, 0, 3, 0.4) for k in range(4)
+    ]
+    with pytest.raises(TypeError, match="must have a field 'caps'"):
+        _core.start_bound(types.SimpleNamespace(**fields), 0, 0, 3, 0.4)
 
 
 def test_link_paths_refuses_grids_counts_and_outputs_that_disagree(panda):
