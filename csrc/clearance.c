@@ -22,9 +22,9 @@
  * for a prismatic one. */
 #include <string.h>
 
-#include "binding.h"
+#include "redundancy.h"
 
-enum { CORE_MUJOCO = 0, CORE_POINT = 1, CORE_SEGMENT = 2, CORE_BOX = 3 };
+enum { CORE_MUJOCO = OM_CORE_MUJOCO, CORE_POINT = OM_CORE_POINT, CORE_SEGMENT = OM_CORE_SEGMENT, CORE_BOX = OM_CORE_BOX };
 #define CORES_TOUCH 1e-9 /* m: cores nearer than this touch (their pair is MuJoCo's) */
 
 static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
@@ -218,9 +218,9 @@ static void link_frames(const double *table, int n_rows, const double *start, co
 
 /* The world pose of each arm geom a (xpos 3, xmat 9 per geom), on link link[a] at offset[a]
  * (R 9, p 3): X = F G. */
-static void place(const double *frames, const int64_t *link, const double *offset, Py_ssize_t A, double *xpos,
+static void place(const double *frames, const int64_t *link, const double *offset, ptrdiff_t A, double *xpos,
                   double *xmat) {
-    for (Py_ssize_t a = 0; a < A; a++) {
+    for (ptrdiff_t a = 0; a < A; a++) {
         const double *F = frames + 12 * link[a], *G = offset + 12 * a;
         for (int i = 0; i < 3; i++) {
             xpos[3 * a + i] = F[9 + i] + F[3 * i] * G[9] + F[3 * i + 1] * G[10] + F[3 * i + 2] * G[11];
@@ -234,10 +234,10 @@ static void place(const double *frames, const int64_t *link, const double *offse
  * spheres are that far apart) and nearest points; nan for the pairs MuJoCo must compute,
  * counted in the return value. */
 static long distances(const int64_t *kind, const double *radius, const double *half, const double *xpos,
-                      const double *xmat, const int64_t *pairs, const double *bounds, Py_ssize_t P, double reach,
+                      const double *xmat, const int64_t *pairs, const double *bounds, ptrdiff_t P, double reach,
                       double *dist, double *fromto) {
     long left = 0;
-    for (Py_ssize_t k = 0; k < P; k++) {
+    for (ptrdiff_t k = 0; k < P; k++) {
         int g1 = (int)pairs[2 * k], g2 = (int)pairs[2 * k + 1];
         double *ft = fromto + 6 * k, w[3];
         for (int i = 0; i < 3; i++) w[i] = xpos[3 * g1 + i] - xpos[3 * g2 + i];
@@ -259,12 +259,12 @@ static long distances(const int64_t *kind, const double *radius, const double *h
  * `near` or farther: what the objective does not read); the first link[a] joints move arm
  * geom a, the first of the pair. */
 static void gradients(const double *dist, const double *fromto, const int64_t *pairs, const int64_t *link,
-                      const double *frames, const uint8_t *slide, Py_ssize_t P, int dof, double reach, double near,
+                      const double *frames, const uint8_t *slide, ptrdiff_t P, int dof, double reach, double near,
                       double *grad) {
     double least = INFINITY;
-    for (Py_ssize_t k = 0; k < P; k++) least = fmin(least, dist[k]);
+    for (ptrdiff_t k = 0; k < P; k++) least = fmin(least, dist[k]);
     if (!(least < near)) near = INFINITY;
-    for (Py_ssize_t k = 0; k < P; k++) {
+    for (ptrdiff_t k = 0; k < P; k++) {
         double *row = grad + k * dof;
         const double *p = fromto + 6 * k;
         memset(row, 0, dof * sizeof(double));
@@ -279,166 +279,37 @@ static void gradients(const double *dist, const double *fromto, const int64_t *p
     }
 }
 
-/* The arm's fixed data, as both entry points read it: the first 7 arguments. */
-enum { N_ARM = 7 };
-static const buffer_spec arm_spec[N_ARM] = {
-    {F64, -1, 0, "table"}, {F64, 12, 0, "start"}, {I64, -1, 0, "link"}, {F64, -1, 0, "offset"},
-    {U8, -1, 0, "slide"},  {F64, -1, 0, "q"},     {F64, -1, 1, "xpos"},
-};
-
-/* Check the arm's arguments (table rows of 6, offsets of 12 per geom, links within 0..dof,
- * q rows of dof); the number of rows of q into *M, dof into *dof. */
-static int check_arm(Py_buffer *v, Py_ssize_t A, Py_ssize_t *M, int *dof, const char *what) {
-    Py_ssize_t n_rows = v[0].len / 48, joints = table_joints(&v[0]);
-    const int64_t *link = v[2].buf;
-    int bad = v[0].len != n_rows * 48 || joints < 1 || joints > OM_MAX_DOF || v[2].len != A * 8 ||
-              v[3].len != A * 96 || v[4].len != joints || v[5].len % (joints * 8) != 0;
-    bad = bad || !indices_within(link, A, 1, 0, joints + 1);
-    if (bad) {
-        PyErr_Format(PyExc_ValueError, "%s: sizes of the chain, geoms and joint vectors disagree", what);
-        return -1;
-    }
-    *M = v[5].len / (joints * 8);
-    *dof = (int)joints;
-    return 0;
+void om_arm_geom_poses(const om_arm_links *arm, const double *q, double *xpos, double *xmat) {
+    double frames[12 * (OM_MAX_DOF + 1)];
+    link_frames(arm->table, arm->n_rows, arm->start, q, frames);
+    place(frames, arm->link, arm->offset, arm->A, xpos, xmat);
 }
 
-/* arm_geom_poses(table, start, link, offset, slide, q, xpos, xmat): the world poses (M, A, 3) and
- * (M, A, 3, 3) of the arm's A geoms at each of the M rows of q (M, dof). */
-static PyObject *om_arm_geom_poses(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
-    if (check_nargs(nargs, N_ARM + 1, "arm_geom_poses") < 0) return NULL;
-    Py_buffer v[N_ARM + 1];
-    buffer_spec sp[N_ARM + 1];
-    memcpy(sp, arm_spec, sizeof arm_spec);
-    sp[N_ARM] = (buffer_spec){F64, -1, 1, "xmat"};
-    if (get_buffers(args, v, sp, N_ARM + 1) < 0) return NULL;
-    Py_ssize_t A = v[2].len / 8, M;
-    int dof;
-    if (check_arm(v, A, &M, &dof, "arm_geom_poses") < 0 || v[6].len != M * A * 24 || v[7].len != M * A * 72) {
-        if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "arm_geom_poses: A poses per joint vector");
-        release_buffers(v, N_ARM + 1);
-        return NULL;
-    }
-    double frames[12 * (OM_MAX_DOF + 1)], *xpos = v[6].buf, *xmat = v[7].buf;
-    const double *q = v[5].buf;
-    for (Py_ssize_t m = 0; m < M; m++) {
-        link_frames(v[0].buf, (int)(v[0].len / 48), v[1].buf, q + m * dof, frames);
-        place(frames, v[2].buf, v[3].buf, A, xpos + 3 * A * m, xmat + 9 * A * m);
-    }
-    release_buffers(v, N_ARM + 1);
-    Py_RETURN_NONE;
-}
-
-/* arm_clearance(table, start, link, offset, slide, q, obstacle_pos, obstacle_mat, kind, radius,
- * half, pairs, bounds, reach, near, dist, fromto, grad, given) -> left: the geoms are the arm's A and
- * the O obstacles (poses (O, 3) and (O, 9)), G = A + O; for each row m of q (M, dof), the arm's
- * geoms placed (in this call's own work array: calls may run in parallel), each pair's
- * distance (M, P) capped at reach and nearest points (M, P, 6) (nan: the `left` pairs MuJoCo
- * must compute), and unless grad is None their gradients (M, P, dof), in a row with a pair
- * nearer than `near` only those of the pairs nearer than it (the others 0). given true: dist and
- * fromto are read, not written, for the gradients of pairs MuJoCo computed. Pairs (P, 2) index
- * the geoms, an arm geom first. */
-static PyObject *om_arm_clearance(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
-    enum { N = N_ARM + 9 }; /* buffers: the arm's, obstacle_mat ... bounds, dist, fromto, grad */
-    if (check_nargs(nargs, 19, "arm_clearance") < 0) return NULL;
-    double reach = PyFloat_AsDouble(args[13]), near = PyFloat_AsDouble(args[14]);
-    if (PyErr_Occurred()) return NULL;
-    int given = PyObject_IsTrue(args[18]), with_grad = args[17] != Py_None;
-    if (given < 0) return NULL;
-    if (given && !with_grad) {
-        PyErr_SetString(PyExc_ValueError, "arm_clearance: given distances need grad");
-        return NULL;
-    }
-    Py_buffer v[N];
-    buffer_spec sp[N];
-    memcpy(sp, arm_spec, sizeof arm_spec);
-    sp[N_ARM - 1] = (buffer_spec){F64, -1, 0, "obstacle_pos"};
-    const buffer_spec rest[N - N_ARM] = {
-        {F64, -1, 0, "obstacle_mat"},  {I64, -1, 0, "kind"},       {F64, -1, 0, "radius"},
-        {F64, -1, 0, "half"},  {I64, -1, 0, "pairs"},      {F64, -1, 0, "bounds"},
-        {F64, -1, !given, "dist"}, {F64, -1, !given, "fromto"}, {F64, -1, 1, "grad"}};
-    memcpy(sp + N_ARM, rest, sizeof rest);
-    PyObject *const objs[N] = {args[0],  args[1],  args[2],  args[3],  args[4],  args[5],  args[6], args[7],
-                               args[8],  args[9],  args[10], args[11], args[12], args[15], args[16], args[17]};
-    int n_views = with_grad ? N : N - 1;
-    if (get_buffers(objs, v, sp, n_views) < 0) return NULL;
-    Py_ssize_t A = v[2].len / 8, G = v[8].len / 8, P = v[12].len / 8, M;
-    int dof;
-    if (check_arm(v, A, &M, &dof, "arm_clearance") < 0) {
-        release_buffers(v, n_views);
-        return NULL;
-    }
-    const int64_t *pairs = v[11].buf;
-    int bad = A > G || v[6].len != (G - A) * 24 || v[7].len != (G - A) * 72 || v[9].len != G * 8 ||
-              v[10].len != G * 24 || v[11].len != P * 16 || v[13].len != M * P * 8 || v[14].len != M * P * 48 ||
-              (with_grad && v[15].len != M * P * dof * 8);
-    bad = bad || !indices_within(pairs, P, 2, 0, A) || !indices_within(pairs + 1, P, 2, A, G);
-    if (bad) {
-        release_buffers(v, n_views);
-        PyErr_SetString(PyExc_ValueError, "arm_clearance: sizes of the geoms, pairs and outputs disagree");
-        return NULL;
-    }
-    const double *table = v[0].buf, *start = v[1].buf, *offset = v[3].buf, *q = v[5].buf;
-    const int64_t *kind = v[8].buf;
-    const uint8_t *slide = v[4].buf;
-    const double *radius = v[9].buf, *half = v[10].buf, *bounds = v[12].buf;
-    double *dist = v[13].buf, *fromto = v[14].buf, *grad = with_grad ? v[15].buf : NULL;
-    /* the poses of all geoms; the pairs and links, checked above with the GIL held, copied: the
-     * kernels index by them with the GIL released, while the caller's arrays may change */
-    double *xpos = PyMem_RawMalloc(((size_t)G * 12 + (size_t)(2 * P + A)) * sizeof(double)), *xmat = xpos + 3 * G;
-    if (!xpos) {
-        release_buffers(v, n_views);
-        return PyErr_NoMemory();
-    }
-    int64_t *pairs_copy = (int64_t *)(xmat + 9 * G), *link = pairs_copy + 2 * P;
-    memcpy(pairs_copy, pairs, (size_t)(2 * P) * sizeof(int64_t));
-    memcpy(link, v[2].buf, (size_t)A * sizeof(int64_t));
-    pairs = pairs_copy;
-    memcpy(xpos + 3 * A, v[6].buf, (size_t)(G - A) * 3 * sizeof(double));
-    memcpy(xmat + 9 * A, v[7].buf, (size_t)(G - A) * 9 * sizeof(double));
-    int n_rows = (int)(v[0].len / 48);
+long om_arm_clearance(const om_arm_links *arm, const om_geom_cores *geoms, ptrdiff_t M, const double *q,
+                      double reach, double near, double *dist, double *fromto, double *grad, bool given,
+                      double *work) {
+    ptrdiff_t A = arm->A, G = geoms->G, P = geoms->P;
+    int dof = arm->dof;
+    double *xpos = work, *xmat = work + 3 * G;
+    memcpy(xpos + 3 * A, geoms->obstacle_pos, (size_t)(G - A) * 3 * sizeof(double));
+    memcpy(xmat + 9 * A, geoms->obstacle_mat, (size_t)(G - A) * 9 * sizeof(double));
     long left = 0;
-    Py_BEGIN_ALLOW_THREADS for (Py_ssize_t m = 0; m < M; m++) {
+    for (ptrdiff_t m = 0; m < M; m++) {
         double frames[12 * (OM_MAX_DOF + 1)], *d = dist + m * P, *ft = fromto + 6 * m * P;
-        link_frames(table, n_rows, start, q + m * dof, frames);
+        link_frames(arm->table, arm->n_rows, arm->start, q + m * dof, frames);
         if (!given) {
-            place(frames, link, offset, A, xpos, xmat);
-            left += distances(kind, radius, half, xpos, xmat, pairs, bounds, P, reach, d, ft);
+            place(frames, arm->link, arm->offset, A, xpos, xmat);
+            left += distances(geoms->kind, geoms->radius, geoms->half, xpos, xmat, geoms->pairs, geoms->bounds, P,
+                              reach, d, ft);
         }
-        if (grad) gradients(d, ft, pairs, link, frames, slide, P, dof, reach, near, grad + m * P * dof);
+        if (grad) gradients(d, ft, geoms->pairs, arm->link, frames, arm->slide, P, dof, reach, near, grad + m * P * dof);
     }
-    Py_END_ALLOW_THREADS PyMem_RawFree(xpos);
-    release_buffers(v, n_views);
-    return PyLong_FromLong(left);
+    return left;
 }
 
-/* box_overlap(pos, mat, half, radius, box_pos, box_mat, box_half, fromto) -> distance:
- * overlap_with_box of a sphere or capsule geom at pos (3; rotation mat, 9 row-major; half sizes
- * half, 3: a capsule's (0, 0, l)) and a box, in the world; fromto (6). */
-static PyObject *om_box_overlap(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
-    if (check_nargs(nargs, 8, "box_overlap") < 0) return NULL;
-    double radius = PyFloat_AsDouble(args[3]);
-    if (PyErr_Occurred()) return NULL;
-    PyObject *const objs[7] = {args[0], args[1], args[2], args[4], args[5], args[6], args[7]};
-    const buffer_spec sp[7] = {{F64, 3, 0, "pos"},     {F64, 9, 0, "mat"},      {F64, 3, 0, "half"},
-                               {F64, 3, 0, "box_pos"}, {F64, 9, 0, "box_mat"}, {F64, 3, 0, "box_half"},
-                               {F64, 6, 1, "fromto"}};
-    Py_buffer v[7];
-    if (get_buffers(objs, v, sp, 7) < 0) return NULL;
+double om_box_overlap(const double *pos, const double *mat, const double *half, double radius,
+                      const double *box_pos, const double *box_mat, const double *box_half, double *fromto) {
     double p[3], q[3];
-    core(v[0].buf, v[1].buf, v[2].buf, 0, p, q);
-    double distance = overlap_with_box(p, q, radius, v[3].buf, v[4].buf, v[5].buf, v[6].buf);
-    release_buffers(v, 7);
-    return PyFloat_FromDouble(distance);
+    core(pos, mat, half, 0, p, q);
+    return overlap_with_box(p, q, radius, box_pos, box_mat, box_half, fromto);
 }
-
-PyMethodDef om_clearance_functions[] = {
-    {"box_overlap", (PyCFunction)(void (*)(void))om_box_overlap, METH_FASTCALL,
-     "box_overlap(pos, mat, half, radius, box_pos, box_mat, box_half, fromto) -> distance"},
-    {"arm_geom_poses", (PyCFunction)(void (*)(void))om_arm_geom_poses, METH_FASTCALL,
-     "arm_geom_poses(table, start, link, offset, slide, q, xpos, xmat)"},
-    {"arm_clearance", (PyCFunction)(void (*)(void))om_arm_clearance, METH_FASTCALL,
-     "arm_clearance(table, start, link, offset, slide, q, obstacle_pos, obstacle_mat, kind, radius, half, pairs, "
-     "bounds, reach, near, dist, fromto, grad, given) -> pairs left to MuJoCo"},
-    {NULL, NULL, 0, NULL},
-};

@@ -11,21 +11,14 @@
  * factorisation to pick a sign). The step maximises the concave model
  *     phi(d) = sum_g w_g min(cap_g, min_j v_j + a_j d) - b d^2 / 2
  * over the box |d| <= radius intersected with the floors v_j + a_j d >= floor_g: phi's right
- * derivative is non-increasing, and bisection on its sign gives the maximiser to rounding. */
+ * derivative is non-increasing, and bisection on its sign gives the maximiser to rounding.
+ * (box_qp.c maximises the same model by its breakpoints, for the climb: taken here, it moves
+ * the tracked arm angles by a few ulps and costs ~1.5 us a step, so the bisection stays.) */
 #include <string.h>
 
-#include "binding.h"
+#include "redundancy.h"
 
-enum { TR_OK = 0, TR_NO_SOLUTION = 1, TR_SINGULAR = 2, TR_INFEASIBLE = 3, TR_LOST = 4 };
-/* layout of the setup vector */
-enum {
-    S_PSI, S_WM, S_WC, S_WS, S_FLOOR_C, S_SING_CAP, S_MAX_STEP, S_CURVATURE, S_JOINT_STEP, S_CLEAR_CAP, S_N_SING,
-    S_N_CLEAR, S_HEAD
-};
-/* layout of the output vector after q (dof) */
-enum { O_PSI, O_STEP, O_CURVATURE, O_MARGIN, O_SINGULARITY, O_CLEARANCE, O_POS, O_ORI, O_EVALS, O_WITHIN, O_N };
-
-#define MAX_PIECES 512
+#define MAX_PIECES OM_TRACK_MAX_PIECES
 #define BISECTIONS 80
 #define HALVINGS 6
 #define MIN_CURVATURE 1e-3
@@ -41,11 +34,15 @@ typedef struct {
     int group[MAX_PIECES];
 } pieces;
 
-typedef struct {
-    const om_solver_data *s;
-    const double *setup, *lower, *upper, *sing_joint, *sing_offset, *q_ref, *clear_d, *clear_g;
-    double weight[3], floor[3], cap[3];
-} tracking;
+typedef om_tracking tracking;
+
+void om_tracking_groups(om_tracking *tr, double w_m, double w_c, double w_s, double clearance_floor) {
+    double weight[3] = {w_m, w_c, w_s}, floor[3] = {FLOOR_SLACK, clearance_floor + FLOOR_SLACK, -INFINITY};
+    double cap[3] = {INFINITY, 1.0, 1.0};
+    memcpy(tr->weight, weight, sizeof weight);
+    memcpy(tr->floor, floor, sizeof floor);
+    memcpy(tr->cap, cap, sizeof cap);
+}
 
 /* The pieces and their rates at q with tangent t. */
 static void pieces_at(const tracking *tr, const double *q, const double *t, pieces *P) {
@@ -57,8 +54,8 @@ static void pieces_at(const tracking *tr, const double *q, const double *t, piec
         P->v[n] = (q[i] - tr->lower[i]) / h, P->a[n] = t[i] / h, P->group[n++] = 0;
         P->v[n] = (tr->upper[i] - q[i]) / h, P->a[n] = -t[i] / h, P->group[n++] = 0;
     }
-    int n_clear = (int)tr->setup[S_N_CLEAR], n_sing = (int)tr->setup[S_N_SING];
-    double d_cap = tr->setup[S_CLEAR_CAP];
+    int n_clear = tr->n_clear, n_sing = tr->n_sing;
+    double d_cap = tr->clearance_cap;
     for (int k = 0; k < n_clear; k++) {
         const double *g = tr->clear_g + k * dof;
         double v = tr->clear_d[k] / d_cap, a = 0.0;
@@ -72,7 +69,7 @@ static void pieces_at(const tracking *tr, const double *q, const double *t, piec
     }
     for (int k = 0; k < n_sing; k++) {
         int j = (int)tr->sing_joint[k];
-        double x = q[j] + tr->sing_offset[k], sn = sin(x), cap = tr->setup[S_SING_CAP];
+        double x = q[j] + tr->sing_offset[k], sn = sin(x), cap = tr->singularity_cap;
         P->v[n] = fabs(sn) / cap, P->a[n] = (sn < 0.0 ? -1.0 : 1.0) * cos(x) * t[j] / cap, P->group[n++] = 2;
     }
     P->n = n;
@@ -184,29 +181,29 @@ static bool pose_motion(const om_solver_data *s, const double *T, const double *
     return true;
 }
 
-static int track(const tracking *tr, const double *T, const int64_t *signs, const double *q_prev, double *q1,
-                 double *out) {
+int om_track(const om_tracking *tr, const double *T, const int64_t *signs, double psi, const double *q_prev,
+             double max_step, double curvature, double *q1, om_tracked *out) {
     const om_solver_data *s = tr->s;
     int dof = s->dof;
-    double psi = tr->setup[S_PSI], q0[OM_MAX_DOF], t0[OM_MAX_DOF], t1[OM_MAX_DOF], dq[OM_MAX_DOF];
+    double q0[OM_MAX_DOF], t0[OM_MAX_DOF], t1[OM_MAX_DOF], dq[OM_MAX_DOF];
     step_prediction moved = {dof, q_prev, dq, 1.0};
     bool predicted = s->mode != OM_FIXED && pose_motion(s, T, q_prev, dq); /* (a fixed dp: no scan to spare) */
     om_result r = om_solve_one(s, T, signs, &psi, q_prev, q0, predicted ? on_step : NULL, &moved);
-    if (r.status != OM_OK || !om_continues(dof, q_prev, q0, NULL, 0.0, NULL)) return TR_NO_SOLUTION;
-    if (!om_self_motion_tangent(s, q0, t0, SINGULAR_TANGENT)) return TR_SINGULAR;
+    if (r.status != OM_OK || !om_continues(dof, q_prev, q0, NULL, 0.0, NULL)) return OM_TRACK_NO_SOLUTION;
+    if (!om_self_motion_tangent(s, q0, t0, SINGULAR_TANGENT)) return OM_TRACK_SINGULAR;
     static pieces P0, P1; /* (the GIL is held: one call at a time) */
     pieces_at(tr, q0, t0, &P0);
-    double b = fmin(fmax(tr->setup[S_CURVATURE], MIN_CURVATURE), MAX_CURVATURE), tmax = 0.0;
+    double b = fmin(fmax(curvature, MIN_CURVATURE), MAX_CURVATURE), tmax = 0.0;
     for (int i = 0; i < dof; i++) tmax = fmax(tmax, fabs(t0[i]));
-    double radius = fmin(tr->setup[S_MAX_STEP], tr->setup[S_JOINT_STEP] / fmax(tmax, 1e-12)), d;
-    if (!box_step(tr, &P0, b, radius, &d)) return TR_INFEASIBLE;
+    double radius = fmin(max_step, tr->joint_step / fmax(tmax, 1e-12)), d;
+    if (!box_step(tr, &P0, b, radius, &d)) return OM_TRACK_INFEASIBLE;
     double psi1 = psi + d;
     for (int k = 0;; k++) {
         psi1 = psi + d;
         step_prediction p = {dof, q0, t0, d};
         r = om_solve_one(s, T, signs, &psi1, q0, q1, on_step, &p);
         if (r.status == OM_OK && om_continues(dof, q0, q1, t0, d, NULL) && om_self_motion_tangent(s, q1, t1, SINGULAR_TANGENT)) break;
-        if (k == HALVINGS) return TR_LOST;
+        if (k == HALVINGS) return OM_TRACK_LEFT;
         d /= 2.0;
     }
     pieces_at(tr, q1, t1, &P1);
@@ -219,59 +216,8 @@ static int track(const tracking *tr, const double *T, const int64_t *signs, cons
         if (active[g] >= 0 && low[g] < tr->cap[g]) y += tr->weight[g] * (P1.a[active[g]] - P0.a[active[g]]);
     if (fabs(d) > 1e-12 && isfinite(y)) b = fmin(fmax(-y / d, MIN_CURVATURE), MAX_CURVATURE);
     /* low: each group's smallest piece, the margin, clearance and singularity reported */
-    double values[O_N] = {psi1, d, b, low[0], low[2], low[1], r.position_error, r.orientation_error,
-                          (double)r.evaluations, r.within_limits};
-    memcpy(out, values, sizeof values);
-    return TR_OK;
+    *out = (om_tracked){psi1, d, b, low[0], low[2], low[1], r.position_error, r.orientation_error, r.evaluations,
+                        r.within_limits};
+    return OM_TRACK_OK;
 }
 
-/* track_step(solver, T, signs, q_prev, setup, lower, upper, sing_joint, sing_offset, q_ref, clear_d,
- * clear_g, q_out, out) -> status: see tracking.py's TrackingWork for the layouts. */
-PyObject *om_track_step(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
-    if (check_nargs(nargs, 14, "track_step") < 0)
-        return NULL;
-    const om_solver_data *s = om_srs7_solver(args[0], "track_step");
-    if (s == NULL) return NULL;
-    Py_buffer v[13];
-    const buffer_spec sp[13] = {{F64, 16, 0, "T"},           {I64, s->n_signs, 0, "signs"}, {F64, 7, 0, "q_prev"},
-                {F64, -1, 0, "setup"},       {F64, 7, 0, "lower"},          {F64, 7, 0, "upper"},
-                {F64, -1, 0, "sing_joint"},  {F64, -1, 0, "sing_offset"},   {F64, 7, 0, "q_ref"},
-                {F64, -1, 0, "clear_d"},     {F64, -1, 0, "clear_g"},       {F64, 7, 1, "q_out"},
-                {F64, O_N, 1, "out"}};
-    if (get_buffers(args + 1, v, sp, 13) < 0)
-        return NULL;
-    double T[16];
-    int64_t signs[3];
-    if (copy_pose_and_signs(&v[0], &v[1], s->n_signs, T, signs) < 0) {
-        release_buffers(v, 13);
-        return NULL;
-    }
-    int status = -1;
-    const double *setup = v[3].buf;
-    Py_ssize_t n_sing = v[6].len / 8, n_clear = v[9].len / 8;
-    const double *sing_joint = v[6].buf;
-    bool joints_ok = true; /* each a joint's index (read as q[j], t[j]) */
-    for (Py_ssize_t k = 0; k < n_sing; k++)
-        joints_ok &= sing_joint[k] >= 0.0 && sing_joint[k] < 7.0 && sing_joint[k] == floor(sing_joint[k]);
-    if (v[3].len < S_HEAD * 8 || setup[S_N_SING] != (double)n_sing || v[7].len != v[6].len ||
-        setup[S_N_CLEAR] != (double)n_clear || v[10].len != n_clear * 7 * 8 || 14 + n_clear + n_sing > MAX_PIECES)
-        PyErr_SetString(PyExc_ValueError, "track_step: sizes of setup, singularities and clearances disagree");
-    else if (!joints_ok)
-        PyErr_SetString(PyExc_ValueError, "track_step: a singularity's joint is not a joint index in [0, 7)");
-    else {
-        tracking tr = {s, setup, v[4].buf, v[5].buf, v[6].buf, v[7].buf, v[8].buf, v[9].buf, v[10].buf,
-                       {setup[S_WM], setup[S_WC], setup[S_WS]},
-                       {FLOOR_SLACK, setup[S_FLOOR_C] + FLOOR_SLACK, -INFINITY},
-                       {INFINITY, 1.0, 1.0}};
-        status = track(&tr, T, signs, v[2].buf, v[11].buf, v[12].buf);
-    }
-    release_buffers(v, 13);
-    return status < 0 ? NULL : PyLong_FromLong(status);
-}
-
-PyMethodDef om_tracking_functions[] = {
-    {"track_step", (PyCFunction)(void (*)(void))om_track_step, METH_FASTCALL,
-     "track_step(solver, T, signs, q_prev, setup, lower, upper, sing_joint, sing_offset, q_ref, clear_d, clear_g, "
-     "q_out, out) -> status"},
-    {NULL, NULL, 0, NULL},
-};

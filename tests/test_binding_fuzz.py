@@ -91,13 +91,8 @@ def recorded_calls() -> dict[str, tuple[Callable[..., Any], tuple[Any, ...]]]:
     written = {
         "arm_angle_gradient": (data.params, data.model_table, q, np.zeros(7)),
         "box_overlap": (
-            np.zeros(3),
-            R,
-            np.array([0, 0, 0.1]),
-            0.05,
-            np.ones(3),
-            R,
-            np.full(3, 0.2),
+            _core.GeomPose(np.zeros(3), R, np.array([0, 0, 0.1]), 0.05),
+            _core.GeomPose(np.ones(3), R, np.full(3, 0.2)),
             np.zeros(6),
         ),
         "branch_values": (2, data.params, q, np.zeros(3)),

@@ -73,9 +73,10 @@ def test_an_uninitialised_solver_raises():
             raises(RuntimeError, getattr(bare, name))
         raises(RuntimeError, bare.solve, T, (), (), None, np.zeros(0))
         raises(RuntimeError, _core.follow, _core.FollowWork(bare, *[None] * 7), 0.0, 0.0, 0.0)
-        walks = [("link_paths", 16), ("track_step", 14), ("self_motion_tangents", 3)]
+        walks = [("link_paths", 16), ("self_motion_tangents", 3)]
         for name, arity in walks:
             raises(RuntimeError, getattr(_core, name), bare, *[None] * (arity - 1))
+        raises(RuntimeError, _core.track_step, _core.TrackingWork(bare, *[None] * 12), None, None, 0.0)
     """)
 
 

@@ -160,16 +160,15 @@ def test_box_overlap_is_the_exact_signed_distance(pos, half, distance, arm_point
     )
     shift = np.array([0.3, -0.2, 0.5])
     fromto = np.empty(6)
-    found = _core.box_overlap(
-        turn @ pos + shift, turn.ravel(), np.array(half), 0.05, shift, turn.ravel(), np.ones(3), fromto
-    )
+    geom = _core.GeomPose(turn @ pos + shift, turn.ravel(), np.array(half), 0.05)
+    found = _core.box_overlap(geom, _core.GeomPose(shift, turn.ravel(), np.ones(3)), fromto)
     assert found == pytest.approx(distance, abs=1e-15)
     if arm_point != box_point:  # (through the box: either of the faces it ties on)
         np.testing.assert_allclose(
             fromto, np.concatenate([turn @ arm_point, turn @ box_point]) + np.tile(shift, 2), atol=1e-15
         )
     with pytest.raises(ValueError, match="box_half"):
-        _core.box_overlap(shift, turn.ravel(), np.array(half), 0.05, shift, turn.ravel(), np.ones(2), fromto)
+        _core.box_overlap(geom, _core.GeomPose(shift, turn.ravel(), np.ones(2)), fromto)
 
 
 def test_threads_sharing_a_clearance_get_its_answers():
@@ -288,11 +287,10 @@ def test_gradients_near_are_the_full_ones_where_the_objective_reads_them(name):
     rng = np.random.default_rng(3)
     Q = np.vstack([within_limits(arm, rng, 25), rng.uniform(-0.1, 0.1, (5, arm.dof))])
     every, full = clearance.distances_and_gradients(Q)
-    arm_args, geoms = clearance._cores.links, clearance._cores.geoms
+    cores = clearance._cores
     left = np.empty(every.shape)  # which pairs the kernel leaves to MuJoCo
-    _core.arm_clearance(
-        *arm_args, Q, *geoms, clearance.distmax, math.inf, left, np.empty((*every.shape, 6)), None, False
-    )
+    out = _core.PairDistances(left, np.empty((*every.shape, 6)), None)
+    _core.arm_clearance(cores, Q, clearance.distmax, math.inf, out, False)
     assert np.isnan(left).any()
     model, data = clearance.model, mujoco.MjData(clearance.model)
     for q, dist, row in zip(Q, every, left, strict=True):  # MuJoCo's pairs as mj_kinematics places the arm
@@ -313,7 +311,7 @@ def test_gradients_near_are_the_full_ones_where_the_objective_reads_them(name):
         np.empty((len(Q), len(clearance.arm_geoms), 3)),
         np.empty((len(Q), len(clearance.arm_geoms), 9)),
     )
-    _core.arm_geom_poses(*arm_args, Q, xpos, xmat)
+    _core.arm_geom_poses(cores, Q, xpos, xmat)
     for q, x, m in zip(Q, xpos, xmat, strict=True):
         single = clearance.geom_poses(q)
         np.testing.assert_array_equal(x, single[0])
@@ -333,27 +331,27 @@ def test_the_kernel_refuses_arrays_of_other_sizes(panda):
     """_core.arm_clearance and arm_geom_poses check every array's size against the others: a
     ValueError, never a read past an end."""
     clearance = om.Clearance.for_arm(panda.arm, [om.Sphere([0.4, 0.1, 0.5], 0.05)])
-    arm, geoms = clearance._cores.links, clearance._cores.geoms
+    cores = clearance._cores
     q, n_pairs = np.zeros(7), len(clearance.pairs)
-    dist, fromto, grad = np.empty(n_pairs), np.empty((n_pairs, 6)), np.empty((n_pairs, 7))
-    assert _core.arm_clearance(*arm, q, *geoms, 1.0, math.inf, dist, fromto, grad, False) == 0
+    out = _core.PairDistances(np.empty(n_pairs), np.empty((n_pairs, 6)), np.empty((n_pairs, 7)))
+    assert _core.arm_clearance(cores, q, 1.0, math.inf, out, False) == 0
     short = [
-        (arm, q[:6], geoms),
-        (arm, q, (geoms[0][:0], *geoms[1:])),
-        ((*arm[:3], arm[3][:-1], arm[4]), q, geoms),
+        (cores, q[:6]),
+        (cores._replace(obstacle_pos=cores.obstacle_pos[:0]), q),
+        (cores._replace(offset=cores.offset[:-1]), q),
     ]
-    for a, x, g in short:
+    for c, x in short:
         with pytest.raises(ValueError, match="disagree"):
-            _core.arm_clearance(*a, x, *g, 1.0, math.inf, dist, fromto, grad, False)
+            _core.arm_clearance(c, x, 1.0, math.inf, out, False)
     with pytest.raises(ValueError, match="disagree"):
-        _core.arm_clearance(*arm, q, *geoms, 1.0, math.inf, dist[:-1], fromto, grad, False)
+        _core.arm_clearance(cores, q, 1.0, math.inf, out._replace(dist=out.dist[:-1]), False)
     # arm_geom_poses: A poses for each of the M rows of q
     rows, n_arm = np.zeros((3, 7)), len(clearance.arm_geoms)
-    _core.arm_geom_poses(*arm, rows, np.empty((3, n_arm, 3)), np.empty((3, n_arm, 9)))
+    _core.arm_geom_poses(cores, rows, np.empty((3, n_arm, 3)), np.empty((3, n_arm, 9)))
     with pytest.raises(ValueError, match="poses per joint vector"):
-        _core.arm_geom_poses(*arm, rows, np.empty((2, n_arm, 3)), np.empty((3, n_arm, 9)))
+        _core.arm_geom_poses(cores, rows, np.empty((2, n_arm, 3)), np.empty((3, n_arm, 9)))
     with pytest.raises(ValueError, match="poses per joint vector"):
-        _core.arm_geom_poses(*arm, rows, np.empty((3, n_arm, 3)), np.empty((3, n_arm - 1, 9)))
+        _core.arm_geom_poses(cores, rows, np.empty((3, n_arm, 3)), np.empty((3, n_arm - 1, 9)))
 
 
 # -- along a way, names, errors and mink's pairs ------------------------------------------

@@ -5,6 +5,8 @@ from __future__ import annotations
 import math
 import re
 import threading
+import types
+from typing import NamedTuple
 
 import numpy as np
 import pytest
@@ -269,34 +271,34 @@ def test_the_bindings_refuse_indices_out_of_range(panda):
         )
 
     def evaluate(limited, joints):
-        q, out, one = np.zeros((1, 7)), np.empty((1, 5)), np.ones(1)
-        numbers = np.array([1.0, 1.0, 1.0, 0.1, 0.03, 0.1])
-        _core.evaluate(7, q, np.empty((1, 0)), limited, one - 1.0, one, one, joints, one, numbers, out)
+        q, out, one = np.zeros((1, 7)), _core.Evaluations(*np.empty((5, 1))), np.ones(1)
+        weights = dict(margin_weight=1.0, clearance_weight=1.0, singularity_weight=1.0)
+        caps = dict(clearance_cap=0.1, min_clearance=0.03, singularity_cap=0.1)
+        terms = _core.ObjectiveTerms(7, limited, one - 1.0, one, one, joints, one, **weights, **caps)
+        _core.evaluate(terms, q, np.empty((1, 0)), out)
 
     clearance = om.Clearance.for_arm(panda.arm, [om.Sphere([0.4, 0.1, 0.5], 0.05)])
-    arm, geoms = clearance._cores.links, clearance._cores.geoms
-    q, n_arm, n_pairs = np.zeros(7), len(arm[2]), len(clearance.pairs)
-    dist, fromto, grad = np.empty(n_pairs), np.empty((n_pairs, 6)), np.empty((n_pairs, 7))
+    cores = clearance._cores
+    q, n_arm, n_pairs = np.zeros(7), len(cores.link), len(clearance.pairs)
+    out = _core.PairDistances(np.empty(n_pairs), np.empty((n_pairs, 6)), np.empty((n_pairs, 7)))
 
     def poses(link):
         xpos, xmat = np.empty((n_arm, 3)), np.empty((n_arm, 9))
-        _core.arm_geom_poses(*arm[:2], link, *arm[3:], q, xpos, xmat)
+        _core.arm_geom_poses(cores._replace(link=link), q, xpos, xmat)
 
     def clear(link, pairs):
-        _core.arm_clearance(
-            *arm[:2], link, *arm[3:], q, *geoms[:5], pairs, geoms[6], 1.0, 1.0, dist, fromto, grad, False
-        )
+        _core.arm_clearance(cores._replace(link=link, pairs=pairs), q, 1.0, 1.0, out, False)
 
     def index(k):
         return np.array([k], dtype=np.int64)
 
     def link_at(value):
-        link = arm[2].copy()
+        link = cores.link.copy()
         link[0] = value
         return link
 
     def pair_at(side, value):
-        pairs = geoms[5].copy()
+        pairs = cores.pairs.copy()
         pairs[0, side] = value
         return pairs
 
@@ -309,17 +311,17 @@ def test_the_bindings_refuse_indices_out_of_range(panda):
         *[(evaluate, (index(k), index(0)), evaluate_sizes) for k in (-1, 7)],
         *[(evaluate, (index(0), index(k)), evaluate_sizes) for k in (-1, 7)],
         *[(poses, (link_at(k),), chain_sizes.format("arm_geom_poses")) for k in (-1, 8)],
-        *[(clear, (link_at(k), geoms[5]), chain_sizes.format("arm_clearance")) for k in (-1, 8)],
-        *[(clear, (arm[2], pair_at(0, k)), pair_sizes) for k in (-1, n_arm)],
-        *[(clear, (arm[2], pair_at(1, k)), pair_sizes) for k in (n_arm - 1, n_arm + 1)],
+        *[(clear, (link_at(k), cores.pairs), chain_sizes.format("arm_clearance")) for k in (-1, 8)],
+        *[(clear, (cores.link, pair_at(0, k)), pair_sizes) for k in (-1, n_arm)],
+        *[(clear, (cores.link, pair_at(1, k)), pair_sizes) for k in (n_arm - 1, n_arm + 1)],
     ]
     for call, args in [
         *[(pieces, (index(k),)) for k in (0, 6)],
         *[(evaluate, (index(k), index(j))) for k in (0, 6) for j in (0, 6)],
         *[(poses, (link_at(k),)) for k in (0, 7)],
-        *[(clear, (link_at(k), geoms[5])) for k in (0, 7)],
-        *[(clear, (arm[2], pair_at(0, k))) for k in (0, n_arm - 1)],
-        (clear, (arm[2], pair_at(1, n_arm))),
+        *[(clear, (link_at(k), cores.pairs)) for k in (0, 7)],
+        *[(clear, (cores.link, pair_at(0, k))) for k in (0, n_arm - 1)],
+        (clear, (cores.link, pair_at(1, n_arm))),
     ]:
         call(*args)
     for call, args, message in refused:
@@ -331,13 +333,15 @@ def test_the_climb_bindings_refuse_groups_and_indices_out_of_range():
     """maximise_1d and step_1d read the pieces of each group between its ends: ends that do not
     start at 0, end at the pieces' count and increase are a ValueError, with no groups too;
     start_bound reads the samples a..b of its start k: k, a and b out of order or out of
-    range, a group column out of range, or a reach that is not >= 0, are a ValueError."""
+    range, a group column out of range, or a reach that is not >= 0, are a ValueError; start_cones
+    reads the samples of its starts: a start out of range is a ValueError."""
     v, a, z = np.arange(5.0), np.ones(5), np.empty(5)
     one, none = np.ones(1), np.empty(0)
 
     def groups(ends, w=one, n=5):
+        pieces = _core.Pieces(v[:n], a[:n], np.array(ends, dtype=np.int64), w, -w, w)
         for kernel in (_core.maximise_1d, _core.step_1d):
-            kernel(v[:n], a[:n], np.array(ends, dtype=np.int64), w, -w, w, 1.0, -1.0, 1.0, z[:n])
+            kernel(pieces, 1.0, -1.0, 1.0, z[:n])
 
     groups([0, 5])
     groups([0], none, 0)
@@ -350,9 +354,16 @@ def test_the_climb_bindings_refuse_groups_and_indices_out_of_range():
     def bound(k, first, last, reach=0.5, columns=(1, 2)):
         group_columns = np.array(columns, dtype=np.int64)
         weights = np.ones(len(columns))
-        return _core.start_bound(psi, values, slopes, group_columns, weights, weights, k, first, last, reach)
+        samples = _core.StartSamples(psi, values, slopes, group_columns, weights, weights)
+        return _core.start_bound(samples, k, first, last, reach)
 
     assert all(bound(k, 0, 3) >= values[k, 0] for k in range(4))  # (at least f_k, read at either end)
+    samples = _core.StartSamples(psi, values, slopes, np.array([1, 2]), np.ones(2), np.ones(2))
+    out = np.empty(2)
+    _core.start_cones(samples, np.array([0, 3]), np.ones(2), out)  # (read at either end)
+    for starts, reach in (([-1, 0], np.ones(2)), ([0, 4], np.ones(2)), ([0, 1], np.ones(3))):
+        with pytest.raises(ValueError, match="start_cones: sizes or indices of the starts disagree"):
+            _core.start_cones(samples, np.array(starts), reach, out)
     for k, first, last, reach, columns in (
         (-1, 0, 3, 0.5, (1, 2)),
         (2, 3, 3, 0.5, (1, 2)),
@@ -365,6 +376,51 @@ def test_the_climb_bindings_refuse_groups_and_indices_out_of_range():
     ):
         with pytest.raises(ValueError, match="start_bound: sizes or indices of the samples disagree"):
             bound(k, first, last, reach, columns)
+
+
+class _Reordered(NamedTuple):
+    """_core.StartSamples' fields in another order."""
+
+    caps: np.ndarray
+    weights: np.ndarray
+    groups: np.ndarray
+    slopes: np.ndarray
+    values: np.ndarray
+    psi: np.ndarray
+
+
+class _Overridden(_core.StartSamples):
+    """_core.StartSamples whose caps getattr does not read from the tuple."""
+
+    __slots__ = ()
+
+    @property
+    def caps(self) -> np.ndarray:
+        return np.zeros(len(self.weights))
+
+
+def test_records_are_read_by_their_fields_names():
+    """The kernels read a record's fields by name (the record's field indices resolved from its
+    type's _fields, else getattr): the same answer from a NamedTuple of the fields in another
+    order and from an object with those attributes; a subclass's property is what is read; a
+    record without a field is a TypeError naming it."""
+    psi, values = np.linspace(0.0, 1.0, 4), np.arange(12.0).reshape(4, 3)
+    fields = dict(psi=psi, values=values, slopes=np.ones(3), groups=np.array([1, 2]), weights=np.ones(2))
+    samples = _core.StartSamples(**fields, caps=np.full(2, 0.5))
+    want = [_core.start_bound(samples, k, 0, 3, 0.4) for k in range(4)]
+    for record in (
+        _Reordered(**fields, caps=samples.caps),
+        types.SimpleNamespace(**fields, caps=samples.caps),
+    ):
+        for _ in range(2):  # (the second read: by the indices resolved at the first)
+            assert [_core.start_bound(record, k, 0, 3, 0.4) for k in range(4)] == want
+    overridden = _Overridden(*samples)
+    capped = [_core.start_bound(overridden, k, 0, 3, 0.4) for k in range(4)]
+    assert capped != want and capped == [
+        _core.start_bound(samples._replace(caps=np.zeros(2)), k, 0, 3, 0.4) for k in range(4)
+    ]
+    with pytest.raises(TypeError, match="must have a field 'caps'"):
+        _core.start_bound(types.SimpleNamespace(**fields), 0, 0, 3, 0.4)
 
 
 def test_link_paths_refuses_grids_counts_and_outputs_that_disagree(panda):

@@ -13,14 +13,27 @@ from hypothesis import strategies as st
 
 import om_redundant as om
 from benchmarks.control_rate import HOMES, MIN_CLEARANCE, obstacles
-from om_redundant.redundancy import optimizer as optimizer_module
-from om_redundant.redundancy.box_qp import Pieces, maximise_1d, step_1d
-from om_redundant.redundancy.climb import maximise
-from om_redundant.redundancy.objective import Group
+from om_redundant import _core
+from om_redundant.redundancy.box_qp import Pieces, step_1d
+from om_redundant.redundancy.objective import Evaluation, Group
 from om_redundant.redundancy.optimizer import _StartBounds
 from om_redundant.redundancy.probe import Probe
 from om_redundant.redundancy.self_motion import self_motion_tangents
 from tests.conftest import random_groups, steps_numpy
+from tests.reference import box_qp as box_qp_numpy
+from tests.reference import objective as objective_numpy
+from tests.reference import start_bounds as start_bounds_numpy
+
+
+def maximise_1d(
+    groups: list[Group], curvature: float, lower: float, upper: float
+) -> tuple[float, list[np.ndarray]] | None:
+    """``_core.maximise_1d`` of the groups' pieces: delta and each group's multipliers, or None
+    when the floors leave no delta (tests/reference/box_qp.py's maximise_1d, compiled)."""
+    pieces = Pieces.of(groups)
+    z = np.empty(len(pieces.values))
+    delta = _core.maximise_1d(pieces, curvature, lower, upper, z)
+    return None if delta is None else (delta, pieces.split(z))
 
 
 @functools.cache
@@ -42,6 +55,12 @@ def joints(optimizer, seed, n=40):
     return np.random.default_rng(seed).uniform(arm.lower - 0.3, arm.upper + 0.3, (n, arm.dof))
 
 
+def test_the_kernels_evaluations_are_read_by_their_names():
+    """_core.evaluate writes each field of Evaluation into the array of that name
+    (_core.Evaluations), whose rows Objective.evaluations reads in Evaluation's order."""
+    assert _core.Evaluations._fields == Evaluation._fields
+
+
 @settings(max_examples=6, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1), name=st.sampled_from(list(HOMES)), count=st.sampled_from([0, 1, 3]))
 def test_batched_evaluations_equal_the_single_ones(seed, name, count):
@@ -53,9 +72,10 @@ def test_batched_evaluations_equal_the_single_ones(seed, name, count):
     assert objective.evaluations(q) == [objective.evaluate(row) for row in q]
     for row in q[:5]:  # the groups' minima, capped, weighted and summed (C's sin or numpy's)
         evaluation, groups = objective.evaluate(row), {g.kind: g for g in objective.groups(row)}
-        assert evaluation.value == pytest.approx(sum(g.term() for g in groups.values()), rel=0, abs=1e-15)
+        terms = [objective_numpy.term(g) for g in groups.values()]
+        assert evaluation.value == pytest.approx(sum(terms), rel=0, abs=1e-15)
         assert evaluation.margin == groups["margin"].values.min()
-        assert evaluation.slack == min(g.slack() for g in groups.values())
+        assert evaluation.slack == min(objective_numpy.slack(g) for g in groups.values())
         if "clearance" in groups:
             assert evaluation.clearance == groups["clearance"].values.min() * objective.clearance_cap
         if "singularity" in groups:
@@ -178,12 +198,12 @@ def test_the_one_variable_qp_step_is_the_models_maximiser(seed, pieces, curvatur
         start=-0.5 * curvature * grid**2,
     )
     delta, multipliers = maximise_1d(groups, curvature, lower, upper)
-    reference = maximise_1d(groups, curvature, lower, upper, compiled=False)  # numpy's
+    reference = box_qp_numpy.maximise_1d(groups, curvature, lower, upper)
     assert delta == reference[0]
     for z, want in zip(multipliers, reference[1], strict=True):
         np.testing.assert_array_equal(z, want)
     below = [Group(g.kind, g.weight, g.floor, g.cap, g.values - 0.5, g.jacobian) for g in groups]
-    found, want = (maximise_1d(below, curvature, lower, upper, compiled=c) for c in (True, False))
+    found, want = (m(below, curvature, lower, upper) for m in (maximise_1d, box_qp_numpy.maximise_1d))
     assert (found is None) == (want is None)  # (the floors may leave no delta)
     if found is not None:
         assert found[0] == want[0]
@@ -217,7 +237,7 @@ def test_the_climbs_one_variable_step_compiled_is_numpys(seed, pieces, curvature
     rng = np.random.default_rng(seed)
     groups = random_groups(rng, 1, lambda floor: rng.uniform(0.0, spread, pieces) + 0.3)
     lower, upper = -reach * rng.uniform(), reach * rng.uniform()
-    found, want = (step_1d(Pieces.of(groups), curvature, lower, upper, compiled=c) for c in (True, False))
+    found, want = (s(Pieces.of(groups), curvature, lower, upper) for s in (step_1d, box_qp_numpy.step_1d))
     assert (found is None) == (want is None)
     if found is None:
         return
@@ -239,8 +259,8 @@ def test_the_climbs_one_variable_step_compiled_is_numpys(seed, pieces, curvature
     for z_g, k, z_kept in zip(Pieces.of(groups).split(z), kept, alone[1], strict=True):
         np.testing.assert_array_equal(z_g[k], z_kept)
         assert (z_g[~k] == 0.0).all()
-    model = Pieces.of(groups).model
-    assert gain == model(delta) - 0.5 * delta * curvature * delta - model(0.0)
+    concatenated, model = Pieces.of(groups), box_qp_numpy.model
+    assert gain == model(concatenated, delta) - 0.5 * delta * curvature * delta - model(concatenated, 0.0)
     moved = [replace(g, values=g.values + 0.1, jacobian=-g.jacobian) for g in groups]
     for mine, fresh in zip(Pieces.of(groups).at(moved), Pieces.of(moved), strict=True):
         np.testing.assert_array_equal(mine, fresh)  # (another point's pieces, the structure shared)
@@ -250,9 +270,12 @@ def test_the_climbs_one_variable_step_compiled_is_numpys(seed, pieces, curvature
         replace(groups[0], values=np.where(np.arange(pieces) == 0, np.nan, groups[0].values)),
         *groups[1:],
     ]
-    for compiled in (True, False):  # (a piece that is not a number: no piece of its group is kept)
+    for step in (
+        step_1d,
+        box_qp_numpy.step_1d,
+    ):  # (a piece that is not a number: no piece of its group is kept)
         with pytest.raises(ValueError):
-            step_1d(Pieces.of(broken), curvature, lower, upper, compiled=compiled)
+            step(Pieces.of(broken), curvature, lower, upper)
 
 
 @settings(max_examples=40, deadline=None)
@@ -288,7 +311,9 @@ def test_the_climbs_start_bounds_hold_for_functions_within_their_slopes(seed, ru
     bounds = _StartBounds(psi, f, terms, first, last, slope, slopes)
     reach = rng.uniform(0.0, 1.0, len(psi))
     cones = bounds.cone(np.arange(len(psi)), reach)
+    np.testing.assert_array_equal(cones, start_bounds_numpy.cone(bounds, np.arange(len(psi)), reach))
     bare = _StartBounds(psi, f, [], first, last, slope, [])
+    np.testing.assert_array_equal(bare.cone(first, reach), start_bounds_numpy.cone(bare, first, reach))
     columns = np.column_stack([f] + [v for _, _, v in terms])
     pairs = [(i, i + 1) for i in range(len(psi) - 1) if first[i] == first[i + 1]]  # neighbours on a run
     sampled = [
@@ -301,37 +326,16 @@ def test_the_climbs_start_bounds_hold_for_functions_within_their_slopes(seed, ru
     ).all()  # (the fixture's own bounds hold)
     for k, (x, r, f_k) in enumerate(zip(psi, reach, f, strict=True)):
         bound = bounds.within(k, r)
-        assert bound == bounds.within(k, r, compiled=False)  # (numpy's, the reference)
-        assert bare.within(k, r) == bare.within(k, r, compiled=False)
+        assert bound == start_bounds_numpy.within(bounds, k, r)  # (numpy's, the reference)
+        assert bare.within(k, r) == start_bounds_numpy.within(bare, k, r)
         assert bound >= objective(np.linspace(x - r, x + r, 2001)).max() - 1e-12
         assert f_k <= bound <= min(cones[k], f_k + slope * r) + 1e-12
     holed = terms[0][2].copy()
     holed[rng.integers(len(psi)), 0] = np.nan  # (a function that is not a number at one sample)
     nan_bounds = _StartBounds(psi, f, [(*terms[0][:2], holed), *terms[1:]], first, last, slope, slopes)
+    everyone = np.arange(len(psi))
+    np.testing.assert_equal(
+        nan_bounds.cone(everyone, reach), start_bounds_numpy.cone(nan_bounds, everyone, reach)
+    )
     for k, r in enumerate(reach.tolist()):  # NaN where numpy's is (then no start is skipped for it)
-        np.testing.assert_equal(nan_bounds.within(k, r), nan_bounds.within(k, r, compiled=False))
-
-
-@pytest.mark.parametrize("name", list(HOMES))
-def test_the_one_variable_climb_is_the_general_one(name, monkeypatch):
-    """climb.maximise with one variable in floats climbs exactly as the general loop on
-    arrays (scalar=False, the reference): the same point, psi and value from every start
-    that global chooses with 3 obstacles about the hand climb at random poses."""
-    solver = optimizer_of(name, 0).solver
-    climbs = []
-
-    def recording(probe, start, lower, upper, radius):
-        found = maximise(probe, start, lower, upper, radius)
-        climbs.append((probe, start, lower, upper, radius, found))
-        return found
-
-    monkeypatch.setattr(optimizer_module, "maximise", recording)
-    for q in np.random.default_rng(3).uniform(solver.arm.lower, solver.arm.upper, (6, solver.arm.dof)):
-        T = solver.arm.fk(q)
-        om.RedundancyOptimizer(solver, obstacles(T[:3, 3], 3), min_clearance=MIN_CLEARANCE).choose(T)
-    assert sum(found.psi != start.psi for _, start, *_, found in climbs) >= 3  # (climbs that moved)
-    for probe, start, lower, upper, radius, found in climbs:
-        reference = maximise(probe, start, lower, upper, radius, scalar=False)
-        assert reference.psi == found.psi
-        np.testing.assert_array_equal(reference.q, found.q)
-        assert reference.evaluation == found.evaluation
+        np.testing.assert_equal(nan_bounds.within(k, r), start_bounds_numpy.within(nan_bounds, k, r))

@@ -157,15 +157,15 @@ extern PyTypeObject om_SolverType;        /* solver_type.c: Solver(SolverData) *
 /* solver_type.c: obj's data if it is a 7-DOF (S-R-S) Solver; NULL with an error naming what. */
 const om_solver_data *om_srs7_solver(PyObject *obj, const char *what);
 extern PyMethodDef om_kernel_functions[]; /* functions.c: kinematics and closed forms */
-extern PyMethodDef om_tracking_functions[]; /* tracking.c: the redundancy optimiser's tracking step */
-extern PyMethodDef om_clearance_functions[]; /* clearance.c: distances of arm and obstacle geoms */
+int om_tracking_init(PyObject *module);       /* binding/tracking.c: track_step, its statuses and result type */
+int om_clearance_init(PyObject *module);      /* binding/clearance.c: arm and obstacle geoms */
 extern PyMethodDef om_follow_functions[];    /* follow.c: a solution path followed along psi */
 int om_follow_init(PyObject *module);         /* follow.c: its result type, ckernels.Followed */
 extern PyMethodDef om_link_functions[];      /* link.c: a branch's solution paths through its grid roots */
 extern PyMethodDef om_tangent_functions[];   /* tangents.c: self-motion tangents of many rows */
-extern PyMethodDef om_objective_functions[]; /* objective.c: the redundancy optimiser's objective */
+extern PyMethodDef om_objective_functions[]; /* binding/objective.c: the redundancy optimiser's objective */
 extern PyMethodDef om_cell_functions[];      /* cells.c: the cell test of the solution paths */
-extern PyMethodDef om_box_qp_functions[];    /* box_qp.c: the climb's QP in one variable */
-extern PyMethodDef om_start_bound_functions[]; /* start_bounds.c: what a climb from a start can reach */
+int om_box_qp_init(PyObject *module);         /* binding/box_qp.c: the climb's QP in one variable */
+extern PyMethodDef om_start_bound_functions[]; /* binding/start_bounds.c: what a climb from a start can reach */
 
 #endif

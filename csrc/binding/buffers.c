@@ -76,8 +76,67 @@ int bind_args(PyObject *const *args, Py_ssize_t nargs, PyObject *kwnames, const 
     return 0;
 }
 
+/* Where a record type (a NamedTuple's: a tuple with _fields) keeps the fields names[0:n]: their
+ * indices in its _fields, resolved by name once per type and names array. Its records are then
+ * read at those indices, by name as getattr reads them and without its cost (a string made and
+ * looked up per field: most of a small kernel's call). The types are kept (a reference each):
+ * the records' few types are the module's classes, alive anyway. */
+enum { FIELD_TYPES = 64, MAX_INDEXED_FIELDS = 16 };
+typedef struct {
+    PyTypeObject *type;
+    const char *const *names;
+    int n;
+    Py_ssize_t index[MAX_INDEXED_FIELDS];
+} field_indices;
+static field_indices indexed[FIELD_TYPES];
+static int n_indexed;
+
+/* The index of the field `name` in the tuple fields, or -1. */
+static Py_ssize_t field_index(PyObject *fields, const char *name) {
+    for (Py_ssize_t k = 0; k < PyTuple_GET_SIZE(fields); k++) {
+        PyObject *field = PyTuple_GET_ITEM(fields, k);
+        if (PyUnicode_Check(field) && PyUnicode_CompareWithASCIIString(field, name) == 0) return k;
+    }
+    return -1;
+}
+
+/* The indices of names[0:n] in record's type, or NULL where they cannot be had (not a tuple with
+ * those _fields, whose getattr gives the tuple's items): then getattr reads them. */
+static const field_indices *indices_of(PyObject *record, const char *const *names, int n) {
+    PyTypeObject *type = Py_TYPE(record);
+    if (!PyTuple_Check(record) || n > MAX_INDEXED_FIELDS) return NULL;
+    for (int i = 0; i < n_indexed; i++)
+        if (indexed[i].type == type && indexed[i].names == names && indexed[i].n == n) return &indexed[i];
+    if (n_indexed == FIELD_TYPES) return NULL;
+    PyObject *fields = PyObject_GetAttrString((PyObject *)type, "_fields");
+    if (!fields || !PyTuple_Check(fields)) {
+        PyErr_Clear();
+        Py_XDECREF(fields);
+        return NULL;
+    }
+    field_indices *entry = &indexed[n_indexed];
+    bool found = true;
+    for (int i = 0; i < n && found; i++) { /* (and getattr reads that item: no property overrides it) */
+        Py_ssize_t k = entry->index[i] = field_index(fields, names[i]);
+        PyObject *item = k >= 0 && k < PyTuple_GET_SIZE(record) ? PyObject_GetAttrString(record, names[i]) : NULL;
+        found = item != NULL && item == PyTuple_GET_ITEM(record, k);
+        Py_XDECREF(item);
+    }
+    Py_DECREF(fields);
+    PyErr_Clear();
+    if (!found) return NULL;
+    entry->type = (PyTypeObject *)Py_NewRef(type), entry->names = names, entry->n = n;
+    n_indexed++;
+    return entry;
+}
+
 int get_fields(PyObject *record, const char *const *names, int n, PyObject **out, const char *what) {
+    const field_indices *at = indices_of(record, names, n);
     for (int i = 0; i < n; i++) {
+        if (at && at->index[i] < PyTuple_GET_SIZE(record)) {
+            out[i] = Py_NewRef(PyTuple_GET_ITEM(record, at->index[i]));
+            continue;
+        }
         out[i] = PyObject_GetAttrString(record, names[i]);
         if (!out[i]) {
             PyErr_Clear();

@@ -46,14 +46,14 @@ PyMODINIT_FUNC PyInit_ckernels(void) {
         {"FOLLOW_CRAWL_STEPS", OM_FOLLOW_CRAWL_STEPS},
     };
     if (PyModule_AddObjectRef(m, "Solver", (PyObject *)&om_SolverType) < 0) goto fail;
-    if (PyModule_AddFunctions(m, om_tracking_functions) < 0) goto fail;
-    if (PyModule_AddFunctions(m, om_clearance_functions) < 0) goto fail;
+    if (om_tracking_init(m) < 0) goto fail;
+    if (om_clearance_init(m) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_follow_functions) < 0 || om_follow_init(m) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_link_functions) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_tangent_functions) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_objective_functions) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_cell_functions) < 0) goto fail;
-    if (PyModule_AddFunctions(m, om_box_qp_functions) < 0) goto fail;
+    if (om_box_qp_init(m) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_start_bound_functions) < 0) goto fail;
     for (size_t i = 0; i < sizeof constants / sizeof constants[0]; i++)
         if (PyModule_AddIntConstant(m, constants[i].name, constants[i].value) < 0) goto fail;

@@ -1,5 +1,5 @@
 r"""Where an arm's collision geoms sit on its DH chain, and the obstacles' cores: what
-``_core.arm_clearance`` reads (:class:`ArmCores`), set up once from a MuJoCo model.
+``_core.arm_clearance`` reads (``_core.ArmCores``), set up once from a MuJoCo model.
 
 A geom moved by joints 1..l sits at a fixed offset :math:`G` in link l's frame
 :math:`F_l(q)` (the chain's frame before joint l+1's row), :math:`X(q) = K F_l(q) G`, with
@@ -11,8 +11,6 @@ placement against MuJoCo's ``mj_kinematics`` at random joint vectors.
 
 from __future__ import annotations
 
-from typing import NamedTuple
-
 import mujoco
 import numpy as np
 
@@ -20,59 +18,17 @@ from .. import _core
 from ..exceptions import ModelMismatch
 from ..mujoco_io.arm_in_model import MATCH_TOLERANCE, ArmJoints
 
-POINT, SEGMENT, BOX = 1, 2, 3  # ArmCores.kind: the cores that _core.arm_clearance computes
+#: ArmCores.kind: the cores that _core.arm_clearance computes (csrc/redundancy.h).
+POINT, SEGMENT, BOX = _core.CORE_POINT, _core.CORE_SEGMENT, _core.CORE_BOX
 _CHECKS = 3  # random joint vectors at which the geoms' placement is checked against MuJoCo's
-
-
-class ArmCores(NamedTuple):
-    """What ``_core.arm_clearance`` reads, in its order: the arm's links (its DH chain
-    placed in the world) with the arm geoms' offsets in them, and the geoms as cores, the
-    arm's A geoms first, then the O obstacles (G = A + O).
-
-    Attributes:
-        table: The arm's DH table (``KinematicChain.table``).
-        start: (12,) world pose of DH frame 0, K: rotation (row-major) and position.
-        link: (A,) each arm geom's link: the number of the arm's joints that move it.
-        offset: (A, 12) each arm geom's pose in its link's frame, as ``start``.
-        slide: (dof,) which joints slide (else turn).
-        obstacle_pos, obstacle_mat: (O, 3), (O, 9) the obstacles' world poses.
-        kind: (G,) each geom's core: :data:`POINT` (sphere), :data:`SEGMENT` (capsule),
-            :data:`BOX`; 0 where MuJoCo computes its distances (other kinds, arm geoms other
-            than spheres and capsules).
-        radius: (G,) radius about the core (0 for a box).
-        half: (G, 3) half length of a segment along its z axis (0, 0, l); a box's half sizes.
-        pairs: (P, 2) each pair's geoms: (arm geom, obstacle) in this numbering.
-        bounds: (P,) sum of each pair's bounding-sphere radii (inf: a plane).
-    """
-
-    table: np.ndarray
-    start: np.ndarray
-    link: np.ndarray
-    offset: np.ndarray
-    slide: np.ndarray
-    obstacle_pos: np.ndarray
-    obstacle_mat: np.ndarray
-    kind: np.ndarray
-    radius: np.ndarray
-    half: np.ndarray
-    pairs: np.ndarray
-    bounds: np.ndarray
-
-    @property
-    def links(self) -> tuple[np.ndarray, ...]:
-        """The arguments of ``_core.arm_geom_poses`` and ``arm_clearance`` before q."""
-        return self[:5]
-
-    @property
-    def geoms(self) -> tuple[np.ndarray, ...]:
-        """The arguments of ``_core.arm_clearance`` after q."""
-        return self[5:]
+#: What ``_core.arm_clearance`` reads: the arm's links and the geoms' cores (``_core.ArmCores``).
+ArmCores = _core.ArmCores
 
 
 def arm_cores(
     model: mujoco.MjModel, data: mujoco.MjData, joints: ArmJoints, arm_geoms: list[int], obstacles: list[int]
 ) -> ArmCores:
-    """The :class:`ArmCores` of a model placed at its ``qpos0`` in data: DH frame 0's world
+    """The ``_core.ArmCores`` of a model placed at its ``qpos0`` in data: DH frame 0's world
     pose fitted to the joints' axis lines (:func:`_dh_frame_zero`), and each arm geom's
     offset in its link, :math:`G = F_l(q_0)^{-1} X(q_0)` at the arm's joints in ``qpos0``."""
     arm, geoms = joints.arm, arm_geoms + obstacles
@@ -163,7 +119,7 @@ def _link_frames(table: np.ndarray, start: np.ndarray, slide: np.ndarray, q: np.
     links = np.arange(len(q) + 1, dtype=np.int64)
     identity = np.tile(np.concatenate([np.eye(3).ravel(), np.zeros(3)]), (len(links), 1))
     xpos, xmat = np.empty((len(links), 3)), np.empty((len(links), 9))
-    _core.arm_geom_poses(table, start, links, identity, slide, q, xpos, xmat)
+    _core.arm_geom_poses(_core.ArmLinks(table, start, links, identity, slide), q, xpos, xmat)
     frames = np.tile(np.eye(4), (len(links), 1, 1))
     frames[:, :3, :3], frames[:, :3, 3] = xmat.reshape(-1, 3, 3), xpos
     return frames

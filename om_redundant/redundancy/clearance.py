@@ -290,7 +290,7 @@ class Clearance:
         """
         q = as_joint_vector(q, self._dof, stack=False)
         xpos, xmat = np.empty((len(self.arm_geoms), 3)), np.empty((len(self.arm_geoms), 9))
-        _core.arm_geom_poses(*self._cores.links, q, xpos, xmat)
+        _core.arm_geom_poses(self._cores, q, xpos, xmat)
         return xpos, xmat.reshape(-1, 3, 3)
 
     def update(self, data: mujoco.MjData) -> bool:
@@ -411,7 +411,7 @@ class Clearance:
         dist, fromto = np.empty(shape), np.empty((*shape, 6))
         grad = np.empty((*shape, self._dof)) if gradient else None
         cores = self._cores
-        if _core.arm_clearance(*cores.links, q, *cores.geoms, reach, near, dist, fromto, grad, False):
+        if _core.arm_clearance(cores, q, reach, near, _core.PairDistances(dist, fromto, grad), False):
             self._by_mujoco(
                 cores, q.reshape(-1, self._dof), reach, near, dist.reshape(-1, self._n_pairs), fromto, grad
             )
@@ -436,7 +436,7 @@ class Clearance:
         rows = np.flatnonzero(left.any(axis=1))
         n_arm = len(self._arm_ids)
         xpos, xmat = np.empty((len(rows), n_arm, 3)), np.empty((len(rows), n_arm, 9))
-        _core.arm_geom_poses(*cores.links, q[rows], xpos, xmat)
+        _core.arm_geom_poses(cores, q[rows], xpos, xmat)
         at, placed = rows.tolist(), self._placed
         kind, radius, half = cores.kind, cores.radius, cores.half
         for r, k in np.argwhere(left[rows]).tolist():  # (only the pair's geoms placed: the ones read)
@@ -451,22 +451,13 @@ class Clearance:
                 # The kernel leaves such a pair where the cores say it overlaps; MuJoCo's
                 # box-capsule distance can be positive for a capsule whose core pierces a
                 # thin box (0.3 % of such pairs, up to 0.09 m): the exact depth instead.
-                found = _core.box_overlap(
-                    xpos[r, i],
-                    xmat[r, i],
-                    half[i],
-                    radius[i],
-                    at_pos,
-                    at_mat,
-                    half[b],
-                    fromto[at[r], k],
-                )
+                geom = _core.GeomPose(xpos[r, i], xmat[r, i], half[i], radius[i])
+                found = _core.box_overlap(geom, _core.GeomPose(at_pos, at_mat, half[b]), fromto[at[r], k])
             dist[at[r], k] = found
         if grad is not None:
             given = np.empty((len(rows), n_pairs, self._dof))
-            _core.arm_clearance(
-                *cores.links, q[rows], *cores.geoms, reach, near, dist[rows], fromto[rows], given, True
-            )
+            given_pairs = _core.PairDistances(dist[rows], fromto[rows], given)
+            _core.arm_clearance(cores, q[rows], reach, near, given_pairs, True)
             grad.reshape(-1, n_pairs, self._dof)[rows] = given
 
 

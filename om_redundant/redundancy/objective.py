@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import functools
 import math
+import threading
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -130,12 +131,6 @@ class Group:
     values: np.ndarray
     jacobian: np.ndarray | None = None
 
-    def term(self) -> float:
-        return self.weight * min(self.cap, float(self.values.min()))
-
-    def slack(self) -> float:
-        return float(self.values.min()) - self.floor
-
     def constraints(self) -> tuple[np.ndarray, np.ndarray]:
         """The group's feasibility functions, >= 0 where feasible, and their derivatives
         (by the first variable of the jacobian). A joint's two margin pieces count as one
@@ -178,8 +173,9 @@ class Evaluation(NamedTuple):
         return self.slack >= 0.0
 
 
-#: An :class:`Evaluation` of a row of ``_core.evaluate``'s five numbers: ``Evaluation._make``
-#: without its length check (the kernel writes five), the cheapest way to build hundreds.
+#: An :class:`Evaluation` of a row of ``_core.evaluate``'s five numbers (its fields, in their
+#: order: ``_core.Evaluations``): ``Evaluation._make`` without its length check, the cheapest way
+#: to build hundreds.
 _evaluation_of_row = functools.partial(tuple.__new__, Evaluation)
 
 
@@ -229,17 +225,31 @@ class Objective:
         self._limited = np.flatnonzero(np.isfinite(arm.lower) & np.isfinite(arm.upper))
         self._lower, self._upper = arm.lower[self._limited], arm.upper[self._limited]
         self._half = (self._upper - self._lower) / 2.0
-        singular = (np.zeros(0, dtype=np.int64), np.zeros(0)) if singularity is None else singularity.rows()
-        numbers = (self.margin_weight, self.clearance_weight, self.singularity_weight)
-        numbers += (self.clearance_cap, self.min_clearance, SINGULARITY_CAP)
+        none = (np.zeros(0, dtype=np.int64), np.zeros(0))
+        joints, offsets = none if singularity is None else singularity.rows()
         # what _core.pieces reads: 2 d_cap, d_cap, d_min / d_cap
         self._clearance_numbers = np.array(
             [self.clearance_reach, self.clearance_cap, self.min_clearance / self.clearance_cap]
         )
         self._no_distances = np.zeros(0)  # _core.evaluate's without obstacles
+        self._scratch = threading.local()  # each thread's record of one row for _core.evaluate
         # what _core.pieces reads of the limits, and _core.evaluate of every term (csrc/objective.c)
         self._limits = (self._limited, self._lower, self._upper, self._half)
-        self._terms = (*self._limits, *singular, np.array(numbers))
+        self._terms = _core.ObjectiveTerms(
+            self._dof,
+            self._limited,
+            self._lower,
+            self._upper,
+            self._half,
+            joints,
+            offsets,
+            margin_weight=self.margin_weight,
+            clearance_weight=self.clearance_weight,
+            singularity_weight=self.singularity_weight,
+            clearance_cap=self.clearance_cap,
+            min_clearance=self.min_clearance,
+            singularity_cap=SINGULARITY_CAP,
+        )
         eye = np.eye(self._dof)[self._limited] / self._half[:, None]
         self._margin_jacobian = np.vstack([eye, -eye])  # pieces (q - l)/h, then (u - q)/h
 
@@ -309,7 +319,15 @@ class Objective:
             q: (dof,) joint vector.
             distances: (P,) the clearance's pair distances at q if already computed.
         """
-        return Evaluation(*self._evaluated(as_joint_vector(q, self._dof, stack=False), distances).tolist())
+        q = as_joint_vector(q, self._dof, stack=False)
+        scratch = self._scratch
+        try:
+            row, record = scratch.row, scratch.record
+        except AttributeError:  # (the thread's first: its out record, each field a slice of one row)
+            row = scratch.row = np.empty(len(_core.Evaluations._fields))
+            record = scratch.record = _core.Evaluations(*(row[k : k + 1] for k in range(len(row))))
+        _core.evaluate(self._terms, q, self._distances(q, distances), record)
+        return Evaluation(*row.tolist())
 
     def evaluations(self, q: np.ndarray, distances: np.ndarray | None = None) -> list[Evaluation]:
         """:meth:`evaluate` at every row of q (M, dof), in one call.
@@ -319,18 +337,18 @@ class Objective:
             distances: (M, P) the rows' pair distances if already computed (with obstacles).
         """
         q = as_joint_vector(q, self._dof).reshape(-1, self._dof)
-        return list(map(_evaluation_of_row, self._evaluated(q, distances).tolist()))
+        out = np.empty((len(_core.Evaluations._fields), len(q)))  # (a field's values in each row)
+        _core.evaluate(self._terms, q, self._distances(q, distances), _core.Evaluations(*out))
+        return list(map(_evaluation_of_row, out.T.tolist()))
 
-    def _evaluated(self, q: np.ndarray, distances: np.ndarray | None) -> np.ndarray:
-        """``_core.evaluate`` at q, (dof,) or (M, dof): (5,) or (M, 5) the fields of
-        :class:`Evaluation`."""
+    def _distances(self, q: np.ndarray, distances: np.ndarray | None) -> np.ndarray:
+        """What ``_core.evaluate`` reads of the pairs' distances at q: those given, else computed
+        (none without obstacles)."""
         if self.clearance is None:
-            distances = self._no_distances
-        elif distances is None:
+            return self._no_distances
+        if distances is None:
             distances = self.clearance.distances(q)
-        out = np.empty((*q.shape[:-1], 5))
-        _core.evaluate(self._dof, q, np.ascontiguousarray(distances, dtype=float), *self._terms, out)
-        return out
+        return np.ascontiguousarray(distances, dtype=float)
 
     def pieces(
         self, q: np.ndarray, tangent: np.ndarray, pairs: tuple[np.ndarray, np.ndarray] | None

@@ -28,7 +28,7 @@ the exact OM solution in it:
    otherwise, a climb that could at most tie) are skipped. This is what finds the global
    optimum rather than the nearest local one.
 3. **Climb** from each start (:func:`~om_redundant.redundancy.climb.maximise`): a trust-region SQP
-   whose QP, solved by OSQP, linearises margins and clearances around the current exact
+   whose QP, solved exactly, linearises margins and clearances around the current exact
    solution, within the interval. The result is the best point's own exact solve.
 
 **Tracking** (``choose(T, previous)``): the one-call tracking step of
@@ -48,7 +48,6 @@ previous one, for the first target of a mink loop.
 
 from __future__ import annotations
 
-import bisect
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
@@ -637,56 +636,34 @@ class _StartBounds:
         self._groups = np.cumsum([1] + [v.shape[1] for _, _, v in terms[:-1]], dtype=np.int64)[: len(terms)]
         self._weights = np.array([w for w, _, _ in terms])
         self._caps = np.array([cap for _, cap, _ in terms])
+        self._samples = _core.StartSamples(
+            self.psi, self._values, self._slopes, self._groups, self._weights, self._caps
+        )
 
     def cone(self, k: np.ndarray, reach: np.ndarray) -> np.ndarray:
         r"""(K,) the bounds from the starts' own cones: the smaller of :math:`f_k + L R` and
-        :math:`\sum_g w_g \min(cap_g, \min_j (v_{jk} + L_j R))`."""
-        return self._bound(self._values[k] + self._slopes * reach[:, None])
+        :math:`\sum_g w_g \min(cap_g, \min_j (v_{jk} + L_j R))`, the groups summed in their
+        order (``_core.start_cones``, ``csrc/start_bounds.c``; its numpy oracle is
+        ``tests/reference/start_bounds.py``)."""
+        bounds, reach = np.empty(len(k)), np.ascontiguousarray(reach, dtype=float)
+        _core.start_cones(self._samples, np.ascontiguousarray(k, dtype=np.int64), reach, bounds)
+        return bounds
 
-    def within(self, k: int, reach: float, compiled: bool = True) -> float:
+    def within(self, k: int, reach: float) -> float:
         r"""The bound of start k from every sample of its run within its reach R (never
         above :meth:`cone`'s for consistent slopes). Between neighbouring samples i, i + 1
         (h apart) the cones of the two meet at most at :math:`(u_i + u_{i+1} + L h)/2`; in
         a cell that R cuts, or beyond the run's end, the last sample's cone reaches
         :math:`u_i + L r` (r the reach left). Per cell or cut cell the smaller of f's bound
-        and the terms' (:meth:`cone`'s sum), the largest over the cells; at least f_k.
+        and the terms' (:meth:`cone`'s sum), the largest over the cells; at least f_k
+        (``_core.start_bound``, ``csrc/start_bounds.c``; its numpy oracle is
+        ``tests/reference/start_bounds.py``).
 
         Args:
             k: The start's sample.
             reach: R >= 0.
-            compiled: By ``_core.start_bound`` (``csrc/start_bounds.c``, the same
-                operations); False: numpy, the reference it is tested against.
         """
-        a, b = int(self.first[k]), int(self.last[k])
-        if compiled:
-            numbers = (self._groups, self._weights, self._caps)
-            return _core.start_bound(self.psi, self._values, self._slopes, *numbers, int(k), a, b, reach)
-        at = self.psi.tolist()
-        x = at[k]
-        lo = bisect.bisect_left(at, x - reach, a, b + 1)  # the samples within reach: lo..hi
-        hi = bisect.bisect_right(at, x + reach, a, b + 1) - 1
-        cells = np.arange(lo - 1 if lo > a else lo, hi + 1 if hi < b else hi)  # whole and cut
-        u, v, h = self._values[cells], self._values[cells + 1], self.psi[cells + 1] - self.psi[cells]
-        peaks = np.maximum(0.5 * (u + v + self._slopes * h[:, None]), np.maximum(u, v))
-        ends = np.array([lo, hi])
-        left = np.maximum(reach - np.abs(self.psi[ends] - x), 0.0)
-        bounds = self._bound(np.vstack([peaks, self._values[ends] + self._slopes * left[:, None]]))
-        bounded = np.full(hi - lo + 2, math.inf)  # the cut cells', then the whole ones
-        bounded[int(lo == a) : len(cells) + int(lo == a)] = bounds[: len(cells)]
-        cut = np.minimum(bounded[[0, -1]], bounds[len(cells) :])
-        whole = bounded[1:-1].max(initial=-math.inf)
-        return float(np.max([whole, cut.max(), self._values[k, 0]]))  # (NaN if any is: numpy's max)
-
-    def _bound(self, values: np.ndarray) -> np.ndarray:
-        """(N,) the smaller of f's bound and sum_g w_g min(cap_g, min_j bound_j), from bounds
-        (N, 1 + n) of f and of each group's functions, the groups summed in their order."""
-        if not len(self._weights):  # no terms: f = 0
-            return np.minimum(values[:, 0], 0.0)
-        terms = self._weights * np.minimum(self._caps, np.minimum.reduceat(values, self._groups, axis=1))
-        total = 0.0
-        for column in terms.T:
-            total = total + column
-        return np.minimum(values[:, 0], total)
+        return _core.start_bound(self._samples, int(k), int(self.first[k]), int(self.last[k]), reach)
 
 
 def _rebuilt(solver: OMSolver, clearance: Clearance | None, options: dict[str, Any]) -> RedundancyOptimizer:

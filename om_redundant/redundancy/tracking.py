@@ -65,59 +65,15 @@ WIDER = 64.0
 #: approached in shorter steps, and then held.
 SHRINKS = 8
 _JOINT_STEP = 0.25  # rad: the step keeps the linearised joint motion within this
-# setup vector layout (csrc/tracking.c)
-_PSI, _MAX_STEP, _CURVATURE, _N_SETUP = 0, 6, 7, 12
-# output layout after q (csrc/tracking.c)
-_O_PSI, _O_CURVATURE, _O_MARGIN, _O_SINGULARITY = 0, 2, 3, 4
-_O_POS, _O_ORI, _O_EVALS, _O_WITHIN, _N_OUT = 6, 7, 8, 9, 10
-_INFEASIBLE, _LEFT = 3, 4  # _core.track_step's status: nothing feasible within the step; off the path
-#: Why _core.track_step refused, by its status (csrc/tracking.c).
+#: Why _core.track_step refused, by its status (csrc/redundancy.h).
 _REFUSED = {
-    1: "no exact solution at the previous psi continues the previous joints",
-    2: "the self-motion folds there (psi does not move along it)",
-    3: "nothing within the limits and clearance within max_step",
-    4: "the step along the self-motion left the solution path",
+    _core.TRACK_NO_SOLUTION: "no exact solution at the previous psi continues the previous joints",
+    _core.TRACK_SINGULAR: "the self-motion folds there (psi does not move along it)",
+    _core.TRACK_INFEASIBLE: "nothing within the limits and clearance within max_step",
+    _core.TRACK_LEFT: "the step along the self-motion left the solution path",
 }
-
-
-class TrackingWork(NamedTuple):
-    """The arrays ``_core.track_step`` reads and writes, set up once per optimiser (the
-    clearances it linearises, a :class:`Linearisation`, are passed as they are).
-
-    Attributes:
-        setup: psi, w_m, w_c, w_s, d_min/d_cap, s_cap, max_step, curvature, joint step,
-            d_cap, number of singularities, number of clearance pairs.
-        lower, upper: (7,) joint limits (inf: not limited).
-        singular_joints, singular_offsets: (k,) the singularities' joints (as floats) and
-            constants (:class:`~om_redundant.Singularity`).
-        q: (7,) the new joints (output).
-        out: the step's results (output).
-    """
-
-    setup: np.ndarray
-    lower: np.ndarray
-    upper: np.ndarray
-    singular_joints: np.ndarray
-    singular_offsets: np.ndarray
-    q: np.ndarray
-    out: np.ndarray
-
-
-class Linearisation(NamedTuple):
-    """The clearances at joints q, the tracking step's model of them about q.
-
-    Attributes:
-        q: (7,) the joints.
-        distances: (P,) the pairs' distances there (m), capped at the objective's reach.
-        gradients: (P, 7) their gradients (zero where capped).
-        version: The clearance's :attr:`~om_redundant.Clearance.version` (the obstacles'
-            poses) they were computed with.
-    """
-
-    q: np.ndarray
-    distances: np.ndarray
-    gradients: np.ndarray
-    version: int = 0
+#: The clearances at joints q, the tracking step's model of them about q (``_core.Linearisation``).
+Linearisation = _core.Linearisation
 
 
 class Tracked(NamedTuple):
@@ -149,34 +105,24 @@ class Tracker:
 
     def __init__(self, solver: OMSolver, objective: Objective, max_step: float):
         self.solver, self.objective = solver, objective
-        sing, clearance = objective.singularity, objective.clearance
+        sing = objective.singularity
         n_sing = 0 if sing is None or objective.singularity_weight == 0.0 else len(sing.joints)
-        n_pairs = 0 if clearance is None else len(clearance.pairs)
-        setup = np.zeros(_N_SETUP)
-        setup[1:_N_SETUP] = (
-            objective.margin_weight,
-            objective.clearance_weight,
-            objective.singularity_weight,
-            objective.min_clearance / objective.clearance_cap,
-            SINGULARITY_CAP,
-            max_step,
-            INITIAL_CURVATURE,
-            _JOINT_STEP,
-            objective.clearance_cap,
-            n_sing,
-            n_pairs,
-        )
         arm = solver.arm
-        self.work = TrackingWork(
-            setup,
+        self.work = _core.TrackingWork(
+            solver.kernel,
             np.ascontiguousarray(arm.lower, dtype=float),
             np.ascontiguousarray(arm.upper, dtype=float),
             np.array(sing.joints[:n_sing] if n_sing else [], dtype=float),
             np.array(sing.offsets[:n_sing] if n_sing else [], dtype=float),
             np.zeros(arm.dof),
-            np.zeros(_N_OUT),
+            margin_weight=objective.margin_weight,
+            clearance_weight=objective.clearance_weight,
+            singularity_weight=objective.singularity_weight,
+            clearance_floor=objective.min_clearance / objective.clearance_cap,
+            clearance_cap=objective.clearance_cap,
+            singularity_cap=SINGULARITY_CAP,
+            joint_step=_JOINT_STEP,
         )
-        self._kernel = solver.kernel
         self.max_step = max_step
         # The last step's clearances, at its result's joints: the next step's linearisation.
         # Without obstacles, no pairs.
@@ -195,7 +141,7 @@ class Tracker:
         """
         with self._lock:
             step = self._step(T, signs, psi, q, curvature, self.max_step)
-            if step == _REFUSED[_INFEASIBLE]:
+            if step == _REFUSED[_core.TRACK_INFEASIBLE]:
                 step = self._step(T, signs, psi, q, curvature, WIDER * self.max_step)
             if isinstance(step, Tracked) and not step.feasible:
                 # just outside a floor (the pieces' curvature over the step): one step more from
@@ -206,7 +152,8 @@ class Tracker:
             for k in range(SHRINKS + 1):
                 # (a maximum on a floor: the step lands on it, rounded outside; at a fold, where
                 # the path ends: the step leaves the path beyond it; the last try stays at psi)
-                if not ((isinstance(step, Tracked) and not step.feasible) or step == _REFUSED[_LEFT]):
+                outside = isinstance(step, Tracked) and not step.feasible
+                if not (outside or step == _REFUSED[_core.TRACK_LEFT]):
                     break
                 reach = reach / 4.0 if k < SHRINKS else 0.0
                 step = self._step(T, signs, psi, q, curvature, reach)
@@ -226,43 +173,40 @@ class Tracker:
         max_step: float,
     ) -> Tracked | str:
         work, objective = self.work, self.objective
-        work.setup[_PSI] = psi
-        work.setup[_MAX_STEP] = max_step
-        work.setup[_CURVATURE] = curvature if math.isfinite(curvature) else INITIAL_CURVATURE
         linearised = self._linearised_at(q)
         signs_array = self._signs.get(signs)
         if signs_array is None:
             signs_array = self._signs[signs] = np.array(signs, dtype=np.int64)
-        status = _core.track_step(
-            self._kernel, T, signs_array, q, *work[:-2], *linearised[:3], work.q, work.out
-        )
-        if status != 0:
-            return _REFUSED[status]
-        out, q_new = work.out.tolist(), work.q.copy()  # Python floats: cheaper arithmetic
-        margin = out[_O_MARGIN]
+        curvature = curvature if math.isfinite(curvature) else INITIAL_CURVATURE
+        start = _core.TrackingStart(T, signs_array, psi, q, curvature)
+        out = _core.track_step(work, start, linearised, max_step)
+        if out.status != _core.TRACK_OK:
+            return _REFUSED[out.status]
+        q_new = work.q.copy()
+        margin = out.margin
         clearance = math.inf
         value = objective.margin_weight * margin if math.isfinite(margin) else 0.0
         if work.singular_joints.size:
-            value += objective.singularity_weight * min(1.0, out[_O_SINGULARITY])
+            value += objective.singularity_weight * min(1.0, out.singularity)
         if objective.clearance is not None:
             self._last = self._linearisation(q_new)
             clearance = float(self._last.distances.min())
             if clearance >= objective.clearance_reach:  # every pair beyond the reach: D itself, uncapped
                 clearance = objective.clearance.minimum(q_new)
             value += objective.clearance_weight * min(1.0, clearance / objective.clearance_cap)
-        configuration = Configuration(signs, (wrap_psi(out[_O_PSI]),))
+        configuration = Configuration(signs, (wrap_psi(out.psi),))
         solution = Solution(
             q_new,
             True,
             "ok",
             configuration,
-            out[_O_POS],
-            out[_O_ORI],
-            int(out[_O_EVALS]),
-            bool(out[_O_WITHIN]),
+            out.position_error,
+            out.orientation_error,
+            out.evaluations,
+            out.within_limits,
         )
         feasible = margin >= 0.0 and clearance >= objective.min_clearance
-        return Tracked(solution, margin, clearance, value, out[_O_CURVATURE], feasible)
+        return Tracked(solution, margin, clearance, value, out.curvature, feasible)
 
     def _linearised_at(self, q: np.ndarray) -> Linearisation:
         """The clearances at q: the last step's where q is its result's joints and the

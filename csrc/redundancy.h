@@ -1,0 +1,149 @@
+/* The redundancy optimiser's kernels (om_redundant/redundancy/): the tracking step
+ * (tracking.c), the clearance of an arm's geoms (clearance.c), the objective (objective.c), the
+ * climb's QP in one variable (box_qp.c) and the bound of a climb's start (start_bounds.c). Their
+ * CPython glue is csrc/binding/ (the same file names). */
+#ifndef OM_REDUNDANCY_H
+#define OM_REDUNDANCY_H
+
+#include "om_kernels.h"
+
+/* self_motion.c and paths (also declared in binding.h, where their glue's users read them). */
+bool om_self_motion_tangent(const om_solver_data *s, const double *q, double *t, double tol);
+bool om_continues(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic);
+bool om_beyond_doubt(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic);
+
+/* ------------------------------------------------------------------------------------ */
+/* box_qp.c: maximise phi(delta) = sum_g w_g min(cap_g, min_{j in g} v_j + a_j delta) - b delta^2 / 2
+ * over [lo, hi] where every group with a floor keeps its minimum >= floor. */
+
+/* G groups of pieces concatenated: group g's pieces are ends[g] .. ends[g + 1] - 1 (at least
+ * one each; ends[0] = 0), each group's weight, floor (-inf: none) and cap. */
+typedef struct {
+    const double *v, *a, *w, *floor, *cap;
+    const int64_t *ends;
+    ptrdiff_t G;
+} om_qp_groups;
+
+enum { OM_QP_NONE = 0, OM_QP_FOUND = 1, OM_QP_NO_MEMORY = -1, OM_QP_EMPTY_GROUP = -2 };
+/* The maximiser into *delta and the n pieces' multipliers into z: OM_QP_FOUND, OM_QP_NONE where
+ * the floors leave no delta, OM_QP_NO_MEMORY. */
+int om_qp_maximise(const om_qp_groups *q, double b, double lo, double hi, double *delta, double *z);
+/* The climb's step: om_qp_maximise of the pieces that can be their group's least somewhere in
+ * the box, *gain the model's gain model(delta) - b delta^2 / 2 - model(0) over all pieces, z every
+ * piece's multiplier (0 for those left out); OM_QP_EMPTY_GROUP where a group keeps no piece (a
+ * piece or a bound not a number). */
+int om_qp_step(const om_qp_groups *q, double b, double lo, double hi, double *delta, double *gain, double *z);
+
+/* ------------------------------------------------------------------------------------ */
+/* start_bounds.c: what a climb from a start can reach. */
+
+/* M samples of runs: psi (M,), values (M, columns) f and the groups' functions, their slope
+ * bounds (columns,), each group's first column (G, increasing, >= 1), weights and caps (G,). */
+typedef struct {
+    const double *psi, *values, *slopes, *weights, *caps;
+    const int64_t *groups;
+    ptrdiff_t columns, G;
+} om_start_samples;
+
+/* The bound of a start k from its own cones, the smaller of f_k + L R and sum_g w_g min(cap_g,
+ * min_j (v_jk + L_j R)); row: scratch (columns). */
+double om_start_cone(const om_start_samples *s, ptrdiff_t k, double reach, double *row);
+/* The bound of start k (its run's samples first .. last) within reach; row: scratch (columns). */
+double om_start_bound(const om_start_samples *s, ptrdiff_t k, ptrdiff_t first, ptrdiff_t last, double reach,
+                      double *row);
+
+/* ------------------------------------------------------------------------------------ */
+/* objective.c: f, M, D, the slack and S at a joint vector. */
+
+typedef struct {
+    const int64_t *limited; /* the L limited joints, their limits and half ranges */
+    const double *lower, *upper, *half;
+    ptrdiff_t L;
+    const int64_t *joints; /* the K singularities' joints and offsets */
+    const double *offsets;
+    ptrdiff_t K;
+    double margin_weight, clearance_weight, singularity_weight, clearance_cap, min_clearance, singularity_cap;
+} om_objective_terms;
+
+typedef struct {
+    double value, margin, clearance, slack, singularity;
+} om_evaluation;
+
+/* The objective at q (dof) with the P pairs' distances d (P = 0: no obstacles). */
+om_evaluation om_evaluate(const om_objective_terms *o, const double *q, const double *d, ptrdiff_t P);
+
+/* ------------------------------------------------------------------------------------ */
+/* clearance.c: distances of an arm's geoms and obstacle geoms. */
+
+enum { OM_CORE_MUJOCO = 0, OM_CORE_POINT = 1, OM_CORE_SEGMENT = 2, OM_CORE_BOX = 3 };
+
+/* An arm's links and geoms on them: its DH table (n_rows rows), the world pose of DH frame 0
+ * (start: R row-major, p), each of the A geoms' link and offset (12), which joints slide. */
+typedef struct {
+    const double *table, *start, *offset;
+    int n_rows, dof;
+    const int64_t *link;
+    const uint8_t *slide;
+    ptrdiff_t A;
+} om_arm_links;
+
+/* The G = A + O geoms' cores (kind, radius, half sizes), the O obstacles' poses, and the P
+ * pairs (arm geom, obstacle) with the sums of their bounding-sphere radii. */
+typedef struct {
+    const double *obstacle_pos, *obstacle_mat, *radius, *half, *bounds;
+    const int64_t *kind, *pairs;
+    ptrdiff_t G, P;
+} om_geom_cores;
+
+/* The world poses xpos (A, 3), xmat (A, 9) of the arm's geoms at q. */
+void om_arm_geom_poses(const om_arm_links *arm, const double *q, double *xpos, double *xmat);
+/* The pairs' distances (P) capped at reach and nearest points (P, 6) at each of M rows of q (dist
+ * (M, P), fromto (M, P, 6); unless given, written, nan for the pairs MuJoCo must compute), and
+ * unless grad is NULL their gradients (M, P, dof), in a row with a pair nearer than near only
+ * those of the pairs nearer than it. work: the G geoms' poses (12 G; the obstacles' copied in).
+ * Returns the pairs left to MuJoCo. */
+long om_arm_clearance(const om_arm_links *arm, const om_geom_cores *geoms, ptrdiff_t M, const double *q,
+                      double reach, double near, double *dist, double *fromto, double *grad, bool given,
+                      double *work);
+/* The signed distance of a sphere or capsule (pos, mat, half sizes (0, 0, l), radius) that
+ * overlaps a box (box_pos, box_mat, box_half), its nearest points into fromto (6). */
+double om_box_overlap(const double *pos, const double *mat, const double *half, double radius,
+                      const double *box_pos, const double *box_mat, const double *box_half, double *fromto);
+
+/* ------------------------------------------------------------------------------------ */
+/* tracking.c: the tracking step. */
+
+/* What om_track answers. */
+enum { OM_TRACK_OK = 0, OM_TRACK_NO_SOLUTION = 1, OM_TRACK_SINGULAR = 2, OM_TRACK_INFEASIBLE = 3, OM_TRACK_LEFT = 4 };
+#define OM_TRACK_MAX_PIECES 512
+
+/* The optimiser's fixed data and a step's clearances linearised about q_ref. */
+typedef struct {
+    const om_solver_data *s;
+    const double *lower, *upper;            /* (7,) joint limits */
+    const double *sing_joint, *sing_offset; /* (n_sing,) the singularities' joints and constants */
+    int n_sing;
+    const double *q_ref, *clear_d, *clear_g; /* (7,), (n_clear,) metres, (n_clear, 7) */
+    int n_clear;
+    double clearance_cap, singularity_cap, joint_step;
+    double weight[3], floor[3], cap[3]; /* of the groups margin, clearance, singularity (om_tracking_groups) */
+} om_tracking;
+
+/* The groups' weights (w_m, w_c, w_s), floors (0, clearance_floor = d_min / d_cap) and caps. */
+void om_tracking_groups(om_tracking *tr, double w_m, double w_c, double w_s, double clearance_floor);
+
+/* A step taken: the new psi, the step, the next curvature, each group's smallest piece at the
+ * new joints (margin, singularity, clearance: normalised, the clearance linearised), the
+ * second solve's errors, evaluations and within_limits. */
+typedef struct {
+    double psi, step, curvature, margin, singularity, clearance, position_error, orientation_error;
+    int64_t evaluations;
+    bool within_limits;
+} om_tracked;
+
+/* From (psi, q_prev) to pose T (signs): the new joints into q1, the step into out; OM_TRACK_OK
+ * or why not. Not reentrant (static scratch): the binding holds the GIL. */
+int om_track(const om_tracking *tr, const double *T, const int64_t *signs, double psi, const double *q_prev,
+             double max_step, double curvature, double *q1, om_tracked *out);
+
+#endif
