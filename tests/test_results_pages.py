@@ -3,8 +3,11 @@ hand-written narrative before and after it stays as it was, to the byte."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
+from benchmarks import pages
 from benchmarks.pages import BEGIN, END, with_block, write_block
 
 NARRATIVE_ABOVE = "# A page\n\nWritten by hand: what the run shows.\n"
@@ -46,10 +49,26 @@ def test_broken_markers_leave_the_page_untouched(tmp_path, page):
         with_block(page, "table\n")
 
 
-def test_every_page_a_benchmark_writes_has_one_block():
-    from benchmarks.report import RESULTS
+def test_write_page_keeps_the_narrative(tmp_path, monkeypatch, capsys):
+    from benchmarks import report
 
-    for path in sorted(RESULTS.glob("*.md")):
-        text = path.read_text()
-        if BEGIN in text or END in text:
-            assert with_block(text, "x")[1], path
+    monkeypatch.setattr(report, "RESULTS", tmp_path)
+    (tmp_path / "bench.md").write_text(f"{NARRATIVE_ABOVE}\n{BEGIN}\nold\n{END}\n{NARRATIVE_BELOW}")
+    report.write_page("bench.md", "new\n")
+    assert (tmp_path / "bench.md").read_text() == f"{NARRATIVE_ABOVE}\n{BEGIN}\nnew\n{END}\n{NARRATIVE_BELOW}"
+
+
+#: Pages no benchmark writes: all hand-written.
+HAND_WRITTEN = {"examples.md", "global_choose.md"}
+
+
+def test_every_page_a_benchmark_writes_has_one_block():
+    results = Path(pages.__file__).parent / "results"
+    names = sorted(path.name for path in results.glob("*.md"))
+    assert "adversarial.md" in names and "peers.md" in names
+    for name in names:
+        text = (results / name).read_text()
+        if name in HAND_WRITTEN:
+            assert BEGIN not in text and END not in text, name
+        else:
+            assert with_block(text, "x")[1], name
