@@ -26,6 +26,7 @@ import om_redundant as om
 from om_redundant.om.experiment import run as run_paper_experiment
 
 from .adapters import PEERS, Peer, Unavailable
+from .pages import write_block
 from .protocols import PROTOCOLS, Targets, measure, measure_batches
 from .report import Results, markdown, plot
 from .robots import check_fk
@@ -152,8 +153,7 @@ def main(argv: list[str] | None = None) -> Results:
 
     results.seconds = time.perf_counter() - start
     results.load = (load_start, os.getloadavg()[0])
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(markdown(results))
+    write_block(out, markdown(results))
     picture = out.with_suffix(".png")
     try:
         why_not = "" if plot(results, picture) else "nothing measured"

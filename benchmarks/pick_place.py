@@ -35,6 +35,8 @@ import numpy as np
 
 import om_redundant as om
 
+from .pages import write_block
+
 RATE = 500.0  # Hz
 DT = 1.0 / RATE
 WAYPOINTS = 20
@@ -319,7 +321,7 @@ def main() -> None:
     if args.out:
         args.out.parent.mkdir(parents=True, exist_ok=True)
         args.out.with_suffix(".json").write_text(json.dumps(rows, indent=1))
-        args.out.write_text(table(rows) + "\n")
+        write_block(args.out, table(rows) + "\n")
     if args.video:
         solver = om.OMSolver(args.arms[0])
         model = scene(solver.arm)

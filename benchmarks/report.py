@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 from importlib import metadata
 from pathlib import Path
 
+from .pages import write_block
 from .protocols import (
     ORIENTATION_TOLERANCE,
     POSITION_TOLERANCE,
@@ -92,10 +93,10 @@ RESULTS = Path(__file__).parent / "results"
 
 
 def write_page(name: str, text: str) -> Path:
-    """Print a result page and write it to ``benchmarks/results/<name>``."""
+    """Print a result page and write it as the generated block of ``benchmarks/results/<name>``
+    (:func:`benchmarks.pages.write_block`: the page's hand-written lines are kept)."""
     print(text)
-    out = RESULTS / name
-    out.write_text(text)
+    out = write_block(RESULTS / name, text)
     print(f"written to {out}")
     return out
 
