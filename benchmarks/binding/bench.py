@@ -7,7 +7,7 @@ compiler, cmake and ``pip install nanobind``)::
 
     cmake -S benchmarks/binding -B build/binding -DPython_EXECUTABLE=$(which python)
     cmake --build build/binding
-    python benchmarks/binding/bench.py build/binding
+    python -m benchmarks.binding.bench build/binding
 
 Results and the decision they support: benchmarks/results/binding.md.
 """
@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 import om_redundant as om
+from benchmarks.report import cpu_model, write_page
 
 sys.path.insert(0, sys.argv[1] if len(sys.argv) > 1 else "build/binding")
 import capi_stub
@@ -58,15 +59,18 @@ def main() -> None:
     assert np.array_equal(capi_stub.solve_pose(T, c).q, nb_stub.solve_pose(T, c).q)
     ours = per_call(lambda: capi_stub.solve_pose(T, c))
     theirs = per_call(lambda: nb_stub.solve_pose(T, c))
-    print(
-        f"binding alone: hand-written C API {ours:.0f} ns, nanobind {theirs:.0f} ns (+{theirs - ours:.0f} ns)"
-    )
     solver = om.OMSolver("panda")
     q = np.array([0.3, -0.4, 0.2, -2.2, 0.3, 1.9, 0.6])
     T_target, c_target = solver.arm.fk(q), solver.configuration_of(q)
     solve = per_call(lambda: solver.solve(T_target, c_target), 5_000)
-    extra = 100 * (theirs - ours) / solve
-    print(f"Panda OMSolver.solve: {solve:.0f} ns; with nanobind's binding {extra:+.0f} %")
+    write_page(
+        "binding.md",
+        "| | ns per call |\n|---|---|\n"
+        f"| binding alone, hand-written C API | {ours:,.0f} |\n"
+        f"| binding alone, nanobind | {theirs:,.0f} ({theirs - ours:+,.0f}) |\n"
+        f"| whole `OMSolver.solve`, Panda (binding + kernel) | {solve:,.0f} |\n\n"
+        f"nanobind's binding on a Panda solve: {100 * (theirs - ours) / solve:+.0f} %, {cpu_model()}.\n",
+    )
 
 
 if __name__ == "__main__":
