@@ -82,7 +82,11 @@ from .ckernels import (
     TORUS,
     UNREACHABLE,
     Followed,
+    Found,
+    Lifted,
+    Solved,
     Solver,
+    TorusBound,
     all_finite,
     arm_angle_gradient,
     arm_clearance,
@@ -188,9 +192,19 @@ __all__ = [
     "STATUS_NAMES",
     "TORUS",
     "UNREACHABLE",
+    "ArmAngleRow",
+    "FamilyModel",
+    "FlangeTarget",
     "FollowWork",
     "Followed",
+    "Found",
+    "Lifted",
+    "Roots",
+    "SolveAllBatch",
+    "SolveBatch",
+    "Solved",
     "Solver",
+    "TorusBound",
     "all_finite",
     "arm_angle_gradient",
     "arm_clearance",
@@ -248,3 +262,125 @@ class FollowWork(NamedTuple):
     centre: np.ndarray
     q: np.ndarray
     t: np.ndarray
+
+
+class Roots(NamedTuple):
+    """The arrays ``Solver.solve_all`` writes a configuration's roots into (its first
+    ``Found.count`` entries; the rest are left as they were).
+
+    Attributes:
+        q: (MAX_ROOTS, dof) the roots, in the arm's own joints.
+        position_error: (MAX_ROOTS,) each root's position error (m).
+        orientation_error: (MAX_ROOTS,) each root's orientation error (rad).
+        within_limits: (MAX_ROOTS,) bool: whether each root is within the joint limits.
+    """
+
+    q: np.ndarray
+    position_error: np.ndarray
+    orientation_error: np.ndarray
+    within_limits: np.ndarray
+
+
+class SolveBatch(NamedTuple):
+    """The arrays of a batch of solves, one row per pose: what ``Solver.solve_rows`` reads and
+    writes (each call rows ``start:stop`` of them).
+
+    Attributes:
+        T: (M, 4, 4) the poses.
+        signs: (M, k) int64 the configurations' branch signs.
+        redundancy: (M, r) their redundancy values.
+        hints: (M, dof) the hints, or None: no hint.
+        q: (M, dof) out: the solutions.
+        status: (M,) int64 out: ``OK``, ``UNREACHABLE`` or ``NO_SOLUTION_IN_CONFIGURATION``.
+        position_error: (M,) out: metres.
+        orientation_error: (M,) out: radians.
+        evaluations: (M,) int64 out: the residual evaluations spent.
+        within_limits: (M,) bool out.
+    """
+
+    T: np.ndarray
+    signs: np.ndarray
+    redundancy: np.ndarray
+    hints: np.ndarray | None
+    q: np.ndarray
+    status: np.ndarray
+    position_error: np.ndarray
+    orientation_error: np.ndarray
+    evaluations: np.ndarray
+    within_limits: np.ndarray
+
+
+class SolveAllBatch(NamedTuple):
+    """The arrays of a batch of bounded searches, one row per pose: what
+    ``Solver.solve_all_rows`` reads and writes (each call rows ``start:stop`` of them; a row's
+    entries beyond its count are left as they were).
+
+    Attributes:
+        T: (M, 4, 4) the poses.
+        signs: (M, k) int64 the configurations' branch signs.
+        redundancy: (M, r) their redundancy values.
+        band: (M,) bool: whether a row without a root of its own searches the branch band.
+        q: (M, MAX_ROOTS, dof) out: each row's roots.
+        count: (M,) int64 out: how many.
+        evaluations: (M,) int64 out: the residual evaluations spent.
+        position_error: (M, MAX_ROOTS) out: metres.
+        orientation_error: (M, MAX_ROOTS) out: radians.
+        within_limits: (M, MAX_ROOTS) bool out.
+    """
+
+    T: np.ndarray
+    signs: np.ndarray
+    redundancy: np.ndarray
+    band: np.ndarray
+    q: np.ndarray
+    count: np.ndarray
+    evaluations: np.ndarray
+    position_error: np.ndarray
+    orientation_error: np.ndarray
+    within_limits: np.ndarray
+
+
+class FamilyModel(NamedTuple):
+    """A closed-form model arm, as ``model_ik`` takes it.
+
+    Attributes:
+        family: The family code (``RRR_SPHERICAL_WRIST``, ``RRP_SPHERICAL_WRIST``, ``SRS``).
+        params: The family's parameter vector (float64).
+        table: The model's DH table (rows of a, d, theta, cos alpha, sin alpha, kind).
+    """
+
+    family: int
+    params: np.ndarray
+    table: np.ndarray
+
+
+class FlangeTarget(NamedTuple):
+    """What a model IK solves for: a flange pose in DH frame 0 in one configuration.
+
+    Attributes:
+        R: (3, 3) or (9,) the flange rotation (float64, row-major).
+        p: (3,) the flange position.
+        signs: (3,) int64 the branch signs.
+        redundancy: The redundancy values (float64): (1,) the arm angle psi of a 7-DOF arm,
+            (0,) for a 6-DOF one.
+    """
+
+    R: np.ndarray
+    p: np.ndarray
+    signs: np.ndarray
+    redundancy: np.ndarray
+
+
+class ArmAngleRow(NamedTuple):
+    """The arm-angle row that ``polish`` adds for a 7-DOF arm: the S-R-S model whose arm
+    angle it holds, and the value.
+
+    Attributes:
+        params: The S-R-S model's parameter vector.
+        model_table: The model's DH table.
+        psi: The arm angle to hold (rad).
+    """
+
+    params: np.ndarray
+    model_table: np.ndarray
+    psi: float

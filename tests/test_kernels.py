@@ -226,32 +226,30 @@ def test_the_binding_rejects_malformed_buffers_with_a_named_error(panda):
         kernel.solve(T, (1, 0, 1), c.redundancy, None, out)
     with pytest.raises(ValueError, match="redundancy must have 1 entries"):
         kernel.solve(T, c.signs, (), None, out)
-    with pytest.raises(ValueError, match="Ts must be"):
-        kernel.solve_rows(
-            T[None],
-            np.ones((1, 3), np.int64),
-            np.zeros((1, 1)),
+
+    def batch(m: int, **changed: np.ndarray) -> _core.SolveBatch:
+        rows = _core.SolveBatch(
+            np.stack([T] * m),
+            np.ones((m, 3), np.int64),
+            np.zeros((m, 1)),
             None,
-            0,
-            2,
-            np.empty((1, 7)),
-            np.empty((1, 5)),
+            q=np.empty((m, 7)),
+            status=np.empty(m, np.int64),
+            position_error=np.empty(m),
+            orientation_error=np.empty(m),
+            evaluations=np.empty(m, np.int64),
+            within_limits=np.empty(m, bool),
         )
-    with pytest.raises(ValueError, match="info must have 15 entries"):
-        kernel.solve_rows(
-            np.stack([T] * 3),
-            np.ones((3, 3), np.int64),
-            np.zeros((3, 1)),
-            None,
-            0,
-            3,
-            np.empty((3, 7)),
-            np.empty((3, 5))[:, :0].copy(),
-        )
-    with pytest.raises(ValueError, match="malformed solver data"):
-        _core.Solver(panda.solver_data()._replace(scan_points=2))
-    with pytest.raises(AttributeError):
-        _core.Solver(object())
+        return rows._replace(**changed)
+
+    with pytest.raises(ValueError, match=r"T must be \(M, 4, 4\)"):
+        kernel.solve_rows(batch(1), 0, 2)
+    with pytest.raises(ValueError, match="position_error must have 3 entries"):
+        kernel.solve_rows(batch(3, position_error=np.empty(0)), 0, 3)
+    with pytest.raises(TypeError, match="within_limits must be bool"):
+        kernel.solve_rows(batch(3, within_limits=np.empty(3)), 0, 3)
+    with pytest.raises(TypeError, match="must have a field 'T'"):
+        kernel.solve_rows(_core.Roots(*batch(3)[:4]), 0, 3)
 
 
 def test_the_bindings_refuse_indices_out_of_range(panda):

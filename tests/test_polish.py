@@ -28,8 +28,8 @@ def _polish(solver: om.OMSolver, T: np.ndarray, psi: float | None, q: np.ndarray
     R, p = np.empty(9), np.empty(3)
     _core.flange_target(np.ascontiguousarray(T), data.T_base_root, data.T_tool_flange, R, p)
     if psi is None:
-        return _core.polish(data.real_table, R, p, q, 20, None, None, 0.0)
-    return _core.polish(data.real_table, R, p, q, 20, data.params, data.model_table, psi)
+        return _core.polish(data.real_table, R, p, q, 20, None)
+    return _core.polish(data.real_table, R, p, q, 20, _core.ArmAngleRow(data.params, data.model_table, psi))
 
 
 def _psi_distance(solver: om.OMSolver, q: np.ndarray, psi: float) -> float:

@@ -14,7 +14,6 @@ static struct PyModuleDef module = {
 };
 
 PyMODINIT_FUNC PyInit_ckernels(void) {
-    if (PyType_Ready(&om_SolverType) < 0) return NULL;
     PyObject *m = PyModule_Create(&module);
     if (!m) return NULL;
     /* The parameter layouts, for the Python side to check its own against (tests). */
@@ -45,7 +44,7 @@ PyMODINIT_FUNC PyInit_ckernels(void) {
         {"FOLLOW_STALLED", OM_FOLLOW_STALLED}, {"FOLLOW_MAX_ATTEMPTS", OM_FOLLOW_MAX_ATTEMPTS},
         {"FOLLOW_CRAWL_STEPS", OM_FOLLOW_CRAWL_STEPS},
     };
-    if (PyModule_AddObjectRef(m, "Solver", (PyObject *)&om_SolverType) < 0) goto fail;
+    if (om_solver_init(m) < 0 || om_functions_init(m) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_tracking_functions) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_clearance_functions) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_follow_functions) < 0 || om_follow_init(m) < 0) goto fail;

@@ -58,7 +58,7 @@ from __future__ import annotations
 import numpy as np
 
 from ... import _core
-from .dispatch import f64, i64
+from .dispatch import f64, flange_target
 
 SRS = 2
 
@@ -93,19 +93,19 @@ def model_ik_lifted(
     q7: float,
     phi4: float,
     q: np.ndarray,
-) -> tuple[float, float, float]:
+) -> _core.Lifted:
     r"""The model IK with q1, q7 and the elbow angle phi4 given rather than solved for
     (phi4 NaN: the elbow equation's root in the ELBOW branch, the edge of reach beyond it).
 
     Writes q (q1 and q7 as given) and returns the residuals of the three equations they
-    must satisfy: the shoulder's and the wrist's consistency and the elbow's,
+    must satisfy, by name: the shoulder's and the wrist's consistency and the elbow's,
     :math:`x - \cos(\varphi_4 - \varphi^*)`. Unlike the closed form, this is smooth
     everywhere but at W = S (NaN): across the straight elbow, where the two ELBOW branches
     meet in a square root, and at the shoulder and wrist singularities, where the Euler
     angles are ill-conditioned. Its roots are the model's IK in every SHOULDER and WRIST
     branch at once (each angle pair's branch follows from q1 or q7).
     """
-    return _core.model_ik_lifted(f64(P), f64(R), f64(p), i64(signs), psi, q1, q7, phi4, q)
+    return _core.model_ik_lifted(f64(P), flange_target(R, p, signs, psi), q1, q7, phi4, q)
 
 
 def model_ik_at_reach(
@@ -120,4 +120,4 @@ def model_ik_at_reach(
     """The closed form, but where the wrist centre lies beyond the model's reach the elbow is
     held at the edge (straight or folded): a start for :func:`model_ik_lifted`, which is
     smooth across that edge. Returns False, and leaves q, only where W = S."""
-    return _core.model_ik_at_reach(f64(P), f64(R), f64(p), i64(signs), psi, f64(q_prev), q)
+    return _core.model_ik_at_reach(f64(P), flange_target(R, p, signs, psi), f64(q_prev), q)
