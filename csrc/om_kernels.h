@@ -82,27 +82,50 @@ void om_jacobian_from_frames(const double *table, int n_rows, const double *base
                              const double *frames, const double *R, const double *p, int dof, double *J);
 
 /* ------------------------------------------------------------------------------------ */
-/* six_dof.c, srs.c, families.c: the model arms' closed forms (see the Python modules     */
-/* om_redundant/om/families/six_dof.py and srs.py for the parameter layouts and the math). */
+/* six_dof.c, srs.c, families.c: the model arms' closed forms (the math: the Python modules */
+/* om_redundant/om/families/six_dof.py and srs.py). The family codes and the parameter      */
+/* layouts are written here alone: Python reads them from om_redundant._core (module.c).    */
 
+/* The family codes (_core.RRR_SPHERICAL_WRIST, RRP_SPHERICAL_WRIST, SRS). */
 enum { OM_RRR_SPHERICAL_WRIST = 0, OM_RRP_SPHERICAL_WRIST = 1, OM_SRS = 2 };
 
-/* six_dof.py parameter layout */
+/* A 6-DOF family's parameter vector (_core.SD_*; built by om/model.py's _position_family,
+ * _six_dof_model and _wrist_offset). */
 enum {
     SD_A1 = 0, SD_D1 = 1, SD_SIGMA1 = 2, SD_THETA1 = 3, SD_LATERAL = 4, SD_A2 = 5, SD_THETA2 = 6,
     SD_ELL3 = 7, SD_BETA = 8, SD_THETA3 = 9, /* RRR */
     SD_SIGMA2 = 7, SD_D3 = 8,                /* RRP */
     SD_SIGMA4 = 10, SD_SIGMA5 = 11, SD_THETA4 = 12, SD_THETA5 = 13, SD_THETA6 = 14,
-    SD_WRIST_CENTRE = 15, SD_E_ROT = 18, SD_WRIST_ROW = 27,
-    SD_WRIST_OFFSET = 28, SD_AXIS4 = 31, SD_AXIS6 = 40, SD_N_PARAMS = 43 /* a4 != 0: wrist_offset.c */
+    SD_WRIST_CENTRE = 15, /* 3 entries: the wrist centre in the flange frame */
+    SD_E_ROT = 18,        /* 9, row-major: the rotation from the frame after Rz(phi6) to the flange */
+    SD_WRIST_ROW = 27,    /* the index in the model's DH table of joint 4's row */
+    /* a wrist with a4 != 0 (zero otherwise; om/model.py's _wrist_offset, wrist_offset.c): */
+    SD_WRIST_OFFSET = 28, /* 3: the real arm's a4, d5, a5 */
+    SD_AXIS4 = 31,        /* 9: joint 4's axis z3 = C0 + C1 cos q1 + C2 sin q1 in DH frame 0 (rows C0, C1, C2) */
+    SD_AXIS6 = 40,        /* 3: joint 6's axis z5 in the flange frame */
+    SD_N_PARAMS = 43
 };
 
-/* srs.py parameter layout */
+/* The S-R-S family's parameter vector (_core.SRS_*; built by om/model.py's _srs_model). */
 enum {
-    SRS_SIGMA1 = 0, SRS_SIGMA2 = 1, SRS_SIGMA5 = 2, SRS_SIN_BETA = 3, SRS_THETA = 4, SRS_SHOULDER = 11,
-    SRS_WRIST = 14, SRS_S3 = 17, SRS_U = 20, SRS_K0 = 23, SRS_K = 24, SRS_PHI_STAR = 25, SRS_R_PRE = 26,
-    SRS_X3 = 35, SRS_X4 = 44, SRS_E_ROT = 53, SRS_UP = 62, SRS_REF = 65, SRS_BEND = 68, SRS_COS_BETA = 69,
-    SRS_COS_PHI_STAR = 70, SRS_SIN_PHI_STAR = 71, SRS_N_PARAMS = 72
+    SRS_SIGMA1 = 0, SRS_SIGMA2 = 1, SRS_SIGMA5 = 2,
+    SRS_SIN_BETA = 3,  /* sin(beta), the wrist's middle twist (joints 6 to 7); +-1 on most arms */
+    SRS_THETA = 4,     /* 7 entries: theta_1..theta_7 (theta_6, theta_7 with a, b of the wrist twist) */
+    SRS_SHOULDER = 11, /* 3: S in DH frame 0 */
+    SRS_WRIST = 14,    /* 3: W in the flange frame */
+    SRS_S3 = 17,       /* 3: S in DH frame 3 */
+    SRS_U = 20,        /* 3: v(phi4) = Rz(phi4) u - s3 */
+    SRS_K0 = 23, SRS_K = 24, SRS_PHI_STAR = 25, /* |W - S|^2 = k0 + K cos(phi4 - phi*) */
+    SRS_R_PRE = 26,    /* 9 (row-major): DH frame 0 to the frame joint 1 turns */
+    SRS_X3 = 35,       /* 9: Rx(alpha_3) */
+    SRS_X4 = 44,       /* 9: Rx(alpha_4) */
+    SRS_E_ROT = 53,    /* 9: from the frame after Rz(phi7) to the flange */
+    SRS_UP = 62,       /* 3: the root frame's up axis, in DH frame 0 */
+    SRS_REF = 65,      /* 3: the arm angle's reference direction r, in DH frame 0 */
+    SRS_BEND = 68,     /* sigma: the bend direction's sign */
+    SRS_COS_BETA = 69, /* cos(beta); 0 on most arms */
+    SRS_COS_PHI_STAR = 70, SRS_SIN_PHI_STAR = 71, /* cos and sin of phi*: the elbow's without trig */
+    SRS_N_PARAMS = 72
 };
 
 /* A model solve's target orientation, with what depends on it alone computed once

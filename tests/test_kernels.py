@@ -11,8 +11,7 @@ import pytest
 
 import om_redundant as om
 from om_redundant import _core
-from om_redundant.om.families import six_dof, srs
-from om_redundant.om.system import MAX_ROOTS, SolverData
+from om_redundant.om.system import SolverData
 from om_redundant.redundancy.self_motion import self_motion_tangent
 from tests.conftest import random_q
 from tests.test_reliability import BOUNDARY_CASES
@@ -430,14 +429,22 @@ def test_link_paths_refuses_grids_counts_and_outputs_that_disagree(panda):
             link(**bad)
 
 
-def test_the_c_layouts_equal_the_python_ones():
-    """The families' parameter layouts and the codes are written twice, in C and in Python."""
-    for module, prefix in ((six_dof, "SD_"), (srs, "SRS_")):
-        names = [n for n in dir(module) if n.isupper() and isinstance(getattr(module, n), int)]
-        for name in names:
-            c_name = name if name in ("RRR_SPHERICAL_WRIST", "RRP_SPHERICAL_WRIST", "SRS") else prefix + name
-            assert getattr(_core, c_name) == getattr(module, name), name
-    assert MAX_ROOTS == _core.MAX_ROOTS
-    for name in ("FIXED", "CIRCLE", "TORUS", "OK", "UNREACHABLE", "NO_SOLUTION_IN_CONFIGURATION"):
-        assert getattr(om.om.system, name) == getattr(_core, name), name
+def test_the_parameter_layouts_fit_the_models_parameter_vectors():
+    """The families' layouts are written once, in C (csrc/om_kernels.h), and read from _core:
+    every index lies within its vector, and each family's model has a vector of its size."""
+    for prefix in ("SD_", "SRS_"):
+        size = getattr(_core, prefix + "N_PARAMS")
+        indices = [getattr(_core, name) for name in dir(_core) if name.startswith(prefix)]
+        assert len(indices) > 10 and all(0 <= i <= size for i in indices), prefix
+    sizes = {
+        _core.RRR_SPHERICAL_WRIST: _core.SD_N_PARAMS,
+        _core.RRP_SPHERICAL_WRIST: _core.SD_N_PARAMS,
+        _core.SRS: _core.SRS_N_PARAMS,
+    }
+    families = set()
+    for name in ("ur5e", "spherical", "panda"):
+        model = om.OMSolver(name).om
+        assert model.params.shape == (sizes[model.family],), name
+        families.add(model.family)
+    assert families == set(sizes)
     assert set(SolverData._fields) >= {"family", "mode", "params", "dp_coefficients"}

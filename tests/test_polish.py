@@ -53,9 +53,9 @@ def test_polish_converges_to_the_pose_and_arm_angle(name, seed, offset, singular
     if singular:  # the wrist's middle joint at the angle that aligns the outer wrist axes
         families = om.om.families
         if solver.om.family == families.SRS:
-            q[5] = -solver.om.params[families.srs.THETA + 5]
+            q[5] = -solver.om.params[_core.SRS_THETA + 5]
         else:
-            q[4] = -solver.om.params[families.six_dof.THETA5]
+            q[4] = -solver.om.params[_core.SD_THETA5]
     T, c = solver.arm.fk(q), solver.configuration_of(q)
     psi = c.redundancy[0] if c.redundancy else None
     start = q + rng.normal(0.0, offset, q.shape)

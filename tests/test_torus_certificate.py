@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 
 from om_redundant import _core
-from om_redundant.om.families import srs
 from om_redundant.om.system import MAX_ROOTS, flange_target
 from tests.conftest import EXACT, random_q, solver_of, wrap
 from tests.test_kernels import _assert_rows_are_solve_all
@@ -78,8 +77,8 @@ def _adversarial_q(solver, rng: np.random.Generator) -> list[np.ndarray]:
     """Joint vectors next to the model's singular shoulder (sin(q2 + theta2) = 0) and wrist
     (sin(q6 + theta6) = 0), and its straight and folded elbow (the edge of reach), at distances
     1e-7 to 1e-1 rad."""
-    theta = solver.solver_data().params[srs.THETA : srs.THETA + 7]
-    phi_star = solver.solver_data().params[srs.PHI_STAR]
+    theta = solver.solver_data().params[_core.SRS_THETA : _core.SRS_THETA + 7]
+    phi_star = solver.solver_data().params[_core.SRS_PHI_STAR]
     out = []
     for q in random_q(solver.arm, 12, rng):
         for eps in (1e-7, 1e-4, 1e-2, 1e-1):
