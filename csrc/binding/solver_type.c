@@ -75,8 +75,8 @@ static int check_data(const om_solver_data *s, long family, long mode, long dp_j
     return problem ? -1 : 0;
 }
 
-/* Solver(data, solution_type=None, configuration_type=None): data is an om_redundant
- * SolverData named tuple; the two types (Solution, Configuration) let solve_pose answer.
+/* Solver(data, solution_type=None, configuration_type=None): data is an
+ * om_redundant._core.SolverData, its fields read by name; the two types (Solution, Configuration) let solve_pose answer.
  * Initialised once: the data is read and checked into a new store, kept only if all of it is
  * good (calls on other threads may be reading the store, the GIL released). */
 static int Solver_init(Solver *self, PyObject *args, PyObject *kwds) {
