@@ -81,6 +81,13 @@ void om_jacobian(const double *table, int n_rows, const double *base, const doub
 void om_jacobian_from_frames(const double *table, int n_rows, const double *base, const double *tool,
                              const double *frames, const double *R, const double *p, int dof, double *J);
 
+/* A DH table: rows of OM_DH_COLUMNS float64, (a, d, theta, cos alpha, sin alpha, kind), kind a
+ * row's joint code. Written here alone: Python builds its tables by them (_core.DH_*,
+ * _core.JOINT_*; om_redundant/kinematics/chain.py). */
+enum { OM_DH_A = 0, OM_DH_D = 1, OM_DH_THETA = 2, OM_DH_COS_ALPHA = 3, OM_DH_SIN_ALPHA = 4, OM_DH_KIND = 5,
+       OM_DH_COLUMNS = 6 };
+enum { OM_JOINT_REVOLUTE = 0, OM_JOINT_PRISMATIC = 1, OM_JOINT_FIXED = 2 };
+
 /* ------------------------------------------------------------------------------------ */
 /* six_dof.c, srs.c, families.c: the model arms' closed forms (the math: the Python modules */
 /* om_redundant/om/families/six_dof.py and srs.py). The family codes and the parameter      */

@@ -64,9 +64,10 @@ bool om_trig_shared(const om_solver_data *s)
     int j = 0;
     for (int k = 0; k < s->n_real_rows && j < 6; k++) {
         const double *row = s->real_table + 6 * k;
-        if (row[5] == 2.0)
+        if (row[OM_DH_KIND] == OM_JOINT_FIXED)
             continue;
-        if (row[5] != 0.0 || memcmp(&row[2], &s->params[SRS_THETA + j], sizeof(double)) != 0)
+        if (row[OM_DH_KIND] != OM_JOINT_REVOLUTE ||
+            memcmp(&row[OM_DH_THETA], &s->params[SRS_THETA + j], sizeof(double)) != 0)
             return false;
         j++;
     }
