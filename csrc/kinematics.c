@@ -1,6 +1,6 @@
 /* DH chains (om_redundant/kinematics/chain.py is the typed front): FK and the Jacobian as
  * explicit 4x4 products and rigid transforms, sums left to right.
- * A table row is (a, d, theta, cos(alpha), sin(alpha), kind). */
+ * A table row is (a, d, theta, cos(alpha), sin(alpha), kind): OM_DH_*, kind an OM_JOINT_* code. */
 #include <string.h>
 
 #include "om_kernels.h"
@@ -10,8 +10,8 @@
  * cos and sin of theta (apply_row computes them, and gives them into *ct_out, *st_out). */
 static inline void apply_row_cs(double *R, double *p, const double *row, double qi, double ct, double st)
 {
-    double d = row[5] == 1.0 ? row[1] + qi : row[1];
-    double ca = row[3], sa = row[4], a = row[0];
+    double d = row[OM_DH_KIND] == OM_JOINT_PRISMATIC ? row[OM_DH_D] + qi : row[OM_DH_D];
+    double ca = row[OM_DH_COS_ALPHA], sa = row[OM_DH_SIN_ALPHA], a = row[OM_DH_A];
     double Rl[9] = {R[0], R[1], R[2], R[3], R[4], R[5], R[6], R[7], R[8]}; /* in registers: R, p do not alias */
     for (int i = 0; i < 3; i++) {
         double r0 = Rl[3 * i], r1 = Rl[3 * i + 1], r2 = Rl[3 * i + 2];
@@ -24,7 +24,7 @@ static inline void apply_row_cs(double *R, double *p, const double *row, double 
 
 static inline void apply_row(double *R, double *p, const double *row, double qi, double *ct_out, double *st_out)
 {
-    double theta = row[5] == 0.0 ? row[2] + qi : row[2];
+    double theta = row[OM_DH_KIND] == OM_JOINT_REVOLUTE ? row[OM_DH_THETA] + qi : row[OM_DH_THETA];
     double ct = cos(theta), st = sin(theta);
     apply_row_cs(R, p, row, qi, ct, st);
     *ct_out = ct;
@@ -53,7 +53,7 @@ int om_chain(const double *table, int n_rows, const double *q, int n, double *R,
     double cs[2];
     for (int k = 0; k < n_rows; k++) {
         const double *row = table + 6 * k;
-        if (row[5] == 2.0) {
+        if (row[OM_DH_KIND] == OM_JOINT_FIXED) {
             apply_row(R, p, row, 0.0, &cs[0], &cs[1]);
             continue;
         }
@@ -100,15 +100,15 @@ void om_flange_pair(const double *first, int n_first, const double *second, int 
     double trig[2 * OM_MAX_DOF], theta[OM_MAX_DOF], cs[2];
     om_flange_trig(first, n_first, q, R1, p1, trig);
     for (int k = 0, j = 0; k < n_first; k++)
-        if (first[6 * k + 5] != 2.0)
+        if (first[OM_DH_COLUMNS * k + OM_DH_KIND] != OM_JOINT_FIXED)
             theta[j++] = first[6 * k + 2];
     set_identity(R2, p2);
     for (int k = 0, j = 0; k < n_second; k++) {
         const double *row = second + 6 * k;
-        if (row[5] == 2.0) {
+        if (row[OM_DH_KIND] == OM_JOINT_FIXED) {
             apply_row(R2, p2, row, 0.0, &cs[0], &cs[1]);
         } else {
-            if (memcmp(&row[2], &theta[j], sizeof(double)) == 0) /* the same angle, bit for bit */
+            if (memcmp(&row[OM_DH_THETA], &theta[j], sizeof(double)) == 0) /* the same angle, bit for bit */
                 apply_row_cs(R2, p2, row, q[j], trig[2 * j], trig[2 * j + 1]);
             else
                 apply_row(R2, p2, row, q[j], &cs[0], &cs[1]);
@@ -157,8 +157,8 @@ void om_jacobian_from_frames(const double *table, int n_rows, const double *base
     double kinds[OM_MAX_DOF];
     int j = 0;
     for (int k = 0; k < n_rows; k++) {
-        if (table[6 * k + 5] != 2.0 && j < dof) {
-            kinds[j] = table[6 * k + 5];
+        if (table[OM_DH_COLUMNS * k + OM_DH_KIND] != OM_JOINT_FIXED && j < dof) {
+            kinds[j] = table[OM_DH_COLUMNS * k + OM_DH_KIND];
             j++;
         }
     }
@@ -173,7 +173,7 @@ void om_jacobian_from_frames(const double *table, int n_rows, const double *base
         const double *F = frames + 12 * j, axis[3] = {F[2], F[5], F[8]};
         double z[3], o[3], r[3];
         rigid(base, axis, 0.0, z);
-        if (kinds[j] == 1.0) {
+        if (kinds[j] == OM_JOINT_PRISMATIC) {
             for (int i = 0; i < 3; i++)
                 J[i * dof + j] = z[i];
         } else {

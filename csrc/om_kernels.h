@@ -81,28 +81,58 @@ void om_jacobian(const double *table, int n_rows, const double *base, const doub
 void om_jacobian_from_frames(const double *table, int n_rows, const double *base, const double *tool,
                              const double *frames, const double *R, const double *p, int dof, double *J);
 
-/* ------------------------------------------------------------------------------------ */
-/* six_dof.c, srs.c, families.c: the model arms' closed forms (see the Python modules     */
-/* om_redundant/om/families/six_dof.py and srs.py for the parameter layouts and the math). */
+/* A DH table: rows of OM_DH_COLUMNS float64, (a, d, theta, cos alpha, sin alpha, kind), kind a
+ * row's joint code. Written here alone: Python builds its tables by them (_core.DH_*,
+ * _core.JOINT_*; om_redundant/kinematics/chain.py). */
+enum { OM_DH_A = 0, OM_DH_D = 1, OM_DH_THETA = 2, OM_DH_COS_ALPHA = 3, OM_DH_SIN_ALPHA = 4, OM_DH_KIND = 5,
+       OM_DH_COLUMNS = 6 };
+enum { OM_JOINT_REVOLUTE = 0, OM_JOINT_PRISMATIC = 1, OM_JOINT_FIXED = 2 };
 
+/* ------------------------------------------------------------------------------------ */
+/* six_dof.c, srs.c, families.c: the model arms' closed forms (the math: the Python modules */
+/* om_redundant/om/families/six_dof.py and srs.py). The family codes and the parameter      */
+/* layouts are written here alone: Python reads them from om_redundant._core (module.c).    */
+
+/* The family codes (_core.RRR_SPHERICAL_WRIST, RRP_SPHERICAL_WRIST, SRS). */
 enum { OM_RRR_SPHERICAL_WRIST = 0, OM_RRP_SPHERICAL_WRIST = 1, OM_SRS = 2 };
 
-/* six_dof.py parameter layout */
+/* A 6-DOF family's parameter vector (_core.SD_*; built by om/model.py's _position_family,
+ * _six_dof_model and _wrist_offset). */
 enum {
     SD_A1 = 0, SD_D1 = 1, SD_SIGMA1 = 2, SD_THETA1 = 3, SD_LATERAL = 4, SD_A2 = 5, SD_THETA2 = 6,
     SD_ELL3 = 7, SD_BETA = 8, SD_THETA3 = 9, /* RRR */
     SD_SIGMA2 = 7, SD_D3 = 8,                /* RRP */
     SD_SIGMA4 = 10, SD_SIGMA5 = 11, SD_THETA4 = 12, SD_THETA5 = 13, SD_THETA6 = 14,
-    SD_WRIST_CENTRE = 15, SD_E_ROT = 18, SD_WRIST_ROW = 27,
-    SD_WRIST_OFFSET = 28, SD_AXIS4 = 31, SD_AXIS6 = 40, SD_N_PARAMS = 43 /* a4 != 0: wrist_offset.c */
+    SD_WRIST_CENTRE = 15, /* 3 entries: the wrist centre in the flange frame */
+    SD_E_ROT = 18,        /* 9, row-major: the rotation from the frame after Rz(phi6) to the flange */
+    SD_WRIST_ROW = 27,    /* the index in the model's DH table of joint 4's row */
+    /* a wrist with a4 != 0 (zero otherwise; om/model.py's _wrist_offset, wrist_offset.c): */
+    SD_WRIST_OFFSET = 28, /* 3: the real arm's a4, d5, a5 */
+    SD_AXIS4 = 31,        /* 9: joint 4's axis z3 = C0 + C1 cos q1 + C2 sin q1 in DH frame 0 (rows C0, C1, C2) */
+    SD_AXIS6 = 40,        /* 3: joint 6's axis z5 in the flange frame */
+    SD_N_PARAMS = 43
 };
 
-/* srs.py parameter layout */
+/* The S-R-S family's parameter vector (_core.SRS_*; built by om/model.py's _srs_model). */
 enum {
-    SRS_SIGMA1 = 0, SRS_SIGMA2 = 1, SRS_SIGMA5 = 2, SRS_SIN_BETA = 3, SRS_THETA = 4, SRS_SHOULDER = 11,
-    SRS_WRIST = 14, SRS_S3 = 17, SRS_U = 20, SRS_K0 = 23, SRS_K = 24, SRS_PHI_STAR = 25, SRS_R_PRE = 26,
-    SRS_X3 = 35, SRS_X4 = 44, SRS_E_ROT = 53, SRS_UP = 62, SRS_REF = 65, SRS_BEND = 68, SRS_COS_BETA = 69,
-    SRS_COS_PHI_STAR = 70, SRS_SIN_PHI_STAR = 71, SRS_N_PARAMS = 72
+    SRS_SIGMA1 = 0, SRS_SIGMA2 = 1, SRS_SIGMA5 = 2,
+    SRS_SIN_BETA = 3,  /* sin(beta), the wrist's middle twist (joints 6 to 7); +-1 on most arms */
+    SRS_THETA = 4,     /* 7 entries: theta_1..theta_7 (theta_6, theta_7 with a, b of the wrist twist) */
+    SRS_SHOULDER = 11, /* 3: S in DH frame 0 */
+    SRS_WRIST = 14,    /* 3: W in the flange frame */
+    SRS_S3 = 17,       /* 3: S in DH frame 3 */
+    SRS_U = 20,        /* 3: v(phi4) = Rz(phi4) u - s3 */
+    SRS_K0 = 23, SRS_K = 24, SRS_PHI_STAR = 25, /* |W - S|^2 = k0 + K cos(phi4 - phi*) */
+    SRS_R_PRE = 26,    /* 9 (row-major): DH frame 0 to the frame joint 1 turns */
+    SRS_X3 = 35,       /* 9: Rx(alpha_3) */
+    SRS_X4 = 44,       /* 9: Rx(alpha_4) */
+    SRS_E_ROT = 53,    /* 9: from the frame after Rz(phi7) to the flange */
+    SRS_UP = 62,       /* 3: the root frame's up axis, in DH frame 0 */
+    SRS_REF = 65,      /* 3: the arm angle's reference direction r, in DH frame 0 */
+    SRS_BEND = 68,     /* sigma: the bend direction's sign */
+    SRS_COS_BETA = 69, /* cos(beta); 0 on most arms */
+    SRS_COS_PHI_STAR = 70, SRS_SIN_PHI_STAR = 71, /* cos and sin of phi*: the elbow's without trig */
+    SRS_N_PARAMS = 72
 };
 
 /* A model solve's target orientation, with what depends on it alone computed once
@@ -299,7 +329,7 @@ void om_set_goal(om_problem *pb, const mat3 *R, vec3 p);
  * pose; q replaced, and its errors into *pos, *ori (NULL: not wanted), only where the polished
  * one verifies with smaller errors. Returns whether q verifies at the end. */
 bool om_near_polish(om_problem *pb, double *q, double *pos, double *ori);
-/* out = flip * in: the arm's own joint coordinates to the kernels' and back (out may be in). */
+/* joints.c: out = flip * in: the arm's own joint coordinates to the kernels' and back (out may be in). */
 void om_flip(const om_solver_data *s, const double *in, double *out);
 /* At q in the arm's own joint coordinates: the real arm's flange Jacobian in DH frame 0 (6 x dof,
  * rows [v; omega], columns by the arm's joints) and the flange pose (R, p; NULL: not wanted); the
@@ -370,7 +400,7 @@ int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool f
  * or out of memory); freed by om_scan_memo_free (NULL: nothing). */
 om_scan_memo *om_scan_memo_new(const om_solver_data *s);
 void om_scan_memo_free(om_scan_memo *memo);
-/* wrist_offset.c: candidates in the bands around the singular wrist of an arm with a4 != 0. */
+/* wrist_bands.c: candidates in the bands around the singular wrist of an arm with a4 != 0. */
 #define OM_WRIST_BAND_CANDIDATES 256 /* room for them */
 int om_wrist_offset_candidates(om_problem *pb, double lo, double hi, bool full_circle, double *q, double *cands,
                                int cap);
@@ -407,7 +437,7 @@ om_torus_bound om_torus_cell_bound(om_problem *pb, double w1, double w7, double 
  * count into *count, on an arm whose offsets are small against it; returns whether it did
  * (false: the grid search decides). */
 bool om_torus_certified_roots(om_problem *pb, double *roots, int *count, const double *centre, double radius);
-/* x = W - S of the model on the torus less its parts that turn with w1 and w7:
+/* problem.c: x = W - S of the model on the torus less its parts that turn with w1 and w7:
  * p_d + R w_F - S + D3 + R D0 (x = it + D4 cos w1 + D5 sin w1 + R (D1 cos w7 + D2 sin w7)). */
 vec3 om_shoulder_wrist_centre(const om_problem *pb);
 
@@ -470,15 +500,12 @@ typedef struct {
 } om_scan_cache;
 #define OM_SCAN_CAPACITY(n_scan) (8 * (n_scan) + 8 + OM_WRIST_BAND_CANDIDATES)
 
-/* boundary.c */
+/* candidates.c */
 /* A candidate q that failed verification, refined on the real arm where a branch quantity is
  * within 1e-2 of zero, or (S-R-S) w_hat within 1e-2 rad of psi's singular half-line, or (an
  * arm near a family) where it is within NEAR_POLISH_FROM of the pose (om_near_polish; else
  * left as it is); returns whether it now verifies. */
 bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori);
-/* The refinement on the real arm toward pb's goal (with psi, S-R-S: in the requested ELBOW
- * branch), giving up a crawl far from a root (om_polish). */
-om_polish_task om_problem_polish_task(const om_problem *pb);
 /* self_motion.c: the null vector of the real 6 x 7 Jacobian at q (the kernels' coordinates) by
  * cofactors (not normalised) */
 void om_self_motion_null(const om_solver_data *s, const double *q, double *n);
@@ -487,10 +514,16 @@ void om_self_motion_null(const om_solver_data *s, const double *q, double *n);
 bool om_eliminate(double *A, double *b, int n, double *det);
 /* om_add_root of q, polished first where it fails verification near the boundary. */
 int om_add_candidate(om_problem *pb, double *q, double *roots, int count);
+
+/* problem.c */
 /* pb's pose in another configuration (signs, redundancy: kept by the caller), its target's
  * constants for that redundancy, its evaluation counter at zero. */
 om_problem om_problem_at(const om_problem *pb, const int64_t *signs, const double *redundancy);
+/* The refinement on the real arm toward pb's goal (with psi, S-R-S: in the requested ELBOW
+ * branch), giving up a crawl far from a root (om_polish). */
+om_polish_task om_problem_polish_task(const om_problem *pb);
 
+/* boundary.c */
 /* For a configuration whose bounded search found no root: the roots at its touch points
  * (samples of the free angle where the model's solution meets a branch zero, refined), and
  * those of the neighbouring configurations (one branch flipped) that hold the problem's own
@@ -498,12 +531,17 @@ om_problem om_problem_at(const om_problem *pb, const int64_t *signs, const doubl
  * (OM_MAX_ROOTS x dof); returns the count. *neighbour_reached: some neighbour had a root.
  * cache: om_loop_roots's. */
 int om_band_roots(om_problem *pb, double *roots, bool *neighbour_reached, om_scan_cache *cache);
+/* A bounded search of a problem's roots, om_all_roots's (search.c), as the boundary's search
+ * hands it to the loop search: the loop search is below the searches (a candidate's polish
+ * takes its pass along a loop, om_loop_pass), and calls om_all_roots only through this. */
+typedef int (*om_roots_search)(om_problem *pb, int n_scan, double *roots, const double *centre, double radius);
 /* loop_search.c: for a 7-DOF S-R-S configuration without a root whose pose's wrist centre may
  * come within 1e-2 rad of psi's singular half-line, the roots met where psi crosses the
  * requested value along the real arm's self-motion loops through the pose's solutions in the
  * same signs at other arm angles, into roots from count on; returns the count. cache (NULL:
- * none) keeps whether the pose may come near the line for the pose's next configuration. */
-int om_loop_roots(om_problem *pb, double *roots, int count, om_scan_cache *cache);
+ * none) keeps whether the pose may come near the line for the pose's next configuration;
+ * all_roots: om_all_roots. */
+int om_loop_roots(om_problem *pb, double *roots, int count, om_scan_cache *cache, om_roots_search all_roots);
 /* For q on the pose (within 1e-12) next to psi's half-line: psi's crossings of the requested
  * value where the self-motion loop through q passes by the line; the first root into q (*pos,
  * *ori its errors). Returns whether there was one. */

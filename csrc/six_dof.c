@@ -66,7 +66,7 @@ static double position_and_wrist(int family, const double *P, const double *tabl
     pin[0] = pin[1] = pin[2] = 0.0;
     int j = 0;
     for (int row = 0; row < (int)P[SD_WRIST_ROW]; row++) {
-        if (table[6 * row + 5] == 2.0) {
+        if (table[OM_DH_COLUMNS * row + OM_DH_KIND] == OM_JOINT_FIXED) {
             om_apply_row(Rin, pin, table + 6 * row, 0.0);
         } else {
             om_apply_row(Rin, pin, table + 6 * row, q[j]);

@@ -7,7 +7,6 @@
  * (an ulp of pi, 2^-51), which exceeds REDUNDANCY_TOL only next to psi's singular set: the
  * half-line, and the wrist centre at the shoulder */
 #define PSI_ROUNDING 4.440892098500626e-16
-#define SRS_ELBOW_SIGN 1    /* (SHOULDER, ELBOW, WRIST) */
 #define MAX_VALUES 16       /* branch values of a family (3 today) */
 #define HUGE_HINT 1e4       /* rad: a revolute joint's hint beyond it is reduced exactly (remainder) first */
 
@@ -42,7 +41,7 @@ static bool in_configuration(const om_solver_data *s, const double *q, const dou
         if (!(values[i] * (double)signs[i] >= 0.0 || fabs(values[i]) <= OM_BRANCH_BAND)) /* NaN: not in it */
             return false;
     if (s->family == OM_SRS) { /* psi: the only redundancy value; in the requested ELBOW branch */
-        double elbow = (double)signs[SRS_ELBOW_SIGN];
+        double elbow = (double)signs[OM_ELBOW_SIGN];
         double psi = trig ? om_srs_arm_angle_trig(s->params, trig, elbow) : om_srs_arm_angle_in(s->params, q, elbow);
         double miss = fabs(om_wrap(psi - psi_requested));
         return miss <= REDUNDANCY_TOL || miss <= psi_rounding(s, q);
@@ -65,9 +64,10 @@ bool om_trig_shared(const om_solver_data *s)
     int j = 0;
     for (int k = 0; k < s->n_real_rows && j < 6; k++) {
         const double *row = s->real_table + 6 * k;
-        if (row[5] == 2.0)
+        if (row[OM_DH_KIND] == OM_JOINT_FIXED)
             continue;
-        if (row[5] != 0.0 || memcmp(&row[2], &s->params[SRS_THETA + j], sizeof(double)) != 0)
+        if (row[OM_DH_KIND] != OM_JOINT_REVOLUTE ||
+            memcmp(&row[OM_DH_THETA], &s->params[SRS_THETA + j], sizeof(double)) != 0)
             return false;
         j++;
     }

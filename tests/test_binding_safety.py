@@ -36,7 +36,7 @@ def raises(kind, call, *args):
 
 
 def solves(call=kernel.solve):
-    assert call(T, c.signs, c.redundancy, None, np.zeros(7))[0] == _core.OK
+    assert call(T, c.signs, c.redundancy, None, np.zeros(7)).status == _core.OK
 """
 
 
@@ -72,6 +72,7 @@ def test_an_uninitialised_solver_raises():
         for name in methods:
             raises(RuntimeError, getattr(bare, name))
         raises(RuntimeError, bare.solve, T, (), (), None, np.zeros(0))
+        raises(RuntimeError, bare.solve_rows, None, 0, 0)
         raises(RuntimeError, _core.follow, _core.FollowWork(bare, *[None] * 7), 0.0, 0.0, 0.0)
         walks = [("link_paths", 16), ("self_motion_tangents", 3)]
         for name, arity in walks:
@@ -99,7 +100,7 @@ def test_lists_emptied_while_they_are_read():
         signs += [Clears(signs, s) for s in c.signs]
         redundancy = []
         redundancy.append(Clears(redundancy, c.redundancy[0]))
-        assert kernel.solve(T, signs, redundancy, None, np.zeros(7))[0] == _core.OK
+        assert kernel.solve(T, signs, redundancy, None, np.zeros(7)).status == _core.OK
         assert kernel.holds(Q, signs[:] or [Clears(signs, s) for s in c.signs], c.redundancy)
         psi, feasible = [], []
         psi += [Clears(psi, 0.0), 0.1, 0.2]
@@ -132,28 +133,41 @@ def test_malformed_solver_data_is_refused():
             params = ur5e.params.copy()
             params[wrist_row] = row
             raises(ValueError, _core.Solver, ur5e._replace(params=params))
-            raises(ValueError, _core.model_ik, 0, params, ur5e.model_table, np.eye(3), np.zeros(3),
-                   np.ones(3, dtype=np.int64), np.zeros(0), np.zeros(6), np.zeros(6), False)
+            target = _core.FlangeTarget(np.eye(3), np.zeros(3), np.ones(3, dtype=np.int64), np.zeros(0))
+            raises(ValueError, _core.model_ik, _core.FamilyModel(0, params, ur5e.model_table), target,
+                   np.zeros(6), np.zeros(6), False)
     """)
 
 
 def test_batch_rows_refuse_signs_and_rows_out_of_range():
     run_case("""
         Ts = np.stack([T, T])
-        q, info = np.zeros((2, 7)), np.zeros((2, 5))
         psi = np.full((2, 1), c.redundancy[0])
+
+        def rows(signs):
+            ints = np.zeros(2, dtype=np.int64)
+            return _core.SolveBatch(Ts, signs, psi, None, np.zeros((2, 7)), ints, np.zeros(2), np.zeros(2),
+                                    ints.copy(), np.zeros(2, dtype=bool))
+
+        def all_rows(signs):
+            n = _core.MAX_ROOTS
+            ints = np.zeros(2, dtype=np.int64)
+            errors = np.zeros((2, n))
+            return _core.SolveAllBatch(Ts, signs, psi, np.ones(2, dtype=bool), np.zeros((2, n, 7)), ints,
+                                       ints.copy(), errors, errors.copy(), np.zeros((2, n), dtype=bool))
+
         for sign in [5, 0, -2**63]:
             signs = np.array([c.signs, c.signs], dtype=np.int64)
             signs[1, 1] = sign
-            raises(ValueError, kernel.solve_rows, Ts, signs, psi, None, 0, 2, q, info)
-            roots, root_info = np.zeros((2, _core.MAX_ROOTS, 7)), np.zeros((2, _core.MAX_ROOTS, 3))
-            raises(ValueError, kernel.solve_all_rows, Ts, signs, psi, 0, 2, roots, root_info,
-                   np.zeros((2, 2), dtype=np.int64), np.ones(2, dtype=bool))
-            kernel.solve_rows(Ts, signs, psi, None, 0, 1, q, info)  # the rows asked for are checked
+            raises(ValueError, kernel.solve_rows, rows(signs), 0, 2)
+            raises(ValueError, kernel.solve_all_rows, all_rows(signs), 0, 2)
+            kernel.solve_rows(rows(signs), 0, 1)  # the rows asked for are checked
         signs = np.array([c.signs, c.signs], dtype=np.int64)
         for start, stop in [(-1, 1), (0, 3), (2, 1), (2**62, 2**62 + 1)]:
-            raises(ValueError, kernel.solve_rows, Ts, signs, psi, None, start, stop, q, info)
-        raises(OverflowError, kernel.solve_rows, Ts, signs, psi, None, 0, 2**70, q, info)
+            raises(ValueError, kernel.solve_rows, rows(signs), start, stop)
+            raises(ValueError, kernel.solve_all_rows, all_rows(signs), start, stop)
+        raises(OverflowError, kernel.solve_rows, rows(signs), 0, 2**70)
+        raises(TypeError, kernel.solve_rows, (Ts, signs), 0, 2)  # (not a batch: no named fields)
         raises(ValueError, kernel.solve, T, (1, 2, 1), c.redundancy, None, np.zeros(7))
     """)
 
@@ -165,9 +179,9 @@ def test_tables_shorter_than_q_are_refused():
         raises(ValueError, _core.flange, table[:2], Q, np.zeros(9), np.zeros(3))
         raises(ValueError, _core.flange, table, Q[:3], np.zeros(9), np.zeros(3))
         raises(ValueError, _core.arm_angle_gradient, data.params, data.model_table[:2], Q, np.zeros(7))
-        raises(ValueError, _core.polish, table, np.eye(3), np.zeros(3), Q, 5, data.params,
-               data.model_table[:2], 0.0)
-        raises(ValueError, _core.polish, table, np.eye(3), np.zeros(3), Q, 2**40, None, None, 0.0)
+        raises(ValueError, _core.polish, table, np.eye(3), np.zeros(3), Q, 5,
+               _core.ArmAngleRow(data.params, data.model_table[:2], 0.0))
+        raises(ValueError, _core.polish, table, np.eye(3), np.zeros(3), Q, 2**40, None)
         J = np.zeros((6, 7))
         _core.jacobian(table, np.eye(4), np.eye(4), Q, J)
         assert np.isfinite(J).all()
@@ -211,9 +225,10 @@ def test_a_rotation_far_from_orthonormal_returns(name):
                     bad = T.copy()
                     bad[i, j] = value
                     kernel.solve(bad, c.signs, c.redundancy, None, np.zeros(dof))
-                    roots, info = np.zeros((_core.MAX_ROOTS, dof)), np.zeros((_core.MAX_ROOTS, 3))
-                    kernel.solve_all(bad, c.signs, c.redundancy, roots, info)
-                    kernel.bounded_search(bad, c.signs, c.redundancy, roots, True)
+                    n = _core.MAX_ROOTS
+                    roots = _core.Roots(np.zeros((n, dof)), np.zeros(n), np.zeros(n), np.zeros(n, dtype=bool))
+                    kernel.solve_all(bad, c.signs, c.redundancy, roots)
+                    kernel.bounded_search(bad, c.signs, c.redundancy, roots.q, True)
                     if j < 3 or not np.isfinite(value):  # (a finite position is a pose, out of reach)
                         raises(om.InvalidInput, solver.solve, bad, c)
         for psi in [np.nan, np.inf, 1e300] if dof == 7 else []:

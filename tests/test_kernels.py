@@ -13,8 +13,7 @@ import pytest
 
 import om_redundant as om
 from om_redundant import _core
-from om_redundant.om.families import six_dof, srs
-from om_redundant.om.system import MAX_ROOTS, SolverData
+from om_redundant.om.system import SolverData
 from om_redundant.redundancy.self_motion import self_motion_tangent
 from tests.conftest import random_q
 from tests.test_reliability import BOUNDARY_CASES
@@ -228,32 +227,30 @@ def test_the_binding_rejects_malformed_buffers_with_a_named_error(panda):
         kernel.solve(T, (1, 0, 1), c.redundancy, None, out)
     with pytest.raises(ValueError, match="redundancy must have 1 entries"):
         kernel.solve(T, c.signs, (), None, out)
-    with pytest.raises(ValueError, match="Ts must be"):
-        kernel.solve_rows(
-            T[None],
-            np.ones((1, 3), np.int64),
-            np.zeros((1, 1)),
+
+    def batch(m: int, **changed: np.ndarray) -> _core.SolveBatch:
+        rows = _core.SolveBatch(
+            np.stack([T] * m),
+            np.ones((m, 3), np.int64),
+            np.zeros((m, 1)),
             None,
-            0,
-            2,
-            np.empty((1, 7)),
-            np.empty((1, 5)),
+            q=np.empty((m, 7)),
+            status=np.empty(m, np.int64),
+            position_error=np.empty(m),
+            orientation_error=np.empty(m),
+            evaluations=np.empty(m, np.int64),
+            within_limits=np.empty(m, bool),
         )
-    with pytest.raises(ValueError, match="info must have 15 entries"):
-        kernel.solve_rows(
-            np.stack([T] * 3),
-            np.ones((3, 3), np.int64),
-            np.zeros((3, 1)),
-            None,
-            0,
-            3,
-            np.empty((3, 7)),
-            np.empty((3, 5))[:, :0].copy(),
-        )
-    with pytest.raises(ValueError, match="malformed solver data"):
-        _core.Solver(panda.solver_data()._replace(scan_points=2))
-    with pytest.raises(AttributeError):
-        _core.Solver(object())
+        return rows._replace(**changed)
+
+    with pytest.raises(ValueError, match=r"T must be \(M, 4, 4\)"):
+        kernel.solve_rows(batch(1), 0, 2)
+    with pytest.raises(ValueError, match="position_error must have 3 entries"):
+        kernel.solve_rows(batch(3, position_error=np.empty(0)), 0, 3)
+    with pytest.raises(TypeError, match="within_limits must be bool"):
+        kernel.solve_rows(batch(3, within_limits=np.empty(3)), 0, 3)
+    with pytest.raises(TypeError, match="must have a field 'T'"):
+        kernel.solve_rows(_core.Roots(*batch(3)[:4]), 0, 3)
 
 
 def test_the_bindings_refuse_indices_out_of_range(panda):
@@ -488,14 +485,22 @@ def test_link_paths_refuses_grids_counts_and_outputs_that_disagree(panda):
             link(**bad)
 
 
-def test_the_c_layouts_equal_the_python_ones():
-    """The families' parameter layouts and the codes are written twice, in C and in Python."""
-    for module, prefix in ((six_dof, "SD_"), (srs, "SRS_")):
-        names = [n for n in dir(module) if n.isupper() and isinstance(getattr(module, n), int)]
-        for name in names:
-            c_name = name if name in ("RRR_SPHERICAL_WRIST", "RRP_SPHERICAL_WRIST", "SRS") else prefix + name
-            assert getattr(_core, c_name) == getattr(module, name), name
-    assert MAX_ROOTS == _core.MAX_ROOTS
-    for name in ("FIXED", "CIRCLE", "TORUS", "OK", "UNREACHABLE", "NO_SOLUTION_IN_CONFIGURATION"):
-        assert getattr(om.om.system, name) == getattr(_core, name), name
+def test_the_parameter_layouts_fit_the_models_parameter_vectors():
+    """The families' layouts are written once, in C (csrc/om_kernels.h), and read from _core:
+    every index lies within its vector, and each family's model has a vector of its size."""
+    for prefix in ("SD_", "SRS_"):
+        size = getattr(_core, prefix + "N_PARAMS")
+        indices = [getattr(_core, name) for name in dir(_core) if name.startswith(prefix)]
+        assert len(indices) > 10 and all(0 <= i <= size for i in indices), prefix
+    sizes = {
+        _core.RRR_SPHERICAL_WRIST: _core.SD_N_PARAMS,
+        _core.RRP_SPHERICAL_WRIST: _core.SD_N_PARAMS,
+        _core.SRS: _core.SRS_N_PARAMS,
+    }
+    families = set()
+    for name in ("ur5e", "spherical", "panda"):
+        model = om.OMSolver(name).om
+        assert model.params.shape == (sizes[model.family],), name
+        families.add(model.family)
+    assert families == set(sizes)
     assert set(SolverData._fields) >= {"family", "mode", "params", "dp_coefficients"}

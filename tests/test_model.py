@@ -10,6 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
+from om_redundant import _core
 from om_redundant._core import flange as flange_kernel
 from om_redundant.om.families import REACH_SLACK, branch_values, model_ik, redundancy_values, srs
 from tests.conftest import random_q, wrap
@@ -94,7 +95,7 @@ def test_model_closed_form_inverts_model_fk(name, seed):
     diff[om_arm.real.revolute] = wrap(diff[om_arm.real.revolute])
     # Joint-space agreement is ill-conditioned only within ~1e-5 rad of a singular joint.
     assert np.abs(diff).max() < 1e-8
-    if om_arm.family == srs.SRS:  # the searches' IK without the shoulder: the same q4..q7, bit for bit
+    if om_arm.family == _core.SRS:  # the searches' IK without the shoulder: the same q4..q7, bit for bit
         wrist = np.full(dof, np.nan)
         model_ik(om_arm.family, om_arm.params, table, R, p, signs, redundancy, np.zeros(dof), wrist, False)
         np.testing.assert_array_equal(wrist[3:], out[3:])
@@ -189,7 +190,7 @@ def _lifted_at(om_arm, q):
     psi = np.empty(1)
     redundancy_values(om_arm.family, P, q, psi)
     out = np.empty(7)
-    phi4 = q[3] + P[srs.THETA + 3]
+    phi4 = q[3] + P[_core.SRS_THETA + 3]
     residual = srs.model_ik_lifted(P, R, p, signs, psi[0], q[0], q[6], phi4, out)
     return (R, p, signs, psi[0]), np.array(residual), out
 
@@ -205,11 +206,11 @@ def test_lifted_model_ik_vanishes_exactly_at_the_model_joints(name, seed, singul
     P = om_arm.params
     q = random_q(om_arm.real, 1, np.random.default_rng(seed))[0]
     if singular == "shoulder":
-        q[1] = -P[srs.THETA + 1]
+        q[1] = -P[_core.SRS_THETA + 1]
     elif singular == "elbow":
-        q[3] = P[srs.PHI_STAR] - P[srs.THETA + 3]
+        q[3] = P[_core.SRS_PHI_STAR] - P[_core.SRS_THETA + 3]
     elif singular == "wrist":
-        q[5] = -P[srs.THETA + 5]
+        q[5] = -P[_core.SRS_THETA + 5]
     _, residual, out = _lifted_at(om_arm, q)
     assert np.abs(residual).max() < 1e-12
     assert np.abs(wrap(out - q)).max() < 1e-10
@@ -231,8 +232,8 @@ def test_model_ik_at_reach_holds_the_elbow_at_the_edge_beyond_reach(name, seed, 
     assert model_ik(om_arm.family, P, table, R, p, signs, np.array([psi]), zeros, closed_form) >= -REACH_SLACK
     assert srs.model_ik_at_reach(P, R, p, signs, psi, zeros, at_reach)
     np.testing.assert_array_equal(at_reach, closed_form)
-    S_W = p + R @ P[srs.WRIST : srs.WRIST + 3] - P[srs.SHOULDER : srs.SHOULDER + 3]
-    longest, shortest = np.sqrt(P[srs.K0] + P[srs.K]), np.sqrt(P[srs.K0] - P[srs.K])
+    S_W = p + R @ P[_core.SRS_WRIST : _core.SRS_WRIST + 3] - P[_core.SRS_SHOULDER : _core.SRS_SHOULDER + 3]
+    longest, shortest = np.sqrt(P[_core.SRS_K0] + P[_core.SRS_K]), np.sqrt(P[_core.SRS_K0] - P[_core.SRS_K])
     for distance in (longest * (1.0 + stretch), shortest * (1.0 - stretch)):
         moved = p + (distance / np.linalg.norm(S_W) - 1.0) * S_W
         margin = model_ik(om_arm.family, P, table, R, moved, signs, np.array([psi]), zeros, np.empty(7))
@@ -250,7 +251,7 @@ def test_lifted_residuals_detect_a_wrong_q1_q7_or_elbow(name):
     rng = np.random.default_rng(8)
     for q in random_q(om_arm.real, 50, rng):
         (R, p, signs, psi), _, _ = _lifted_at(om_arm, q)
-        x = np.array([q[0], q[6], q[3] + P[srs.THETA + 3]])
+        x = np.array([q[0], q[6], q[3] + P[_core.SRS_THETA + 3]])
         for k in range(3):
             moved = x.copy()
             moved[k] += 0.1
@@ -277,12 +278,12 @@ def test_arm_angle_is_the_elbow_bend_direction_about_the_shoulder_wrist_line(nam
         branch_values(om_arm.family, om_arm.params, q, values)
         bend = np.cross(z4, w_hat) * (1 if values[1] >= 0 else -1)
         elbow = (T @ frames[3])[:3, 3] - S  # the elbow point lies on the bend side
-        assert np.dot(bend, elbow - np.dot(elbow, w_hat) * w_hat) * om_arm.params[srs.BEND] > 0
+        assert np.dot(bend, elbow - np.dot(elbow, w_hat) * w_hat) * om_arm.params[_core.SRS_BEND] > 0
         up, ref = np.array([0.0, 0.0, 1.0]), np.array([-1.0, 0.0, 0.0])
         v, c = np.cross(up, w_hat), np.dot(up, w_hat)
         K = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
         n = (np.eye(3) + K + K @ K / (1 + c)) @ ref
-        bend = bend * om_arm.params[srs.BEND]
+        bend = bend * om_arm.params[_core.SRS_BEND]
         psi = np.arctan2(np.dot(np.cross(w_hat, n), bend), np.dot(n, bend))
         out = np.empty(1)
         redundancy_values(om_arm.family, om_arm.params, q, out)

@@ -27,12 +27,11 @@ def polished_roots(solver: om.OMSolver, T: np.ndarray, psi: float, rng: np.rando
     exact = nominal.exact
     R, p = system.flange_target(T, np.linalg.inv(exact.T_root_base), np.linalg.inv(exact.T_flange_tool))
     seven = solver.arm.dof == 7
-    P = solver.om.params if seven else None
-    model = solver.model.chain.table if seven else None
+    arm_angle = _core.ArmAngleRow(solver.om.params, solver.model.chain.table, psi) if seven else None
     roots: list[np.ndarray] = []
     for start in rng.uniform(-np.pi, np.pi, (STARTS, solver.arm.dof)):
         q = np.ascontiguousarray(start)
-        if _core.polish(exact.table, R, p, q, 100, P, model, psi) > 1e-13:
+        if _core.polish(exact.table, R, p, q, 100, arm_angle) > 1e-13:
             continue
         q = nominal.flip * q
         if not any(distance(solver.arm, q, r) < 1e-7 for r in roots):

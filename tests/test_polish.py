@@ -28,8 +28,8 @@ def _polish(solver: om.OMSolver, T: np.ndarray, psi: float | None, q: np.ndarray
     R, p = np.empty(9), np.empty(3)
     _core.flange_target(np.ascontiguousarray(T), data.T_base_root, data.T_tool_flange, R, p)
     if psi is None:
-        return _core.polish(data.real_table, R, p, q, 20, None, None, 0.0)
-    return _core.polish(data.real_table, R, p, q, 20, data.params, data.model_table, psi)
+        return _core.polish(data.real_table, R, p, q, 20, None)
+    return _core.polish(data.real_table, R, p, q, 20, _core.ArmAngleRow(data.params, data.model_table, psi))
 
 
 def _psi_distance(solver: om.OMSolver, q: np.ndarray, psi: float) -> float:
@@ -53,9 +53,9 @@ def test_polish_converges_to_the_pose_and_arm_angle(name, seed, offset, singular
     if singular:  # the wrist's middle joint at the angle that aligns the outer wrist axes
         families = om.om.families
         if solver.om.family == families.SRS:
-            q[5] = -solver.om.params[families.srs.THETA + 5]
+            q[5] = -solver.om.params[_core.SRS_THETA + 5]
         else:
-            q[4] = -solver.om.params[families.six_dof.THETA5]
+            q[4] = -solver.om.params[_core.SD_THETA5]
     T, c = solver.arm.fk(q), solver.configuration_of(q)
     psi = c.redundancy[0] if c.redundancy else None
     start = q + rng.normal(0.0, offset, q.shape)

@@ -9,9 +9,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
+from om_redundant import _core
+from om_redundant._core import FlangeTarget, srs_model_q7
 from om_redundant._core import flange as flange_kernel
-from om_redundant._core import srs_model_q7
-from om_redundant.om.families import REACH_SLACK, branch_values, model_ik, redundancy_values, srs
+from om_redundant.om.families import REACH_SLACK, branch_values, model_ik, redundancy_values
 from tests.conftest import random_q, wrap
 
 
@@ -32,7 +33,7 @@ def test_q7_alone_equals_the_closed_form(name, seed, shift, wrist):
     rng = np.random.default_rng(seed)
     q = random_q(om_arm.real, 1, rng)[0]
     if wrist is not None:  # sin(q6 + theta6) = wrist
-        q[5] = wrist - P[srs.THETA + 5]
+        q[5] = wrist - P[_core.SRS_THETA + 5]
     R, p = np.empty((3, 3)), np.empty(3)
     flange_kernel(table, q, R, p)
     p = p + shift * rng.standard_normal(3)
@@ -43,7 +44,8 @@ def test_q7_alone_equals_the_closed_form(name, seed, shift, wrist):
     q_prev = rng.uniform(-np.pi, np.pi, 7)
     full, alone = np.empty(7), np.full(7, np.nan)
     margin = model_ik(om_arm.family, P, table, R, p, signs, psi, q_prev, full)
-    assert srs_model_q7(P, R, p, signs.astype(np.int64), float(psi[0]), q_prev, alone) == margin
+    target = FlangeTarget(R, p, signs.astype(np.int64), psi)
+    assert srs_model_q7(P, target, q_prev, alone) == margin
     assert np.isnan(alone[:6]).all()
     if margin >= -REACH_SLACK:
         assert abs(wrap(alone[6] - full[6])) < 1e-12

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import om_redundant as om
+from om_redundant import _core
 from tests.conftest import random_q
 
 
@@ -72,13 +73,21 @@ def test_grid_rows_do_not_depend_on_the_rows_before(name, seed):
 def _solve_all_rows(solver: om.OMSolver, Ts: np.ndarray, signs: np.ndarray, psi: np.ndarray) -> np.ndarray:
     """The kernel's (count, evaluations) of each row, the rows one batch (one scan memo), without
     the library's checks of the poses (which refuse a pose that is not a number)."""
-    m = len(Ts)
-    roots = np.full((m, om.om.system.MAX_ROOTS, solver.arm.dof), np.nan)
-    info = np.full((m, om.om.system.MAX_ROOTS, 3), np.nan)
-    counts = np.zeros((m, 2), dtype=np.int64)
-    band = np.ones(m, dtype=bool)
-    solver.kernel.solve_all_rows(Ts, signs, psi[:, None], 0, m, roots, info, counts, band)
-    return counts
+    m, n = len(Ts), _core.MAX_ROOTS
+    batch = _core.SolveAllBatch(
+        Ts,
+        signs,
+        psi[:, None],
+        band=np.ones(m, dtype=bool),
+        q=np.full((m, n, solver.arm.dof), np.nan),
+        count=np.zeros(m, dtype=np.int64),
+        evaluations=np.zeros(m, dtype=np.int64),
+        position_error=np.full((m, n), np.nan),
+        orientation_error=np.full((m, n), np.nan),
+        within_limits=np.zeros((m, n), dtype=bool),
+    )
+    solver.kernel.solve_all_rows(batch, 0, m)
+    return np.stack([batch.count, batch.evaluations], axis=1)
 
 
 def test_a_pose_that_is_not_a_number_does_not_read_the_rows_before():

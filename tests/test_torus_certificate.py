@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 
 from om_redundant import _core
-from om_redundant.om.families import srs
 from om_redundant.om.system import MAX_ROOTS, flange_target
 from tests.conftest import EXACT, random_q, solver_of, wrap
 from tests.test_kernels import _assert_rows_are_solve_all
@@ -29,8 +28,9 @@ def _map(solver, T, signs, psi, w):
     for k, (w1, w7) in enumerate(w):
         delta = D[0] + D[1] * np.cos(w7) + D[2] * np.sin(w7)
         pm = p + D[3] + D[4] * np.cos(w1) + D[5] * np.sin(w1) + R @ delta
-        args = (data.family, data.params, data.model_table, R, pm, np.array(signs), np.array([psi]))
-        margin = _core.model_ik(*args, np.zeros(7), q, True)
+        model = _core.FamilyModel(data.family, data.params, data.model_table)
+        target = _core.FlangeTarget(R, pm, np.array(signs), np.array([psi]))
+        margin = _core.model_ik(model, target, np.zeros(7), q, True)
         if margin >= -1e-12:
             out[k] = q[0], q[6]
     return out
@@ -55,7 +55,8 @@ def test_rate_bounds_hold_for_the_map(name):
         T, c = solver.arm.fk(q), solver.configuration_of(q)
         for h in (4.0, np.pi / 4, np.pi / 32, np.pi / 256):
             centre = rng.uniform(-np.pi, np.pi, 2)
-            g1, g7, _, _ = solver.kernel.torus_bound(T, c.signs, c.redundancy, centre[0], centre[1], h)
+            bound = solver.kernel.torus_bound(T, c.signs, c.redundancy, centre[0], centre[1], h)
+            g1, g7 = bound.g1, bound.g7
             if not (np.isfinite(g1) or np.isfinite(g7)):
                 continue
             half = np.pi if h >= np.pi else 2 * h  # the square C' the bound holds on
@@ -76,8 +77,8 @@ def _adversarial_q(solver, rng: np.random.Generator) -> list[np.ndarray]:
     """Joint vectors next to the model's singular shoulder (sin(q2 + theta2) = 0) and wrist
     (sin(q6 + theta6) = 0), and its straight and folded elbow (the edge of reach), at distances
     1e-7 to 1e-1 rad."""
-    theta = solver.solver_data().params[srs.THETA : srs.THETA + 7]
-    phi_star = solver.solver_data().params[srs.PHI_STAR]
+    theta = solver.solver_data().params[_core.SRS_THETA : _core.SRS_THETA + 7]
+    phi_star = solver.solver_data().params[_core.SRS_PHI_STAR]
     out = []
     for q in random_q(solver.arm, 12, rng):
         for eps in (1e-7, 1e-4, 1e-2, 1e-1):
@@ -90,8 +91,8 @@ def _adversarial_q(solver, rng: np.random.Generator) -> list[np.ndarray]:
 
 def _roots(solver, T, c, certify: bool) -> tuple[np.ndarray, int]:
     roots = np.empty((MAX_ROOTS, 7))
-    n, evaluations = solver.kernel.bounded_search(T, c.signs, c.redundancy, roots, certify)
-    return roots[:n], evaluations
+    found = solver.kernel.bounded_search(T, c.signs, c.redundancy, roots, certify)
+    return roots[: found.count], found.evaluations
 
 
 @pytest.mark.parametrize("name", TORUS_ARMS)

@@ -154,9 +154,13 @@ int om_follow_path(const om_solver_data *s, const double *T, const int64_t *sign
                    double min_step, int *steps);
 
 extern PyTypeObject om_SolverType;        /* solver_type.c: Solver(SolverData) */
+/* solver_type.c: the Solver type and its methods' result types (ckernels.Solver, Solved, Found,
+ * TorusBound) into the module; -1 with an error. */
+int om_solver_init(PyObject *module);
 /* solver_type.c: obj's data if it is a 7-DOF (S-R-S) Solver; NULL with an error naming what. */
 const om_solver_data *om_srs7_solver(PyObject *obj, const char *what);
 extern PyMethodDef om_kernel_functions[]; /* functions.c: kinematics and closed forms */
+int om_functions_init(PyObject *module);  /* functions.c: their result types (ckernels.Lifted) */
 int om_tracking_init(PyObject *module);       /* binding/tracking.c: track_step, its statuses and result type */
 int om_clearance_init(PyObject *module);      /* binding/clearance.c: arm and obstacle geoms */
 extern PyMethodDef om_follow_functions[];    /* follow.c: a solution path followed along psi */

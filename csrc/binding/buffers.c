@@ -207,7 +207,7 @@ int copy_pose_and_signs(const Py_buffer *pose, const Py_buffer *signs, int k, do
 Py_ssize_t table_joints(const Py_buffer *table) {
     const double *t = table->buf;
     Py_ssize_t joints = 0;
-    for (Py_ssize_t i = 0; i < table->len / 48; i++) joints += t[6 * i + 5] != 2.0;
+    for (Py_ssize_t i = 0; i < table->len / 48; i++) joints += t[OM_DH_COLUMNS * i + OM_DH_KIND] != OM_JOINT_FIXED;
     return joints;
 }
 

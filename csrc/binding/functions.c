@@ -120,47 +120,95 @@ int check_family(long family, const Py_buffer *P, Py_ssize_t dof, const Py_buffe
     return 0;
 }
 
-/* model_ik(family, P, table, R, p, signs, redundancy, q_prev, q, all_joints) -> margin. */
-static PyObject *k_model_ik(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
-    if (check_nargs(nargs, 10, "model_ik") < 0) return NULL;
-    long family = PyLong_AsLong(args[0]);
-    int all_joints = PyObject_IsTrue(args[9]);
-    if (PyErr_Occurred() || all_joints < 0) return NULL;
-    Py_buffer v[8];
-    buffer_spec sp[8] = {{F64, -1, 0, "P"}, {F64, -1, 0, "table"}, {F64, 9, 0, "R"}, {F64, 3, 0, "p"},
-                         {I64, 3, 0, "signs"}, {F64, -1, 0, "redundancy"}, {F64, -1, 0, "q_prev"}, {F64, -1, 1, "q"}};
-    if (get_buffers(args + 1, v, sp, 8) < 0) return NULL;
-    if (check_family(family, &v[0], v[7].len / 8, &v[1]) < 0 || v[6].len != v[7].len ||
-        v[5].len != (family == OM_SRS ? 8 : 0)) {
-        if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "model_ik: shapes disagree");
-        release_buffers(v, 8);
-        return NULL;
-    }
-    mat3 R = load_mat(v[2].buf);
-    om_target t = om_target_at((int)family, v[0].buf, &R, v[5].buf);
-    double margin = om_model_ik((int)family, v[0].buf, v[1].buf, &t, load_vec(v[3].buf), v[4].buf, v[6].buf,
-                                v[7].buf, all_joints);
-    release_buffers(v, 8);
-    return PyFloat_FromDouble(margin);
+/* The fields of a model IK's target (om_redundant._core.FlangeTarget) it reads. */
+enum { FT_R, FT_P, FT_SIGNS, FT_REDUNDANCY, FT_N };
+static const char *const target_names[FT_N] = {"R", "p", "signs", "redundancy"};
+
+/* A FlangeTarget's arrays into v[0:4] (R (9), p (3), signs (3) int64, redundancy: n_redundancy
+ * entries, any if < 0), held until released (release_buffers(v, 4)); -1 with an error naming
+ * what. */
+static int get_target(PyObject *target, Py_ssize_t n_redundancy, Py_buffer *v, const char *what) {
+    PyObject *w[FT_N];
+    if (get_fields(target, target_names, FT_N, w, what) < 0) return -1;
+    const buffer_spec sp[FT_N] = {{F64, 9, 0, "R"}, {F64, 3, 0, "p"}, {I64, 3, 0, "signs"},
+                                  {F64, n_redundancy, 0, "redundancy"}};
+    int rc = get_buffers(w, v, sp, FT_N);
+    release_fields(w, FT_N); /* (the buffers hold their arrays) */
+    return rc;
 }
 
-/* model_ik_at_reach(P, R, p, signs, psi, q_prev, q) -> bool and srs_model_q7(the same) -> margin:
- * the S-R-S closed form's variants (q7_alone: q7 alone, as the circle residual takes it). */
+/* The fields of a closed-form model (om_redundant._core.FamilyModel) model_ik reads. */
+enum { FM_FAMILY, FM_PARAMS, FM_TABLE, FM_N };
+static const char *const model_names[FM_N] = {"family", "params", "table"};
+
+/* model_ik(model, target, q_prev, q, all_joints) -> margin: the closed form of model (a
+ * FamilyModel: family, params, table) for target (a FlangeTarget). */
+static PyObject *k_model_ik(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    PyObject *w[FM_N];
+    if (check_nargs(nargs, 5, "model_ik") < 0 || get_fields(args[0], model_names, FM_N, w, "model_ik's model") < 0)
+        return NULL;
+    PyObject *result = NULL;
+    long family = PyLong_AsLong(w[FM_FAMILY]);
+    int all_joints = PyErr_Occurred() ? -1 : PyObject_IsTrue(args[4]);
+    if (all_joints < 0) goto done;
+    Py_buffer v[8]; /* params, table, q_prev, q, then the target's R, p, signs, redundancy */
+    PyObject *const arrays[4] = {w[FM_PARAMS], w[FM_TABLE], args[2], args[3]};
+    const buffer_spec sp[4] = {{F64, -1, 0, "params"}, {F64, -1, 0, "table"}, {F64, -1, 0, "q_prev"}, {F64, -1, 1, "q"}};
+    if (get_buffers(arrays, v, sp, 4) < 0) goto done;
+    if (get_target(args[1], -1, v + 4, "model_ik's target") < 0) {
+        release_buffers(v, 4);
+        goto done;
+    }
+    if (check_family(family, &v[0], v[3].len / 8, &v[1]) < 0 || v[2].len != v[3].len ||
+        v[7].len != (family == OM_SRS ? 8 : 0)) {
+        if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "model_ik: shapes disagree");
+    } else {
+        mat3 R = load_mat(v[4].buf);
+        om_target t = om_target_at((int)family, v[0].buf, &R, v[7].buf);
+        double margin = om_model_ik((int)family, v[0].buf, v[1].buf, &t, load_vec(v[5].buf), v[6].buf, v[2].buf,
+                                    v[3].buf, all_joints);
+        result = PyFloat_FromDouble(margin);
+    }
+    release_buffers(v, 8);
+done:
+    release_fields(w, FM_N);
+    return result;
+}
+
+/* An S-R-S call's parameters P (SRS_N_PARAMS), target (a FlangeTarget whose redundancy is
+ * psi alone) and joint vectors joints[0:n] (7 each; the last written) into v[0], v[1:5],
+ * v[5:5 + n]; -1 with an error (nothing held). */
+static int get_srs_call(PyObject *P, PyObject *target, PyObject *const *joints, int n, const char *const *names,
+                        Py_buffer *v, const char *what) {
+    if (get_buffer(P, &v[0], F64, SRS_N_PARAMS, 0, "P") < 0) return -1;
+    if (get_target(target, 1, v + 1, what) < 0) {
+        release_buffers(v, 1);
+        return -1;
+    }
+    buffer_spec sp[2];
+    for (int i = 0; i < n; i++) sp[i] = (buffer_spec){F64, 7, i == n - 1, names[i]};
+    if (get_buffers(joints, v + 5, sp, n) < 0) {
+        release_buffers(v, 5);
+        return -1;
+    }
+    return 0;
+}
+
+/* model_ik_at_reach(P, target, q_prev, q) -> bool and srs_model_q7(the same) -> margin: the
+ * S-R-S closed form's variants (q7_alone: q7 alone, as the circle residual takes it), for
+ * target (a FlangeTarget, its redundancy the arm angle psi). */
 static PyObject *srs_variant(PyObject *const *args, Py_ssize_t nargs, int q7_alone) {
-    if (check_nargs(nargs, 7, q7_alone ? "srs_model_q7" : "model_ik_at_reach") < 0) return NULL;
-    double psi = PyFloat_AsDouble(args[4]);
-    if (PyErr_Occurred()) return NULL;
-    PyObject *const a[6] = {args[0], args[1], args[2], args[3], args[5], args[6]};
-    Py_buffer v[6];
-    buffer_spec sp[6] = {{F64, SRS_N_PARAMS, 0, "P"}, {F64, 9, 0, "R"}, {F64, 3, 0, "p"}, {I64, 3, 0, "signs"},
-                         {F64, 7, 0, "q_prev"}, {F64, 7, 1, "q"}};
-    if (get_buffers(a, v, sp, 6) < 0) return NULL;
+    const char *what = q7_alone ? "srs_model_q7" : "model_ik_at_reach";
+    if (check_nargs(nargs, 4, what) < 0) return NULL;
+    static const char *const names[2] = {"q_prev", "q"};
+    Py_buffer v[7]; /* P, the target's R, p, signs, psi, then q_prev, q */
+    if (get_srs_call(args[0], args[1], args + 2, 2, names, v, what) < 0) return NULL;
     mat3 R = load_mat(v[1].buf);
-    om_target t = om_target_at(OM_SRS, v[0].buf, &R, &psi);
+    om_target t = om_target_at(OM_SRS, v[0].buf, &R, v[4].buf);
     vec3 p = load_vec(v[2].buf);
-    PyObject *out = q7_alone ? PyFloat_FromDouble(om_srs_model_q7(v[0].buf, &t, p, v[3].buf, v[4].buf, v[5].buf))
-                             : PyBool_FromLong(om_srs_model_ik_at_reach(v[0].buf, &t, p, v[3].buf, v[4].buf, v[5].buf));
-    release_buffers(v, 6);
+    PyObject *out = q7_alone ? PyFloat_FromDouble(om_srs_model_q7(v[0].buf, &t, p, v[3].buf, v[5].buf, v[6].buf))
+                             : PyBool_FromLong(om_srs_model_ik_at_reach(v[0].buf, &t, p, v[3].buf, v[5].buf, v[6].buf));
+    release_buffers(v, 7);
     return out;
 }
 
@@ -172,22 +220,37 @@ static PyObject *k_srs_model_q7(PyObject *mod, PyObject *const *args, Py_ssize_t
     return srs_variant(args, nargs, 1);
 }
 
-/* model_ik_lifted(P, R, p, signs, psi, q1, q7, phi4, q) -> (shoulder, wrist, elbow) residuals. */
+static PyStructSequence_Field lifted_fields[] = {
+    {"shoulder", "the shoulder's consistency residual"},
+    {"wrist", "the wrist's consistency residual"},
+    {"elbow", "the elbow equation's residual, x - cos(phi4 - phi*)"},
+    {NULL, NULL},
+};
+static PyStructSequence_Desc lifted_desc = {"om_redundant.ckernels.Lifted", "model_ik_lifted's residuals.",
+                                            lifted_fields, 3};
+static PyTypeObject *lifted_type;
+
+int om_functions_init(PyObject *module) {
+    if (!lifted_type && !(lifted_type = PyStructSequence_NewType(&lifted_desc))) return -1;
+    return PyModule_AddObjectRef(module, "Lifted", (PyObject *)lifted_type);
+}
+
+/* model_ik_lifted(P, target, q1, q7, phi4, q) -> Lifted(shoulder, wrist, elbow): the residuals
+ * of the S-R-S model IK with q1, q7 and phi4 given, for target (a FlangeTarget, its redundancy
+ * the arm angle psi). */
 static PyObject *k_model_ik_lifted(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
-    if (check_nargs(nargs, 9, "model_ik_lifted") < 0) return NULL;
-    double psi = PyFloat_AsDouble(args[4]), q1 = PyFloat_AsDouble(args[5]), q7 = PyFloat_AsDouble(args[6]),
-           phi4 = PyFloat_AsDouble(args[7]);
+    if (check_nargs(nargs, 6, "model_ik_lifted") < 0) return NULL;
+    double q1 = PyFloat_AsDouble(args[2]), q7 = PyFloat_AsDouble(args[3]), phi4 = PyFloat_AsDouble(args[4]);
     if (PyErr_Occurred()) return NULL;
-    PyObject *const a[5] = {args[0], args[1], args[2], args[3], args[8]};
-    Py_buffer v[5];
-    buffer_spec sp[5] = {{F64, SRS_N_PARAMS, 0, "P"}, {F64, 9, 0, "R"}, {F64, 3, 0, "p"}, {I64, 3, 0, "signs"},
-                         {F64, 7, 1, "q"}};
-    if (get_buffers(a, v, sp, 5) < 0) return NULL;
+    static const char *const names[1] = {"q"};
+    Py_buffer v[6]; /* P, the target's R, p, signs, psi, then q */
+    if (get_srs_call(args[0], args[1], args + 5, 1, names, v, "model_ik_lifted") < 0) return NULL;
     mat3 R = load_mat(v[1].buf);
-    om_target t = om_target_at(OM_SRS, v[0].buf, &R, &psi);
-    vec3 r = om_srs_model_ik_lifted(v[0].buf, &t, load_vec(v[2].buf), v[3].buf, q1, q7, phi4, v[4].buf);
-    release_buffers(v, 5);
-    return Py_BuildValue("(ddd)", r.x, r.y, r.z);
+    om_target t = om_target_at(OM_SRS, v[0].buf, &R, v[4].buf);
+    vec3 r = om_srs_model_ik_lifted(v[0].buf, &t, load_vec(v[2].buf), v[3].buf, q1, q7, phi4, v[5].buf);
+    release_buffers(v, 6);
+    PyObject *items[3] = {PyFloat_FromDouble(r.x), PyFloat_FromDouble(r.y), PyFloat_FromDouble(r.z)};
+    return new_record(lifted_type, items, 3);
 }
 
 /* branch_values(family, P, q, out) and redundancy_values(family, P, q, out). */
@@ -291,24 +354,33 @@ static PyObject *k_all_finite(PyObject *mod, PyObject *const *args, Py_ssize_t n
 /* The most Gauss-Newton steps a polish call takes (each a few microseconds, the GIL released). */
 #define MAX_POLISH_ITERATIONS 10000
 
-/* polish(table, R, p, q, iterations, P, model_table, psi) -> residual: om_polish of q in place
- * toward the flange pose (R (9), p (3)) in DH frame 0 of the chain `table`; P and model_table
- * None: no arm-angle row, else an S-R-S model's parameters and table with target psi. */
+/* The fields of a polish's arm-angle row (om_redundant._core.ArmAngleRow) it reads. */
+enum { AR_PARAMS, AR_TABLE, AR_PSI, AR_N };
+static const char *const arm_angle_names[AR_N] = {"params", "model_table", "psi"};
+
+/* polish(table, R, p, q, iterations, arm_angle) -> residual: om_polish of q in place toward
+ * the flange pose (R (9), p (3)) in DH frame 0 of the chain `table`; arm_angle None: no
+ * arm-angle row, else an ArmAngleRow: an S-R-S model's params and model_table, and the
+ * target psi. */
 static PyObject *k_polish(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
-    if (check_nargs(nargs, 8, "polish") < 0) return NULL;
+    if (check_nargs(nargs, 6, "polish") < 0) return NULL;
     long iterations = PyLong_AsLong(args[4]);
-    double psi = PyFloat_AsDouble(args[7]);
     if (PyErr_Occurred()) return NULL;
     if (iterations < 0 || iterations > MAX_POLISH_ITERATIONS) {
         PyErr_Format(PyExc_ValueError, "polish: iterations must be 0 ... %d", MAX_POLISH_ITERATIONS);
         return NULL;
     }
     int with_psi = args[5] != Py_None;
-    PyObject *const a[6] = {args[0], args[1], args[2], args[3], args[5], args[6]};
+    PyObject *w[AR_N] = {NULL, NULL, NULL};
+    if (with_psi && get_fields(args[5], arm_angle_names, AR_N, w, "polish's arm_angle") < 0) return NULL;
+    double psi = with_psi ? PyFloat_AsDouble(w[AR_PSI]) : 0.0;
+    PyObject *result = NULL;
+    if (PyErr_Occurred()) goto done;
+    PyObject *const a[6] = {args[0], args[1], args[2], args[3], w[AR_PARAMS], w[AR_TABLE]};
     Py_buffer v[6];
     buffer_spec sp[6] = {{F64, -1, 0, "table"}, {F64, 9, 0, "R"}, {F64, 3, 0, "p"}, {F64, -1, 1, "q"},
-                         {F64, SRS_N_PARAMS, 0, "P"}, {F64, -1, 0, "model_table"}};
-    if (get_buffers(a, v, sp, with_psi ? 6 : 4) < 0) return NULL;
+                         {F64, SRS_N_PARAMS, 0, "params"}, {F64, -1, 0, "model_table"}};
+    if (get_buffers(a, v, sp, with_psi ? 6 : 4) < 0) goto done;
     om_polish_task t;
     t.table = v[0].buf;
     t.n_rows = (int)table_rows(&v[0]);
@@ -317,7 +389,7 @@ static PyObject *k_polish(PyObject *mod, PyObject *const *args, Py_ssize_t nargs
         (with_psi && check_family(OM_SRS, &v[4], 7, &v[5]) < 0)) {
         release_buffers(v, with_psi ? 6 : 4);
         PyErr_SetString(PyExc_ValueError, "polish: table, q (and a 7-joint arm for psi) disagree");
-        return NULL;
+        goto done;
     }
     t.P = with_psi ? v[4].buf : NULL;
     t.model_table = with_psi ? v[5].buf : NULL;
@@ -330,7 +402,10 @@ static PyObject *k_polish(PyObject *mod, PyObject *const *args, Py_ssize_t nargs
     double r;
     Py_BEGIN_ALLOW_THREADS r = om_polish(&t, (int)iterations, v[3].buf);
     Py_END_ALLOW_THREADS release_buffers(v, with_psi ? 6 : 4);
-    return PyFloat_FromDouble(r);
+    result = PyFloat_FromDouble(r);
+done:
+    release_fields(w, with_psi ? AR_N : 0);
+    return result;
 }
 
 #define FAST(name, doc) {#name, (PyCFunction)(void (*)(void))k_##name, METH_FASTCALL, doc}
@@ -340,15 +415,15 @@ PyMethodDef om_kernel_functions[] = {
     FAST(jacobian, "jacobian(table, base, tool, q, J)"),
     FAST(flange, "flange(table, q, R, p)"),
     FAST(flange_target, "flange_target(T, T_base_root, T_tool_flange, R, p)"),
-    FAST(model_ik, "model_ik(family, P, table, R, p, signs, redundancy, q_prev, q, all_joints) -> margin"),
-    FAST(model_ik_at_reach, "model_ik_at_reach(P, R, p, signs, psi, q_prev, q) -> bool"),
-    FAST(srs_model_q7, "srs_model_q7(P, R, p, signs, psi, q_prev, q) -> margin"),
-    FAST(model_ik_lifted, "model_ik_lifted(P, R, p, signs, psi, q1, q7, phi4, q) -> residuals"),
+    FAST(model_ik, "model_ik(model, target, q_prev, q, all_joints) -> margin (a FamilyModel, a FlangeTarget)"),
+    FAST(model_ik_at_reach, "model_ik_at_reach(P, target, q_prev, q) -> bool (target: a FlangeTarget)"),
+    FAST(srs_model_q7, "srs_model_q7(P, target, q_prev, q) -> margin (target: a FlangeTarget)"),
+    FAST(model_ik_lifted, "model_ik_lifted(P, target, q1, q7, phi4, q) -> Lifted (target: a FlangeTarget)"),
     FAST(branch_values, "branch_values(family, P, q, out)"),
     FAST(redundancy_values, "redundancy_values(family, P, q, out)"),
     FAST(arm_angle_gradient, "arm_angle_gradient(P, table, q, grad) -> psi"),
     FAST(pose_is_valid, "pose_is_valid(T, tolerance) -> bool"),
     FAST(all_finite, "all_finite(values) -> bool"),
-    FAST(polish, "polish(table, R, p, q, iterations, P, model_table, psi) -> residual"),
+    FAST(polish, "polish(table, R, p, q, iterations, arm_angle) -> residual (arm_angle: None or an ArmAngleRow)"),
     {NULL, NULL, 0, NULL},
 };

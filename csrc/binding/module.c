@@ -14,10 +14,9 @@ static struct PyModuleDef module = {
 };
 
 PyMODINIT_FUNC PyInit_ckernels(void) {
-    if (PyType_Ready(&om_SolverType) < 0) return NULL;
     PyObject *m = PyModule_Create(&module);
     if (!m) return NULL;
-    /* The parameter layouts, for the Python side to check its own against (tests). */
+    /* The codes and layouts Python reads from here (om_redundant._core): each written once, in C. */
     static const struct {
         const char *name;
         int value;
@@ -44,10 +43,13 @@ PyMODINIT_FUNC PyInit_ckernels(void) {
         {"FOLLOW_ARRIVED", OM_FOLLOW_ARRIVED}, {"FOLLOW_SINGULAR", OM_FOLLOW_SINGULAR},
         {"FOLLOW_STALLED", OM_FOLLOW_STALLED}, {"FOLLOW_MAX_ATTEMPTS", OM_FOLLOW_MAX_ATTEMPTS},
         {"FOLLOW_CRAWL_STEPS", OM_FOLLOW_CRAWL_STEPS},
+        {"DH_A", OM_DH_A}, {"DH_D", OM_DH_D}, {"DH_THETA", OM_DH_THETA}, {"DH_COS_ALPHA", OM_DH_COS_ALPHA},
+        {"DH_SIN_ALPHA", OM_DH_SIN_ALPHA}, {"DH_KIND", OM_DH_KIND}, {"DH_COLUMNS", OM_DH_COLUMNS},
+        {"JOINT_REVOLUTE", OM_JOINT_REVOLUTE}, {"JOINT_PRISMATIC", OM_JOINT_PRISMATIC},
+        {"JOINT_FIXED", OM_JOINT_FIXED},
     };
-    if (PyModule_AddObjectRef(m, "Solver", (PyObject *)&om_SolverType) < 0) goto fail;
-    if (om_tracking_init(m) < 0) goto fail;
-    if (om_clearance_init(m) < 0) goto fail;
+    if (om_solver_init(m) < 0 || om_functions_init(m) < 0) goto fail;
+    if (om_tracking_init(m) < 0 || om_clearance_init(m) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_follow_functions) < 0 || om_follow_init(m) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_link_functions) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_tangent_functions) < 0) goto fail;

@@ -75,8 +75,8 @@ static int check_data(const om_solver_data *s, long family, long mode, long dp_j
     return problem ? -1 : 0;
 }
 
-/* Solver(data, solution_type=None, configuration_type=None): data is an om_redundant
- * SolverData named tuple; the two types (Solution, Configuration) let solve_pose answer.
+/* Solver(data, solution_type=None, configuration_type=None): data is an
+ * om_redundant._core.SolverData, its fields read by name; the two types (Solution, Configuration) let solve_pose answer.
  * Initialised once: the data is read and checked into a new store, kept only if all of it is
  * good (calls on other threads may be reading the store, the GIL released). */
 static int Solver_init(Solver *self, PyObject *args, PyObject *kwds) {
@@ -174,9 +174,59 @@ const om_solver_data *om_solver_ready(const om_Solver *self) {
     return NULL;
 }
 
-static PyObject *result_tuple(om_result r) {
-    return Py_BuildValue("(iddLO)", r.status, r.position_error, r.orientation_error, (long long)r.evaluations,
-                         r.within_limits ? Py_True : Py_False);
+/* ------------------------------------------------------------------------------------ */
+/* The methods' results, by name: PyStructSequence types made at import (om_solver_init).  */
+
+static PyStructSequence_Field solved_fields[] = {
+    {"status", "OK, UNREACHABLE or NO_SOLUTION_IN_CONFIGURATION"},
+    {"position_error", "|p_real(q) - p_d| (m)"},
+    {"orientation_error", "the angle of R_d^T R_real(q) (rad)"},
+    {"evaluations", "the residual evaluations spent"},
+    {"within_limits", "whether q is within the joint limits"},
+    {NULL, NULL},
+};
+static PyStructSequence_Desc solved_desc = {"om_redundant.ckernels.Solved", "What Solver.solve found.", solved_fields,
+                                            5};
+static PyStructSequence_Field found_fields[] = {
+    {"count", "the roots found"},
+    {"evaluations", "the residual evaluations spent"},
+    {NULL, NULL},
+};
+static PyStructSequence_Desc found_desc = {"om_redundant.ckernels.Found",
+                                           "How many roots Solver.solve_all or Solver.bounded_search found.",
+                                           found_fields, 2};
+static PyStructSequence_Field torus_bound_fields[] = {
+    {"g1", "the rate bound of the model's q1 on the cell"},
+    {"g7", "the rate bound of the model's q7 on the cell"},
+    {"unreachable", "whether the residual cannot vanish on the cell"},
+    {"q1", "the model's q1 at the cell's centre"},
+    {"q7", "the model's q7 at the cell's centre"},
+    {NULL, NULL},
+};
+static PyStructSequence_Desc torus_bound_desc = {"om_redundant.ckernels.TorusBound",
+                                                 "om_torus_cell_bound's bounds on a cell of the torus.",
+                                                 torus_bound_fields, 5};
+static PyTypeObject *solved_type, *found_type, *torus_bound_type;
+
+int om_solver_init(PyObject *module) {
+    if (PyType_Ready(&om_SolverType) < 0 || PyModule_AddObjectRef(module, "Solver", (PyObject *)&om_SolverType) < 0)
+        return -1;
+    const struct {
+        PyTypeObject **type;
+        PyStructSequence_Desc *desc;
+        const char *name;
+    } types[] = {{&solved_type, &solved_desc, "Solved"}, {&found_type, &found_desc, "Found"},
+                 {&torus_bound_type, &torus_bound_desc, "TorusBound"}};
+    for (size_t i = 0; i < sizeof types / sizeof types[0]; i++) {
+        if (!*types[i].type && !(*types[i].type = PyStructSequence_NewType(types[i].desc))) return -1;
+        if (PyModule_AddObjectRef(module, types[i].name, (PyObject *)*types[i].type) < 0) return -1;
+    }
+    return 0;
+}
+
+static PyObject *new_found(int count, int64_t evaluations) {
+    PyObject *items[2] = {PyLong_FromLong(count), PyLong_FromLongLong(evaluations)};
+    return new_record(found_type, items, 2);
 }
 
 /* A configuration's signs and redundancy values, as the kernels take them. */
@@ -194,8 +244,8 @@ static int get_call(const om_solver_data *s, PyObject *const *args, Py_ssize_t n
     return get_doubles(args[2], c->redundancy, s->n_redundancy, "redundancy");
 }
 
-/* solve(T, signs, redundancy, hint, q_out) -> (status, position error, orientation error,
- * evaluations, within limits). hint None: no hint. */
+/* solve(T, signs, redundancy, hint, q_out) -> Solved(status, position_error,
+ * orientation_error, evaluations, within_limits). hint None: no hint. */
 static PyObject *Solver_solve(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
     const om_solver_data *s = om_solver_ready(self);
     configuration c;
@@ -210,30 +260,35 @@ static PyObject *Solver_solve(Solver *self, PyObject *const *args, Py_ssize_t na
     om_result r;
     Py_BEGIN_ALLOW_THREADS r = om_solve_one(s, T, c.signs, c.redundancy, n == 3 ? v[2].buf : NULL, v[1].buf, NULL, NULL);
     Py_END_ALLOW_THREADS release_buffers(v, n);
-    return result_tuple(r);
+    PyObject *items[5] = {PyLong_FromLong(r.status), PyFloat_FromDouble(r.position_error),
+                          PyFloat_FromDouble(r.orientation_error), PyLong_FromLongLong(r.evaluations),
+                          PyBool_FromLong(r.within_limits)};
+    return new_record(solved_type, items, 5);
 }
 
-/* A batch call's rows start:stop (args[3], args[4]) and inputs: Ts (M, 4, 4) from args[0] into
- * v[0], signs (M, k) int64 and redundancy (M, r) from args[1], args[2] into v[1], v[2], and
- * the outputs outs[i] by specs[i] (n_out of them; entries given per row, times M here) into
- * v[3 + i]; the rows' signs, each -1 or +1, copied into *signs (k per row from row start on;
- * PyMem_Free it), for the caller's array may change while the GIL is released and the kernels
- * take a sign's value as given. Returns M, or -1 with a TypeError or ValueError (nothing
- * acquired). */
-static Py_ssize_t get_rows(const om_solver_data *s, PyObject *const *args, PyObject *const *outs,
+/* A batch's rows start:stop and inputs: T (M, 4, 4) from rows[0] into v[0], signs (M, k)
+ * int64 and redundancy (M, r) from rows[1], rows[2] into v[1], v[2], start and stop from
+ * rows[3], rows[4], and the outputs outs[i] by specs[i] (n_out <= OM_MAX_BATCH_OUTPUTS of
+ * them; entries given per row, times M here) into v[3 + i]; the rows' signs, each -1 or +1,
+ * copied into *signs (k per row from row start on; PyMem_Free it), for the caller's array
+ * may change while the GIL is released and the kernels take a sign's value as given.
+ * Returns M, or -1 with a TypeError or ValueError (nothing acquired). */
+enum { OM_MAX_BATCH_OUTPUTS = 8 };
+static Py_ssize_t get_rows(const om_solver_data *s, PyObject *const *rows, PyObject *const *outs,
                            const buffer_spec *specs, int n_out, Py_buffer *v, Py_ssize_t *start, Py_ssize_t *stop,
                            int64_t **signs) {
-    *start = PyLong_AsSsize_t(args[3]), *stop = PyLong_AsSsize_t(args[4]);
+    *start = PyLong_AsSsize_t(rows[3]), *stop = PyLong_AsSsize_t(rows[4]);
     if (PyErr_Occurred()) return -1;
-    if (get_buffer(args[0], &v[0], F64, -1, 0, "Ts") < 0) return -1;
+    if (get_buffer(rows[0], &v[0], F64, -1, 0, "T") < 0) return -1;
     Py_ssize_t m = v[0].len / (16 * 8);
     if (v[0].len != m * 16 * 8 || *start < 0 || *stop > m || *start > *stop) {
-        PyErr_SetString(PyExc_ValueError, "Ts must be (M, 4, 4) and 0 <= start <= stop <= M");
+        PyErr_SetString(PyExc_ValueError, "T must be (M, 4, 4) and 0 <= start <= stop <= M");
         release_buffers(v, 1);
         return -1;
     }
-    PyObject *objs[8] = {args[1], args[2]};
-    buffer_spec all[8] = {{I64, m * s->n_signs, 0, "signs"}, {F64, m * s->n_redundancy, 0, "redundancy"}};
+    PyObject *objs[2 + OM_MAX_BATCH_OUTPUTS] = {rows[1], rows[2]};
+    buffer_spec all[2 + OM_MAX_BATCH_OUTPUTS] = {{I64, m * s->n_signs, 0, "signs"},
+                                                 {F64, m * s->n_redundancy, 0, "redundancy"}};
     for (int i = 0; i < n_out; i++) {
         objs[2 + i] = outs[i];
         all[2 + i] = specs[i];
@@ -255,101 +310,158 @@ static Py_ssize_t get_rows(const om_solver_data *s, PyObject *const *args, PyObj
     return m;
 }
 
-/* solve_rows(Ts, signs, redundancy, hints, start, stop, q_out, info): rows start:stop of a
- * batch; Ts (M, 4, 4), signs (M, k) int64, redundancy (M, r), hints (M, dof) or None,
- * q_out (M, dof), info (M, 5) gets (status, position error, orientation error,
- * evaluations, within limits). */
+/* The fields of solve_rows' batch (om_redundant._core.SolveBatch) it reads. */
+enum { SB_T, SB_SIGNS, SB_REDUNDANCY, SB_HINTS, SB_Q, SB_STATUS, SB_POSITION, SB_ORIENTATION, SB_EVALUATIONS,
+       SB_WITHIN, SB_N };
+static const char *const solve_batch_names[SB_N] = {"T", "signs", "redundancy", "hints", "q", "status",
+                                                    "position_error", "orientation_error", "evaluations",
+                                                    "within_limits"};
+
+/* solve_rows(batch, start, stop): rows start:stop of a batch (om_redundant._core.SolveBatch):
+ * T (M, 4, 4), signs (M, k) int64, redundancy (M, r), hints (M, dof) or None in; q (M, dof),
+ * status (M,) int64, position_error (M,), orientation_error (M,), evaluations (M,) int64 and
+ * within_limits (M,) bool out, each row's as solve's. */
 static PyObject *Solver_solve_rows(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
     const om_solver_data *s = om_solver_ready(self);
-    if (!s || check_nargs(nargs, 8, "solve_rows") < 0) return NULL;
-    int dof = s->dof, k = s->n_signs, nr = s->n_redundancy, n_out = args[3] != Py_None ? 3 : 2;
-    PyObject *rows[5] = {args[0], args[1], args[2], args[4], args[5]};
-    PyObject *outs[3] = {args[6], args[7], args[3]};
-    const buffer_spec specs[3] = {{F64, dof, 1, "q_out"}, {F64, 5, 1, "info"}, {F64, dof, 0, "q_hint"}};
-    Py_buffer v[6]; /* Ts, signs, redundancy, q_out, info and the hints last */
+    PyObject *w[SB_N];
+    if (!s || check_nargs(nargs, 3, "solve_rows") < 0 || get_fields(args[0], solve_batch_names, SB_N, w, "solve_rows' batch") < 0)
+        return NULL;
+    int dof = s->dof, k = s->n_signs, nr = s->n_redundancy, n_out = w[SB_HINTS] != Py_None ? 7 : 6;
+    PyObject *rows[5] = {w[SB_T], w[SB_SIGNS], w[SB_REDUNDANCY], args[1], args[2]};
+    PyObject *outs[7] = {w[SB_Q],           w[SB_STATUS],      w[SB_POSITION], w[SB_ORIENTATION],
+                         w[SB_EVALUATIONS], w[SB_WITHIN],      w[SB_HINTS]};
+    const buffer_spec specs[7] = {{F64, dof, 1, "q"},           {I64, 1, 1, "status"},
+                                  {F64, 1, 1, "position_error"}, {F64, 1, 1, "orientation_error"},
+                                  {I64, 1, 1, "evaluations"},   {U8, 1, 1, "within_limits"},
+                                  {F64, dof, 0, "hints"}};
+    Py_buffer v[10]; /* T, signs, redundancy, the six outputs, and the hints last */
     Py_ssize_t start, stop;
     int64_t *signs;
-    if (get_rows(s, rows, outs, specs, n_out, v, &start, &stop, &signs) < 0) return NULL;
-    const double *Tb = v[0].buf, *rb = v[2].buf, *hb = n_out == 3 ? v[5].buf : NULL;
-    double *qb = v[3].buf, *ib = v[4].buf;
+    PyObject *result = NULL;
+    if (get_rows(s, rows, outs, specs, n_out, v, &start, &stop, &signs) < 0) goto done;
+    const double *Tb = v[0].buf, *rb = v[2].buf, *hb = n_out == 7 ? v[9].buf : NULL;
+    double *qb = v[3].buf, *position = v[5].buf, *orientation = v[6].buf;
+    int64_t *status = v[4].buf, *evaluations = v[7].buf;
+    uint8_t *within = v[8].buf;
     Py_BEGIN_ALLOW_THREADS for (Py_ssize_t i = start; i < stop; i++) {
         om_result r = om_solve_one(s, Tb + 16 * i, signs + k * (i - start), rb + nr * i, hb ? hb + dof * i : NULL,
                                    qb + dof * i, NULL, NULL);
-        double *row = ib + 5 * i;
-        row[0] = r.status;
-        row[1] = r.position_error;
-        row[2] = r.orientation_error;
-        row[3] = (double)r.evaluations;
-        row[4] = r.within_limits;
+        status[i] = r.status;
+        position[i] = r.position_error;
+        orientation[i] = r.orientation_error;
+        evaluations[i] = r.evaluations;
+        within[i] = r.within_limits;
     }
     Py_END_ALLOW_THREADS release_buffers(v, 3 + n_out);
     PyMem_Free(signs);
-    Py_RETURN_NONE;
+    result = Py_NewRef(Py_None);
+done:
+    release_fields(w, SB_N);
+    return result;
 }
 
-/* solve_all_rows(Ts, signs, redundancy, start, stop, roots, info, counts, band): om_solve_all
- * of rows start:stop of a batch; Ts (M, 4, 4), signs (M, k) int64, redundancy (M, r), band
- * (M,) bool (whether a row without a root of its own searches the band); roots (M,
- * MAX_ROOTS, dof) and info (M, MAX_ROOTS, 3) get each row's as solve_all's, counts (M, 2)
- * int64 its (count, evaluations). */
+/* A root's errors and limits from om_solve_all's info row (position error, orientation
+ * error, within limits) into the named arrays at entry at. */
+static void put_root_info(const double *info, Py_ssize_t at, double *position, double *orientation, uint8_t *within) {
+    position[at] = info[0];
+    orientation[at] = info[1];
+    within[at] = info[2] != 0.0;
+}
+
+/* The fields of solve_all_rows' batch (om_redundant._core.SolveAllBatch) it reads. */
+enum { SA_T, SA_SIGNS, SA_REDUNDANCY, SA_BAND, SA_Q, SA_COUNT, SA_EVALUATIONS, SA_POSITION, SA_ORIENTATION,
+       SA_WITHIN, SA_N };
+static const char *const solve_all_batch_names[SA_N] = {"T", "signs", "redundancy", "band", "q", "count",
+                                                        "evaluations", "position_error", "orientation_error",
+                                                        "within_limits"};
+
+/* solve_all_rows(batch, start, stop): om_solve_all of rows start:stop of a batch
+ * (om_redundant._core.SolveAllBatch): T (M, 4, 4), signs (M, k) int64, redundancy (M, r),
+ * band (M,) bool (whether a row without a root of its own searches the band) in; q (M,
+ * MAX_ROOTS, dof), count (M,) int64, evaluations (M,) int64, and per root position_error,
+ * orientation_error (M, MAX_ROOTS) and within_limits (M, MAX_ROOTS) bool out, each row's as
+ * solve_all's (the entries beyond a row's count left as they were). */
 static PyObject *Solver_solve_all_rows(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
     const om_solver_data *s = om_solver_ready(self);
-    if (!s || check_nargs(nargs, 9, "solve_all_rows") < 0) return NULL;
+    PyObject *w[SA_N];
+    if (!s || check_nargs(nargs, 3, "solve_all_rows") < 0 ||
+        get_fields(args[0], solve_all_batch_names, SA_N, w, "solve_all_rows' batch") < 0)
+        return NULL;
     int dof = s->dof, k = s->n_signs, nr = s->n_redundancy;
-    PyObject *outs[4] = {args[5], args[6], args[7], args[8]};
-    const buffer_spec specs[4] = {{F64, OM_MAX_ROOTS * dof, 1, "roots"},
-                                  {F64, OM_MAX_ROOTS * 3, 1, "info"},
-                                  {I64, 2, 1, "counts"},
+    PyObject *rows[5] = {w[SA_T], w[SA_SIGNS], w[SA_REDUNDANCY], args[1], args[2]};
+    PyObject *outs[7] = {w[SA_Q],        w[SA_COUNT],   w[SA_EVALUATIONS], w[SA_POSITION],
+                         w[SA_ORIENTATION], w[SA_WITHIN], w[SA_BAND]};
+    const buffer_spec specs[7] = {{F64, OM_MAX_ROOTS * dof, 1, "q"},      {I64, 1, 1, "count"},
+                                  {I64, 1, 1, "evaluations"},             {F64, OM_MAX_ROOTS, 1, "position_error"},
+                                  {F64, OM_MAX_ROOTS, 1, "orientation_error"}, {U8, OM_MAX_ROOTS, 1, "within_limits"},
                                   {U8, 1, 0, "band"}};
-    Py_buffer v[7];
+    Py_buffer v[10];
     Py_ssize_t start, stop;
     int64_t *signs;
-    if (get_rows(s, args, outs, specs, 4, v, &start, &stop, &signs) < 0) return NULL;
+    PyObject *result = NULL;
+    if (get_rows(s, rows, outs, specs, 7, v, &start, &stop, &signs) < 0) goto done;
     const double *Tb = v[0].buf, *rb = v[2].buf;
-    double *roots = v[3].buf, *info = v[4].buf;
-    int64_t *counts = v[5].buf;
-    const uint8_t *band = v[6].buf;
+    double *roots = v[3].buf, *position = v[6].buf, *orientation = v[7].buf;
+    int64_t *count = v[4].buf, *evaluations = v[5].buf;
+    uint8_t *within = v[8].buf;
+    const uint8_t *band = v[9].buf;
     /* Neighbouring rows that differ in the SHOULDER sign alone share the circle's candidates,
      * and the rows' scans of one pose the model's parts at their samples (the memo). */
     om_scan_cache cache = {.valid = false, .capacity = OM_SCAN_CAPACITY(s->scan_points)};
     Py_BEGIN_ALLOW_THREADS cache.candidates = malloc((size_t)cache.capacity * sizeof(double));
     cache.memo = om_scan_memo_new(s);
     for (Py_ssize_t i = start; i < stop; i++) {
-        int64_t evaluations;
-        counts[2 * i] = om_solve_all(s, Tb + 16 * i, signs + k * (i - start), rb + nr * i,
-                                     roots + OM_MAX_ROOTS * dof * i, info + OM_MAX_ROOTS * 3 * i, &evaluations, band[i],
-                                     cache.candidates ? &cache : NULL);
-        counts[2 * i + 1] = evaluations;
+        double info[OM_MAX_ROOTS * 3];
+        count[i] = om_solve_all(s, Tb + 16 * i, signs + k * (i - start), rb + nr * i, roots + OM_MAX_ROOTS * dof * i,
+                                info, &evaluations[i], band[i], cache.candidates ? &cache : NULL);
+        for (int r = 0; r < count[i]; r++) put_root_info(info + 3 * r, OM_MAX_ROOTS * i + r, position, orientation, within);
     }
     free(cache.candidates);
     om_scan_memo_free(cache.memo);
-    Py_END_ALLOW_THREADS release_buffers(v, 7);
+    Py_END_ALLOW_THREADS release_buffers(v, 10);
     PyMem_Free(signs);
-    Py_RETURN_NONE;
+    result = Py_NewRef(Py_None);
+done:
+    release_fields(w, SA_N);
+    return result;
 }
 
-/* solve_all(T, signs, redundancy, roots, info) -> (count, evaluations); roots (MAX_ROOTS,
- * dof), info (MAX_ROOTS, 3) gets (position error, orientation error, within limits). */
+/* The fields of solve_all's roots (om_redundant._core.Roots) it writes. */
+enum { RT_Q, RT_POSITION, RT_ORIENTATION, RT_WITHIN, RT_N };
+static const char *const roots_names[RT_N] = {"q", "position_error", "orientation_error", "within_limits"};
+
+/* solve_all(T, signs, redundancy, roots) -> Found(count, evaluations); roots
+ * (om_redundant._core.Roots) gets the first count roots: q (MAX_ROOTS, dof), position_error,
+ * orientation_error (MAX_ROOTS,) and within_limits (MAX_ROOTS,) bool. */
 static PyObject *Solver_solve_all(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
     const om_solver_data *s = om_solver_ready(self);
     configuration c;
-    if (!s || get_call(s, args, nargs, 5, "solve_all", &c) < 0) return NULL;
-    PyObject *objs[3] = {args[0], args[3], args[4]};
-    buffer_spec specs[3] = {{F64, 16, 0, "T"}, {F64, OM_MAX_ROOTS * s->dof, 1, "roots"},
-                            {F64, OM_MAX_ROOTS * 3, 1, "info"}};
-    Py_buffer v[3];
-    if (get_buffers(objs, v, specs, 3) < 0) return NULL;
-    double T[16]; /* (a copy, as solve's) */
+    PyObject *w[RT_N];
+    if (!s || get_call(s, args, nargs, 4, "solve_all", &c) < 0 ||
+        get_fields(args[3], roots_names, RT_N, w, "solve_all's roots") < 0)
+        return NULL;
+    PyObject *objs[5] = {args[0], w[RT_Q], w[RT_POSITION], w[RT_ORIENTATION], w[RT_WITHIN]};
+    buffer_spec specs[5] = {{F64, 16, 0, "T"}, {F64, OM_MAX_ROOTS * s->dof, 1, "q"},
+                            {F64, OM_MAX_ROOTS, 1, "position_error"}, {F64, OM_MAX_ROOTS, 1, "orientation_error"},
+                            {U8, OM_MAX_ROOTS, 1, "within_limits"}};
+    Py_buffer v[5];
+    PyObject *result = NULL;
+    if (get_buffers(objs, v, specs, 5) < 0) goto done;
+    double T[16], info[OM_MAX_ROOTS * 3]; /* (T: a copy, as solve's) */
     memcpy(T, v[0].buf, sizeof T);
     int n;
     int64_t evaluations;
-    Py_BEGIN_ALLOW_THREADS n = om_solve_all(s, T, c.signs, c.redundancy, v[1].buf, v[2].buf, &evaluations, true, NULL);
-    Py_END_ALLOW_THREADS release_buffers(v, 3);
-    return Py_BuildValue("(iL)", n, (long long)evaluations);
+    Py_BEGIN_ALLOW_THREADS n = om_solve_all(s, T, c.signs, c.redundancy, v[1].buf, info, &evaluations, true, NULL);
+    for (int r = 0; r < n; r++) put_root_info(info + 3 * r, r, v[2].buf, v[3].buf, v[4].buf);
+    Py_END_ALLOW_THREADS release_buffers(v, 5);
+    result = new_found(n, evaluations);
+done:
+    release_fields(w, RT_N);
+    return result;
 }
 
-/* bounded_search(T, signs, redundancy, roots, certify) -> (count, evaluations): the bounded
- * search's roots of a configuration (om_all_roots on the whole circle or torus; roots
+/* bounded_search(T, signs, redundancy, roots, certify) -> Found(count, evaluations): the
+ * bounded search's roots of a configuration (om_all_roots on the whole circle or torus; roots
  * (MAX_ROOTS, dof), as found, in the arm's own joints), with the torus certificate where it
  * proves them (certify) or the grid search alone: what the tests compare. */
 static PyObject *Solver_bounded_search(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
@@ -372,10 +484,10 @@ static PyObject *Solver_bounded_search(Solver *self, PyObject *const *args, Py_s
     for (int r = 0; r < n && s->flipped; r++)
         om_flip(s, (double *)v[1].buf + r * s->dof, (double *)v[1].buf + r * s->dof);
     Py_END_ALLOW_THREADS release_buffers(v, 2);
-    return Py_BuildValue("(iL)", n, (long long)pb.counter);
+    return new_found(n, pb.counter);
 }
 
-/* torus_bound(T, signs, redundancy, w1, w7, h) -> (g1, g7, unreachable, (q1, q7)):
+/* torus_bound(T, signs, redundancy, w1, w7, h) -> TorusBound(g1, g7, unreachable, q1, q7):
  * om_torus_cell_bound for the configuration (an arm whose search is on the torus), what its
  * tests check against the map itself. */
 static PyObject *Solver_torus_bound(Solver *self, PyObject *const *args, Py_ssize_t nargs) {
@@ -396,7 +508,9 @@ static PyObject *Solver_torus_bound(Solver *self, PyObject *const *args, Py_ssiz
     om_problem_init(&pb, s, T.buf, c.signs, c.redundancy, psi, zeros);
     om_torus_bound b = om_torus_cell_bound(&pb, w1, w7, h, q);
     PyBuffer_Release(&T);
-    return Py_BuildValue("(ddO(dd))", b.g1, b.g7, b.unreachable ? Py_True : Py_False, q[0], q[6]);
+    PyObject *items[5] = {PyFloat_FromDouble(b.g1), PyFloat_FromDouble(b.g7), PyBool_FromLong(b.unreachable),
+                          PyFloat_FromDouble(q[0]), PyFloat_FromDouble(q[6])};
+    return new_record(torus_bound_type, items, 5);
 }
 
 /* configuration_values(q, branch, redundancy): the branch quantities and redundancy values at q. */
@@ -427,20 +541,27 @@ static PyObject *Solver_holds(Solver *self, PyObject *const *args, Py_ssize_t na
 }
 
 static PyMethodDef Solver_methods[] = {
-    {"solve", (PyCFunction)(void (*)(void))Solver_solve, METH_FASTCALL, "One solve; see om_redundant.om.solver."},
+    {"solve", (PyCFunction)(void (*)(void))Solver_solve, METH_FASTCALL,
+     "solve(T, signs, redundancy, hint, q_out) -> Solved: one solve; see om_redundant.om.solver."},
     {"solve_pose", (PyCFunction)(void (*)(void))om_solver_solve_pose, METH_FASTCALL,
      "solve_pose(T, configuration) -> Solution, or None: the whole unhinted solve in one call."},
-    {"solve_rows", (PyCFunction)(void (*)(void))Solver_solve_rows, METH_FASTCALL, "Rows of a batch."},
+    {"solve_rows", (PyCFunction)(void (*)(void))Solver_solve_rows, METH_FASTCALL,
+     "solve_rows(batch, start, stop): rows of a batch (a _core.SolveBatch)."},
     {"solve_all_rows", (PyCFunction)(void (*)(void))Solver_solve_all_rows, METH_FASTCALL,
-     "Every root in each configuration of rows of a batch."},
-    {"solve_all", (PyCFunction)(void (*)(void))Solver_solve_all, METH_FASTCALL, "Every root in a configuration."},
+     "solve_all_rows(batch, start, stop): every root in each configuration of rows of a batch (a "
+     "_core.SolveAllBatch)."},
+    {"solve_all", (PyCFunction)(void (*)(void))Solver_solve_all, METH_FASTCALL,
+     "solve_all(T, signs, redundancy, roots) -> Found: every root in a configuration, into roots (a _core.Roots)."},
     {"configuration_values", (PyCFunction)(void (*)(void))Solver_configuration_values, METH_FASTCALL,
-     "Branch quantities and redundancy values at q."},
+     "configuration_values(q, branch, redundancy): branch quantities and redundancy values at q."},
     {"bounded_search", (PyCFunction)(void (*)(void))Solver_bounded_search, METH_FASTCALL,
-     "The bounded search's roots of a configuration, with or without the torus certificate."},
+     "bounded_search(T, signs, redundancy, roots, certify) -> Found: the bounded search's roots of a "
+     "configuration, with or without the torus certificate."},
     {"torus_bound", (PyCFunction)(void (*)(void))Solver_torus_bound, METH_FASTCALL,
-     "The torus map's rate bounds on a cell (om_torus_cell_bound)."},
-    {"holds", (PyCFunction)(void (*)(void))Solver_holds, METH_FASTCALL, "Whether q is in a configuration (band)."},
+     "torus_bound(T, signs, redundancy, w1, w7, h) -> TorusBound: the torus map's rate bounds on a cell "
+     "(om_torus_cell_bound)."},
+    {"holds", (PyCFunction)(void (*)(void))Solver_holds, METH_FASTCALL,
+     "holds(q, signs, redundancy) -> bool: whether q is in a configuration (band)."},
     {NULL, NULL, 0, NULL},
 };
 

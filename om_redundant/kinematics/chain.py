@@ -39,7 +39,12 @@ class JointKind(StrEnum):
     FIXED = "fixed"
 
 
-_KIND_CODE = {JointKind.REVOLUTE: 0, JointKind.PRISMATIC: 1, JointKind.FIXED: 2}
+#: A row's kind as the kernels' tables hold it (the codes are C's: csrc/om_kernels.h, OM_JOINT_*).
+_KIND_CODE = {
+    JointKind.REVOLUTE: _core.JOINT_REVOLUTE,
+    JointKind.PRISMATIC: _core.JOINT_PRISMATIC,
+    JointKind.FIXED: _core.JOINT_FIXED,
+}
 
 
 @dataclass(frozen=True)
@@ -98,10 +103,15 @@ class KinematicChain:
     table: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        table = np.array(
-            [(r.a, r.d, r.theta, np.cos(r.alpha), np.sin(r.alpha), _KIND_CODE[r.kind]) for r in self.rows],
-            dtype=np.float64,
-        ).reshape(-1, 6)
+        # the kernels' table: its columns are C's (csrc/om_kernels.h, OM_DH_*), read from _core
+        rows = self.rows
+        table = np.empty((len(rows), _core.DH_COLUMNS))
+        table[:, _core.DH_A] = [r.a for r in rows]
+        table[:, _core.DH_D] = [r.d for r in rows]
+        table[:, _core.DH_THETA] = [r.theta for r in rows]
+        table[:, _core.DH_COS_ALPHA] = [np.cos(r.alpha) for r in rows]
+        table[:, _core.DH_SIN_ALPHA] = [np.sin(r.alpha) for r in rows]
+        table[:, _core.DH_KIND] = [_KIND_CODE[r.kind] for r in rows]
         object.__setattr__(self, "table", table)
         for name in ("T_root_base", "T_flange_tool"):
             object.__setattr__(self, name, np.ascontiguousarray(getattr(self, name), dtype=np.float64))

@@ -43,7 +43,6 @@ from ..exceptions import ModelError
 from ..kinematics.arm import Arm
 from ..kinematics.chain import DHRow, JointKind, KinematicChain
 from ..validation import as_instance
-from .families import six_dof, srs
 
 _ANGLE_EPS = 1e-9
 #: Largest deviation (rad) of a twist from +-90 deg (or from 0 between parallel joints) that
@@ -77,7 +76,7 @@ class ModelArm:
         redundancy_names: Names of the configuration's redundancy values (``("psi",)`` for a
             7-DOF arm, empty for 6-DOF).
         dp_joint: Index of the joint that :math:`\\delta` depends on, or -1 for none; 0 (q1)
-            for a wrist with :math:`a_4 \\ne 0`, whose dp turns with q1 (``six_dof.WRIST_OFFSET``
+            for a wrist with :math:`a_4 \\ne 0`, whose dp turns with q1 (``SD_WRIST_OFFSET``
             in ``params``; ``delta`` and ``shoulder`` are then zero).
         delta: (3, 3) coefficients of dp seen from the flange, rows :math:`D_0, D_1, D_2`:
             :math:`\\delta(q_J) = D_0 + D_1 \\cos q_J + D_2 \\sin q_J` (a revolute joint's
@@ -126,7 +125,7 @@ def derive_model(arm: Arm) -> ModelArm:
         sign_names, redundancy_names = ("ARM", "ELBOW", "WRIST"), ()
     elif arm.dof == 7:
         model_chain, shoulderless, params = _srs_model(arm)
-        family, family_name = srs.SRS, "S-R-S: spherical shoulder, elbow, spherical wrist"
+        family, family_name = _core.SRS, "S-R-S: spherical shoulder, elbow, spherical wrist"
         sign_names, redundancy_names = ("SHOULDER", "ELBOW", "WRIST"), ("psi",)
     else:
         above = (
@@ -137,8 +136,8 @@ def derive_model(arm: Arm) -> ModelArm:
         )
         raise ModelError(f"arm '{arm.name}' has {arm.dof} joints; models exist for 6- and 7-DOF arms{above}")
     model = arm.with_chain(model_chain, f"{arm.name}-model")
-    if arm.dof == 6 and params[six_dof.WRIST_OFFSET] != 0.0:  # dp turns with q1: see _wrist_offset
-        a4, d5, a5 = params[six_dof.WRIST_OFFSET : six_dof.WRIST_OFFSET + 3]
+    if arm.dof == 6 and params[_core.SD_WRIST_OFFSET] != 0.0:  # dp turns with q1: see _wrist_offset
+        a4, d5, a5 = params[_core.SD_WRIST_OFFSET : _core.SD_WRIST_OFFSET + 3]
         dp_joint, delta, shoulder = 0, np.zeros((3, 3)), np.zeros((3, 3))
         dp_max = float(np.hypot(a4, d5) + abs(a5))
     else:
@@ -228,17 +227,17 @@ def _six_dof_model(arm: Arm) -> tuple[KinematicChain, int, str, np.ndarray]:
     rows[jr[4]] = dataclasses.replace(rows[jr[4]], a=0.0, d=0.0)
     model_chain = arm.chain.replace_rows(rows)
     family, family_name, params = _position_family(arm, rows)
-    params[six_dof.WRIST_ROW] = jr[3]
-    for key, j in ((six_dof.SIGMA4, 3), (six_dof.SIGMA5, 4)):
+    params[_core.SD_WRIST_ROW] = jr[3]
+    for key, j in ((_core.SD_SIGMA4, 3), (_core.SD_SIGMA5, 4)):
         params[key] = np.sign(np.sin(rows[jr[j]].alpha))
-    for key, j in ((six_dof.THETA4, 3), (six_dof.THETA5, 4), (six_dof.THETA6, 5)):
+    for key, j in ((_core.SD_THETA4, 3), (_core.SD_THETA5, 4), (_core.SD_THETA6, 5)):
         params[key] = rows[jr[j]].theta
-    params[six_dof.E_ROT : six_dof.E_ROT + 9] = _tail_rotation(rows, jr[5]).ravel()
+    params[_core.SD_E_ROT : _core.SD_E_ROT + 9] = _tail_rotation(rows, jr[5]).ravel()
     # Wrist centre in the flange frame: origin of joint 5's frame, the same for any q.
     q0 = np.zeros(6)
     _, o4 = _pose(model_chain.table[: jr[3] + 1], q0[:4])
     R_fl, p_fl = _pose(model_chain.table, q0)
-    params[six_dof.WRIST_CENTRE : six_dof.WRIST_CENTRE + 3] = R_fl.T @ (o4 - p_fl)
+    params[_core.SD_WRIST_CENTRE : _core.SD_WRIST_CENTRE + 3] = R_fl.T @ (o4 - p_fl)
     if offsets[0] != 0.0:
         _wrist_offset(arm, model_chain, offsets, params, R_fl)
         family_name += ", wrist offset a4 (dp turns with q1)"
@@ -248,7 +247,7 @@ def _six_dof_model(arm: Arm) -> tuple[KinematicChain, int, str, np.ndarray]:
 def _wrist_offset(
     arm: Arm, model_chain: KinematicChain, offsets: tuple[float, ...], params: np.ndarray, R_fl: np.ndarray
 ) -> None:
-    r"""The dp circle of a 6-DOF wrist with :math:`a_4 \ne 0`, into ``params`` (``six_dof.WRIST_OFFSET``).
+    r"""The dp circle of a 6-DOF wrist with :math:`a_4 \ne 0`, into ``params`` (``SD_WRIST_OFFSET``).
 
     Seen from the flange, dp then turns with joints 5 and 6; in DH frame 0 it turns with q1
     alone. Joint 5's axis :math:`z_4` is normal to joint 4's, :math:`z_3`, and to joint 6's,
@@ -284,11 +283,11 @@ def _wrist_offset(
             "parallel): dp then turns with joint 1"
         ) from None
     axis6 = R_fl.T @ _pose(table[: jr[5]], np.zeros(5))[0][:, 2]  # R_fl: the flange's rotation at q = 0
-    params[six_dof.WRIST_OFFSET : six_dof.WRIST_OFFSET + 3] = offsets
-    params[six_dof.AXIS4 : six_dof.AXIS4 + 9] = axis4.ravel()
-    params[six_dof.AXIS6 : six_dof.AXIS6 + 3] = axis6
+    params[_core.SD_WRIST_OFFSET : _core.SD_WRIST_OFFSET + 3] = offsets
+    params[_core.SD_AXIS4 : _core.SD_AXIS4 + 9] = axis4.ravel()
+    params[_core.SD_AXIS6 : _core.SD_AXIS6 + 3] = axis6
     a4, d5, a5 = offsets
-    s4, s5 = params[six_dof.SIGMA4], params[six_dof.SIGMA5]
+    s4, s5 = params[_core.SD_SIGMA4], params[_core.SD_SIGMA5]
     rng = np.random.default_rng(2)
     for _ in range(16):
         q = rng.uniform(-np.pi, np.pi, 6)
@@ -296,7 +295,7 @@ def _wrist_offset(
         z3 = axis4.T @ [1.0, np.cos(q[0]), np.sin(q[0])]
         z5 = R @ axis6
         n = np.cross(z3, z5)
-        z4 = -s4 * s5 * np.sign(np.sin(q[4] + params[six_dof.THETA5])) * n / np.linalg.norm(n)
+        z4 = -s4 * s5 * np.sign(np.sin(q[4] + params[_core.SD_THETA5])) * n / np.linalg.norm(n)
         dp = -(a4 * s4 * np.cross(z3, z4) + d5 * z4 + a5 * s5 * np.cross(z4, z5))
         if np.abs(dp - (p_model - _pose(arm.chain.table, q)[1])).max() > 1e-12:
             raise ModelError(
@@ -368,31 +367,33 @@ def _srs_model(arm: Arm) -> tuple[KinematicChain, KinematicChain, np.ndarray]:
         raise ModelError(
             f"arm '{arm.name}': {_joint_name(arm, 3)} does not change the shoulder-wrist distance"
         )
-    P = np.zeros(srs.N_PARAMS)
-    P[srs.SIGMA1], P[srs.SIGMA2], P[srs.SIGMA5] = (np.sign(np.sin(rows[jr[j]].alpha)) for j in (0, 1, 4))
-    P[srs.THETA : srs.THETA + 7] = [rows[r].theta for r in jr]
+    P = np.zeros(_core.SRS_N_PARAMS)
+    P[_core.SRS_SIGMA1], P[_core.SRS_SIGMA2], P[_core.SRS_SIGMA5] = (
+        np.sign(np.sin(rows[jr[j]].alpha)) for j in (0, 1, 4)
+    )
+    P[_core.SRS_THETA : _core.SRS_THETA + 7] = [rows[r].theta for r in jr]
     # The wrist's middle rotation Rx(alpha_6) F = Rz(a) Rx(beta) Rz(b), F the fixed rows'.
     middle = _rotx(rows[jr[5]].alpha) @ _pose(table[jr[5] + 1 : jr[6]], q0[:0])[0]
     sin_beta = np.sign(np.sin(rows[jr[5]].alpha)) * np.sqrt(max(1.0 - middle[2, 2] ** 2, 0.0))
-    P[srs.SIN_BETA], P[srs.COS_BETA] = sin_beta, middle[2, 2]
-    P[srs.THETA + 5] += np.arctan2(middle[0, 2] / sin_beta, -middle[1, 2] / sin_beta)
-    P[srs.THETA + 6] += np.arctan2(middle[2, 0] / sin_beta, middle[2, 1] / sin_beta)
-    P[srs.SHOULDER : srs.SHOULDER + 3] = S
-    P[srs.WRIST : srs.WRIST + 3] = R_fl.T @ (W - p_fl)
-    P[srs.S3 : srs.S3 + 3] = s3
-    P[srs.U : srs.U + 3] = u
-    P[srs.K0], P[srs.K], P[srs.PHI_STAR] = k0, np.hypot(k1, k2), np.arctan2(k2, k1)
-    P[srs.COS_PHI_STAR], P[srs.SIN_PHI_STAR] = k1 / P[srs.K], k2 / P[srs.K]
-    P[srs.R_PRE : srs.R_PRE + 9] = _pose(table[: jr[0]], q0[:0])[0].ravel()
-    P[srs.X3 : srs.X3 + 9] = _rotx(rows[jr[2]].alpha).ravel()
-    P[srs.X4 : srs.X4 + 9] = _rotx(rows[jr[3]].alpha).ravel()
-    P[srs.E_ROT : srs.E_ROT + 9] = _tail_rotation(rows, jr[6]).ravel()
+    P[_core.SRS_SIN_BETA], P[_core.SRS_COS_BETA] = sin_beta, middle[2, 2]
+    P[_core.SRS_THETA + 5] += np.arctan2(middle[0, 2] / sin_beta, -middle[1, 2] / sin_beta)
+    P[_core.SRS_THETA + 6] += np.arctan2(middle[2, 0] / sin_beta, middle[2, 1] / sin_beta)
+    P[_core.SRS_SHOULDER : _core.SRS_SHOULDER + 3] = S
+    P[_core.SRS_WRIST : _core.SRS_WRIST + 3] = R_fl.T @ (W - p_fl)
+    P[_core.SRS_S3 : _core.SRS_S3 + 3] = s3
+    P[_core.SRS_U : _core.SRS_U + 3] = u
+    P[_core.SRS_K0], P[_core.SRS_K], P[_core.SRS_PHI_STAR] = k0, np.hypot(k1, k2), np.arctan2(k2, k1)
+    P[_core.SRS_COS_PHI_STAR], P[_core.SRS_SIN_PHI_STAR] = k1 / P[_core.SRS_K], k2 / P[_core.SRS_K]
+    P[_core.SRS_R_PRE : _core.SRS_R_PRE + 9] = _pose(table[: jr[0]], q0[:0])[0].ravel()
+    P[_core.SRS_X3 : _core.SRS_X3 + 9] = _rotx(rows[jr[2]].alpha).ravel()
+    P[_core.SRS_X4 : _core.SRS_X4 + 9] = _rotx(rows[jr[3]].alpha).ravel()
+    P[_core.SRS_E_ROT : _core.SRS_E_ROT + 9] = _tail_rotation(rows, jr[6]).ravel()
     R_base = chain.T_root_base[:3, :3]
     # sigma: with the elbow bent (phi4 = phi* + pi/2, ELBOW = +1), b3 points to the elbow -s3.
-    v = _rotz(P[srs.PHI_STAR] + np.pi / 2) @ u - s3
-    P[srs.BEND] = np.sign(np.cross([0.0, 0.0, 1.0], v) @ -s3)
-    P[srs.UP : srs.UP + 3] = R_base.T @ np.array([0.0, 0.0, 1.0])
-    P[srs.REF : srs.REF + 3] = R_base.T @ np.array([-1.0, 0.0, 0.0])
+    v = _rotz(P[_core.SRS_PHI_STAR] + np.pi / 2) @ u - s3
+    P[_core.SRS_BEND] = np.sign(np.cross([0.0, 0.0, 1.0], v) @ -s3)
+    P[_core.SRS_UP : _core.SRS_UP + 3] = R_base.T @ np.array([0.0, 0.0, 1.0])
+    P[_core.SRS_REF : _core.SRS_REF + 3] = R_base.T @ np.array([-1.0, 0.0, 0.0])
     return chain, shoulderless, P
 
 
@@ -491,7 +492,7 @@ def _tail_rotation(rows: list[DHRow], last: int) -> np.ndarray:
 def _position_family(arm: Arm, rows: list[DHRow]) -> tuple[int, str, np.ndarray]:
     jr = arm.chain.joint_rows
     r1, r2, r3, r4 = (rows[jr[j]] for j in range(4))
-    P = np.zeros(six_dof.N_PARAMS)
+    P = np.zeros(_core.SD_N_PARAMS)
     if r1.kind is not JointKind.REVOLUTE or r2.kind is not JointKind.REVOLUTE:
         raise ModelError(
             f"arm '{arm.name}': {_joint_name(arm, 0)} and {_joint_name(arm, 1)} must be revolute for a "
@@ -509,9 +510,9 @@ def _position_family(arm: Arm, rows: list[DHRow]) -> tuple[int, str, np.ndarray]
             "(alpha_1 = +-90 deg), got "
             f"{np.degrees(r1.alpha):.10g} deg"
         )
-    P[six_dof.A1], P[six_dof.D1], P[six_dof.THETA1] = r1.a, r1.d, r1.theta
-    P[six_dof.SIGMA1] = np.sign(np.sin(r1.alpha))
-    P[six_dof.A2], P[six_dof.THETA2] = r2.a, r2.theta
+    P[_core.SD_A1], P[_core.SD_D1], P[_core.SD_THETA1] = r1.a, r1.d, r1.theta
+    P[_core.SD_SIGMA1] = np.sign(np.sin(r1.alpha))
+    P[_core.SD_A2], P[_core.SD_THETA2] = r2.a, r2.theta
     between = rows[jr[2] + 1 : jr[3]]
     if any(r.a != 0.0 or r.d != 0.0 for r in between):
         raise ModelError(
@@ -526,27 +527,27 @@ def _position_family(arm: Arm, rows: list[DHRow]) -> tuple[int, str, np.ndarray]
                 f"arm '{arm.name}': a2 = 0 leaves {_joint_name(arm, 1)} and {_joint_name(arm, 2)} "
                 "without a link"
             )
-        P[six_dof.LATERAL] = np.cos(r2.alpha) * r2.d + r3.d + r4.d * np.cos(r3.alpha)
+        P[_core.SD_LATERAL] = np.cos(r2.alpha) * r2.d + r3.d + r4.d * np.cos(r3.alpha)
         planar = np.array([r3.a, -r4.d * np.sin(r3.alpha)])
-        P[six_dof.ELL3] = np.linalg.norm(planar)
-        P[six_dof.BETA] = np.arctan2(planar[1], planar[0])
-        P[six_dof.THETA3] = r3.theta
+        P[_core.SD_ELL3] = np.linalg.norm(planar)
+        P[_core.SD_BETA] = np.arctan2(planar[1], planar[0])
+        P[_core.SD_THETA3] = r3.theta
         if np.cos(r2.alpha) < 0.0:
             raise ModelError(
                 f"arm '{arm.name}': alpha_2 = 180 deg ({_joint_name(arm, 2)} turning against "
                 f"{_joint_name(arm, 1)}) is not supported"
             )
-        return six_dof.RRR_SPHERICAL_WRIST, "RRR + spherical wrist (parallel joints 2, 3)", P
+        return _core.RRR_SPHERICAL_WRIST, "RRR + spherical wrist (parallel joints 2, 3)", P
     if r3.kind is JointKind.PRISMATIC and _off_right_angle(r2.alpha) <= _RIGHT_ANGLE_EPS:
         if r3.a != 0.0 or r4.d != 0.0:
             raise ModelError(
                 f"arm '{arm.name}': the RRP family needs a3 = 0 and d4 = 0 (the axis of "
                 f"{_joint_name(arm, 3)} through that of {_joint_name(arm, 2)})"
             )
-        P[six_dof.LATERAL] = r2.d
-        P[six_dof.SIGMA2] = np.sign(np.sin(r2.alpha))
-        P[six_dof.D3] = r3.d
-        return six_dof.RRP_SPHERICAL_WRIST, "RRP + spherical wrist", P
+        P[_core.SD_LATERAL] = r2.d
+        P[_core.SD_SIGMA2] = np.sign(np.sin(r2.alpha))
+        P[_core.SD_D3] = r3.d
+        return _core.RRP_SPHERICAL_WRIST, "RRP + spherical wrist", P
     raise ModelError(
         f"arm '{arm.name}': {_joints_named(arm, (0, 1, 2))} match no closed-form family (RRR with "
         "joints 2 and 3 parallel, or RRP); Theorem 2 C2 cannot be used here"

@@ -289,23 +289,37 @@ class OMSolver:
         T = as_pose(T)
         self.check_configuration(configuration)
         q = np.empty(self.arm.dof)
-        status, pos, ori, evals, within = self._kernel.solve(
-            T, configuration.signs, configuration.redundancy, self._hint(q_hint), q
-        )
+        r = self._kernel.solve(T, configuration.signs, configuration.redundancy, self._hint(q_hint), q)
         return Solution(
-            q, status == system.OK, system.STATUS_NAMES[status], configuration, pos, ori, evals, within
+            q,
+            r.status == system.OK,
+            system.STATUS_NAMES[r.status],
+            configuration,
+            r.position_error,
+            r.orientation_error,
+            r.evaluations,
+            r.within_limits,
         )
 
     def solve_all(self, T: Any, configuration: Configuration) -> list[Solution]:
         """Every real solution with this configuration (the bounded search), possibly none."""
         T = as_pose(T)
         self.check_configuration(configuration)
-        roots = np.empty((system.MAX_ROOTS, self.arm.dof))
-        info = np.empty((system.MAX_ROOTS, 3))
-        n, evals = self._kernel.solve_all(T, configuration.signs, configuration.redundancy, roots, info)
+        n = system.MAX_ROOTS
+        roots = _core.Roots(np.empty((n, self.arm.dof)), np.empty(n), np.empty(n), np.empty(n, dtype=bool))
+        found = self._kernel.solve_all(T, configuration.signs, configuration.redundancy, roots)
         return [
-            Solution(roots[r], True, "ok", configuration, info[r, 0], info[r, 1], evals, bool(info[r, 2]))
-            for r in range(n)
+            Solution(
+                roots.q[r],
+                True,
+                "ok",
+                configuration,
+                roots.position_error[r],
+                roots.orientation_error[r],
+                found.evaluations,
+                bool(roots.within_limits[r]),
+            )
+            for r in range(found.count)
         ]
 
     def solve_batch(
@@ -341,23 +355,32 @@ class OMSolver:
             hints = as_joint_vector(q_hint, self.arm.dof, "q_hint").reshape(-1, self.arm.dof)
             if len(hints) != m:
                 raise InvalidInput(f"q_hint must have {m} rows, got {len(hints)}")
-        q = np.empty((m, self.arm.dof))
-        info = np.empty((m, 5))  # status, position error, orientation error, evaluations, within limits
+        batch = _core.SolveBatch(
+            T,
+            signs,
+            redundancy,
+            hints,
+            q=np.empty((m, self.arm.dof)),
+            status=np.empty(m, dtype=np.int64),
+            position_error=np.empty(m),
+            orientation_error=np.empty(m),
+            evaluations=np.empty(m, dtype=np.int64),
+            within_limits=np.empty(m, dtype=bool),
+        )
         kernel = self._kernel
 
         def solve_range(start: int, stop: int) -> None:
-            kernel.solve_rows(T, signs, redundancy, hints, start, stop, q, info)
+            kernel.solve_rows(batch, start, stop)
 
         system.run_rows(solve_range, m, threads)
-        status = info[:, 0].astype(np.int64)
         return BatchSolution(
-            q,
-            status == system.OK,
-            status,
-            info[:, 1],
-            info[:, 2],
-            info[:, 3].astype(np.int64),
-            info[:, 4] > 0.0,
+            batch.q,
+            batch.status == system.OK,
+            batch.status,
+            batch.position_error,
+            batch.orientation_error,
+            batch.evaluations,
+            batch.within_limits,
         )
 
     def solve_all_batch(
@@ -403,16 +426,33 @@ class OMSolver:
         band = np.ones(m, dtype=bool) if band is None else np.ascontiguousarray(band, dtype=bool)
         if band.shape != (m,):
             raise InvalidInput(f"band must have one entry per row ({m}), got shape {band.shape}")
-        roots = np.full((m, system.MAX_ROOTS, dof), np.nan)
-        info = np.full((m, system.MAX_ROOTS, 3), np.nan)
-        counts = np.zeros((m, 2), dtype=np.int64)
+        n = system.MAX_ROOTS
+        batch = _core.SolveAllBatch(
+            T,
+            signs,
+            redundancy,
+            band,
+            q=np.full((m, n, dof), np.nan),
+            count=np.zeros(m, dtype=np.int64),
+            evaluations=np.zeros(m, dtype=np.int64),
+            position_error=np.full((m, n), np.nan),
+            orientation_error=np.full((m, n), np.nan),
+            within_limits=np.zeros((m, n), dtype=bool),
+        )
         kernel = self._kernel
 
         def solve_range(start: int, stop: int) -> None:
-            kernel.solve_all_rows(T, signs, redundancy, start, stop, roots, info, counts, band)
+            kernel.solve_all_rows(batch, start, stop)
 
         system.run_rows(solve_range, m, threads)
-        return BatchRoots(roots, counts[:, 0], info[..., 0], info[..., 1], counts[:, 1], info[..., 2] > 0.0)
+        return BatchRoots(
+            batch.q,
+            batch.count,
+            batch.position_error,
+            batch.orientation_error,
+            batch.evaluations,
+            batch.within_limits,
+        )
 
     def check_configuration(self, configuration: Configuration) -> None:
         """Check that a configuration fits this arm.

@@ -59,7 +59,6 @@ import os
 import threading
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
-from typing import NamedTuple
 
 import numpy as np
 
@@ -79,61 +78,9 @@ TORUS = _core.TORUS  # shoulder offsets too: dp depends on (q_1, q_7), a torus
 #: Roots kept per configuration.
 MAX_ROOTS = _core.MAX_ROOTS
 
-
-class SolverData(NamedTuple):
-    r"""A solver's fixed data, as the compiled kernels take it (C-contiguous float64 arrays).
-
-    Attributes:
-        family: Closed-form family code of the model (:mod:`om_redundant.om.families`).
-        mode: ``FIXED``, ``CIRCLE`` or ``TORUS``.
-        params: The family's parameter vector.
-        model_table: The model's DH table (rows of a, d, theta, cos alpha, sin alpha, kind).
-        real_table: The real arm's DH table.
-        dp_joint: The joint J that delta depends on on the circle (0 otherwise).
-        dp_coefficients: (6, 3): rows 0-2 the coefficients D of
-            :math:`\delta(w) = D_0 + D_1 \cos w + D_2 \sin w`, rows 3-5 those of the shoulder
-            offsets' :math:`a(q_1)` (zero off the torus).
-        T_base_root: Inverse of the pose of DH frame 0 in the root frame.
-        T_tool_flange: Inverse of the pose of the end-effector frame in the flange frame.
-        revolute: (dof,) bool.
-        lower, upper: (dof,) joint limits.
-        scan_points: Grid points of the bounded search.
-        position_tolerance, orientation_tolerance: Accepted errors (m, rad).
-        nominal_table: For an arm near a family, its nominal arm's DH table (the model side of
-            system (9), whose correction ``csrc/near.c`` solves); real_table is then the arm's
-            exact chain and lower, upper its limits, in the nominal joint coordinates
-            ``flip * q``. Empty (0 rows) for an arm in its family.
-        flip: (dof,) +-1: the kernels' joint coordinates are ``flip * q`` (all +1 but a near
-            arm's reversed axes); joint vectors cross the kernels' entry points in the arm's own.
-        near_deviation: A bound (m) on how far the nominal arm's flange frame is from the
-            arm's (:attr:`~om_redundant.om.nominal.NominalArm.deviation`); 0 in its family.
-        near_left: The correction on the left, in DH frame 0 (an arm whose nominal arm zeroes a
-            shoulder offset, :attr:`~om_redundant.om.nominal.NominalArm.shoulder_offset`, larger
-            than its wrist offset); False: on the right, in the flange frame (``csrc/near.c``).
-        near_mixed: The correction's translation mixed from its last two steps (an arm whose
-            nominal arm zeroes a shoulder or wrist offset; ``csrc/near.c``).
-    """
-
-    family: int
-    mode: int
-    params: np.ndarray
-    model_table: np.ndarray
-    real_table: np.ndarray
-    dp_joint: int
-    dp_coefficients: np.ndarray
-    T_base_root: np.ndarray
-    T_tool_flange: np.ndarray
-    revolute: np.ndarray
-    lower: np.ndarray
-    upper: np.ndarray
-    scan_points: int
-    position_tolerance: float
-    orientation_tolerance: float
-    nominal_table: np.ndarray
-    flip: np.ndarray
-    near_deviation: float
-    near_left: bool
-    near_mixed: bool
+#: A solver's fixed data, as the compiled kernels take it (defined with the kernels' other
+#: records in :mod:`om_redundant._core`).
+SolverData = _core.SolverData
 
 
 def flange_target(

@@ -3,15 +3,15 @@
 A family solves the MODEL arm exactly for a flange pose in DH frame 0, a set of branch
 signs and (for redundant arms) redundancy values, and evaluates the branch quantities and
 redundancy values that define the configuration of a joint vector. The closed forms are C
-(``csrc/``); these modules hold their parameter layouts and their math, and call them from
-Python (:mod:`.dispatch`). :mod:`om_redundant.om.model` recognises the family of a model
-arm and packs its parameters.
+(``csrc/``); these modules hold their math and call them from Python (:mod:`.dispatch`).
+:mod:`om_redundant.om.model` recognises the family of a model arm and packs its parameters.
+The family codes and the parameter layouts are written once, in ``csrc/om_kernels.h``, and
+read from :mod:`om_redundant._core` (the codes re-exported here).
 """
 
+from ..._core import RRP_SPHERICAL_WRIST, RRR_SPHERICAL_WRIST, SRS
 from .common import REACH_SLACK
 from .dispatch import branch_values, model_ik, redundancy_values
-from .six_dof import RRP_SPHERICAL_WRIST, RRR_SPHERICAL_WRIST
-from .srs import SRS
 
 __all__ = [
     "REACH_SLACK",

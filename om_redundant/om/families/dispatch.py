@@ -7,6 +7,8 @@ solver itself calls them inside its compiled kernels.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from ... import _core
@@ -42,18 +44,8 @@ def model_ik(
         The reach margin: negative (beyond ``REACH_SLACK``) when the pose is out of the
         model's reach, in which case q is not written; it measures how far.
     """
-    return _core.model_ik(
-        int(family),
-        f64(P),
-        f64(table),
-        f64(R),
-        f64(p),
-        i64(signs),
-        f64(redundancy),
-        f64(q_prev),
-        q,
-        all_joints,
-    )
+    model = _core.FamilyModel(int(family), f64(P), f64(table))
+    return _core.model_ik(model, flange_target(R, p, signs, redundancy), f64(q_prev), q, all_joints)
 
 
 def branch_values(family: int, P: np.ndarray, q: np.ndarray, out: np.ndarray) -> None:
@@ -64,6 +56,12 @@ def branch_values(family: int, P: np.ndarray, q: np.ndarray, out: np.ndarray) ->
 def redundancy_values(family: int, P: np.ndarray, q: np.ndarray, out: np.ndarray) -> None:
     """Write the redundancy values of the configuration at q (the arm angle for 7-DOF)."""
     _core.redundancy_values(int(family), f64(P), f64(q), out)
+
+
+def flange_target(R: np.ndarray, p: np.ndarray, signs: np.ndarray, redundancy: Any) -> _core.FlangeTarget:
+    """The kernels' record of a flange pose (R, p) in DH frame 0 in a configuration (signs,
+    redundancy: an array, or the arm angle psi of a 7-DOF arm as a number)."""
+    return _core.FlangeTarget(f64(R), f64(p), i64(signs), f64(redundancy).reshape(-1))
 
 
 def f64(values: np.ndarray) -> np.ndarray:

@@ -33,25 +33,22 @@ At :math:`\sin\varphi_5 = 0` (rule 3 of the paper) :math:`q_4` keeps its previou
 likewise :math:`q_1` (rule 1) when the wrist centre is on the axis of joint 1. Every angle
 comes from atan2, never acos, so that precision holds near singular joints.
 
-The closed form is C (``csrc/six_dof.c``); the parameter vector layout is given by the index
-constants below.
+The closed form is C (``csrc/six_dof.c``). The family codes and the parameter vector's layout
+are written once, in ``csrc/om_kernels.h``: Python reads them from :mod:`om_redundant._core`
+(``_core.RRR_SPHERICAL_WRIST``, ``_core.SD_A1``, ... ``_core.SD_N_PARAMS``) where it uses them.
 """
 
 from __future__ import annotations
 
-RRR_SPHERICAL_WRIST = 0
-RRP_SPHERICAL_WRIST = 1
+from typing import Any
 
-# Parameter vector layout.
-A1, D1, SIGMA1, THETA1, LATERAL, A2, THETA2 = 0, 1, 2, 3, 4, 5, 6
-ELL3, BETA, THETA3 = 7, 8, 9  # RRR
-SIGMA2, D3 = 7, 8  # RRP
-SIGMA4, SIGMA5, THETA4, THETA5, THETA6 = 10, 11, 12, 13, 14
-WRIST_CENTRE = 15  # 3 entries: wrist centre in the flange frame
-E_ROT = 18  # 9 entries, row-major: rotation from the frame after Rz(phi6) to the flange
-WRIST_ROW = 27  # index in the table of joint 4's row
-# A wrist with a4 != 0 (zero otherwise; see om_redundant.om.model and csrc/wrist_offset.c):
-WRIST_OFFSET = 28  # 3 entries: the real arm's a4, d5, a5
-AXIS4 = 31  # 9 entries: joint 4's axis z3 = C0 + C1 cos q1 + C2 sin q1 in DH frame 0 (rows C0, C1, C2)
-AXIS6 = 40  # 3 entries: joint 6's axis z5 in the flange frame
-N_PARAMS = 43
+from ... import _core
+
+
+def __getattr__(name: str) -> Any:
+    """``six_dof.X``, the layout's index ``_core.SD_X``: for the callers that still read the
+    layout here (om_redundant/redundancy/singularity.py), until they read ``_core``'s."""
+    try:
+        return getattr(_core, "SD_" + name)
+    except AttributeError:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}") from None

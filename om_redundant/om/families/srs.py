@@ -1,6 +1,9 @@
 r"""7-DOF model arms: spherical shoulder, one elbow joint, spherical wrist (Hollerbach arms).
 
-The closed form is C (``csrc/srs.c``); this module holds its parameter layout and math.
+The closed form is C (``csrc/srs.c``); this module holds its math. The family code and the
+parameter vector's layout are written once, in ``csrc/om_kernels.h``: Python reads them from
+:mod:`om_redundant._core` (``_core.SRS``, ``_core.SRS_THETA``, ... ``_core.SRS_N_PARAMS``) where it
+uses them.
 
 Joints 1-3 intersect at the shoulder centre S (fixed in DH frame 0), joints 5-7 at the wrist
 centre W (fixed in the flange frame), and joint 4 is the elbow. Offsets between S and W
@@ -55,32 +58,21 @@ rows between joints 6 and 7 (the Sawyer's) fold into the wrist's middle rotation
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from ... import _core
-from .dispatch import f64, i64
+from .dispatch import f64, flange_target
 
-SRS = 2
 
-# Parameter vector layout.
-SIGMA1, SIGMA2, SIGMA5 = 0, 1, 2
-SIN_BETA = 3  # sin(beta), the wrist's middle twist (joints 6 to 7); +-1 on most arms
-THETA = 4  # 7 entries: theta_1..theta_7 (theta_6, theta_7 with a, b of the wrist twist)
-SHOULDER = 11  # 3: S in DH frame 0
-WRIST = 14  # 3: W in the flange frame
-S3 = 17  # 3: S in DH frame 3
-U = 20  # 3: v(phi4) = Rz(phi4) u - s3
-K0, K, PHI_STAR = 23, 24, 25
-R_PRE = 26  # 9 (row-major): DH frame 0 to the frame joint 1 turns
-X3 = 35  # 9: Rx(alpha_3)
-X4 = 44  # 9: Rx(alpha_4)
-E_ROT = 53  # 9: from the frame after Rz(phi7) to the flange
-UP = 62  # 3: the root frame's up axis, in DH frame 0
-REF = 65  # 3: the reference direction r, in DH frame 0
-BEND = 68  # sigma: the bend direction's sign
-COS_BETA = 69  # cos(beta); 0 on most arms
-COS_PHI_STAR, SIN_PHI_STAR = 70, 71  # cos and sin of phi*: the elbow's cos and sin without trig
-N_PARAMS = 72
+def __getattr__(name: str) -> Any:
+    """``srs.X``, the layout's index ``_core.SRS_X``: for the callers that still read the
+    layout here (om_redundant/redundancy/singularity.py), until they read ``_core``'s."""
+    try:
+        return getattr(_core, "SRS_" + name)
+    except AttributeError:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}") from None
 
 
 def model_ik_lifted(
@@ -93,19 +85,19 @@ def model_ik_lifted(
     q7: float,
     phi4: float,
     q: np.ndarray,
-) -> tuple[float, float, float]:
+) -> _core.Lifted:
     r"""The model IK with q1, q7 and the elbow angle phi4 given rather than solved for
     (phi4 NaN: the elbow equation's root in the ELBOW branch, the edge of reach beyond it).
 
     Writes q (q1 and q7 as given) and returns the residuals of the three equations they
-    must satisfy: the shoulder's and the wrist's consistency and the elbow's,
+    must satisfy, by name: the shoulder's and the wrist's consistency and the elbow's,
     :math:`x - \cos(\varphi_4 - \varphi^*)`. Unlike the closed form, this is smooth
     everywhere but at W = S (NaN): across the straight elbow, where the two ELBOW branches
     meet in a square root, and at the shoulder and wrist singularities, where the Euler
     angles are ill-conditioned. Its roots are the model's IK in every SHOULDER and WRIST
     branch at once (each angle pair's branch follows from q1 or q7).
     """
-    return _core.model_ik_lifted(f64(P), f64(R), f64(p), i64(signs), psi, q1, q7, phi4, q)
+    return _core.model_ik_lifted(f64(P), flange_target(R, p, signs, psi), q1, q7, phi4, q)
 
 
 def model_ik_at_reach(
@@ -120,4 +112,4 @@ def model_ik_at_reach(
     """The closed form, but where the wrist centre lies beyond the model's reach the elbow is
     held at the edge (straight or folded): a start for :func:`model_ik_lifted`, which is
     smooth across that edge. Returns False, and leaves q, only where W = S."""
-    return _core.model_ik_at_reach(f64(P), f64(R), f64(p), i64(signs), psi, f64(q_prev), q)
+    return _core.model_ik_at_reach(f64(P), flange_target(R, p, signs, psi), f64(q_prev), q)
