@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 
 import om_redundant as om
 from benchmarks import adversarial as adv
+from om_redundant import _core
 from tests.conftest import random_q, run_python
 
 _SOLVERS: dict[str, om.OMSolver] = {}
@@ -57,11 +58,11 @@ def _branch_joint(solver: om.OMSolver, name: str) -> tuple[int, float] | None:
     families, params = om.om.families, solver.om.params
     srs = solver.om.family == families.SRS
     if name == "WRIST":
-        return (5, params[families.srs.THETA + 5]) if srs else (4, params[families.six_dof.THETA5])
+        return (5, params[_core.SRS_THETA + 5]) if srs else (4, params[_core.SD_THETA5])
     if srs:
-        return 3, params[families.srs.THETA + 3] - params[families.srs.PHI_STAR]
+        return 3, params[_core.SRS_THETA + 3] - params[_core.SRS_PHI_STAR]
     if solver.om.family == families.RRR_SPHERICAL_WRIST:
-        return 2, params[families.six_dof.THETA3] + params[families.six_dof.BETA]
+        return 2, params[_core.SD_THETA3] + params[_core.SD_BETA]
     return None
 
 
@@ -116,7 +117,7 @@ def test_holds_reads_psi_in_the_requested_elbow_branch():
     """A straight elbow holds both ELBOW branches, at psi in one and psi + pi in the other."""
     panda = _solver("panda")
     q = random_q(panda.arm, 1, np.random.default_rng(2))[0]
-    q[3] = panda.om.params[om.om.families.srs.PHI_STAR] - panda.om.params[om.om.families.srs.THETA + 3]
+    q[3] = panda.om.params[_core.SRS_PHI_STAR] - panda.om.params[_core.SRS_THETA + 3]
     c = panda.configuration_of(q)
     elbow = panda.sign_names.index("ELBOW")
     flipped = _flipped(panda, c, elbow)
@@ -633,6 +634,7 @@ def test_a_loop_segment_the_corrector_cannot_split_ends_its_search():
 import math
 import numpy as np
 import om_redundant as om
+from om_redundant import _core
 from tests.test_reliability import _assert_exact
 solver = om.OMSolver("fr3")
 q = np.array({_FR3_LOOP_SPLIT!r})

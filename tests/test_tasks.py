@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 import om_redundant as om
 from benchmarks.mink_reach import SETUPS, TOLERANCE, reach
 from benchmarks.robots import home_joints, pose_errors, random_joints, reference_spec
-from om_redundant.om.families import srs
+from om_redundant import _core
 from tests.conftest import load_reference_model
 
 REACH_TARGETS = 500
@@ -279,7 +279,9 @@ def singular_margins(solver, q):
 
     w = origin(4) - origin(0)
     P = solver.om.params
-    return 1.0 + w[2] / np.linalg.norm(w), abs(math.sin(q[3] + P[srs.THETA + 3] - P[srs.PHI_STAR]))
+    return 1.0 + w[2] / np.linalg.norm(w), abs(
+        math.sin(q[3] + P[_core.SRS_THETA + 3] - P[_core.SRS_PHI_STAR])
+    )
 
 
 SOLVERS_7DOF = {name: om.OMSolver(name) for name in ("panda", "fr3", "iiwa14", "xarm7")}

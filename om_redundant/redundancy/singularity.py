@@ -28,7 +28,8 @@ from functools import cached_property
 
 import numpy as np
 
-from ..om.families import RRR_SPHERICAL_WRIST, SRS, six_dof, srs
+from .. import _core
+from ..om.families import RRR_SPHERICAL_WRIST, SRS
 from ..om.model import ModelArm
 from ..validation import as_instance, as_joint_vector
 
@@ -60,16 +61,16 @@ class Singularity:
         """
         P = as_instance(model, ModelArm, "model").params
         if model.family == SRS:
-            theta = P[srs.THETA : srs.THETA + 7]
+            theta = P[_core.SRS_THETA : _core.SRS_THETA + 7]
             rows = (
                 ("wrist", 5, theta[5]),
-                ("elbow", 3, theta[3] - P[srs.PHI_STAR]),
+                ("elbow", 3, theta[3] - P[_core.SRS_PHI_STAR]),
                 ("shoulder", 1, theta[1]),
             )
         elif model.family == RRR_SPHERICAL_WRIST:
-            rows = (("wrist", 4, P[six_dof.THETA5]), ("elbow", 2, P[six_dof.THETA3] + P[six_dof.BETA]))
+            rows = (("wrist", 4, P[_core.SD_THETA5]), ("elbow", 2, P[_core.SD_THETA3] + P[_core.SD_BETA]))
         else:
-            rows = (("wrist", 4, P[six_dof.THETA5]),)
+            rows = (("wrist", 4, P[_core.SD_THETA5]),)
         names, joints, offsets = zip(*rows, strict=True)
         joints, offsets = np.array(joints), np.array(offsets, dtype=float)
         if flip is not None:  # |sin(-q + c)| = |sin(q - c)|

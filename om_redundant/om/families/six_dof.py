@@ -39,16 +39,3 @@ are written once, in ``csrc/om_kernels.h``: Python reads them from :mod:`om_redu
 """
 
 from __future__ import annotations
-
-from typing import Any
-
-from ... import _core
-
-
-def __getattr__(name: str) -> Any:
-    """``six_dof.X``, the layout's index ``_core.SD_X``: for the callers that still read the
-    layout here (om_redundant/redundancy/singularity.py), until they read ``_core``'s."""
-    try:
-        return getattr(_core, "SD_" + name)
-    except AttributeError:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}") from None

@@ -58,21 +58,10 @@ rows between joints 6 and 7 (the Sawyer's) fold into the wrist's middle rotation
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 
 from ... import _core
 from .dispatch import f64, flange_target
-
-
-def __getattr__(name: str) -> Any:
-    """``srs.X``, the layout's index ``_core.SRS_X``: for the callers that still read the
-    layout here (om_redundant/redundancy/singularity.py), until they read ``_core``'s."""
-    try:
-        return getattr(_core, "SRS_" + name)
-    except AttributeError:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}") from None
 
 
 def model_ik_lifted(
