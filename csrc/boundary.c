@@ -1,14 +1,136 @@
-/* The singular boundary's search, for a configuration whose bounded search found no root: the
- * touch points (the model's solution meeting a branch zero) and the neighbouring
- * configurations' roots within the band, each candidate made exact by candidates.c
- * (the refinement on the REAL arm) and verified like every other (verify.c). */
+/* The singular boundary: candidates that the model's closed form leaves a few digits short
+ * where a branch quantity vanishes (an angle from acos or atan2 of a vanishing pair), made
+ * exact by the Gauss-Newton refinement on the REAL arm (polish.c) and then verified like
+ * every other candidate (verify.c). */
 #include "om_system.h"
 
+#define NEAR_BOUNDARY 1e-2 /* |branch quantity| under which a failed candidate is polished */
+#define POLISH_STEPS 100   /* Jacobians per refinement: 2-4 at a simple root, more at a double one */
+#define SHOULDER_SIGN 0    /* (SHOULDER or ARM, ELBOW, WRIST) in every family */
+#define ELBOW_SIGN 1
+#define WRIST_SIGN 2
+#define SPLIT_STARTS 16    /* starts of q1 (wrist centre on joint 1's axis) or of the aligned wrist's split */
+#define SPLIT_NEAR 1e-6    /* |branch quantity| under which the model's split is arbitrary: SPLIT_STARTS */
 #define GATE_POINTS 8      /* free-angle samples of the cheap test before a neighbour's search */
 #define GATE_NEAR 0.2      /* |branch quantity| at a sample that lets a neighbour be searched */
 #define DIP_STEPS 24       /* golden-section steps to a dip's bottom: 0.618^24 of two cells, 1e-5 rad */
 #define SWING 1.5          /* rad: a change of g across one scan cell that is a swing of q_J (pi), not its slope */
 #define WRIST_BISECTIONS 64 /* halvings of a cell of the wrist residual's sign change: to the last bit */
+
+/* The smallest |branch quantity| of q and its index (NaN-safe: INFINITY for NaN). */
+static double nearest_branch(const om_solver_data *s, const double *q, int *index)
+{
+    double values[3], nearest = INFINITY;
+    om_branch_values(s->family, s->params, q, values);
+    for (int i = 0; i < s->n_signs; i++) {
+        if (fabs(values[i]) < nearest) {
+            nearest = fabs(values[i]);
+            *index = i;
+        }
+    }
+    return nearest;
+}
+
+om_polish_task om_problem_polish_task(const om_problem *pb)
+{
+    const om_solver_data *s = pb->s;
+    bool srs = s->family == OM_SRS;
+    om_polish_task t = {s->real_table, s->n_real_rows, s->dof, srs ? s->params : NULL,
+                        srs ? s->model_table : NULL, s->n_model_rows, pb->goal.R, pb->goal_p,
+                        srs ? pb->redundancy[0] : 0.0, srs ? (double)pb->signs[ELBOW_SIGN] : 0.0, true};
+    return t;
+}
+
+bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori)
+{
+    const om_solver_data *s = pb->s;
+    int branch = -1;
+    double nearest = nearest_branch(s, q, &branch);
+    bool srs = s->family == OM_SRS;
+    /* Next to psi's singular half-line the circle's root holds q to a few digits only: g turns
+     * by 2 pi within 1e-16 / rho of w there, the model's reference n by 1e-16 / rho rad */
+    bool half_line = srs && om_srs_half_line_angle(s->params, q) < NEAR_BOUNDARY;
+    /* An arm near a family's root of G holds q to the correction's settling (near.c) */
+    bool near_root = s->nominal_table && om_near_polish(pb, q, pos, ori);
+    if (near_root || (!(nearest < NEAR_BOUNDARY) && !half_line))
+        return near_root;
+    om_polish_task t = om_problem_polish_task(pb);
+    double start[OM_MAX_DOF];
+    memcpy(start, q, (size_t)s->dof * sizeof(double));
+    om_polish(&t, POLISH_STEPS, q);
+    if (om_verify(pb, q, pos, ori))
+        return true;
+    if (half_line && s->dof == 7) { /* the pose met, psi not: psi turns along the loop next to the half-line */
+        double on_pose[7];
+        om_polish_task pose = t;
+        pose.P = NULL;
+        memcpy(on_pose, q, sizeof on_pose);
+        om_polish(&pose, POLISH_STEPS, on_pose);
+        if (om_loop_pass(pb, on_pose, pos, ori)) {
+            memcpy(q, on_pose, sizeof on_pose);
+            return true;
+        }
+    }
+    /* The model's q1 is arbitrary all along its shoulder boundary where that boundary is the
+     * wrist centre on joint 1's axis (no lateral offset; a candidate there may be far off in
+     * q1 and in the ARM quantity); with a lateral offset, as at every other boundary, only
+     * within SPLIT_NEAR of it. */
+    bool on_axis = s->family == OM_SRS || s->params[SD_LATERAL] == 0.0;
+    if (!pb->split_starts || !(nearest < NEAR_BOUNDARY) || branch == ELBOW_SIGN ||
+        ((branch != SHOULDER_SIGN || !on_axis) && !(nearest < SPLIT_NEAR)))
+        return false;
+    /* The wrist centre on joint 1's axis: the model's q1 is arbitrary there (atan2 of a
+     * vanishing pair), the real arm's is not: starts around the circle of q1, each with the
+     * wrist as it was and flipped (q_{m-1} + pi, -q_m, q_{m+1} + pi: the same rotation of a
+     * spherical wrist, the other WRIST sign), since turning q1 by a turns the hand, and the
+     * wrist must turn it back, which from the kept wrist may lead the refinement across its
+     * singularity into the other WRIST sign (the Spherical arm's ARM = -3e-14 reproducer).
+     * The wrist aligned (its middle joint m = dof - 2 at zero): the model splits q_{m-1} +-
+     * q_{m+1} by the previous q, the real arm's offsets do not: starts that turn q_{m-1} by a
+     * and q_{m+1} by -+a (the model's pose kept for either alignment of the two axes). */
+    bool shoulder = branch == SHOULDER_SIGN;
+    int m = s->dof - 2;
+    for (int k = 1; k < SPLIT_STARTS; k++) {
+        double a = 2.0 * OM_PI * (double)k / (double)SPLIT_STARTS;
+        for (int turn = -1; turn <= 1; turn += 2) {
+            memcpy(q, start, (size_t)s->dof * sizeof(double));
+            if (shoulder) {
+                q[0] += a;
+                if (turn > 0) { /* the flipped wrist */
+                    q[m - 1] += OM_PI;
+                    q[m] = -q[m];
+                    q[m + 1] += OM_PI;
+                }
+            } else {
+                q[m - 1] += a;
+                q[m + 1] += (double)turn * a;
+            }
+            om_polish(&t, POLISH_STEPS, q);
+            if (om_verify(pb, q, pos, ori))
+                return true;
+        }
+    }
+    return false;
+}
+
+int om_add_candidate(om_problem *pb, double *q, double *roots, int count)
+{
+    if (!om_verify(pb, q, NULL, NULL) && !om_polish_candidate(pb, q, NULL, NULL))
+        return count;
+    return om_add_root(pb, q, roots, count);
+}
+
+om_problem om_problem_at(const om_problem *pb, const int64_t *signs, const double *redundancy)
+{
+    const om_solver_data *s = pb->s;
+    om_problem other = *pb;
+    other.signs = signs;
+    other.redundancy = redundancy;
+    other.goal = om_target_at(s->family, s->params, &pb->goal.R, redundancy);
+    other.t = other.goal;
+    other.counter = 0;
+    return other;
+}
 
 /* The problem with branch i flipped: the neighbouring configuration across that boundary.
  * psi's reference flips with the ELBOW branch, so there psi becomes psi + pi. */
@@ -19,7 +141,7 @@ static om_problem neighbour(const om_problem *pb, int i, int64_t *signs, double 
     signs[i] = -signs[i];
     for (int r = 0; r < s->n_redundancy; r++)
         redundancy[r] = pb->redundancy[r];
-    if (s->family == OM_SRS && i == OM_ELBOW_SIGN)
+    if (s->family == OM_SRS && i == ELBOW_SIGN)
         redundancy[0] = om_wrap(redundancy[0] + OM_PI);
     return om_problem_at(pb, signs, redundancy);
 }
@@ -61,7 +183,7 @@ static int dip_roots(om_problem *pb, int i, double w, double h, double *roots, i
         }
     }
     double bottom = fc < fd ? c : d;
-    if (!(branch_at(pb, i, bottom, q) < OM_NEAR_BOUNDARY))
+    if (!(branch_at(pb, i, bottom, q) < NEAR_BOUNDARY))
         return count;
     if (pb->s->mode == OM_CIRCLE)
         q[pb->s->dp_joint] = bottom;
@@ -145,7 +267,7 @@ static int wrist_roots(om_problem *pb, double *roots, int count)
 }
 
 /* Touch points: GATE_POINTS samples of the free angle w in the problem's own configuration.
- * Where the model's solution has a branch quantity within OM_NEAR_BOUNDARY of zero, it is a
+ * Where the model's solution has a branch quantity within NEAR_BOUNDARY of zero, it is a
  * candidate from the crossing (q_J = w), refined and verified into roots (a singular wrist
  * aligned to the last bit keeps the previous wrist joint, so g there never crosses zero).
  * Also the cheap test before a neighbour's bounded search: near[i] if branch i comes within
@@ -174,7 +296,7 @@ static int touch_points(om_problem *pb, bool *near, double *roots)
         double nearest = INFINITY;
         for (int i = 0; i < s->n_signs; i++)
             nearest = py_min(nearest, fabs(v[i]));
-        if (nearest < OM_NEAR_BOUNDARY) {
+        if (nearest < NEAR_BOUNDARY) {
             if (s->mode == OM_CIRCLE)
                 q[s->dp_joint] = w;
             count = om_add_candidate(pb, q, roots, count);
@@ -233,8 +355,8 @@ int om_band_roots(om_problem *pb, double *roots, bool *neighbour_reached, om_sca
     int count = touch_points(pb, near, roots);
     if (s->family != OM_SRS && s->mode == OM_CIRCLE && s->dp_joint == 5) /* q6 given: not for a4 != 0 */
         count = wrist_roots(pb, roots, count);
-    if (s->mode == OM_CIRCLE && OM_WRIST_SIGN < s->n_signs && !near[OM_WRIST_SIGN])
-        near[OM_WRIST_SIGN] = q_j_swings(pb);
+    if (s->mode == OM_CIRCLE && WRIST_SIGN < s->n_signs && !near[WRIST_SIGN])
+        near[WRIST_SIGN] = q_j_swings(pb);
     *neighbour_reached = false;
     for (int i = 0; i < s->n_signs; i++) {
         if (!near[i])
@@ -247,6 +369,6 @@ int om_band_roots(om_problem *pb, double *roots, bool *neighbour_reached, om_sca
             count = om_add_root(pb, found + r * s->dof, roots, count);
     }
     if (count == 0) /* next to psi's half-line the model's search may miss what the real arm's loop meets */
-        count = om_loop_roots(pb, roots, count, cache, om_all_roots);
+        count = om_loop_roots(pb, roots, count, cache);
     return count;
 }

@@ -14,7 +14,7 @@
  * (om_loop_pass). */
 #include "om_system.h"
 
-#define LOOP_NEAR 1e-2       /* rad: the half-line's reach (om_polish_candidate's OM_NEAR_BOUNDARY) */
+#define LOOP_NEAR 1e-2       /* rad: the half-line's reach (om_polish_candidate's NEAR_BOUNDARY) */
 #define LOOP_GATE 64         /* nodes per offset angle of the cheap test whether a pose may come near the line */
 #define LOOP_STARTS 8        /* arm angles psi + 2 pi k / LOOP_STARTS whose roots start the traces */
 #define LOOP_STEP 0.05       /* largest trace step (|dq|, rad) */
@@ -394,7 +394,7 @@ static bool _seen(const loop_search *ls, const double *q)
     return false;
 }
 
-int om_loop_roots(om_problem *pb, double *roots, int count, om_scan_cache *cache, om_roots_search all_roots)
+int om_loop_roots(om_problem *pb, double *roots, int count, om_scan_cache *cache)
 {
     const om_solver_data *s = pb->s;
     if (s->family != OM_SRS || s->dof != 7 || !_may_pass(pb, cache))
@@ -408,7 +408,7 @@ int om_loop_roots(om_problem *pb, double *roots, int count, om_scan_cache *cache
     for (int i = 0; i < LOOP_STARTS - 1 && count == 0; i++) {
         double psi = om_wrap(pb->redundancy[0] + 2.0 * OM_PI * (double)order[i] / (double)LOOP_STARTS);
         om_problem other = om_problem_at(pb, pb->signs, &psi);
-        int n = all_roots(&other, s->scan_points, starts, pb->q_prev, INFINITY);
+        int n = om_all_roots(&other, s->scan_points, starts, pb->q_prev, INFINITY);
         pb->counter += other.counter;
         for (int r = 0; r < n; r++)
             if (!_seen(&ls, starts + 7 * r))

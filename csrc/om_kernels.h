@@ -329,7 +329,7 @@ void om_set_goal(om_problem *pb, const mat3 *R, vec3 p);
  * pose; q replaced, and its errors into *pos, *ori (NULL: not wanted), only where the polished
  * one verifies with smaller errors. Returns whether q verifies at the end. */
 bool om_near_polish(om_problem *pb, double *q, double *pos, double *ori);
-/* joints.c: out = flip * in: the arm's own joint coordinates to the kernels' and back (out may be in). */
+/* out = flip * in: the arm's own joint coordinates to the kernels' and back (out may be in). */
 void om_flip(const om_solver_data *s, const double *in, double *out);
 /* At q in the arm's own joint coordinates: the real arm's flange Jacobian in DH frame 0 (6 x dof,
  * rows [v; omega], columns by the arm's joints) and the flange pose (R, p; NULL: not wanted); the
@@ -400,7 +400,7 @@ int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool f
  * or out of memory); freed by om_scan_memo_free (NULL: nothing). */
 om_scan_memo *om_scan_memo_new(const om_solver_data *s);
 void om_scan_memo_free(om_scan_memo *memo);
-/* wrist_bands.c: candidates in the bands around the singular wrist of an arm with a4 != 0. */
+/* wrist_offset.c: candidates in the bands around the singular wrist of an arm with a4 != 0. */
 #define OM_WRIST_BAND_CANDIDATES 256 /* room for them */
 int om_wrist_offset_candidates(om_problem *pb, double lo, double hi, bool full_circle, double *q, double *cands,
                                int cap);
@@ -437,7 +437,7 @@ om_torus_bound om_torus_cell_bound(om_problem *pb, double w1, double w7, double 
  * count into *count, on an arm whose offsets are small against it; returns whether it did
  * (false: the grid search decides). */
 bool om_torus_certified_roots(om_problem *pb, double *roots, int *count, const double *centre, double radius);
-/* problem.c: x = W - S of the model on the torus less its parts that turn with w1 and w7:
+/* x = W - S of the model on the torus less its parts that turn with w1 and w7:
  * p_d + R w_F - S + D3 + R D0 (x = it + D4 cos w1 + D5 sin w1 + R (D1 cos w7 + D2 sin w7)). */
 vec3 om_shoulder_wrist_centre(const om_problem *pb);
 
@@ -500,12 +500,15 @@ typedef struct {
 } om_scan_cache;
 #define OM_SCAN_CAPACITY(n_scan) (8 * (n_scan) + 8 + OM_WRIST_BAND_CANDIDATES)
 
-/* candidates.c */
+/* boundary.c */
 /* A candidate q that failed verification, refined on the real arm where a branch quantity is
  * within 1e-2 of zero, or (S-R-S) w_hat within 1e-2 rad of psi's singular half-line, or (an
  * arm near a family) where it is within NEAR_POLISH_FROM of the pose (om_near_polish; else
  * left as it is); returns whether it now verifies. */
 bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori);
+/* The refinement on the real arm toward pb's goal (with psi, S-R-S: in the requested ELBOW
+ * branch), giving up a crawl far from a root (om_polish). */
+om_polish_task om_problem_polish_task(const om_problem *pb);
 /* self_motion.c: the null vector of the real 6 x 7 Jacobian at q (the kernels' coordinates) by
  * cofactors (not normalised) */
 void om_self_motion_null(const om_solver_data *s, const double *q, double *n);
@@ -514,16 +517,10 @@ void om_self_motion_null(const om_solver_data *s, const double *q, double *n);
 bool om_eliminate(double *A, double *b, int n, double *det);
 /* om_add_root of q, polished first where it fails verification near the boundary. */
 int om_add_candidate(om_problem *pb, double *q, double *roots, int count);
-
-/* problem.c */
 /* pb's pose in another configuration (signs, redundancy: kept by the caller), its target's
  * constants for that redundancy, its evaluation counter at zero. */
 om_problem om_problem_at(const om_problem *pb, const int64_t *signs, const double *redundancy);
-/* The refinement on the real arm toward pb's goal (with psi, S-R-S: in the requested ELBOW
- * branch), giving up a crawl far from a root (om_polish). */
-om_polish_task om_problem_polish_task(const om_problem *pb);
 
-/* boundary.c */
 /* For a configuration whose bounded search found no root: the roots at its touch points
  * (samples of the free angle where the model's solution meets a branch zero, refined), and
  * those of the neighbouring configurations (one branch flipped) that hold the problem's own
@@ -531,17 +528,12 @@ om_polish_task om_problem_polish_task(const om_problem *pb);
  * (OM_MAX_ROOTS x dof); returns the count. *neighbour_reached: some neighbour had a root.
  * cache: om_loop_roots's. */
 int om_band_roots(om_problem *pb, double *roots, bool *neighbour_reached, om_scan_cache *cache);
-/* A bounded search of a problem's roots, om_all_roots's (search.c), as the boundary's search
- * hands it to the loop search: the loop search is below the searches (a candidate's polish
- * takes its pass along a loop, om_loop_pass), and calls om_all_roots only through this. */
-typedef int (*om_roots_search)(om_problem *pb, int n_scan, double *roots, const double *centre, double radius);
 /* loop_search.c: for a 7-DOF S-R-S configuration without a root whose pose's wrist centre may
  * come within 1e-2 rad of psi's singular half-line, the roots met where psi crosses the
  * requested value along the real arm's self-motion loops through the pose's solutions in the
  * same signs at other arm angles, into roots from count on; returns the count. cache (NULL:
- * none) keeps whether the pose may come near the line for the pose's next configuration;
- * all_roots: om_all_roots. */
-int om_loop_roots(om_problem *pb, double *roots, int count, om_scan_cache *cache, om_roots_search all_roots);
+ * none) keeps whether the pose may come near the line for the pose's next configuration. */
+int om_loop_roots(om_problem *pb, double *roots, int count, om_scan_cache *cache);
 /* For q on the pose (within 1e-12) next to psi's half-line: psi's crossings of the requested
  * value where the self-motion loop through q passes by the line; the first root into q (*pos,
  * *ori its errors). Returns whether there was one. */

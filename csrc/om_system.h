@@ -10,12 +10,6 @@
 #include "om_kernels.h"
 
 
-/* The branch signs' places in every family: (SHOULDER or ARM, ELBOW, WRIST). */
-enum { OM_SHOULDER_SIGN = 0, OM_ELBOW_SIGN = 1, OM_WRIST_SIGN = 2 };
-/* |branch quantity| under which a failed candidate is polished (candidates.c) and a touch
- * point is taken (boundary.c). */
-#define OM_NEAR_BOUNDARY 1e-2
-
 /* Python's a % n for n > 0 (never negative). */
 static inline int py_mod(int a, int n) { int r = a % n; return r < 0 ? r + n : r; }
 

@@ -231,6 +231,12 @@ static vec3 _shoulder_wrist(om_problem *pb, double w1, double w7, vec3 *d1, vec3
     return v_add(v_add(pb->p, pb->t.wrist), v_add(a, m_mv(*R, om_delta(D, w7))));
 }
 
+vec3 om_shoulder_wrist_centre(const om_problem *pb)
+{
+    const double(*D)[3] = pb->s->D;
+    return v_add(v_add(pb->p, pb->t.wrist), v_add(v_load(D[3], 0), m_mv(pb->t.R, v_load(D[0], 0))));
+}
+
 /* The part of x across up in the basis (b1, b2) across it. */
 static void _across(vec3 x, vec3 b1, vec3 b2, double *h)
 {

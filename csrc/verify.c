@@ -7,6 +7,7 @@
  * (an ulp of pi, 2^-51), which exceeds REDUNDANCY_TOL only next to psi's singular set: the
  * half-line, and the wrist centre at the shoulder */
 #define PSI_ROUNDING 4.440892098500626e-16
+#define SRS_ELBOW_SIGN 1    /* (SHOULDER, ELBOW, WRIST) */
 #define MAX_VALUES 16       /* branch values of a family (3 today) */
 #define HUGE_HINT 1e4       /* rad: a revolute joint's hint beyond it is reduced exactly (remainder) first */
 
@@ -41,7 +42,7 @@ static bool in_configuration(const om_solver_data *s, const double *q, const dou
         if (!(values[i] * (double)signs[i] >= 0.0 || fabs(values[i]) <= OM_BRANCH_BAND)) /* NaN: not in it */
             return false;
     if (s->family == OM_SRS) { /* psi: the only redundancy value; in the requested ELBOW branch */
-        double elbow = (double)signs[OM_ELBOW_SIGN];
+        double elbow = (double)signs[SRS_ELBOW_SIGN];
         double psi = trig ? om_srs_arm_angle_trig(s->params, trig, elbow) : om_srs_arm_angle_in(s->params, q, elbow);
         double miss = fabs(om_wrap(psi - psi_requested));
         return miss <= REDUNDANCY_TOL || miss <= psi_rounding(s, q);
