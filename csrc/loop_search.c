@@ -87,6 +87,7 @@ static bool _may_pass(const om_problem *pb, om_scan_cache *cache)
     }
     return cache->gate;
 }
+
 /* The search around the closest approach near the trace point a where a is below the
  * horizon, within LOOP_NEAR of the half-line and a local minimum of the line angle between
  * its neighbours before and after (om_loop_pass_roots, out to them). Returns the root count. */

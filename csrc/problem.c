@@ -12,6 +12,7 @@ om_polish_task om_problem_polish_task(const om_problem *pb)
                         srs ? pb->redundancy[0] : 0.0, srs ? (double)pb->signs[ELBOW_SIGN] : 0.0, true};
     return t;
 }
+
 om_problem om_problem_at(const om_problem *pb, const int64_t *signs, const double *redundancy)
 {
     const om_solver_data *s = pb->s;
