@@ -1,5 +1,25 @@
 /* Private helpers of the OM system's kernels (residual.c ... solve.c): Python's float
  * semantics where the algorithm relies on them. Not part of the binding's contract. */
+
+/* The system's files by the calls between them, bottom to top: a file calls only files on the
+ * lines above its own (no cycles: issue 33). Where a lower file must reach a higher one, the
+ * higher passes its function down: om_near_settle's model IK (residual.c's evaluations, near.c),
+ * a near arm's window of G (circle.c's, to circle_runs.c as circle_scan.window).
+ *   common.c kinematics.c wrist_offset.c
+ *   six_dof.c srs.c
+ *   srs_arm_angle.c
+ *   families.c polish.c
+ *   problem.c verify.c
+ *   near.c
+ *   residual.c self_motion.c
+ *   scalar.c circle_pole.c loop_pass.c torus_newton.c
+ *   boundary.c circle_samples.c circle_runs.c
+ *   circle.c contraction.c torus_half_line.c
+ *   torus.c wrist_offset_bands.c
+ *   search.c
+ *   loop_search.c
+ *   bands.c
+ *   solve.c */
 #ifndef OM_SYSTEM_H
 #define OM_SYSTEM_H
 

@@ -77,7 +77,7 @@ bool om_trig_shared(const om_solver_data *s)
 
 /* Position and orientation error of the REAL arm at q (into *pos, *ori), and the
  * configuration check; returns whether q is accepted. The problem's redundancy is reduced
- * (solve.c; a neighbour's in boundary.c is wrapped). */
+ * (solve.c; a neighbour's in bands.c is wrapped). */
 bool om_verify(om_problem *pb, const double *q, double *pos, double *ori)
 {
     const om_solver_data *data = pb->s;

@@ -5,7 +5,7 @@ between two samples. A coarse search, whose cells hide many islands, still finds
 that a dense one finds; with the islands left unsearched it would not (the Panda then fails
 its own self-check at 16 points).
 
-Close roots inside one cell (``csrc/circle.c``, _cell_roots): a cell is halved where the
+Close roots inside one cell (``csrc/circle_runs.c``, _cell_roots): a cell is halved where the
 curvature of g estimated from the samples allows g to turn back to zero inside it, so a
 search at 16 points holds q where close pairs and triples share its cells."""
 

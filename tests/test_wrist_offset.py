@@ -133,7 +133,7 @@ def test_a_wrist_offset_at_a_nearly_singular_wrist(q):
     """q5 within 4e-3 rad of the wrist singularity (joints 4 and 6 parallel) with a4 = 0.074:
     z4 turns through nearly pi over a few 1e-3 rad of q1, and the target's island of reach on
     the circle is narrower than the scan's cells. Each was missed (no root, or only the other
-    one) before the bands around the singular w (wrist_offset.c, om_wrist_offset_candidates)."""
+    one) before the bands around the singular w (wrist_offset_bands.c, om_wrist_offset_candidates)."""
     solver = om.OMSolver(with_offsets(om.load_arm("ur5e"), joint3={"a": 0.074}))
     assert solver.nominal is None
     check_exact(solver, np.array(q), strict=True)

@@ -1,0 +1,60 @@
+/* What the torus search (torus.c), its damped Newton (torus_newton.c) and its search at psi's
+ * half-line (torus_half_line.c) share. */
+#ifndef OM_TORUS_H
+#define OM_TORUS_H
+
+#include "om_system.h"
+
+/* Coordinates of the lifted system around a point w* of the torus where the model's w_hat is
+ * -up (psi's singular half-line): y = (r, phi, phi4) for (w1, w7) = w* + M r (cos phi, sin phi),
+ * M the inverse of the Jacobian of h (w_hat's part across up, in a basis across it) at w*.
+ * There h is about r (cos phi, sin phi): its azimuth, which psi's reference turns with, is phi,
+ * and the lifted residual, which turns by 2 pi about w* within any distance, is smooth in y. */
+typedef struct {
+    double w1, w7, m[2][2];
+} half_line_chart;
+
+/* x = (w1, w7, phi4) of chart coordinates y (chart NULL: y is x). */
+static inline vec3 lifted_of(const half_line_chart *chart, vec3 y)
+{
+    if (!chart)
+        return y;
+    double u = y.x * cos(y.y), v = y.x * sin(y.y);
+    return v3(chart->w1 + chart->m[0][0] * u + chart->m[0][1] * v, chart->w7 + chart->m[1][0] * u + chart->m[1][1] * v,
+              y.z);
+}
+
+/* Whether two points (w1, w7, phi4) are one: each coordinate within OM_SAME_ROOT, modulo 2 pi. */
+static inline bool same_point(vec3 a, vec3 b)
+{
+    return py_max(py_max(fabs(om_wrap(a.x - b.x)), fabs(om_wrap(a.y - b.y))), fabs(om_wrap(a.z - b.z))) < OM_SAME_ROOT;
+}
+
+/* om_add_candidate of a copy of q, logged (log not NULL): the search's q stays as Newton left
+ * it, whatever the verification's refinement, which depends on the configuration's signs,
+ * makes of the copy. So the candidates, in order, are those of every configuration that
+ * differs in the SHOULDER and WRIST signs alone (om_srs_model_ik_lifted does not read them). */
+static inline int torus_candidate(om_problem *pb, const double *q, double *roots, int count, om_candidate_log *log)
+{
+    double candidate[OM_MAX_DOF];
+    memcpy(candidate, q, sizeof candidate);
+    if (log) {
+        int dof = pb->s->dof;
+        if (log->count < log->cap)
+            memcpy(log->q + (size_t)dof * (size_t)log->count, q, (size_t)dof * sizeof(double));
+        log->count++;
+    }
+    return om_add_candidate(pb, candidate, roots, count);
+}
+
+/* Damped Newton on the lifted system from x (chart not NULL: in its coordinates), deflated by
+ * the first n_known rows of known; returns the residual's max norm at the end, *x_end the end
+ * point (lifted), q the model IK there (om_newton: chart NULL). */
+double om_lifted_newton(om_problem *pb, const half_line_chart *chart, vec3 x, double *q, const double *known,
+                        int n_known, vec3 *x_end);
+/* Roots next to the points of psi's half-line in the grid's square (lo1, lo7, step, m nodes a
+ * side), candidates as torus_candidate's; returns the root count. */
+int om_half_line_roots(om_problem *pb, double lo1, double lo7, double step, int m, double *q, double *roots,
+                       int count, om_candidate_log *log);
+
+#endif

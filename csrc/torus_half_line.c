@@ -1,0 +1,150 @@
+/* The torus search at psi's singular half-line: the points of the grid's square where the
+ * model's w_hat is -up (Newton on h = 0, the part of W - S across up), and Newton in each
+ * point's chart from seeds around it, where the lifted residual turns about the point
+ * (the method: om_redundant/om/system.py). */
+#include "torus.h"
+
+#define LINE_SEEDS 16          /* directions phi around a point of psi's half-line from which Newton starts */
+#define LINE_START 1e-6        /* m: the seeds' r (the lifted residual is about linear in r there) */
+#define LINE_ROOT 1e-6         /* lifted residual under which a chart's end is a candidate (rounding: 1e-16 / rho) */
+#define LINE_POINTS 8          /* points of the half-line kept per search */
+#define LINE_NEWTON 30         /* Newton steps to a point of the half-line (h = 0) */
+
+/* x(w1, w7) = W - S = p_d + a(w1) + R delta(w7) + R w_F - S of the model on the torus, and
+ * its derivatives in w1 and w7 (d1, d7). */
+static vec3 _shoulder_wrist(om_problem *pb, double w1, double w7, vec3 *d1, vec3 *d7)
+{
+    const double(*D)[3] = pb->s->D;
+    const mat3 *R = &pb->t.R;
+    double c1 = cos(w1), s1 = sin(w1), c7 = cos(w7), s7 = sin(w7);
+    vec3 a = v_add(v_load(D[3], 0), v_add(v_scale(c1, v_load(D[4], 0)), v_scale(s1, v_load(D[5], 0))));
+    *d1 = v_sub(v_scale(c1, v_load(D[5], 0)), v_scale(s1, v_load(D[4], 0)));
+    *d7 = m_mv(*R, v_sub(v_scale(c7, v_load(D[2], 0)), v_scale(s7, v_load(D[1], 0))));
+    return v_add(v_add(pb->p, pb->t.wrist), v_add(a, m_mv(*R, om_delta(D, w7))));
+}
+
+vec3 om_shoulder_wrist_centre(const om_problem *pb)
+{
+    const double(*D)[3] = pb->s->D;
+    return v_add(v_add(pb->p, pb->t.wrist), v_add(v_load(D[3], 0), m_mv(pb->t.R, v_load(D[0], 0))));
+}
+
+/* The part of x across up in the basis (b1, b2) across it. */
+static void _across(vec3 x, vec3 b1, vec3 b2, double *h)
+{
+    h[0] = v_dot(b1, x);
+    h[1] = v_dot(b2, x);
+}
+
+/* The points of the grid's square (lo1, lo7, step, m nodes a side) where the model's w_hat is
+ * -up, psi's singular half-line, into charts (LINE_POINTS); returns the count. Newton on h = 0
+ * from each cell where both parts of h may change sign (their range over the corners widened
+ * by what the cell's curvature may hide); a point is kept if Newton converges there, below
+ * the shoulder, with h's Jacobian regular. */
+static int _half_line_points(om_problem *pb, double lo1, double lo7, double step, int m, half_line_chart *charts)
+{
+    vec3 up = v_load(pb->s->params, SRS_UP), d1, d7;
+    vec3 b1 = v_unit(v_cross(up, fabs(up.x) < 0.9 ? v3(1.0, 0.0, 0.0) : v3(0.0, 1.0, 0.0))), b2 = v_cross(up, b1);
+    const double(*D)[3] = pb->s->D;
+    double r1 = v_norm(v_load(D[4], 0)) + v_norm(v_load(D[5], 0));
+    double r7 = v_norm(v_load(D[1], 0)) + v_norm(v_load(D[2], 0));
+    /* x = centre + (D4 cos w1 + D5 sin w1) + R (D1 cos w7 + D2 sin w7), the last two at most
+     * r1 and r7 long: no point where the centre's part across up, or its height, exceeds that */
+    vec3 centre = om_shoulder_wrist_centre(pb);
+    double h0[2];
+    _across(centre, b1, b2, h0);
+    if (hypot(h0[0], h0[1]) > r1 + r7 || v_dot(up, centre) > r1 + r7)
+        return 0;
+    double bend = (r1 + r7) * step * step;
+    double *H = malloc(2 * (size_t)m * (size_t)m * sizeof(double));
+    vec3 *rows = malloc(2 * (size_t)m * sizeof(vec3)), *cols = rows + m;
+    if (!H || !rows) {
+        free(H);
+        free(rows);
+        return 0;
+    }
+    vec3 corner = _shoulder_wrist(pb, lo1, lo7, &d1, &d7);
+    for (int i = 0; i < m; i++) { /* x = rows[i] + cols[j] at node (i, j) */
+        rows[i] = _shoulder_wrist(pb, lo1 + (double)i * step, lo7, &d1, &d7);
+        cols[i] = v_sub(_shoulder_wrist(pb, lo1, lo7 + (double)i * step, &d1, &d7), corner);
+    }
+    for (int i = 0; i < m; i++)
+        for (int j = 0; j < m; j++)
+            _across(v_add(rows[i], cols[j]), b1, b2, H + 2 * (i * m + j));
+    free(rows);
+    int count = 0;
+    for (int i = 0; i + 1 < m && count < LINE_POINTS; i++) {
+        for (int j = 0; j + 1 < m && count < LINE_POINTS; j++) {
+            bool crosses = true;
+            for (int c = 0; c < 2; c++) {
+                double lo = INFINITY, hi = -INFINITY;
+                for (int k = 0; k < 4; k++) {
+                    double v = H[2 * ((i + k / 2) * m + j + k % 2) + c];
+                    lo = py_min(lo, v);
+                    hi = py_max(hi, v);
+                }
+                crosses = crosses && lo - bend <= 0.0 && 0.0 <= hi + bend;
+            }
+            if (!crosses)
+                continue;
+            double w1 = lo1 + ((double)i + 0.5) * step, w7 = lo7 + ((double)j + 0.5) * step, h[2], J[2][2], det = 0.0;
+            vec3 x = v3(NAN, NAN, NAN);
+            for (int it = 0; it < LINE_NEWTON; it++) {
+                x = _shoulder_wrist(pb, w1, w7, &d1, &d7);
+                _across(x, b1, b2, h);
+                J[0][0] = v_dot(b1, d1), J[0][1] = v_dot(b1, d7), J[1][0] = v_dot(b2, d1), J[1][1] = v_dot(b2, d7);
+                det = J[0][0] * J[1][1] - J[0][1] * J[1][0];
+                if (!(fabs(det) > 0.0))
+                    break;
+                double s1 = (J[1][1] * h[0] - J[0][1] * h[1]) / det, s7 = (J[0][0] * h[1] - J[1][0] * h[0]) / det;
+                if (w1 - s1 == w1 && w7 - s7 == w7)
+                    break;
+                w1 -= s1;
+                w7 -= s7;
+            }
+            bool inside = fabs(w1 - lo1 - ((double)i + 0.5) * step) <= step &&
+                          fabs(w7 - lo7 - ((double)j + 0.5) * step) <= step;
+            if (!(fabs(det) > 0.0) || !inside || !(v_dot(up, x) < 0.0) || hypot(h[0], h[1]) > 1e-12 * v_norm(x))
+                continue;
+            bool seen = false;
+            for (int k = 0; k < count; k++)
+                seen = seen || same_point(v3(w1, w7, 0.0), v3(charts[k].w1, charts[k].w7, 0.0));
+            if (seen)
+                continue;
+            half_line_chart chart = {w1, w7, {{J[1][1] / det, -J[0][1] / det}, {-J[1][0] / det, J[0][0] / det}}};
+            charts[count++] = chart;
+        }
+    }
+    free(H);
+    return count;
+}
+
+/* Roots next to the points of psi's half-line in the grid's square (_half_line_points):
+ * Newton in each point's chart from LINE_SEEDS directions at r = LINE_START; an end whose
+ * lifted residual is below LINE_ROOT (its rounding there is about 1e-16 / rho) is a candidate,
+ * refined on the real arm and verified (torus_candidate). Returns the root count. */
+int om_half_line_roots(om_problem *pb, double lo1, double lo7, double step, int m, double *q, double *roots,
+                       int count, om_candidate_log *log)
+{
+    half_line_chart charts[LINE_POINTS];
+    int n = _half_line_points(pb, lo1, lo7, step, m, charts);
+    vec3 ends[LINE_SEEDS];
+    for (int c = 0; c < n; c++) {
+        int n_ends = 0;
+        for (int k = 0; k < LINE_SEEDS; k++) {
+            vec3 y = v3(LINE_START, 2.0 * OM_PI * (double)k / (double)LINE_SEEDS, NAN), end;
+            om_lifted_residual(pb, lifted_of(&charts[c], y), q);
+            y.z = q[3] + pb->s->params[SRS_THETA + 3]; /* the elbow's root there */
+            if (om_lifted_newton(pb, &charts[c], y, q, NULL, 0, &end) > LINE_ROOT)
+                continue;
+            bool seen = false;
+            for (int e = 0; e < n_ends; e++)
+                seen = seen || same_point(end, ends[e]);
+            if (seen)
+                continue;
+            ends[n_ends++] = end;
+            count = torus_candidate(pb, q, roots, count, log);
+        }
+    }
+    return count;
+}
