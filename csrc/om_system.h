@@ -24,6 +24,11 @@ static inline double om_near_ik(om_problem *pb, om_model_eval eval, const void *
     return om_near_settle(pb, eval, args, q);
 }
 
+/* near.c: the local solve's root of an arm near a family from its nominal arm's root q (every
+ * joint), by Gauss-Newton steps on the exact chain; q replaced, and its errors into *pos, *ori,
+ * only where the root reached verifies. Returns whether it did. */
+bool om_near_newton(om_problem *pb, double *q, double *pos, double *ori);
+
 /* Whether solver s is an arm near a family whose searches take its nominal arm's residual g~
  * first, and the real arm's G where they may differ (near.c): up to OM_NEAR_SCAN. */
 static inline bool om_scans_nominal(const om_solver_data *s)
