@@ -103,7 +103,8 @@
 #define NEAR_POLISH 3         /* Gauss-Newton steps of a root's polish on the exact chain */
 #define NEAR_POLISH_FROM 1e-8 /* m + rad: the pose errors of a root polished, from ... */
 #define NEAR_POLISHED 1e-14   /* ... down to (rounding: left as it is) */
-#define NEAR_NEWTON 4         /* Gauss-Newton steps from the nominal arm's root to the real one's (om_near_newton) */
+#define NEAR_CHORD 2          /* chord steps from the nominal arm's root to the real one's (om_near_newton) ... */
+#define NEAR_NEWTON 4         /* ... and Gauss-Newton steps where they do not verify */
 
 /* C(q) = T_real(q)^-1 T_nom(q), or on the left (s->near_left) L(q) = T_nom(q) T_real(q)^-1, into
  * (*R, *p) (q in the kernels' coordinates). */
@@ -264,22 +265,28 @@ bool om_near_polish(om_problem *pb, double *q, double *pos, double *ori)
 
 /* The nominal arm's root q (every joint: T_nom(q) = T_d, psi and c met on the model) is within
  * about delta of the real arm's root nearest it, whose pose error it is (|C(q) - I| <= delta):
- * Newton's (Gauss-Newton's) steps on the exact chain from q take it there quadratically, two or
- * three steps at delta <= OM_NEAR_SCAN (1e-6 -> 1e-12 -> rounding) where the secant on G from
- * q takes three or four evaluations of G, each a fixed point of two or three model IKs and
+ * Newton's steps on the exact chain from q take it there, NEAR_CHORD of them with q's Jacobian
+ * (om_polish_chord: each multiplies the error by about delta, 1e-6 -> 1e-12 -> rounding; at
+ * delta = 1e-4 to 1e-12, which om_near_polish takes to rounding), where the secant on G from q
+ * takes three or four evaluations of G, each a fixed point of two or three model IKs and
  * corrections. The root it reaches is verified like every other (pose to the tolerances, c by
- * the model's branch quantities and psi at it); where it does not verify -- q next to the
- * model's singular set, where the real root need not be the nearest one, or no real root there
- * -- q is left as it was, and the local solve goes on with the secant on G. */
+ * the model's branch quantities and psi at it); where it does not, NEAR_NEWTON damped
+ * Gauss-Newton steps from q (om_polish) are, and where their root does not verify either -- q
+ * next to the model's singular set, where the real root need not be the nearest one, or no
+ * real root there -- q is left as it was, and the local solve goes on with the secant on G. */
 bool om_near_newton(om_problem *pb, double *q, double *pos, double *ori)
 {
     double x[OM_MAX_DOF];
     size_t size = (size_t)pb->s->dof * sizeof(double);
     om_polish_task t = om_problem_polish_task(pb);
     memcpy(x, q, size);
-    om_polish(&t, NEAR_NEWTON, x);
-    if (!om_verify(pb, x, pos, ori))
-        return false;
+    om_polish_chord(&t, NEAR_CHORD, x);
+    if (!om_verify(pb, x, pos, ori)) {
+        memcpy(x, q, size);
+        om_polish(&t, NEAR_NEWTON, x);
+        if (!om_verify(pb, x, pos, ori))
+            return false;
+    }
     memcpy(q, x, size);
     return true;
 }
