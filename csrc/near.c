@@ -242,10 +242,9 @@ double om_near_settle(om_problem *pb, om_model_eval eval, const void *args, doub
  * (m, rad); NEAR_POLISH Gauss-Newton steps on the exact chain take a root within
  * NEAR_POLISH_FROM of the pose (quadratically) to its rounding. The polish's minimum-norm
  * steps keep it at that root. */
-bool om_near_polish(om_problem *pb, double *q, double *pos, double *ori)
+static bool _polished(om_problem *pb, double *q, double p0, double o0, bool verified, double *pos, double *ori)
 {
-    double p0, o0, polished[OM_MAX_DOF], p1, o1;
-    bool verified = om_verify(pb, q, &p0, &o0);
+    double polished[OM_MAX_DOF], p1, o1;
     if (!(p0 + o0 > NEAR_POLISHED && p0 + o0 < NEAR_POLISH_FROM)) {
         if (pos)
             *pos = p0, *ori = o0;
@@ -261,6 +260,20 @@ bool om_near_polish(om_problem *pb, double *q, double *pos, double *ori)
     if (pos)
         *pos = p0, *ori = o0;
     return verified;
+}
+
+bool om_near_polish(om_problem *pb, double *q, double *pos, double *ori)
+{
+    double p0, o0;
+    bool verified = om_verify(pb, q, &p0, &o0);
+    return _polished(pb, q, p0, o0, verified, pos, ori);
+}
+
+/* A returned root's polish, its errors known from its verification: most are within
+ * NEAR_POLISHED already, and the FK is not walked again. */
+void om_near_finish(om_problem *pb, double *q, double *pos, double *ori)
+{
+    _polished(pb, q, *pos, *ori, true, pos, ori);
 }
 
 /* The nominal arm's root q (every joint: T_nom(q) = T_d, psi and c met on the model) is within

@@ -28,6 +28,8 @@ static inline double om_near_ik(om_problem *pb, om_model_eval eval, const void *
  * joint), by Gauss-Newton steps on the exact chain; q replaced, and its errors into *pos, *ori,
  * only where the root reached verifies. Returns whether it did. */
 bool om_near_newton(om_problem *pb, double *q, double *pos, double *ori);
+/* near.c: om_near_polish of a verified root q whose errors *pos, *ori hold (not verified again). */
+void om_near_finish(om_problem *pb, double *q, double *pos, double *ori);
 /* polish.c: `steps` Newton steps on the exact chain with the start's Jacobian (the chord
  * method), q in place, untested (the caller verifies it). */
 void om_polish_chord(const om_polish_task *t, int steps, double *q);

@@ -53,7 +53,7 @@ static bool _finish(om_problem *pb, const double *q, const double *hint, bool ha
     double polished[OM_MAX_DOF];
     if (s->nominal_table) { /* an arm near a family's root to its last digits */
         memcpy(polished, q, (size_t)dof * sizeof(double));
-        om_near_polish(pb, polished, pos, ori);
+        om_near_finish(pb, polished, pos, ori); /* (*pos, *ori: its errors) */
         q = polished;
     }
     double q_pos = *pos, q_ori = *ori;
