@@ -103,7 +103,7 @@
 #define NEAR_POLISH 3         /* Gauss-Newton steps of a root's polish on the exact chain */
 #define NEAR_POLISH_FROM 1e-8 /* m + rad: the pose errors of a root polished, from ... */
 #define NEAR_POLISHED 1e-14   /* ... down to (rounding: left as it is) */
-#define NEAR_CHORD 2          /* chord steps from the nominal arm's root to the real one's (om_near_newton) ... */
+#define NEAR_CHORD 2          /* chord steps from the nominal arm's root to the real one's (om_near_secant) ... */
 #define NEAR_NEWTON 4         /* ... and Gauss-Newton steps where they do not verify */
 
 /* C(q) = T_real(q)^-1 T_nom(q), or on the left (s->near_left) L(q) = T_nom(q) T_real(q)^-1, into
@@ -286,8 +286,8 @@ void om_near_finish(om_problem *pb, double *q, double *pos, double *ori)
  * the model's branch quantities and psi at it); where it does not, NEAR_NEWTON damped
  * Gauss-Newton steps from q (om_polish) are, and where their root does not verify either -- q
  * next to the model's singular set, where the real root need not be the nearest one, or no
- * real root there -- q is left as it was, and the local solve goes on with the secant on G. */
-bool om_near_newton(om_problem *pb, double *q, double *pos, double *ori)
+ * real root there -- q is left as it was, and om_near_secant goes on with the secant on G. */
+static bool _newton(om_problem *pb, double *q, double *pos, double *ori)
 {
     double x[OM_MAX_DOF];
     size_t size = (size_t)pb->s->dof * sizeof(double);
@@ -302,6 +302,22 @@ bool om_near_newton(om_problem *pb, double *q, double *pos, double *ori)
     }
     memcpy(q, x, size);
     return true;
+}
+
+bool om_near_secant(om_problem *pb, double w, bool in_reach, double *q, double *pos, double *ori)
+{
+    double (*secant)(om_problem *, double, double *) = in_reach ? om_secant_in_reach : om_secant;
+    if (om_scans_nominal(pb->s) && pb->s->mode == OM_CIRCLE) { /* the nominal arm's root first */
+        pb->nominal = true;
+        bool touched = secant(pb, w, q) < OM_TOUCH;
+        pb->nominal = false;
+        if (touched && _newton(pb, q, pos, ori)) /* the real root nearest it, verified */
+            return true;
+        if (touched) /* G's from it */
+            w = q[pb->s->dp_joint];
+    }
+    secant(pb, w, q);
+    return false;
 }
 
 /* ------------------------------------------------------------------------------------ */

@@ -219,8 +219,8 @@ static om_result _solve(const om_solver_data *s, const double *T, const int64_t 
         double order[START_POINTS];
         _starts_away_from(outside_w, order);
         for (int k = 0; k < START_POINTS; k++) {
-            om_secant(pb, order[k], q);
-            if (om_verify(pb, q, &pos, &ori) && _finish(pb, q, hint, false, q_out, &pos, &ori))
+            bool verified = om_near_secant(pb, order[k], false, q, &pos, &ori) || om_verify(pb, q, &pos, &ori);
+            if (verified && _finish(pb, q, hint, false, q_out, &pos, &ori))
                 return _result(OM_OK, pos, ori, problem.counter, true);
         }
     }
