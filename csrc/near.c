@@ -103,7 +103,7 @@
 #define NEAR_POLISH 3         /* Gauss-Newton steps of a root's polish on the exact chain */
 #define NEAR_POLISH_FROM 1e-8 /* m + rad: the pose errors of a root polished, from ... */
 #define NEAR_POLISHED 1e-14   /* ... down to (rounding: left as it is) */
-#define NEAR_CHORD 2          /* chord steps from the nominal arm's root to the real one's (om_near_secant) ... */
+#define NEAR_CHORD 3          /* chord steps (at most) from the nominal arm's root to the real one's (om_near_secant) ... */
 #define NEAR_NEWTON 4         /* ... and Gauss-Newton steps where they do not verify */
 
 /* C(q) = T_real(q)^-1 T_nom(q), or on the left (s->near_left) L(q) = T_nom(q) T_real(q)^-1, into

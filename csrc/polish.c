@@ -200,7 +200,9 @@ double om_polish(const om_polish_task *t, int iterations, double *q)
  * about e relative over the steps, each step multiplies the residual by about e, so that from
  * e = 1e-6 two steps reach rounding, for one Jacobian and one factorization (om_polish: one of
  * each per step). No step is tested: the caller verifies q. Stops early at |e| below
- * POLISH_DONE, or where the residual is not finite or the factorization fails. */
+ * POLISH_DONE, where the last two residuals' rate puts the next below it (not computed to show
+ * it: from 1e-6, two steps and two residuals), or where the residual is not finite or the
+ * factorization fails. */
 void om_polish_chord(const om_polish_task *t, int steps, double *q)
 {
     int dof = t->dof, rows = t->P ? 7 : 6;
@@ -215,8 +217,14 @@ void om_polish_chord(const om_polish_task *t, int steps, double *q)
         A[a * rows + a] += POLISH_DAMPING * scale;
     if (!cholesky_factor(A, rows))
         return;
+    double last = NAN; /* the cost before the last step (squared norms, as cost) */
     for (int k = 0; k < steps; k++) {
         if (k > 0) {
+            /* at the last two steps' rate, cost / last, the next cost is below POLISH_DONE^2:
+             * no residual is computed to show it */
+            if (cost * cost < POLISH_DONE * POLISH_DONE * last)
+                return;
+            last = cost;
             cost = residual(t, q, e, psi_row, frames, chain_end);
             if (!(cost > POLISH_DONE * POLISH_DONE && isfinite(cost)))
                 return;
