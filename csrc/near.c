@@ -69,6 +69,12 @@
  * polished on the real arm and verified, or missed: on a set of targets of measure O(delta).
  * Every answer is polished on the exact chain to its last digits (om_near_polish).
  *
+ * The local solve (om_near_secant: from the fixed-point start, the hint, the solve's other
+ * starts) needs one root, not all: the nominal arm's root from its start (the secant on g~, the
+ * exact family's cost), then Newton's steps on the exact chain from it, which is within about
+ * delta of the real root, verified as every candidate is; the secant on G only where they do
+ * not verify. The search above is unchanged: its every candidate is refined on G.
+ *
  * The correction on the left (om_solver_data.near_left): a 7-DOF arm's shoulder offset a2,
  * which the nominal arm zeroes (nominal.py), moves the joints after it by a2 x2(q1, q2), so
  * L(q) = T_nom(q) T_real(q)^-1 is the translation by dp(q1, q2) in DH frame 0 and (N) reads
