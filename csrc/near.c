@@ -69,6 +69,12 @@
  * polished on the real arm and verified, or missed: on a set of targets of measure O(delta).
  * Every answer is polished on the exact chain to its last digits (om_near_polish).
  *
+ * The local solve (om_near_secant: from the fixed-point start, the hint, the solve's other
+ * starts) needs one root, not all: the nominal arm's root from its start (the secant on g~, the
+ * exact family's cost), then Newton's steps on the exact chain from it, which is within about
+ * delta of the real root, verified as every candidate is; the secant on G only where they do
+ * not verify. The search above is unchanged: its every candidate is refined on G.
+ *
  * The correction on the left (om_solver_data.near_left): a 7-DOF arm's shoulder offset a2,
  * which the nominal arm zeroes (nominal.py), moves the joints after it by a2 x2(q1, q2), so
  * L(q) = T_nom(q) T_real(q)^-1 is the translation by dp(q1, q2) in DH frame 0 and (N) reads
@@ -103,6 +109,8 @@
 #define NEAR_POLISH 3         /* Gauss-Newton steps of a root's polish on the exact chain */
 #define NEAR_POLISH_FROM 1e-8 /* m + rad: the pose errors of a root polished, from ... */
 #define NEAR_POLISHED 1e-14   /* ... down to (rounding: left as it is) */
+#define NEAR_CHORD 3          /* chord steps (at most) from the nominal arm's root to the real one's (om_near_secant) ... */
+#define NEAR_NEWTON 4         /* ... and Gauss-Newton steps where they do not verify */
 
 /* C(q) = T_real(q)^-1 T_nom(q), or on the left (s->near_left) L(q) = T_nom(q) T_real(q)^-1, into
  * (*R, *p) (q in the kernels' coordinates). */
@@ -240,10 +248,9 @@ double om_near_settle(om_problem *pb, om_model_eval eval, const void *args, doub
  * (m, rad); NEAR_POLISH Gauss-Newton steps on the exact chain take a root within
  * NEAR_POLISH_FROM of the pose (quadratically) to its rounding. The polish's minimum-norm
  * steps keep it at that root. */
-bool om_near_polish(om_problem *pb, double *q, double *pos, double *ori)
+static bool _polished(om_problem *pb, double *q, double p0, double o0, bool verified, double *pos, double *ori)
 {
-    double p0, o0, polished[OM_MAX_DOF], p1, o1;
-    bool verified = om_verify(pb, q, &p0, &o0);
+    double polished[OM_MAX_DOF], p1, o1;
     if (!(p0 + o0 > NEAR_POLISHED && p0 + o0 < NEAR_POLISH_FROM)) {
         if (pos)
             *pos = p0, *ori = o0;
@@ -259,6 +266,64 @@ bool om_near_polish(om_problem *pb, double *q, double *pos, double *ori)
     if (pos)
         *pos = p0, *ori = o0;
     return verified;
+}
+
+bool om_near_polish(om_problem *pb, double *q, double *pos, double *ori)
+{
+    double p0, o0;
+    bool verified = om_verify(pb, q, &p0, &o0);
+    return _polished(pb, q, p0, o0, verified, pos, ori);
+}
+
+/* A returned root's polish, its errors known from its verification: most are within
+ * NEAR_POLISHED already, and the FK is not walked again. */
+void om_near_finish(om_problem *pb, double *q, double *pos, double *ori)
+{
+    _polished(pb, q, *pos, *ori, true, pos, ori);
+}
+
+/* The nominal arm's root q (every joint: T_nom(q) = T_d, psi and c met on the model) is within
+ * about delta of the real arm's root nearest it, whose pose error it is (|C(q) - I| <= delta):
+ * Newton's steps on the exact chain from q take it there, NEAR_CHORD of them with q's Jacobian
+ * (om_polish_chord: each multiplies the error by about delta, 1e-6 -> 1e-12 -> rounding; at
+ * delta = 1e-4 to 1e-12, which om_near_polish takes to rounding), where the secant on G from q
+ * takes three or four evaluations of G, each a fixed point of two or three model IKs and
+ * corrections. The root it reaches is verified like every other (pose to the tolerances, c by
+ * the model's branch quantities and psi at it); where it does not, NEAR_NEWTON damped
+ * Gauss-Newton steps from q (om_polish) are, and where their root does not verify either -- q
+ * next to the model's singular set, where the real root need not be the nearest one, or no
+ * real root there -- q is left as it was, and om_near_secant goes on with the secant on G. */
+static bool _newton(om_problem *pb, double *q, double *pos, double *ori)
+{
+    double x[OM_MAX_DOF];
+    size_t size = (size_t)pb->s->dof * sizeof(double);
+    om_polish_task t = om_problem_polish_task(pb);
+    memcpy(x, q, size);
+    om_polish_chord(&t, NEAR_CHORD, x);
+    if (!om_verify(pb, x, pos, ori)) {
+        memcpy(x, q, size);
+        om_polish(&t, NEAR_NEWTON, x);
+        if (!om_verify(pb, x, pos, ori))
+            return false;
+    }
+    memcpy(q, x, size);
+    return true;
+}
+
+bool om_near_secant(om_problem *pb, double w, bool in_reach, double *q, double *pos, double *ori)
+{
+    double (*secant)(om_problem *, double, double *) = in_reach ? om_secant_in_reach : om_secant;
+    if (om_scans_nominal(pb->s) && pb->s->mode == OM_CIRCLE) { /* the nominal arm's root first */
+        pb->nominal = true;
+        bool touched = secant(pb, w, q) < OM_TOUCH;
+        pb->nominal = false;
+        if (touched && _newton(pb, q, pos, ori)) /* the real root nearest it, verified */
+            return true;
+        if (touched) /* G's from it */
+            w = q[pb->s->dp_joint];
+    }
+    secant(pb, w, q);
+    return false;
 }
 
 /* ------------------------------------------------------------------------------------ */

@@ -44,6 +44,19 @@ static inline double om_near_ik(om_problem *pb, om_model_eval eval, const void *
     return om_near_settle(pb, eval, args, q);
 }
 
+/* near.c: a local root from w on the circle (the secant on g, om_secant_in_reach if in_reach,
+ * else om_secant): for an arm near a family that scans its nominal arm, the nominal arm's root
+ * from w first and Newton's steps on the exact chain from it, returning true with q that
+ * verified root (its errors into *pos, *ori; NULL: not wanted); where they fail (and for every
+ * other arm), the secant on G from the nominal root (from w where it touched no zero): false,
+ * q its model IK at the end. */
+bool om_near_secant(om_problem *pb, double w, bool in_reach, double *q, double *pos, double *ori);
+/* near.c: om_near_polish of a verified root q whose errors *pos, *ori hold (not verified again). */
+void om_near_finish(om_problem *pb, double *q, double *pos, double *ori);
+/* polish.c: `steps` Newton steps on the exact chain with the start's Jacobian (the chord
+ * method), q in place, untested (the caller verifies it). */
+void om_polish_chord(const om_polish_task *t, int steps, double *q);
+
 /* Whether solver s is an arm near a family whose searches take its nominal arm's residual g~
  * first, and the real arm's G where they may differ (near.c): up to OM_NEAR_SCAN. */
 static inline bool om_scans_nominal(const om_solver_data *s)

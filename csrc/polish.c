@@ -74,9 +74,9 @@ static void jacobian(const om_polish_task *t, const double *frames, const double
         memcpy(J + 6 * t->dof, psi_row, (size_t)t->dof * sizeof(double));
 }
 
-/* Solve the symmetric positive definite A y = b (n x n, A overwritten by its Cholesky
- * factor); returns false if A is not positive definite to working precision. */
-static bool cholesky_solve(double *A, double *b, int n)
+/* A's Cholesky factor L (n x n symmetric positive definite, its lower triangle overwritten by
+ * L); returns false if A is not positive definite to working precision. */
+static bool cholesky_factor(double *A, int n)
 {
     for (int j = 0; j < n; j++) {
         double d = A[j * n + j];
@@ -92,6 +92,13 @@ static bool cholesky_solve(double *A, double *b, int n)
             A[i * n + j] = v / A[j * n + j];
         }
     }
+    return true;
+}
+
+/* b replaced by y with L L^T y = b (L: cholesky_factor's). */
+static void cholesky_substitute(const double *L, double *b, int n)
+{
+    const double *A = L;
     for (int i = 0; i < n; i++) { /* L z = b */
         for (int k = 0; k < i; k++)
             b[i] -= A[i * n + k] * b[k];
@@ -102,7 +109,32 @@ static bool cholesky_solve(double *A, double *b, int n)
             b[i] -= A[k * n + i] * b[k];
         b[i] /= A[i * n + i];
     }
+}
+
+/* Solve the symmetric positive definite A y = b (n x n, A overwritten by its Cholesky
+ * factor); returns false if A is not positive definite to working precision. */
+static bool cholesky_solve(double *A, double *b, int n)
+{
+    if (!cholesky_factor(A, n))
+        return false;
+    cholesky_substitute(A, b, n);
     return true;
+}
+
+/* J J^T (rows x rows, from J: rows x dof) into G; returns its largest diagonal entry. */
+static double gram(const double *J, int rows, int dof, double *G)
+{
+    double scale = 0.0;
+    for (int a = 0; a < rows; a++) { /* symmetric: each product sum once */
+        for (int b = 0; b <= a; b++) {
+            double d = 0.0;
+            for (int j = 0; j < dof; j++)
+                d += J[a * dof + j] * J[b * dof + j];
+            G[a * rows + b] = G[b * rows + a] = d;
+        }
+        scale = py_max(scale, G[a * rows + a]);
+    }
+    return scale;
 }
 
 /* Refine q in place by damped Gauss-Newton steps dq = J^T (J J^T + lambda^2 I)^-1 e: the
@@ -129,16 +161,7 @@ double om_polish(const om_polish_task *t, int iterations, double *q)
                 break;
             window_cost = cost;
         }
-        double scale = 0.0;
-        for (int a = 0; a < rows; a++) { /* J J^T (symmetric: each product sum once), its largest diagonal */
-            for (int b = 0; b <= a; b++) {
-                double d = 0.0;
-                for (int j = 0; j < dof; j++)
-                    d += J[a * dof + j] * J[b * dof + j];
-                G[a * rows + b] = G[b * rows + a] = d;
-            }
-            scale = py_max(scale, G[a * rows + a]);
-        }
+        double scale = gram(J, rows, dof, G); /* J J^T, its largest diagonal */
         bool improved = false;
         while (!improved && damping <= POLISH_DAMPING_MAX) {
             memcpy(A, G, (size_t)(rows * rows) * sizeof(double));
@@ -170,4 +193,48 @@ double om_polish(const om_polish_task *t, int iterations, double *q)
             break;
     }
     return sqrt(cost);
+}
+
+/* Newton's steps with the start's Jacobian (the chord method; the minimum-norm step, damped as
+ * om_polish's first): from a start within e of a simple root, where the Jacobian changes by
+ * about e relative over the steps, each step multiplies the residual by about e, so that from
+ * e = 1e-6 two steps reach rounding, for one Jacobian and one factorization (om_polish: one of
+ * each per step). No step is tested: the caller verifies q. Stops early at |e| below
+ * POLISH_DONE, where the last two residuals' rate puts the next below it (not computed to show
+ * it: from 1e-6, two steps and two residuals), or where the residual is not finite or the
+ * factorization fails. */
+void om_polish_chord(const om_polish_task *t, int steps, double *q)
+{
+    int dof = t->dof, rows = t->P ? 7 : 6;
+    double e[POLISH_ROWS], J[POLISH_ROWS * OM_MAX_DOF], A[POLISH_ROWS * POLISH_ROWS];
+    double psi_row[OM_MAX_DOF], frames[12 * OM_MAX_DOF], chain_end[12];
+    double cost = residual(t, q, e, psi_row, frames, chain_end);
+    if (!(cost > POLISH_DONE * POLISH_DONE && isfinite(cost)))
+        return;
+    jacobian(t, frames, chain_end, psi_row, J);
+    double scale = gram(J, rows, dof, A);
+    for (int a = 0; a < rows; a++)
+        A[a * rows + a] += POLISH_DAMPING * scale;
+    if (!cholesky_factor(A, rows))
+        return;
+    double last = NAN; /* the cost before the last step (squared norms, as cost) */
+    for (int k = 0; k < steps; k++) {
+        if (k > 0) {
+            /* at the last two steps' rate, cost / last, the next cost is below POLISH_DONE^2:
+             * no residual is computed to show it */
+            if (cost * cost < POLISH_DONE * POLISH_DONE * last)
+                return;
+            last = cost;
+            cost = residual(t, q, e, psi_row, frames, chain_end);
+            if (!(cost > POLISH_DONE * POLISH_DONE && isfinite(cost)))
+                return;
+        }
+        cholesky_substitute(A, e, rows);
+        for (int j = 0; j < dof; j++) {
+            double dq = 0.0;
+            for (int a = 0; a < rows; a++)
+                dq += J[a * dof + j] * e[a];
+            q[j] += dq;
+        }
+    }
 }

@@ -58,6 +58,8 @@ static double _secant_from(om_problem *pb, double w0, double g0, double *q)
         }
     }
     bool complete = false; /* whether q holds every joint at w */
+    /* near a family every evaluation of G writes every joint (om_model_ik_at) */
+    bool every = pb->s->nominal_table && !pb->nominal && !pb->wrist;
     double best = fabs(gw);
     int stalled = 0;
     for (int it = 0; it < 40 && stalled < STALL; it++) {
@@ -82,7 +84,7 @@ static double _secant_from(om_problem *pb, double w0, double g0, double *q)
         slope = (g_new - gw) / step;
         w = w + step;
         gw = g_new;
-        complete = last;
+        complete = last || every;
         if (fabs(gw) < OM_ROOT_TOL) /* q_J and w agree to 1e-13 rad: dp to about 1e-14 m */
             break;
         stalled = fabs(gw) < PROGRESS * best ? 0 : stalled + 1;

@@ -213,7 +213,10 @@ bool om_fixed_point_start(om_problem *pb, double *q, double *start)
 /* Local solve from the joint vector start, verified with the real arm: the secant on g from
  * its q_J; on the torus, and on a 7-DOF circle arm where the secant fails, the lifted Newton
  * (from the whole start: see om_complete_start); near the singular boundary, the refinement
- * on the real arm last. Returns accepted (errors into *pos, *ori); q holds the model IK at the end. */
+ * on the real arm last. An arm near a family takes its nominal arm's root first and Newton's
+ * steps on its exact chain from there (om_near_secant), the secant on G where they fail.
+ * Returns accepted (errors into *pos, *ori); q holds the model IK at the end (or the root
+ * Newton's steps reached). */
 bool om_local_solve(om_problem *pb, double *start, bool *start_complete, double *q, double *pos, double *ori)
 {
     const om_solver_data *data = pb->s;
@@ -222,13 +225,8 @@ bool om_local_solve(om_problem *pb, double *start, bool *start_complete, double 
         return om_verify(pb, q, pos, ori);
     }
     double w = data->mode == OM_CIRCLE ? start[data->dp_joint] : 0.0;
-    if (om_scans_nominal(data) && data->mode == OM_CIRCLE) { /* the nominal arm's root first, G's from it */
-        pb->nominal = true;
-        if (om_secant_in_reach(pb, w, q) < OM_TOUCH)
-            w = q[data->dp_joint];
-        pb->nominal = false;
-    }
-    om_secant_in_reach(pb, w, q);
+    if (om_near_secant(pb, w, true, q, pos, ori)) /* (near a family: a root verified) */
+        return true;
     bool accepted = om_verify(pb, q, pos, ori);
     if (!accepted && data->family == OM_SRS && data->mode == OM_CIRCLE) {
         om_complete_start(pb, start, start_complete);

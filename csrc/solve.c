@@ -53,7 +53,7 @@ static bool _finish(om_problem *pb, const double *q, const double *hint, bool ha
     double polished[OM_MAX_DOF];
     if (s->nominal_table) { /* an arm near a family's root to its last digits */
         memcpy(polished, q, (size_t)dof * sizeof(double));
-        om_near_polish(pb, polished, pos, ori);
+        om_near_finish(pb, polished, pos, ori); /* (*pos, *ori: its errors) */
         q = polished;
     }
     double q_pos = *pos, q_ori = *ori;
@@ -219,8 +219,8 @@ static om_result _solve(const om_solver_data *s, const double *T, const int64_t 
         double order[START_POINTS];
         _starts_away_from(outside_w, order);
         for (int k = 0; k < START_POINTS; k++) {
-            om_secant(pb, order[k], q);
-            if (om_verify(pb, q, &pos, &ori) && _finish(pb, q, hint, false, q_out, &pos, &ori))
+            bool verified = om_near_secant(pb, order[k], false, q, &pos, &ori) || om_verify(pb, q, &pos, &ori);
+            if (verified && _finish(pb, q, hint, false, q_out, &pos, &ori))
                 return _result(OM_OK, pos, ori, problem.counter, true);
         }
     }
