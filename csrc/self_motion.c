@@ -6,7 +6,7 @@
  * of the 6 x 7 Jacobian, here by cofactors, n_i = (-1)^i det J_{-i} (J without column i;
  * smooth in q, no factorisation to pick a sign). The arm angle moves by
  * dpsi = Dpsi(q) . n, so dq/dpsi = n / (Dpsi(q) . n). */
-#include "binding.h"
+#include "om_paths.h"
 
 /* Gaussian elimination with partial pivoting of the n x n matrix A (row-major, destroyed),
  * carrying b along (NULL: none) and then solving A x = b into b by back substitution; det A

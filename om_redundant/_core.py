@@ -3,6 +3,7 @@ one module that imports it. The rest of the package reaches the kernels, their c
 the records that cross into them through here.
 """
 
+from collections.abc import Sequence
 from typing import NamedTuple
 
 import numpy as np
@@ -19,6 +20,9 @@ from .ckernels import (
     FOLLOW_MAX_ATTEMPTS,
     FOLLOW_SINGULAR,
     FOLLOW_STALLED,
+    LINK_DONE,
+    LINK_FULL,
+    LINK_SINGULAR,
     MAX_DOF,
     MAX_ROOTS,
     MAX_SCAN_POINTS,
@@ -82,6 +86,7 @@ from .ckernels import (
     TORUS,
     UNREACHABLE,
     Followed,
+    Linked,
     Solver,
     all_finite,
     arm_angle_gradient,
@@ -126,6 +131,9 @@ __all__ = [
     "FOLLOW_MAX_ATTEMPTS",
     "FOLLOW_SINGULAR",
     "FOLLOW_STALLED",
+    "LINK_DONE",
+    "LINK_FULL",
+    "LINK_SINGULAR",
     "MAX_DOF",
     "MAX_ROOTS",
     "MAX_SCAN_POINTS",
@@ -188,8 +196,15 @@ __all__ = [
     "STATUS_NAMES",
     "TORUS",
     "UNREACHABLE",
+    "CellModels",
+    "CellSamples",
     "FollowWork",
     "Followed",
+    "LinkRoots",
+    "LinkRows",
+    "Linked",
+    "PieceLimits",
+    "PieceRows",
     "Solver",
     "all_finite",
     "arm_angle_gradient",
@@ -227,8 +242,8 @@ __all__ = [
 
 class FollowWork(NamedTuple):
     """The arrays ``follow`` reads and writes, set up once per
-    :class:`~om_redundant.redundancy.probe.Probe` (the
-    first six: the branch that ``link_paths`` links).
+    :class:`~om_redundant.redundancy.probe.Probe` (``link_paths`` reads the branch's: all but
+    ``q`` and ``t``).
 
     Attributes:
         kernel: The compiled solver.
@@ -248,3 +263,107 @@ class FollowWork(NamedTuple):
     centre: np.ndarray
     q: np.ndarray
     t: np.ndarray
+
+
+class LinkRoots(NamedTuple):
+    """A branch's roots at the grid psi that ``link_paths`` links into paths.
+
+    Attributes:
+        psi: (n,) the grid, increasing within a turn.
+        counts: (n,) the roots at each grid psi (int64), M in all.
+        q, t: (M, 7) the roots' joints and tangents, grid psi by grid psi.
+    """
+
+    psi: np.ndarray
+    counts: np.ndarray
+    q: np.ndarray
+    t: np.ndarray
+
+
+class LinkRows(NamedTuple):
+    """Where ``link_paths`` writes the paths it links: the R rows that following adds (rows
+    M, M + 1, ... after the M roots) and each path's rows.
+
+    Attributes:
+        psi: (R,) the added rows' psi.
+        q, t: (R, 7) their joints and tangents.
+        members: (M + R, 2) int64: the paths' rows in order, path after path, each with the
+            turns of psi it is taken at.
+        paths: (M + R, 2) int64: per path, where its members end and its turns (a loop's, else 0).
+    """
+
+    psi: np.ndarray
+    q: np.ndarray
+    t: np.ndarray
+    members: np.ndarray
+    paths: np.ndarray
+
+
+class PieceRows(NamedTuple):
+    """The M joint vectors at which ``pieces`` computes the feasibility functions.
+
+    Attributes:
+        q: (M, dof) the joints.
+        t: (M, dof) dq/dpsi there.
+        distances: (M, P) the clearance pairs' distances.
+        gradients: (M, P, dof) their gradients.
+    """
+
+    q: np.ndarray
+    t: np.ndarray
+    distances: np.ndarray
+    gradients: np.ndarray
+
+
+class PieceLimits(NamedTuple):
+    """The L limited joints of an arm, as ``pieces`` reads them.
+
+    Attributes:
+        limited: (L,) their indices (int64).
+        lower, upper: (L,) their limits.
+        half: (L,) half their ranges.
+    """
+
+    limited: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+    half: np.ndarray
+
+
+class CellModels(NamedTuple):
+    """The cubic Hermite models of a cell's n feasibility functions between its ends a and b
+    (``surprise``, ``crossing``).
+
+    Attributes:
+        ga, da: (n,) the functions and their rates along psi at a.
+        gb, db: (n,) the same at b.
+        span: psi_b - psi_a.
+        hermite: (4, N) the Hermite basis at the cell's N points.
+    """
+
+    ga: np.ndarray
+    da: np.ndarray
+    gb: np.ndarray
+    db: np.ndarray
+    span: float
+    hermite: np.ndarray
+
+
+class CellSamples(NamedTuple):
+    """The M samples of P paths, path after path, whose cells ``cell_looks`` tests.
+
+    Attributes:
+        q: M joint vectors (float64, (dof,) each).
+        psi: M floats.
+        pieces: M pairs (g, dg) of float64 arrays (n,): the feasibility functions and rates.
+        feasible: M bools.
+        bounds: (P + 1,) int64: each path's first sample, then M.
+        cyclic: (P, dof) bool: each path's joints compared modulo 2 pi.
+    """
+
+    q: Sequence[np.ndarray]
+    psi: Sequence[float]
+    pieces: Sequence[tuple[np.ndarray, np.ndarray]]
+    feasible: Sequence[bool]
+    bounds: np.ndarray
+    cyclic: np.ndarray

@@ -62,7 +62,7 @@ def test_surprise_is_numpys(seed, pieces, span):
     ga, gb = rng.normal(0.3, 0.5, (2, pieces))
     da, db = rng.normal(0.0, 3.0 / span, (2, pieces))
     fa, fb = bool((ga >= 0).all()), bool((gb >= 0).all())
-    got = _core.surprise(ga, da, gb, db, span, _HERMITE, fa, fb, _BOUND_SLACK)
+    got = _core.surprise(_core.CellModels(ga, da, gb, db, span, _HERMITE), fa, fb, _BOUND_SLACK)
     assert got == surprise_numpy(ga, da, gb, db, span, fa, fb)
 
 
@@ -90,7 +90,10 @@ def test_crossing_is_numpys(seed, pieces, span):
     rng = np.random.default_rng(seed)
     ga, gb = np.abs(rng.normal(0.3, 0.5, pieces)), rng.normal(0.3, 0.5, pieces)
     da, db = rng.normal(0.0, 3.0 / max(abs(span), 1e-6), (2, pieces))
-    got, want = _core.crossing(ga, da, gb, db, span, _HERMITE), crossing_numpy(ga, da, gb, db, span)
+    got, want = (
+        _core.crossing(_core.CellModels(ga, da, gb, db, span, _HERMITE)),
+        crossing_numpy(ga, da, gb, db, span),
+    )
     assert (got is None) == (want is None)
     if want is not None:
         assert 0.0 <= got <= 1.0 and abs(got - want) <= 1e-12
@@ -138,7 +141,8 @@ def cell_looks(paths):
     bounds = np.cumsum([0, *lengths])
     cyclic = np.array([c for *_, c in paths], dtype=bool).reshape(-1, 7)
     first = np.full(len(psi), -7.0)
-    _core.cell_looks(q, psi, pieces, feasible, bounds, cyclic, FINE_STEP, _BOUND_SLACK, _HERMITE, first)
+    samples = _core.CellSamples(q, psi, pieces, feasible, bounds, cyclic)
+    _core.cell_looks(samples, FINE_STEP, _BOUND_SLACK, _HERMITE, first)
     return np.split(first, bounds[1:-1]) if paths else []
 
 
@@ -161,7 +165,7 @@ def test_a_quiet_cell_has_no_surprise(seed, pieces, span):
     quiet = quiet_numpy(
         np.array([span]), ga[None], da[None], gb[None], db[None], np.array([fa]), np.array([fb])
     )
-    surprise = _core.surprise(ga, da, gb, db, span, _HERMITE, fa, fb, _BOUND_SLACK)
+    surprise = _core.surprise(_core.CellModels(ga, da, gb, db, span, _HERMITE), fa, fb, _BOUND_SLACK)
     assert np.isnan(first[0]) == (quiet[0] or surprise is None)
     if quiet[0]:
         assert surprise is None
@@ -210,14 +214,17 @@ def test_cell_looks_refuses_what_it_cannot_read():
     q, pieces, feasible = [np.zeros(7)] * 2, [(np.zeros(3), np.zeros(3))] * 2, [True, True]
     bounds, cyclic, first = np.array([0, 2]), np.ones((1, 7), dtype=bool), np.empty(2)
     rest = (FINE_STEP, _BOUND_SLACK, _HERMITE, first)
-    _core.cell_looks(q, [0.0, 0.1], pieces, feasible, bounds, cyclic, *rest)
+    _core.cell_looks(_core.CellSamples(q, [0.0, 0.1], pieces, feasible, bounds, cyclic), *rest)
     assert first[0] == 0.5 or np.isnan(first[0])
     wider = [pieces[0], (np.zeros(4), np.zeros(4))]
     with pytest.raises(ValueError, match="g must have 3 entries"):
-        _core.cell_looks(q, [0.0, 0.1], wider, feasible, bounds, cyclic, *rest)
+        _core.cell_looks(_core.CellSamples(q, [0.0, 0.1], wider, feasible, bounds, cyclic), *rest)
     with pytest.raises(TypeError, match="q must be float64"):
-        _core.cell_looks([q[0], np.zeros(7, np.float32)], [0.0, 0.1], pieces, feasible, bounds, cyclic, *rest)
+        _core.cell_looks(
+            _core.CellSamples([q[0], np.zeros(7, np.float32)], [0.0, 0.1], pieces, feasible, bounds, cyclic),
+            *rest,
+        )
     with pytest.raises(ValueError, match="disagree"):
-        _core.cell_looks(q, [0.0, 0.1], pieces, feasible, np.array([0, 3]), cyclic, *rest)
+        _core.cell_looks(_core.CellSamples(q, [0.0, 0.1], pieces, feasible, np.array([0, 3]), cyclic), *rest)
     with pytest.raises(ValueError, match="disagree"):
-        _core.cell_looks(q, [0.0], pieces, feasible, bounds, cyclic, *rest)
+        _core.cell_looks(_core.CellSamples(q, [0.0], pieces, feasible, bounds, cyclic), *rest)

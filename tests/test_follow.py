@@ -144,15 +144,14 @@ def link_rows(probe: Probe, psi: np.ndarray, flat: list[Point], counts: np.ndarr
     q = np.array([p.q for p in flat], dtype=float).reshape(-1, 7)
     t = np.array([p.tangent[:, 0] for p in flat], dtype=float).reshape(-1, 7)
     members, ends = np.empty((2, len(flat) + capacity, 2), dtype=np.int64)
-    out = np.empty(3, dtype=np.int64)
-    rows = np.empty(capacity), np.empty((capacity, 7)), np.empty((capacity, 7))
-    _core.link_paths(*probe._work[:6], psi, counts, q, t, *rows, members, ends, out)
-    return out.tolist(), members, ends, rows[0]
+    rows = _core.LinkRows(np.empty(capacity), np.empty((capacity, 7)), np.empty((capacity, 7)), members, ends)
+    linked = _core.link_paths(probe._work, _core.LinkRoots(psi, counts, q, t), rows)
+    return tuple(linked), members, ends, rows.psi
 
 
 def test_link_paths_puts_every_row_on_one_path_and_says_when_it_has_no_room():
     """With room for the points that following adds, every row (the roots, then those
-    points) is on exactly one path, in increasing psi along it; without room, status 2 (the
+    points) is on exactly one path, in increasing psi along it; without room, LINK_FULL (the
     caller's loop decides) and no path. On every branch of a pose whose linking adds points."""
     added_somewhere = False
     for probe, psi, roots in grid_roots("panda", 0):
@@ -161,7 +160,7 @@ def test_link_paths_puts_every_row_on_one_path_and_says_when_it_has_no_room():
         (status, added, n_paths), members, ends, new_psi = link_rows(
             probe, psi, flat, counts, 2 * len(flat) + len(psi)
         )
-        assert status == 0
+        assert status == _core.LINK_DONE
         on_paths = members[: ends[n_paths - 1, 0] if n_paths else 0]
         assert sorted(on_paths[:, 0].tolist()) == list(range(len(flat) + added))
         row_psi = np.concatenate([[p.psi for p in flat], new_psi[:added]])
@@ -170,7 +169,7 @@ def test_link_paths_puts_every_row_on_one_path_and_says_when_it_has_no_room():
             assert (np.diff(along) > 0.0).all()
         if added:
             added_somewhere = True
-            assert link_rows(probe, psi, flat, counts, 0)[0] == [2, 0, 0]
+            assert link_rows(probe, psi, flat, counts, 0)[0] == (_core.LINK_FULL, 0, 0)
     assert added_somewhere
 
 

@@ -44,13 +44,12 @@ PyMODINIT_FUNC PyInit_ckernels(void) {
         {"FOLLOW_ARRIVED", OM_FOLLOW_ARRIVED}, {"FOLLOW_SINGULAR", OM_FOLLOW_SINGULAR},
         {"FOLLOW_STALLED", OM_FOLLOW_STALLED}, {"FOLLOW_MAX_ATTEMPTS", OM_FOLLOW_MAX_ATTEMPTS},
         {"FOLLOW_CRAWL_STEPS", OM_FOLLOW_CRAWL_STEPS},
+        {"LINK_DONE", OM_LINK_DONE}, {"LINK_SINGULAR", OM_LINK_SINGULAR}, {"LINK_FULL", OM_LINK_FULL},
     };
     if (PyModule_AddObjectRef(m, "Solver", (PyObject *)&om_SolverType) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_tracking_functions) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_clearance_functions) < 0) goto fail;
-    if (PyModule_AddFunctions(m, om_follow_functions) < 0 || om_follow_init(m) < 0) goto fail;
-    if (PyModule_AddFunctions(m, om_link_functions) < 0) goto fail;
-    if (PyModule_AddFunctions(m, om_tangent_functions) < 0) goto fail;
+    if (PyModule_AddFunctions(m, om_path_functions) < 0 || om_paths_init(m) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_objective_functions) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_cell_functions) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_box_qp_functions) < 0) goto fail;

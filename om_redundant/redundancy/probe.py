@@ -48,7 +48,6 @@ _ARRIVED, _SINGULAR, _STALLED = _core.FOLLOW_ARRIVED, _core.FOLLOW_SINGULAR, _co
 # MAX_ATTEMPTS attempts: then SingularSelfMotion.
 CRAWL, CRAWL_STEPS = _core.FOLLOW_CRAWL, _core.FOLLOW_CRAWL_STEPS
 MAX_ATTEMPTS = _core.FOLLOW_MAX_ATTEMPTS
-_LINKED = 0  # _core.link_paths' status where it linked the paths
 
 
 class _Terms:
@@ -403,17 +402,18 @@ class Probe:
         q = np.array([p.q for p in flat], dtype=float).reshape(len(flat), 7)
         t = np.array([p.tangent for p in flat], dtype=float).reshape(len(flat), 7)  # (each (7, 1))
         capacity = 2 * len(flat) + len(psi)
-        new_psi, new_q, new_t = np.empty(capacity), np.empty((capacity, 7)), np.empty((capacity, 7))
         members, paths = np.empty((2, len(flat) + capacity, 2), dtype=np.int64)
-        out = np.empty(3, dtype=np.int64)
-        _core.link_paths(*work[:6], psi, counts, q, t, new_psi, new_q, new_t, members, paths, out)
-        status, added, n_paths = out.tolist()
-        if status != _LINKED:
+        added = _core.LinkRows(
+            np.empty(capacity), np.empty((capacity, 7)), np.empty((capacity, 7)), members, paths
+        )
+        found = _core.link_paths(work, _core.LinkRoots(psi, counts, q, t), added)
+        if found.status != _core.LINK_DONE:
             return None
-        for x, qk, tk in zip(new_psi[:added].tolist(), new_q[:added], new_t[:added, :, None], strict=True):
+        new = slice(0, found.added)
+        for x, qk, tk in zip(added.psi[new].tolist(), added.q[new], added.t[new, :, None], strict=True):
             flat.append(Point(x, qk, tk, _Terms(self.objective, qk, tk)))
         linked, begin = [], 0
-        for end, turns in paths[:n_paths].tolist():  # (a member's k: the turns of psi it is taken at)
+        for end, turns in paths[: found.paths].tolist():  # (a member's k: the turns of psi it is taken at)
             rows = members[begin:end].tolist()
             linked.append(([flat[r].at(flat[r].psi + _TURN * k) if k else flat[r] for r, k in rows], turns))
             begin = end
