@@ -1,6 +1,6 @@
 /* The self-motion of a 7-DOF arm, shared by the tracking step (tracking.c) and the path
- * following of the global choose (follow.c); om_redundant/redundancy/self_motion.py is the
- * reference.
+ * following of the global choose (follow.c); tests/reference/self_motion.py is the numpy
+ * reference it is tested against.
  *
  * The hand stays fixed along the self-motion, J(q) dq = 0, so dq is along the null vector n
  * of the 6 x 7 Jacobian, here by cofactors, n_i = (-1)^i det J_{-i} (J without column i;

@@ -202,3 +202,30 @@ def test_a_path_within_rounding_of_a_singular_set_stalls_rather_than_crawls():
         assert all(interval.signs not in stalled for interval in choice.intervals)
     with pytest.raises(om.SingularSelfMotion, match="crawls"):  # (the branch alone: nothing else answers)
         om.RedundancyOptimizer(solver, branches=[stalled[0]]).choose(T_PANDA_ZERO_ROUNDED)
+
+
+def test_a_link_without_room_is_made_again_with_more():
+    """Where following adds more rows than Probe.link's first call has room for (LINK_FULL),
+    it calls again with more room and links the paths the Python loop links (the rows of
+    the first call given none here)."""
+    link_paths, calls = _core.link_paths, []
+
+    def cramped(work, roots, rows):
+        calls.append(len(rows.psi))
+        if len(calls) == 1:  # (no room at all: full as soon as a follow adds a row)
+            members, ends = np.empty((2, len(roots.q), 2), np.int64)
+            rows = _core.LinkRows(np.empty(0), np.empty((0, 7)), np.empty((0, 7)), members, ends)
+        return link_paths(work, roots, rows)
+
+    for probe, psi, roots in grid_roots("panda", 0):
+        calls.clear()
+        with mock.patch.object(_core, "link_paths", cramped):
+            linked = probe.link(psi, [list(points) for points in roots])
+        slow = paths._link(probe, psi, [list(points) for points in roots], compiled=False)
+        assert [turns for _, turns in linked] == [path.turns for path in slow]
+        for (points, _), path in zip(linked, slow, strict=True):
+            assert [(p.psi, p.q.tolist()) for p in points] == [(p.psi, p.q.tolist()) for p in path.points]
+        if len(calls) > 1:
+            assert calls[1] > calls[0]
+            return
+    raise AssertionError("no branch whose linking adds rows")
