@@ -1,8 +1,9 @@
 """The compiled cell test of the global choose's solution paths (``_core.pieces``,
 ``_core.surprise``, ``_core.joint_step`` and ``_core.cell_looks``, csrc/cells.c)
-against the numpy it replaces: the feasibility functions of the margin and clearance groups
-and their rates, where the cubic Hermite models of a cell predict a feasibility its ends do
-not explain, the largest joint step, and the first tests of every cell of a path."""
+against the numpy it replaces (tests/reference/cells.py): the feasibility functions of the
+margin and clearance groups and their rates, where the cubic Hermite models of a cell
+predict a feasibility its ends do not explain, the largest joint step, and the first tests
+of every cell of a path."""
 
 from __future__ import annotations
 
@@ -18,6 +19,7 @@ from om_redundant import _core
 from om_redundant.redundancy.paths import _BOUND_SLACK, _HERMITE, FINE_STEP
 from om_redundant.redundancy.self_motion import self_motion_tangents
 from tests.conftest import steps_numpy
+from tests.reference.cells import crossing_numpy, looks_numpy, quiet_numpy, surprise_numpy
 from tests.test_redundancy_batch import optimizer_of
 
 
@@ -42,16 +44,6 @@ def test_pieces_are_the_groups_constraints(seed, name, count):
         np.testing.assert_allclose(dg, want_dg, rtol=0, atol=1e-13 * (1 + np.abs(want_dg).max()))
 
 
-def surprise_numpy(ga, da, gb, db, span, feasible_a, feasible_b):
-    """The reference: every model at every point of the cell."""
-    models = np.column_stack([ga, da * span, gb, db * span]) @ _HERMITE
-    pattern = np.concatenate([[feasible_a], (models >= 0.0).all(axis=0), [feasible_b]])
-    changes = np.flatnonzero(pattern[1:] != pattern[:-1])
-    if len(changes) <= int(pattern[0] != pattern[-1]):
-        return None
-    return (changes[0] + 1 + changes[1]) / 2.0 / (len(pattern) - 1)
-
-
 @settings(max_examples=300, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1), pieces=st.integers(1, 12), span=st.floats(1e-6, 1.0))
 def test_surprise_is_numpys(seed, pieces, span):
@@ -64,21 +56,6 @@ def test_surprise_is_numpys(seed, pieces, span):
     fa, fb = bool((ga >= 0).all()), bool((gb >= 0).all())
     got = _core.surprise(_core.CellModels(ga, da, gb, db, span, _HERMITE), fa, fb, _BOUND_SLACK)
     assert got == surprise_numpy(ga, da, gb, db, span, fa, fb)
-
-
-def crossing_numpy(ga, da, gb, db, span):
-    """The reference: the first point of the cell where a model is negative, and the secant
-    of the most negative one there from the point before (from the cell's start at the
-    first point)."""
-    models = np.column_stack([ga, da * span, gb, db * span]) @ _HERMITE
-    below = np.flatnonzero((models < 0.0).any(axis=0))
-    if len(below) == 0:
-        return None
-    k = below[0]
-    j = np.argmin(models[:, k])
-    n = models.shape[1] + 1
-    s0, m0 = (0.0, ga[j]) if k == 0 else (k / n, models[j, k - 1])
-    return s0 + (1.0 / n) * m0 / (m0 - models[j, k])
 
 
 @settings(max_examples=300, deadline=None)
@@ -97,35 +74,6 @@ def test_crossing_is_numpys(seed, pieces, span):
     assert (got is None) == (want is None)
     if want is not None:
         assert 0.0 <= got <= 1.0 and abs(got - want) <= 1e-12
-
-
-def quiet_numpy(span, ga, da, gb, db, feasible_a, feasible_b):
-    """The reference of cell_looks' quiet test, cells (rows) at once: a model lies within
-    (4/27) |span| (|g'_a| + |g'_b|) of the ends' range; quiet: both ends feasible and every
-    model stays > 0, or both infeasible and one function's model stays < 0."""
-    spread = 4.0 / 27.0 * np.abs(span)[:, None] * (np.abs(da) + np.abs(db)) + _BOUND_SLACK
-    clear = (np.minimum(ga, gb) - spread > 0.0).all(axis=1)
-    blocked = (np.maximum(ga, gb) + spread < 0.0).any(axis=1)
-    return (feasible_a == feasible_b) & np.where(feasible_a, clear, blocked)
-
-
-def looks_numpy(q, psi, g, dg, feasible, cyclic):
-    """The reference of cell_looks for one path: NaN where a cell is calm (no step above
-    FINE_STEP, quiet), 1/2 where a step is above FINE_STEP, else the numpy surprise (NaN for
-    none); NaN for the last sample."""
-    steps = steps_numpy(cyclic, q[:-1], q[1:])
-    quiet = quiet_numpy(psi[1:] - psi[:-1], g[:-1], dg[:-1], g[1:], dg[1:], feasible[:-1], feasible[1:])
-    first = []
-    for k in range(len(steps)):
-        if steps[k] <= FINE_STEP and quiet[k]:
-            first.append(np.nan)
-        elif steps[k] > FINE_STEP:
-            first.append(0.5)
-        else:
-            span = psi[k + 1] - psi[k]
-            t = surprise_numpy(g[k], dg[k], g[k + 1], dg[k + 1], span, feasible[k], feasible[k + 1])
-            first.append(np.nan if t is None or g.shape[1] == 0 else t)
-    return np.array([*first, np.nan])
 
 
 def cell_looks(paths):
