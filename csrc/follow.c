@@ -26,8 +26,6 @@
 
 #include "om_paths.h"
 
-#define AIM (63.0 / 64.0) /* of the distance to a predicted end, a step aimed there goes */
-
 static void represent(int dof, const uint8_t *centred, const double *centre, double *q) {
     for (int i = 0; i < dof; i++)
         if (centred[i]) q[i] = centre[i] + om_wrap_angle(q[i] - centre[i]);
@@ -108,7 +106,7 @@ static double predicted_end(int n, const double *f_prev, const double *f, double
 
 /* Follow from (psi, q, t) towards target; q and t are updated in place to the point reached
  * (om_paths.h). Where the secant of an end measure predicts the path's end short of the next step, the step
- * aims just short of it instead (AIM of the way, at least 1.5 min_step): the end is then
+ * aims just short of it instead (OM_FOLLOW_AIM of the way, at least 1.5 min_step): the end is then
  * approached in a few successful steps rather than by halving, each halving costing about
  * two attempts, most of them failing beyond the end, where a failed local solve is the
  * costliest. A step of 1.5 min_step that fails ends the path as the halving would (below
@@ -125,7 +123,7 @@ int om_follow_path(const om_solver_data *s, const double *T, const int64_t *sign
         if (fabs(step) < min_step) return OM_FOLLOW_ENDED;
         if (attempts == OM_FOLLOW_MAX_ATTEMPTS || crawled == OM_FOLLOW_CRAWL_STEPS) return OM_FOLLOW_STALLED;
         double x = fabs(target - *psi) <= fabs(step) ? target : *psi + step;
-        double aim = moved > 0.0 ? fmax(AIM * predicted_end(n_ends, ends_prev, ends, moved), 1.5 * min_step) : INFINITY;
+        double aim = moved > 0.0 ? fmax(OM_FOLLOW_AIM * predicted_end(n_ends, ends_prev, ends, moved), 1.5 * min_step) : INFINITY;
         if (aim < fabs(x - *psi)) x = *psi + copysign(aim, step);
         prediction p = {dof, cyclic, centred, centre, q, t, x - *psi, farthest(dof, t, x - *psi)};
         bool ok = p.farthest <= FARTHEST_CONTINUED && om_solve_near(s, T, signs, &x, q, x_q, on_path, &p, NULL);

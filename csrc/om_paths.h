@@ -26,11 +26,15 @@ bool om_beyond_doubt(int dof, const double *q0, const double *q1, const double *
  * remainder and maximum: a NaN step is NaN). */
 double om_largest_joint_step(int dof, const double *q0, const double *q1, const uint8_t *cyclic);
 
-/* Paths in the arm angle (probe.py's END_TOLERANCE and SAME, read from here): a following step
- * below OM_END_TOLERANCE (rad) has ended its path; two solutions at one psi within OM_PATH_SAME
- * (rad, max-norm) are one. */
+/* Paths in the arm angle (probe.py's END_TOLERANCE, SAME, JUMP and _AIM, read from here): a
+ * following step below OM_END_TOLERANCE (rad) has ended its path; two solutions at one psi
+ * within OM_PATH_SAME (rad, max-norm) are one; neighbouring solutions of one path are at most
+ * OM_PATH_JUMP (rad, max-norm) apart; a step aimed at a path's predicted end goes
+ * OM_FOLLOW_AIM of the way there. */
 #define OM_END_TOLERANCE 1e-9
 #define OM_PATH_SAME 1e-6
+#define OM_PATH_JUMP 1.0
+#define OM_FOLLOW_AIM (63.0 / 64.0)
 /* follow.c: what om_follow_path answers. */
 enum { OM_FOLLOW_ARRIVED = 0, OM_FOLLOW_ENDED = 1, OM_FOLLOW_SINGULAR = 2, OM_FOLLOW_STALLED = 3 };
 /* A path that runs within rounding of a singular set (the Panda's self-motion through

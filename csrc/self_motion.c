@@ -106,7 +106,7 @@ static void _continuation(int dof, const double *q0, const double *q1, const dou
 bool om_continues(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic) {
     double moved, error;
     _continuation(dof, q0, q1, t, d, cyclic, &moved, &error);
-    return moved <= 1.0 && error <= 0.5 * moved + 1e-6;
+    return moved <= OM_PATH_JUMP && error <= 0.5 * moved + OM_PATH_SAME;
 }
 
 double om_largest_joint_step(int dof, const double *q0, const double *q1, const uint8_t *cyclic) {
@@ -124,5 +124,5 @@ double om_largest_joint_step(int dof, const double *q0, const double *q1, const 
 bool om_beyond_doubt(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic) {
     double moved, error;
     _continuation(dof, q0, q1, t, d, cyclic, &moved, &error);
-    return moved <= 1.0 && error <= 0.25 * moved;
+    return moved <= OM_PATH_JUMP && error <= 0.25 * moved;
 }

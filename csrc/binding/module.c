@@ -61,7 +61,8 @@ PyMODINIT_FUNC PyInit_ckernels(void) {
         double value;
     } floats[] = {
         {"REACH_SLACK", OM_REACH_SLACK}, {"BRANCH_BAND", OM_BRANCH_BAND}, {"ORTHONORMALITY_TOLERANCE", OM_ORTHONORMALITY_TOL},
-        {"END_TOLERANCE", OM_END_TOLERANCE}, {"PATH_SAME", OM_PATH_SAME},
+        {"END_TOLERANCE", OM_END_TOLERANCE}, {"PATH_SAME", OM_PATH_SAME}, {"PATH_JUMP", OM_PATH_JUMP},
+        {"FOLLOW_AIM", OM_FOLLOW_AIM},
         {"FOLLOW_CRAWL", OM_FOLLOW_CRAWL}};
     for (size_t i = 0; i < sizeof floats / sizeof floats[0]; i++) {
         PyObject *v = PyFloat_FromDouble(floats[i].value);

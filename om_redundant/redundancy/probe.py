@@ -35,12 +35,13 @@ from ..om.solver import BRANCH_BAND, OMSolver, Solution
 from .objective import Evaluation, Group, Objective
 from .self_motion import self_motion_tangent, self_motion_tangents
 
-JUMP = 1.0  # rad, max-norm joint step between neighbouring solutions of one path
+#: rad, max-norm: the largest joint step between neighbouring solutions of one path (csrc/om_paths.h's).
+JUMP = _core.PATH_JUMP
 #: rad: a path whose following step falls below this has ended (one value with csrc/om_paths.h's).
 END_TOLERANCE = _core.END_TOLERANCE
 #: rad, max-norm: two solutions at one psi this close are one (csrc/link.c reads it there too).
 SAME = _core.PATH_SAME
-_AIM = 63.0 / 64.0  # of the distance to a path's predicted end, a step aimed there goes (csrc/follow.c)
+_AIM = _core.FOLLOW_AIM  # of the distance to a path's predicted end, a step aimed there goes
 _TURN = 2.0 * math.pi
 _ARRIVED, _SINGULAR, _STALLED = _core.FOLLOW_ARRIVED, _core.FOLLOW_SINGULAR, _core.FOLLOW_STALLED
 # A follow stalls (csrc/om_paths.h: a path within rounding of a singular set advances by
