@@ -118,7 +118,7 @@ extern PyMethodDef om_clearance_functions[]; /* clearance.c: distances of arm an
 extern PyMethodDef om_path_functions[];
 int om_paths_init(PyObject *module); /* paths.c: their result types, ckernels.Followed and Linked */
 extern PyMethodDef om_objective_functions[]; /* objective.c: the redundancy optimiser's objective */
-extern PyMethodDef om_cell_functions[];      /* cells.c (binding/cells.c): the cell test of the solution paths */
+extern PyMethodDef om_cell_functions[];      /* binding/cells.c: the cell test of the solution paths (cells.c) */
 extern PyMethodDef om_box_qp_functions[];    /* box_qp.c: the climb's QP in one variable */
 extern PyMethodDef om_start_bound_functions[]; /* start_bounds.c: what a climb from a start can reach */
 
