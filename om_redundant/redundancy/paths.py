@@ -166,7 +166,9 @@ def lockstep(processes: list[Generator[Follow, tuple[Point, bool], Any]]) -> lis
 def _link(probe: Probe, psi: np.ndarray, roots: list[list[Point]], compiled: bool = True) -> list[Path]:
     """Paths through the solutions at each grid psi (module docstring). In one call where the
     probe follows compiled (:meth:`Probe.link`), else in the loop here, which makes the same
-    follows and decisions (``compiled=False``: the loop, the reference it is tested against)."""
+    follows and decisions: where a follow met a fold exactly (the loop's follows then decide
+    there, :meth:`Probe.follow`), and with ``compiled=False`` (the reference it is tested
+    against)."""
     linked = probe.link(psi, roots) if compiled else None
     if linked is not None:
         return [Path(points, turns) for points, turns in linked]
