@@ -24,9 +24,7 @@
  * fold met exactly) the call stops and says so: the caller's own loop then decides. */
 #include <string.h>
 
-#include "binding.h"
-
-#define AIM (63.0 / 64.0) /* of the distance to a predicted end, a step aimed there goes */
+#include "om_paths.h"
 
 static void represent(int dof, const uint8_t *centred, const double *centre, double *q) {
     for (int i = 0; i < dof; i++)
@@ -107,8 +105,8 @@ static double predicted_end(int n, const double *f_prev, const double *f, double
 }
 
 /* Follow from (psi, q, t) towards target; q and t are updated in place to the point reached
- * (binding.h). Where the secant of an end measure predicts the path's end short of the next step, the step
- * aims just short of it instead (AIM of the way, at least 1.5 min_step): the end is then
+ * (om_paths.h). Where the secant of an end measure predicts the path's end short of the next step, the step
+ * aims just short of it instead (OM_FOLLOW_AIM of the way, at least 1.5 min_step): the end is then
  * approached in a few successful steps rather than by halving, each halving costing about
  * two attempts, most of them failing beyond the end, where a failed local solve is the
  * costliest. A step of 1.5 min_step that fails ends the path as the halving would (below
@@ -125,7 +123,7 @@ int om_follow_path(const om_solver_data *s, const double *T, const int64_t *sign
         if (fabs(step) < min_step) return OM_FOLLOW_ENDED;
         if (attempts == OM_FOLLOW_MAX_ATTEMPTS || crawled == OM_FOLLOW_CRAWL_STEPS) return OM_FOLLOW_STALLED;
         double x = fabs(target - *psi) <= fabs(step) ? target : *psi + step;
-        double aim = moved > 0.0 ? fmax(AIM * predicted_end(n_ends, ends_prev, ends, moved), 1.5 * min_step) : INFINITY;
+        double aim = moved > 0.0 ? fmax(OM_FOLLOW_AIM * predicted_end(n_ends, ends_prev, ends, moved), 1.5 * min_step) : INFINITY;
         if (aim < fabs(x - *psi)) x = *psi + copysign(aim, step);
         prediction p = {dof, cyclic, centred, centre, q, t, x - *psi, farthest(dof, t, x - *psi)};
         bool ok = p.farthest <= FARTHEST_CONTINUED && om_solve_near(s, T, signs, &x, q, x_q, on_path, &p, NULL);
@@ -150,61 +148,3 @@ int om_follow_path(const om_solver_data *s, const double *T, const int64_t *sign
     }
     return OM_FOLLOW_ARRIVED;
 }
-
-static PyStructSequence_Field followed_fields[] = {
-    {"psi", "the arm angle reached"},
-    {"status", "FOLLOW_ARRIVED, FOLLOW_ENDED, FOLLOW_SINGULAR or FOLLOW_STALLED"},
-    {"steps", "the accepted steps"},
-    {NULL, NULL},
-};
-static PyStructSequence_Desc followed_desc = {"om_redundant.ckernels.Followed", "What follow reached.",
-                                              followed_fields, 3};
-static PyTypeObject *followed_type;
-
-/* The fields of follow's work record (om_redundant._core.FollowWork) it reads. */
-enum { W_KERNEL, W_T, W_SIGNS, W_CYCLIC, W_CENTRED, W_CENTRE, W_Q, W_T7, W_N };
-static const char *const work_names[W_N] = {"kernel", "T", "signs", "cyclic", "centred", "centre", "q", "t"};
-
-/* follow(work, psi, target, min_step) -> Followed(psi, status, steps): work.q and work.t (7,
- * in place) become the point reached. */
-static PyObject *om_follow(PyObject *mod, PyObject *const *args, Py_ssize_t nargs, PyObject *kwnames) {
-    static const char *const names[] = {"work", "psi", "target", "min_step"};
-    static const arg_spec spec = {"follow", names, 4, 4};
-    PyObject *a[4], *w[W_N];
-    if (bind_args(args, nargs, kwnames, &spec, a) < 0) return NULL;
-    double psi = PyFloat_AsDouble(a[1]), target = PyFloat_AsDouble(a[2]), min_step = PyFloat_AsDouble(a[3]);
-    if (PyErr_Occurred()) return NULL;
-    if (get_fields(a[0], work_names, W_N, w, "follow's work") < 0) return NULL;
-    PyObject *result = NULL;
-    const om_solver_data *s = om_srs7_solver(w[W_KERNEL], "follow");
-    Py_buffer v[7];
-    const buffer_spec sp[7] = {{F64, 16, 0, "T"}, {I64, s ? s->n_signs : 0, 0, "signs"}, {U8, 7, 0, "cyclic"},
-                               {U8, 7, 0, "centred"}, {F64, 7, 0, "centre"}, {F64, 7, 1, "q"},
-                               {F64, 7, 1, "t"}};
-    if (s == NULL || get_buffers(w + W_T, v, sp, 7) < 0) goto done;
-    double T[16];
-    int64_t signs[3];
-    if (copy_pose_and_signs(&v[0], &v[1], s->n_signs, T, signs) == 0) {
-        int steps = 0, status;
-        Py_BEGIN_ALLOW_THREADS status = om_follow_path(s, T, signs, v[2].buf, v[3].buf, v[4].buf, &psi,
-                                                       v[5].buf, v[6].buf, target, min_step, &steps);
-        Py_END_ALLOW_THREADS PyObject *items[3] = {PyFloat_FromDouble(psi), PyLong_FromLong(status),
-                                                   PyLong_FromLong(steps)};
-        result = new_record(followed_type, items, 3);
-    }
-    release_buffers(v, 7);
-done:
-    release_fields(w, W_N);
-    return result;
-}
-
-int om_follow_init(PyObject *module) {
-    followed_type = PyStructSequence_NewType(&followed_desc);
-    return followed_type ? PyModule_AddObjectRef(module, "Followed", (PyObject *)followed_type) : -1;
-}
-
-PyMethodDef om_follow_functions[] = {
-    {"follow", (PyCFunction)(void (*)(void))om_follow, METH_FASTCALL | METH_KEYWORDS,
-     "follow(work, psi, target, min_step) -> Followed(psi, status, steps)"},
-    {NULL, NULL, 0, NULL},
-};

@@ -17,15 +17,13 @@
  * +-pi to psi_0 + 2 pi and joined to the path starting at psi_0 with the same solution (one
  * not yet joined to); the chains of joined paths are output from their heads, then the closed
  * ones as loops; in front of a chain that is not a loop, where its first path ends, followed
- * back from its first sample towards the grid psi before. */
+ * back from its first sample towards the grid psi before. (Its binding: csrc/binding/paths.c.) */
 #include <stdlib.h>
 #include <string.h>
 
-#include "binding.h"
+#include "om_paths.h"
 
 #define TURN (2.0 * OM_PI)   /* (paths.py's _TURN) */
-enum { LINK_DONE = 0, LINK_SINGULAR = 1, LINK_FULL = 2 };
-enum { L_STATUS, L_ROWS, L_PATHS, L_N }; /* the out vector */
 
 /* The branch, the rows and the paths being linked. */
 typedef struct {
@@ -123,13 +121,13 @@ static int link_roots(linker *l, int64_t n, const double *grid, const int64_t *c
                 reached = only;
             else {
                 int status = follow_from(l, last, grid[k], &reached);
-                if (status == OM_FOLLOW_SINGULAR) return LINK_SINGULAR;
+                if (status == OM_FOLLOW_SINGULAR) return OM_LINK_SINGULAR;
                 arrived = status == OM_FOLLOW_ARRIVED;
             }
             if (!arrived) {
                 if (reached == REACHED) {
                     int64_t r = add_reached(l);
-                    if (r < 0) return LINK_FULL;
+                    if (r < 0) return OM_LINK_FULL;
                     append(l, i, r);
                 }
                 continue;
@@ -137,7 +135,7 @@ static int link_roots(linker *l, int64_t n, const double *grid, const int64_t *c
             int64_t j = same(l, reached, w->candidates, n_candidates);
             if (j < 0) { /* a solution the bounded search did not list (a follow's: grid[k] is not last's psi) */
                 int64_t r = add_reached(l);
-                if (r < 0) return LINK_FULL;
+                if (r < 0) return OM_LINK_FULL;
                 w->candidates[n_candidates] = r, w->taken[n_candidates] = 0, j = n_candidates++;
             }
             if (!w->taken[j]) { /* (else two paths met: this one stops here) */
@@ -157,7 +155,7 @@ static int link_roots(linker *l, int64_t n, const double *grid, const int64_t *c
     for (int64_t o = 0; o < n_ongoing; o++) {
         int64_t i = w->ongoing[o];
         int status = follow_from(l, l->tail[i], grid[0] + TURN, &reached);
-        if (status == OM_FOLLOW_SINGULAR) return LINK_SINGULAR;
+        if (status == OM_FOLLOW_SINGULAR) return OM_LINK_SINGULAR;
         if (status == OM_FOLLOW_ARRIVED) {
             int64_t n_starts = 0;
             for (int64_t j = 0; j < l->n_paths; j++)
@@ -166,7 +164,7 @@ static int link_roots(linker *l, int64_t n, const double *grid, const int64_t *c
             if (j >= 0) w->following[i] = starts[j], w->joined[starts[j]] = 1, keys[n_keys++] = i;
         } else if (reached == REACHED) {
             int64_t r = add_reached(l);
-            if (r < 0) return LINK_FULL;
+            if (r < 0) return OM_LINK_FULL;
             append(l, i, r);
         }
     }
@@ -189,10 +187,10 @@ static int link_roots(linker *l, int64_t n, const double *grid, const int64_t *c
         if (!loop) { /* _back_to_end: where it ends before its first grid sample */
             int64_t k = l->first[chain[0]], first_row = l->head[chain[0]];
             int status = follow_from(l, first_row, k > 0 ? grid[k - 1] : grid[n - 1] - TURN, &reached);
-            if (status == OM_FOLLOW_SINGULAR) return LINK_SINGULAR;
+            if (status == OM_FOLLOW_SINGULAR) return OM_LINK_SINGULAR;
             if (reached == REACHED) {
                 int64_t r = add_reached(l);
-                if (r < 0) return LINK_FULL;
+                if (r < 0) return OM_LINK_FULL;
                 l->next[r] = first_row, l->head[chain[0]] = r;
             }
         }
@@ -202,80 +200,30 @@ static int link_roots(linker *l, int64_t n, const double *grid, const int64_t *c
         paths[2 * n_out] = n_members, paths[2 * n_out + 1] = loop ? n_chain : 0, n_out++;
     }
     l->n_paths = n_out;
-    return LINK_DONE;
+    return OM_LINK_DONE;
 }
 
-/* link_paths(solver, T, signs, cyclic, centred, centre, grid, counts, q, t, psi_out, q_out,
- * t_out, members, paths, out) -> None: the branch's paths through its roots (the top of this
- * file): the roots' joints q and tangents t (M, 7), counts[k] of them at grid[k] (n, increasing,
- * within a turn); the rows that following adds into psi_out (R), q_out and t_out (R, 7); each
- * path's rows, in order, into members (M + R, 2: the row, and the turns of psi it is taken
- * at), and into paths (M + R, 2) where its members end and its turns (a loop's, else 0); out =
- * (status: 0 done, 1 a follow met a fold exactly or stalled, 2 more than R rows added; the rows added,
- * the paths). The caller's loop decides where the status is not 0. */
-static PyObject *om_link_paths(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
-    if (check_nargs(nargs, 16, "link_paths") < 0) return NULL;
-    const om_solver_data *s = om_srs7_solver(args[0], "link_paths");
-    if (s == NULL) return NULL;
-    Py_buffer v[15];
-    const buffer_spec sp[15] = {
-        {F64, 16, 0, "T"},      {I64, s->n_signs, 0, "signs"}, {U8, 7, 0, "cyclic"},      {U8, 7, 0, "centred"},
-        {F64, 7, 0, "centre"},  {F64, -1, 0, "grid"},          {I64, -1, 0, "counts"},     {F64, -1, 0, "q"},
-        {F64, -1, 0, "t"},      {F64, -1, 1, "psi_out"},       {F64, -1, 1, "q_out"},      {F64, -1, 1, "t_out"},
-        {I64, -1, 1, "members"}, {I64, -1, 1, "paths"},        {I64, L_N, 1, "out"},
-    };
-    if (get_buffers(args + 1, v, sp, 15) < 0) return NULL;
-    Py_ssize_t n = v[6].len / 8, m = v[7].len / 8 / 7, capacity = v[9].len / 8, rows = m + capacity, total = 0;
-    bool ok = n >= 1 && v[5].len / 8 == n && v[7].len == 8 * 7 * m && v[8].len == v[7].len;
-    ok = ok && v[10].len == 8 * 7 * capacity && v[11].len == v[10].len && v[12].len == 8 * 2 * rows &&
-         v[13].len == v[12].len;
-    double T[16];
-    int64_t signs[3], *work = NULL, *counts;
-    double *root_psi = NULL, *grid;
-    if (!ok) goto refuse;
-    work = malloc(sizeof(int64_t) * (size_t)(12 * rows + n + 1));
-    root_psi = malloc(sizeof(double) * (size_t)(m + n + 1));
+/* (om_paths.h) The scratch and the roots' psi allocated here, the linker set up over job. */
+int om_link_paths(const om_link_job *job, int64_t *added, int64_t *n_paths) {
+    int64_t m = job->m, rows = m + job->capacity;
+    int64_t *work = malloc(sizeof(int64_t) * (size_t)(12 * rows + 1));
+    double *root_psi = malloc(sizeof(double) * (size_t)(m + 1));
+    *added = 0, *n_paths = 0;
     if (!work || !root_psi) {
-        PyErr_NoMemory();
-        goto fail;
+        free(work), free(root_psi);
+        return OM_LINK_NO_MEMORY;
     }
-    /* the pose, signs, grid and counts copied, then checked: the kernels read them with the GIL
-     * released, while the caller's arrays may change */
-    counts = work + 12 * rows, grid = root_psi + m;
-    memcpy(counts, v[6].buf, (size_t)n * sizeof(int64_t));
-    memcpy(grid, v[5].buf, (size_t)n * sizeof(double));
-    if (copy_pose_and_signs(&v[0], &v[1], s->n_signs, T, signs) < 0) goto fail;
-    for (Py_ssize_t k = 0; ok && k < n; k++) {
-        ok = counts[k] >= 0 && counts[k] <= m && isfinite(grid[k]) && (k == 0 || grid[k] > grid[k - 1]);
-        total += ok ? counts[k] : 0;
-    }
-    if (!ok || total != m || !(grid[n - 1] - grid[0] < TURN)) goto refuse;
-    for (Py_ssize_t k = 0, r = 0; k < n; k++)
-        for (int64_t c = 0; c < counts[k]; c++) root_psi[r++] = grid[k];
-    linker l = {.s = s, .T = T, .signs = signs, .cyclic = v[2].buf, .centred = v[3].buf,
-                .centre = v[4].buf, .n_roots = m, .n_rows = m, .capacity = capacity, .root_psi = root_psi,
-                .root_q = v[7].buf, .root_t = v[8].buf, .new_psi = v[9].buf, .new_q = v[10].buf, .new_t = v[11].buf,
-                .next = work, .n_paths = 0, .head = work + rows, .tail = work + 2 * rows, .first = work + 3 * rows};
+    for (int64_t k = 0, r = 0; k < job->n; k++)
+        for (int64_t c = 0; c < job->counts[k]; c++) root_psi[r++] = job->grid[k];
+    linker l = {.s = job->s, .T = job->T, .signs = job->signs, .cyclic = job->cyclic, .centred = job->centred,
+                .centre = job->centre, .n_roots = m, .n_rows = m, .capacity = job->capacity, .root_psi = root_psi,
+                .root_q = job->q, .root_t = job->t, .new_psi = job->new_psi, .new_q = job->new_q,
+                .new_t = job->new_t, .next = work, .n_paths = 0, .head = work + rows, .tail = work + 2 * rows,
+                .first = work + 3 * rows};
     scratch w = {work + 4 * rows, work + 5 * rows, work + 6 * rows, work + 7 * rows,
                  work + 8 * rows, work + 9 * rows, work + 10 * rows, work + 11 * rows};
-    int status;
-    Py_BEGIN_ALLOW_THREADS status = link_roots(&l, n, grid, counts, &w, v[12].buf, v[13].buf);
-    Py_END_ALLOW_THREADS int64_t *out = v[14].buf;
-    out[L_STATUS] = status, out[L_ROWS] = l.n_rows - m, out[L_PATHS] = status == LINK_DONE ? l.n_paths : 0;
+    int status = link_roots(&l, job->n, job->grid, job->counts, &w, job->members, job->paths);
+    *added = l.n_rows - m, *n_paths = status == OM_LINK_DONE ? l.n_paths : 0;
     free(work), free(root_psi);
-    release_buffers(v, 15);
-    Py_RETURN_NONE;
-refuse:
-    PyErr_SetString(PyExc_ValueError, "link_paths: sizes of the grid, counts, roots and outputs disagree, or "
-                                      "the grid is not increasing within a turn");
-fail:
-    free(work), free(root_psi), release_buffers(v, 15);
-    return NULL;
+    return status;
 }
-
-PyMethodDef om_link_functions[] = {
-    {"link_paths", (PyCFunction)(void (*)(void))om_link_paths, METH_FASTCALL,
-     "link_paths(solver, T, signs, cyclic, centred, centre, grid, counts, q, t, psi_out, q_out, t_out, members, "
-     "paths, out) -> None"},
-    {NULL, NULL, 0, NULL},
-};

@@ -1,12 +1,12 @@
 /* The self-motion of a 7-DOF arm, shared by the tracking step (tracking.c) and the path
- * following of the global choose (follow.c); om_redundant/redundancy/self_motion.py is the
- * reference.
+ * following of the global choose (follow.c); tests/reference/self_motion.py is the numpy
+ * reference it is tested against.
  *
  * The hand stays fixed along the self-motion, J(q) dq = 0, so dq is along the null vector n
  * of the 6 x 7 Jacobian, here by cofactors, n_i = (-1)^i det J_{-i} (J without column i;
  * smooth in q, no factorisation to pick a sign). The arm angle moves by
  * dpsi = Dpsi(q) . n, so dq/dpsi = n / (Dpsi(q) . n). */
-#include "binding.h"
+#include "om_paths.h"
 
 /* Gaussian elimination with partial pivoting of the n x n matrix A (row-major, destroyed),
  * carrying b along (NULL: none) and then solving A x = b into b by back substitution; det A
@@ -106,7 +106,7 @@ static void _continuation(int dof, const double *q0, const double *q1, const dou
 bool om_continues(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic) {
     double moved, error;
     _continuation(dof, q0, q1, t, d, cyclic, &moved, &error);
-    return moved <= 1.0 && error <= 0.5 * moved + 1e-6;
+    return moved <= OM_PATH_JUMP && error <= 0.5 * moved + OM_PATH_SAME;
 }
 
 double om_largest_joint_step(int dof, const double *q0, const double *q1, const uint8_t *cyclic) {
@@ -124,5 +124,5 @@ double om_largest_joint_step(int dof, const double *q0, const double *q1, const 
 bool om_beyond_doubt(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic) {
     double moved, error;
     _continuation(dof, q0, q1, t, d, cyclic, &moved, &error);
-    return moved <= 1.0 && error <= 0.25 * moved;
+    return moved <= OM_PATH_JUMP && error <= 0.25 * moved;
 }

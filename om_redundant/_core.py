@@ -3,6 +3,7 @@ one module that imports it. The rest of the package reaches the kernels, their c
 the records that cross into them through here.
 """
 
+from collections.abc import Sequence
 from typing import NamedTuple
 
 import numpy as np
@@ -24,6 +25,7 @@ from .ckernels import (
     DH_THETA,
     END_TOLERANCE,
     FIXED,
+    FOLLOW_AIM,
     FOLLOW_ARRIVED,
     FOLLOW_CRAWL,
     FOLLOW_CRAWL_STEPS,
@@ -33,6 +35,9 @@ from .ckernels import (
     JOINT_FIXED,
     JOINT_PRISMATIC,
     JOINT_REVOLUTE,
+    LINK_DONE,
+    LINK_FULL,
+    LINK_SINGULAR,
     MAX_DOF,
     MAX_ROOTS,
     MAX_SCAN_POINTS,
@@ -40,6 +45,7 @@ from .ckernels import (
     NO_SOLUTION_IN_CONFIGURATION,
     OK,
     ORTHONORMALITY_TOLERANCE,
+    PATH_JUMP,
     PATH_SAME,
     REACH_SLACK,
     RRP_SPHERICAL_WRIST,
@@ -103,6 +109,7 @@ from .ckernels import (
     Followed,
     Found,
     Lifted,
+    Linked,
     QPStep,
     Solved,
     Solver,
@@ -157,6 +164,7 @@ __all__ = [
     "DH_THETA",
     "END_TOLERANCE",
     "FIXED",
+    "FOLLOW_AIM",
     "FOLLOW_ARRIVED",
     "FOLLOW_CRAWL",
     "FOLLOW_CRAWL_STEPS",
@@ -166,6 +174,9 @@ __all__ = [
     "JOINT_FIXED",
     "JOINT_PRISMATIC",
     "JOINT_REVOLUTE",
+    "LINK_DONE",
+    "LINK_FULL",
+    "LINK_SINGULAR",
     "MAX_DOF",
     "MAX_ROOTS",
     "MAX_SCAN_POINTS",
@@ -173,6 +184,7 @@ __all__ = [
     "NO_SOLUTION_IN_CONFIGURATION",
     "OK",
     "ORTHONORMALITY_TOLERANCE",
+    "PATH_JUMP",
     "PATH_SAME",
     "REACH_SLACK",
     "RRP_SPHERICAL_WRIST",
@@ -236,6 +248,8 @@ __all__ = [
     "ArmAngleRow",
     "ArmCores",
     "ArmLinks",
+    "CellModels",
+    "CellSamples",
     "Evaluations",
     "FamilyModel",
     "FlangeTarget",
@@ -245,8 +259,13 @@ __all__ = [
     "GeomPose",
     "Lifted",
     "Linearisation",
+    "LinkRoots",
+    "LinkRows",
+    "Linked",
     "ObjectiveTerms",
     "PairDistances",
+    "PieceLimits",
+    "PieceRows",
     "Pieces",
     "QPStep",
     "Roots",
@@ -297,8 +316,8 @@ __all__ = [
 
 class FollowWork(NamedTuple):
     """The arrays ``follow`` reads and writes, set up once per
-    :class:`~om_redundant.redundancy.probe.Probe` (the
-    first six: the branch that ``link_paths`` links).
+    :class:`~om_redundant.redundancy.probe.Probe` (``link_paths`` reads the branch's: all but
+    ``q`` and ``t``).
 
     Attributes:
         kernel: The compiled solver.
@@ -726,3 +745,107 @@ class ArmAngleRow(NamedTuple):
     params: np.ndarray
     model_table: np.ndarray
     psi: float
+
+
+class LinkRoots(NamedTuple):
+    """A branch's roots at the grid psi that ``link_paths`` links into paths.
+
+    Attributes:
+        psi: (n,) the grid, increasing within a turn.
+        counts: (n,) the roots at each grid psi (int64), M in all.
+        q, t: (M, 7) the roots' joints and tangents, grid psi by grid psi.
+    """
+
+    psi: np.ndarray
+    counts: np.ndarray
+    q: np.ndarray
+    t: np.ndarray
+
+
+class LinkRows(NamedTuple):
+    """Where ``link_paths`` writes the paths it links: the R rows that following adds (rows
+    M, M + 1, ... after the M roots) and each path's rows.
+
+    Attributes:
+        psi: (R,) the added rows' psi.
+        q, t: (R, 7) their joints and tangents.
+        members: (M + R, 2) int64: the paths' rows in order, path after path, each with the
+            turns of psi it is taken at.
+        paths: (M + R, 2) int64: per path, where its members end and its turns (a loop's, else 0).
+    """
+
+    psi: np.ndarray
+    q: np.ndarray
+    t: np.ndarray
+    members: np.ndarray
+    paths: np.ndarray
+
+
+class PieceRows(NamedTuple):
+    """The M joint vectors at which ``pieces`` computes the feasibility functions.
+
+    Attributes:
+        q: (M, dof) the joints.
+        t: (M, dof) dq/dpsi there.
+        distances: (M, P) the clearance pairs' distances.
+        gradients: (M, P, dof) their gradients.
+    """
+
+    q: np.ndarray
+    t: np.ndarray
+    distances: np.ndarray
+    gradients: np.ndarray
+
+
+class PieceLimits(NamedTuple):
+    """The L limited joints of an arm, as ``pieces`` reads them.
+
+    Attributes:
+        limited: (L,) their indices (int64).
+        lower, upper: (L,) their limits.
+        half: (L,) half their ranges.
+    """
+
+    limited: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+    half: np.ndarray
+
+
+class CellModels(NamedTuple):
+    """The cubic Hermite models of a cell's n feasibility functions between its ends a and b
+    (``surprise``, ``crossing``).
+
+    Attributes:
+        ga, da: (n,) the functions and their rates along psi at a.
+        gb, db: (n,) the same at b.
+        span: psi_b - psi_a.
+        hermite: (4, N) the Hermite basis at the cell's N points.
+    """
+
+    ga: np.ndarray
+    da: np.ndarray
+    gb: np.ndarray
+    db: np.ndarray
+    span: float
+    hermite: np.ndarray
+
+
+class CellSamples(NamedTuple):
+    """The M samples of P paths, path after path, whose cells ``cell_looks`` tests.
+
+    Attributes:
+        q: M joint vectors (float64, (dof,) each).
+        psi: M floats.
+        pieces: M pairs (g, dg) of float64 arrays (n,): the feasibility functions and rates.
+        feasible: M bools.
+        bounds: (P + 1,) int64: each path's first sample, then M.
+        cyclic: (P, dof) bool: each path's joints compared modulo 2 pi.
+    """
+
+    q: Sequence[np.ndarray]
+    psi: Sequence[float]
+    pieces: Sequence[tuple[np.ndarray, np.ndarray]]
+    feasible: Sequence[bool]
+    bounds: np.ndarray
+    cyclic: np.ndarray

@@ -74,7 +74,9 @@ def test_an_uninitialised_solver_raises():
         raises(RuntimeError, bare.solve, T, (), (), None, np.zeros(0))
         raises(RuntimeError, bare.solve_rows, None, 0, 0)
         raises(RuntimeError, _core.follow, _core.FollowWork(bare, *[None] * 7), 0.0, 0.0, 0.0)
-        walks = [("link_paths", 16), ("self_motion_tangents", 3)]
+        work, roots = _core.FollowWork(bare, *[None] * 7), _core.LinkRoots(*[None] * 4)
+        raises(RuntimeError, _core.link_paths, work, roots, _core.LinkRows(*[None] * 5))
+        walks = [("self_motion_tangents", 3)]
         for name, arity in walks:
             raises(RuntimeError, getattr(_core, name), bare, *[None] * (arity - 1))
         raises(RuntimeError, _core.track_step, _core.TrackingWork(bare, *[None] * 12), None, None, 0.0)
@@ -108,8 +110,8 @@ def test_lists_emptied_while_they_are_read():
         q = [Q.copy() for _ in range(3)]
         pieces = [(np.ones(1), np.zeros(1))] * 3
         first = np.zeros(3)
-        _core.cell_looks(q, psi, pieces, feasible, np.array([0, 3]), np.zeros(7, dtype=bool), 1.0, 0.0,
-                            np.zeros((4, 3)), first)
+        samples = _core.CellSamples(q, psi, pieces, feasible, np.array([0, 3]), np.zeros(7, dtype=bool))
+        _core.cell_looks(samples, 1.0, 0.0, np.zeros((4, 3)), first)
     """)
 
 

@@ -144,15 +144,14 @@ def link_rows(probe: Probe, psi: np.ndarray, flat: list[Point], counts: np.ndarr
     q = np.array([p.q for p in flat], dtype=float).reshape(-1, 7)
     t = np.array([p.tangent[:, 0] for p in flat], dtype=float).reshape(-1, 7)
     members, ends = np.empty((2, len(flat) + capacity, 2), dtype=np.int64)
-    out = np.empty(3, dtype=np.int64)
-    rows = np.empty(capacity), np.empty((capacity, 7)), np.empty((capacity, 7))
-    _core.link_paths(*probe._work[:6], psi, counts, q, t, *rows, members, ends, out)
-    return out.tolist(), members, ends, rows[0]
+    rows = _core.LinkRows(np.empty(capacity), np.empty((capacity, 7)), np.empty((capacity, 7)), members, ends)
+    linked = _core.link_paths(probe._work, _core.LinkRoots(psi, counts, q, t), rows)
+    return tuple(linked), members, ends, rows.psi
 
 
 def test_link_paths_puts_every_row_on_one_path_and_says_when_it_has_no_room():
     """With room for the points that following adds, every row (the roots, then those
-    points) is on exactly one path, in increasing psi along it; without room, status 2 (the
+    points) is on exactly one path, in increasing psi along it; without room, LINK_FULL (the
     caller's loop decides) and no path. On every branch of a pose whose linking adds points."""
     added_somewhere = False
     for probe, psi, roots in grid_roots("panda", 0):
@@ -161,7 +160,7 @@ def test_link_paths_puts_every_row_on_one_path_and_says_when_it_has_no_room():
         (status, added, n_paths), members, ends, new_psi = link_rows(
             probe, psi, flat, counts, 2 * len(flat) + len(psi)
         )
-        assert status == 0
+        assert status == _core.LINK_DONE
         on_paths = members[: ends[n_paths - 1, 0] if n_paths else 0]
         assert sorted(on_paths[:, 0].tolist()) == list(range(len(flat) + added))
         row_psi = np.concatenate([[p.psi for p in flat], new_psi[:added]])
@@ -170,7 +169,7 @@ def test_link_paths_puts_every_row_on_one_path_and_says_when_it_has_no_room():
             assert (np.diff(along) > 0.0).all()
         if added:
             added_somewhere = True
-            assert link_rows(probe, psi, flat, counts, 0)[0] == [2, 0, 0]
+            assert link_rows(probe, psi, flat, counts, 0)[0] == (_core.LINK_FULL, 0, 0)
     assert added_somewhere
 
 
@@ -203,3 +202,30 @@ def test_a_path_within_rounding_of_a_singular_set_stalls_rather_than_crawls():
         assert all(interval.signs not in stalled for interval in choice.intervals)
     with pytest.raises(om.SingularSelfMotion, match="crawls"):  # (the branch alone: nothing else answers)
         om.RedundancyOptimizer(solver, branches=[stalled[0]]).choose(T_PANDA_ZERO_ROUNDED)
+
+
+def test_a_link_without_room_is_made_again_with_more():
+    """Where following adds more rows than Probe.link's first call has room for (LINK_FULL),
+    it calls again with more room and links the paths the Python loop links (the rows of
+    the first call given none here)."""
+    link_paths, calls = _core.link_paths, []
+
+    def cramped(work, roots, rows):
+        calls.append(len(rows.psi))
+        if len(calls) == 1:  # (no room at all: full as soon as a follow adds a row)
+            members, ends = np.empty((2, len(roots.q), 2), np.int64)
+            rows = _core.LinkRows(np.empty(0), np.empty((0, 7)), np.empty((0, 7)), members, ends)
+        return link_paths(work, roots, rows)
+
+    for probe, psi, roots in grid_roots("panda", 0):
+        calls.clear()
+        with mock.patch.object(_core, "link_paths", cramped):
+            linked = probe.link(psi, [list(points) for points in roots])
+        slow = paths._link(probe, psi, [list(points) for points in roots], compiled=False)
+        assert [turns for _, turns in linked] == [path.turns for path in slow]
+        for (points, _), path in zip(linked, slow, strict=True):
+            assert [(p.psi, p.q.tolist()) for p in points] == [(p.psi, p.q.tolist()) for p in path.points]
+        if len(calls) > 1:
+            assert calls[1] > calls[0]
+            return
+    raise AssertionError("no branch whose linking adds rows")

@@ -263,9 +263,8 @@ def test_the_bindings_refuse_indices_out_of_range(panda):
         q, g = np.zeros((1, 7)), np.empty((1, 1))
         half, numbers = np.full(1, 0.5), np.array([0.2, 0.1, 0.5])
         lower, upper = np.zeros(1), np.ones(1)
-        _core.pieces(
-            7, q, q, np.empty((1, 0)), np.empty((1, 0, 7)), limited, lower, upper, half, numbers, g, g
-        )
+        rows = _core.PieceRows(q, q, np.empty((1, 0)), np.empty((1, 0, 7)))
+        _core.pieces(7, rows, _core.PieceLimits(limited, lower, upper, half), numbers, g, g)
 
     def evaluate(limited, joints):
         q, out, one = np.zeros((1, 7)), _core.Evaluations(*np.empty((5, 1))), np.ones(1)
@@ -429,38 +428,41 @@ def test_link_paths_refuses_grids_counts_and_outputs_that_disagree(panda):
     q0 = np.array([0.3, -0.4, 0.2, -2.0, 0.1, 1.6, 0.5])
     configuration = panda.configuration_of(q0)
     (psi0,) = configuration.redundancy
-    work = (
+    work = _core.FollowWork(
         panda.kernel,
         panda.arm.fk(q0),
         np.array(configuration.signs, dtype=np.int64),
         np.ones(7, dtype=np.uint8),
         np.zeros(7, dtype=np.uint8),
         np.zeros(7),
+        np.empty(7),
+        np.empty(7),
     )
     tangent = self_motion_tangent(panda, q0)[:, 0]
 
     def link(
         grid=(0.0, 0.1, 0.2), counts=(1, 0, 0), roots=1, tangents=1, room=8, q_out=8, members=9, paths=9
     ):
-        out = np.empty(3, dtype=np.int64)
-        _core.link_paths(
-            *work,
+        grid_roots = _core.LinkRoots(
             psi0 + np.array(grid),
             np.array(counts, dtype=np.int64),
             np.tile(q0, (roots, 1)),
             np.tile(tangent, (tangents, 1)),
+        )
+        rows = _core.LinkRows(
             np.empty(room),
             np.empty((q_out, 7)),
             np.empty((room, 7)),
             np.empty((members, 2), dtype=np.int64),
             np.empty((paths, 2), dtype=np.int64),
-            out,
         )
-        return out
+        return _core.link_paths(work, grid_roots, rows)
 
-    status, added, n_paths = link().tolist()
-    assert status == 0 and n_paths == 1 and 2 <= added <= 4  # (the roots at 0.1 and 0.2 unlisted)
-    assert link(counts=(0, 0, 0), roots=0, tangents=0, members=8, paths=8).tolist() == [0, 0, 0]
+    linked = link()
+    assert (
+        linked.status == _core.LINK_DONE and linked.paths == 1 and 2 <= linked.added <= 4
+    )  # (0.1, 0.2 unlisted)
+    assert tuple(link(counts=(0, 0, 0), roots=0, tangents=0, members=8, paths=8)) == (_core.LINK_DONE, 0, 0)
     message = (
         "link_paths: sizes of the grid, counts, roots and outputs disagree, or the grid is not "
         "increasing within a turn"

@@ -6,6 +6,7 @@
 #include <Python.h>
 
 #include "om_kernels.h"
+#include "om_paths.h"
 
 enum { F64, I64, U8 }; /* buffer kinds: float64, int64, bool */
 
@@ -107,52 +108,6 @@ int om_solver_set_types(om_Solver *self, PyObject *solution_type, PyObject *conf
 void om_solver_clear_types(om_Solver *self);
 PyObject *om_solver_solve_pose(om_Solver *self, PyObject *const *args, Py_ssize_t nargs);
 
-/* self_motion.c: dq/dpsi of a 7-DOF arm at q into t (see there), both in the arm's own joint
- * coordinates; false where psi does not move along the self-motion, |Dpsi . n| <= tol |Dpsi|
- * |n| (or t is not finite). */
-bool om_self_motion_tangent(const om_solver_data *s, const double *q, double *t, double tol);
-/* x - 2 pi k in [-pi, pi), as numpy's remainder(x + pi, 2 pi) - pi rounds it (paths.py's _wrap). */
-double om_wrap_angle(double x);
-/* Whether q1 (at psi + d) continues the self-motion from q0 with tangent t (paths.py's
- * Probe.continues): no joint moved more than 1 rad, and |dq - t d|_inf <= |dq|_inf / 2 + 1e-6;
- * t NULL: only that no joint jumped. cyclic (NULL: none): joints compared modulo 2 pi. */
-bool om_continues(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic);
-/* Whether q1 continues the path from (q0, t) d ahead beyond doubt: no joint moved more than
- * 1 rad and the first-order prediction's error is within 1/4 of the joint step. A root of
- * another path is off by the paths' separation, which no shorter step shrinks; one that
- * merely continues (om_continues: within 1/2) may be the partner at a fold. */
-bool om_beyond_doubt(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic);
-/* The largest joint step |q1 - q0|_inf, cyclic joints (NULL: none) modulo 2 pi (Probe.step; numpy's
- * remainder and maximum: a NaN step is NaN). */
-double om_largest_joint_step(int dof, const double *q0, const double *q1, const uint8_t *cyclic);
-
-/* Paths in the arm angle (probe.py's END_TOLERANCE and SAME, read from here): a following step
- * below OM_END_TOLERANCE (rad) has ended its path; two solutions at one psi within OM_PATH_SAME
- * (rad, max-norm) are one. */
-#define OM_END_TOLERANCE 1e-9
-#define OM_PATH_SAME 1e-6
-/* follow.c: what om_follow_path answers. */
-enum { OM_FOLLOW_ARRIVED = 0, OM_FOLLOW_ENDED = 1, OM_FOLLOW_SINGULAR = 2, OM_FOLLOW_STALLED = 3 };
-/* A path that runs within rounding of a singular set (the Panda's self-motion through
- * q2 = q6 = 0 at the pose of its q = 0) is accepted only in steps of ~1e-6 rad, millions of
- * them, each a windowed scan: a follow stalls (is not followed further) after
- * OM_FOLLOW_CRAWL_STEPS accepted steps in a row shorter than OM_FOLLOW_CRAWL (rad; an end
- * approached by aimed steps takes two or three), or after OM_FOLLOW_MAX_ATTEMPTS attempts (the
- * most seen in 2,000 global choices on 6 arms: 58). */
-#define OM_FOLLOW_CRAWL 1e-5
-#define OM_FOLLOW_CRAWL_STEPS 16
-#define OM_FOLLOW_MAX_ATTEMPTS 256
-/* A 7-DOF branch's solution path followed from (*psi, q, t) (t = dq/dpsi) towards target
- * (probe.py's Probe.follow), *psi, q and t updated in place to the point reached, *steps the
- * accepted steps: OM_FOLLOW_ARRIVED there, OM_FOLLOW_ENDED where the step fell below min_step
- * (the path ended on the way), OM_FOLLOW_SINGULAR where an accepted point has no tangent (a
- * fold met exactly; the point reached is then the last one that has), OM_FOLLOW_STALLED after
- * OM_FOLLOW_MAX_ATTEMPTS attempts (the point reached: the last accepted). Revolute joints are
- * compared modulo 2 pi where cyclic, and taken nearest mid-range centre where centred. */
-int om_follow_path(const om_solver_data *s, const double *T, const int64_t *signs, const uint8_t *cyclic,
-                   const uint8_t *centred, const double *centre, double *psi, double *q, double *t, double target,
-                   double min_step, int *steps);
-
 extern PyTypeObject om_SolverType;        /* solver_type.c: Solver(SolverData) */
 /* solver_type.c: the Solver type and its methods' result types (ckernels.Solver, Solved, Found,
  * TorusBound) into the module; -1 with an error. */
@@ -163,12 +118,11 @@ extern PyMethodDef om_kernel_functions[]; /* functions.c: kinematics and closed 
 int om_functions_init(PyObject *module);  /* functions.c: their result types (ckernels.Lifted) */
 int om_tracking_init(PyObject *module);       /* binding/tracking.c: track_step, its statuses and result type */
 int om_clearance_init(PyObject *module);      /* binding/clearance.c: arm and obstacle geoms */
-extern PyMethodDef om_follow_functions[];    /* follow.c: a solution path followed along psi */
-int om_follow_init(PyObject *module);         /* follow.c: its result type, ckernels.Followed */
-extern PyMethodDef om_link_functions[];      /* link.c: a branch's solution paths through its grid roots */
-extern PyMethodDef om_tangent_functions[];   /* tangents.c: self-motion tangents of many rows */
+/* binding/paths.c: follow, link_paths and self_motion_tangents (follow.c, link.c, tangents.c) */
+extern PyMethodDef om_path_functions[];
+int om_paths_init(PyObject *module); /* binding/paths.c: their result types, ckernels.Followed and Linked */
 extern PyMethodDef om_objective_functions[]; /* binding/objective.c: the redundancy optimiser's objective */
-extern PyMethodDef om_cell_functions[];      /* cells.c: the cell test of the solution paths */
+extern PyMethodDef om_cell_functions[];      /* binding/cells.c: the cell test of the solution paths (cells.c) */
 int om_box_qp_init(PyObject *module);         /* binding/box_qp.c: the climb's QP in one variable */
 extern PyMethodDef om_start_bound_functions[]; /* binding/start_bounds.c: what a climb from a start can reach */
 

@@ -47,12 +47,11 @@ PyMODINIT_FUNC PyInit_ckernels(void) {
         {"DH_SIN_ALPHA", OM_DH_SIN_ALPHA}, {"DH_KIND", OM_DH_KIND}, {"DH_COLUMNS", OM_DH_COLUMNS},
         {"JOINT_REVOLUTE", OM_JOINT_REVOLUTE}, {"JOINT_PRISMATIC", OM_JOINT_PRISMATIC},
         {"JOINT_FIXED", OM_JOINT_FIXED},
+        {"LINK_DONE", OM_LINK_DONE}, {"LINK_SINGULAR", OM_LINK_SINGULAR}, {"LINK_FULL", OM_LINK_FULL},
     };
     if (om_solver_init(m) < 0 || om_functions_init(m) < 0) goto fail;
     if (om_tracking_init(m) < 0 || om_clearance_init(m) < 0) goto fail;
-    if (PyModule_AddFunctions(m, om_follow_functions) < 0 || om_follow_init(m) < 0) goto fail;
-    if (PyModule_AddFunctions(m, om_link_functions) < 0) goto fail;
-    if (PyModule_AddFunctions(m, om_tangent_functions) < 0) goto fail;
+    if (PyModule_AddFunctions(m, om_path_functions) < 0 || om_paths_init(m) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_objective_functions) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_cell_functions) < 0) goto fail;
     if (om_box_qp_init(m) < 0) goto fail;
@@ -64,7 +63,8 @@ PyMODINIT_FUNC PyInit_ckernels(void) {
         double value;
     } floats[] = {
         {"REACH_SLACK", OM_REACH_SLACK}, {"BRANCH_BAND", OM_BRANCH_BAND}, {"ORTHONORMALITY_TOLERANCE", OM_ORTHONORMALITY_TOL},
-        {"END_TOLERANCE", OM_END_TOLERANCE}, {"PATH_SAME", OM_PATH_SAME},
+        {"END_TOLERANCE", OM_END_TOLERANCE}, {"PATH_SAME", OM_PATH_SAME}, {"PATH_JUMP", OM_PATH_JUMP},
+        {"FOLLOW_AIM", OM_FOLLOW_AIM},
         {"FOLLOW_CRAWL", OM_FOLLOW_CRAWL}};
     for (size_t i = 0; i < sizeof floats / sizeof floats[0]; i++) {
         PyObject *v = PyFloat_FromDouble(floats[i].value);

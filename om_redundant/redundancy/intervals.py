@@ -255,5 +255,5 @@ def _modelled_end(inside: Point, outside: Point) -> float | None:
     model's secant from the point before; None where none is negative there."""
     (ga, da), (gb, db) = inside.pieces(), outside.pieces()
     span = outside.psi - inside.psi
-    s = _core.crossing(ga, da, gb, db, span, _HERMITE) if len(ga) else None
+    s = _core.crossing(_core.CellModels(ga, da, gb, db, span, _HERMITE)) if len(ga) else None
     return None if s is None else inside.psi + span * s

@@ -234,7 +234,7 @@ class Objective:
         self._no_distances = np.zeros(0)  # _core.evaluate's without obstacles
         self._scratch = threading.local()  # each thread's record of one row for _core.evaluate
         # what _core.pieces reads of the limits, and _core.evaluate of every term (csrc/objective.c)
-        self._limits = (self._limited, self._lower, self._upper, self._half)
+        self._piece_limits = _core.PieceLimits(self._limited, self._lower, self._upper, self._half)
         self._terms = _core.ObjectiveTerms(
             self._dof,
             self._limited,
@@ -373,7 +373,8 @@ class Objective:
         distances, gradients = np.ascontiguousarray(pairs[0], float), np.ascontiguousarray(pairs[1], float)
         g, dg = np.empty((2, *rows, len(self._limited) + distances.shape[-1]))
         q, rate = np.ascontiguousarray(q, float), np.ascontiguousarray(tangent[..., 0], float)
-        _core.pieces(self._dof, q, rate, distances, gradients, *self._limits, self._clearance_numbers, g, dg)
+        sampled = _core.PieceRows(q, rate, distances, gradients)
+        _core.pieces(self._dof, sampled, self._piece_limits, self._clearance_numbers, g, dg)
         return g, dg
 
     def term_functions(

@@ -166,7 +166,9 @@ def lockstep(processes: list[Generator[Follow, tuple[Point, bool], Any]]) -> lis
 def _link(probe: Probe, psi: np.ndarray, roots: list[list[Point]], compiled: bool = True) -> list[Path]:
     """Paths through the solutions at each grid psi (module docstring). In one call where the
     probe follows compiled (:meth:`Probe.link`), else in the loop here, which makes the same
-    follows and decisions (``compiled=False``: the loop, the reference it is tested against)."""
+    follows and decisions: where a follow met a fold exactly (the loop's follows then decide
+    there, :meth:`Probe.follow`), and with ``compiled=False`` (the reference it is tested
+    against)."""
     linked = probe.link(psi, roots) if compiled else None
     if linked is not None:
         return [Path(points, turns) for points, turns in linked]
@@ -268,18 +270,15 @@ def _with_hidden(paths: list[tuple[Probe, Path]]) -> list[Path]:
     owner = np.repeat(np.arange(len(paths)), lengths).tolist()  # each end's path
     start = np.cumsum([0, *lengths]).tolist()  # each path's first end in flat
     first = np.empty(len(flat))  # cell a: between ends a, a + 1
-    _core.cell_looks(
+    samples = _core.CellSamples(
         [p.q for p in flat],
         [p.psi for p in flat],
         [p.pieces() for p in flat],
         [p.evaluation.feasible for p in flat],
         np.array(start, dtype=np.int64),
         np.array([probe.cyclic for probe, _ in paths]),
-        FINE_STEP,
-        _BOUND_SLACK,
-        _HERMITE,
-        first,
     )
+    _core.cell_looks(samples, FINE_STEP, _BOUND_SLACK, _HERMITE, first)
     looked = np.flatnonzero(~np.isnan(first)).tolist()
     t = first[looked].tolist()
     cells = [_hidden(paths[owner[a]][0], flat[a], flat[a + 1], t_a) for a, t_a in zip(looked, t, strict=True)]
@@ -347,5 +346,5 @@ def _surprise(a: Point, b: Point) -> float | None:
     (ga, da), (gb, db) = a.pieces(), b.pieces()
     if len(ga) == 0:
         return None
-    feasible = a.evaluation.feasible, b.evaluation.feasible
-    return _core.surprise(ga, da, gb, db, b.psi - a.psi, _HERMITE, *feasible, _BOUND_SLACK)
+    models = _core.CellModels(ga, da, gb, db, b.psi - a.psi, _HERMITE)
+    return _core.surprise(models, a.evaluation.feasible, b.evaluation.feasible, _BOUND_SLACK)

@@ -35,20 +35,20 @@ from ..om.solver import BRANCH_BAND, OMSolver, Solution
 from .objective import Evaluation, Group, Objective
 from .self_motion import self_motion_tangent, self_motion_tangents
 
-JUMP = 1.0  # rad, max-norm joint step between neighbouring solutions of one path
-#: rad: a path whose following step falls below this has ended (one value with csrc/binding.h's).
+#: rad, max-norm: the largest joint step between neighbouring solutions of one path (csrc/om_paths.h's).
+JUMP = _core.PATH_JUMP
+#: rad: a path whose following step falls below this has ended (one value with csrc/om_paths.h's).
 END_TOLERANCE = _core.END_TOLERANCE
 #: rad, max-norm: two solutions at one psi this close are one (csrc/link.c reads it there too).
 SAME = _core.PATH_SAME
-_AIM = 63.0 / 64.0  # of the distance to a path's predicted end, a step aimed there goes (csrc/follow.c)
+_AIM = _core.FOLLOW_AIM  # of the distance to a path's predicted end, a step aimed there goes
 _TURN = 2.0 * math.pi
 _ARRIVED, _SINGULAR, _STALLED = _core.FOLLOW_ARRIVED, _core.FOLLOW_SINGULAR, _core.FOLLOW_STALLED
-# A follow stalls (csrc/binding.h: a path within rounding of a singular set advances by
+# A follow stalls (csrc/om_paths.h: a path within rounding of a singular set advances by
 # ~1e-6 rad a step) after CRAWL_STEPS accepted steps in a row shorter than CRAWL, or after
 # MAX_ATTEMPTS attempts: then SingularSelfMotion.
 CRAWL, CRAWL_STEPS = _core.FOLLOW_CRAWL, _core.FOLLOW_CRAWL_STEPS
 MAX_ATTEMPTS = _core.FOLLOW_MAX_ATTEMPTS
-_LINKED = 0  # _core.link_paths' status where it linked the paths
 
 
 class _Terms:
@@ -390,11 +390,12 @@ class Probe:
         turn) that :func:`~om_redundant.redundancy.paths._link`'s loop finds, in one
         ``_core.link_paths`` call (``csrc/link.c``: the same follows, in the same order, and
         the same decisions): each path's points and turns. Python builds only the points that
-        following added. None where the solver is not a 7-DOF arm's compiled one, where a
-        follow met a fold exactly (:meth:`_follow_compiled`) or where following added more
-        points than the call has room for: the loop then decides. (Room for two per root and
-        one per grid psi: paths start only at listed roots and end once on each side, and a
-        root that the bounded search did not list, which a follow arrives at, is rare.)"""
+        following added. None where the solver is not a 7-DOF arm's compiled one or where a
+        follow met a fold exactly (:meth:`_follow_compiled`): the loop then decides. (Room for
+        two added points per root and one per grid psi: paths start only at listed roots and
+        end once on each side, and a root that the bounded search did not list, which a
+        follow arrives at, is rare; where following adds more, the call is made again with
+        twice the room: its follows and decisions are the same, only their rows more.)"""
         work = self._work
         if work is None:
             return None
@@ -403,17 +404,22 @@ class Probe:
         q = np.array([p.q for p in flat], dtype=float).reshape(len(flat), 7)
         t = np.array([p.tangent for p in flat], dtype=float).reshape(len(flat), 7)  # (each (7, 1))
         capacity = 2 * len(flat) + len(psi)
-        new_psi, new_q, new_t = np.empty(capacity), np.empty((capacity, 7)), np.empty((capacity, 7))
-        members, paths = np.empty((2, len(flat) + capacity, 2), dtype=np.int64)
-        out = np.empty(3, dtype=np.int64)
-        _core.link_paths(*work[:6], psi, counts, q, t, new_psi, new_q, new_t, members, paths, out)
-        status, added, n_paths = out.tolist()
-        if status != _LINKED:
+        while True:
+            members, paths = np.empty((2, len(flat) + capacity, 2), dtype=np.int64)
+            added = _core.LinkRows(
+                np.empty(capacity), np.empty((capacity, 7)), np.empty((capacity, 7)), members, paths
+            )
+            found = _core.link_paths(work, _core.LinkRoots(psi, counts, q, t), added)
+            if found.status != _core.LINK_FULL:
+                break
+            capacity = 2 * capacity + 1  # (the same follows and decisions again, with room for their rows)
+        if found.status != _core.LINK_DONE:
             return None
-        for x, qk, tk in zip(new_psi[:added].tolist(), new_q[:added], new_t[:added, :, None], strict=True):
+        new = slice(0, found.added)
+        for x, qk, tk in zip(added.psi[new].tolist(), added.q[new], added.t[new, :, None], strict=True):
             flat.append(Point(x, qk, tk, _Terms(self.objective, qk, tk)))
         linked, begin = [], 0
-        for end, turns in paths[:n_paths].tolist():  # (a member's k: the turns of psi it is taken at)
+        for end, turns in paths[: found.paths].tolist():  # (a member's k: the turns of psi it is taken at)
             rows = members[begin:end].tolist()
             linked.append(([flat[r].at(flat[r].psi + _TURN * k) if k else flat[r] for r, k in rows], turns))
             begin = end

@@ -10,9 +10,6 @@ from ..om.solver import OMSolver
 from ..validation import as_joint_vector
 from .arm_angle import arm_angle_and_gradient, check_arm_angle
 
-_MINORS = np.array([[j for j in range(7) if j != i] for i in range(7)])  # J without column i
-_COFACTOR_SIGNS = (-1.0) ** np.arange(7)
-
 
 def self_motion_tangent(solver: OMSolver, q: np.ndarray) -> np.ndarray:
     r"""dq/dpsi: how the joints move per unit of the redundancy variables, hand fixed.
@@ -64,16 +61,16 @@ def self_motion_tangent(solver: OMSolver, q: np.ndarray) -> np.ndarray:
     return tangent
 
 
-def self_motion_tangents(solver: OMSolver, q: np.ndarray, compiled: bool = True) -> np.ndarray:
+def self_motion_tangents(solver: OMSolver, q: np.ndarray) -> np.ndarray:
     r"""dq/dpsi of a 7-DOF arm (one redundancy variable) at every row of q, as
-    :func:`self_motion_tangent` computes it (the same operations per row, the 6x6 minors of
-    all rows in one batch; compiled, by :func:`compiled_tangents`), NaN rows where psi does not
-    move along the self-motion.
+    :func:`self_motion_tangent` computes it, by the arm's compiled solver in one call
+    (``_core.self_motion_tangents``, ``csrc/tangents.c``: the cofactors of the real arm's
+    Jacobian in its base frame, the same null vector, and the tangents of ``_core.follow``),
+    NaN rows where psi does not move along the self-motion.
 
     Args:
         solver: The solver of a 7-DOF arm.
         q: (M, 7) joint vectors.
-        compiled: The solver's kernel; False: numpy (the reference it is tested against).
 
     Returns:
         (M, 7, 1) tangents.
@@ -83,35 +80,6 @@ def self_motion_tangents(solver: OMSolver, q: np.ndarray, compiled: bool = True)
     """
     check_arm_angle(solver)
     q = as_joint_vector(q, solver.arm.dof).reshape(-1, solver.arm.dof)
-    if compiled and solver.arm.dof == 7:
-        return compiled_tangents(solver.kernel, q)
-    chain, model, flip = solver.arm.chain, solver.model.chain, solver.flip
-    jacobians = np.empty((len(q), 6, 7))
-    gradients = np.empty((len(q), 7))
-    for row, J, grad in zip(q, jacobians, gradients, strict=True):
-        _core.jacobian(chain.table, chain.T_root_base, chain.T_flange_tool, row, J)
-        _core.arm_angle_gradient(solver.om.params, model.table, flip * row, grad)
-    gradients *= flip
-    null = _COFACTOR_SIGNS * np.linalg.det(jacobians[:, :, _MINORS].transpose(0, 2, 1, 3))
-    change = np.array([g @ n for g, n in zip(gradients, null, strict=True)])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        tangent = null / change[:, None]
-    tangent[~np.isfinite(tangent).all(axis=1)] = np.nan
-    return tangent[:, :, None]
-
-
-def compiled_tangents(kernel: _core.Solver, q: np.ndarray) -> np.ndarray:
-    """:func:`self_motion_tangents` by a 7-DOF arm's compiled solver
-    (``_core.self_motion_tangents``, ``csrc/tangents.c``: the cofactors of the real arm's
-    Jacobian in its base frame, the same null vector, and the tangents of ``_core.follow``).
-
-    Args:
-        kernel: The compiled solver.
-        q: (M, 7) joint vectors.
-
-    Returns:
-        (M, 7, 1) tangents, NaN rows where psi does not move along the self-motion.
-    """
     tangent = np.empty((len(q), 7))
-    _core.self_motion_tangents(kernel, q, tangent)
+    _core.self_motion_tangents(solver.kernel, q, tangent)
     return tangent[:, :, None]
