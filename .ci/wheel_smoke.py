@@ -26,13 +26,14 @@ def main(project: Path) -> None:
         work = Path(scratch)
         check = (
             "import sys, numpy as np, om_redundant as om\n"
-            "from om_redundant._core import ckernels\n"
-            f"assert ckernels.__file__.startswith({sysconfig.get_paths()['purelib']!r}), ckernels.__file__\n"
+            "from om_redundant import _core\n"
+            "built = _core.ckernels.__file__\n"
+            f"assert built.startswith({sysconfig.get_paths()['purelib']!r}), built\n"
             "solver = om.OMSolver('panda')\n"
             "q = np.array([0.3, -0.4, 0.2, -2.2, 0.3, 1.9, 0.6])\n"
             "solution = solver.solve(solver.arm.fk(q), solver.configuration_of(q))\n"
             "assert solution.ok and np.allclose(solution.q, q), solution\n"
-            "print('installed:', ckernels.__file__)\n"
+            "print('installed:', built)\n"
         )
         readme = (project / "README.md").read_text()
         example = re.search(r"```python\n(.*?)```", readme, re.DOTALL)
