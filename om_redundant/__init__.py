@@ -19,7 +19,7 @@ from .exceptions import (
     UnknownArm,
     UnreachableTarget,
 )
-from .kinematics import Arm, DHRow, JointKind, KinematicChain, arm_names, load_arm, write_arm_file
+from .kinematics import Arm, DHRow, JointKind, arm_names, load_arm, write_arm_file
 from .mujoco_io import (
     ArmJoints,
     ArmRoot,
@@ -30,32 +30,20 @@ from .mujoco_io import (
     compare_mujoco_model,
     load_mujoco_model,
     scene_mjcf,
-    without_meshes,
 )
 from .om import (
-    ANGLE_ROUNDING,
-    BRANCH_BAND,
-    LENGTH_ROUNDING,
-    NEAR_LENGTH,
-    NEAR_TWIST,
     BatchRoots,
     BatchSolution,
     Configuration,
-    ModelArm,
-    NominalArm,
     OMSolver,
     Solution,
-    derive_model,
-    nominal_arm,
 )
 from .redundancy import (
     MAX_EXTENT,
     Box,
     Capsule,
     Clearance,
-    Evaluation,
     FreeRotation,
-    Objective,
     PsiInterval,
     RedundancyChoice,
     RedundancyOptimizer,
@@ -63,19 +51,13 @@ from .redundancy import (
     Sphere,
     arm_angle_and_gradient,
     joint_margins,
-    self_motion_tangent,
 )
 from .tasks import ArmAngleTask, ExactPoseTask
 
 __version__ = "0.1.0"
 
 __all__ = [
-    "ANGLE_ROUNDING",
-    "BRANCH_BAND",
-    "LENGTH_ROUNDING",
     "MAX_EXTENT",
-    "NEAR_LENGTH",
-    "NEAR_TWIST",
     "Arm",
     "ArmAngleTask",
     "ArmFileError",
@@ -88,22 +70,17 @@ __all__ = [
     "Clearance",
     "Configuration",
     "DHRow",
-    "Evaluation",
     "ExactPoseTask",
     "FrameNotFound",
     "FreeRotation",
     "InvalidInput",
     "JointKind",
     "JointNotFound",
-    "KinematicChain",
-    "ModelArm",
     "ModelComparison",
     "ModelError",
     "ModelMismatch",
-    "NominalArm",
     "OMError",
     "OMSolver",
-    "Objective",
     "PsiInterval",
     "RedundancyChoice",
     "RedundancyOptimizer",
@@ -119,13 +96,9 @@ __all__ = [
     "arm_model",
     "arm_names",
     "compare_mujoco_model",
-    "derive_model",
     "joint_margins",
     "load_arm",
     "load_mujoco_model",
-    "nominal_arm",
     "scene_mjcf",
-    "self_motion_tangent",
-    "without_meshes",
     "write_arm_file",
 ]

@@ -22,6 +22,7 @@ import om_redundant as om
 from benchmarks.menagerie import EXTRA, available, frame_pose
 from om_redundant.cli import main
 from om_redundant.mujoco_io.arm_import import IMPORT_TOLERANCE
+from om_redundant.om import derive_model
 from tests.conftest import MENAGERIE, random_q, wrap
 
 #: model file, frame, frame type, and None where OMSolver accepts the arm, else the reason.
@@ -132,7 +133,7 @@ def test_imports_of_the_shipped_arms_agree_with_their_files(name):
     assert np.array_equal(arm.lower, shipped.lower) and np.array_equal(arm.upper, shipped.upper)
     q = random_q(arm, 100, np.random.default_rng(2))
     np.testing.assert_allclose(arm.fk(q), shipped.fk(q), rtol=0, atol=1e-9)
-    assert om.derive_model(arm).family_name == om.derive_model(shipped).family_name
+    assert derive_model(arm).family_name == derive_model(shipped).family_name
 
 
 # ---------------------------------------------------------------------------------------

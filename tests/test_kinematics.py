@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 import om_redundant as om
-from om_redundant.kinematics import standard_rows_from_modified
+from om_redundant.kinematics import KinematicChain, standard_rows_from_modified
 
 angles = st.floats(-np.pi, np.pi)
 lengths = st.floats(-0.5, 0.5)
@@ -56,7 +56,7 @@ def test_modified_rows_convert_exactly(rows, data):
         theta = r.theta + (qi if r.kind is om.JointKind.REVOLUTE else 0.0)
         d = r.d + (qi if r.kind is om.JointKind.PRISMATIC else 0.0)
         T = T @ rot_x(r.alpha) @ trans(r.a, 0, 0) @ rot_z(theta) @ trans(0, 0, d)
-    chain = om.KinematicChain(tuple(standard_rows_from_modified(rows)))
+    chain = KinematicChain(tuple(standard_rows_from_modified(rows)))
     np.testing.assert_allclose(chain.fk(q), T, atol=1e-12)
 
 
@@ -66,7 +66,7 @@ def chains(draw):
     rows = [om.DHRow(r.a, r.alpha, r.d, r.theta, r.kind) for r in rows]
     base = rot_z(draw(angles)) @ rot_x(draw(angles)) @ trans(draw(lengths), draw(lengths), draw(lengths))
     tool = rot_x(draw(angles)) @ rot_z(draw(angles)) @ trans(draw(lengths), draw(lengths), draw(lengths))
-    return om.KinematicChain(tuple(rows), base, tool)
+    return KinematicChain(tuple(rows), base, tool)
 
 
 @settings(max_examples=60, deadline=None)

@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 import om_redundant as om
 from om_redundant import _core
 from om_redundant._core import flange as flange_kernel
+from om_redundant.om import derive_model
 from om_redundant.om.families import REACH_SLACK, branch_values, model_ik, redundancy_values, srs
 from tests.conftest import random_q, wrap
 
@@ -42,13 +43,13 @@ def modified(arm: om.Arm, joint: int, **changes) -> om.Arm:
 def test_arms_outside_theorem_2_are_refused_with_the_reason(joint, changes, message):
     arm = modified(om.load_arm("ur5e"), joint, **changes)
     with pytest.raises(om.ModelError, match=message):
-        om.derive_model(arm)
+        derive_model(arm)
 
 
 def test_model_zeroes_only_a4_a5_d5():
     for name in ("spherical", "ur5e"):
         arm = om.load_arm(name)
-        model = om.derive_model(arm).model
+        model = derive_model(arm).model
         jr = arm.chain.joint_rows
         for i, (real, mod) in enumerate(zip(arm.chain.rows, model.chain.rows, strict=True)):
             if i in (jr[3], jr[4]):
@@ -60,7 +61,7 @@ def test_model_zeroes_only_a4_a5_d5():
 
 @pytest.mark.parametrize("name, dp_max", [("spherical", 0.02), ("ur5e", 0.1)])
 def test_dp_depends_on_joint_6_alone_and_its_norm_is_dp_max(name, dp_max):
-    om_arm = om.derive_model(om.load_arm(name))
+    om_arm = derive_model(om.load_arm(name))
     assert om_arm.dp_joint == 5
     assert om_arm.dp_max == pytest.approx(dp_max, abs=1e-15)
     Q = random_q(om_arm.real, 300, np.random.default_rng(3))
@@ -77,7 +78,7 @@ SOLVABLE = om.arm_names()
 @given(seed=st.integers(0, 2**32 - 1))
 def test_model_closed_form_inverts_model_fk(name, seed):
     """IK_model(FK_model(q), c(q)) = q, so the closed form is one-to-one off singularities."""
-    om_arm = om.derive_model(om.load_arm(name))
+    om_arm = derive_model(om.load_arm(name))
     dof = om_arm.real.dof
     q = random_q(om_arm.real, 1, np.random.default_rng(seed))[0]
     table = om_arm.model.chain.table
@@ -105,7 +106,7 @@ def test_model_closed_form_inverts_model_fk(name, seed):
 @pytest.mark.parametrize("name, zeroed", [("panda", {5: ("a",)}), ("xarm7", {5: ("a",)}), ("iiwa14", {})])
 def test_seven_dof_model_zeroes_only_the_offsets_off_the_spherical_joints(name, zeroed):
     arm = om.load_arm(name)
-    model = om.derive_model(arm).model
+    model = derive_model(arm).model
     jr = arm.chain.joint_rows
     for i, (real, mod) in enumerate(zip(arm.chain.rows, model.chain.rows, strict=True)):
         fields = next((f for j, f in zeroed.items() if jr[j] == i), ())
@@ -118,7 +119,7 @@ def test_seven_dof_model_zeroes_only_the_offsets_off_the_spherical_joints(name, 
     "name, dp_max", [("panda", 0.088), ("fr3", 0.088), ("xarm7", 0.076), ("iiwa14", 0.0)]
 )
 def test_seven_dof_dp_depends_on_joint_7_alone(name, dp_max):
-    om_arm = om.derive_model(om.load_arm(name))
+    om_arm = derive_model(om.load_arm(name))
     assert om_arm.dp_joint == (6 if dp_max else -1)
     assert om_arm.dp_max == pytest.approx(dp_max, abs=1e-15)
     Q = random_q(om_arm.real, 300, np.random.default_rng(4))
@@ -144,7 +145,7 @@ def test_seven_dof_dp_depends_on_joint_7_alone(name, dp_max):
 )
 def test_shoulder_offsets_dp_turns_with_joint_1_alone(name, shoulder, wrist_min, wrist_max):
     """dp = R_flange delta(q7) + a(q1), a(q1) = A0 + A1 cos q1 + A2 sin q1 in DH frame 0."""
-    om_arm = om.derive_model(om.load_arm(name))
+    om_arm = derive_model(om.load_arm(name))
     real = om_arm.real
     Q = random_q(real, 300, np.random.default_rng(6))
     base = real.chain.T_root_base
@@ -164,7 +165,7 @@ def test_sawyer_model_moves_the_length_before_joint_7_past_it():
     Menagerie tilts by 7.35e-6 rad) moves into joint 7's row: joint 7's axis then meets the
     wrist centre and the hand moves by 0.11 m times the tilt, not 0.11 m."""
     arm = om.load_arm("sawyer")
-    om_arm = om.derive_model(arm)
+    om_arm = derive_model(arm)
     real_rows, model_rows = arm.chain.rows, om_arm.model.chain.rows
     jr = arm.chain.joint_rows
     fixed = jr[5] + 1
@@ -202,7 +203,7 @@ def test_lifted_model_ik_vanishes_exactly_at_the_model_joints(name, seed, singul
     """With q1, q7 and phi4 given, the three residuals vanish at the model's own joints and q
     comes back, also exactly at the shoulder, elbow and wrist singularities, where the
     closed form's Euler angles and square root are ill-conditioned."""
-    om_arm = om.derive_model(om.load_arm(name))
+    om_arm = derive_model(om.load_arm(name))
     P = om_arm.params
     q = random_q(om_arm.real, 1, np.random.default_rng(seed))[0]
     if singular == "shoulder":
@@ -223,7 +224,7 @@ def test_model_ik_at_reach_holds_the_elbow_at_the_edge_beyond_reach(name, seed, 
     """Within reach it is the closed form; with the wrist centre moved beyond the reach, or
     inside the folded elbow's, the elbow is held straight or folded at the edge:
     sin(phi4 - phi*) = 0, a start for the lifted Newton."""
-    om_arm = om.derive_model(om.load_arm(name))
+    om_arm = derive_model(om.load_arm(name))
     P = om_arm.params
     q = random_q(om_arm.real, 1, np.random.default_rng(seed))[0]
     (R, p, signs, psi), _, _ = _lifted_at(om_arm, q)
@@ -246,7 +247,7 @@ def test_model_ik_at_reach_holds_the_elbow_at_the_edge_beyond_reach(name, seed, 
 
 @pytest.mark.parametrize("name", ["gen3", "sawyer"])
 def test_lifted_residuals_detect_a_wrong_q1_q7_or_elbow(name):
-    om_arm = om.derive_model(om.load_arm(name))
+    om_arm = derive_model(om.load_arm(name))
     P = om_arm.params
     rng = np.random.default_rng(8)
     for q in random_q(om_arm.real, 50, rng):
@@ -262,7 +263,7 @@ def test_lifted_residuals_detect_a_wrong_q1_q7_or_elbow(name):
 @pytest.mark.parametrize("name", ["panda", "iiwa14", "gen3", "xarm7", "sawyer"])
 def test_arm_angle_is_the_elbow_bend_direction_about_the_shoulder_wrist_line(name):
     """psi from the closed form's parameters equals psi computed from FK points directly."""
-    om_arm = om.derive_model(om.load_arm(name))
+    om_arm = derive_model(om.load_arm(name))
     chain = om_arm.model.chain
     Q = random_q(om_arm.real, 200, np.random.default_rng(5))
     for q in Q:

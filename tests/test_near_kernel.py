@@ -2,7 +2,7 @@
 arm as the model's side. Its roots are every root an independent search finds; an arm whose
 axis is reversed answers as the arm itself through every compiled entry point (solves, the
 optimiser's global choice and tracking steps); micrometre offsets of rounded twists are the
-nominal arm's zeros (om.NEAR_LENGTH), so that the arm keeps its family's search."""
+nominal arm's zeros (NEAR_LENGTH), so that the arm keeps its family's search."""
 
 from __future__ import annotations
 
@@ -136,7 +136,7 @@ def test_a_near_arm_tracks_with_the_compiled_step():
 
 def test_micrometre_offsets_of_rounded_twists_are_the_nominal_arms_zeros():
     """An xArm7 with twists 3.7e-6 rad off 90 deg and the offsets they leave (d = 1.1e-6 m), as
-    its URDF has them: the nominal arm zeros them (om.NEAR_LENGTH per metre of reach), so it
+    its URDF has them: the nominal arm zeros them (NEAR_LENGTH per metre of reach), so it
     keeps the circle search of the xArm7 (the shoulder offset d2 made it a torus arm), and
     solves exactly."""
     arm = bent(om.load_arm("xarm7"), 3.7e-6, np.random.default_rng(1))

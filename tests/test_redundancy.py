@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import om_redundant as om
+from om_redundant.redundancy import self_motion_tangent
 from tests.conftest import random_q, wrap
 
 DENSE = 10_000  # psi values per branch of the brute-force sweep
@@ -264,7 +265,7 @@ def test_derivatives_match_finite_differences_of_exact_solutions(name, request):
     h = 1e-6
     for q in random_q(solver.arm, 10, rng):
         T, c = solver.arm.fk(q), solver.configuration_of(q)
-        tangent = om.self_motion_tangent(solver, q)[:, 0]
+        tangent = self_motion_tangent(solver, q)[:, 0]
         ahead, behind = (
             solver.solve(T, om.Configuration(c.signs, (c.redundancy[0] + s,)), q_hint=q).q for s in (h, -h)
         )

@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 import om_redundant as om
 from benchmarks import adversarial as adv
 from om_redundant import _core
+from om_redundant.om import BRANCH_BAND
 from tests.conftest import random_q, run_python
 
 _SOLVERS: dict[str, om.OMSolver] = {}
@@ -110,7 +111,7 @@ def test_holds_takes_both_sides_within_the_band_and_one_beyond(name, seed, expon
     joint, theta = _branch_joint(solver, "WRIST")
     value = math.sin(q[joint] + theta)
     assert solver.holds(q, c)
-    assert solver.holds(q, _flipped(solver, c, wrist)) == (abs(value) <= om.BRANCH_BAND)
+    assert solver.holds(q, _flipped(solver, c, wrist)) == (abs(value) <= BRANCH_BAND)
 
 
 def test_holds_reads_psi_in_the_requested_elbow_branch():
@@ -260,7 +261,7 @@ def test_a_pose_next_to_a_branch_boundary_is_solved(name, branch, seed, exponent
     asked = [c]
     # Inside the band, not on its edge: the root found differs from q by the pose's conditioning
     # (about 1e-9 rad at 1e-7 of a singularity), which may carry it across the edge.
-    if abs(math.sin(q[joint] + theta)) <= 0.9 * om.BRANCH_BAND:
+    if abs(math.sin(q[joint] + theta)) <= 0.9 * BRANCH_BAND:
         asked.append(_flipped(solver, c, solver.sign_names.index(branch)))
     for configuration in asked:
         sol = solver.solve(T, configuration)

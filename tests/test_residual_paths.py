@@ -12,6 +12,7 @@ import om_redundant as om
 from om_redundant import _core
 from om_redundant._core import FlangeTarget, srs_model_q7
 from om_redundant._core import flange as flange_kernel
+from om_redundant.om import derive_model
 from om_redundant.om.families import REACH_SLACK, branch_values, model_ik, redundancy_values
 from tests.conftest import random_q, wrap
 
@@ -28,7 +29,7 @@ def test_q7_alone_equals_the_closed_form(name, seed, shift, wrist):
     on both sides of the 1e-3 below which the closed form decides), moved by up to 0.1 m as
     the residual moves p_m: the same reach margin, bit for bit, the same q7 to 1e-12 rad,
     and no other joint written."""
-    om_arm = om.derive_model(om.load_arm(name))
+    om_arm = derive_model(om.load_arm(name))
     P, table = om_arm.params, om_arm.model.chain.table
     rng = np.random.default_rng(seed)
     q = random_q(om_arm.real, 1, rng)[0]

@@ -1,6 +1,6 @@
 """Rounding is not geometry: URDFs written to 11-12 digits leave DH offsets of ~5e-13 m where
 the arm has none (a Kinova Jaco2 refused for a d5 of 5.08e-13 m, TIAGo and Baxter for an a2
-of 4.4e-13 m). A length within ``om.LENGTH_ROUNDING`` per metre of reach of zero never
+of 4.4e-13 m). A length within ``LENGTH_ROUNDING`` per metre of reach of zero never
 changes the method an arm gets: the arm is solved through its nominal arm, which has it zero,
 while its exact table verifies every answer. Refusals name the arm's own joints."""
 
@@ -15,6 +15,8 @@ import numpy as np
 import pytest
 
 import om_redundant as om
+from om_redundant.kinematics import KinematicChain
+from om_redundant.om import LENGTH_ROUNDING, derive_model
 from om_redundant.om.model import rounding_length
 from tests.conftest import check_exact, random_q, well_conditioned
 from tests.test_wrist_offset import with_offsets
@@ -71,7 +73,7 @@ def test_the_rounding_scales_with_the_arm():
     large = ur5e.with_chain(ur5e.chain.replace_rows(rows), "ur5e-x10")
     assert rounding_length(large.chain) == pytest.approx(10 * rounding_length(ur5e.chain), rel=1e-12)
     assert rounding_length(ur5e.chain) == pytest.approx(
-        om.LENGTH_ROUNDING * sum(math.hypot(r.a, r.d) for r in ur5e.chain.rows), rel=1e-12
+        LENGTH_ROUNDING * sum(math.hypot(r.a, r.d) for r in ur5e.chain.rows), rel=1e-12
     )
     offset = {"joint3": {"a": 2e-9}}
     assert "wrist offset" not in om.OMSolver(with_offsets(large, **offset)).om.family_name
@@ -82,7 +84,7 @@ def test_derive_model_names_the_rounding_it_leaves_to_the_nominal_arm():
     arm = with_offsets(om.load_arm("panda"), joint1={"a": 4.38e-13})
     cause = r"a = 4.38e-13 m in the row of joint 2 \('joint2'\) is rounding of 0 \(within 1e-09 m per metre"
     with pytest.raises(om.ModelError, match=cause):
-        om.derive_model(arm)
+        derive_model(arm)
 
 
 @pytest.mark.parametrize(
@@ -114,7 +116,7 @@ def test_rounding_left_by_merging_fixed_rows_is_zero_too():
     rows[1] = dataclasses.replace(rows[1], d=-0.2 + 1e-13)
     rows.insert(1, om.DHRow(d=0.2, kind=om.JointKind.FIXED))
     arm = ur5e.with_chain(
-        om.KinematicChain(tuple(rows), ur5e.chain.T_root_base, ur5e.chain.T_flange_tool), "merged"
+        KinematicChain(tuple(rows), ur5e.chain.T_root_base, ur5e.chain.T_flange_tool), "merged"
     )
     solver = om.OMSolver(arm)
     assert solver.nominal.arm.chain.rows[1].d == 0.0 and method(solver) == method(om.OMSolver("ur5e"))

@@ -13,7 +13,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
-from om_redundant.om import system
+from om_redundant.kinematics import KinematicChain
+from om_redundant.om import derive_model, system
 from tests.conftest import check_exact, random_q, well_conditioned
 
 G1_OFFSET, TIAGO_PRO_OFFSET, BAXTER_OFFSET = 0.00624, 0.02, 0.01
@@ -43,7 +44,7 @@ def g1_arm(a2: float, a5: float = 0.0) -> om.Arm:
     names += ("wrist_yaw",)
     return om.Arm(
         name=f"g1-left-a2-{a2:g}-a5-{a5:g}",
-        chain=om.KinematicChain(rows, base, np.eye(4)),
+        chain=KinematicChain(rows, base, np.eye(4)),
         joint_names=tuple(f"{name}_joint" for name in names),
         lower=np.array([-3.0892, -1.5882, -2.618, -1.0472, -1.97222, -1.61443, -1.61443]),
         upper=np.array([2.6704, 2.2515, 2.618, 2.0944, 1.97222, 1.61443, 1.61443]),
@@ -64,7 +65,7 @@ def test_the_nominal_arm_zeroes_the_offsets_and_corrects_on_the_larger_ones_side
     in the flange frame), where the larger one is, on the torus."""
     cause = r"shoulder offset a2 = .* \('left_shoulder_roll_joint'\).*nominal arm" if a2 else "depends on"
     with pytest.raises(om.ModelError, match=cause):
-        om.derive_model(g1_arm(a2, a5))
+        derive_model(g1_arm(a2, a5))
     solver = solver_of(a2, a5)
     assert solver.nominal is not None
     assert (solver.nominal.shoulder_offset, solver.nominal.wrist_offset) == (a2, a5)
@@ -112,7 +113,7 @@ def test_what_stays_refused_with_a_shoulder_offset():
     rows = list(arm.chain.rows)
     rows.insert(6, om.DHRow(a=0.01, d=0.05, kind=om.JointKind.FIXED))
     bent = arm.with_chain(
-        om.KinematicChain(tuple(rows), arm.chain.T_root_base, arm.chain.T_flange_tool), "g1-bent"
+        KinematicChain(tuple(rows), arm.chain.T_root_base, arm.chain.T_flange_tool), "g1-bent"
     )
     cause = r"between joint 6 \('left_wrist_pitch_joint'\) and joint 7 \('left_wrist_yaw_joint'\) need a = 0"
     with pytest.raises(om.ModelError, match=cause):

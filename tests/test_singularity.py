@@ -12,6 +12,7 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
+from om_redundant.redundancy import Objective, self_motion_tangent
 from om_redundant.redundancy.objective import SINGULARITY_CAP
 
 ARMS = ("panda", "iiwa14", "gen3", "sawyer", "ur5e", "spherical")
@@ -83,7 +84,7 @@ def test_the_objective_group_along_psi_matches_finite_differences(solvers, name)
         ahead, behind = (
             solver.solve(T, om.Configuration(c.signs, (c.redundancy[0] + s,)), q_hint=q).q for s in (H, -H)
         )
-        tangent = om.self_motion_tangent(solver, q)
+        tangent = self_motion_tangent(solver, q)
         (group,) = [g for g in objective.groups(q, tangent=tangent) if g.kind == "singularity"]
         slopes = group.jacobian[:, 0] * SINGULARITY_CAP
         differences = (singularity.distances(ahead) - singularity.distances(behind)) / (2 * H)
@@ -132,15 +133,15 @@ def test_bad_singularity_weights_are_named(solvers, weight):
     with pytest.raises(om.InvalidInput, match="singularity_weight must be a finite number"):
         om.RedundancyOptimizer(solvers["panda"], singularity_weight=weight)
     with pytest.raises(om.InvalidInput, match="singularity_weight must be a finite number"):
-        om.Objective(solvers["panda"].arm, singularity_weight=weight)
+        Objective(solvers["panda"].arm, singularity_weight=weight)
 
 
 def test_bad_singularities_are_named(solvers):
     with pytest.raises(om.InvalidInput, match="model must be a ModelArm"):
         om.Singularity.of("panda")
     with pytest.raises(om.InvalidInput, match="singularity must be a Singularity"):
-        om.Objective(solvers["panda"].arm, singularity="wrist")
+        Objective(solvers["panda"].arm, singularity="wrist")
     with pytest.raises(om.InvalidInput, match="the singularity's arm has 6 joints, the arm 7"):
-        om.Objective(solvers["panda"].arm, singularity=om.Singularity.of(solvers["ur5e"].om))
+        Objective(solvers["panda"].arm, singularity=om.Singularity.of(solvers["ur5e"].om))
     with pytest.raises(om.InvalidInput, match="q must have shape \\(7,\\)"):
         om.Singularity.of(solvers["panda"].om).distances(np.zeros(6))

@@ -21,6 +21,7 @@ import om_redundant as om
 from benchmarks.mink_reach import SETUPS, TOLERANCE, reach
 from benchmarks.robots import home_joints, pose_errors, random_joints, reference_spec
 from om_redundant import _core
+from om_redundant.kinematics import KinematicChain
 from tests.conftest import load_reference_model
 
 REACH_TARGETS = 500
@@ -275,7 +276,7 @@ def singular_margins(solver, q):
     rows, first = chain.rows, chain.joint_rows
 
     def origin(j):  # DH origin after joint j's row, in the root frame
-        return om.KinematicChain(rows[: first[j] + 1], chain.T_root_base).fk(q[: j + 1])[:3, 3]
+        return KinematicChain(rows[: first[j] + 1], chain.T_root_base).fk(q[: j + 1])[:3, 3]
 
     w = origin(4) - origin(0)
     P = solver.om.params

@@ -18,6 +18,7 @@ import om_redundant as om
 from benchmarks import urdf_arms
 from benchmarks.menagerie import Entry
 from om_redundant.cli import main
+from om_redundant.kinematics import KinematicChain
 from tests.conftest import random_q
 from tests.test_arm_import import UR_JOINTS
 
@@ -251,7 +252,7 @@ def test_a_chain_with_joints_above_the_arm_is_refused_naming_the_root():
     whose body is the root to give."""
     panda = om.load_arm("panda")
     lift = om.DHRow(d=0.3, kind=om.JointKind.PRISMATIC)
-    chain = om.KinematicChain((lift, *panda.chain.rows), panda.chain.T_root_base, panda.chain.T_flange_tool)
+    chain = KinematicChain((lift, *panda.chain.rows), panda.chain.T_root_base, panda.chain.T_flange_tool)
     arm = om.Arm(
         "tiago",
         chain,

@@ -12,6 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
+from om_redundant.om import derive_model
 
 
 @pytest.fixture(scope="module")
@@ -350,7 +351,7 @@ def test_objects_of_the_wrong_type_are_named(panda):
     with pytest.raises(om.InvalidInput, match="arm must be an Arm, got str"):
         om.arm_mjcf("panda")
     with pytest.raises(om.InvalidInput, match="arm must be an Arm, got None"):
-        om.derive_model(None)
+        derive_model(None)
     with pytest.raises(om.InvalidInput, match=r"model must be a mujoco\.MjModel, got str"):
         om.compare_mujoco_model(panda.arm, "panda.xml")
     with pytest.raises(om.InvalidInput, match="obstacles must be shapes"):

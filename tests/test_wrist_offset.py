@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 
 import om_redundant as om
 from benchmarks.near_family import bent, reversed_joint
+from om_redundant.om import derive_model
 from tests.conftest import check_exact, random_q, well_conditioned
 
 
@@ -39,7 +40,7 @@ def test_dp_of_a_wrist_offset_turns_with_q1_and_is_bounded_by_dp_max(arm_a4_a5, 
     compares the formula with the FK)."""
     name, a4, a5 = arm_a4_a5
     arm = with_offsets(om.load_arm(name), joint3={"a": a4}, joint4={"a": a5})
-    model = om.derive_model(arm)
+    model = derive_model(arm)
     assert model.dp_joint == 0 and "wrist offset a4" in model.family_name
     d5 = arm.chain.rows[arm.chain.joint_rows[4]].d
     assert model.dp_max == pytest.approx(np.hypot(a4, d5) + abs(a5), rel=1e-15)
@@ -174,6 +175,6 @@ def test_a_wrist_offset_whose_joint_4_turns_with_joint_2_is_refused():
         r"joint 4's axis turns with joint 1 \('shoulder_pan_joint'\) alone"
     )
     with pytest.raises(om.ModelError, match=cause):
-        om.derive_model(offset)
+        derive_model(offset)
     with pytest.raises(om.ModelError, match=cause):
         om.OMSolver(offset)

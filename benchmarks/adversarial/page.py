@@ -241,7 +241,7 @@ def markdown(
             "",
             "## The other side of the boundary",
             "",
-            f"Poses with |branch offset| <= {BRANCH_BAND:g} (`om.BRANCH_BAND`), asked in the configuration "
+            f"Poses with |branch offset| <= {BRANCH_BAND:g} (`BRANCH_BAND`), asked in the configuration "
             "with that branch's sign flipped: by the band contract such a pose belongs to both, so a "
             "'no' there is a false no (counted in the singular class above).",
             "",

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-import om_redundant as om
+from om_redundant.om import BRANCH_BAND  # a branch quantity this close to zero counts for both signs
 
 TURN = 2.0 * math.pi
 POSITION_TOLERANCE = 1e-10  # m, MuJoCo's FK against T (at |p| up to 1e5 m; see FK_ROUNDING)
@@ -20,7 +20,6 @@ POSITION_TOLERANCE = 1e-10  # m, MuJoCo's FK against T (at |p| up to 1e5 m; see 
 #: checker's rounding, not the library's tolerance (the solver still verifies to 1e-10 m).
 FK_ROUNDING = 8.0 * float(np.finfo(np.float64).eps)
 ORIENTATION_TOLERANCE = 1e-10  # rad
-BRANCH_BAND = om.BRANCH_BAND  # a branch quantity this close to zero counts for both signs
 REDUNDANCY_TOLERANCE = 1e-9  # rad, modulo 2 pi
 ROOT_MATCH = 1e-6  # rad (or m): q among solve_all's roots
 HINT_NOISE = 0.05  # rad, standard deviation of the random class's hint

@@ -7,6 +7,7 @@ from pathlib import Path
 import mujoco
 
 import om_redundant as om
+from om_redundant.mujoco_io import without_meshes
 
 #: The reference MuJoCo Menagerie models (kinematics only), beside the project.
 MENAGERIE = Path(__file__).resolve().parents[3] / "shared" / "reference" / "menagerie"
@@ -15,7 +16,7 @@ MENAGERIE = Path(__file__).resolve().parents[3] / "shared" / "reference" / "mena
 def reference_spec(relative_path: str) -> mujoco.MjSpec:
     """A Menagerie MJCF under :data:`MENAGERIE` with its meshes stripped (the files ship
     without them), to edit before compiling."""
-    return om.without_meshes(mujoco.MjSpec.from_file(str(MENAGERIE / relative_path)))
+    return without_meshes(mujoco.MjSpec.from_file(str(MENAGERIE / relative_path)))
 
 
 def reference_model(relative_path: str) -> mujoco.MjModel:
