@@ -8,8 +8,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from om_redundant.om import BRANCH_BAND  # a branch quantity this close to zero counts for both signs
-
 TURN = 2.0 * math.pi
 POSITION_TOLERANCE = 1e-10  # m, MuJoCo's FK against T (at |p| up to 1e5 m; see FK_ROUNDING)
 #: Relative part of the position check, for poses 1e5 ... 1e300 m away (arms with an unlimited
