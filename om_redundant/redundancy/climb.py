@@ -30,7 +30,8 @@ import math
 import numpy as np
 
 from .box_qp import Pieces, step_1d
-from .probe import Point, Probe
+from .points import Point
+from .probe import Probe
 
 STEP_TOLERANCE = 1e-9  # rad: the climb stops when the step is this small
 GAIN_TOLERANCE = 1e-12  # the climb stops when the model promises no more

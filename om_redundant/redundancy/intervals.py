@@ -27,7 +27,8 @@ from typing import NamedTuple
 from .. import _core
 from .arm_angle import wrap_psi
 from .paths import _HERMITE, Follow, Path, lockstep
-from .probe import END_TOLERANCE, Point, Probe
+from .points import Point
+from .probe import END_TOLERANCE, Probe
 
 SLACK_TOLERANCE = 1e-12  # a refined end whose feasibility slack is this small is on the boundary
 _MAX_REFINE = 60  # trials per refined end

@@ -74,7 +74,8 @@ from .objective import (
     check_weights,
 )
 from .paths import sweep_circle
-from .probe import Point, Probe
+from .points import Point
+from .probe import Probe
 from .reachable import DEFAULT_TRAVEL_WEIGHT, Way, candidates, clear_way
 from .shapes import Shape
 from .singularity import Singularity

@@ -32,7 +32,7 @@ from ..kinematics.arm import Arm
 from .clearance import ALONG_TOLERANCE
 from .intervals import Run
 from .objective import Evaluation, Objective
-from .probe import Point
+from .points import Point
 
 #: w_t: objective given up per radian of joint travel (default).
 DEFAULT_TRAVEL_WEIGHT = 0.25
