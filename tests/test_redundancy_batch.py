@@ -16,7 +16,7 @@ from benchmarks.control_rate import HOMES, MIN_CLEARANCE, obstacles
 from om_redundant import _core
 from om_redundant.redundancy import self_motion_tangent
 from om_redundant.redundancy.box_qp import Pieces, step_1d
-from om_redundant.redundancy.objective import Evaluation, Group
+from om_redundant.redundancy.objective_terms import Evaluation, Group
 from om_redundant.redundancy.optimizer import _StartBounds
 from om_redundant.redundancy.probe import Probe
 from om_redundant.redundancy.self_motion import self_motion_tangents

@@ -190,7 +190,7 @@ class ObjectiveTerms(NamedTuple):
 
 class Evaluations(NamedTuple):
     """Where ``evaluate`` writes the objective at M joint vectors: (M,) each, the fields of
-    :class:`~om_redundant.redundancy.objective.Evaluation`.
+    :class:`~om_redundant.redundancy.objective_terms.Evaluation`.
 
     Attributes:
         value, margin, clearance, slack, singularity: f, M, D, the slack and S.

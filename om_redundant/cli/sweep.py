@@ -22,7 +22,7 @@ import numpy as np
 from ..mujoco_io.loading import load_mujoco_model
 from ..om.configuration import Configuration
 from ..om.solver import OMSolver
-from ..redundancy.objective import DEFAULT_SINGULARITY_WEIGHT
+from ..redundancy.objective_terms import DEFAULT_SINGULARITY_WEIGHT
 from ..redundancy.sweep import SHAPES, Obstacle, SweepRequest, compute_sweep
 from .common import (
     UsageError,

@@ -24,7 +24,7 @@ import itertools
 import numpy as np
 
 from .. import _core
-from .objective import Group
+from .objective_terms import Group
 
 
 class Pieces(_core.Pieces):

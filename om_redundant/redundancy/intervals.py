@@ -5,7 +5,7 @@ A **feasible interval** is a maximal psi interval over which one solution path
 (:mod:`om_redundant.redundancy.paths`) is exact, within the limits and clear: a run of feasible
 neighbouring samples of the path, extended at each end to the boundary. Where the path's
 next sample is infeasible, the boundary is the root of the continuous feasibility slack
-(:class:`~om_redundant.redundancy.objective.Evaluation`) along the path between the two
+(:class:`~om_redundant.redundancy.objective_terms.Evaluation`) along the path between the two
 (:func:`_refined`: from the root of the cubic models of the cell, Newton steps on the
 rates the trials carry, the Illinois method where those leave the bracket; every end of the
 sweep at once); where the path itself ends, its end; both to

@@ -40,143 +40,29 @@ clearance and S), and pieces :math:`v_j(q)` whose minimum it takes. The QP linea
 
 from __future__ import annotations
 
-import functools
 import math
 import threading
-from dataclasses import dataclass
-from typing import Any, NamedTuple
+from typing import Any
 
 import numpy as np
 
 from .. import _core
 from ..exceptions import InvalidInput
 from ..kinematics.arm import Arm
-from ..validation import as_instance, as_joint_vector, as_number
+from ..validation import as_instance, as_joint_vector
 from .clearance import Clearance
+from .objective_terms import (
+    DEFAULT_CLEARANCE_WEIGHT,
+    DEFAULT_MARGIN_WEIGHT,
+    DEFAULT_SINGULARITY_WEIGHT,
+    SINGULARITY_CAP,
+    Evaluation,
+    Group,
+    check_weights,
+    evaluation_of_row,
+    limit_distances,
+)
 from .singularity import Singularity
-
-#: s_cap: a singularity distance |sin x| beyond this (30 degrees) earns nothing more.
-SINGULARITY_CAP = 0.5
-#: Default weights: w_m, w_c, w_s (module docstring).
-DEFAULT_MARGIN_WEIGHT, DEFAULT_CLEARANCE_WEIGHT, DEFAULT_SINGULARITY_WEIGHT = 1.0, 1.0, 0.1
-
-
-def joint_margins(arm: Arm, q: np.ndarray) -> np.ndarray:
-    """Normalised joint-limit margins m_i(q) (module docstring); +inf for unlimited joints.
-
-    Args:
-        arm: The arm.
-        q: (dof,) or (M, dof) joint vectors.
-
-    Returns:
-        Margins of the same shape as q: 1 at mid-range, 0 on a limit, negative beyond.
-    """
-    q = as_joint_vector(q, as_instance(arm, Arm, "arm").dof)
-    limited = np.isfinite(arm.lower) & np.isfinite(arm.upper)
-    half = np.where(limited, (arm.upper - arm.lower) / 2.0, 1.0)
-    return np.where(limited, np.minimum(*_limit_distances(q, arm.lower, arm.upper, half)), np.inf)
-
-
-def _limit_distances(
-    q: np.ndarray, lower: np.ndarray, upper: np.ndarray, half: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """The two affine pieces of the margins, (q - l)/h and (u - q)/h."""
-    return (q - lower) / half, (upper - q) / half
-
-
-def check_weights(
-    margin_weight: Any,
-    clearance_weight: Any,
-    clearance_cap: Any,
-    min_clearance: Any,
-    singularity_weight: Any = DEFAULT_SINGULARITY_WEIGHT,
-) -> None:
-    """Raise InvalidInput naming the first of the objective's numbers that is out of range."""
-    weights = (
-        ("margin_weight", margin_weight),
-        ("clearance_weight", clearance_weight),
-        ("singularity_weight", singularity_weight),
-    )
-    for name, value in weights:
-        if not as_number(value, name) >= 0.0:
-            raise InvalidInput(f"{name} must be a finite number >= 0, got {value}")
-    if not as_number(clearance_cap, "clearance_cap") > 0.0:
-        raise InvalidInput(f"clearance_cap must be a positive number of metres, got {clearance_cap}")
-    if not 0.0 <= as_number(min_clearance, "min_clearance") < clearance_cap:
-        raise InvalidInput(
-            f"min_clearance must be >= 0 and below clearance_cap ({clearance_cap} m), got {min_clearance}"
-        )
-
-
-@dataclass(slots=True)
-class Group:
-    """One term of the objective: ``weight * min(cap, min_j values_j)``, feasible if
-    ``min_j values_j >= floor``. (Not frozen, but never changed: a frozen dataclass is built
-    several times slower, and each step of a climb builds the groups of its point.)
-
-    Attributes:
-        kind: ``"margin"``, ``"clearance"`` or ``"singularity"``.
-        weight: w >= 0.
-        floor: Feasibility bound on the minimum; -inf for none (no constraint).
-        cap: Upper cap of the term (inf for none).
-        values: (p,) the pieces v_j.
-        jacobian: (p, n) their derivatives by n variables (q, or the redundancy variables),
-            or None when not asked for.
-    """
-
-    kind: str
-    weight: float
-    floor: float
-    cap: float
-    values: np.ndarray
-    jacobian: np.ndarray | None = None
-
-    def constraints(self) -> tuple[np.ndarray, np.ndarray]:
-        """The group's feasibility functions, >= 0 where feasible, and their derivatives
-        (by the first variable of the jacobian). A joint's two margin pieces count as one
-        function, the smaller: 1 - |q_i - c_i| / h_i about mid-range c_i, continuous also
-        where a revolute joint's angle is taken modulo 2 pi at the representative nearest c_i.
-        A group without a floor has none.
-        """
-        if self.floor == -math.inf:
-            return np.zeros(0), np.zeros(0)
-        v, d = self.values - self.floor, self.jacobian[:, 0]
-        if self.kind != "margin":
-            return v, d
-        half = len(v) // 2
-        lower = v[:half] <= v[half:]
-        return np.where(lower, v[:half], v[half:]), np.where(lower, d[:half], d[half:])
-
-
-class Evaluation(NamedTuple):
-    """The objective at one joint vector (a named tuple: the path sweep,
-    ``paths.sweep_circle``, builds one per sample, and a tuple is built several times faster
-    than a frozen dataclass).
-
-    Attributes:
-        value: f(q).
-        margin: M(q), the smallest normalised joint-limit margin (inf if no joint is limited).
-        clearance: D(q) in metres (inf without obstacles).
-        slack: The smallest of M(q) and (D(q) - d_min) / d_cap; q is feasible iff >= 0.
-        singularity: S(q), the smallest ``|sin|`` of the model's singular angles (inf without
-            the term).
-    """
-
-    value: float
-    margin: float
-    clearance: float
-    slack: float
-    singularity: float = math.inf
-
-    @property
-    def feasible(self) -> bool:
-        return self.slack >= 0.0
-
-
-#: An :class:`Evaluation` of a row of ``_core.evaluate``'s five numbers (its fields, in their
-#: order: ``_core.Evaluations``): ``Evaluation._make`` without its length check, the cheapest way
-#: to build hundreds.
-_evaluation_of_row = functools.partial(tuple.__new__, Evaluation)
 
 
 class Objective:
@@ -339,7 +225,7 @@ class Objective:
         q = as_joint_vector(q, self._dof).reshape(-1, self._dof)
         out = np.empty((len(_core.Evaluations._fields), len(q)))  # (a field's values in each row)
         _core.evaluate(self._terms, q, self._distances(q, distances), _core.Evaluations(*out))
-        return list(map(_evaluation_of_row, out.T.tolist()))
+        return list(map(evaluation_of_row, out.T.tolist()))
 
     def _distances(self, q: np.ndarray, distances: np.ndarray | None) -> np.ndarray:
         """What ``_core.evaluate`` reads of the pairs' distances at q: those given, else computed
@@ -405,11 +291,11 @@ class Objective:
 
     def _margins(self, q: np.ndarray) -> np.ndarray:
         """The limited joints' margins m_i at the rows of q (M, dof): (M, limited)."""
-        return np.minimum(*_limit_distances(q[:, self._limited], self._lower, self._upper, self._half))
+        return np.minimum(*limit_distances(q[:, self._limited], self._lower, self._upper, self._half))
 
     def _margin(self, q: np.ndarray, jacobian: bool, tangent: np.ndarray | None) -> Group:
         lim = self._limited
-        pieces = np.concatenate(_limit_distances(q[lim], self._lower, self._upper, self._half))
+        pieces = np.concatenate(limit_distances(q[lim], self._lower, self._upper, self._half))
         rates = _chained(self._margin_jacobian, tangent) if jacobian else None
         return Group("margin", self.margin_weight, 0.0, math.inf, pieces, rates)
 

@@ -66,11 +66,11 @@ from .clearance import DEFAULT_DISTMAX, Clearance
 from .climb import maximise
 from .free_rotation import FreeRotation
 from .intervals import BranchRuns, PsiInterval, Run, feasible_runs
-from .objective import (
+from .objective import Objective
+from .objective_terms import (
     DEFAULT_CLEARANCE_WEIGHT,
     DEFAULT_MARGIN_WEIGHT,
     DEFAULT_SINGULARITY_WEIGHT,
-    Objective,
     check_weights,
 )
 from .paths import sweep_circle

@@ -31,7 +31,8 @@ import numpy as np
 from ..kinematics.arm import Arm
 from .clearance import ALONG_TOLERANCE
 from .intervals import Run
-from .objective import Evaluation, Objective
+from .objective import Objective
+from .objective_terms import Evaluation
 from .points import Point
 
 #: w_t: objective given up per radian of joint travel (default).

@@ -20,7 +20,7 @@ import numpy as np
 from ..om.configuration import Configuration
 from ..om.solver import OMSolver
 from .clearance import Clearance
-from .objective import DEFAULT_SINGULARITY_WEIGHT, joint_margins
+from .objective_terms import DEFAULT_SINGULARITY_WEIGHT, joint_margins
 from .optimizer import RedundancyChoice, RedundancyOptimizer
 from .shapes import Box, Capsule, Shape, Sphere
 

@@ -51,7 +51,8 @@ from .. import _core
 from ..om.configuration import Configuration
 from ..om.solver import OMSolver, Solution
 from .arm_angle import wrap_psi
-from .objective import SINGULARITY_CAP, Objective
+from .objective import Objective
+from .objective_terms import SINGULARITY_CAP
 
 #: Curvature b of the first tracking step's model (per rad^2), and its largest (csrc/tracking.c).
 INITIAL_CURVATURE, MAX_CURVATURE = 0.1, 1e3

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from om_redundant.redundancy.box_qp import Pieces
-from om_redundant.redundancy.objective import Group
+from om_redundant.redundancy.objective_terms import Group
 
 _TIE = 1e-12  # pieces within this of their group's minimum meet there
 

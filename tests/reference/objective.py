@@ -3,7 +3,7 @@ oracle of ``_core.evaluate`` (``csrc/objective.c``), which computes f and the sl
 
 from __future__ import annotations
 
-from om_redundant.redundancy.objective import Group
+from om_redundant.redundancy.objective_terms import Group
 
 
 def term(group: Group) -> float:
