@@ -14,6 +14,7 @@ def joint_name(arm: Arm, j: int) -> str:
 
 
 def joints_named(arm: Arm, joints: Iterable[int]) -> str:
+    """Joints (0-based) as messages name them, comma-separated."""
     return ", ".join(joint_name(arm, j) for j in joints)
 
 

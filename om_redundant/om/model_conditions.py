@@ -21,6 +21,8 @@ RIGHT_ANGLE_EPS = 1e-11
 
 
 def check_right_angle(arm: Arm, row: DHRow, j: int) -> None:
+    """Raise :class:`ModelError` unless joints j and j + 1 (0-based) are perpendicular: the twist
+    of joint j's row within :data:`RIGHT_ANGLE_EPS` of +-90 deg."""
     if abs(np.sin(row.alpha)) < PARALLEL_EPS:
         raise ModelError(
             f"arm '{arm.name}': {joint_name(arm, j)} and {joint_name(arm, j + 1)} are parallel; the "

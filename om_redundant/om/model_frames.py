@@ -13,17 +13,20 @@ from .joint_names import joint_name
 
 
 def pose(table: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rotation and position of the frame after the rows of a DH table at joint values q."""
     R, p = np.empty((3, 3)), np.empty(3)
     _core.flange(np.ascontiguousarray(table), np.ascontiguousarray(q, dtype=np.float64), R, p)
     return R, p
 
 
 def rotx(alpha: float) -> np.ndarray:
+    """Rotation by alpha about x."""
     c, s = np.cos(alpha), np.sin(alpha)
     return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
 
 
 def rotz(theta: float) -> np.ndarray:
+    """Rotation by theta about z."""
     c, s = np.cos(theta), np.sin(theta)
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 

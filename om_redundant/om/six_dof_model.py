@@ -50,6 +50,8 @@ def six_dof_model(arm: Arm) -> tuple[KinematicChain, int, str, np.ndarray]:
 
 
 def position_family(arm: Arm, rows: list[DHRow]) -> tuple[int, str, np.ndarray]:
+    """The family of joints 1-3 (RRR with joints 2 and 3 parallel, or RRP): its code, name and
+    parameter vector with the position joints' entries filled."""
     jr = arm.chain.joint_rows
     r1, r2, r3, r4 = (rows[jr[j]] for j in range(4))
     P = np.zeros(_core.SD_N_PARAMS)
