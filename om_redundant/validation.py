@@ -382,9 +382,6 @@ def as_quaternion(quat: Any, name: str = "quaternion") -> np.ndarray:
     return unit / length
 
 
-# ---------------------------------------------------------------------------------------
-
-
 def _describe(value: Any) -> str:
     """The value, short, with its type when the repr does not show it."""
     if value is None or isinstance(value, bool | np.bool_):

@@ -8,8 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
-from om_redundant.om import derive_model
-from om_redundant.om import model as model_module
+from om_redundant.om import derive_model, model_conditions
 from tests.conftest import random_q, wrap
 from tests.ur_closed_form import ur_ik
 
@@ -173,7 +172,7 @@ def test_an_arm_that_cannot_solve_is_refused_at_construction(monkeypatch):
         r"got 90.5729578 deg \(0.01 rad off\)",
     ):
         om.OMSolver(bent)
-    monkeypatch.setattr(model_module, "_RIGHT_ANGLE_EPS", 1e-1)
+    monkeypatch.setattr(model_conditions, "RIGHT_ANGLE_EPS", 1e-1)
     derive_model(bent)  # accepted by the loosened check ...
     with pytest.raises(
         om.ModelError,

@@ -1,4 +1,4 @@
-"""6-DOF arms whose wrist has a4 != 0: dp turns with q1 (om.model._wrist_offset), solved exactly."""
+"""6-DOF arms whose wrist has a4 != 0: dp turns with q1 (om.six_dof_model.wrist_offset), solved exactly."""
 
 from __future__ import annotations
 

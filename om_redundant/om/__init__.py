@@ -1,12 +1,13 @@
 """The offset modification method: configurations (:mod:`.configuration`), the model arm
 (:mod:`.model`) with its closed-form families (:mod:`.families`), system (9) and its bounded
 search (:mod:`.system`), arms near a family (:mod:`.nominal`, :mod:`.near`), and the solver
-that fronts them (:mod:`.solver`)."""
+that fronts them (:mod:`.solver`, its batch entry points in :mod:`.batch`)."""
 
+from .batch import BatchRoots, BatchSolution
 from .configuration import Configuration
 from .model import ANGLE_ROUNDING, LENGTH_ROUNDING, ModelArm, derive_model
 from .nominal import NEAR_LENGTH, NEAR_TWIST, NominalArm, nominal_arm
-from .solver import BRANCH_BAND, BatchRoots, BatchSolution, OMSolver, Solution
+from .solver import BRANCH_BAND, OMSolver, Solution
 
 __all__ = [
     "ANGLE_ROUNDING",

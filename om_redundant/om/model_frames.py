@@ -1,0 +1,60 @@
+"""DH frames for the model's derivation: the pose after a run of DH rows, the elementary
+rotations, and the exact fit of a quantity that turns with one joint."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import _core
+from ..exceptions import ModelError
+from ..kinematics.arm import Arm
+from ..kinematics.chain import DHRow, JointKind, KinematicChain
+from .joint_names import joint_name
+
+
+def pose(table: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rotation and position of the frame after the rows of a DH table at joint values q."""
+    R, p = np.empty((3, 3)), np.empty(3)
+    _core.flange(np.ascontiguousarray(table), np.ascontiguousarray(q, dtype=np.float64), R, p)
+    return R, p
+
+
+def rotx(alpha: float) -> np.ndarray:
+    """Rotation by alpha about x."""
+    c, s = np.cos(alpha), np.sin(alpha)
+    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+def rotz(theta: float) -> np.ndarray:
+    """Rotation by theta about z."""
+    c, s = np.cos(theta), np.sin(theta)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def tail_rotation(rows: list[DHRow], last: int) -> np.ndarray:
+    """Rotation from the frame after the last joint's Rz(phi) to the flange."""
+    tail = [DHRow(alpha=rows[last].alpha, kind=JointKind.FIXED), *rows[last + 1 :]]
+    return pose(KinematicChain(tuple(tail)).table, np.zeros(0))[0]
+
+
+def circle_fit(arm: Arm, what: str, joint: int, f) -> np.ndarray:
+    """Fit f(q) = C0 + C1 cos q_J + C2 sin q_J exactly from four angles of joint J (f constant
+    for J = -1), and check it at random joint vectors."""
+    rng = np.random.default_rng(1)
+    q = rng.uniform(-np.pi, np.pi, arm.dof)
+
+    def at(w: float) -> np.ndarray:
+        if joint >= 0:
+            q[joint] = w
+        return f(q)
+
+    d0, d1, d2, d3 = (at(w) for w in (0.0, np.pi / 2, np.pi, -np.pi / 2))
+    C = np.array([(d0 + d2) / 2, (d0 - d2) / 2, (d1 - d3) / 2])
+    for _ in range(16):
+        q = rng.uniform(-np.pi, np.pi, arm.dof)
+        w = q[joint] if joint >= 0 else 0.0
+        misfit = np.abs(C[0] + C[1] * np.cos(w) + C[2] * np.sin(w) - f(q)).max()
+        if misfit > 1e-13:
+            shape = "constant" if joint < 0 else f"affine in cos and sin of {joint_name(arm, joint)}"
+            raise ModelError(f"arm '{arm.name}': {what} is not {shape} (off by {misfit:.2g})")
+    return C
