@@ -140,7 +140,7 @@ def measure(
         row["solver"] = f"refused: {error}"
         return row
     near = ", near: its nominal arm" if solver.nominal is not None else ""
-    row["solver"] = f"accepted ({solver.om.family_name.split(':')[0]}{near})"
+    row["solver"] = f"accepted ({solver.model_arm.family_name.split(':')[0]}{near})"
     data = mujoco.MjData(model)
     among = hinted = nearer = wrong = roots_total = 0
     worst_position = worst_orientation = 0.0

@@ -3,7 +3,7 @@
 Run: ``python -m benchmarks.near_family [--n 2000] [--seed 0]``; writes
 ``results/near_family.md``. For each arm and each deviation eps, every joint row's twist is
 moved by +-eps (random signs, seeded), which no closed form takes exactly, so the solver
-goes through the nominal arm (``om_redundant.om.near``). At N random in-limit q: T =
+goes through the nominal arm (``om_redundant.ik.near``). At N random in-limit q: T =
 fk(q), c its configuration; a *wrong root* is one of ``solve_all(T, c)`` that misses T
 (1e-10 m, 1e-10 rad) or c; a *miss* is a q not among the roots (T is reachable in c).
 Also the variants with joint 3's axis reversed and with a fixed row between joints 2 and 3.

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import argparse
 
-from om_redundant.om.experiment import run
+from om_redundant.ik.experiment import run
 
 from .report import write_page
 

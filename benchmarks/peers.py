@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 import om_redundant as om
-from om_redundant.om.experiment import run as run_paper_experiment
+from om_redundant.ik.experiment import run as run_paper_experiment
 
 from .adapters import PEERS, Peer, Unavailable
 from .pages import write_block

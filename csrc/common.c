@@ -1,5 +1,5 @@
 /* The Euler decomposition of a revolute triple with intersecting axes (a spherical shoulder
- * or wrist): see om_redundant/om/families/common.py for the math.
+ * or wrist): see om_redundant/ik/families/common.py for the math.
  * Every expression keeps the Python operand order (numba evaluates left to right). */
 #include "om_kernels.h"
 

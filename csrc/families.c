@@ -1,4 +1,4 @@
-/* Dispatch on the family code (om_redundant/om/families/dispatch.py calls it from Python). */
+/* Dispatch on the family code (om_redundant/ik/families/dispatch.py calls it from Python). */
 #include "om_kernels.h"
 
 /* The target for the flange orientation R (and, S-R-S, the arm angle redundancy[0]): what

@@ -1,5 +1,5 @@
 /* Arms NEAR a closed-form family: the OM system (9) with the nominal arm as the model's side,
- * its orientation difference included (om_redundant/om/nominal.py builds the nominal arm).
+ * its orientation difference included (om_redundant/ik/nominal.py builds the nominal arm).
  *
  * The real arm's exact chain (in the nominal joint coordinates q) and its nominal arm (twists
  * snapped to right angles, reversed axes flipped, fixed rows merged, small lengths zeroed)

@@ -90,7 +90,7 @@ enum { OM_JOINT_REVOLUTE = 0, OM_JOINT_PRISMATIC = 1, OM_JOINT_FIXED = 2 };
 
 /* ------------------------------------------------------------------------------------ */
 /* six_dof.c, srs.c, families.c: the model arms' closed forms (the math: the Python modules */
-/* om_redundant/om/families/six_dof.py and srs.py). The family codes and the parameter      */
+/* om_redundant/ik/families/six_dof.py and srs.py). The family codes and the parameter      */
 /* layouts are written here alone: Python reads them from om_redundant._core (module.c).    */
 
 /* The family codes (_core.RRR_SPHERICAL_WRIST, RRP_SPHERICAL_WRIST, SRS). */

@@ -1,5 +1,5 @@
 /* 6-DOF model arms with a spherical wrist (RRR and RRP position families): the math is in
- * om_redundant/om/families/six_dof.py. */
+ * om_redundant/ik/families/six_dof.py. */
 #include "om_kernels.h"
 
 

@@ -1,5 +1,5 @@
 /* The entry points: one solve, and every root of one configuration
- * (the method: om_redundant/om/system.py). */
+ * (the method: om_redundant/ik/system.py). */
 #include "om_system.h"
 
 #define START_POINTS 8 /* starts on the dp circle where a first root is out of limits */

@@ -1,6 +1,6 @@
 /* 7-DOF S-R-S model arms (spherical shoulder, elbow, spherical wrist): the closed form at an
  * arm angle (its arm angle and gradient at q: srs_arm_angle.c). The math and the parameter
- * layout are in the docstrings of om_redundant/om/families/srs.py. */
+ * layout are in the docstrings of om_redundant/ik/families/srs.py. */
 #include "srs.h"
 
 /* |sin phi6 sin beta| below which om_srs_model_q7 leaves q7 to the closed form: q7 is

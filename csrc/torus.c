@@ -1,7 +1,7 @@
 /* The bounded search on the torus (w1, w7) of an arm with shoulder offsets: the lifted
  * residual on a grid, damped Newton (torus_newton.c) from its local minima and sign changes,
  * with deflation and fold partners, and at psi's half-line (torus_half_line.c)
- * (the method: om_redundant/om/system.py). */
+ * (the method: om_redundant/ik/system.py). */
 #include "torus.h"
 
 #define MAX_KNOWN 64           /* roots of the lifted torus system kept for deflation */

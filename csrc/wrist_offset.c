@@ -1,4 +1,4 @@
-/* The dp circle of a 6-DOF arm whose wrist has a4 != 0 (the method: om_redundant/om/model.py,
+/* The dp circle of a 6-DOF arm whose wrist has a4 != 0 (the method: om_redundant/ik/model.py,
  * _wrist_offset). With joints 2, 3 and 4 parallel, joint 4's axis z3 turns with q1 alone and
  * joint 6's axis z5 is the target's; joint 5's axis is normal to both, z4 = -sigma4 sigma5
  * WRIST (z3 x z5) / |z3 x z5| (|z3 x z5| = |sin phi5|), so at a solution

@@ -2,7 +2,7 @@
 
 The folders follow the data path: an arm file becomes a kinematic chain
 (:mod:`.kinematics`), the offset modification method derives the model arm and solves
-system (9) (:mod:`.om`), the arm angle of a 7-DOF arm is chosen by the redundancy optimiser
+system (9) (:mod:`.ik`), the arm angle of a 7-DOF arm is chosen by the redundancy optimiser
 (:mod:`.redundancy`), MuJoCo models hold the arm (:mod:`.mujoco_io`), and mink tasks
 (:mod:`.tasks`) and the command line (:mod:`.cli`) use the result.
 """
@@ -19,6 +19,13 @@ from .exceptions import (
     UnknownArm,
     UnreachableTarget,
 )
+from .ik import (
+    BatchRoots,
+    BatchSolution,
+    Configuration,
+    OMSolver,
+    Solution,
+)
 from .kinematics import Arm, DHRow, JointKind, arm_names, load_arm, write_arm_file
 from .mujoco_io import (
     ArmJoints,
@@ -30,13 +37,6 @@ from .mujoco_io import (
     compare_mujoco_model,
     load_mujoco_model,
     scene_mjcf,
-)
-from .om import (
-    BatchRoots,
-    BatchSolution,
-    Configuration,
-    OMSolver,
-    Solution,
 )
 from .redundancy import (
     MAX_EXTENT,

@@ -167,7 +167,7 @@ def well_conditioned(solver: om.OMSolver, q: np.ndarray) -> bool:
     two roots of (T, c) meet), the pose map on a 6-DOF arm, and every branch quantity (of the
     model, at ``solver.flip * q``)."""
     values = np.empty(len(solver.sign_names))
-    _core.branch_values(solver.om.family, solver.om.params, solver.flip * q, values)
+    _core.branch_values(solver.model_arm.family, solver.model_arm.params, solver.flip * q, values)
     jacobian = solver.arm.jacobian(q)
     if solver.arm.dof == 7:
         jacobian = np.vstack([jacobian, om.arm_angle_and_gradient(solver, q)[1]])

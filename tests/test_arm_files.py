@@ -153,7 +153,7 @@ def test_spherical_arm_reproduces_the_papers_delta_p():
         ],
         axis=1,
     )
-    np.testing.assert_allclose(solver.om.dp(Q), expected, atol=1e-15)
+    np.testing.assert_allclose(solver.model_arm.dp(Q), expected, atol=1e-15)
     assert solver.dp_max == pytest.approx(d5, abs=1e-15)
 
 

@@ -21,8 +21,8 @@ import pytest
 import om_redundant as om
 from benchmarks.menagerie import EXTRA, available, frame_pose
 from om_redundant.cli import main
+from om_redundant.ik import derive_model
 from om_redundant.mujoco_io.arm_import import IMPORT_TOLERANCE
-from om_redundant.om import derive_model
 from tests.conftest import MENAGERIE, random_q, wrap
 
 #: model file, frame, frame type, and None where OMSolver accepts the arm, else the reason.

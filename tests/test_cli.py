@@ -21,7 +21,7 @@ import om_redundant as om
 from om_redundant.cli import build_parser, main
 from om_redundant.cli.common import UsageError
 from om_redundant.cli.sweep import Progress, build_request, parse_obstacle, psi_grid, read_path
-from om_redundant.om.model import derive_model
+from om_redundant.ik.model import derive_model
 from om_redundant.redundancy.sweep import SweepResult, compute_sweep, optimizer_for
 from tests.conftest import MENAGERIE, ROOT, checkout_env, run_python
 

@@ -8,7 +8,7 @@ import re
 
 import pytest
 
-from om_redundant.om.experiment import run
+from om_redundant.ik.experiment import run
 from tests.conftest import ROOT, run_python
 
 

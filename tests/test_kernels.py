@@ -13,7 +13,7 @@ import pytest
 
 import om_redundant as om
 from om_redundant import _core
-from om_redundant.om.system import SolverData
+from om_redundant._core import SolverData
 from om_redundant.redundancy.self_motion import self_motion_tangent
 from tests.conftest import random_q
 from tests.test_reliability import BOUNDARY_CASES
@@ -501,7 +501,7 @@ def test_the_parameter_layouts_fit_the_models_parameter_vectors():
     }
     families = set()
     for name in ("ur5e", "spherical", "panda"):
-        model = om.OMSolver(name).om
+        model = om.OMSolver(name).model_arm
         assert model.params.shape == (sizes[model.family],), name
         families.add(model.family)
     assert families == set(sizes)

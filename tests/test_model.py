@@ -12,8 +12,8 @@ from hypothesis import strategies as st
 import om_redundant as om
 from om_redundant import _core
 from om_redundant._core import flange as flange_kernel
-from om_redundant.om import derive_model
-from om_redundant.om.families import REACH_SLACK, branch_values, model_ik, redundancy_values, srs
+from om_redundant.ik import derive_model
+from om_redundant.ik.families import REACH_SLACK, branch_values, model_ik, redundancy_values, srs
 from tests.conftest import random_q, wrap
 
 

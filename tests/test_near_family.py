@@ -1,6 +1,6 @@
 """Arms NEAR a closed-form family (issue 17, item 2): twists off 0/90/180 deg by 1e-8 ... 1e-3
 rad, reversed axes, fixed rows between joints; solved exactly through the nominal arm
-(om/nominal.py, csrc/near.c), or refused at construction with a ModelError naming the cause."""
+(ik/nominal.py, csrc/near.c), or refused at construction with a ModelError naming the cause."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 import om_redundant as om
 from benchmarks.near_family import bent, cases, fixed_row_between, reversed_joint
 from om_redundant import _core
-from om_redundant.om.nominal import NEAR_TWIST, nominal_arm
+from om_redundant.ik.nominal import NEAR_TWIST, nominal_arm
 from tests.conftest import EXACT, check_exact, random_q, well_conditioned, wrap
 
 
@@ -141,7 +141,7 @@ def test_arm_angle_and_singularities_of_a_reversed_joint(joint):
     the finite difference's, the singularities' distances the model's at flip * q."""
     solver = om.OMSolver(reversed_joint(om.load_arm("panda"), joint))
     assert solver.flip[joint] == -1
-    singularity = om.Singularity.of(solver.om, solver.flip)
+    singularity = om.Singularity.of(solver.model_arm, solver.flip)
     for q in random_q(solver.arm, 10, np.random.default_rng(joint)):
         psi, grad = om.arm_angle_and_gradient(solver, q)
         assert abs(wrap(psi - solver.configuration_of(q).redundancy[0])) < 1e-12
@@ -151,7 +151,7 @@ def test_arm_angle_and_singularities_of_a_reversed_joint(joint):
             dq[j] = step
             fd = wrap(om.arm_angle_and_gradient(solver, q + dq)[0] - psi) / step
             assert abs(fd - grad[j]) < 1e-5
-        nominal = om.Singularity.of(solver.om).distances(solver.flip * q)
+        nominal = om.Singularity.of(solver.model_arm).distances(solver.flip * q)
         np.testing.assert_allclose(singularity.distances(q), nominal, rtol=0, atol=1e-15)
 
 
@@ -197,7 +197,7 @@ def test_targets_at_a_branch_boundary_of_a_near_arm(branch, q):
     solver = bent_solver("ur5e", np.log10(2e-4), 0)
     q = np.array(q)
     values = np.empty(3)
-    _core.branch_values(solver.om.family, solver.om.params, solver.flip * q, values)
+    _core.branch_values(solver.model_arm.family, solver.model_arm.params, solver.flip * q, values)
     assert abs(values[branch]) < 5e-3
     check_exact(solver, q, strict=True)
 

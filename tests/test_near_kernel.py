@@ -12,7 +12,7 @@ import pytest
 import om_redundant as om
 from benchmarks.near_family import bent, reversed_joint
 from om_redundant import _core
-from om_redundant.om import system
+from om_redundant.ik.kernel_data import flange_target
 from tests.conftest import EXACT, distance, random_q
 
 #: Random starts of the independent search per target.
@@ -25,9 +25,9 @@ def polished_roots(solver: om.OMSolver, T: np.ndarray, psi: float, rng: np.rando
     the OM system but the chain and psi's definition. In the arm's own joint coordinates."""
     nominal = solver.nominal
     exact = nominal.exact
-    R, p = system.flange_target(T, np.linalg.inv(exact.T_root_base), np.linalg.inv(exact.T_flange_tool))
+    R, p = flange_target(T, np.linalg.inv(exact.T_root_base), np.linalg.inv(exact.T_flange_tool))
     seven = solver.arm.dof == 7
-    arm_angle = _core.ArmAngleRow(solver.om.params, solver.model.chain.table, psi) if seven else None
+    arm_angle = _core.ArmAngleRow(solver.model_arm.params, solver.model.chain.table, psi) if seven else None
     roots: list[np.ndarray] = []
     for start in rng.uniform(-np.pi, np.pi, (STARTS, solver.arm.dof)):
         q = np.ascontiguousarray(start)
@@ -146,7 +146,7 @@ def test_micrometre_offsets_of_rounded_twists_are_the_nominal_arms_zeros():
     ]
     arm = arm.with_chain(arm.chain.replace_rows(rows), "xarm7-urdf-like")
     solver = om.OMSolver(arm)
-    assert solver.solver_data().mode == system.CIRCLE
+    assert solver.solver_data().mode == _core.CIRCLE
     assert 0.0 < solver.nominal.deviation < 1e-4
     for q in random_q(arm, 20, np.random.default_rng(2)):
         T = arm.fk(q)

@@ -51,11 +51,11 @@ def test_polish_converges_to_the_pose_and_arm_angle(name, seed, offset, singular
     rng = np.random.default_rng(seed)
     q = random_q(solver.arm, 1, rng)[0]
     if singular:  # the wrist's middle joint at the angle that aligns the outer wrist axes
-        families = om.om.families
-        if solver.om.family == families.SRS:
-            q[5] = -solver.om.params[_core.SRS_THETA + 5]
+        families = om.ik.families
+        if solver.model_arm.family == families.SRS:
+            q[5] = -solver.model_arm.params[_core.SRS_THETA + 5]
         else:
-            q[4] = -solver.om.params[_core.SD_THETA5]
+            q[4] = -solver.model_arm.params[_core.SD_THETA5]
     T, c = solver.arm.fk(q), solver.configuration_of(q)
     psi = c.redundancy[0] if c.redundancy else None
     start = q + rng.normal(0.0, offset, q.shape)

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 import om_redundant as om
 from benchmarks import adversarial as adv
 from om_redundant import _core
-from om_redundant.om import BRANCH_BAND
+from om_redundant.ik import BRANCH_BAND
 from tests.conftest import random_q, run_python
 
 _SOLVERS: dict[str, om.OMSolver] = {}
@@ -56,13 +56,13 @@ def _assert_solved(
 def _branch_joint(solver: om.OMSolver, name: str) -> tuple[int, float] | None:
     """The joint j and offset theta with the branch quantity ``name`` = sin(q_j + theta)
     (None: the branch is not an angle, as the Spherical arm's prismatic elbow)."""
-    families, params = om.om.families, solver.om.params
-    srs = solver.om.family == families.SRS
+    families, params = om.ik.families, solver.model_arm.params
+    srs = solver.model_arm.family == families.SRS
     if name == "WRIST":
         return (5, params[_core.SRS_THETA + 5]) if srs else (4, params[_core.SD_THETA5])
     if srs:
         return 3, params[_core.SRS_THETA + 3] - params[_core.SRS_PHI_STAR]
-    if solver.om.family == families.RRR_SPHERICAL_WRIST:
+    if solver.model_arm.family == families.RRR_SPHERICAL_WRIST:
         return 2, params[_core.SD_THETA3] + params[_core.SD_BETA]
     return None
 
@@ -118,7 +118,7 @@ def test_holds_reads_psi_in_the_requested_elbow_branch():
     """A straight elbow holds both ELBOW branches, at psi in one and psi + pi in the other."""
     panda = _solver("panda")
     q = random_q(panda.arm, 1, np.random.default_rng(2))[0]
-    q[3] = panda.om.params[_core.SRS_PHI_STAR] - panda.om.params[_core.SRS_THETA + 3]
+    q[3] = panda.model_arm.params[_core.SRS_PHI_STAR] - panda.model_arm.params[_core.SRS_THETA + 3]
     c = panda.configuration_of(q)
     elbow = panda.sign_names.index("ELBOW")
     flipped = _flipped(panda, c, elbow)

@@ -12,8 +12,8 @@ import om_redundant as om
 from om_redundant import _core
 from om_redundant._core import FlangeTarget, srs_model_q7
 from om_redundant._core import flange as flange_kernel
-from om_redundant.om import derive_model
-from om_redundant.om.families import REACH_SLACK, branch_values, model_ik, redundancy_values
+from om_redundant.ik import derive_model
+from om_redundant.ik.families import REACH_SLACK, branch_values, model_ik, redundancy_values
 from tests.conftest import random_q, wrap
 
 

@@ -15,9 +15,9 @@ import numpy as np
 import pytest
 
 import om_redundant as om
+from om_redundant.ik import LENGTH_ROUNDING, derive_model
+from om_redundant.ik.model import rounding_length
 from om_redundant.kinematics import KinematicChain
-from om_redundant.om import LENGTH_ROUNDING, derive_model
-from om_redundant.om.model import rounding_length
 from tests.conftest import check_exact, random_q, well_conditioned
 from tests.test_wrist_offset import with_offsets
 
@@ -42,7 +42,7 @@ def solvers(case: str) -> tuple[om.OMSolver, om.OMSolver]:
 
 def method(solver: om.OMSolver) -> tuple:
     """What the arm gets: the family, the joint dp turns with, and whether the shoulder turns it."""
-    return solver.om.family_name, solver.om.dp_joint, bool(solver.om.shoulder.any())
+    return solver.model_arm.family_name, solver.model_arm.dp_joint, bool(solver.model_arm.shoulder.any())
 
 
 @pytest.mark.parametrize("case", ROUNDED)
@@ -76,8 +76,8 @@ def test_the_rounding_scales_with_the_arm():
         LENGTH_ROUNDING * sum(math.hypot(r.a, r.d) for r in ur5e.chain.rows), rel=1e-12
     )
     offset = {"joint3": {"a": 2e-9}}
-    assert "wrist offset" not in om.OMSolver(with_offsets(large, **offset)).om.family_name
-    assert "wrist offset a4" in om.OMSolver(with_offsets(ur5e, **offset)).om.family_name
+    assert "wrist offset" not in om.OMSolver(with_offsets(large, **offset)).model_arm.family_name
+    assert "wrist offset a4" in om.OMSolver(with_offsets(ur5e, **offset)).model_arm.family_name
 
 
 def test_derive_model_names_the_rounding_it_leaves_to_the_nominal_arm():

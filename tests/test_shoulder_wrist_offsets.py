@@ -1,7 +1,7 @@
 """7-DOF arms with a shoulder offset a2 (the common normal of joints 2 and 3: Unitree G1 6.24 mm,
 TIAGo Pro 20 mm) or a wrist offset a5 (of joints 5 and 6: Baxter 10 mm), issue 32: the nominal
 arm zeroes them and the correction, on the left or the right, solves the OM system (9)
-(om/nominal.py, csrc/near.c); every root exact, q among them and the hinted solve's answer."""
+(ik/nominal.py, csrc/near.c); every root exact, q among them and the hinted solve's answer."""
 
 from __future__ import annotations
 
@@ -13,8 +13,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
+from om_redundant import _core
+from om_redundant.ik import derive_model
 from om_redundant.kinematics import KinematicChain
-from om_redundant.om import derive_model, system
 from tests.conftest import check_exact, random_q, well_conditioned
 
 G1_OFFSET, TIAGO_PRO_OFFSET, BAXTER_OFFSET = 0.00624, 0.02, 0.01
@@ -73,7 +74,7 @@ def test_the_nominal_arm_zeroes_the_offsets_and_corrects_on_the_larger_ones_side
     assert (solver.arm.chain.rows[1].a, solver.arm.chain.rows[4].a) == (a2, a5)
     data = solver.solver_data()
     assert solver.nominal.deviation >= a2 + a5 and data.near_mixed and data.near_left == (a2 >= a5)
-    assert data.mode == system.TORUS  # q1 and q7 given, the fixed point in q2 or q6
+    assert data.mode == _core.TORUS  # q1 and q7 given, the fixed point in q2 or q6
 
 
 @settings(max_examples=20, deadline=None)

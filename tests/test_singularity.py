@@ -39,7 +39,7 @@ unit_vectors = st.lists(st.floats(0.0, 1.0), min_size=7, max_size=7).map(np.arra
 def test_distances_vanish_where_the_branch_signs_change(solvers, name, unit):
     """Each distance is |sin x| of the angle whose sign is a branch sign of the model."""
     solver = solvers[name]
-    singularity = om.Singularity.of(solver.om)
+    singularity = om.Singularity.of(solver.model_arm)
     q = limited_q(solver.arm, unit[: solver.arm.dof])
     x = q[singularity.joints] + singularity.offsets
     assume(np.abs(np.sin(x)).min() > 1e-6)  # (on a singularity the sign is that of rounding)
@@ -51,7 +51,7 @@ def test_distances_vanish_where_the_branch_signs_change(solvers, name, unit):
 
 
 def test_each_arm_has_the_singularities_of_its_family(solvers):
-    names = {name: om.Singularity.of(solver.om).names for name, solver in solvers.items()}
+    names = {name: om.Singularity.of(solver.model_arm).names for name, solver in solvers.items()}
     assert names["panda"] == names["sawyer"] == ("wrist", "elbow", "shoulder")
     assert names["ur5e"] == ("wrist", "elbow")
     assert names["spherical"] == ("wrist",)
@@ -61,7 +61,7 @@ def test_each_arm_has_the_singularities_of_its_family(solvers):
 @given(name=st.sampled_from(ARMS), unit=unit_vectors, direction=unit_vectors)
 def test_gradients_match_finite_differences(solvers, name, unit, direction):
     solver = solvers[name]
-    singularity = om.Singularity.of(solver.om)
+    singularity = om.Singularity.of(solver.model_arm)
     dof = solver.arm.dof
     q, v = limited_q(solver.arm, unit[:dof]), direction[:dof] - 0.5
     s, gradient = singularity.distances_and_gradients(q)
@@ -142,6 +142,6 @@ def test_bad_singularities_are_named(solvers):
     with pytest.raises(om.InvalidInput, match="singularity must be a Singularity"):
         Objective(solvers["panda"].arm, singularity="wrist")
     with pytest.raises(om.InvalidInput, match="the singularity's arm has 6 joints, the arm 7"):
-        Objective(solvers["panda"].arm, singularity=om.Singularity.of(solvers["ur5e"].om))
+        Objective(solvers["panda"].arm, singularity=om.Singularity.of(solvers["ur5e"].model_arm))
     with pytest.raises(om.InvalidInput, match="q must have shape \\(7,\\)"):
-        om.Singularity.of(solvers["panda"].om).distances(np.zeros(6))
+        om.Singularity.of(solvers["panda"].model_arm).distances(np.zeros(6))

@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
-from om_redundant.om import derive_model, model_conditions
+from om_redundant.ik import derive_model, model_conditions
 from tests.conftest import random_q, wrap
 from tests.ur_closed_form import ur_ik
 
@@ -123,7 +123,7 @@ def test_ur5e_configurations_agree_with_an_independent_closed_form(ur5e):
         for e in expected:
             assert min(np.abs(wrap(f - e)).max() for f in found) < 1e-9
         values = np.empty(3)
-        om.om.families.branch_values(ur5e.om.family, ur5e.om.params, q, values)
+        om.ik.families.branch_values(ur5e.model_arm.family, ur5e.model_arm.params, q, values)
         if len(expected) == 8 and abs(values[0]) > 2 * ur5e.dp_max:
             checked += 1
             for c in ur5e.configurations():

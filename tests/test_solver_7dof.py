@@ -8,8 +8,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
-from om_redundant.om.families import REACH_SLACK, model_ik
-from om_redundant.om.system import flange_target
+from om_redundant.ik.families import REACH_SLACK, model_ik
+from om_redundant.ik.kernel_data import flange_target
 from tests.conftest import random_q, wrap
 
 pytestmark = pytest.mark.sanitize  # also run under ASan and UBSan (.ci/sanitize)
@@ -175,7 +175,7 @@ def test_targets_beyond_the_models_reach_are_solved_by_the_lifted_newton(name):
     elbow held at the edge, solves them exactly without the bounded search: a few dozen
     residual evaluations (median 8 here) rather than the bounded search's hundreds."""
     solver = om.OMSolver(name)
-    chain, model = solver.arm.chain, solver.om
+    chain, model = solver.arm.chain, solver.model_arm
     base_inv, tool_inv = np.linalg.inv(chain.T_root_base), np.linalg.inv(chain.T_flange_tool)
     table = model.model.chain.table
     evaluations = []

@@ -279,7 +279,7 @@ def singular_margins(solver, q):
         return KinematicChain(rows[: first[j] + 1], chain.T_root_base).fk(q[: j + 1])[:3, 3]
 
     w = origin(4) - origin(0)
-    P = solver.om.params
+    P = solver.model_arm.params
     return 1.0 + w[2] / np.linalg.norm(w), abs(
         math.sin(q[3] + P[_core.SRS_THETA + 3] - P[_core.SRS_PHI_STAR])
     )

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from om_redundant import _core
-from om_redundant.om.system import MAX_ROOTS, flange_target
+from om_redundant._core import MAX_ROOTS
+from om_redundant.ik.kernel_data import flange_target
 from tests.conftest import EXACT, random_q, solver_of, wrap
 from tests.test_kernels import _assert_rows_are_solve_all
 

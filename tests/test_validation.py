@@ -12,7 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
-from om_redundant.om import derive_model
+from om_redundant.ik import derive_model
 
 
 @pytest.fixture(scope="module")
@@ -327,7 +327,7 @@ def test_solver_arguments_are_named(make, message):
 
 def test_scan_points_bounds_are_whole_numbers():
     assert om.OMSolver("ur5e", scan_points=64.0).scan_points == 64
-    assert om.OMSolver("ur5e", scan_points=np.int32(om.om.solver.MAX_SCAN_POINTS)).scan_points == 1024
+    assert om.OMSolver("ur5e", scan_points=np.int32(om.ik.solver.MAX_SCAN_POINTS)).scan_points == 1024
 
 
 def test_numbers_are_numbers(panda):

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 
 import om_redundant as om
 from benchmarks.near_family import bent, reversed_joint
-from om_redundant.om import derive_model
+from om_redundant.ik import derive_model
 from tests.conftest import check_exact, random_q, well_conditioned
 
 
@@ -68,7 +68,7 @@ def test_a_wrist_offset_near_a_family(deviation):
     7e-6 rad), every twist moved by +-deviation: solved through the nominal arm, exactly."""
     arm = reversed_joint(with_offsets(om.load_arm("ur5e"), joint3={"a": 0.074}), 2, 7e-6)
     solver = om.OMSolver(bent(arm, deviation, np.random.default_rng(1)) if deviation else arm)
-    assert solver.nominal is not None and "wrist offset a4" in solver.om.family_name
+    assert solver.nominal is not None and "wrist offset a4" in solver.model_arm.family_name
     for q in random_q(solver.arm, 30, np.random.default_rng(5)):
         check_exact(solver, q, well_conditioned(solver, q))
 

@@ -20,10 +20,11 @@ checked against MuJoCo's own FK of the project's MJCF of the arm (``om.arm_model
   ``solve_batch`` of all, ``solve_all`` (which must hold q). A false "no" is ok False, or an
   empty ``solve_all``.
 * **singular**: q moved along one joint, within its limits, to a randomly drawn crossing so
-  that a branch quantity (``om.om.families.branch_values``, index 0, 1, 2) is +-10**u, u
+  that a branch quantity (``om.ik.families.branch_values``, index 0, 1, 2) is +-10**u, u
   uniform in [-14, -3]; and joints at their limits +- 1e-12. Then ``solve``, hinted ``solve``
   and ``solve_all`` in c = configuration_of(q). Also "the other side": the flipped sign where
-  |offset| <= ``om_redundant.om.BRANCH_BAND`` (1e-7), where the pose belongs to both configurations.
+  |offset| <= ``om_redundant.ik.BRANCH_BAND`` (1e-7), where the pose belongs to both
+  configurations.
 * **huge/tiny**: hints of magnitude 1e3 ... 1e300; psi + 2 pi k for huge k (the same answer as
   for ``math.remainder(psi, 2 pi)``); poses translated by 1e3 ... 1e300 m (ok False,
   "unreachable"); translations changed by 1e-300 (a reachable pose) or of size 1e-300.
@@ -39,7 +40,7 @@ checked against MuJoCo's own FK of the project's MJCF of the arm (``om.arm_model
 
 An ok answer is **wrong** if MuJoCo's FK differs from T by more than 1e-10 m or 1e-10 rad,
 or q is not in the requested configuration (``OMSolver.holds``: signs equal, a branch quantity
-within ``om_redundant.om.BRANCH_BAND`` of zero counting for both; psi, read in the requested ELBOW branch,
+within ``om_redundant.ik.BRANCH_BAND`` of zero counting for both; psi, read in the requested ELBOW branch,
 within 1e-9 modulo 2 pi or within its own rounding next to its singular half-line), or
 ``within_limits`` is not
 ``lower <= q <= upper``. A **non-library exception** is anything raised that is not an

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 import om_redundant as om
-from om_redundant.om import system
+from om_redundant import _core
 
 from .checker import Checker
 from .draws import PoseDraws
@@ -27,7 +27,7 @@ class ArmRun(PoseDraws):
         self.checker = Checker(self.solver)
         self.rng = np.random.default_rng([seed, zlib.crc32(name.encode())])
         self.result = ArmResult(name)
-        self.torus = self.solver.solver_data().mode == system.TORUS
+        self.torus = self.solver.solver_data().mode == _core.TORUS
         self.limited = np.flatnonzero(np.isfinite(self.arm.lower) & np.isfinite(self.arm.upper))
         self.pending: list | None = None  # deferred checks, see judge()
 

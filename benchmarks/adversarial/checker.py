@@ -9,11 +9,11 @@ import mujoco
 import numpy as np
 
 import om_redundant as om
+from om_redundant.ik import BRANCH_BAND
+from om_redundant.ik.families import branch_values, redundancy_values
 from om_redundant.mujoco_io.mjcf import DEFAULT_SITE
-from om_redundant.om.families import branch_values, redundancy_values
 
 from .records import (
-    BRANCH_BAND,
     FK_ROUNDING,
     ORIENTATION_TOLERANCE,
     POSITION_TOLERANCE,
@@ -32,7 +32,7 @@ class Checker:
         self.model = om.arm_model(solver.arm)
         self.data = mujoco.MjData(self.model)
         self.site = self.model.site(solver.arm.frame_name or DEFAULT_SITE).id
-        self.family, self.params = int(solver.om.family), np.ascontiguousarray(solver.om.params)
+        self.family, self.params = int(solver.model_arm.family), np.ascontiguousarray(solver.model_arm.params)
         self.n_signs = len(solver.sign_names)
         self.n_redundancy = len(solver.redundancy_names)
         self._lock = threading.Lock()

@@ -112,7 +112,7 @@ class PoseDraws:
         """The model's up axis, two unit vectors across it, and w(Q): W - S of the model at Q,
         all in DH frame 0 (where the kernels' up, shoulder and flange-frame wrist offset are;
         the model's FK is in the root frame, turned on the Gen3: z down)."""
-        model, P, data = self.solver.om.model, self.solver.om.params, self.solver.solver_data()
+        model, P, data = self.solver.model_arm.model, self.solver.model_arm.params, self.solver.solver_data()
         up = P[_core.SRS_UP : _core.SRS_UP + 3]
         e1 = np.cross(up, [1.0, 0.0, 0.0] if abs(up[0]) < 0.9 else [0.0, 1.0, 0.0])
         e1 /= np.linalg.norm(e1)

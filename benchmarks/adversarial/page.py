@@ -13,11 +13,11 @@ from typing import Any
 import numpy as np
 
 import om_redundant as om
+from om_redundant.ik import BRANCH_BAND
 
 from ..bad_input import BadInput, bad_input_table
 from ..report import cpu_model
 from .records import (
-    BRANCH_BAND,
     CLASSES,
     DECADES,
     FK_ROUNDING,

@@ -8,9 +8,11 @@ from collections import Counter
 
 import numpy as np
 
+from om_redundant.ik import BRANCH_BAND
+
 from .answers import flipped
 from .arm_run import ArmRun
-from .records import BRANCH_BAND, Tally
+from .records import Tally
 
 
 def run_singular(run: ArmRun, n: int, n_limits: int, n_line: int = 0) -> Tally:

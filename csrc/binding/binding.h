@@ -77,14 +77,14 @@ int get_doubles(PyObject *obj, double *out, int k, const char *name);
 int om_pose_is_valid(const double *T, double tol);
 
 /* The bounded search's grid points a Solver takes (ckernels.MIN_SCAN_POINTS, MAX_SCAN_POINTS;
- * om_redundant.om.solver takes its bounds from here). */
+ * om_redundant.ik.solver takes its bounds from here). */
 #define OM_MIN_SCAN_POINTS 8
 #define OM_MAX_SCAN_POINTS 1024
 
 /* The status names by status code (ckernels.STATUS_NAMES), made at import (module.c). */
 extern PyObject *om_status_names;
 
-/* The fields of a solve's result type (om_redundant.om.solver.Solution), in this order. */
+/* The fields of a solve's result type (om_redundant.ik.solver.Solution), in this order. */
 #define OM_SOLUTION_FIELDS \
     { "q", "ok", "status", "configuration", "position_error", "orientation_error", "iterations", "within_limits" }
 enum { OM_N_SOLUTION_FIELDS = 8 };

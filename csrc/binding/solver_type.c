@@ -542,7 +542,7 @@ static PyObject *Solver_holds(Solver *self, PyObject *const *args, Py_ssize_t na
 
 static PyMethodDef Solver_methods[] = {
     {"solve", (PyCFunction)(void (*)(void))Solver_solve, METH_FASTCALL,
-     "solve(T, signs, redundancy, hint, q_out) -> Solved: one solve; see om_redundant.om.solver."},
+     "solve(T, signs, redundancy, hint, q_out) -> Solved: one solve; see om_redundant.ik.solver."},
     {"solve_pose", (PyCFunction)(void (*)(void))om_solver_solve_pose, METH_FASTCALL,
      "solve_pose(T, configuration) -> Solution, or None: the whole unhinted solve in one call."},
     {"solve_rows", (PyCFunction)(void (*)(void))Solver_solve_rows, METH_FASTCALL,

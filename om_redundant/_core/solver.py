@@ -12,7 +12,7 @@ class SolverData(NamedTuple):
     r"""A solver's fixed data, as the compiled kernels take it (C-contiguous float64 arrays).
 
     Attributes:
-        family: Closed-form family code of the model (:mod:`om_redundant.om.families`).
+        family: Closed-form family code of the model (:mod:`om_redundant.ik.families`).
         mode: ``FIXED``, ``CIRCLE`` or ``TORUS``.
         params: The family's parameter vector.
         model_table: The model's DH table (rows of a, d, theta, cos alpha, sin alpha, kind).
@@ -34,9 +34,9 @@ class SolverData(NamedTuple):
         flip: (dof,) +-1: the kernels' joint coordinates are ``flip * q`` (all +1 but a near
             arm's reversed axes); joint vectors cross the kernels' entry points in the arm's own.
         near_deviation: A bound (m) on how far the nominal arm's flange frame is from the
-            arm's (:attr:`~om_redundant.om.nominal.NominalArm.deviation`); 0 in its family.
+            arm's (:attr:`~om_redundant.ik.nominal.NominalArm.deviation`); 0 in its family.
         near_left: The correction on the left, in DH frame 0 (an arm whose nominal arm zeroes a
-            shoulder offset, :attr:`~om_redundant.om.nominal.NominalArm.shoulder_offset`, larger
+            shoulder offset, :attr:`~om_redundant.ik.nominal.NominalArm.shoulder_offset`, larger
             than its wrist offset); False: on the right, in the flange frame (``csrc/near.c``).
         near_mixed: The correction's translation mixed from its last two steps (an arm whose
             nominal arm zeroes a shoulder or wrist offset; ``csrc/near.c``).

@@ -5,8 +5,8 @@ from __future__ import annotations
 import argparse
 
 from ..exceptions import ModelError
+from ..ik.solver import OMSolver
 from ..kinematics import arm_names, load_arm
-from ..om.solver import OMSolver
 from .common import add_output_options, table_wanted, write_json
 
 
@@ -49,7 +49,7 @@ def _describe(name: str) -> dict:
         "reason": None,
     }
     try:
-        model = OMSolver(arm).om  # the solver's acceptance: a closed-form model that solves the arm
+        model = OMSolver(arm).model_arm  # the solver's acceptance: a closed-form model that solves the arm
     except ModelError as exc:
         reason = str(exc).removeprefix(f"arm '{arm.name}': ")
         return (

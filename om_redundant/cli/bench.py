@@ -24,7 +24,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..om.experiment import run as run_experiment
+    from ..ik.experiment import run as run_experiment
 
     if args.n < 1:
         raise UsageError(f"--n must be positive, got {args.n}")

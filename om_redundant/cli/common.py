@@ -12,8 +12,8 @@ from typing import Any
 import numpy as np
 
 from ..exceptions import InvalidInput, OMError
+from ..ik.solver import OMSolver
 from ..kinematics import Arm, arm_names, pose_from_xyz_quat
-from ..om.solver import OMSolver
 from ..validation import as_pose, as_signs, numbers_text
 
 #: Joint vectors whose forward kinematics is the built-in target, by number of joints;

@@ -5,11 +5,11 @@ from __future__ import annotations
 import argparse
 
 from ..exceptions import ModelError
+from ..ik.solver import OMSolver
 from ..kinematics import write_arm_file
 from ..mujoco_io.arm_import import IMPORT_TOLERANCE, arm_from_mujoco
 from ..mujoco_io.loading import load_mujoco_model
 from ..mujoco_io.model_match import compare_mujoco_model
-from ..om.solver import OMSolver
 from .common import add_output_options, check_output_path, table_wanted, write_json
 
 
@@ -53,7 +53,7 @@ def run(args: argparse.Namespace) -> int:
     arm = arm_from_mujoco(args.model, args.frame, args.frame_type, args.prefix, args.root, name=args.name)
     match = compare_mujoco_model(arm, load_mujoco_model(args.model), tolerance=IMPORT_TOLERANCE)
     try:
-        family, reason = OMSolver(arm).om.family_name, None
+        family, reason = OMSolver(arm).model_arm.family_name, None
     except ModelError as exc:
         family, reason = None, str(exc).removeprefix(f"arm '{arm.name}': ")
     write_arm_file(arm, args.output, f"Written by om-redundant import-arm from {args.model}.")

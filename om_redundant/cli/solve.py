@@ -7,8 +7,8 @@ import argparse
 import mujoco
 import numpy as np
 
-from ..om.configuration import Configuration
-from ..om.solver import OMSolver, Solution
+from ..ik.configuration import Configuration
+from ..ik.solver import OMSolver, Solution
 from .common import (
     UsageError,
     add_arm_option,
@@ -72,7 +72,7 @@ def run(args: argparse.Namespace) -> int:
     result = {
         "arm": solver.arm.name,
         "description": solver.arm.description,
-        "model_family": solver.om.family_name,
+        "model_family": solver.model_arm.family_name,
         "dp_max": solver.dp_max,
         "target": T,
         "sign_names": solver.sign_names,
@@ -118,7 +118,7 @@ def _table(solver: OMSolver, T: np.ndarray, redundancy: tuple[float, ...], rows:
     mujoco.mju_mat2Quat(quat, np.ascontiguousarray(T[:3, :3]).ravel())
     lines = [
         f"arm: {solver.arm.name} ({solver.arm.description})",
-        f"model: {solver.om.family_name}, dp_max = {solver.dp_max:.4f} m",
+        f"model: {solver.model_arm.family_name}, dp_max = {solver.dp_max:.4f} m",
         f"target: xyz = {_vector(T[:3, 3])} m, quat = {_vector(quat)}",
     ]
     lines += [

@@ -1,6 +1,6 @@
 r"""The arm angle psi of a 7-DOF arm and its gradient d psi / dq, from the model's kinematics.
 
-psi is defined in :mod:`om_redundant.om.families.srs` on the MODEL arm at joints q: with the
+psi is defined in :mod:`om_redundant.ik.families.srs` on the MODEL arm at joints q: with the
 shoulder centre S, the wrist centre W, :math:`w = W - S`, :math:`\hat w = w/|w|`, joint 4's
 axis :math:`z_4` and the bend direction :math:`b = e\,\sigma\,(z_4 \times \hat w)`
 (e the ELBOW sign, :math:`\sigma` the model's constant bend sign),
@@ -44,7 +44,7 @@ import numpy as np
 
 from .. import _core
 from ..exceptions import InvalidInput
-from ..om.solver import OMSolver
+from ..ik.solver import OMSolver
 from ..validation import as_instance, as_joint_vector
 
 
@@ -82,6 +82,6 @@ def arm_angle_and_gradient(solver: OMSolver, q: np.ndarray) -> tuple[float, np.n
     grad = np.empty(solver.arm.dof)
     flip = solver.flip  # the model's joint coordinates are flip * q
     psi = _core.arm_angle_gradient(
-        solver.om.params, solver.model.chain.table, np.ascontiguousarray(flip * q), grad
+        solver.model_arm.params, solver.model.chain.table, np.ascontiguousarray(flip * q), grad
     )
     return float(psi), flip * grad

@@ -71,7 +71,7 @@ class Objective:
     Args:
         arm: The arm.
         clearance: Obstacle distances, or None for no obstacles.
-        singularity: The model's singularities (``Singularity.of(solver.om)``), or None for
+        singularity: The model's singularities (``Singularity.of(solver.model_arm)``), or None for
             no singularity term.
         margin_weight: w_m >= 0.
         clearance_weight: w_c >= 0 (ignored without obstacles).

@@ -58,8 +58,8 @@ import numpy as np
 
 from .. import _core
 from ..exceptions import InvalidInput, SingularSelfMotion
-from ..om.configuration import Configuration
-from ..om.solver import OMSolver, Solution
+from ..ik.configuration import Configuration
+from ..ik.solver import OMSolver, Solution
 from ..validation import as_count, as_instance, as_joint_vector, as_number, as_pose, as_signs
 from .arm_angle import wrap_psi
 from .clearance import DEFAULT_DISTMAX, Clearance
@@ -160,7 +160,7 @@ class RedundancyOptimizer:
             MJCF of the arm); or a :class:`~om_redundant.Clearance` (e.g. of your own model).
         margin_weight, clearance_weight, singularity_weight, clearance_cap, min_clearance: The
             objective (:class:`~om_redundant.redundancy.objective.Objective`; the singularity
-            term is the model's, ``Singularity.of(solver.om)``).
+            term is the model's, ``Singularity.of(solver.model_arm)``).
         branches: Allowed branch signs, e.g. ``[(1, -1, 1)]``; default all.
         grid_points: psi samples per branch of the sweep, a whole number from 16 to 100,000.
         max_step: Largest psi change (rad) per tracking call, in (0, pi].
@@ -208,7 +208,7 @@ class RedundancyOptimizer:
         self.objective = Objective(
             solver.arm,
             obstacles,
-            Singularity.of(solver.om, solver.flip),
+            Singularity.of(solver.model_arm, solver.flip),
             margin_weight=margin_weight,
             clearance_weight=clearance_weight,
             singularity_weight=singularity_weight,
@@ -231,7 +231,7 @@ class RedundancyOptimizer:
             raise InvalidInput(f"travel_weight must be >= 0, got {travel_weight}")
         self._tracker = Tracker(solver, self.objective, self.max_step)
         # shoulder offsets (the torus): a batch's branches share their grid search
-        self._shared_search = bool(np.any(solver.om.shoulder))
+        self._shared_search = bool(np.any(solver.model_arm.shoulder))
 
     def __reduce__(self) -> tuple[Any, tuple[Any, ...]]:
         """Pickled as its solver, clearance and options (the tracking step's state is rebuilt)."""

@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from ..om.solver import Solution
+from ..ik.solver import Solution
 from .objective import Objective
 from .objective_terms import Evaluation, Group
 

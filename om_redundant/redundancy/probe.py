@@ -28,8 +28,8 @@ import numpy as np
 
 from .. import _core
 from ..exceptions import SingularSelfMotion
-from ..om.configuration import Configuration
-from ..om.solver import BRANCH_BAND, OMSolver, Solution
+from ..ik.configuration import Configuration
+from ..ik.solver import BRANCH_BAND, OMSolver, Solution
 from .objective import Objective
 from .points import Point, PointTerms, evaluated_terms
 from .self_motion import self_motion_tangent, self_motion_tangents

@@ -6,7 +6,7 @@ import numpy as np
 
 from .. import _core
 from ..exceptions import SingularSelfMotion
-from ..om.solver import OMSolver
+from ..ik.solver import OMSolver
 from ..validation import as_joint_vector
 from .arm_angle import arm_angle_and_gradient, check_arm_angle
 

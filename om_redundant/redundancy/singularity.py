@@ -1,10 +1,10 @@
 r"""Distance from the singularities of an arm's closed-form model: wrist, elbow, shoulder.
 
-The model arm (:mod:`om_redundant.om.model`) branches where one of its branch quantities
+The model arm (:mod:`om_redundant.ik.model`) branches where one of its branch quantities
 vanishes; there two branches meet, a joint axis pair aligns and the hand loses a direction
 of motion. Each is the sine of one joint angle :math:`x_k = q_{j_k} + c_k`:
 
-* 7-DOF (S-R-S model, :mod:`om_redundant.om.families.srs`): the wrist,
+* 7-DOF (S-R-S model, :mod:`om_redundant.ik.families.srs`): the wrist,
   :math:`\sin(q_6 + \theta_6)` (axes 5 and 7 align); the elbow,
   :math:`\sin(q_4 + \theta_4 - \varphi^*)` (straight or folded: the shoulder-wrist distance
   is extremal); the shoulder, :math:`\sin(q_2 + \theta_2)` (axes 1 and 3 align). Their
@@ -29,8 +29,8 @@ from functools import cached_property
 import numpy as np
 
 from .. import _core
-from ..om.families import RRR_SPHERICAL_WRIST, SRS
-from ..om.model import ModelArm
+from ..ik.families import RRR_SPHERICAL_WRIST, SRS
+from ..ik.model import ModelArm
 from ..validation import as_instance, as_joint_vector
 
 

@@ -17,8 +17,8 @@ from dataclasses import dataclass, field, replace
 import mujoco
 import numpy as np
 
-from ..om.configuration import Configuration
-from ..om.solver import OMSolver
+from ..ik.configuration import Configuration
+from ..ik.solver import OMSolver
 from .clearance import Clearance
 from .objective_terms import DEFAULT_SINGULARITY_WEIGHT, joint_margins
 from .optimizer import RedundancyChoice, RedundancyOptimizer

@@ -48,8 +48,8 @@ from typing import NamedTuple
 import numpy as np
 
 from .. import _core
-from ..om.configuration import Configuration
-from ..om.solver import OMSolver, Solution
+from ..ik.configuration import Configuration
+from ..ik.solver import OMSolver, Solution
 from .arm_angle import wrap_psi
 from .objective import Objective
 from .objective_terms import SINGULARITY_CAP

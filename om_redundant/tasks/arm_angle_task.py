@@ -12,8 +12,8 @@ from mink import TargetNotSet
 from mink.exceptions import InvalidTarget
 
 from ..exceptions import InvalidInput, UnreachableTarget
-from ..om.configuration import Configuration
-from ..om.solver import OMSolver
+from ..ik.configuration import Configuration
+from ..ik.solver import OMSolver
 from ..redundancy.arm_angle import arm_angle_and_gradient, check_arm_angle
 from ..validation import as_number
 from .arm_task import ArmTask
@@ -24,7 +24,7 @@ class ArmAngleTask(ArmTask):
 
     For users who track the hand with mink's ``FrameTask`` and only want to choose the
     elbow's swivel about the shoulder-wrist line. psi is the model's arm angle
-    (:mod:`om_redundant.om.families.srs`, ``solver.configuration_of(q).redundancy[0]``):
+    (:mod:`om_redundant.ik.families.srs`, ``solver.configuration_of(q).redundancy[0]``):
 
     .. math::  e(q) = \mathrm{wrap}\big(\psi(q) - \psi^*\big) \in (-\pi, \pi], \qquad
                J = \partial\psi/\partial q \in \mathbb{R}^{1 \times n_v},

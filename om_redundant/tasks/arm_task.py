@@ -9,9 +9,9 @@ from mink import Configuration as MinkConfiguration
 from mink import Task, TaskDefinitionError
 
 from ..exceptions import InvalidInput, UnreachableTarget
+from ..ik.configuration import Configuration
+from ..ik.solver import OMSolver
 from ..mujoco_io.arm_in_model import ArmJoints
-from ..om.configuration import Configuration
-from ..om.solver import OMSolver
 from ..validation import as_array, as_instance, as_number
 
 

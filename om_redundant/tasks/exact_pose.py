@@ -18,9 +18,9 @@ from mink import SE3, TargetNotSet, TaskDefinitionError
 from mink import Configuration as MinkConfiguration
 
 from ..exceptions import InvalidInput, UnreachableTarget
+from ..ik.configuration import Configuration
+from ..ik.solver import OMSolver
 from ..mujoco_io.arm_in_model import ArmRoot
-from ..om.configuration import Configuration
-from ..om.solver import OMSolver
 from ..redundancy.free_rotation import FreeRotation
 from ..validation import as_instance, as_pose
 from .approach import DEFAULT_LEAD, JointWay, LeadsToJumpedTargets, Patience, as_lead

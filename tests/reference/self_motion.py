@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from om_redundant import _core
-from om_redundant.om.solver import OMSolver
+from om_redundant.ik.solver import OMSolver
 
 _MINORS = np.array([[j for j in range(7) if j != i] for i in range(7)])  # J without column i
 _COFACTOR_SIGNS = (-1.0) ** np.arange(7)
@@ -27,7 +27,7 @@ def self_motion_tangents(solver: OMSolver, q: np.ndarray) -> np.ndarray:
     gradients = np.empty((len(q), 7))
     for row, J, grad in zip(q, jacobians, gradients, strict=True):
         _core.jacobian(chain.table, chain.T_root_base, chain.T_flange_tool, row, J)
-        _core.arm_angle_gradient(solver.om.params, model.table, flip * row, grad)
+        _core.arm_angle_gradient(solver.model_arm.params, model.table, flip * row, grad)
     gradients *= flip
     null = _COFACTOR_SIGNS * np.linalg.det(jacobians[:, :, _MINORS].transpose(0, 2, 1, 3))
     change = np.array([g @ n for g, n in zip(gradients, null, strict=True)])

@@ -4,8 +4,8 @@ A family solves the MODEL arm exactly for a flange pose in DH frame 0, a set of 
 signs and (for redundant arms) redundancy values, and evaluates the branch quantities and
 redundancy values that define the configuration of a joint vector. The closed forms are C
 (``csrc/``); these modules hold their math and call them from Python (:mod:`.dispatch`).
-:mod:`om_redundant.om.model` recognises the family of a model arm, and
-:mod:`~om_redundant.om.six_dof_model` and :mod:`~om_redundant.om.srs_model` pack its parameters.
+:mod:`om_redundant.ik.model` recognises the family of a model arm, and
+:mod:`~om_redundant.ik.six_dof_model` and :mod:`~om_redundant.ik.srs_model` pack its parameters.
 The family codes and the parameter layouts are written once, in ``csrc/om_kernels.h``, and
 read from :mod:`om_redundant._core` (the codes re-exported here).
 """

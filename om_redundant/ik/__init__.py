@@ -1,7 +1,8 @@
 """The offset modification method: configurations (:mod:`.configuration`), the model arm
-(:mod:`.model`) with its closed-form families (:mod:`.families`), system (9) and its bounded
-search (:mod:`.system`), arms near a family (:mod:`.nominal`, :mod:`.near`), and the solver
-that fronts them (:mod:`.solver`, its batch entry points in :mod:`.batch`)."""
+(:mod:`.model`) with its closed-form families (:mod:`.families`), system (9) and the data its
+compiled kernels take (:mod:`.kernel_data`), arms near a family (:mod:`.nominal`), and the
+solver that fronts them (:mod:`.solver`, its batch entry points in :mod:`.batch` on the
+worker threads of :mod:`.threads`)."""
 
 from .batch import BatchRoots, BatchSolution
 from .configuration import Configuration

@@ -8,7 +8,7 @@ the few lengths that stand in the way of a closed form:
   joint-indexed rows), which makes the wrist spherical.
 * 7-DOF arms: :math:`a_1, d_2` (shoulder offsets, Gen3 and Sawyer) and
   :math:`a_5, a_6, d_6` (wrist offsets), which make the shoulder and the wrist spherical
-  while the elbow keeps its offsets (a Hollerbach arm, see :mod:`om_redundant.om.families.srs`).
+  while the elbow keeps its offsets (a Hollerbach arm, see :mod:`om_redundant.ik.families.srs`).
 
 For equal joints the hand orientations agree and the positions differ by
 
@@ -21,7 +21,7 @@ J: joint 6 of UR5e and the Spherical arm (:math:`a_4 = 0`), joint 7 of the 7-DOF
 iiwa14 has :math:`\delta = 0`). A 6-DOF wrist with :math:`a_4 \ne 0` (Menagerie's ARX L5,
 Unitree Z1, i2rt YAM) makes :math:`\delta` depend on joints 5 and 6; where joint 4's axis
 turns with q1 alone (joints 2, 3 and 4 parallel), dp at a solution is a function of q1 and
-the target's orientation instead (:func:`~om_redundant.om.six_dof_model.wrist_offset`): the
+the target's orientation instead (:func:`~om_redundant.ik.six_dof_model.wrist_offset`): the
 solutions again lie on a circle, in :math:`w = q_1`. The shoulder offsets' dp :math:`a(q_1)`, in DH frame 0,
 turns with joint 1 alone, because :math:`a_1` lies along :math:`x_1` and :math:`d_2` along
 joint 2's axis, both fixed in frame 1; it is zero when joints 1-3 meet. The solutions of
@@ -51,7 +51,7 @@ from .srs_model import srs_model
 #: geometry (a URDF written to 11 digits leaves offsets of 5e-13 m where the arm has none): it
 #: never changes the method an arm gets. :func:`derive_model` refuses an arm with a nonzero
 #: length within it, so that the arm is solved through its nominal arm
-#: (:func:`~om_redundant.om.nominal.nominal_arm`), which has it zero, while its exact table
+#: (:func:`~om_redundant.ik.nominal.nominal_arm`), which has it zero, while its exact table
 #: verifies every answer.
 LENGTH_ROUNDING = 1e-9
 #: An angle (rad) within this of a multiple of 90 deg is the rounding of that multiple (see
@@ -66,7 +66,7 @@ class ModelArm:
     Attributes:
         real: The real arm.
         model: The offset-modified arm (same joints, names, limits, base and tool).
-        family: Closed-form family code (see :mod:`om_redundant.om.families`).
+        family: Closed-form family code (see :mod:`om_redundant.ik.families`).
         family_name: Human-readable family name.
         params: Parameter vector of the family kernel.
         sign_names: Names of the configuration's branch signs.
@@ -105,7 +105,7 @@ def derive_model(arm: Arm) -> ModelArm:
     """Derive the closed-form model arm of a real arm.
 
     6-DOF arms get a spherical-wrist model (Theorem 2); 7-DOF arms a Hollerbach model with a
-    spherical shoulder and wrist (:mod:`om_redundant.om.families.srs`), keeping the elbow's
+    spherical shoulder and wrist (:mod:`om_redundant.ik.families.srs`), keeping the elbow's
     offsets.
 
     Raises:

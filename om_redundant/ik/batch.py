@@ -1,4 +1,4 @@
-"""Many targets at once: the batch entry points of :class:`~om_redundant.om.solver.OMSolver`
+"""Many targets at once: the batch entry points of :class:`~om_redundant.ik.solver.OMSolver`
 (:class:`BatchSolves`) and the records they return, one row per target."""
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from .. import _core
 from ..exceptions import InvalidInput
 from ..kinematics import Arm
 from ..validation import as_count, as_joint_vector, as_poses, as_redundancy, as_signs
-from . import system
+from .threads import run_rows
 
 #: Most worker threads ``solve_batch`` accepts (it uses at most one per core).
 MAX_THREADS = 1024
@@ -42,7 +42,7 @@ class BatchSolution:
 
     @property
     def status(self) -> list[str]:
-        return [system.STATUS_NAMES[c] for c in self.status_code]
+        return [_core.STATUS_NAMES[c] for c in self.status_code]
 
 
 @dataclass(frozen=True, eq=False, slots=True)
@@ -69,7 +69,7 @@ class BatchRoots:
 
 
 class BatchSolves:
-    """The batch entry points of :class:`~om_redundant.om.solver.OMSolver`: its solves of many
+    """The batch entry points of :class:`~om_redundant.ik.solver.OMSolver`: its solves of many
     targets at once, in parallel on the compiled kernel, row by row."""
 
     arm: Arm
@@ -127,10 +127,10 @@ class BatchSolves:
         def solve_range(start: int, stop: int) -> None:
             kernel.solve_rows(batch, start, stop)
 
-        system.run_rows(solve_range, m, threads)
+        run_rows(solve_range, m, threads)
         return BatchSolution(
             batch.q,
-            batch.status == system.OK,
+            batch.status == _core.OK,
             batch.status,
             batch.position_error,
             batch.orientation_error,
@@ -181,7 +181,7 @@ class BatchSolves:
         band = np.ones(m, dtype=bool) if band is None else np.ascontiguousarray(band, dtype=bool)
         if band.shape != (m,):
             raise InvalidInput(f"band must have one entry per row ({m}), got shape {band.shape}")
-        n = system.MAX_ROOTS
+        n = _core.MAX_ROOTS
         batch = _core.SolveAllBatch(
             T,
             signs,
@@ -199,7 +199,7 @@ class BatchSolves:
         def solve_range(start: int, stop: int) -> None:
             kernel.solve_all_rows(batch, start, stop)
 
-        system.run_rows(solve_range, m, threads)
+        run_rows(solve_range, m, threads)
         return BatchRoots(
             batch.q,
             batch.count,

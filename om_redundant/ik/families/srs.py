@@ -45,7 +45,7 @@ Shoulder and wrist. Given :math:`\psi`, :math:`R_{03}` maps the frame-3 triad
 :math:`(\hat v, \hat b_3, \hat v \times \hat b_3)`, :math:`b_3 = \mathrm{ELBOW}\,\sigma\,
 (e_z \times v)` (the shoulder-wrist direction and the bend direction in frame 3) onto
 :math:`(\hat w, m, \hat w \times m)`, :math:`m = \cos\psi\, n + \sin\psi\, (\hat w \times n)`.
-Joints 1-3 and 5-7 then follow from :mod:`~om_redundant.om.families.common`
+Joints 1-3 and 5-7 then follow from :mod:`~om_redundant.ik.families.common`
 with the SHOULDER and WRIST signs
 (:math:`\mathrm{sign}\sin\varphi_2`, :math:`\mathrm{sign}\sin\varphi_6`).
 
@@ -53,7 +53,7 @@ Angles :math:`\varphi_i = q_i + \theta_i` are DH joint angles with their offsets
 rows between joints 6 and 7 (the Sawyer's) fold into the wrist's middle rotation,
 :math:`R_x(\alpha_6) F = R_z(a) R_x(\beta) R_z(b)`: a joins :math:`\theta_6`, b joins
 :math:`\theta_7`, and :math:`\beta` is the twist between joints 6 and 7 (see
-:mod:`~om_redundant.om.families.common`).
+:mod:`~om_redundant.ik.families.common`).
 """
 
 from __future__ import annotations

@@ -1,4 +1,5 @@
-r"""The OM system (9) and its solvers: the data of the compiled kernels (``csrc/``).
+r"""The OM system (9), which the compiled kernels (``csrc/``) solve, and the data they take:
+the fixed data of an arm and its model, and a target as its flange pose.
 
 System (9) asks for the model's hand position :math:`p_m` with
 
@@ -6,19 +7,19 @@ System (9) asks for the model's hand position :math:`p_m` with
 
 Every solution has the form :math:`p_m = p_d + R_d\,\delta(w)`, where :math:`\delta` is dp
 seen from the flange and depends on one wrist joint, :math:`w = q_J` (see
-:mod:`om_redundant.om.model`). So the three equations reduce exactly to one on the circle,
+:mod:`om_redundant.ik.model`). So the three equations reduce exactly to one on the circle,
 
 .. math::  g(w) = \mathrm{wrap}\big(\mathrm{IK}_{model}(R_d, p_d + R_d\,\delta(w), c)_J - w\big) = 0,
 
 and a root gives the real arm's joints :math:`q = \mathrm{IK}_{model}(\ldots)` with
 :math:`|p_{real}(q) - p_d| = |\delta(w) - \delta(q_J)| \le \Delta p_{max}\,|g(w)|`.
 A 6-DOF wrist with :math:`a_4 \ne 0` has the circle :math:`p_m = p_d + \Delta p(w)`,
-:math:`w = q_1`, instead (:mod:`om_redundant.om.model`, ``csrc/wrist_offset.c``).
+:math:`w = q_1`, instead (:mod:`om_redundant.ik.model`, ``csrc/wrist_offset.c``).
 
 Arms with shoulder offsets (Gen3, Sawyer) add :math:`a(q_1)`, so solutions lie on a torus
 :math:`(w_1, w_7) = (q_1, q_7)`: :math:`p_m = p_d + a(w_1) + R_d\,\delta(w_7)`. There the
 system is lifted to three unknowns :math:`(w_1, w_7, \varphi_4)` and three residuals that
-are smooth everywhere (:func:`~om_redundant.om.families.srs.model_ik_lifted`): the model IK
+are smooth everywhere (:func:`~om_redundant.ik.families.srs.model_ik_lifted`): the model IK
 with q1, q7 and the elbow angle given is consistent with the shoulder, the wrist and the
 elbow equation. In (w1, w7) alone the residual has a square-root branch point at the edge of
 reach (the straight or folded elbow) and steep Euler angles at the shoulder and wrist
@@ -55,32 +56,62 @@ tuples and C-contiguous float64 arrays.
 
 from __future__ import annotations
 
-import os
-import threading
-from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor
-
 import numpy as np
 
 from .. import _core
+from .model import ModelArm
+from .nominal import NominalArm
 
-# Status codes of a solve, and their names by code (defined in csrc/: om_kernels.h, module.c).
-OK = _core.OK
-UNREACHABLE = _core.UNREACHABLE
-NO_SOLUTION_IN_CONFIGURATION = _core.NO_SOLUTION_IN_CONFIGURATION
-STATUS_NAMES: tuple[str, ...] = _core.STATUS_NAMES
 
-# How the solutions of system (9) are searched (SolverData.mode; csrc/om_kernels.h).
-FIXED = _core.FIXED  # dp = 0: the model is the real arm, one evaluation of the closed form
-CIRCLE = _core.CIRCLE  # dp depends on one wrist joint w = q_J: a circle
-TORUS = _core.TORUS  # shoulder offsets too: dp depends on (q_1, q_7), a torus
+def kernel_data(
+    om: ModelArm, tolerances: tuple[float, float], scan_points: int, nominal: NominalArm | None = None
+) -> _core.SolverData:
+    """The :class:`~om_redundant.ik._core.SolverData` of ``ckernels.Solver`` for an arm and
+    its closed-form model.
 
-#: Roots kept per configuration.
-MAX_ROOTS = _core.MAX_ROOTS
-
-#: A solver's fixed data, as the compiled kernels take it (defined with the kernels' other
-#: records in :mod:`om_redundant._core`).
-SolverData = _core.SolverData
+    Args:
+        om: The closed-form model (:func:`~om_redundant.ik.model.derive_model`) of the arm, or
+            of its nominal arm (``om.real``) for an arm near a family.
+        tolerances: Accepted position and orientation errors (m, rad).
+        scan_points: Grid points of the bounded search.
+        nominal: The nominal arm of an arm near a family (None: ``om.real`` is the arm): every
+            answer is verified with the arm's exact chain, in the nominal joint coordinates.
+    """
+    arm = om.real
+    chain = arm.chain
+    shoulder, wrist = (0.0, 0.0) if nominal is None else (nominal.shoulder_offset, nominal.wrist_offset)
+    # dp turns with q1 and q7: the torus (q1, q7); with a shoulder offset a2 or a wrist offset a5
+    # zeroed by the nominal arm, q1 and q7 are given on the torus and the correction's fixed
+    # point turns with q2 (on the left) or q6 (on the right) alone
+    if om.shoulder.any() or shoulder or wrist:
+        mode, dp_joint = _core.TORUS, 0
+    elif om.dp_joint >= 0:
+        mode, dp_joint = _core.CIRCLE, om.dp_joint
+    else:
+        mode, dp_joint = _core.FIXED, 0
+    c = as_kernel_array
+    return _core.SolverData(
+        family=int(om.family),
+        mode=mode,
+        params=c(om.params),
+        model_table=c(om.model.chain.table),
+        real_table=c((chain if nominal is None else nominal.exact).table),
+        dp_joint=int(dp_joint),
+        dp_coefficients=c(np.vstack([om.delta, om.shoulder])),
+        T_base_root=c(np.linalg.inv(chain.T_root_base)),
+        T_tool_flange=c(np.linalg.inv(chain.T_flange_tool)),
+        revolute=np.ascontiguousarray(arm.revolute, dtype=np.bool_),
+        lower=c(arm.lower),
+        upper=c(arm.upper),
+        scan_points=scan_points,
+        position_tolerance=tolerances[0],
+        orientation_tolerance=tolerances[1],
+        nominal_table=c(np.empty((0, 6)) if nominal is None else chain.table),
+        flip=c(np.ones(arm.dof) if nominal is None else nominal.flip),
+        near_deviation=0.0 if nominal is None else nominal.deviation,
+        near_left=shoulder != 0.0 and abs(shoulder) >= abs(wrist),
+        near_mixed=shoulder != 0.0 or wrist != 0.0,
+    )
 
 
 def flange_target(
@@ -98,62 +129,3 @@ def flange_target(
 def as_kernel_array(array: np.ndarray) -> np.ndarray:
     """The array as the kernels take it: C-contiguous float64 (a copy only if needed)."""
     return np.ascontiguousarray(array, dtype=np.float64)
-
-
-#: Rows of a batch handed to one thread at a time.
-BATCH_CHUNK = 64
-
-_pool: ThreadPoolExecutor | None = None
-_pool_lock = threading.Lock()
-_CORES = os.cpu_count() or 1  # read once: os.cpu_count() reads a file (~30 us a call on Linux)
-
-
-def _forget_the_pool() -> None:
-    """In a forked child: the parent's pool threads do not exist there (a batch would wait for
-    them forever); the child makes its own when it needs one."""
-    global _pool, _pool_lock
-    _pool, _pool_lock = None, threading.Lock()
-
-
-os.register_at_fork(after_in_child=_forget_the_pool)
-
-
-def run_rows(solve_range: Callable[[int, int], None], rows: int, threads: int | None = None) -> None:
-    """Run ``solve_range(start, stop)`` over ``range(rows)`` in chunks, on ``threads`` threads.
-
-    The kernels release the GIL, so threads run them in parallel; each thread takes the next
-    chunk as it comes free, which balances targets of unequal cost. The calling thread is one
-    of them (it would only wait otherwise; on a busy machine a pool thread may be slow to
-    wake, and then the caller takes its chunks). ``threads`` None: one per core (at most that
-    many in any case); 1: every row on the calling thread, in one call. An exception in the
-    calling thread (Ctrl-C: KeyboardInterrupt, raised between its chunks) stops every thread
-    after its current chunk, and is raised at once.
-    """
-    global _pool
-    cores = _CORES
-    workers = cores if threads is None else min(cores, threads)
-    if rows <= BATCH_CHUNK or workers == 1:
-        solve_range(0, rows)
-        return
-    with _pool_lock:
-        if _pool is None:
-            _pool = ThreadPoolExecutor(cores, thread_name_prefix="om_redundant")
-    chunk = max(1, min(BATCH_CHUNK, -(-rows // workers)))
-    starts, lock, stop = iter(range(0, rows, chunk)), threading.Lock(), threading.Event()
-
-    def drain() -> None:
-        while not stop.is_set():
-            with lock:
-                start = next(starts, None)
-            if start is None:
-                return
-            solve_range(start, min(start + chunk, rows))
-
-    helpers = [_pool.submit(drain) for _ in range(workers - 1)]
-    try:
-        drain()
-        for future in helpers:
-            future.result()
-    except BaseException:
-        stop.set()  # (the helpers finish the chunk they are in, into the abandoned batch's arrays)
-        raise

@@ -20,7 +20,6 @@ from ..validation import (
     as_positive,
     as_redundancy,
 )
-from . import system
 from .batch import BatchSolves
 from .configuration import Configuration
 from .kernel_data import kernel_data
@@ -117,10 +116,10 @@ class OMSolver(BatchSolves):
             as_positive(orientation_tolerance, "orientation_tolerance"),
         )
         self.scan_points = as_count(scan_points, "scan_points", MIN_SCAN_POINTS, MAX_SCAN_POINTS)
-        self.om: ModelArm
+        self.model_arm: ModelArm
         #: The nominal arm the model is derived from, for an arm NEAR a family; else None.
         self.nominal: NominalArm | None
-        self.om, self.nominal = closed_form(self.arm)
+        self.model_arm, self.nominal = closed_form(self.arm)
         self._flip = np.ones(self.arm.dof) if self.nominal is None else self.nominal.flip
         types = {"solution_type": Solution, "configuration_type": Configuration}
         self._kernel = _core.Solver(self.solver_data(), **types)
@@ -132,11 +131,11 @@ class OMSolver(BatchSolves):
         position, orientation = self.tolerances
         return (_rebuilt, (self.arm, position, orientation, self.scan_points))
 
-    def solver_data(self) -> system.SolverData:
-        """The fixed data of the compiled kernel (see :class:`~om_redundant.om.system.SolverData`):
+    def solver_data(self) -> _core.SolverData:
+        """The fixed data of the compiled kernel (see :class:`~om_redundant.ik._core.SolverData`):
         of the arm, or, for an arm near a family (:attr:`nominal`), of its nominal arm's model with
         the arm's exact chain (``csrc/near.c``)."""
-        return kernel_data(self.om, self.tolerances, self.scan_points, self.nominal)
+        return kernel_data(self.model_arm, self.tolerances, self.scan_points, self.nominal)
 
     @property
     def kernel(self) -> _core.Solver:
@@ -147,28 +146,28 @@ class OMSolver(BatchSolves):
     def model(self) -> Arm:
         """The offset-modified model arm (of the nominal arm for an arm near a family, in the
         model's joint coordinates ``flip * q``)."""
-        return self.om.model
+        return self.model_arm.model
 
     @property
     def flip(self) -> np.ndarray:
         """The (dof,) signs (+-1) that give the model's joint coordinates ``flip * q`` (-1 where
-        an arm near a family has a reversed axis, see :mod:`~om_redundant.om.nominal`)."""
+        an arm near a family has a reversed axis, see :mod:`~om_redundant.ik.nominal`)."""
         return self._flip
 
     @property
     def dp_max(self) -> float:
         """Radius of the ball that holds every solution p_m of system (9), in metres."""
-        return self.om.dp_max
+        return self.model_arm.dp_max
 
     @property
     def sign_names(self) -> tuple[str, ...]:
         """Names of the configuration's branch signs, e.g. ``("SHOULDER", "ELBOW", "WRIST")``."""
-        return self.om.sign_names
+        return self.model_arm.sign_names
 
     @property
     def redundancy_names(self) -> tuple[str, ...]:
         """Names of the configuration's redundancy values (``("psi",)`` for 7-DOF arms)."""
-        return self.om.redundancy_names
+        return self.model_arm.redundancy_names
 
     def configurations(self, redundancy: Any = ()) -> list[Configuration]:
         """Every branch-sign combination this arm's model distinguishes, with the given
@@ -239,8 +238,8 @@ class OMSolver(BatchSolves):
         r = self._kernel.solve(T, configuration.signs, configuration.redundancy, self._hint(q_hint), q)
         return Solution(
             q,
-            r.status == system.OK,
-            system.STATUS_NAMES[r.status],
+            r.status == _core.OK,
+            _core.STATUS_NAMES[r.status],
             configuration,
             r.position_error,
             r.orientation_error,
@@ -252,7 +251,7 @@ class OMSolver(BatchSolves):
         """Every real solution with this configuration (the bounded search), possibly none."""
         T = as_pose(T)
         self.check_configuration(configuration)
-        n = system.MAX_ROOTS
+        n = _core.MAX_ROOTS
         roots = _core.Roots(np.empty((n, self.arm.dof)), np.empty(n), np.empty(n), np.empty(n, dtype=bool))
         found = self._kernel.solve_all(T, configuration.signs, configuration.redundancy, roots)
         return [
@@ -320,7 +319,7 @@ class OMSolver(BatchSolves):
                 raise ModelError(
                     f"arm '{arm.name}' does not solve its own pose at q = [{shown}] "
                     f"(configuration {', '.join(named)}): {solution.status}; the offset-modified "
-                    f"model ({self.om.family_name}) does not fit this arm"
+                    f"model ({self.model_arm.family_name}) does not fit this arm"
                 )
         _SELF_CHECKED.setdefault(arm, set()).add(key)
 

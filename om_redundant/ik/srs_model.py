@@ -1,5 +1,5 @@
 """The model of a 7-DOF arm and its closed form's parameters: a Hollerbach arm with a spherical
-shoulder and wrist (:mod:`om_redundant.om.families.srs`), the elbow's offsets kept."""
+shoulder and wrist (:mod:`om_redundant.ik.families.srs`), the elbow's offsets kept."""
 
 from __future__ import annotations
 
@@ -24,7 +24,7 @@ def srs_model(arm: Arm) -> tuple[KinematicChain, KinematicChain, np.ndarray]:
     likewise :math:`a_5 = 0` and :math:`d_6 = a_6 = 0` put axes 5-7 through W = :math:`o_5`.
     The elbow's offsets (:math:`a_3, d_4, a_4`) are kept. :math:`a_2` would make dp depend on
     q2 as well and is refused here; the arm's nominal arm zeroes it
-    (:mod:`~om_redundant.om.nominal`), whose correction solves it.
+    (:mod:`~om_redundant.ik.nominal`), whose correction solves it.
 
     Returns:
         The model chain, the real chain with only its shoulder offsets zeroed, and the
