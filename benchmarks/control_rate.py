@@ -37,8 +37,8 @@ import mink
 import numpy as np
 
 import om_redundant as om
+from om_redundant.redundancy.choice import RedundancyChoice
 from om_redundant.redundancy.climb import maximise
-from om_redundant.redundancy.optimizer import RedundancyChoice
 from om_redundant.redundancy.probe import Probe
 
 from .report import cpu_model, write_page

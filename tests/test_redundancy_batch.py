@@ -17,9 +17,9 @@ from om_redundant import _core
 from om_redundant.redundancy import self_motion_tangent
 from om_redundant.redundancy.box_qp import Pieces, step_1d
 from om_redundant.redundancy.objective_terms import Evaluation, Group
-from om_redundant.redundancy.optimizer import _StartBounds
 from om_redundant.redundancy.probe import Probe
 from om_redundant.redundancy.self_motion import self_motion_tangents
+from om_redundant.redundancy.start_bounds import StartBounds
 from tests.conftest import random_groups, steps_numpy
 from tests.reference import box_qp as box_qp_numpy
 from tests.reference import objective as objective_numpy
@@ -283,7 +283,7 @@ def test_the_climbs_one_variable_step_compiled_is_numpys(seed, pieces, curvature
 @settings(max_examples=40, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1), runs=st.integers(1, 3), scale=st.floats(0.0, 4.0))
 def test_the_climbs_start_bounds_hold_for_functions_within_their_slopes(seed, runs, scale):
-    """optimizer._StartBounds.within, for term functions c + A sin(omega psi + phi) (slope
+    """start_bounds.StartBounds.within, for term functions c + A sin(omega psi + phi) (slope
     bound A omega; f's the weighted sum of its groups' largest) sampled on runs of uneven
     spacing: every start's bound is at least f anywhere within its reach (a dense grid), at
     least f at the start and at most the bound from its own cones (``cone``, the bound before);
@@ -310,11 +310,11 @@ def test_the_climbs_start_bounds_hold_for_functions_within_their_slopes(seed, ru
     last = np.append(starts[1:], len(psi))[owner] - 1
     terms = [(w, cap, v) for (w, cap, _), v in zip(groups, functions(psi), strict=True)]
     f = objective(psi)
-    bounds = _StartBounds(psi, f, terms, first, last, slope, slopes)
+    bounds = StartBounds(psi, f, terms, first, last, slope, slopes)
     reach = rng.uniform(0.0, 1.0, len(psi))
     cones = bounds.cone(np.arange(len(psi)), reach)
     np.testing.assert_array_equal(cones, start_bounds_numpy.cone(bounds, np.arange(len(psi)), reach))
-    bare = _StartBounds(psi, f, [], first, last, slope, [])
+    bare = StartBounds(psi, f, [], first, last, slope, [])
     np.testing.assert_array_equal(bare.cone(first, reach), start_bounds_numpy.cone(bare, first, reach))
     columns = np.column_stack([f] + [v for _, _, v in terms])
     pairs = [(i, i + 1) for i in range(len(psi) - 1) if first[i] == first[i + 1]]  # neighbours on a run
@@ -322,7 +322,7 @@ def test_the_climbs_start_bounds_hold_for_functions_within_their_slopes(seed, ru
         max((abs(c[j] - c[i]) / max(psi[j] - psi[i], 1e-12) for i, j in pairs), default=0.0)
         for c in columns.T
     ]
-    np.testing.assert_array_equal(_StartBounds(psi, f, terms, first, last)._slopes, sampled)  # (L sampled)
+    np.testing.assert_array_equal(StartBounds(psi, f, terms, first, last)._slopes, sampled)  # (L sampled)
     assert (
         np.array(sampled) <= np.concatenate([[slope], *slopes]) + 1e-9
     ).all()  # (the fixture's own bounds hold)
@@ -334,7 +334,7 @@ def test_the_climbs_start_bounds_hold_for_functions_within_their_slopes(seed, ru
         assert f_k <= bound <= min(cones[k], f_k + slope * r) + 1e-12
     holed = terms[0][2].copy()
     holed[rng.integers(len(psi)), 0] = np.nan  # (a function that is not a number at one sample)
-    nan_bounds = _StartBounds(psi, f, [(*terms[0][:2], holed), *terms[1:]], first, last, slope, slopes)
+    nan_bounds = StartBounds(psi, f, [(*terms[0][:2], holed), *terms[1:]], first, last, slope, slopes)
     everyone = np.arange(len(psi))
     np.testing.assert_equal(
         nan_bounds.cone(everyone, reach), start_bounds_numpy.cone(nan_bounds, everyone, reach)

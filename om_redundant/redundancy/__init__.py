@@ -6,12 +6,13 @@
 shows (:mod:`.sweep`)."""
 
 from .arm_angle import arm_angle_and_gradient
+from .choice import RedundancyChoice
 from .clearance import MAX_EXTENT, Clearance
 from .free_rotation import FreeRotation
 from .intervals import PsiInterval
 from .objective import Objective
 from .objective_terms import Evaluation, joint_margins
-from .optimizer import RedundancyChoice, RedundancyOptimizer
+from .optimizer import RedundancyOptimizer
 from .self_motion import self_motion_tangent
 from .shapes import Box, Capsule, Sphere
 from .singularity import Singularity

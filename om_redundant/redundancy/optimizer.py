@@ -24,7 +24,7 @@ the exact OM solution in it:
    S-R-S arm binding the margin, the hand nearest an obstacle, or a term at its cap), f
    cannot rise above its start value.
    Starts are climbed best first, and those whose bound is below the best value found (by
-   more than :data:`PLATEAU` when tracking; not above it by :data:`_CLIMB_ROUNDING`
+   more than :data:`PLATEAU` when tracking; not above it by :data:`~.start_bounds.CLIMB_ROUNDING`
    otherwise, a climb that could at most tie) are skipped. This is what finds the global
    optimum rather than the nearest local one.
 3. **Climb** from each start (:func:`~om_redundant.redundancy.climb.maximise`): a trust-region SQP
@@ -50,22 +50,20 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from typing import Any
 
 import mujoco
 import numpy as np
 
-from .. import _core
-from ..exceptions import InvalidInput, SingularSelfMotion
-from ..ik.configuration import Configuration
-from ..ik.solver import OMSolver, Solution
+from ..exceptions import InvalidInput
+from ..ik.solver import OMSolver
 from ..validation import as_count, as_instance, as_joint_vector, as_number, as_pose, as_signs
-from .arm_angle import wrap_psi
+from .choice import RedundancyChoice
 from .clearance import DEFAULT_DISTMAX, Clearance
-from .climb import maximise
 from .free_rotation import FreeRotation
-from .intervals import BranchRuns, PsiInterval, Run, feasible_runs
+from .global_choice import GlobalChoice
+from .intervals import PsiInterval
 from .objective import Objective
 from .objective_terms import (
     DEFAULT_CLEARANCE_WEIGHT,
@@ -73,79 +71,18 @@ from .objective_terms import (
     DEFAULT_SINGULARITY_WEIGHT,
     check_weights,
 )
-from .paths import sweep_circle
-from .points import Point
-from .probe import Probe
-from .reachable import DEFAULT_TRAVEL_WEIGHT, Way, candidates, clear_way
+from .reachable import DEFAULT_TRAVEL_WEIGHT
 from .shapes import Shape
 from .singularity import Singularity
 from .tracking import MAX_CURVATURE, Tracked, Tracker
 
 #: Tracking with a free rotation: a turn is taken where it gains more than this.
 _TURN_GAIN = 1e-9
-#: Global choose: a start whose bound is within this of the best found is not climbed (it can
-#: at most tie).
-_CLIMB_ROUNDING = 1e-12
 #: Bounds of ``grid_points`` (psi samples per branch; the sweep's cost grows with it).
 MIN_GRID_POINTS, MAX_GRID_POINTS = 16, 100_000
 
 
-@dataclass(frozen=True, eq=False)
-class RedundancyChoice:
-    """What :meth:`RedundancyOptimizer.choose` picked.
-
-    Attributes:
-        ok: A feasible configuration was found.
-        configuration: The chosen configuration (signs, (psi,)), psi in [-pi, pi); None if not ok.
-        solution: The exact OM solution in it; None if not ok.
-        margin: Smallest normalised joint-limit margin M(q) (nan if not ok).
-        clearance: Clearance D(q) in metres (inf without obstacles, nan if not ok).
-        value: The objective f(q) (nan if not ok).
-        intervals: The feasible intervals searched: every allowed branch's, or, chosen
-            afresh from the arm's joints, those of the branches swept (the previous one
-            first); empty from the one-call tracking step
-            (:mod:`~om_redundant.redundancy.tracking`), which searches none.
-        reason: Why nothing is feasible, or why tracking chose afresh; "" otherwise.
-        branch_flipped: The choice left the previous choice's branch.
-        curvature: The curvature (per rad^2) of the objective along psi that the next
-            tracking step's model takes (:mod:`~om_redundant.redundancy.tracking`); nan:
-            its initial value.
-        rechosen: Tracking could not continue from the previous choice, and this choice
-            was made afresh from the arm's joints (``reason`` says why).
-        travel: Joint travel (rad, Euclidean) from the arm's joints ``q_current`` (or the
-            previous choice's) to ``solution.q``; nan from a global choice.
-        way_clearance: Of a choice made afresh from the arm's joints: a lower bound of the
-            clearance along the straight joint-space way from them to ``solution.q``
-            (:meth:`~om_redundant.Clearance.minimum_along`), at least
-            ``min(min_clearance, D(q_current))`` less 1 mm where the way is clear; inf
-            without obstacles; nan otherwise (a tracking step moves the joints a step at a
-            time, each step's joints clear).
-        way_clear: The way is certified clear, or none was checked (``way_clearance`` nan).
-        turn: With a free rotation (``choose(..., free=...)``), the turn R of the target the
-            solution reaches, :meth:`FreeRotation.turned(T, R)
-            <om_redundant.FreeRotation.turned>`; None without.
-        pose: The end-effector pose the solution reaches (T, or T turned); None if not ok.
-    """
-
-    ok: bool
-    configuration: Configuration | None
-    solution: Solution | None
-    margin: float
-    clearance: float
-    value: float
-    intervals: tuple[PsiInterval, ...]
-    reason: str = ""
-    branch_flipped: bool = False
-    curvature: float = math.nan
-    rechosen: bool = False
-    travel: float = math.nan
-    way_clearance: float = math.nan
-    way_clear: bool = True
-    turn: np.ndarray | None = None
-    pose: np.ndarray | None = None
-
-
-class RedundancyOptimizer:
+class RedundancyOptimizer(GlobalChoice):
     """Picks the arm angle psi (and branch) of a 7-DOF arm for margin, clearance and distance
     from singularities.
 
@@ -319,48 +256,6 @@ class RedundancyOptimizer:
 
     # -----------------------------------------------------------------------------------
 
-    def _sweep(self, T: np.ndarray, branches: list[tuple[int, ...]]) -> list[BranchRuns]:
-        """Every branch's solution paths and feasible runs. Where a path runs within rounding
-        of a singular set (SingularSelfMotion), the branches are swept one by one and those
-        that raise have none, the reason in their ``stalled``.
-
-        Raises:
-            SingularSelfMotion: Every branch raised.
-        """
-        probes = [self._probe(T, signs) for signs in branches]
-        try:
-            swept = sweep_circle(probes, self.grid_points)
-        except SingularSelfMotion as singular:
-            if len(branches) == 1:
-                raise
-            alone = [self._sweep_alone(T, signs) for signs in branches]
-            if all(branch.stalled for branch in alone):
-                raise singular
-            return alone
-        paths = [(probe, path) for probe, paths in zip(probes, swept, strict=True) for path in paths]
-        runs = iter(feasible_runs(paths))
-        return [
-            BranchRuns(signs, paths, [run for _ in paths for run in next(runs)])
-            for signs, paths in zip(branches, swept, strict=True)
-        ]
-
-    def _sweep_alone(self, T: np.ndarray, signs: tuple[int, ...]) -> BranchRuns:
-        try:
-            return self._sweep(T, [signs])[0]
-        except SingularSelfMotion as singular:
-            return BranchRuns(signs, [], [], str(singular))
-
-    def _probe(self, T: np.ndarray, signs: tuple[int, ...]) -> Probe:
-        return Probe(self.solver, self.objective, T, signs)
-
-    def _best_anywhere(self, T: np.ndarray, branches: list[tuple[int, ...]]) -> RedundancyChoice:
-        swept = self._sweep(T, branches)
-        runs = [run for branch in swept for run in branch.runs]
-        if not runs:
-            why = "; ".join(self._why(branch) for branch in swept)
-            return _failure((), f"no feasible arm angle: {why}")
-        return self._result(T, self._climb_all(T, runs), runs)
-
     def _track(
         self,
         T: np.ndarray,
@@ -422,255 +317,7 @@ class RedundancyOptimizer:
             reason += f" ({chosen.reason})"
         return replace(chosen, rechosen=True, branch_flipped=flipped, reason=reason)
 
-    def _from_joints(
-        self,
-        T: np.ndarray,
-        q_from: np.ndarray | None,
-        signs: tuple[int, ...] | None,
-        free: FreeRotation | None,
-    ) -> RedundancyChoice:
-        """The fresh choice from the arm's joints (:mod:`~om_redundant.redundancy.reachable`;
-        without them, the best scored): branch ``signs`` first (None: every allowed branch at
-        once); with a free rotation, over the turns it starts from. An arm whose branches share
-        their grid search in one batch (shoulder offsets: the torus) sweeps them all at once."""
-        hand = None if q_from is None else self.solver.arm.fk(q_from)
-        turns = [None] if free is None else free.starts(T, hand)
-        targets = [T if R is None else free.turned(T, R) for R in turns]
-        at_once = signs is None or self._shared_search
-        first = self.branches if at_once else [signs]
-        swept = [self._sweep(target, first) for target in targets]
-        way = self._way(targets, swept, q_from, signs)
-        note = ""
-        if (way is None or not way[0].clear) and signs is not None:
-            own = [b for branches in swept for b in branches if b.signs == signs]
-            stalled = next((b.stalled for b in own if b.stalled), "")
-            ran = any(b.runs for b in own)
-            note = f"branch {signs} has no {'clear way' if ran else 'feasible arm angle at this pose'}"
-            note = f"branch {signs} was not swept: {stalled}" if stalled else note
-            if not at_once:
-                others = [b for b in self.branches if b != signs]
-                swept = [
-                    branch + self._sweep(target, others)
-                    for branch, target in zip(swept, targets, strict=True)
-                ]
-            way = self._way(targets, swept, q_from)
-        if way is not None and not way[0].clear:
-            note = "; ".join(filter(None, [note, "no candidate has a clear way: the best is taken"]))
-        if way is None:
-            why = "; ".join(self._why(branch) for branch in swept[0])
-            return _failure((), f"no feasible arm angle: {why}")
-        chosen, k = way
-        intervals = tuple(run.interval for branch in swept[k] for run in branch.runs)
-        return self._chosen(targets[k], chosen, intervals, note, turns[k])
-
-    def _way(
-        self,
-        targets: list[np.ndarray],
-        swept: list[list[BranchRuns]],
-        q_from: np.ndarray | None,
-        signs: tuple[int, ...] | None = None,
-    ) -> tuple[Way, int] | None:
-        """The best candidate of the targets' runs (branch ``signs``' only, if given) with a
-        clear way from q_from (or the best), and its target's index."""
-        owner, ranked = {}, []
-        for k, branches in enumerate(swept):
-            runs = [run for b in branches if signs in (None, b.signs) for run in b.runs]
-            owner.update((id(run), k) for run in runs)
-            ranked += candidates(self.objective, runs, q_from, self.travel_weight)
-        ranked.sort(key=lambda c: -c.score)
-        way = clear_way(self.objective, ranked, q_from)
-        return None if way is None else (way, owner[id(way.candidate.run)])
-
-    def _chosen(
-        self, T: np.ndarray, way: Way, intervals: tuple[PsiInterval, ...], note: str, turn: np.ndarray | None
-    ) -> RedundancyChoice:
-        """The choice of a candidate: its exact solution at its joints."""
-        candidate = way.candidate
-        configuration = Configuration(candidate.run.interval.signs, (wrap_psi(candidate.point.psi),))
-        solution = candidate.point.solution or self.solver.solve(T, configuration, q_hint=candidate.point.q)
-        solution = replace(
-            solution,
-            q=candidate.q,
-            configuration=configuration,
-            within_limits=self.solver.arm.within_limits(candidate.q),
-        )
-        ev = candidate.evaluation
-        return RedundancyChoice(
-            solution.ok,
-            configuration,
-            solution,
-            ev.margin,
-            ev.clearance,
-            ev.value,
-            intervals,
-            reason=note,
-            travel=candidate.travel,
-            way_clearance=way.clearance,
-            way_clear=way.clear,
-            turn=turn,
-            pose=T,
-        )
-
-    def _climb_all(self, T: np.ndarray, runs: list[Run]) -> tuple[Run, Point]:
-        """The global maximum over the runs: climbs from the best starts (module docstring)."""
-        # every run's samples at once (their slope bounds: _StartBounds)
-        points = [p for run in runs for p in run.points]
-        owner = np.repeat(np.arange(len(runs)), [len(run.points) for run in runs])
-        first = np.flatnonzero(np.diff(owner, prepend=-1))  # each run's first sample
-        first, last = first[owner], np.append(first[1:], len(points))[owner] - 1
-        psi = np.array([p.psi for p in points])
-        f = np.array([p.evaluation.value for p in points])
-        pairs = [p.terms.get_pairs() for p in points]  # (computed for the evaluations)
-        distances = None if pairs[0] is None else np.array([d for d, _ in pairs])
-        terms = self.objective.term_functions(np.array([p.q for p in points]), distances)
-        # local maxima among a run's samples (its ends against their one neighbour)
-        rising = np.concatenate([[True], f[1:] >= f[:-1]]) | (first == np.arange(len(f)))
-        falling = np.concatenate([f[:-1] >= f[1:], [True]]) | (last == np.arange(len(f)))
-        k = np.flatnonzero(rising & falling)
-        gap = np.maximum(psi[np.minimum(k + 1, last[k])] - psi[k], psi[k] - psi[np.maximum(k - 1, first[k])])
-        bounds = _StartBounds(psi, f, terms, first, last)
-        bound = bounds.cone(k, 2.0 * gap)
-        rows = zip(f[k].tolist(), gap.tolist(), bound.tolist(), k.tolist(), strict=True)
-        starts = [(f_k, gap_k, bound_k, j) for f_k, gap_k, bound_k, j in rows]
-        starts.sort(key=lambda s: -s[0])
-        found = [(runs[owner[starts[0][3]]], points[starts[0][3]])]
-        best = found[0][1].evaluation.value
-        probes = {}
-        for _, gap, bound, j in starts:
-            least = best + _CLIMB_ROUNDING  # what a climb must reach
-            if bound < least or bounds.within(j, 2.0 * gap) < least:  # (the cheap bound first)
-                continue
-            run, start = runs[owner[j]], points[j]
-            lo, hi = (-math.inf, math.inf) if run.interval.closed else (run.interval.lo, run.interval.hi)
-            signs = run.interval.signs
-            if signs not in probes:
-                probes[signs] = self._probe(T, signs)
-            point = maximise(probes[signs], start, lo, hi, max(gap, 1e-6))
-            found.append((run, point))
-            best = max(best, point.evaluation.value)
-        return next((run, point) for run, point in found if point.evaluation.value == best)
-
-    def _result(self, T: np.ndarray, best: tuple[Run, Point], runs: list[Run]) -> RedundancyChoice:
-        run, point = best
-        configuration = Configuration(run.interval.signs, (wrap_psi(point.psi),))
-        # The point's own solve (a batch sample is solved again, nearest itself), at the
-        # point's representative of the joints: where psi has several roots near a singular
-        # wrist, a fresh solve might return another one.
-        solution = point.solution or self.solver.solve(T, configuration, q_hint=point.q)
-        if not solution.ok:
-            return _failure(
-                tuple(r.interval for r in runs), f"the exact solve at the chosen psi: {solution.status}"
-            )
-        solution = replace(
-            solution,
-            q=point.q,
-            configuration=configuration,
-            within_limits=self.solver.arm.within_limits(point.q),
-        )
-        ev = point.evaluation
-        return RedundancyChoice(
-            solution.ok,
-            configuration,
-            solution,
-            ev.margin,
-            ev.clearance,
-            ev.value,
-            tuple(r.interval for r in runs),
-            pose=T,
-        )
-
-    def _why(self, branch: BranchRuns) -> str:
-        """Why a branch's solution paths hold nothing feasible."""
-        signs = branch.signs
-        if branch.stalled:
-            return f"branch {signs}: not swept ({branch.stalled})"
-        points = [p for path in branch.paths for p in path.points]
-        if not points:
-            return f"branch {signs}: no solution at any of {self.grid_points} arm angles"
-        within = [p for p in points if p.evaluation.margin >= 0.0]
-        if not within:
-            best = max(p.evaluation.margin for p in points)
-            return f"branch {signs}: outside the joint limits wherever solved (best margin {best:.3f})"
-        best = max(p.evaluation.clearance for p in within)
-        return (
-            f"branch {signs}: clearance below {self.objective.min_clearance} m wherever within the limits "
-            f"(best {best:.4f} m)"
-        )
-
-
-class _StartBounds:
-    r"""Bounds of what climbs from the samples of runs can reach (module docstring, Starts):
-    f within a reach R of a start, a function u of slope bound L being below the cones
-    :math:`u_i + L |x - \psi_i|` of the samples of its run.
-
-    Args:
-        psi, f: (M,) the runs' samples, a run's in increasing psi, and f there.
-        terms: :meth:`~om_redundant.redundancy.objective.Objective.term_functions` at them.
-        first, last: (M,) each sample's run's first and last sample.
-        slope, slopes: L of f and of each group's functions (p_g,); None: sampled, the
-            largest slope between neighbouring samples of a run (module docstring).
-    """
-
-    def __init__(
-        self,
-        psi: np.ndarray,
-        f: np.ndarray,
-        terms: list[tuple[float, float, np.ndarray]],
-        first: np.ndarray,
-        last: np.ndarray,
-        slope: float | None = None,
-        slopes: list[np.ndarray] | None = None,
-    ):
-        # f and every group's functions as the columns of one array, their slope bounds L
-        self.psi, self.first, self.last = psi, first, last
-        self._values = np.ascontiguousarray(
-            np.hstack([f[:, None]] + [v for _, _, v in terms])
-        )  # (row by row)
-        if slope is None:
-            inner = first[1:] == first[:-1]  # neighbours on one run
-            step = np.maximum(np.diff(psi), 1e-12)[inner]
-            rise = np.abs(np.diff(self._values, axis=0)[inner])
-            self._slopes = np.max(rise / step[:, None], axis=0, initial=0.0)
-        else:
-            self._slopes = np.concatenate([[slope], *slopes])
-        # each group's first column
-        self._groups = np.cumsum([1] + [v.shape[1] for _, _, v in terms[:-1]], dtype=np.int64)[: len(terms)]
-        self._weights = np.array([w for w, _, _ in terms])
-        self._caps = np.array([cap for _, cap, _ in terms])
-        self._samples = _core.StartSamples(
-            self.psi, self._values, self._slopes, self._groups, self._weights, self._caps
-        )
-
-    def cone(self, k: np.ndarray, reach: np.ndarray) -> np.ndarray:
-        r"""(K,) the bounds from the starts' own cones: the smaller of :math:`f_k + L R` and
-        :math:`\sum_g w_g \min(cap_g, \min_j (v_{jk} + L_j R))`, the groups summed in their
-        order (``_core.start_cones``, ``csrc/start_bounds.c``; its numpy oracle is
-        ``tests/reference/start_bounds.py``)."""
-        bounds, reach = np.empty(len(k)), np.ascontiguousarray(reach, dtype=float)
-        _core.start_cones(self._samples, np.ascontiguousarray(k, dtype=np.int64), reach, bounds)
-        return bounds
-
-    def within(self, k: int, reach: float) -> float:
-        r"""The bound of start k from every sample of its run within its reach R (never
-        above :meth:`cone`'s for consistent slopes). Between neighbouring samples i, i + 1
-        (h apart) the cones of the two meet at most at :math:`(u_i + u_{i+1} + L h)/2`; in
-        a cell that R cuts, or beyond the run's end, the last sample's cone reaches
-        :math:`u_i + L r` (r the reach left). Per cell or cut cell the smaller of f's bound
-        and the terms' (:meth:`cone`'s sum), the largest over the cells; at least f_k
-        (``_core.start_bound``, ``csrc/start_bounds.c``; its numpy oracle is
-        ``tests/reference/start_bounds.py``).
-
-        Args:
-            k: The start's sample.
-            reach: R >= 0.
-        """
-        return _core.start_bound(self._samples, int(k), int(self.first[k]), int(self.last[k]), reach)
-
 
 def _rebuilt(solver: OMSolver, clearance: Clearance | None, options: dict[str, Any]) -> RedundancyOptimizer:
     """A :class:`RedundancyOptimizer` unpickled (:meth:`RedundancyOptimizer.__reduce__`)."""
     return RedundancyOptimizer(solver, clearance, **options)
-
-
-def _failure(intervals: tuple[PsiInterval, ...], reason: str) -> RedundancyChoice:
-    return RedundancyChoice(False, None, None, math.nan, math.nan, math.nan, intervals, reason)

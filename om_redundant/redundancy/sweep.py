@@ -19,9 +19,10 @@ import numpy as np
 
 from ..ik.configuration import Configuration
 from ..ik.solver import OMSolver
+from .choice import RedundancyChoice
 from .clearance import Clearance
 from .objective_terms import DEFAULT_SINGULARITY_WEIGHT, joint_margins
-from .optimizer import RedundancyChoice, RedundancyOptimizer
+from .optimizer import RedundancyOptimizer
 from .shapes import Box, Capsule, Shape, Sphere
 
 #: Obstacle shapes: the numbers each takes, in order (metres, in the arm's root frame).

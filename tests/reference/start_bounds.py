@@ -1,4 +1,4 @@
-"""The bounds of a climb's start in numpy (``optimizer._StartBounds.cone`` and ``within``): the
+"""The bounds of a climb's start in numpy (``start_bounds.StartBounds.cone`` and ``within``): the
 oracle of ``_core.start_cones`` and ``_core.start_bound`` (``csrc/start_bounds.c``, the same
 operations in loops)."""
 
@@ -9,10 +9,10 @@ import math
 
 import numpy as np
 
-from om_redundant.redundancy.optimizer import _StartBounds
+from om_redundant.redundancy.start_bounds import StartBounds
 
 
-def bound(bounds: _StartBounds, values: np.ndarray) -> np.ndarray:
+def bound(bounds: StartBounds, values: np.ndarray) -> np.ndarray:
     """(N,) the smaller of f's bound and sum_g w_g min(cap_g, min_j bound_j), from bounds
     (N, 1 + n) of f and of each group's functions, the groups summed in their order."""
     if not len(bounds._weights):  # no terms: f = 0
@@ -25,13 +25,13 @@ def bound(bounds: _StartBounds, values: np.ndarray) -> np.ndarray:
     return np.minimum(values[:, 0], total)
 
 
-def cone(bounds: _StartBounds, k: np.ndarray, reach: np.ndarray) -> np.ndarray:
-    """:meth:`_StartBounds.cone`: (K,) the bounds of starts k from their own cones with reach R."""
+def cone(bounds: StartBounds, k: np.ndarray, reach: np.ndarray) -> np.ndarray:
+    """:meth:`StartBounds.cone`: (K,) the bounds of starts k from their own cones with reach R."""
     return bound(bounds, bounds._values[k] + bounds._slopes * reach[:, None])
 
 
-def within(bounds: _StartBounds, k: int, reach: float) -> float:
-    """:meth:`_StartBounds.within` of start k with reach R (its docstring), from the samples'
+def within(bounds: StartBounds, k: int, reach: float) -> float:
+    """:meth:`StartBounds.within` of start k with reach R (its docstring), from the samples'
     arrays of ``bounds``."""
     a, b = int(bounds.first[k]), int(bounds.last[k])
     values, slopes, psi = bounds._values, bounds._slopes, bounds.psi

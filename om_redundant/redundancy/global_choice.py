@@ -1,0 +1,253 @@
+r"""The optimiser's global choice (the module docstring of :mod:`.optimizer`, steps 1-3): every
+allowed branch swept along psi (its solution paths and feasible runs), the best start of each
+run climbed, and, from where the arm is, the best candidate with a clear joint-space way."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+
+from ..exceptions import SingularSelfMotion
+from ..ik.configuration import Configuration
+from ..ik.solver import OMSolver
+from .arm_angle import wrap_psi
+from .choice import RedundancyChoice, failed_choice
+from .climb import maximise
+from .free_rotation import FreeRotation
+from .intervals import BranchRuns, PsiInterval, Run, feasible_runs
+from .objective import Objective
+from .paths import sweep_circle
+from .points import Point
+from .probe import Probe
+from .reachable import Way, candidates, clear_way
+from .start_bounds import CLIMB_ROUNDING, StartBounds
+
+
+class GlobalChoice:
+    """The global choice of :class:`~om_redundant.RedundancyOptimizer` (its ``solver``,
+    ``objective``, ``branches``, ``grid_points`` and ``_shared_search``)."""
+
+    solver: OMSolver
+    objective: Objective
+    branches: list[tuple[int, ...]]
+    grid_points: int
+    _shared_search: bool
+
+    def _sweep(self, T: np.ndarray, branches: list[tuple[int, ...]]) -> list[BranchRuns]:
+        """Every branch's solution paths and feasible runs. Where a path runs within rounding
+        of a singular set (SingularSelfMotion), the branches are swept one by one and those
+        that raise have none, the reason in their ``stalled``.
+
+        Raises:
+            SingularSelfMotion: Every branch raised.
+        """
+        probes = [self._probe(T, signs) for signs in branches]
+        try:
+            swept = sweep_circle(probes, self.grid_points)
+        except SingularSelfMotion as singular:
+            if len(branches) == 1:
+                raise
+            alone = [self._sweep_alone(T, signs) for signs in branches]
+            if all(branch.stalled for branch in alone):
+                raise singular
+            return alone
+        paths = [(probe, path) for probe, paths in zip(probes, swept, strict=True) for path in paths]
+        runs = iter(feasible_runs(paths))
+        return [
+            BranchRuns(signs, paths, [run for _ in paths for run in next(runs)])
+            for signs, paths in zip(branches, swept, strict=True)
+        ]
+
+    def _sweep_alone(self, T: np.ndarray, signs: tuple[int, ...]) -> BranchRuns:
+        try:
+            return self._sweep(T, [signs])[0]
+        except SingularSelfMotion as singular:
+            return BranchRuns(signs, [], [], str(singular))
+
+    def _probe(self, T: np.ndarray, signs: tuple[int, ...]) -> Probe:
+        return Probe(self.solver, self.objective, T, signs)
+
+    def _best_anywhere(self, T: np.ndarray, branches: list[tuple[int, ...]]) -> RedundancyChoice:
+        swept = self._sweep(T, branches)
+        runs = [run for branch in swept for run in branch.runs]
+        if not runs:
+            why = "; ".join(self._why(branch) for branch in swept)
+            return failed_choice((), f"no feasible arm angle: {why}")
+        return self._result(T, self._climb_all(T, runs), runs)
+
+    def _from_joints(
+        self,
+        T: np.ndarray,
+        q_from: np.ndarray | None,
+        signs: tuple[int, ...] | None,
+        free: FreeRotation | None,
+    ) -> RedundancyChoice:
+        """The fresh choice from the arm's joints (:mod:`~om_redundant.redundancy.reachable`;
+        without them, the best scored): branch ``signs`` first (None: every allowed branch at
+        once); with a free rotation, over the turns it starts from. An arm whose branches share
+        their grid search in one batch (shoulder offsets: the torus) sweeps them all at once."""
+        hand = None if q_from is None else self.solver.arm.fk(q_from)
+        turns = [None] if free is None else free.starts(T, hand)
+        targets = [T if R is None else free.turned(T, R) for R in turns]
+        at_once = signs is None or self._shared_search
+        first = self.branches if at_once else [signs]
+        swept = [self._sweep(target, first) for target in targets]
+        way = self._way(targets, swept, q_from, signs)
+        note = ""
+        if (way is None or not way[0].clear) and signs is not None:
+            own = [b for branches in swept for b in branches if b.signs == signs]
+            stalled = next((b.stalled for b in own if b.stalled), "")
+            ran = any(b.runs for b in own)
+            note = f"branch {signs} has no {'clear way' if ran else 'feasible arm angle at this pose'}"
+            note = f"branch {signs} was not swept: {stalled}" if stalled else note
+            if not at_once:
+                others = [b for b in self.branches if b != signs]
+                swept = [
+                    branch + self._sweep(target, others)
+                    for branch, target in zip(swept, targets, strict=True)
+                ]
+            way = self._way(targets, swept, q_from)
+        if way is not None and not way[0].clear:
+            note = "; ".join(filter(None, [note, "no candidate has a clear way: the best is taken"]))
+        if way is None:
+            why = "; ".join(self._why(branch) for branch in swept[0])
+            return failed_choice((), f"no feasible arm angle: {why}")
+        chosen, k = way
+        intervals = tuple(run.interval for branch in swept[k] for run in branch.runs)
+        return self._chosen(targets[k], chosen, intervals, note, turns[k])
+
+    def _way(
+        self,
+        targets: list[np.ndarray],
+        swept: list[list[BranchRuns]],
+        q_from: np.ndarray | None,
+        signs: tuple[int, ...] | None = None,
+    ) -> tuple[Way, int] | None:
+        """The best candidate of the targets' runs (branch ``signs``' only, if given) with a
+        clear way from q_from (or the best), and its target's index."""
+        owner, ranked = {}, []
+        for k, branches in enumerate(swept):
+            runs = [run for b in branches if signs in (None, b.signs) for run in b.runs]
+            owner.update((id(run), k) for run in runs)
+            ranked += candidates(self.objective, runs, q_from, self.travel_weight)
+        ranked.sort(key=lambda c: -c.score)
+        way = clear_way(self.objective, ranked, q_from)
+        return None if way is None else (way, owner[id(way.candidate.run)])
+
+    def _chosen(
+        self, T: np.ndarray, way: Way, intervals: tuple[PsiInterval, ...], note: str, turn: np.ndarray | None
+    ) -> RedundancyChoice:
+        """The choice of a candidate: its exact solution at its joints."""
+        candidate = way.candidate
+        configuration = Configuration(candidate.run.interval.signs, (wrap_psi(candidate.point.psi),))
+        solution = candidate.point.solution or self.solver.solve(T, configuration, q_hint=candidate.point.q)
+        solution = replace(
+            solution,
+            q=candidate.q,
+            configuration=configuration,
+            within_limits=self.solver.arm.within_limits(candidate.q),
+        )
+        ev = candidate.evaluation
+        return RedundancyChoice(
+            solution.ok,
+            configuration,
+            solution,
+            ev.margin,
+            ev.clearance,
+            ev.value,
+            intervals,
+            reason=note,
+            travel=candidate.travel,
+            way_clearance=way.clearance,
+            way_clear=way.clear,
+            turn=turn,
+            pose=T,
+        )
+
+    def _climb_all(self, T: np.ndarray, runs: list[Run]) -> tuple[Run, Point]:
+        """The global maximum over the runs: climbs from the best starts (module docstring)."""
+        # every run's samples at once (their slope bounds: StartBounds)
+        points = [p for run in runs for p in run.points]
+        owner = np.repeat(np.arange(len(runs)), [len(run.points) for run in runs])
+        first = np.flatnonzero(np.diff(owner, prepend=-1))  # each run's first sample
+        first, last = first[owner], np.append(first[1:], len(points))[owner] - 1
+        psi = np.array([p.psi for p in points])
+        f = np.array([p.evaluation.value for p in points])
+        pairs = [p.terms.get_pairs() for p in points]  # (computed for the evaluations)
+        distances = None if pairs[0] is None else np.array([d for d, _ in pairs])
+        terms = self.objective.term_functions(np.array([p.q for p in points]), distances)
+        # local maxima among a run's samples (its ends against their one neighbour)
+        rising = np.concatenate([[True], f[1:] >= f[:-1]]) | (first == np.arange(len(f)))
+        falling = np.concatenate([f[:-1] >= f[1:], [True]]) | (last == np.arange(len(f)))
+        k = np.flatnonzero(rising & falling)
+        gap = np.maximum(psi[np.minimum(k + 1, last[k])] - psi[k], psi[k] - psi[np.maximum(k - 1, first[k])])
+        bounds = StartBounds(psi, f, terms, first, last)
+        bound = bounds.cone(k, 2.0 * gap)
+        rows = zip(f[k].tolist(), gap.tolist(), bound.tolist(), k.tolist(), strict=True)
+        starts = [(f_k, gap_k, bound_k, j) for f_k, gap_k, bound_k, j in rows]
+        starts.sort(key=lambda s: -s[0])
+        found = [(runs[owner[starts[0][3]]], points[starts[0][3]])]
+        best = found[0][1].evaluation.value
+        probes = {}
+        for _, gap, bound, j in starts:
+            least = best + CLIMB_ROUNDING  # what a climb must reach
+            if bound < least or bounds.within(j, 2.0 * gap) < least:  # (the cheap bound first)
+                continue
+            run, start = runs[owner[j]], points[j]
+            lo, hi = (-math.inf, math.inf) if run.interval.closed else (run.interval.lo, run.interval.hi)
+            signs = run.interval.signs
+            if signs not in probes:
+                probes[signs] = self._probe(T, signs)
+            point = maximise(probes[signs], start, lo, hi, max(gap, 1e-6))
+            found.append((run, point))
+            best = max(best, point.evaluation.value)
+        return next((run, point) for run, point in found if point.evaluation.value == best)
+
+    def _result(self, T: np.ndarray, best: tuple[Run, Point], runs: list[Run]) -> RedundancyChoice:
+        run, point = best
+        configuration = Configuration(run.interval.signs, (wrap_psi(point.psi),))
+        # The point's own solve (a batch sample is solved again, nearest itself), at the
+        # point's representative of the joints: where psi has several roots near a singular
+        # wrist, a fresh solve might return another one.
+        solution = point.solution or self.solver.solve(T, configuration, q_hint=point.q)
+        if not solution.ok:
+            return failed_choice(
+                tuple(r.interval for r in runs), f"the exact solve at the chosen psi: {solution.status}"
+            )
+        solution = replace(
+            solution,
+            q=point.q,
+            configuration=configuration,
+            within_limits=self.solver.arm.within_limits(point.q),
+        )
+        ev = point.evaluation
+        return RedundancyChoice(
+            solution.ok,
+            configuration,
+            solution,
+            ev.margin,
+            ev.clearance,
+            ev.value,
+            tuple(r.interval for r in runs),
+            pose=T,
+        )
+
+    def _why(self, branch: BranchRuns) -> str:
+        """Why a branch's solution paths hold nothing feasible."""
+        signs = branch.signs
+        if branch.stalled:
+            return f"branch {signs}: not swept ({branch.stalled})"
+        points = [p for path in branch.paths for p in path.points]
+        if not points:
+            return f"branch {signs}: no solution at any of {self.grid_points} arm angles"
+        within = [p for p in points if p.evaluation.margin >= 0.0]
+        if not within:
+            best = max(p.evaluation.margin for p in points)
+            return f"branch {signs}: outside the joint limits wherever solved (best margin {best:.3f})"
+        best = max(p.evaluation.clearance for p in within)
+        return (
+            f"branch {signs}: clearance below {self.objective.min_clearance} m wherever within the limits "
+            f"(best {best:.4f} m)"
+        )
