@@ -6,8 +6,9 @@
 shows (:mod:`.sweep`)."""
 
 from .arm_angle import arm_angle_and_gradient
+from .arm_geoms import MAX_EXTENT
 from .choice import RedundancyChoice
-from .clearance import MAX_EXTENT, Clearance
+from .clearance import Clearance
 from .free_rotation import FreeRotation
 from .intervals import PsiInterval
 from .objective import Objective

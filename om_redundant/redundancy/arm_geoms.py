@@ -15,7 +15,7 @@ import mujoco
 import numpy as np
 
 from .. import _core
-from ..exceptions import ModelMismatch
+from ..exceptions import InvalidInput, ModelMismatch
 from ..mujoco_io.arm_in_model import MATCH_TOLERANCE, ArmJoints
 
 #: ArmCores.kind: the cores that _core.arm_clearance computes (csrc/redundancy.h).
@@ -193,3 +193,28 @@ def subtree(model: mujoco.MjModel, root: int) -> np.ndarray:
     for b in range(model.nbody):  # parents come before their children
         inside[b] = b == root or (b > 0 and inside[model.body_parentid[b]])
     return inside
+
+
+#: The largest coordinate or size (m) of an obstacle geom: distances are computed in doubles to
+#: about 1e-16 of the largest coordinates, 1e-10 m at this extent; beyond about 1e154 their
+#: squares overflow (a sphere of radius 1e155 about the arm was reported clear).
+MAX_EXTENT = 1e6
+
+
+def find_geom(model: mujoco.MjModel, name: str) -> int:
+    """The id of the model's geom named ``name``; InvalidInput if there is none."""
+    index = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, name)
+    if index < 0:
+        raise InvalidInput(f"the MuJoCo model has no geom named '{name}'")
+    return index
+
+
+def check_extent(model: mujoco.MjModel, obstacles: list[int], position: np.ndarray) -> None:
+    """Every obstacle's position and sizes within :data:`MAX_EXTENT` (m)."""
+    for o, p in zip(obstacles, position, strict=True):
+        extent = max(np.abs(p).max(), model.geom_size[o].max())
+        if not extent <= MAX_EXTENT:
+            raise InvalidInput(
+                f"obstacle geom '{geom_label(model, o)}': its position and sizes must be within "
+                f"{MAX_EXTENT:g} m, got {extent:.3g} m"
+            )

@@ -52,7 +52,6 @@ gripper's) stay at ``qpos0``.
 from __future__ import annotations
 
 import math
-import threading
 from collections.abc import Sequence
 from typing import Any
 
@@ -66,28 +65,21 @@ from ..mujoco_io.arm_in_model import ArmJoints
 from ..mujoco_io.mjcf import arm_mjcf
 from ..validation import as_count, as_instance, as_joint_vector, as_number, as_positive
 from .arm_geoms import (
-    BOX,
-    POINT,
-    SEGMENT,
-    ArmCores,
     arm_cores,
     as_row,
     body_pose,
+    check_extent,
     check_placement,
+    find_geom,
     geom_label,
     lever_arms,
     subtree,
 )
+from .mujoco_pairs import MujocoPairs
+from .segment_clearance import segment_minimum
 from .shapes import Shape, model_geoms, shape_geoms
 
 DEFAULT_DISTMAX = 1.0  # m: pairs farther apart report this distance
-#: m: :meth:`Clearance.minimum_along` stops splitting a segment whose bound is this close to its ends'.
-ALONG_TOLERANCE = 2e-4
-
-#: The largest coordinate or size (m) of an obstacle geom: distances are computed in doubles to
-#: about 1e-16 of the largest coordinates, 1e-10 m at this extent; beyond about 1e154 their
-#: squares overflow (a sphere of radius 1e155 about the arm was reported clear).
-MAX_EXTENT = 1e6
 
 
 class Clearance:
@@ -158,33 +150,31 @@ class Clearance:
             )
         if not obstacle_geoms:
             raise InvalidInput("no obstacle geoms given")
-        obstacles = [_find(model, name) for name in obstacle_geoms]
+        obstacles = [find_geom(model, name) for name in obstacle_geoms]
         for o in obstacles:
             if moving[model.geom_bodyid[o]]:
                 raise InvalidInput(f"obstacle geom '{geom_label(model, o)}' moves with the arm")
         # the model's geom ids of each pair (arm geom, obstacle) and the arm geom's index, for
         # mj_geomDistance
-        self._pair_geoms = [(a, o, i) for i, a in enumerate(arm_geoms) for o in obstacles]
+        pair_geoms = [(a, o, i) for i, a in enumerate(arm_geoms) for o in obstacles]
         self._arm_ids, self._obstacle_ids = np.array(arm_geoms, dtype=np.int64), np.array(obstacles)
-        self._data = mujoco.MjData(model)  # at qpos0, placed: the obstacles and mj_geomDistance's scratch
-        mujoco.mj_kinematics(model, self._data)
-        _check_extent(model, obstacles, self._data.geom_xpos[obstacles])
-        self._placed = (self._data.geom_xpos, self._data.geom_xmat)  # (views of the data's arrays)
-        self._data_lock = threading.Lock()  # the data is every call's scratch: one call at a time
-        self._cores = arm_cores(model, self._data, joints, arm_geoms, obstacles)
-        self._n_pairs = len(self._pair_geoms)
+        self._mujoco = MujocoPairs(model, pair_geoms, len(arm_geoms), arm.dof)
+        data = self._mujoco.data  # at qpos0: the obstacles placed
+        check_extent(model, obstacles, data.geom_xpos[obstacles])
+        self._cores = arm_cores(model, data, joints, arm_geoms, obstacles)
+        self._n_pairs = len(pair_geoms)
         # The arm's root body (its first joint's body's parent) carries DH frame 0: K_root, K in it.
         self._root = int(model.body_parentid[first_body])
         self._root_moves = bool(model.body_weldid[self._root] != 0)
         K = np.eye(4)
         K[:3, :3], K[:3, 3] = self._cores.start[:9].reshape(3, 3), self._cores.start[9:]
-        self._start_in_root = np.linalg.solve(body_pose(self._data, self._root), K)
+        self._start_in_root = np.linalg.solve(body_pose(data, self._root), K)
         self._lever = lever_arms(model, self._cores, arm_geoms, joints)
         self.version = 0
         self.arm_geoms: tuple[str, ...] = tuple(geom_label(model, g) for g in arm_geoms)
         check_placement(model, joints, self._arm_ids, self.geom_poses)
         self.pairs: tuple[tuple[str, str], ...] = tuple(
-            (geom_label(model, a), geom_label(model, o)) for a, o, _ in self._pair_geoms
+            (geom_label(model, a), geom_label(model, o)) for a, o, _ in pair_geoms
         )
         self.geom_pairs: list[tuple[list[int], list[int]]] = [(list(arm_geoms), list(obstacles))]
 
@@ -328,7 +318,7 @@ class Clearance:
             and np.array_equal(start, cores.start)
         ):
             return False
-        _check_extent(self.model, ids.tolist(), position)
+        check_extent(self.model, ids.tolist(), position)
         # (one assignment: a call in another thread reads the old poses or the new, whole)
         self._cores = cores._replace(
             start=np.ascontiguousarray(start),
@@ -370,34 +360,7 @@ class Clearance:
         floor = as_number(floor, "floor")
         budget = math.inf if max_samples is None else as_count(max_samples, "max_samples", 0, 2**31)
         lipschitz = float(self._lever @ np.abs(q_to - q_from))
-        t = np.array([0.0, 1.0])
-        ends = self.distances(np.array([q_from, q_to])).min(axis=1)
-        pieces = [(0.0, 1.0, ends[0], ends[1])]
-        least = math.inf
-        while pieces:
-            lowest = min(min(d0, d1) for _, _, d0, d1 in pieces)
-            if lowest < floor:
-                return lowest
-            split = []
-            for t0, t1, d0, d1 in pieces:
-                bound = 0.5 * (d0 + d1 - lipschitz * (t1 - t0))
-                if bound >= floor or lipschitz * (t1 - t0) <= ALONG_TOLERANCE:
-                    least = min(least, bound)
-                else:
-                    split.append((t0, t1, d0, d1))
-            if not split:
-                break
-            if len(split) > budget:
-                return math.nan
-            budget -= len(split)
-            t = np.array([0.5 * (t0 + t1) for t0, t1, _, _ in split])
-            middle = self.distances(q_from + t[:, None] * (q_to - q_from)).min(axis=1).tolist()
-            pieces = [
-                piece
-                for (t0, t1, d0, d1), tm, dm in zip(split, t.tolist(), middle, strict=True)
-                for piece in ((t0, tm, d0, dm), (tm, t1, dm, d1))
-            ]
-        return least
+        return segment_minimum(self.distances, q_from, q_to, lipschitz, floor, budget)
 
     def _evaluate(
         self, q: np.ndarray, reach: float, gradient: bool, near: float = math.inf
@@ -405,78 +368,17 @@ class Clearance:
         """Distances capped at reach and, if asked (else None), their gradients (only the
         pairs nearer than ``near`` where one is: :meth:`distances_and_gradients`) at a joint
         vector or the rows of q: one ``_core.arm_clearance`` call, then
-        ``mj_geomDistance`` for the pairs it leaves (:meth:`_by_mujoco`)."""
+        ``mj_geomDistance`` for the pairs it leaves (:class:`~.mujoco_pairs.MujocoPairs`)."""
         q = as_joint_vector(q, self._dof)
         shape = (*q.shape[:-1], self._n_pairs)
         dist, fromto = np.empty(shape), np.empty((*shape, 6))
         grad = np.empty((*shape, self._dof)) if gradient else None
         cores = self._cores
         if _core.arm_clearance(cores, q, reach, near, _core.PairDistances(dist, fromto, grad), False):
-            self._by_mujoco(
+            self._mujoco.fill(
                 cores, q.reshape(-1, self._dof), reach, near, dist.reshape(-1, self._n_pairs), fromto, grad
             )
         return dist, grad
-
-    def _by_mujoco(
-        self,
-        cores: ArmCores,
-        q: np.ndarray,
-        reach: float,
-        near: float,
-        dist: np.ndarray,
-        fromto: np.ndarray,
-        grad: np.ndarray | None,
-    ) -> None:
-        """The pairs ``_core.arm_clearance`` left (nan: kinds it does not compute, cores
-        touching, boxes touched) by ``mj_geomDistance``, the arm geoms placed as it places
-        them (all those rows' in one call), and those rows' gradients (in one call)."""
-        m, d, n_pairs = self.model, self._data, self._n_pairs
-        fromto = fromto.reshape(-1, n_pairs, 6)
-        left = np.isnan(dist)
-        rows = np.flatnonzero(left.any(axis=1))
-        n_arm = len(self._arm_ids)
-        xpos, xmat = np.empty((len(rows), n_arm, 3)), np.empty((len(rows), n_arm, 9))
-        _core.arm_geom_poses(cores, q[rows], xpos, xmat)
-        at, placed = rows.tolist(), self._placed
-        kind, radius, half = cores.kind, cores.radius, cores.half
-        for r, k in np.argwhere(left[rows]).tolist():  # (only the pair's geoms placed: the ones read)
-            a, o, i = self._pair_geoms[k]
-            b = cores.pairs[k, 1]
-            at_pos, at_mat = cores.obstacle_pos[b - n_arm], cores.obstacle_mat[b - n_arm]
-            with self._data_lock:
-                placed[0][a], placed[1][a] = xpos[r, i], xmat[r, i]
-                placed[0][o], placed[1][o] = at_pos, at_mat
-                found = mujoco.mj_geomDistance(m, d, a, o, reach, fromto[at[r], k])
-            if found > 0.0 and kind[b] == BOX and kind[i] in (POINT, SEGMENT):
-                # The kernel leaves such a pair where the cores say it overlaps; MuJoCo's
-                # box-capsule distance can be positive for a capsule whose core pierces a
-                # thin box (0.3 % of such pairs, up to 0.09 m): the exact depth instead.
-                geom = _core.GeomPose(xpos[r, i], xmat[r, i], half[i], radius[i])
-                found = _core.box_overlap(geom, _core.GeomPose(at_pos, at_mat, half[b]), fromto[at[r], k])
-            dist[at[r], k] = found
-        if grad is not None:
-            given = np.empty((len(rows), n_pairs, self._dof))
-            given_pairs = _core.PairDistances(dist[rows], fromto[rows], given)
-            _core.arm_clearance(cores, q[rows], reach, near, given_pairs, True)
-            grad.reshape(-1, n_pairs, self._dof)[rows] = given
-
-
-def _find(model: mujoco.MjModel, name: str) -> int:
-    index = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, name)
-    if index < 0:
-        raise InvalidInput(f"the MuJoCo model has no geom named '{name}'")
-    return index
-
-
-def _check_extent(model: mujoco.MjModel, obstacles: list[int], position: np.ndarray) -> None:
-    """Every obstacle's position and sizes within :data:`MAX_EXTENT` (m)."""
-    for o, p in zip(obstacles, position, strict=True):
-        extent = max(np.abs(p).max(), model.geom_size[o].max())
-        if not extent <= MAX_EXTENT:
-            raise InvalidInput(
-                f"obstacle geom '{geom_label(model, o)}': its position and sizes must be within "
-                f"{MAX_EXTENT:g} m, got {extent:.3g} m"
-            )
 
 
 def _restored(

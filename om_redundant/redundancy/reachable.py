@@ -29,11 +29,11 @@ from typing import NamedTuple
 import numpy as np
 
 from ..kinematics.arm import Arm
-from .clearance import ALONG_TOLERANCE
 from .intervals import Run
 from .objective import Objective
 from .objective_terms import Evaluation
 from .points import Point
+from .segment_clearance import ALONG_TOLERANCE
 
 #: w_t: objective given up per radian of joint travel (default).
 DEFAULT_TRAVEL_WEIGHT = 0.25
@@ -126,7 +126,7 @@ def candidates(
 
 def way_floor(objective: Objective, q_from: np.ndarray) -> float:
     r"""What a clear way from q_from keeps: :math:`\min(d_{min} + m, D(q_0))` less
-    :data:`~om_redundant.redundancy.clearance.ALONG_TOLERANCE`, m = :data:`WAY_MARGIN` for the
+    :data:`~om_redundant.redundancy.segment_clearance.ALONG_TOLERANCE`, m = :data:`WAY_MARGIN` for the
     arm's deviation from the straight way (-inf without obstacles)."""
     if objective.clearance is None:
         return -math.inf
