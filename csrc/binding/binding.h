@@ -107,6 +107,19 @@ const om_solver_data *om_solver_ready(const om_Solver *self);
 int om_solver_set_types(om_Solver *self, PyObject *solution_type, PyObject *configuration_type);
 void om_solver_clear_types(om_Solver *self);
 PyObject *om_solver_solve_pose(om_Solver *self, PyObject *const *args, Py_ssize_t nargs);
+/* solver_calls.c: the Solver's calls in one configuration (its methods of these names). */
+PyObject *om_Solver_solve(om_Solver *self, PyObject *const *args, Py_ssize_t nargs);
+PyObject *om_Solver_solve_all(om_Solver *self, PyObject *const *args, Py_ssize_t nargs);
+PyObject *om_Solver_bounded_search(om_Solver *self, PyObject *const *args, Py_ssize_t nargs);
+PyObject *om_Solver_torus_bound(om_Solver *self, PyObject *const *args, Py_ssize_t nargs);
+PyObject *om_Solver_configuration_values(om_Solver *self, PyObject *const *args, Py_ssize_t nargs);
+PyObject *om_Solver_holds(om_Solver *self, PyObject *const *args, Py_ssize_t nargs);
+/* solver_calls.c: a root's (position error, orientation error, within limits) from a kernel's
+ * info row into the result arrays at index at. */
+void om_put_root_info(const double *info, Py_ssize_t at, double *position, double *orientation, uint8_t *within);
+/* solver_batches.c: Solver.solve_rows and solve_all_rows (batch, start, stop). */
+PyObject *om_solver_solve_rows(om_Solver *self, PyObject *const *args, Py_ssize_t nargs);
+PyObject *om_solver_solve_all_rows(om_Solver *self, PyObject *const *args, Py_ssize_t nargs);
 
 extern PyTypeObject om_SolverType;        /* solver_type.c: Solver(SolverData) */
 /* solver_type.c: the Solver type and its methods' result types (ckernels.Solver, Solved, Found,
