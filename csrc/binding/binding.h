@@ -47,6 +47,8 @@ typedef struct {
 int get_buffers(PyObject *const *objs, Py_buffer *views, const buffer_spec *specs, int n);
 /* Release views[0:n]. */
 void release_buffers(Py_buffer *views, int n);
+/* The rows of a DH table's buffer (rows of 6 float64). */
+static inline Py_ssize_t table_rows(const Py_buffer *table) { return table->len / (6 * 8); }
 /* The joints (rows of kind 0 or 1, not 2: fixed) of a DH table's buffer (rows of 6 float64). */
 Py_ssize_t table_joints(const Py_buffer *table);
 /* Whether index[k * stride] lies in [lo, hi) for every k < n (a binding's check of the
@@ -128,7 +130,8 @@ int om_solver_init(PyObject *module);
 /* solver_type.c: obj's data if it is a 7-DOF (S-R-S) Solver; NULL with an error naming what. */
 const om_solver_data *om_srs7_solver(PyObject *obj, const char *what);
 extern PyMethodDef om_kernel_functions[]; /* functions.c: kinematics and closed forms */
-int om_functions_init(PyObject *module);  /* functions.c: their result types (ckernels.Lifted) */
+extern PyMethodDef om_closed_form_functions[]; /* closed_forms.c: the model arms' closed forms */
+int om_closed_forms_init(PyObject *module);     /* closed_forms.c: their result type (ckernels.Lifted) */
 int om_tracking_init(PyObject *module);       /* binding/tracking.c: track_step, its statuses and result type */
 int om_clearance_init(PyObject *module);      /* binding/clearance.c: arm and obstacle geoms */
 /* binding/paths.c: follow, link_paths and self_motion_tangents (follow.c, link.c, tangents.c) */

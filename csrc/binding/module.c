@@ -49,7 +49,8 @@ PyMODINIT_FUNC PyInit_ckernels(void) {
         {"JOINT_FIXED", OM_JOINT_FIXED},
         {"LINK_DONE", OM_LINK_DONE}, {"LINK_SINGULAR", OM_LINK_SINGULAR}, {"LINK_FULL", OM_LINK_FULL},
     };
-    if (om_solver_init(m) < 0 || om_functions_init(m) < 0) goto fail;
+    if (om_solver_init(m) < 0) goto fail;
+    if (PyModule_AddFunctions(m, om_closed_form_functions) < 0 || om_closed_forms_init(m) < 0) goto fail;
     if (om_tracking_init(m) < 0 || om_clearance_init(m) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_path_functions) < 0 || om_paths_init(m) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_objective_functions) < 0) goto fail;
