@@ -37,9 +37,9 @@ import mink
 import numpy as np
 
 import om_redundant as om
-from om_redundant.redundancy.choice import RedundancyChoice
-from om_redundant.redundancy.climb import maximise
-from om_redundant.redundancy.probe import Probe
+from om_redundant.redundancy.choice.climb import maximise
+from om_redundant.redundancy.choice.result import RedundancyChoice
+from om_redundant.redundancy.paths.probe import Probe
 
 from .report import cpu_model, write_page
 from .robots import random_joints
@@ -212,7 +212,7 @@ def global_times(name: str, poses: int, ticks: int) -> tuple[np.ndarray, np.ndar
 
 def converged_gap(optimizer: om.RedundancyOptimizer, q: np.ndarray) -> tuple[float, float] | None:
     """Tracking at pose fk(q) from q itself until psi stops moving, against the global
-    optimiser's climb (:func:`~om_redundant.redundancy.climb.maximise`) from the tracked
+    optimiser's climb (:func:`~om_redundant.redundancy.choice.climb.maximise`) from the tracked
     optimum on the same branch: (|psi gap|, value gain of the climb over the tracked value).
     None where q is infeasible (outside the limits or too near an obstacle) or tracking
     leaves it (the branch has nothing feasible within reach of q's psi)."""

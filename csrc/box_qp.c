@@ -1,4 +1,4 @@
-/* The climb's QP in one redundancy variable, solved exactly (om_redundant/redundancy/box_qp.py's
+/* The climb's QP in one redundancy variable, solved exactly (om_redundant/redundancy/choice/box_qp.py's
  * maximise_1d, whose numpy version is the reference): maximise the concave, piecewise
  * quadratic phi(delta) = sum_g w_g min(cap_g, min_{j in g} v_j + a_j delta) - b delta^2 / 2 over
  * [lower, upper] where every group with a floor keeps its minimum >= floor. The maximiser is a

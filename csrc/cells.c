@@ -1,4 +1,4 @@
-/* The cell test of the global choose's solution paths (om_redundant/redundancy/paths.py's
+/* The cell test of the global choose's solution paths (om_redundant/redundancy/paths/linking.py's
  * _surprise): the feasibility functions g_j of a point and their rates along psi, and where
  * their cubic Hermite models between two neighbouring points predict a feasibility that the
  * ends do not explain. (Its binding: csrc/binding/cells.c, whose docstrings say what each

@@ -1,5 +1,5 @@
 /* Distances between an arm's geoms and obstacle geoms, and their gradients, for many joint
- * vectors in one call (om_redundant/redundancy/clearance.py).
+ * vectors in one call (om_redundant/redundancy/objective/clearance.py).
  *
  * Placement: the arm's links are the frames of its DH chain (csrc/kinematics.c's rows) started
  * from the world pose of DH frame 0; link l (l = 0..dof) is the frame just before joint l+1's

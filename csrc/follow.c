@@ -1,5 +1,5 @@
 /* A solution path of one branch followed along the arm angle in one call: the loop of
- * Probe.follow (om_redundant/redundancy/probe.py) for a 7-DOF arm's compiled solver (also link.c's).
+ * Probe.follow (om_redundant/redundancy/paths/probe.py) for a 7-DOF arm's compiled solver (also link.c's).
  *
  * From the point (psi_0, q_0) with tangent t_0 = dq/dpsi towards psi*: the step h starts at
  * psi* - psi_0; at x = psi_k + h (psi* once within reach) the exact solution q nearest q_k

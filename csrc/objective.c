@@ -1,4 +1,4 @@
-/* The redundancy optimiser's objective at joint vectors (om_redundant/redundancy/objective.py's
+/* The redundancy optimiser's objective at joint vectors (om_redundant/redundancy/objective/objective.py's
  * Objective.evaluate and evaluations, which call it): the normalised joint-limit margin
  * M = min_i min((q_i - l_i)/h_i, (u_i - q_i)/h_i), the clearance D = min_k d_k (the pairs'
  * distances, computed by MuJoCo and clearance.c), the singularity distance

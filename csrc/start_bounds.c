@@ -1,4 +1,4 @@
-/* The bound of what a climb from a start can reach (om_redundant/redundancy/optimizer.py's
+/* The bound of what a climb from a start can reach (om_redundant/redundancy/choice/optimizer.py's
  * _StartBounds.within, whose numpy version is the reference; the same operations in its
  * order): from the cones u_i + L |x - psi_i| of every sample of the start's run within its
  * reach R, of f (column 0) and of each group's functions (the other columns). Minima and maxima

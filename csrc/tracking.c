@@ -1,4 +1,4 @@
-/* The redundancy optimiser's tracking step in one call (om_redundant/redundancy/tracking.py):
+/* The redundancy optimiser's tracking step in one call (om_redundant/redundancy/choice/tracking.py):
  * the exact solve at the previous arm angle, the objective's pieces and their rates along
  * the self-motion, the step of the 1-variable box QP, the exact solve at the new arm angle.
  *

@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 import om_redundant as om
 from om_redundant import _core
 from om_redundant.mujoco_io.loading import load_mujoco_model
-from om_redundant.redundancy.objective_terms import Group
+from om_redundant.redundancy.objective.terms import Group
 
 # The suite's property tests draw the same examples on every run, so that CI answers for the
 # code and not for the draw; HYPOTHESIS_PROFILE=explore draws new ones (run it to hunt bugs:

@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 
 from benchmarks.control_rate import HOMES
 from om_redundant import _core
-from om_redundant.redundancy.paths import _BOUND_SLACK, _HERMITE, FINE_STEP
+from om_redundant.redundancy.paths.linking import _BOUND_SLACK, _HERMITE, FINE_STEP
 from om_redundant.redundancy.self_motion import self_motion_tangents
 from tests.conftest import steps_numpy
 from tests.reference.cells import crossing_numpy, looks_numpy, quiet_numpy, surprise_numpy

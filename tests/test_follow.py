@@ -17,8 +17,8 @@ import om_redundant as om
 from benchmarks.control_rate import MIN_CLEARANCE, obstacles
 from om_redundant import _core
 from om_redundant.redundancy import paths
-from om_redundant.redundancy.points import Point
-from om_redundant.redundancy.probe import END_TOLERANCE, Probe
+from om_redundant.redundancy.paths.points import Point
+from om_redundant.redundancy.paths.probe import END_TOLERANCE, Probe
 from tests.conftest import solver_of
 from tests.test_redundancy_batch import optimizer_of
 

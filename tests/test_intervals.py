@@ -1,4 +1,4 @@
-"""The ends of the feasible intervals (om_redundant/redundancy/intervals.py): each refined end
+"""The ends of the feasible intervals (om_redundant/redundancy/paths/intervals.py): each refined end
 is the last feasible point before the boundary, and refining every end at once (lockstep)
 makes the same follows as refining each alone."""
 
@@ -10,9 +10,9 @@ from hypothesis import strategies as st
 
 import om_redundant as om
 from benchmarks.control_rate import MIN_CLEARANCE, obstacles
-from om_redundant.redundancy.intervals import SLACK_TOLERANCE, _refined, _runs, _spans
-from om_redundant.redundancy.paths import lockstep, sweep_circle
-from om_redundant.redundancy.probe import END_TOLERANCE
+from om_redundant.redundancy.paths.intervals import SLACK_TOLERANCE, _refined, _runs, _spans
+from om_redundant.redundancy.paths.linking import lockstep, sweep_circle
+from om_redundant.redundancy.paths.probe import END_TOLERANCE
 from tests.conftest import random_pose, random_scenes, solver_of
 
 

@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
-from om_redundant.redundancy.reachable import WAY_MARGIN, nearest_turns
+from om_redundant.redundancy.choice.reachable import WAY_MARGIN, nearest_turns
 from tests.conftest import EXACT, random_q
 
 OBSTACLES = [om.Sphere([0.45, 0.25, 0.55], 0.07), om.Capsule([0.3, -0.6, 0.35], [0.3, 0.6, 0.35], 0.03)]

@@ -15,11 +15,11 @@ import om_redundant as om
 from benchmarks.control_rate import HOMES, MIN_CLEARANCE, obstacles
 from om_redundant import _core
 from om_redundant.redundancy import self_motion_tangent
-from om_redundant.redundancy.box_qp import Pieces, step_1d
-from om_redundant.redundancy.objective_terms import Evaluation, Group
-from om_redundant.redundancy.probe import Probe
+from om_redundant.redundancy.choice.box_qp import Pieces, step_1d
+from om_redundant.redundancy.choice.start_bounds import StartBounds
+from om_redundant.redundancy.objective.terms import Evaluation, Group
+from om_redundant.redundancy.paths.probe import Probe
 from om_redundant.redundancy.self_motion import self_motion_tangents
-from om_redundant.redundancy.start_bounds import StartBounds
 from tests.conftest import random_groups, steps_numpy
 from tests.reference import box_qp as box_qp_numpy
 from tests.reference import objective as objective_numpy

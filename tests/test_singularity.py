@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 
 import om_redundant as om
 from om_redundant.redundancy import Objective, self_motion_tangent
-from om_redundant.redundancy.objective_terms import SINGULARITY_CAP
+from om_redundant.redundancy.objective.terms import SINGULARITY_CAP
 
 ARMS = ("panda", "iiwa14", "gen3", "sawyer", "ur5e", "spherical")
 H = 1e-6  # finite-difference step (rad)

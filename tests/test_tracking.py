@@ -25,7 +25,7 @@ from benchmarks.control_rate import (
     obstacles,
     turned,
 )
-from om_redundant.redundancy.tracking import Tracker
+from om_redundant.redundancy.choice.tracking import Tracker
 from tests.conftest import in_threads, random_q
 
 TICKS = 200  # of a figure eight, one lap

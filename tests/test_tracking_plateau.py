@@ -12,7 +12,7 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
-from om_redundant.redundancy.choice import RedundancyChoice
+from om_redundant.redundancy.choice.result import RedundancyChoice
 
 PLATEAU = 1e-6  # objective values within this of each other are flat
 WINDOW = 41  # psi samples across the tracking window, checked against the choice

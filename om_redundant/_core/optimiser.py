@@ -13,7 +13,7 @@ if TYPE_CHECKING:
 
 class TrackingWork(NamedTuple):
     """What ``track_step`` reads of the optimiser, set up once per
-    :class:`~om_redundant.redundancy.tracking.Tracker`, and where it writes the new joints.
+    :class:`~om_redundant.redundancy.choice.tracking.Tracker`, and where it writes the new joints.
 
     Attributes:
         kernel: The compiled solver of the 7-DOF arm.
@@ -161,7 +161,7 @@ class GeomPose(NamedTuple):
 
 class ObjectiveTerms(NamedTuple):
     """The objective's terms, as ``evaluate`` reads them
-    (:class:`~om_redundant.redundancy.objective.Objective`).
+    (:class:`~om_redundant.redundancy.objective.objective.Objective`).
 
     Attributes:
         dof: The arm's joints.
@@ -190,7 +190,7 @@ class ObjectiveTerms(NamedTuple):
 
 class Evaluations(NamedTuple):
     """Where ``evaluate`` writes the objective at M joint vectors: (M,) each, the fields of
-    :class:`~om_redundant.redundancy.objective_terms.Evaluation`.
+    :class:`~om_redundant.redundancy.objective.terms.Evaluation`.
 
     Attributes:
         value, margin, clearance, slack, singularity: f, M, D, the slack and S.

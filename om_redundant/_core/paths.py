@@ -14,7 +14,7 @@ if TYPE_CHECKING:
 
 class FollowWork(NamedTuple):
     """The arrays ``follow`` reads and writes, set up once per
-    :class:`~om_redundant.redundancy.probe.Probe` (``link_paths`` reads the branch's: all but
+    :class:`~om_redundant.redundancy.paths.probe.Probe` (``link_paths`` reads the branch's: all but
     ``q`` and ``t``).
 
     Attributes:

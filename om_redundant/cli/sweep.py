@@ -22,7 +22,7 @@ import numpy as np
 from ..ik.configuration import Configuration
 from ..ik.solver import OMSolver
 from ..mujoco_io.loading import load_mujoco_model
-from ..redundancy.objective_terms import DEFAULT_SINGULARITY_WEIGHT
+from ..redundancy.objective.terms import DEFAULT_SINGULARITY_WEIGHT
 from ..redundancy.sweep import SHAPES, Obstacle, SweepRequest, compute_sweep
 from .common import (
     UsageError,

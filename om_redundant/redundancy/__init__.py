@@ -6,17 +6,17 @@
 shows (:mod:`.sweep`)."""
 
 from .arm_angle import arm_angle_and_gradient
-from .arm_geoms import MAX_EXTENT
-from .choice import RedundancyChoice
-from .clearance import Clearance
+from .choice.optimizer import RedundancyOptimizer
+from .choice.result import RedundancyChoice
 from .free_rotation import FreeRotation
-from .intervals import PsiInterval
-from .objective import Objective
-from .objective_terms import Evaluation, joint_margins
-from .optimizer import RedundancyOptimizer
+from .objective.arm_geoms import MAX_EXTENT
+from .objective.clearance import Clearance
+from .objective.objective import Objective
+from .objective.shapes import Box, Capsule, Sphere
+from .objective.singularity import Singularity
+from .objective.terms import Evaluation, joint_margins
+from .paths.intervals import PsiInterval
 from .self_motion import self_motion_tangent
-from .shapes import Box, Capsule, Sphere
-from .singularity import Singularity
 from .sweep import (
     BranchSweep,
     Choice,

@@ -19,11 +19,11 @@ import numpy as np
 
 from ..ik.configuration import Configuration
 from ..ik.solver import OMSolver
-from .choice import RedundancyChoice
-from .clearance import Clearance
-from .objective_terms import DEFAULT_SINGULARITY_WEIGHT, joint_margins
-from .optimizer import RedundancyOptimizer
-from .shapes import Box, Capsule, Shape, Sphere
+from .choice.optimizer import RedundancyOptimizer
+from .choice.result import RedundancyChoice
+from .objective.clearance import Clearance
+from .objective.shapes import Box, Capsule, Shape, Sphere
+from .objective.terms import DEFAULT_SINGULARITY_WEIGHT, joint_margins
 
 #: Obstacle shapes: the numbers each takes, in order (metres, in the arm's root frame).
 SHAPES = {

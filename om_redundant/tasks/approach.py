@@ -39,7 +39,7 @@ import mujoco
 import numpy as np
 
 from ..exceptions import InvalidInput, UnreachableTarget
-from ..redundancy.segment_clearance import ALONG_TOLERANCE
+from ..redundancy.objective.segment_clearance import ALONG_TOLERANCE
 from ..validation import as_vector
 
 #: An arm held short of its aim (farther than :data:`NEAR` rad) whose joints move less than

@@ -1,12 +1,12 @@
-"""The climb's QP in one variable in numpy (:mod:`om_redundant.redundancy.box_qp`): the oracle of
+"""The climb's QP in one variable in numpy (:mod:`om_redundant.redundancy.choice.box_qp`): the oracle of
 ``_core.maximise_1d`` and ``_core.step_1d`` (``csrc/box_qp.c``, the same operations in loops)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from om_redundant.redundancy.box_qp import Pieces
-from om_redundant.redundancy.objective_terms import Group
+from om_redundant.redundancy.choice.box_qp import Pieces
+from om_redundant.redundancy.objective.terms import Group
 
 _TIE = 1e-12  # pieces within this of their group's minimum meet there
 
@@ -42,7 +42,7 @@ def groups_of(pieces: Pieces) -> list[Group]:
 def step_1d(
     pieces: Pieces, curvature: float, lower: float, upper: float
 ) -> tuple[float, float, np.ndarray] | None:
-    """:func:`om_redundant.redundancy.box_qp.step_1d`: the pieces that can be their group's
+    """:func:`om_redundant.redundancy.choice.box_qp.step_1d`: the pieces that can be their group's
     minimum somewhere in the box maximised as by :func:`maximise_1d`, the model's gain, every
     piece's multiplier (0 for those left out); None when the floors leave no delta."""
     reach = max(-lower, upper)
@@ -63,7 +63,7 @@ def step_1d(
 def maximise_1d(
     groups: list[Group], curvature: float, lower: float, upper: float
 ) -> tuple[float, list[np.ndarray]] | None:
-    """The maximiser delta of phi (:mod:`om_redundant.redundancy.box_qp`) and each group's
+    """The maximiser delta of phi (:mod:`om_redundant.redundancy.choice.box_qp`) and each group's
     multipliers, or None when the floors leave no delta.
 
     Args:
@@ -122,7 +122,7 @@ def _least_rate(group: Group, v: np.ndarray, a: np.ndarray, at: np.ndarray) -> n
 def _multipliers(
     groups: list[Group], v: list[np.ndarray], a: list[np.ndarray], curvature: float, delta: float
 ) -> list[np.ndarray]:
-    """Each piece's multiplier at delta (:mod:`om_redundant.redundancy.box_qp`)."""
+    """Each piece's multiplier at delta (:mod:`om_redundant.redundancy.choice.box_qp`)."""
     multipliers = [np.zeros(len(vg)) for vg in v]
     kinks, balance = [], curvature * delta
     for g, vg, ag, z in zip(groups, v, a, multipliers, strict=True):

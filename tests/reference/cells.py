@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from om_redundant.redundancy.paths import _BOUND_SLACK, _HERMITE, FINE_STEP
+from om_redundant.redundancy.paths.linking import _BOUND_SLACK, _HERMITE, FINE_STEP
 from tests.conftest import steps_numpy
 
 

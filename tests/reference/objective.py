@@ -1,9 +1,9 @@
-"""The objective's terms from its groups (:class:`~om_redundant.redundancy.objective.Group`): the
+"""The objective's terms from its groups (:class:`~om_redundant.redundancy.objective.objective.Group`): the
 oracle of ``_core.evaluate`` (``csrc/objective.c``), which computes f and the slack at once."""
 
 from __future__ import annotations
 
-from om_redundant.redundancy.objective_terms import Group
+from om_redundant.redundancy.objective.terms import Group
 
 
 def term(group: Group) -> float:

@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 
-from om_redundant.redundancy.start_bounds import StartBounds
+from om_redundant.redundancy.choice.start_bounds import StartBounds
 
 
 def bound(bounds: StartBounds, values: np.ndarray) -> np.ndarray:

@@ -9,19 +9,19 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..exceptions import SingularSelfMotion
-from ..ik.configuration import Configuration
-from ..ik.solver import OMSolver
-from .arm_angle import wrap_psi
-from .choice import RedundancyChoice, failed_choice
+from ...exceptions import SingularSelfMotion
+from ...ik.configuration import Configuration
+from ...ik.solver import OMSolver
+from ..arm_angle import wrap_psi
+from ..free_rotation import FreeRotation
+from ..objective.objective import Objective
+from ..paths.intervals import BranchRuns, PsiInterval, Run, feasible_runs
+from ..paths.linking import sweep_circle
+from ..paths.points import Point
+from ..paths.probe import Probe
 from .climb import maximise
-from .free_rotation import FreeRotation
-from .intervals import BranchRuns, PsiInterval, Run, feasible_runs
-from .objective import Objective
-from .paths import sweep_circle
-from .points import Point
-from .probe import Probe
 from .reachable import Way, candidates, clear_way
+from .result import RedundancyChoice, failed_choice
 from .start_bounds import CLIMB_ROUNDING, StartBounds
 
 
@@ -84,7 +84,7 @@ class GlobalChoice:
         signs: tuple[int, ...] | None,
         free: FreeRotation | None,
     ) -> RedundancyChoice:
-        """The fresh choice from the arm's joints (:mod:`~om_redundant.redundancy.reachable`;
+        """The fresh choice from the arm's joints (:mod:`~om_redundant.redundancy.choice.reachable`;
         without them, the best scored): branch ``signs`` first (None: every allowed branch at
         once); with a free rotation, over the turns it starts from. An arm whose branches share
         their grid search in one batch (shoulder offsets: the torus) sweeps them all at once."""

@@ -8,9 +8,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..ik.configuration import Configuration
-from ..ik.solver import Solution
-from .intervals import PsiInterval
+from ...ik.configuration import Configuration
+from ...ik.solver import Solution
+from ..paths.intervals import PsiInterval
 
 
 @dataclass(frozen=True, eq=False)
@@ -27,11 +27,11 @@ class RedundancyChoice:
         intervals: The feasible intervals searched: every allowed branch's, or, chosen
             afresh from the arm's joints, those of the branches swept (the previous one
             first); empty from the one-call tracking step
-            (:mod:`~om_redundant.redundancy.tracking`), which searches none.
+            (:mod:`~om_redundant.redundancy.choice.tracking`), which searches none.
         reason: Why nothing is feasible, or why tracking chose afresh; "" otherwise.
         branch_flipped: The choice left the previous choice's branch.
         curvature: The curvature (per rad^2) of the objective along psi that the next
-            tracking step's model takes (:mod:`~om_redundant.redundancy.tracking`); nan:
+            tracking step's model takes (:mod:`~om_redundant.redundancy.choice.tracking`); nan:
             its initial value.
         rechosen: Tracking could not continue from the previous choice, and this choice
             was made afresh from the arm's joints (``reason`` says why).

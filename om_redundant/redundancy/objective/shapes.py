@@ -12,8 +12,8 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from ..exceptions import InvalidInput
-from ..validation import as_instance, as_pose, as_positive, as_vector
+from ...exceptions import InvalidInput
+from ...validation import as_instance, as_pose, as_positive, as_vector
 
 _PRIMITIVES = {
     mujoco.mjtGeom.mjGEOM_PLANE,

@@ -1,5 +1,5 @@
 r"""Exact solutions along one branch of a 7-DOF arm at one pose: the points of its solution
-paths (:mod:`om_redundant.redundancy.paths`), and how a path is followed along psi.
+paths (:mod:`om_redundant.redundancy.paths.linking`), and how a path is followed along psi.
 
 **Following.** From a solution, the next one is the solution nearest it (``q_hint``),
 accepted when it continues the path (:meth:`Probe.continues`: no joint moves more than
@@ -16,7 +16,7 @@ prediction moves a joint farther than any root as near as the local one could co
 fails without it, as it would with it); Python builds only the point reached. The linking of
 a branch's grid roots into paths runs in one call too (:meth:`Probe.link`,
 ``_core.link_paths``, ``csrc/link.c``: those follows and the decisions of
-:func:`~om_redundant.redundancy.paths._link`'s loop).
+:func:`~om_redundant.redundancy.paths.linking._link`'s loop).
 """
 
 from __future__ import annotations
@@ -26,13 +26,13 @@ import math
 
 import numpy as np
 
-from .. import _core
-from ..exceptions import SingularSelfMotion
-from ..ik.configuration import Configuration
-from ..ik.solver import BRANCH_BAND, OMSolver, Solution
-from .objective import Objective
+from ... import _core
+from ...exceptions import SingularSelfMotion
+from ...ik.configuration import Configuration
+from ...ik.solver import BRANCH_BAND, OMSolver, Solution
+from ..objective.objective import Objective
+from ..self_motion import self_motion_tangent, self_motion_tangents
 from .points import Point, PointTerms, evaluated_terms
-from .self_motion import self_motion_tangent, self_motion_tangents
 
 #: rad, max-norm: the largest joint step between neighbouring solutions of one path (csrc/om_paths.h's).
 JUMP = _core.PATH_JUMP
@@ -258,7 +258,7 @@ class Probe:
 
     def link(self, psi: np.ndarray, roots: list[list[Point]]) -> list[tuple[list[Point], int]] | None:
         """The paths through the solutions ``roots[k]`` at the increasing grid psi[k] (within a
-        turn) that :func:`~om_redundant.redundancy.paths._link`'s loop finds, in one
+        turn) that :func:`~om_redundant.redundancy.paths.linking._link`'s loop finds, in one
         ``_core.link_paths`` call (``csrc/link.c``: the same follows, in the same order, and
         the same decisions): each path's points and turns. Python builds only the points that
         following added. None where the solver is not a 7-DOF arm's compiled one or where a

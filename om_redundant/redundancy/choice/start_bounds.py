@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import _core
+from ... import _core
 
 #: A start whose bound is within this of the best found is not climbed (it can at most tie).
 CLIMB_ROUNDING = 1e-12
@@ -19,7 +19,7 @@ class StartBounds:
 
     Args:
         psi, f: (M,) the runs' samples, a run's in increasing psi, and f there.
-        terms: :meth:`~om_redundant.redundancy.objective.Objective.term_functions` at them.
+        terms: :meth:`~om_redundant.redundancy.objective.objective.Objective.term_functions` at them.
         first, last: (M,) each sample's run's first and last sample.
         slope, slopes: L of f and of each group's functions (p_g,); None: sampled, the
             largest slope between neighbouring samples of a run (module docstring).

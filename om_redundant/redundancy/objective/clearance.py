@@ -7,7 +7,7 @@ geoms and the obstacle geoms,
 
 over the pairs k of (arm geom :math:`A_k`, obstacle geom :math:`O_k`), negative when the
 geoms overlap, capped at ``distmax``. The arm geoms are placed by the arm's DH chain
-(:mod:`~om_redundant.redundancy.arm_geoms`: each at its offset in its link, checked against
+(:mod:`~om_redundant.redundancy.objective.arm_geoms`: each at its offset in its link, checked against
 MuJoCo's ``mj_kinematics`` at set-up). One compiled call (``_core.arm_clearance``,
 ``csrc/clearance.c``) places the geoms for every row of a batch of joint vectors and computes
 the pairs of a sphere or capsule arm geom and a sphere, capsule or box obstacle exactly
@@ -37,7 +37,7 @@ base. :class:`~om_redundant.ExactPoseTask` does this every tick from its
 
 **Along a motion.** :meth:`Clearance.minimum_along` bounds the clearance along a straight
 joint-space segment from below: every pair's distance changes by at most
-:math:`\sum_j r_j |\Delta q_j|` (:func:`~om_redundant.redundancy.arm_geoms.lever_arms`), so
+:math:`\sum_j r_j |\Delta q_j|` (:func:`~om_redundant.redundancy.objective.arm_geoms.lever_arms`), so
 two ends' distances certify the segment between them, split where they do not.
 
 Obstacles come three ways: simple shapes (:class:`Sphere`, :class:`Capsule`, :class:`Box`)
@@ -58,12 +58,12 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from .. import _core
-from ..exceptions import InvalidInput
-from ..kinematics.arm import Arm
-from ..mujoco_io.arm_in_model import ArmJoints
-from ..mujoco_io.mjcf import arm_mjcf
-from ..validation import as_count, as_instance, as_joint_vector, as_number, as_positive
+from ... import _core
+from ...exceptions import InvalidInput
+from ...kinematics.arm import Arm
+from ...mujoco_io.arm_in_model import ArmJoints
+from ...mujoco_io.mjcf import arm_mjcf
+from ...validation import as_count, as_instance, as_joint_vector, as_number, as_positive
 from .arm_geoms import (
     arm_cores,
     as_row,
@@ -233,7 +233,7 @@ class Clearance:
             near: Where a pair of a row is nearer than this (m), only the gradients of the
                 pairs nearer than it, the others zero (the objective reads no more:
                 :attr:`Objective.clearance_reach
-                <om_redundant.redundancy.objective.Objective.clearance_reach>`); all by default.
+                <om_redundant.redundancy.objective.objective.Objective.clearance_reach>`); all by default.
         """
         return self._evaluate(q, self.distmax, gradient=True, near=near)
 

@@ -6,7 +6,7 @@ From the previous choice (branch signs, psi, joints q'), :func:`_core.track_step
 1. the exact solution :math:`q_0` at the previous psi, hinted by :math:`q'`;
 2. the self-motion tangent :math:`t = dq/d\psi = n / (D\psi(q_0)\,n)`, n the null vector of
    the Jacobian by cofactors, :math:`n_i = (-1)^i \det J_{-i}` (no factorisation);
-3. every piece :math:`v_j` of the objective (:mod:`om_redundant.redundancy.objective`) at
+3. every piece :math:`v_j` of the objective (:mod:`om_redundant.redundancy.objective.objective`) at
    :math:`q_0` and its rate :math:`a_j = \nabla v_j \cdot t` -- the margins and the
    singularity distances exactly, the clearances linearised about the joints where they were
    last evaluated, :math:`d_k + \nabla d_k \cdot (q_0 - q_{ref})`;
@@ -34,7 +34,7 @@ as the next step's linearisation, :meth:`~om_redundant.Clearance.distances_withi
 result is a :class:`~om_redundant.RedundancyChoice`. A step that cannot be taken (no exact
 solution continues the previous joints, a fold of the self-motion, nothing feasible within
 the step, the result infeasible) answers why, in words: the optimiser then chooses afresh
-from the arm's joints (:mod:`~om_redundant.redundancy.reachable`). Repeated at one pose the
+from the arm's joints (:mod:`~om_redundant.redundancy.choice.reachable`). Repeated at one pose the
 steps converge to a local optimum of the objective on the branch (a Newton-like iteration on
 the crossing of the active pieces).
 """
@@ -47,12 +47,12 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .. import _core
-from ..ik.configuration import Configuration
-from ..ik.solver import OMSolver, Solution
-from .arm_angle import wrap_psi
-from .objective import Objective
-from .objective_terms import SINGULARITY_CAP
+from ... import _core
+from ...ik.configuration import Configuration
+from ...ik.solver import OMSolver, Solution
+from ..arm_angle import wrap_psi
+from ..objective.objective import Objective
+from ..objective.terms import SINGULARITY_CAP
 
 #: Curvature b of the first tracking step's model (per rad^2), and its largest (csrc/tracking.c).
 INITIAL_CURVATURE, MAX_CURVATURE = 0.1, 1e3

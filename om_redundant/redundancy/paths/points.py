@@ -9,9 +9,9 @@ from typing import Any
 
 import numpy as np
 
-from ..ik.solver import Solution
-from .objective import Objective
-from .objective_terms import Evaluation, Group
+from ...ik.solver import Solution
+from ..objective.objective import Objective
+from ..objective.terms import Evaluation, Group
 
 
 class PointTerms:
@@ -138,5 +138,5 @@ class Point:
 
     def pieces(self) -> tuple[np.ndarray, np.ndarray]:
         """The feasibility functions g_j (all >= 0 iff feasible; see
-        :meth:`~om_redundant.redundancy.objective_terms.Group.constraints`) and dg_j/dpsi."""
+        :meth:`~om_redundant.redundancy.objective.terms.Group.constraints`) and dg_j/dpsi."""
         return self.terms.get_pieces()

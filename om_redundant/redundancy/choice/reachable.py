@@ -2,7 +2,7 @@ r"""Choices reachable from where the arm is: joint travel, and clearance along t
 
 When the optimiser chooses from the arm's current joints :math:`q_0` (a fresh choice in a
 mink loop, or a re-choice where tracking cannot continue), each feasible sample of the
-sweep (:mod:`~om_redundant.redundancy.intervals`) is a candidate. A revolute joint is taken
+sweep (:mod:`~om_redundant.redundancy.paths.intervals`) is a candidate. A revolute joint is taken
 at the turn nearest :math:`q_0` that stays within its limits (an unlimited joint goes the
 short way round), and the candidate scores
 
@@ -28,12 +28,12 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..kinematics.arm import Arm
-from .intervals import Run
-from .objective import Objective
-from .objective_terms import Evaluation
-from .points import Point
-from .segment_clearance import ALONG_TOLERANCE
+from ...kinematics.arm import Arm
+from ..objective.objective import Objective
+from ..objective.segment_clearance import ALONG_TOLERANCE
+from ..objective.terms import Evaluation
+from ..paths.intervals import Run
+from ..paths.points import Point
 
 #: w_t: objective given up per radian of joint travel (default).
 DEFAULT_TRAVEL_WEIGHT = 0.25
@@ -126,7 +126,8 @@ def candidates(
 
 def way_floor(objective: Objective, q_from: np.ndarray) -> float:
     r"""What a clear way from q_from keeps: :math:`\min(d_{min} + m, D(q_0))` less
-    :data:`~om_redundant.redundancy.segment_clearance.ALONG_TOLERANCE`, m = :data:`WAY_MARGIN` for the
+    :data:`~om_redundant.redundancy.objective.segment_clearance.ALONG_TOLERANCE`, m =
+    :data:`WAY_MARGIN` for the
     arm's deviation from the straight way (-inf without obstacles)."""
     if objective.clearance is None:
         return -math.inf

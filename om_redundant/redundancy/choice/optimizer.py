@@ -2,14 +2,15 @@ r"""The redundancy optimiser: a QP picks the arm angle for joint-limit margin, c
 distance from singularities.
 
 For a pose T, :meth:`RedundancyOptimizer.choose` returns the configuration
-c = (signs, psi) that maximises the objective f of :mod:`om_redundant.redundancy.objective` (weighted
+c = (signs, psi) that maximises the objective f of
+:mod:`om_redundant.redundancy.objective.objective` (weighted
 normalised joint-limit margin, capped obstacle clearance and capped distance from the
 model's singularities) over the feasible set (within the limits, clearance >= d_min), and
 the exact OM solution in it:
 
 1. **Sweep.** Every allowed branch's exact solutions are sampled on a psi grid and linked
-   into solution paths (:mod:`om_redundant.redundancy.paths`), which are cut into feasible intervals
-   with refined ends (:mod:`om_redundant.redundancy.intervals`).
+   into solution paths (:mod:`om_redundant.redundancy.paths.linking`), which are cut into feasible intervals
+   with refined ends (:mod:`om_redundant.redundancy.paths.intervals`).
 2. **Starts.** In each interval, the samples that are local maxima of f. A climb from a
    start is taken to end within R, twice the start's distance to its farther neighbour, and
    each function to change at most by L, its largest slope between neighbouring samples
@@ -19,7 +20,7 @@ the exact OM solution in it:
    ``u_0 + L R``). A start can only lead above the larger side's smaller of that bound of f
    and ``sum_g w_g min(cap_g, min_j bound_j)``, the second with each function v_j of each
    group (a joint's margin, a pair's distance, a singularity distance;
-   :meth:`~om_redundant.redundancy.objective.Objective.term_functions`) bounded by its own
+   :meth:`~om_redundant.redundancy.objective.objective.Objective.term_functions`) bounded by its own
    slope: where what binds every term does not move with the self-motion (the elbow of an
    S-R-S arm binding the margin, the hand nearest an obstacle, or a term at its cap), f
    cannot rise above its start value.
@@ -27,15 +28,15 @@ the exact OM solution in it:
    more than :data:`PLATEAU` when tracking; not above it by :data:`~.start_bounds.CLIMB_ROUNDING`
    otherwise, a climb that could at most tie) are skipped. This is what finds the global
    optimum rather than the nearest local one.
-3. **Climb** from each start (:func:`~om_redundant.redundancy.climb.maximise`): a trust-region SQP
+3. **Climb** from each start (:func:`~om_redundant.redundancy.choice.climb.maximise`): a trust-region SQP
    whose QP, solved exactly, linearises margins and clearances around the current exact
    solution, within the interval. The result is the best point's own exact solve.
 
 **Tracking** (``choose(T, previous)``): the one-call tracking step of
-:mod:`~om_redundant.redundancy.tracking` (an exact solve at the previous psi, the 1-variable
+:mod:`~om_redundant.redundancy.choice.tracking` (an exact solve at the previous psi, the 1-variable
 box QP along the self-motion, an exact solve at the new psi). Where it cannot step or lands
 on an infeasible point, the optimiser **chooses afresh from the arm's joints** ``q_current``
-(:mod:`~om_redundant.redundancy.reachable`): the previous branch's feasible samples first,
+(:mod:`~om_redundant.redundancy.choice.reachable`): the previous branch's feasible samples first,
 scored by f less the joint travel from ``q_current``, the first with a clear way winning;
 the other branches only if the previous one has no feasible sample with a clear way. The
 result says so (``rechosen``, ``branch_flipped``, ``reason``). It is not ok only when no
@@ -56,24 +57,24 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from ..exceptions import InvalidInput
-from ..ik.solver import OMSolver
-from ..validation import as_count, as_instance, as_joint_vector, as_number, as_pose, as_signs
-from .choice import RedundancyChoice
-from .clearance import DEFAULT_DISTMAX, Clearance
-from .free_rotation import FreeRotation
-from .global_choice import GlobalChoice
-from .intervals import PsiInterval
-from .objective import Objective
-from .objective_terms import (
+from ...exceptions import InvalidInput
+from ...ik.solver import OMSolver
+from ...validation import as_count, as_instance, as_joint_vector, as_number, as_pose, as_signs
+from ..free_rotation import FreeRotation
+from ..objective.clearance import DEFAULT_DISTMAX, Clearance
+from ..objective.objective import Objective
+from ..objective.shapes import Shape
+from ..objective.singularity import Singularity
+from ..objective.terms import (
     DEFAULT_CLEARANCE_WEIGHT,
     DEFAULT_MARGIN_WEIGHT,
     DEFAULT_SINGULARITY_WEIGHT,
     check_weights,
 )
+from ..paths.intervals import PsiInterval
+from .global_choice import GlobalChoice
 from .reachable import DEFAULT_TRAVEL_WEIGHT
-from .shapes import Shape
-from .singularity import Singularity
+from .result import RedundancyChoice
 from .tracking import MAX_CURVATURE, Tracked, Tracker
 
 #: Tracking with a free rotation: a turn is taken where it gains more than this.
@@ -96,13 +97,13 @@ class RedundancyOptimizer(GlobalChoice):
             MuJoCo model of obstacles, in the arm's root frame (combined with the project's
             MJCF of the arm); or a :class:`~om_redundant.Clearance` (e.g. of your own model).
         margin_weight, clearance_weight, singularity_weight, clearance_cap, min_clearance: The
-            objective (:class:`~om_redundant.redundancy.objective.Objective`; the singularity
+            objective (:class:`~om_redundant.redundancy.objective.objective.Objective`; the singularity
             term is the model's, ``Singularity.of(solver.model_arm)``).
         branches: Allowed branch signs, e.g. ``[(1, -1, 1)]``; default all.
         grid_points: psi samples per branch of the sweep, a whole number from 16 to 100,000.
         max_step: Largest psi change (rad) per tracking call, in (0, pi].
         travel_weight: w_t >= 0, the objective given up per radian of joint travel when
-            choosing from the arm's joints (:mod:`~om_redundant.redundancy.reachable`).
+            choosing from the arm's joints (:mod:`~om_redundant.redundancy.choice.reachable`).
 
     Raises:
         InvalidInput: An argument of the wrong type or out of range (named); numbers must be

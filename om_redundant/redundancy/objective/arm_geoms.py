@@ -14,9 +14,9 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from .. import _core
-from ..exceptions import InvalidInput, ModelMismatch
-from ..mujoco_io.arm_in_model import MATCH_TOLERANCE, ArmJoints
+from ... import _core
+from ...exceptions import InvalidInput, ModelMismatch
+from ...mujoco_io.arm_in_model import MATCH_TOLERANCE, ArmJoints
 
 #: ArmCores.kind: the cores that _core.arm_clearance computes (csrc/redundancy.h).
 POINT, SEGMENT, BOX = _core.CORE_POINT, _core.CORE_SEGMENT, _core.CORE_BOX

@@ -1,4 +1,4 @@
-r"""The climb's QP (:mod:`om_redundant.redundancy.climb`) in one redundancy variable, solved exactly.
+r"""The climb's QP (:mod:`om_redundant.redundancy.choice.climb`) in one redundancy variable, solved exactly.
 
 With one variable the epigraph QP is the maximisation of the concave, piecewise quadratic
 
@@ -23,8 +23,8 @@ import itertools
 
 import numpy as np
 
-from .. import _core
-from .objective_terms import Group
+from ... import _core
+from ..objective.terms import Group
 
 
 class Pieces(_core.Pieces):

@@ -28,10 +28,10 @@ from functools import cached_property
 
 import numpy as np
 
-from .. import _core
-from ..ik.families import RRR_SPHERICAL_WRIST, SRS
-from ..ik.model import ModelArm
-from ..validation import as_instance, as_joint_vector
+from ... import _core
+from ...ik.families import RRR_SPHERICAL_WRIST, SRS
+from ...ik.model import ModelArm
+from ...validation import as_instance, as_joint_vector
 
 
 @dataclass(frozen=True)

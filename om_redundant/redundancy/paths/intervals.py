@@ -2,14 +2,14 @@ r"""Feasible intervals of the arm angle psi: where a branch's exact solution exi
 within the joint limits and keeps the required clearance.
 
 A **feasible interval** is a maximal psi interval over which one solution path
-(:mod:`om_redundant.redundancy.paths`) is exact, within the limits and clear: a run of feasible
+(:mod:`om_redundant.redundancy.paths.linking`) is exact, within the limits and clear: a run of feasible
 neighbouring samples of the path, extended at each end to the boundary. Where the path's
 next sample is infeasible, the boundary is the root of the continuous feasibility slack
-(:class:`~om_redundant.redundancy.objective_terms.Evaluation`) along the path between the two
+(:class:`~om_redundant.redundancy.objective.terms.Evaluation`) along the path between the two
 (:func:`_refined`: from the root of the cubic models of the cell, Newton steps on the
 rates the trials carry, the Illinois method where those leave the bracket; every end of the
 sweep at once); where the path itself ends, its end; both to
-:data:`~om_redundant.redundancy.probe.END_TOLERANCE`.
+:data:`~om_redundant.redundancy.paths.probe.END_TOLERANCE`.
 
 So a psi can lie in two intervals of one branch (two solution paths), and a solution that
 no path reaches (a path shorter than the sweep's grid step that meets no other) is not
@@ -24,9 +24,9 @@ from collections.abc import Generator, Sequence
 from dataclasses import dataclass
 from typing import NamedTuple
 
-from .. import _core
-from .arm_angle import wrap_psi
-from .paths import _HERMITE, Follow, Path, lockstep
+from ... import _core
+from ..arm_angle import wrap_psi
+from .linking import _HERMITE, Follow, Path, lockstep
 from .points import Point
 from .probe import END_TOLERANCE, Probe
 
@@ -81,7 +81,7 @@ class Run:
 
 def feasible_runs(paths: Sequence[tuple[Probe, Path]]) -> list[list[Run]]:
     """The feasible intervals along each (probe, path), with their ends refined: every end
-    of every path at once (:func:`~om_redundant.redundancy.paths.lockstep`)."""
+    of every path at once (:func:`~om_redundant.redundancy.paths.linking.lockstep`)."""
     spans = [[(probe, span) for span in _spans(path)] for probe, path in paths]
     ends = [
         _refined(probe, inside, outside)
@@ -183,18 +183,18 @@ def _run(probe: Probe, span: _Span, lo: Point | None, hi: Point | None) -> Run:
 
 def _refined(probe: Probe, inside: Point, outside: Point) -> Generator[Follow, tuple[Point, bool], Point]:
     r"""The last feasible point between a feasible ``inside`` and an infeasible ``outside``,
-    neighbours on one path: a process of :func:`~om_redundant.redundancy.paths.lockstep`,
+    neighbours on one path: a process of :func:`~om_redundant.redundancy.paths.linking.lockstep`,
     which asks for each trial's follow.
 
     The feasibility slack s (the smallest feasibility function g_j) changes sign between
     them. Each trial is followed from the inner end of the bracket
-    (:meth:`~om_redundant.redundancy.probe.Probe.follow`) and replaces the end on its side.
+    (:meth:`~om_redundant.redundancy.paths.probe.Probe.follow`) and replaces the end on its side.
     The trials: first where the cubic Hermite models of the g_j (:func:`_modelled_end`)
     first reach zero; then Newton steps on the g_j binding at the last trial, aimed at
     :math:`s = \frac12` :data:`SLACK_TOLERANCE` with the rate dg_j/dpsi the trial carries,
     so that they end on the feasible side; where such a step leaves the bracket, the
     Illinois method (regula falsi that halves the slack kept at a stale end). It stops when
-    the bracket is narrower than :data:`~om_redundant.redundancy.probe.END_TOLERANCE` or the
+    the bracket is narrower than :data:`~om_redundant.redundancy.paths.probe.END_TOLERANCE` or the
     inner slack below :data:`SLACK_TOLERANCE`.
 
     **Path ends.** ``inside`` can be where its path ends (a run that is its path's first or

@@ -9,7 +9,7 @@ import threading
 import mujoco
 import numpy as np
 
-from .. import _core
+from ... import _core
 from .arm_geoms import BOX, POINT, SEGMENT, ArmCores
 
 

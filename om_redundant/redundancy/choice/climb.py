@@ -1,7 +1,7 @@
 r"""The climb: a trust-region SQP that maximises the objective over the arm angle.
 
 From a feasible exact solution q(psi) on a branch, every piece v_j of every group g of the
-objective (:mod:`om_redundant.redundancy.objective`) is linearised through the self-motion tangent
+objective (:mod:`om_redundant.redundancy.objective.objective`) is linearised through the self-motion tangent
 dq/dpsi (:func:`self_motion_tangent`), :math:`v_j(\psi + \delta) \approx v_j + a_j\delta`,
 and the QP
 
@@ -12,7 +12,7 @@ and the QP
 
 (the epigraph form of the max-min objective; the floors keep the linearised margins >= 0
 and clearances >= d_min) is solved exactly in its one variable
-(:func:`~om_redundant.redundancy.box_qp.step_1d`, ``csrc/box_qp.c``). b is a damped BFGS
+(:func:`~om_redundant.redundancy.choice.box_qp.step_1d`, ``csrc/box_qp.c``). b is a damped BFGS
 estimate of the curvature of the Lagrangian, from the QP's multipliers z_j:
 :math:`s = \delta`, :math:`y = -\sum_j z_j (a_j^{new} - a_j^{old})`. The step is solved
 exactly (the current q as hint); it is accepted when the exact point is feasible and gains
@@ -29,9 +29,9 @@ import math
 
 import numpy as np
 
+from ..paths.points import Point
+from ..paths.probe import Probe
 from .box_qp import Pieces, step_1d
-from .points import Point
-from .probe import Probe
 
 STEP_TOLERANCE = 1e-9  # rad: the climb stops when the step is this small
 GAIN_TOLERANCE = 1e-12  # the climb stops when the model promises no more
@@ -47,7 +47,7 @@ def maximise(probe: Probe, start: Point, lower: float, upper: float, radius: flo
     The trust radius Delta is also kept below ``_JOINT_STEP / max_i |dq_i/dpsi|``, so that no
     step moves a joint by more than 0.25 rad to first order (near a fold of the solution path
     dq/dpsi is large and the linearisation holds only briefly). The pieces of a point are
-    concatenated once (:class:`~om_redundant.redundancy.box_qp.Pieces`).
+    concatenated once (:class:`~om_redundant.redundancy.choice.box_qp.Pieces`).
 
     Args:
         probe: Exact solutions on the branch at the pose.

@@ -39,7 +39,7 @@ from typing import Any
 
 import numpy as np
 
-from .. import _core
+from ... import _core
 from .points import Point, evaluate_points
 from .probe import END_TOLERANCE, SAME, Probe
 
@@ -139,7 +139,7 @@ def lockstep(processes: list[Generator[Follow, tuple[Point, bool], Any]]) -> lis
     """Run processes that each follow their paths one step after another (the refinement
     of an interval's end, the look inside a cell), all at once: each round follows every
     process's request (:data:`Follow`), evaluates the objective at all the points reached
-    in one batch (:func:`~om_redundant.redundancy.points.evaluate_points`) and sends each
+    in one batch (:func:`~om_redundant.redundancy.paths.points.evaluate_points`) and sends each
     process its answer, ``probe.follow``'s (point reached, arrived). Each process makes the
     same follows as it would alone; the objective is evaluated in batches instead of point
     by point. The processes' probes share one objective.

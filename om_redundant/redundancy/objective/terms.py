@@ -1,6 +1,6 @@
 r"""The objective's parts: its weights and caps, the joint-limit margins, a term's group of
 pieces and the evaluation of all terms at a joint vector (:class:`Objective
-<om_redundant.redundancy.objective.Objective>` combines them)."""
+<om_redundant.redundancy.objective.objective.Objective>` combines them)."""
 
 from __future__ import annotations
 
@@ -11,9 +11,9 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from ..exceptions import InvalidInput
-from ..kinematics.arm import Arm
-from ..validation import as_instance, as_joint_vector, as_number
+from ...exceptions import InvalidInput
+from ...kinematics.arm import Arm
+from ...validation import as_instance, as_joint_vector, as_number
 
 #: s_cap: a singularity distance |sin x| beyond this (30 degrees) earns nothing more.
 SINGULARITY_CAP = 0.5

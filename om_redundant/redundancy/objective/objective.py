@@ -8,15 +8,15 @@ Joint-limit margin of joint i (limited joints only), normalised by half its rang
 
 1 at mid-range, 0 on a limit, negative beyond it; :math:`M(q) = \min_i m_i(q)`. (The
 optimiser takes each revolute joint at its turn nearest mid-range, which has the most
-margin; :mod:`om_redundant.redundancy.paths`.) Each
+margin; :mod:`om_redundant.redundancy.paths.linking`.) Each
 :math:`m_i` is the minimum of two functions affine in q, :math:`(q_i - l_i)/h_i` and
 :math:`(u_i - q_i)/h_i`, so M is the minimum of ``2 * limited`` affine pieces.
 
-Clearance :math:`D(q) = \min_k d_k(q)` (:mod:`om_redundant.redundancy.clearance`), capped at
+Clearance :math:`D(q) = \min_k d_k(q)` (:mod:`om_redundant.redundancy.objective.clearance`), capped at
 :math:`d_{cap}` and normalised by it.
 
 Singularity distance :math:`S(q) = \min_k s_k(q)`, :math:`s_k = |\sin x_k|` for the model's
-wrist, elbow and shoulder angles :math:`x_k` (:mod:`om_redundant.redundancy.singularity`),
+wrist, elbow and shoulder angles :math:`x_k` (:mod:`om_redundant.redundancy.objective.singularity`),
 capped at :data:`SINGULARITY_CAP` :math:`= s_{cap}` and normalised by it.
 
 The objective, maximised over the redundancy variables, with weights :math:`w_m, w_c, w_s \ge 0`:
@@ -35,7 +35,7 @@ less margin and clearance than it gains, and beyond 30 degrees from every singul
 Each term is a *group*: a weight w, a floor (the feasibility bound: 0 for M,
 :math:`d_{min}/d_{cap}` for the clearance, none for S), a cap (none for M, 1 for the
 clearance and S), and pieces :math:`v_j(q)` whose minimum it takes. The QP linearises every piece
-(:func:`~om_redundant.redundancy.climb.maximise`).
+(:func:`~om_redundant.redundancy.choice.climb.maximise`).
 """
 
 from __future__ import annotations
@@ -46,12 +46,13 @@ from typing import Any
 
 import numpy as np
 
-from .. import _core
-from ..exceptions import InvalidInput
-from ..kinematics.arm import Arm
-from ..validation import as_instance, as_joint_vector
+from ... import _core
+from ...exceptions import InvalidInput
+from ...kinematics.arm import Arm
+from ...validation import as_instance, as_joint_vector
 from .clearance import Clearance
-from .objective_terms import (
+from .singularity import Singularity
+from .terms import (
     DEFAULT_CLEARANCE_WEIGHT,
     DEFAULT_MARGIN_WEIGHT,
     DEFAULT_SINGULARITY_WEIGHT,
@@ -62,7 +63,6 @@ from .objective_terms import (
     evaluation_of_row,
     limit_distances,
 )
-from .singularity import Singularity
 
 
 class Objective:
