@@ -6,11 +6,7 @@
 #define OM_REDUNDANCY_H
 
 #include "om_kernels.h"
-
-/* self_motion.c and paths (also declared in binding.h, where their glue's users read them). */
-bool om_self_motion_tangent(const om_solver_data *s, const double *q, double *t, double tol);
-bool om_continues(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic);
-bool om_beyond_doubt(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic);
+#include "om_paths.h" /* the self-motion's tangent and the paths' continuation tests */
 
 /* ------------------------------------------------------------------------------------ */
 /* box_qp.c: maximise phi(delta) = sum_g w_g min(cap_g, min_{j in g} v_j + a_j delta) - b delta^2 / 2
