@@ -377,7 +377,7 @@ def test_the_clearance_along_a_way_is_bounded_from_below(panda, seed, floor):
     if along >= floor:
         assert dense >= along - 1e-12  # certified: no point of the segment is nearer
     else:
-        assert dense < floor + om.redundancy.segment_clearance.ALONG_TOLERANCE + spacing / 2
+        assert dense < floor + om.redundancy.objective.segment_clearance.ALONG_TOLERANCE + spacing / 2
     # with a budget of samples: the same answer where it suffices, else undecided (NaN) and
     # only where the unbounded check needed more; never a wrong "clear"
     for budget in (0, 1, 8, 64):

@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 import om_redundant as om
 from benchmarks.control_rate import MIN_CLEARANCE, obstacles
 from om_redundant import _core
-from om_redundant.redundancy import paths
+from om_redundant.redundancy.paths import linking as paths
 from om_redundant.redundancy.paths.points import Point
 from om_redundant.redundancy.paths.probe import END_TOLERANCE, Probe
 from tests.conftest import solver_of

@@ -16,7 +16,7 @@ from hypothesis import example, settings
 import om_redundant as om
 from benchmarks.control_rate import MIN_CLEARANCE, obstacles
 from om_redundant import _core
-from om_redundant.redundancy import paths
+from om_redundant.redundancy.paths import linking as paths
 from om_redundant.redundancy.paths.linking import _TURN, FINE_STEP, sweep_circle
 from tests.conftest import random_pose, random_scenes, solver_of
 

@@ -86,7 +86,7 @@ def test_a_fresh_choice_weighs_travel_and_certifies_its_way(panda, optimizer, se
     dense = clearance.minima(q_now + t * (fresh.solution.q - q_now)).min()
     floor = (
         min(MIN_CLEARANCE + WAY_MARGIN, clearance.minimum(q_now))
-        - om.redundancy.segment_clearance.ALONG_TOLERANCE
+        - om.redundancy.objective.segment_clearance.ALONG_TOLERANCE
     )
     if fresh.way_clear:
         assert fresh.way_clearance >= floor and dense >= fresh.way_clearance - 1e-12

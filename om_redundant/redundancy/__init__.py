@@ -1,9 +1,9 @@
-"""The redundancy of 7-DOF arms: the arm angle (:mod:`.arm_angle`) and the self-motion
-(:mod:`.self_motion`), the objective (:mod:`.objective`, :mod:`.clearance`,
-:mod:`.singularity`), solution paths along psi (:mod:`.paths`), feasible intervals
-(:mod:`.intervals`), the climb (:mod:`.climb`), the optimiser that combines them
-(:mod:`.optimizer`), and the sweep of psi for a pose or a path that ``om-redundant sweep``
-shows (:mod:`.sweep`)."""
+"""The redundancy of 7-DOF arms: the arm angle (:mod:`.arm_angle`), the self-motion
+(:mod:`.self_motion`), targets with a free rotation (:mod:`.free_rotation`), and the global
+choice's path: a branch's solution paths along psi and their feasible intervals
+(:mod:`.paths`), what is maximised along them (:mod:`.objective`), and the optimiser that
+chooses and tracks (:mod:`.choice`); the sweep of psi for a pose or a path that
+``om-redundant sweep`` shows is :mod:`.sweep`."""
 
 from .arm_angle import arm_angle_and_gradient
 from .choice.optimizer import RedundancyOptimizer
