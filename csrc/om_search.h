@@ -65,6 +65,8 @@ typedef struct {
 bool om_srs_reach_possible(om_problem *pb, om_reach_bound *bound, double a, double b);
 /* S-R-S: W(w) - S = e + u1 cos w + u2 sin w on the circle. */
 void om_srs_wrist_circle(const om_problem *pb, vec3 *e, vec3 *u1, vec3 *u2);
+/* circle.c: whether the reach margin, sampled as ms (count samples), may reach zero between
+ * samples i and i + 1, both out of reach. */
 bool om_margin_may_reach(const double *ms, int i, int count, bool cyclic);
 /* The model's hand position at the torus point (w1, w7) (not counted as an evaluation). */
 vec3 om_torus_point(const om_problem *pb, double w1, double w7);
@@ -91,16 +93,16 @@ double om_extremum(om_problem *pb, double a, double b, double x0, double sign, b
  * them, and keep them there (the same bits as computed). */
 int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool full_circle, double *q,
                          double *cands, int cap);
-/* A scan memo for the problems of solver s, none held yet (NULL: an arm whose scans keep none,
+/* circle_samples.c: a scan memo for the problems of solver s, none held yet (NULL: an arm whose scans keep none,
  * or out of memory); freed by om_scan_memo_free (NULL: nothing). */
 om_scan_memo *om_scan_memo_new(const om_solver_data *s);
 void om_scan_memo_free(om_scan_memo *memo);
-/* wrist_offset.c: candidates in the bands around the singular wrist of an arm with a4 != 0. */
+/* wrist_offset_bands.c: candidates in the bands around the singular wrist of an arm with a4 != 0. */
 #define OM_WRIST_BAND_CANDIDATES 256 /* room for them */
 int om_wrist_offset_candidates(om_problem *pb, double lo, double hi, bool full_circle, double *q, double *cands,
                                int cap);
 
-/* torus.c */
+/* torus_newton.c */
 double om_newton(om_problem *pb, vec3 x, double *q, const double *known, int n_known, vec3 *x_end);
 double om_lifted_solve(om_problem *pb, const double *start, double *q);
 /* The candidates a torus search hands to verification, in order: q (dof each) of the first cap
@@ -132,7 +134,7 @@ om_torus_bound om_torus_cell_bound(om_problem *pb, double w1, double w7, double 
  * count into *count, on an arm whose offsets are small against it; returns whether it did
  * (false: the grid search decides). */
 bool om_torus_certified_roots(om_problem *pb, double *roots, int *count, const double *centre, double radius);
-/* x = W - S of the model on the torus less its parts that turn with w1 and w7:
+/* torus_half_line.c: x = W - S of the model on the torus less its parts that turn with w1 and w7:
  * p_d + R w_F - S + D3 + R D0 (x = it + D4 cos w1 + D5 sin w1 + R (D1 cos w7 + D2 sin w7)). */
 vec3 om_shoulder_wrist_centre(const om_problem *pb);
 
@@ -201,8 +203,8 @@ typedef struct {
  * arm near a family) where it is within NEAR_POLISH_FROM of the pose (om_near_polish; else
  * left as it is); returns whether it now verifies. */
 bool om_polish_candidate(om_problem *pb, double *q, double *pos, double *ori);
-/* The refinement on the real arm toward pb's goal (with psi, S-R-S: in the requested ELBOW
- * branch), giving up a crawl far from a root (om_polish). */
+/* problem.c: the refinement on the real arm toward pb's goal (with psi, S-R-S: in the
+ * requested ELBOW branch), giving up a crawl far from a root (om_polish). */
 om_polish_task om_problem_polish_task(const om_problem *pb);
 /* self_motion.c: the null vector of the real 6 x 7 Jacobian at q (the kernels' coordinates) by
  * cofactors (not normalised) */
@@ -210,13 +212,13 @@ void om_self_motion_null(const om_solver_data *s, const double *q, double *n);
 /* det A (n x n row-major, destroyed) into *det (NULL: not wanted) by elimination with partial
  * pivoting and, b not NULL, x of A x = b into b; false where a pivot is zero (*det = 0). */
 bool om_eliminate(double *A, double *b, int n, double *det);
-/* om_add_root of q, polished first where it fails verification near the boundary. */
+/* boundary.c: om_add_root of q, polished first where it fails verification near the boundary. */
 int om_add_candidate(om_problem *pb, double *q, double *roots, int count);
-/* pb's pose in another configuration (signs, redundancy: kept by the caller), its target's
+/* problem.c: pb's pose in another configuration (signs, redundancy: kept by the caller), its target's
  * constants for that redundancy, its evaluation counter at zero. */
 om_problem om_problem_at(const om_problem *pb, const int64_t *signs, const double *redundancy);
 
-/* For a configuration whose bounded search found no root: the roots at its touch points
+/* bands.c: for a configuration whose bounded search found no root: the roots at its touch points
  * (samples of the free angle where the model's solution meets a branch zero, refined), and
  * those of the neighbouring configurations (one branch flipped) that hold the problem's own
  * (their flipped branch quantity within OM_BRANCH_BAND of zero), verified, into roots
@@ -229,9 +231,9 @@ int om_band_roots(om_problem *pb, double *roots, bool *neighbour_reached, om_sca
  * same signs at other arm angles, into roots from count on; returns the count. cache (NULL:
  * none) keeps whether the pose may come near the line for the pose's next configuration. */
 int om_loop_roots(om_problem *pb, double *roots, int count, om_scan_cache *cache);
-/* For q on the pose (within 1e-12) next to psi's half-line: psi's crossings of the requested
- * value where the self-motion loop through q passes by the line; the first root into q (*pos,
- * *ori its errors). Returns whether there was one. */
+/* loop_pass.c: for q on the pose (within 1e-12) next to psi's half-line: psi's crossings of
+ * the requested value where the self-motion loop through q passes by the line; the first root
+ * into q (*pos, *ori its errors). Returns whether there was one. */
 bool om_loop_pass(om_problem *pb, double *q, double *pos, double *ori);
 
 /* search.c */
