@@ -17,6 +17,7 @@ import time
 import numpy as np
 
 import om_redundant as om
+from om_redundant.angles import wrap_angles
 
 from .report import write_page
 
@@ -67,10 +68,6 @@ def _random_q(arm: om.Arm, n: int, rng: np.random.Generator) -> np.ndarray:
     return rng.uniform(lower, upper, (n, arm.dof))
 
 
-def _wrap(x: np.ndarray) -> np.ndarray:
-    return np.remainder(x + np.pi, 2 * np.pi) - np.pi
-
-
 def measure(arm: om.Arm, n: int, seed: int) -> dict:
     """Wrong roots, misses, worst errors and time of solve_all over n random q."""
     solver = om.OMSolver(arm)
@@ -82,7 +79,9 @@ def measure(arm: om.Arm, n: int, seed: int) -> dict:
         c = solver.configuration_of(q)
         roots = solver.solve_all(T, c)
         roots_total += len(roots)
-        misses += not any(np.abs(np.where(arm.revolute, _wrap(r.q - q), r.q - q)).max() < 1e-7 for r in roots)
+        misses += not any(
+            np.abs(np.where(arm.revolute, wrap_angles(r.q - q), r.q - q)).max() < 1e-7 for r in roots
+        )
         for root in roots:
             reached = arm.fk(root.q)
             position = float(np.linalg.norm(reached[:3, 3] - T[:3, 3]))

@@ -23,13 +23,10 @@ import time
 import numpy as np
 
 import om_redundant as om
+from om_redundant.angles import wrap_angles
 
 from .report import cpu_model, write_page
 from .robots import random_joints
-
-
-def _wrap(x: np.ndarray) -> np.ndarray:
-    return (x + np.pi) % (2 * np.pi) - np.pi
 
 
 def recovery(name: str, n: int, seed: int) -> dict[str, float]:
@@ -48,19 +45,19 @@ def recovery(name: str, n: int, seed: int) -> dict[str, float]:
     for i, (q, c) in enumerate(zip(Q, configurations, strict=True)):
         roots = solver.solve_all(T[i], c)
         roots_total += len(roots)
-        among += any(np.abs(_wrap(r.q - q)).max() < 1e-9 for r in roots)
+        among += any(np.abs(wrap_angles(r.q - q)).max() < 1e-9 for r in roots)
         # Every returned solution: the roots of solve_all and the hinted batch solve.
         returned = [(r.ok, r.q, r.position_error, r.orientation_error) for r in roots]
         returned.append((batch.ok[i], batch.q[i], batch.position_error[i], batch.orientation_error[i]))
         for ok, q_returned, pos, ori in returned:
             worst_pos, worst_ori = max(worst_pos, pos), max(worst_ori, ori)
             wrong_c += not (ok and solver.configuration_of(q_returned).isclose(c))
-        returned_q = np.abs(_wrap(batch.q[i] - q)).max() < 1e-9
+        returned_q = np.abs(wrap_angles(batch.q[i] - q)).max() < 1e-9
         hinted_q += returned_q
         if not returned_q:  # how far the root returned instead lies from q
-            twin = max(twin, np.linalg.norm(_wrap(batch.q[i] - q)))
-        to_hint = [np.linalg.norm(_wrap(r.q - hints[i])) for r in roots]
-        nearest += np.linalg.norm(_wrap(batch.q[i] - hints[i])) <= min(to_hint, default=np.inf) + 1e-9
+            twin = max(twin, np.linalg.norm(wrap_angles(batch.q[i] - q)))
+        to_hint = [np.linalg.norm(wrap_angles(r.q - hints[i])) for r in roots]
+        nearest += np.linalg.norm(wrap_angles(batch.q[i] - hints[i])) <= min(to_hint, default=np.inf) + 1e-9
     return {
         "arm": name,
         "dp_max": solver.dp_max,

@@ -23,7 +23,7 @@
 
 #include "om_paths.h"
 
-#define TURN (2.0 * OM_PI)   /* (paths.py's _TURN) */
+#define TURN (2.0 * OM_PI)   /* (om_redundant/angles.py's TURN) */
 
 /* The branch, the rows and the paths being linked. */
 typedef struct {

@@ -16,8 +16,9 @@ from hypothesis import example, settings
 import om_redundant as om
 from benchmarks.control_rate import MIN_CLEARANCE, obstacles
 from om_redundant import _core
+from om_redundant.angles import TURN
 from om_redundant.redundancy.paths import linking as paths
-from om_redundant.redundancy.paths.linking import _TURN, FINE_STEP, sweep_circle
+from om_redundant.redundancy.paths.linking import FINE_STEP, sweep_circle
 from tests.conftest import random_pose, random_scenes, solver_of
 
 
@@ -36,7 +37,7 @@ def cells(path: paths.Path):
     """The neighbouring samples of a path, a loop's closing cell too."""
     points = path.points
     if path.turns:
-        points = [*points, points[0].at(points[0].psi + _TURN * path.turns)]
+        points = [*points, points[0].at(points[0].psi + TURN * path.turns)]
     return itertools.pairwise(points)
 
 

@@ -6,9 +6,8 @@ import math
 from dataclasses import dataclass
 from itertools import product
 
+from ..angles import TURN
 from ..validation import as_instance, as_number, as_redundancy, as_signs
-
-_TURN = 2.0 * math.pi
 
 
 @dataclass(frozen=True)
@@ -49,7 +48,7 @@ class Configuration:
         # Each angle reduced first (exactly, as the solver does): a - b of a huge angle and a
         # small one would lose the small one's digits.
         return all(
-            abs(math.remainder(math.remainder(a, _TURN) - math.remainder(b, _TURN), _TURN)) <= atol
+            abs(math.remainder(math.remainder(a, TURN) - math.remainder(b, TURN), TURN)) <= atol
             for a, b in zip(self.redundancy, other.redundancy, strict=True)
         )
 

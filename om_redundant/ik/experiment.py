@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..angles import wrap_angles
 from .solver import OMSolver
 
 #: The paper's figures for the Spherical arm (C on a SUN SPARCstation 2).
@@ -90,7 +91,7 @@ def run(arm: str = "spherical", n: int = 100_000, seed: int = 0) -> ExperimentRe
         solver.configuration_of(q) != c for q, c, good in zip(q_out, configurations, ok, strict=True) if good
     )
     diff = q_out - Q
-    diff[:, solver.arm.revolute] = (diff[:, solver.arm.revolute] + np.pi) % (2 * np.pi) - np.pi
+    diff[:, solver.arm.revolute] = wrap_angles(diff[:, solver.arm.revolute])
     recovered = np.abs(diff).max(axis=1) < 1e-9
     us = times * 1e6
     return ExperimentResult(

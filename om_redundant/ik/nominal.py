@@ -46,6 +46,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..angles import wrap_angles
 from ..exceptions import ModelError
 from ..kinematics.arm import Arm
 from ..kinematics.chain import DHRow, JointKind, KinematicChain, row_transform
@@ -152,7 +153,7 @@ def _nearest_right_angle(alpha: float) -> float:
 
 
 def _off(alpha: float, nominal: float) -> float:
-    return abs(float(np.remainder(alpha - nominal + np.pi, 2 * np.pi) - np.pi))
+    return abs(float(wrap_angles(alpha - nominal)))
 
 
 def _flipped(chain: KinematicChain, snap: bool) -> tuple[KinematicChain, np.ndarray]:

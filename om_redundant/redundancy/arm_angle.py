@@ -38,20 +38,12 @@ elbow), where this gradient is the one-sided derivative of either branch. The ke
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from .. import _core
 from ..exceptions import InvalidInput
 from ..ik.solver import OMSolver
 from ..validation import as_instance, as_joint_vector
-
-
-def wrap_psi(psi: float) -> float:
-    """psi's representative in [-pi, pi) (``math.remainder`` gives [-pi, pi])."""
-    psi = math.remainder(psi, 2.0 * math.pi)
-    return -math.pi if psi >= math.pi else psi
 
 
 def check_arm_angle(solver: OMSolver) -> None:

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field, replace
 import mujoco
 import numpy as np
 
+from ..angles import wrap_angles
 from ..ik.configuration import Configuration
 from ..ik.solver import OMSolver
 from .choice.optimizer import RedundancyOptimizer
@@ -239,5 +240,5 @@ def _nearest_mid_range(arm, q: np.ndarray) -> np.ndarray:
     """Revolute joints with limits at their turn nearest mid-range, as the optimiser takes them."""
     centred = arm.revolute & np.isfinite(arm.lower) & np.isfinite(arm.upper)
     centre = np.where(centred, (arm.lower + arm.upper) / 2.0, 0.0)
-    wrapped = centre + np.remainder(q - centre + math.pi, 2.0 * math.pi) - math.pi
+    wrapped = centre + wrap_angles(q - centre)
     return np.where(centred, wrapped, q)

@@ -11,6 +11,7 @@ from mink import Configuration as MinkConfiguration
 from mink import TargetNotSet
 from mink.exceptions import InvalidTarget
 
+from ..angles import TURN
 from ..exceptions import InvalidInput, UnreachableTarget
 from ..ik.configuration import Configuration
 from ..ik.solver import OMSolver
@@ -94,7 +95,7 @@ class ArmAngleTask(ArmTask):
     def compute_error(self, configuration: MinkConfiguration) -> np.ndarray:
         r"""The arm-angle error :math:`\mathrm{wrap}(\psi(q) - \psi^*)`, shape (1,)."""
         psi, _ = self._psi(configuration)
-        return np.array([math.remainder(psi - self.target_psi, 2.0 * math.pi)])
+        return np.array([math.remainder(psi - self.target_psi, TURN)])
 
     def compute_jacobian(self, configuration: MinkConfiguration) -> np.ndarray:
         r""":math:`\partial\psi/\partial q` in the arm's dof columns, (1, nv)."""

@@ -9,10 +9,10 @@ from dataclasses import replace
 
 import numpy as np
 
+from ...angles import wrap_angle
 from ...exceptions import SingularSelfMotion
 from ...ik.configuration import Configuration
 from ...ik.solver import OMSolver
-from ..arm_angle import wrap_psi
 from ..free_rotation import FreeRotation
 from ..objective.objective import Objective
 from ..paths.intervals import BranchRuns, PsiInterval, Run, feasible_runs
@@ -141,7 +141,7 @@ class GlobalChoice:
     ) -> RedundancyChoice:
         """The choice of a candidate: its exact solution at its joints."""
         candidate = way.candidate
-        configuration = Configuration(candidate.run.interval.signs, (wrap_psi(candidate.point.psi),))
+        configuration = Configuration(candidate.run.interval.signs, (wrap_angle(candidate.point.psi),))
         solution = candidate.point.solution or self.solver.solve(T, configuration, q_hint=candidate.point.q)
         solution = replace(
             solution,
@@ -207,7 +207,7 @@ class GlobalChoice:
 
     def _result(self, T: np.ndarray, best: tuple[Run, Point], runs: list[Run]) -> RedundancyChoice:
         run, point = best
-        configuration = Configuration(run.interval.signs, (wrap_psi(point.psi),))
+        configuration = Configuration(run.interval.signs, (wrap_angle(point.psi),))
         # The point's own solve (a batch sample is solved again, nearest itself), at the
         # point's representative of the joints: where psi has several roots near a singular
         # wrist, a fresh solve might return another one.

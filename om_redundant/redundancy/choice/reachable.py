@@ -28,6 +28,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ...angles import TURN
 from ...kinematics.arm import Arm
 from ..objective.objective import Objective
 from ..objective.segment_clearance import ALONG_TOLERANCE
@@ -82,7 +83,7 @@ def nearest_turns(arm: Arm, q: np.ndarray, q_from: np.ndarray) -> np.ndarray:
     """q (M, dof) with each revolute joint moved by the whole turns k that bring it nearest
     q_from (dof,) while it stays within the arm's limits: the k nearest the unconstrained
     best, among those of the limits (q itself within them: an interval of k holding 0)."""
-    turn = 2.0 * math.pi
+    turn = TURN
     k = np.clip(
         np.round((q_from - q) / turn), np.ceil((arm.lower - q) / turn), np.floor((arm.upper - q) / turn)
     )

@@ -48,9 +48,9 @@ from typing import NamedTuple
 import numpy as np
 
 from ... import _core
+from ...angles import wrap_angle
 from ...ik.configuration import Configuration
 from ...ik.solver import OMSolver, Solution
-from ..arm_angle import wrap_psi
 from ..objective.objective import Objective
 from ..objective.terms import SINGULARITY_CAP
 
@@ -195,7 +195,7 @@ class Tracker:
             if clearance >= objective.clearance_reach:  # every pair beyond the reach: D itself, uncapped
                 clearance = objective.clearance.minimum(q_new)
             value += objective.clearance_weight * min(1.0, clearance / objective.clearance_cap)
-        configuration = Configuration(signs, (wrap_psi(out.psi),))
+        configuration = Configuration(signs, (wrap_angle(out.psi),))
         solution = Solution(
             q_new,
             True,

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 from ... import _core
-from ..arm_angle import wrap_psi
+from ...angles import wrap_angle
 from .linking import _HERMITE, Follow, Path, lockstep
 from .points import Point
 from .probe import END_TOLERANCE, Probe
@@ -175,7 +175,7 @@ def _run(probe: Probe, span: _Span, lo: Point | None, hi: Point | None) -> Run:
     if span.closed:
         return Run(PsiInterval(probe.signs, -math.pi, math.pi, closed=True), span.points)
     points = [*([] if lo is None else [lo]), *span.points, *([] if hi is None else [hi])]
-    lo_psi = wrap_psi(points[0].psi)
+    lo_psi = wrap_angle(points[0].psi)
     shift = lo_psi - points[0].psi
     points = [p.at(p.psi + shift) for p in points] if shift else points
     return Run(PsiInterval(probe.signs, lo_psi, points[-1].psi), points)

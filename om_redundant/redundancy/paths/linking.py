@@ -40,6 +40,7 @@ from typing import Any
 import numpy as np
 
 from ... import _core
+from ...angles import TURN
 from .points import Point, evaluate_points
 from .probe import END_TOLERANCE, SAME, Probe
 
@@ -50,7 +51,6 @@ _T = np.arange(1, _MODEL_POINTS + 1) / (_MODEL_POINTS + 1)
 _HERMITE = np.array(
     [2 * _T**3 - 3 * _T**2 + 1, _T**3 - 2 * _T**2 + _T, -2 * _T**3 + 3 * _T**2, _T**3 - _T**2]
 )
-_TURN = 2.0 * math.pi
 _BOUND_SLACK = 1e-9  # covers the rounding of the Hermite models in cell_looks' bounds
 
 #: What a process of :func:`lockstep` asks for: follow from the point towards psi on the
@@ -79,7 +79,7 @@ def sweep_circle(probes: list[Probe], n: int) -> list[list[Path]]:
     pose, and each follows its own branch's paths here and after (a probe keeps no state
     between its answers)."""
     solver, T, branches = probes[0].solver, probes[0].T, [probe.signs for probe in probes]
-    psi = -math.pi + _TURN * np.arange(n) / n
+    psi = -math.pi + TURN * np.arange(n) / n
     # Rows psi by psi, the branches that differ in the first sign alone next to each other:
     # the solver shares their circle search where it is the same (S-R-S: the SHOULDER sign).
     order = sorted(range(len(branches)), key=lambda b: (branches[b][1:], branches[b][0]))
@@ -214,7 +214,7 @@ def _joined(
     starting at the first), loops closed, and the other starts followed back to their end."""
     following: dict[int, int] = {}  # path i continues across +-pi into path following[i]
     for i in last:
-        reached, arrived = probe.follow(paths[i][-1], psi[0] + _TURN)
+        reached, arrived = probe.follow(paths[i][-1], psi[0] + TURN)
         starts = [j for j in range(len(paths)) if first[j] == 0 and j not in following.values()]
         j = _same(probe, reached, [paths[j][0] for j in starts]) if arrived else None
         if j is not None:
@@ -230,7 +230,7 @@ def _joined(
         while chain[-1] in following and following[chain[-1]] not in chain:
             chain.append(following[chain[-1]])
         seen.update(chain)
-        points = [p.at(p.psi + _TURN * turn) if turn else p for turn, i in enumerate(chain) for p in paths[i]]
+        points = [p.at(p.psi + TURN * turn) if turn else p for turn, i in enumerate(chain) for p in paths[i]]
         if following.get(chain[-1]) == chain[0]:
             result.append(Path(points, turns=len(chain)))
         else:
@@ -240,7 +240,7 @@ def _joined(
 
 def _back_to_end(probe: Probe, psi: np.ndarray, points: list[Point], k: int) -> list[Point]:
     """The path's samples with, in front, where it ends before its first grid sample."""
-    previous = psi[k - 1] if k > 0 else psi[-1] - _TURN
+    previous = psi[k - 1] if k > 0 else psi[-1] - TURN
     reached, _ = probe.follow(points[0], previous)
     return ([reached] if reached is not points[0] else []) + points
 
@@ -262,7 +262,7 @@ def _with_hidden(paths: list[tuple[Probe, Path]]) -> list[Path]:
         return []
     ends_of = []  # each path's samples, then a loop's closing cell's end (its first, a loop later)
     for _, path in paths:
-        closing = [path.points[0].at(path.points[0].psi + _TURN * path.turns)] if path.turns else []
+        closing = [path.points[0].at(path.points[0].psi + TURN * path.turns)] if path.turns else []
         ends_of.append(list(path.points) + closing)
     flat = [p for ends in ends_of for p in ends]
     evaluate_points(paths[0][0].objective, flat)  # (the path ends that the following found)

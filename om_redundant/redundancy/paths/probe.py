@@ -27,6 +27,7 @@ import math
 import numpy as np
 
 from ... import _core
+from ...angles import TURN, wrap_angles
 from ...exceptions import SingularSelfMotion
 from ...ik.configuration import Configuration
 from ...ik.solver import BRANCH_BAND, OMSolver, Solution
@@ -41,7 +42,6 @@ END_TOLERANCE = _core.END_TOLERANCE
 #: rad, max-norm: two solutions at one psi this close are one (csrc/link.c reads it there too).
 SAME = _core.PATH_SAME
 _AIM = _core.FOLLOW_AIM  # of the distance to a path's predicted end, a step aimed there goes
-_TURN = 2.0 * math.pi
 _ARRIVED, _SINGULAR, _STALLED = _core.FOLLOW_ARRIVED, _core.FOLLOW_SINGULAR, _core.FOLLOW_STALLED
 # A follow stalls (csrc/om_paths.h: a path within rounding of a singular set advances by
 # ~1e-6 rad a step) after CRAWL_STEPS accepted steps in a row shorter than CRAWL, or after
@@ -105,14 +105,14 @@ class Probe:
 
     def _delta(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         d = b - a
-        return _wrap(d) if self._all_cyclic else np.where(self._cyclic, _wrap(d), d)
+        return wrap_angles(d) if self._all_cyclic else np.where(self._cyclic, wrap_angles(d), d)
 
     def point(self, psi: float | np.ndarray, q: np.ndarray, solution: Solution | None = None) -> Point:
         """The point of solution q at psi, q at its representative (see the class)."""
         return self._point(psi, self._represent(q), solution)
 
     def _represent(self, q: np.ndarray) -> np.ndarray:
-        centred = self._centre + _wrap(q - self._centre)
+        centred = self._centre + wrap_angles(q - self._centre)
         return centred if self._all_centred else np.where(self._centred, centred, q)
 
     def _point(self, psi: float | np.ndarray, q: np.ndarray, solution: Solution | None) -> Point:
@@ -292,7 +292,7 @@ class Probe:
         linked, begin = [], 0
         for end, turns in paths[: found.paths].tolist():  # (a member's k: the turns of psi it is taken at)
             rows = members[begin:end].tolist()
-            linked.append(([flat[r].at(flat[r].psi + _TURN * k) if k else flat[r] for r, k in rows], turns))
+            linked.append(([flat[r].at(flat[r].psi + TURN * k) if k else flat[r] for r, k in rows], turns))
             begin = end
         return linked
 
@@ -313,11 +313,6 @@ def _predicted_end(before: list[float], now: list[float], moved: float) -> float
     (measures ``before``); inf where none falls."""
     ahead = [moved * f / (b - f) for b, f in zip(before, now, strict=True) if 0.0 < f < b]
     return min(ahead, default=math.inf)
-
-
-def _wrap(x: np.ndarray) -> np.ndarray:
-    """x taken to [-pi, pi) (``np.remainder``'s, as csrc/'s ``om_wrap_angle``)."""
-    return (x + math.pi) % _TURN - math.pi
 
 
 def _continuing(moved: np.ndarray, error: np.ndarray) -> np.ndarray:
