@@ -6,15 +6,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from typing import Any
 
 import numpy as np
 
 from ...angles import wrap_angle
 from ...exceptions import SingularSelfMotion
 from ...ik.configuration import Configuration
-from ...ik.solver import OMSolver
+from ...ik.solver import OMSolver, Solution
 from ..free_rotation import FreeRotation
 from ..objective.objective import Objective
+from ..objective.terms import Evaluation
 from ..paths.intervals import BranchRuns, PsiInterval, Run, feasible_runs
 from ..paths.linking import sweep_circle
 from ..paths.points import Point
@@ -143,27 +145,18 @@ class GlobalChoice:
         candidate = way.candidate
         configuration = Configuration(candidate.run.interval.signs, (wrap_angle(candidate.point.psi),))
         solution = candidate.point.solution or self.solver.solve(T, configuration, q_hint=candidate.point.q)
-        solution = replace(
-            solution,
-            q=candidate.q,
-            configuration=configuration,
-            within_limits=self.solver.arm.within_limits(candidate.q),
-        )
-        ev = candidate.evaluation
-        return RedundancyChoice(
-            solution.ok,
+        return self._exact_choice(
+            T,
             configuration,
             solution,
-            ev.margin,
-            ev.clearance,
-            ev.value,
+            candidate.q,
+            candidate.evaluation,
             intervals,
             reason=note,
             travel=candidate.travel,
             way_clearance=way.clearance,
             way_clear=way.clear,
             turn=turn,
-            pose=T,
         )
 
     def _climb_all(self, T: np.ndarray, runs: list[Run]) -> tuple[Run, Point]:
@@ -216,23 +209,27 @@ class GlobalChoice:
             return failed_choice(
                 tuple(r.interval for r in runs), f"the exact solve at the chosen psi: {solution.status}"
             )
+        intervals = tuple(r.interval for r in runs)
+        return self._exact_choice(T, configuration, solution, point.q, point.evaluation, intervals)
+
+    def _exact_choice(
+        self,
+        T: np.ndarray,
+        configuration: Configuration,
+        solution: Solution,
+        q: np.ndarray,
+        evaluation: Evaluation,
+        intervals: tuple[PsiInterval, ...],
+        **fields: Any,
+    ) -> RedundancyChoice:
+        """The choice of the exact solution at joints q (q's own turns of the solution's
+        joints) in ``configuration`` (psi wrapped), with q's evaluation."""
         solution = replace(
-            solution,
-            q=point.q,
-            configuration=configuration,
-            within_limits=self.solver.arm.within_limits(point.q),
+            solution, q=q, configuration=configuration, within_limits=self.solver.arm.within_limits(q)
         )
-        ev = point.evaluation
-        return RedundancyChoice(
-            solution.ok,
-            configuration,
-            solution,
-            ev.margin,
-            ev.clearance,
-            ev.value,
-            tuple(r.interval for r in runs),
-            pose=T,
-        )
+        ev = evaluation
+        values = (ev.margin, ev.clearance, ev.value)
+        return RedundancyChoice(solution.ok, configuration, solution, *values, intervals, pose=T, **fields)
 
     def _why(self, branch: BranchRuns) -> str:
         """Why a branch's solution paths hold nothing feasible."""
