@@ -252,19 +252,13 @@ class OMSolver(BatchSolves):
         T = as_pose(T)
         self.check_configuration(configuration)
         n = _core.MAX_ROOTS
-        roots = _core.Roots(np.empty((n, self.arm.dof)), np.empty(n), np.empty(n), np.empty(n, dtype=bool))
+        q, position, orientation = np.empty((n, self.arm.dof)), np.empty(n), np.empty(n)
+        within = np.empty(n, dtype=bool)
+        roots = _core.Roots(q, position, orientation, within)
         found = self._kernel.solve_all(T, configuration.signs, configuration.redundancy, roots)
+        evals = found.evaluations
         return [
-            Solution(
-                roots.q[r],
-                True,
-                "ok",
-                configuration,
-                roots.position_error[r],
-                roots.orientation_error[r],
-                found.evaluations,
-                bool(roots.within_limits[r]),
-            )
+            Solution(q[r], True, "ok", configuration, position[r], orientation[r], evals, bool(within[r]))
             for r in range(found.count)
         ]
 
