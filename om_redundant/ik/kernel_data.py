@@ -66,7 +66,7 @@ from .nominal import NominalArm
 def kernel_data(
     om: ModelArm, tolerances: tuple[float, float], scan_points: int, nominal: NominalArm | None = None
 ) -> _core.SolverData:
-    """The :class:`~om_redundant.ik._core.SolverData` of ``ckernels.Solver`` for an arm and
+    """The :class:`~om_redundant._core.SolverData` of ``_core.Solver`` for an arm and
     its closed-form model.
 
     Args:
