@@ -32,6 +32,16 @@ int get_fields(PyObject *record, const char *const *names, int n, PyObject **out
 /* A new result record of a PyStructSequence type (named fields) from items[0:n], whose
  * references it steals (NULL items: a failed conversion; NULL then, every item released). */
 PyObject *new_record(PyTypeObject *type, PyObject **items, int n);
+/* A named int constant of the module (ckernels.NAME). */
+typedef struct {
+    const char *name;
+    int value;
+} int_constant;
+/* Add constants[0:n] to module; -1 with an error. */
+int add_int_constants(PyObject *module, const int_constant *constants, size_t n);
+/* Make the result type *type from desc, once (kept should the module be initialised again), and
+ * add it to module as name; -1 with an error. */
+int add_record_type(PyObject *module, PyTypeObject **type, PyStructSequence_Desc *desc, const char *name);
 /* Release get_fields' references out[0:n]. */
 void release_fields(PyObject **out, int n);
 /* An arm's joint count from obj into *dof, 1 ... OM_MAX_DOF; -1 with an error naming what. */

@@ -95,6 +95,5 @@ static PyMethodDef functions[] = {
 
 int om_box_qp_init(PyObject *module) {
     if (PyModule_AddFunctions(module, functions) < 0) return -1;
-    step_type = PyStructSequence_NewType(&step_desc);
-    return step_type ? PyModule_AddObjectRef(module, "QPStep", (PyObject *)step_type) : -1;
+    return add_record_type(module, &step_type, &step_desc, "QPStep");
 }

@@ -160,6 +160,17 @@ PyObject *new_record(PyTypeObject *type, PyObject **items, int n) {
     return record;
 }
 
+int add_int_constants(PyObject *module, const int_constant *constants, size_t n) {
+    for (size_t i = 0; i < n; i++)
+        if (PyModule_AddIntConstant(module, constants[i].name, constants[i].value) < 0) return -1;
+    return 0;
+}
+
+int add_record_type(PyObject *module, PyTypeObject **type, PyStructSequence_Desc *desc, const char *name) {
+    if (!*type && !(*type = PyStructSequence_NewType(desc))) return -1;
+    return PyModule_AddObjectRef(module, name, (PyObject *)*type);
+}
+
 void release_fields(PyObject **out, int n) {
     for (int i = 0; i < n; i++) Py_CLEAR(out[i]);
 }

@@ -198,13 +198,8 @@ static PyMethodDef functions[] = {
 };
 
 int om_clearance_init(PyObject *module) {
-    static const struct {
-        const char *name;
-        int value;
-    } kinds[] = {{"CORE_MUJOCO", OM_CORE_MUJOCO}, {"CORE_POINT", OM_CORE_POINT},
+    static const int_constant kinds[] = {{"CORE_MUJOCO", OM_CORE_MUJOCO}, {"CORE_POINT", OM_CORE_POINT},
                  {"CORE_SEGMENT", OM_CORE_SEGMENT}, {"CORE_BOX", OM_CORE_BOX}};
     if (PyModule_AddFunctions(module, functions) < 0) return -1;
-    for (size_t i = 0; i < sizeof kinds / sizeof kinds[0]; i++)
-        if (PyModule_AddIntConstant(module, kinds[i].name, kinds[i].value) < 0) return -1;
-    return 0;
+    return add_int_constants(module, kinds, sizeof kinds / sizeof kinds[0]);
 }

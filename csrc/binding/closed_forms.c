@@ -137,8 +137,7 @@ static PyStructSequence_Desc lifted_desc = {"om_redundant.ckernels.Lifted", "mod
 static PyTypeObject *lifted_type;
 
 int om_closed_forms_init(PyObject *module) {
-    if (!lifted_type && !(lifted_type = PyStructSequence_NewType(&lifted_desc))) return -1;
-    return PyModule_AddObjectRef(module, "Lifted", (PyObject *)lifted_type);
+    return add_record_type(module, &lifted_type, &lifted_desc, "Lifted");
 }
 
 /* model_ik_lifted(P, target, q1, q7, phi4, q) -> Lifted(shoulder, wrist, elbow): the residuals

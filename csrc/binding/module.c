@@ -17,10 +17,7 @@ PyMODINIT_FUNC PyInit_ckernels(void) {
     PyObject *m = PyModule_Create(&module);
     if (!m) return NULL;
     /* The codes and layouts Python reads from here (om_redundant._core): each written once, in C. */
-    static const struct {
-        const char *name;
-        int value;
-    } constants[] = {
+    static const int_constant constants[] = {
         {"MAX_ROOTS", OM_MAX_ROOTS}, {"MAX_DOF", OM_MAX_DOF},
         {"MIN_SCAN_POINTS", OM_MIN_SCAN_POINTS}, {"MAX_SCAN_POINTS", OM_MAX_SCAN_POINTS},
         {"SD_A1", SD_A1}, {"SD_D1", SD_D1}, {"SD_SIGMA1", SD_SIGMA1}, {"SD_THETA1", SD_THETA1},
@@ -57,8 +54,7 @@ PyMODINIT_FUNC PyInit_ckernels(void) {
     if (PyModule_AddFunctions(m, om_cell_functions) < 0) goto fail;
     if (om_box_qp_init(m) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_start_bound_functions) < 0) goto fail;
-    for (size_t i = 0; i < sizeof constants / sizeof constants[0]; i++)
-        if (PyModule_AddIntConstant(m, constants[i].name, constants[i].value) < 0) goto fail;
+    if (add_int_constants(m, constants, sizeof constants / sizeof constants[0]) < 0) goto fail;
     const struct {
         const char *name;
         double value;

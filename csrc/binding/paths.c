@@ -183,10 +183,8 @@ static PyObject *om_tangents(PyObject *mod, PyObject *const *args, Py_ssize_t na
 }
 
 int om_paths_init(PyObject *module) {
-    followed_type = PyStructSequence_NewType(&followed_desc);
-    if (!followed_type || PyModule_AddObjectRef(module, "Followed", (PyObject *)followed_type) < 0) return -1;
-    linked_type = PyStructSequence_NewType(&linked_desc);
-    return linked_type ? PyModule_AddObjectRef(module, "Linked", (PyObject *)linked_type) : -1;
+    if (add_record_type(module, &followed_type, &followed_desc, "Followed") < 0) return -1;
+    return add_record_type(module, &linked_type, &linked_desc, "Linked");
 }
 
 PyMethodDef om_path_functions[] = {

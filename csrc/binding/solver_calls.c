@@ -42,17 +42,9 @@ static PyTypeObject *solved_type, *found_type, *torus_bound_type;
 int om_solver_init(PyObject *module) {
     if (PyType_Ready(&om_SolverType) < 0 || PyModule_AddObjectRef(module, "Solver", (PyObject *)&om_SolverType) < 0)
         return -1;
-    const struct {
-        PyTypeObject **type;
-        PyStructSequence_Desc *desc;
-        const char *name;
-    } types[] = {{&solved_type, &solved_desc, "Solved"}, {&found_type, &found_desc, "Found"},
-                 {&torus_bound_type, &torus_bound_desc, "TorusBound"}};
-    for (size_t i = 0; i < sizeof types / sizeof types[0]; i++) {
-        if (!*types[i].type && !(*types[i].type = PyStructSequence_NewType(types[i].desc))) return -1;
-        if (PyModule_AddObjectRef(module, types[i].name, (PyObject *)*types[i].type) < 0) return -1;
-    }
-    return 0;
+    if (add_record_type(module, &solved_type, &solved_desc, "Solved") < 0) return -1;
+    if (add_record_type(module, &found_type, &found_desc, "Found") < 0) return -1;
+    return add_record_type(module, &torus_bound_type, &torus_bound_desc, "TorusBound");
 }
 
 static PyObject *new_found(int count, int64_t evaluations) {

@@ -131,15 +131,10 @@ static PyMethodDef functions[] = {
 };
 
 int om_tracking_init(PyObject *module) {
-    static const struct {
-        const char *name;
-        int value;
-    } statuses[] = {{"TRACK_OK", OM_TRACK_OK}, {"TRACK_NO_SOLUTION", OM_TRACK_NO_SOLUTION},
+    static const int_constant statuses[] = {{"TRACK_OK", OM_TRACK_OK}, {"TRACK_NO_SOLUTION", OM_TRACK_NO_SOLUTION},
                     {"TRACK_SINGULAR", OM_TRACK_SINGULAR}, {"TRACK_INFEASIBLE", OM_TRACK_INFEASIBLE},
                     {"TRACK_LEFT", OM_TRACK_LEFT}};
     if (PyModule_AddFunctions(module, functions) < 0) return -1;
-    for (size_t i = 0; i < sizeof statuses / sizeof statuses[0]; i++)
-        if (PyModule_AddIntConstant(module, statuses[i].name, statuses[i].value) < 0) return -1;
-    step_type = PyStructSequence_NewType(&step_desc);
-    return step_type ? PyModule_AddObjectRef(module, "TrackingStep", (PyObject *)step_type) : -1;
+    if (add_int_constants(module, statuses, sizeof statuses / sizeof statuses[0]) < 0) return -1;
+    return add_record_type(module, &step_type, &step_desc, "TrackingStep");
 }
