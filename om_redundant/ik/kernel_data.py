@@ -64,40 +64,40 @@ from .nominal import NominalArm
 
 
 def kernel_data(
-    om: ModelArm, tolerances: tuple[float, float], scan_points: int, nominal: NominalArm | None = None
+    model_arm: ModelArm, tolerances: tuple[float, float], scan_points: int, nominal: NominalArm | None = None
 ) -> _core.SolverData:
     """The :class:`~om_redundant._core.SolverData` of ``_core.Solver`` for an arm and
     its closed-form model.
 
     Args:
-        om: The closed-form model (:func:`~om_redundant.ik.model.derive_model`) of the arm, or
-            of its nominal arm (``om.real``) for an arm near a family.
+        model_arm: The closed-form model (:func:`~om_redundant.ik.model.derive_model`) of the arm, or
+            of its nominal arm (``model_arm.real``) for an arm near a family.
         tolerances: Accepted position and orientation errors (m, rad).
         scan_points: Grid points of the bounded search.
-        nominal: The nominal arm of an arm near a family (None: ``om.real`` is the arm): every
+        nominal: The nominal arm of an arm near a family (None: ``model_arm.real`` is the arm): every
             answer is verified with the arm's exact chain, in the nominal joint coordinates.
     """
-    arm = om.real
+    arm = model_arm.real
     chain = arm.chain
     shoulder, wrist = (0.0, 0.0) if nominal is None else (nominal.shoulder_offset, nominal.wrist_offset)
     # dp turns with q1 and q7: the torus (q1, q7); with a shoulder offset a2 or a wrist offset a5
     # zeroed by the nominal arm, q1 and q7 are given on the torus and the correction's fixed
     # point turns with q2 (on the left) or q6 (on the right) alone
-    if om.shoulder.any() or shoulder or wrist:
+    if model_arm.shoulder.any() or shoulder or wrist:
         mode, dp_joint = _core.TORUS, 0
-    elif om.dp_joint >= 0:
-        mode, dp_joint = _core.CIRCLE, om.dp_joint
+    elif model_arm.dp_joint >= 0:
+        mode, dp_joint = _core.CIRCLE, model_arm.dp_joint
     else:
         mode, dp_joint = _core.FIXED, 0
     c = as_kernel_array
     return _core.SolverData(
-        family=int(om.family),
+        family=int(model_arm.family),
         mode=mode,
-        params=c(om.params),
-        model_table=c(om.model.chain.table),
+        params=c(model_arm.params),
+        model_table=c(model_arm.model.chain.table),
         real_table=c((chain if nominal is None else nominal.exact).table),
         dp_joint=int(dp_joint),
-        dp_coefficients=c(np.vstack([om.delta, om.shoulder])),
+        dp_coefficients=c(np.vstack([model_arm.delta, model_arm.shoulder])),
         T_base_root=c(np.linalg.inv(chain.T_root_base)),
         T_tool_flange=c(np.linalg.inv(chain.T_flange_tool)),
         revolute=np.ascontiguousarray(arm.revolute, dtype=np.bool_),
