@@ -127,15 +127,14 @@ int om_follow_path(const om_solver_data *s, const double *T, const int64_t *sign
         if (aim < fabs(x - *psi)) x = *psi + copysign(aim, step);
         prediction p = {dof, cyclic, centred, centre, q, t, x - *psi, farthest(dof, t, x - *psi)};
         bool ok = p.farthest <= FARTHEST_CONTINUED && om_solve_near(s, T, signs, &x, q, x_q, on_path, &p, NULL);
-        if (ok) {
+        if (ok) { /* (a root without a tangent, a fold met exactly, fails as any other) */
             represent(dof, centred, centre, x_q);
-            ok = om_continues(dof, q, x_q, t, x - *psi, cyclic);
+            ok = om_continues(dof, q, x_q, t, x - *psi, cyclic) && om_self_motion_tangent(s, x_q, x_t, 0.0);
         }
         if (!ok) { /* (halved from x, not from step: psi* nearer than step is not tried again) */
             step = 0.5 * (x - *psi);
             continue;
         }
-        if (!om_self_motion_tangent(s, x_q, x_t, 0.0)) return OM_FOLLOW_SINGULAR;
         moved = fabs(x - *psi);
         crawled = moved < OM_FOLLOW_CRAWL ? crawled + 1 : 0;
         step = 2.0 * (x - *psi);

@@ -121,7 +121,6 @@ static int link_roots(linker *l, int64_t n, const double *grid, const int64_t *c
                 reached = only;
             else {
                 int status = follow_from(l, last, grid[k], &reached);
-                if (status == OM_FOLLOW_SINGULAR) return OM_LINK_SINGULAR;
                 arrived = status == OM_FOLLOW_ARRIVED;
             }
             if (!arrived) {
@@ -155,7 +154,6 @@ static int link_roots(linker *l, int64_t n, const double *grid, const int64_t *c
     for (int64_t o = 0; o < n_ongoing; o++) {
         int64_t i = w->ongoing[o];
         int status = follow_from(l, l->tail[i], grid[0] + TURN, &reached);
-        if (status == OM_FOLLOW_SINGULAR) return OM_LINK_SINGULAR;
         if (status == OM_FOLLOW_ARRIVED) {
             int64_t n_starts = 0;
             for (int64_t j = 0; j < l->n_paths; j++)
@@ -187,8 +185,7 @@ static int link_roots(linker *l, int64_t n, const double *grid, const int64_t *c
         if (!loop) { /* _back_to_end: where it ends before its first grid sample */
             int64_t k = l->first[chain[0]], first_row = l->head[chain[0]];
             int status = follow_from(l, first_row, k > 0 ? grid[k - 1] : grid[n - 1] - TURN, &reached);
-            if (status == OM_FOLLOW_SINGULAR) return OM_LINK_SINGULAR;
-            if (reached == REACHED) {
+                if (reached == REACHED) {
                 int64_t r = add_reached(l);
                 if (r < 0) return OM_LINK_FULL;
                 l->next[r] = first_row, l->head[chain[0]] = r;

@@ -37,7 +37,7 @@ double om_largest_joint_step(int dof, const double *q0, const double *q1, const 
 #define OM_PATH_JUMP 1.0
 #define OM_FOLLOW_AIM (63.0 / 64.0)
 /* follow.c: what om_follow_path answers. */
-enum { OM_FOLLOW_ARRIVED = 0, OM_FOLLOW_ENDED = 1, OM_FOLLOW_SINGULAR = 2, OM_FOLLOW_STALLED = 3 };
+enum { OM_FOLLOW_ARRIVED = 0, OM_FOLLOW_ENDED = 1, OM_FOLLOW_STALLED = 2 };
 /* A path that runs within rounding of a singular set (the Panda's self-motion through
  * q2 = q6 = 0 at the pose of its q = 0) is accepted only in steps of ~1e-6 rad, millions of
  * them, each a windowed scan: a follow stalls (is not followed further) after
@@ -50,8 +50,8 @@ enum { OM_FOLLOW_ARRIVED = 0, OM_FOLLOW_ENDED = 1, OM_FOLLOW_SINGULAR = 2, OM_FO
 /* A 7-DOF branch's solution path followed from (*psi, q, t) (t = dq/dpsi) towards target
  * (probe.py's Probe.follow), *psi, q and t updated in place to the point reached, *steps the
  * accepted steps: OM_FOLLOW_ARRIVED there, OM_FOLLOW_ENDED where the step fell below min_step
- * (the path ended on the way), OM_FOLLOW_SINGULAR where an accepted point has no tangent (a
- * fold met exactly; the point reached is then the last one that has), OM_FOLLOW_STALLED after
+ * (the path ended on the way; a root without a tangent, a fold met exactly, fails its step as
+ * any other, so the path ends beside it), OM_FOLLOW_STALLED after
  * OM_FOLLOW_MAX_ATTEMPTS attempts (the point reached: the last accepted). Revolute joints are
  * compared modulo 2 pi where cyclic, and taken nearest mid-range centre where centred. */
 int om_follow_path(const om_solver_data *s, const double *T, const int64_t *signs, const uint8_t *cyclic,
@@ -61,9 +61,9 @@ int om_follow_path(const om_solver_data *s, const double *T, const int64_t *sign
  * a row of NaN where psi does not move along the self-motion. */
 void om_self_motion_tangents(const om_solver_data *s, const double *q, double *t, ptrdiff_t rows);
 
-/* link.c: what om_link_paths answers (ckernels.LINK_DONE, ...): the paths linked; a follow met
- * a fold exactly; more rows added than the capacity; no memory for its scratch. */
-enum { OM_LINK_DONE = 0, OM_LINK_SINGULAR = 1, OM_LINK_FULL = 2, OM_LINK_NO_MEMORY = 3 };
+/* link.c: what om_link_paths answers (ckernels.LINK_DONE, ...): the paths linked; more rows
+ * added than the capacity; no memory for its scratch. */
+enum { OM_LINK_DONE = 0, OM_LINK_FULL = 1, OM_LINK_NO_MEMORY = 2 };
 /* A branch's grid roots to link into paths, and where the paths go (link.c's top comment). */
 typedef struct {
     /* the branch: its solver (7-DOF, S-R-S), pose, signs and the joints follow compares

@@ -1,8 +1,7 @@
-"""The compiled path following (``_core.follow``, csrc/follow.c) against the Python loop
-it replaces (``Probe(..., compiled=False).follow``): the same point reached, the same answer
-whether it arrived, on random poses and steps of both 7-DOF arms; and the compiled linking of
-a branch's grid roots into paths (``_core.link_paths``, csrc/link.c) against the Python
-loop (``paths._link(..., compiled=False)``): the same paths, to the bit."""
+"""The compiled path following (``_core.follow``, csrc/follow.c) against the Python loop of
+tests/reference/follow.py: the same point reached, the same answer whether it arrived, on
+random poses and steps; and the compiled linking of a branch's grid roots into paths
+(``_core.link_paths``, csrc/link.c) against the reference's loop: the same paths, to the bit."""
 
 from __future__ import annotations
 
@@ -20,6 +19,7 @@ from om_redundant.redundancy.paths import linking as paths
 from om_redundant.redundancy.paths.points import Point
 from om_redundant.redundancy.paths.probe import END_TOLERANCE, Probe
 from tests.conftest import solver_of
+from tests.reference import follow as reference
 from tests.test_redundancy_batch import optimizer_of
 
 
@@ -38,12 +38,11 @@ def test_compiled_follow_reaches_what_the_python_loop_reaches(seed, name, step, 
     configuration = solver.configuration_of(q)
     (psi,) = configuration.redundancy
     T = arm.fk(q)
-    probes = [
-        Probe(solver, optimizer.objective, T, configuration.signs, wrapped, compiled=c) for c in (True, False)
-    ]
-    starts = [p.point(psi, q) for p in probes]
+    probe = Probe(solver, optimizer.objective, T, configuration.signs, wrapped)
+    starts = [probe.point(psi, q) for _ in range(2)]
     (fast, fast_arrived), (slow, slow_arrived) = (
-        p.follow(s, psi + step) for p, s in zip(probes, starts, strict=True)
+        probe.follow(starts[0], psi + step),
+        reference.follow(probe, starts[1], psi + step),
     )
     assert fast_arrived == slow_arrived
     assert fast.psi == pytest.approx(slow.psi, abs=1e-12)
@@ -59,18 +58,18 @@ def test_compiled_follow_reaches_what_the_python_loop_reaches(seed, name, step, 
 @settings(max_examples=12, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1), name=st.sampled_from(["panda", "iiwa14"]), step=st.floats(-0.5, 0.5))
 def test_compiled_next_is_the_python_next(seed, name, step):
-    """Probe.next (one attempt of the loop, the climb's trial step) compiled and in Python:
-    the same answer, the same point."""
+    """Probe.next (one attempt of the loop, the climb's trial step) and the reference's: the
+    same answer, the same point."""
     optimizer = optimizer_of(name, 3)
     solver = optimizer.solver
     q = np.random.default_rng(seed).uniform(solver.arm.lower, solver.arm.upper)
     configuration = solver.configuration_of(q)
     (psi,) = configuration.redundancy
-    probes = [
-        Probe(solver, optimizer.objective, solver.arm.fk(q), configuration.signs, compiled=c)
-        for c in (True, False)
-    ]
-    fast, slow = (p.next(p.point(psi, q), psi + step) for p in probes)
+    probe = Probe(solver, optimizer.objective, solver.arm.fk(q), configuration.signs)
+    fast, slow = (
+        probe.next(probe.point(psi, q), psi + step),
+        reference.next_point(probe, probe.point(psi, q), psi + step),
+    )
     assert (fast is None) == (slow is None)
     if fast is not None:
         assert fast.psi == slow.psi
@@ -91,11 +90,19 @@ def test_a_path_ends_where_follow_says(seed, name, compiled):
     q = np.random.default_rng(seed).uniform(solver.arm.lower, solver.arm.upper)
     configuration = solver.configuration_of(q)
     (psi,) = configuration.redundancy
-    probe = Probe(solver, optimizer.objective, solver.arm.fk(q), configuration.signs, compiled=compiled)
+    probe = Probe(solver, optimizer.objective, solver.arm.fk(q), configuration.signs)
+    follow, next_point = (
+        (probe.follow, probe.next)
+        if compiled
+        else (
+            lambda start, psi: reference.follow(probe, start, psi),
+            lambda point, psi: reference.next_point(probe, point, psi),
+        )
+    )
     for side in (1.0, -1.0):
-        end, arrived = probe.follow(probe.point(psi, q), psi + side * np.pi)
+        end, arrived = follow(probe.point(psi, q), psi + side * np.pi)
         if not arrived:
-            assert probe.next(end, end.psi + side * 2.0 * END_TOLERANCE) is None
+            assert next_point(end, end.psi + side * 2.0 * END_TOLERANCE) is None
 
 
 def grid_roots(name: str, seed: int) -> list[tuple[Probe, np.ndarray, list[list[Point]]]]:
@@ -106,13 +113,13 @@ def grid_roots(name: str, seed: int) -> list[tuple[Probe, np.ndarray, list[list[
     q = np.random.default_rng(seed).uniform(np.maximum(arm.lower, -np.pi), np.minimum(arm.upper, np.pi))
     T = arm.fk(q)
     optimizer = om.RedundancyOptimizer(solver, obstacles(T[:3, 3], 1), min_clearance=MIN_CLEARANCE)
-    linked, link = [], paths._link
+    linked, link = [], Probe.link
 
     def recorded(probe, psi, roots):
         linked.append((probe, psi, [list(points) for points in roots]))
         return link(probe, psi, roots)
 
-    with mock.patch.object(paths, "_link", recorded):
+    with mock.patch.object(Probe, "link", recorded):
         paths.sweep_circle(
             [optimizer._probe(T, signs) for signs in optimizer.branches], optimizer.grid_points
         )
@@ -124,11 +131,10 @@ def grid_roots(name: str, seed: int) -> list[tuple[Probe, np.ndarray, list[list[
 def test_compiled_link_makes_the_python_loops_paths(seed, name):
     """On random poses of several arms, every branch's paths linked in one call are those of
     the Python loop: the same paths, turns and points (psi, joints and tangents to the bit),
-    the grid roots themselves where the loop has them, and the call links them itself."""
+    the grid roots themselves where the loop has them."""
     for probe, psi, roots in grid_roots(name, seed):
-        assert probe.link(psi, [list(points) for points in roots]) is not None
-        fast = paths._link(probe, psi, [list(points) for points in roots])
-        slow = paths._link(probe, psi, [list(points) for points in roots], compiled=False)
+        fast = [paths.Path(points, turns) for points, turns in probe.link(psi, [list(p) for p in roots])]
+        slow = reference.link(probe, psi, [list(points) for points in roots])
         grid = {id(p) for points in roots for p in points}
         assert [path.turns for path in fast] == [path.turns for path in slow]
         for a, b in zip(fast, slow, strict=True):
@@ -222,7 +228,7 @@ def test_a_link_without_room_is_made_again_with_more():
         calls.clear()
         with mock.patch.object(_core, "link_paths", cramped):
             linked = probe.link(psi, [list(points) for points in roots])
-        slow = paths._link(probe, psi, [list(points) for points in roots], compiled=False)
+        slow = reference.link(probe, psi, [list(points) for points in roots])
         assert [turns for _, turns in linked] == [path.turns for path in slow]
         for (points, _), path in zip(linked, slow, strict=True):
             assert [(p.psi, p.q.tolist()) for p in points] == [(p.psi, p.q.tolist()) for p in path.points]

@@ -9,7 +9,7 @@
 
 static PyStructSequence_Field followed_fields[] = {
     {"psi", "the arm angle reached"},
-    {"status", "FOLLOW_ARRIVED, FOLLOW_ENDED, FOLLOW_SINGULAR or FOLLOW_STALLED"},
+    {"status", "FOLLOW_ARRIVED, FOLLOW_ENDED or FOLLOW_STALLED"},
     {"steps", "the accepted steps"},
     {NULL, NULL},
 };
@@ -18,8 +18,7 @@ static PyStructSequence_Desc followed_desc = {"om_redundant.ckernels.Followed", 
 static PyTypeObject *followed_type;
 
 static PyStructSequence_Field linked_fields[] = {
-    {"status", "LINK_DONE, LINK_SINGULAR (a follow met a fold exactly) or LINK_FULL (more rows added than the "
-               "rows' capacity)"},
+    {"status", "LINK_DONE or LINK_FULL (more rows added than the rows' capacity)"},
     {"added", "the rows that following added"},
     {"paths", "the paths (LINK_DONE), else 0"},
     {NULL, NULL},

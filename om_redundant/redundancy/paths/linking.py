@@ -5,8 +5,11 @@ One (signs, psi) can have several exact solutions (2-4 near a singular wrist or 
 elbow), so the solutions of a branch are organised as *paths*:
 
 * **Following.** From a solution, the next one is the solution nearest it (``q_hint``),
-  accepted when it continues the path (:meth:`Probe.continues`: no joint moves more than
-  :data:`JUMP`, and the joints move as the path's tangent predicts); a step that fails is
+  accepted when it continues the path (no joint moves more than :data:`~.probe.JUMP`, and
+  the joints move as the path's tangent predicts to first order,
+  :math:`|\Delta q - (dq/d\psi)\,\Delta\psi|_\infty \le \frac12 |\Delta q|_\infty`; a
+  solution on another path, however near, is off by the paths' separation, which no shorter
+  step of psi shrinks); a step that fails is
   halved (near a singular shoulder or wrist two joints turn fast), and doubled again after
   a success (:meth:`Probe.follow`). Below :data:`END_TOLERANCE` the path has *ended*:
   it folded back in psi (meeting a second path there), or left the branch or the reach.
@@ -19,7 +22,8 @@ elbow), so the solutions of a branch are organised as *paths*:
   several per psi) comes from one parallel batch (:meth:`~om_redundant.OMSolver.solve_all_batch`).
   Each solution is followed to the next grid psi and linked to the
   solution it arrives at; solutions not arrived at start new paths, followed backwards to
-  where they end; paths are joined across +-pi, and close into loops.
+  where they end; paths are joined across +-pi, and close into loops (one
+  ``_core.link_paths`` call per branch, :meth:`Probe.link`).
 * **Cells.** Between neighbouring samples of a path where a joint moves more than
   :data:`FINE_STEP`, samples are inserted. Every sample carries its feasibility functions
   :math:`g_j` (each joint's margin, each clearance minus d_min, normalised; feasible iff all
@@ -99,7 +103,7 @@ def sweep_circle(probes: list[Probe], n: int) -> list[list[Path]]:
             for k, point in zip(grid.tolist(), probe.points(psi[grid], distinct), strict=True):
                 if point is not None:
                     roots[k].append(point)
-        swept.append([(probe, path) for path in _link(probe, psi, roots)])
+        swept.append([(probe, Path(points, turns)) for points, turns in probe.link(psi, roots)])
     filled = iter(_with_hidden([path for paths in swept for path in paths]))  # (every branch's at once)
     return [[next(filled) for _ in paths] for paths in swept]
 
@@ -164,96 +168,6 @@ def lockstep(processes: list[Generator[Follow, tuple[Point, bool], Any]]) -> lis
     return results
 
 
-def _link(probe: Probe, psi: np.ndarray, roots: list[list[Point]], compiled: bool = True) -> list[Path]:
-    """Paths through the solutions at each grid psi (module docstring). In one call where the
-    probe follows compiled (:meth:`Probe.link`), else in the loop here, which makes the same
-    follows and decisions: where a follow met a fold exactly (the loop's follows then decide
-    there, :meth:`Probe.follow`), and with ``compiled=False`` (the reference it is tested
-    against)."""
-    linked = probe.link(psi, roots) if compiled else None
-    if linked is not None:
-        return [Path(points, turns) for points, turns in linked]
-    n = len(psi)
-    paths: list[list[Point]] = []
-    first: list[int] = []  # grid index of each path's first sample
-    ongoing: list[int] = []  # paths that reached the previous grid psi
-    for k in range(n):
-        taken = [False] * len(roots[k])
-        reaching = []
-        for i in ongoing:
-            last = paths[i][-1]
-            if len(roots[k]) == 1 and probe.continues(last, roots[k][0]):
-                reached, arrived = roots[k][0], True  # the only solution, and it continues the path
-            else:
-                reached, arrived = probe.follow(paths[i][-1], psi[k])
-            if not arrived:
-                paths[i] += [reached] if reached is not paths[i][-1] else []
-                continue
-            j = _same(probe, reached, roots[k])
-            if j is None:  # a solution the bounded search did not list
-                roots[k].append(reached)
-                taken.append(False)
-                j = len(roots[k]) - 1
-            if not taken[j]:  # (else two paths met: this one stops here)
-                taken[j] = True
-                paths[i].append(roots[k][j])
-                reaching.append(i)
-        for j, root in enumerate(roots[k]):
-            if not taken[j]:
-                paths.append([root])
-                first.append(k)
-                reaching.append(len(paths) - 1)
-        ongoing = reaching
-    return _joined(probe, psi, paths, first, ongoing)
-
-
-def _joined(
-    probe: Probe, psi: np.ndarray, paths: list[list[Point]], first: list[int], last: list[int]
-) -> list[Path]:
-    """The paths joined across +-pi (those reaching the last grid psi continue into those
-    starting at the first), loops closed, and the other starts followed back to their end."""
-    following: dict[int, int] = {}  # path i continues across +-pi into path following[i]
-    for i in last:
-        reached, arrived = probe.follow(paths[i][-1], psi[0] + TURN)
-        starts = [j for j in range(len(paths)) if first[j] == 0 and j not in following.values()]
-        j = _same(probe, reached, [paths[j][0] for j in starts]) if arrived else None
-        if j is not None:
-            following[i] = starts[j]
-        elif not arrived and reached is not paths[i][-1]:
-            paths[i].append(reached)
-    heads = [i for i in range(len(paths)) if i not in following.values()]
-    result, seen = [], set()
-    for head in heads + list(following):  # chains from their heads, then the loops
-        if head in seen:
-            continue
-        chain = [head]
-        while chain[-1] in following and following[chain[-1]] not in chain:
-            chain.append(following[chain[-1]])
-        seen.update(chain)
-        points = [p.at(p.psi + TURN * turn) if turn else p for turn, i in enumerate(chain) for p in paths[i]]
-        if following.get(chain[-1]) == chain[0]:
-            result.append(Path(points, turns=len(chain)))
-        else:
-            result.append(Path(_back_to_end(probe, psi, points, first[chain[0]])))
-    return result
-
-
-def _back_to_end(probe: Probe, psi: np.ndarray, points: list[Point], k: int) -> list[Point]:
-    """The path's samples with, in front, where it ends before its first grid sample."""
-    previous = psi[k - 1] if k > 0 else psi[-1] - TURN
-    reached, _ = probe.follow(points[0], previous)
-    return ([reached] if reached is not points[0] else []) + points
-
-
-def _same(probe: Probe, point: Point, candidates: list[Point]) -> int | None:
-    """The index of the candidate that is the same solution as point, if any."""
-    for j, candidate in enumerate(candidates):
-        if candidate is point:  # (the candidates are more than SAME apart)
-            return j
-    steps = [probe.step(point.q, c.q) for c in candidates]
-    return int(np.argmin(steps)) if steps and min(steps) <= SAME else None
-
-
 def _with_hidden(paths: list[tuple[Probe, Path]]) -> list[Path]:
     """The paths with exact samples inserted where a cell hides a feature (module
     docstring): the look inside every cell of every (probe, path) at once (:func:`lockstep`).
@@ -302,7 +216,7 @@ def _hidden(probe: Probe, a: Point, b: Point, t: float) -> Generator[Follow, tup
     end, and where that is not arrived at, from its right end.
 
     **Path ends.** a can be where its path ends: a path's first sample, followed back to a
-    fold (:func:`_back_to_end`), where :math:`q - q_f \sim (\psi - \psi_f)^{1/2}` and
+    fold (the linking follows it back to where it ends), where :math:`q - q_f \sim (\psi - \psi_f)^{1/2}` and
     :math:`|dq/d\psi|` is about 1e4-1e10. No follow leaves it (the first-order prediction of
     a step longer than its distance to the fold overshoots; a shorter one, below
     :data:`END_TOLERANCE`, is refused), so the samples of such a cell are followed from its

@@ -7,30 +7,29 @@ accepted when it continues the path (:meth:`Probe.continues`: no joint moves mor
 halved (near a singular shoulder or wrist two joints turn fast), and doubled again after a
 success; where the last two points predict the path's end short of the next step, the step
 aims just short of it (:meth:`Probe.follow`). Below :data:`END_TOLERANCE` the path has *ended*: it folded
-back in psi, or left the branch or the reach. With a compiled solver the loop runs in one
-call (``_core.follow``, ``csrc/follow.c``: the same steps and tests, the tangents of
+back in psi, or left the branch or the reach (a solution exactly at a fold, where psi does not
+move along the self-motion, fails its step as any other: the path ends beside it). The loop
+runs in one call (``_core.follow``, ``csrc/follow.c``; the tangents of
 ``csrc/self_motion.c``; its solves are the hinted solve's local part, so a failed local solve
 is a failed step without the bounded search, a root within a quarter of its step of the
 first-order prediction is taken without the scan for a nearer one, and a step whose
 prediction moves a joint farther than any root as near as the local one could continue
 fails without it, as it would with it); Python builds only the point reached. The linking of
 a branch's grid roots into paths runs in one call too (:meth:`Probe.link`,
-``_core.link_paths``, ``csrc/link.c``: those follows and the decisions of
-:func:`~om_redundant.redundancy.paths.linking._link`'s loop).
+``_core.link_paths``, ``csrc/link.c``). Both loops are written in Python in
+``tests/reference/follow.py``, the oracle they are tested against.
 """
 
 from __future__ import annotations
 
 import itertools
-import math
 
 import numpy as np
 
 from ... import _core
 from ...angles import TURN, wrap_angles
 from ...exceptions import SingularSelfMotion
-from ...ik.configuration import Configuration
-from ...ik.solver import BRANCH_BAND, OMSolver, Solution
+from ...ik.solver import OMSolver, Solution
 from ..objective.objective import Objective
 from ..self_motion import self_motion_tangent, self_motion_tangents
 from .points import Point, PointTerms, evaluated_terms
@@ -41,24 +40,19 @@ JUMP = _core.PATH_JUMP
 END_TOLERANCE = _core.END_TOLERANCE
 #: rad, max-norm: two solutions at one psi this close are one (csrc/link.c reads it there too).
 SAME = _core.PATH_SAME
-_AIM = _core.FOLLOW_AIM  # of the distance to a path's predicted end, a step aimed there goes
-_ARRIVED, _SINGULAR, _STALLED = _core.FOLLOW_ARRIVED, _core.FOLLOW_SINGULAR, _core.FOLLOW_STALLED
 # A follow stalls (csrc/om_paths.h: a path within rounding of a singular set advances by
-# ~1e-6 rad a step) after CRAWL_STEPS accepted steps in a row shorter than CRAWL, or after
-# MAX_ATTEMPTS attempts: then SingularSelfMotion.
-CRAWL, CRAWL_STEPS = _core.FOLLOW_CRAWL, _core.FOLLOW_CRAWL_STEPS
-MAX_ATTEMPTS = _core.FOLLOW_MAX_ATTEMPTS
+# ~1e-6 rad a step, FOLLOW_CRAWL_STEPS steps in a row, or takes FOLLOW_MAX_ATTEMPTS
+# attempts): then SingularSelfMotion.
+_ARRIVED, _STALLED = _core.FOLLOW_ARRIVED, _core.FOLLOW_STALLED
 
 
 class Probe:
-    """Exact solutions along one branch at one pose, and their objective.
+    """Exact solutions along one branch of a 7-DOF arm at one pose, and their objective.
 
     Args:
         solver, objective, T, signs: The solver, the objective, the pose and the branch.
         wrapped: Revolute joints modulo 2 pi, at the representative nearest mid-range (for
             the feasible intervals); False keeps them as solved (for tracking).
-        compiled: Follow paths with ``_core.follow`` where the arm has 7 joints; False:
-            always the Python loop (the reference it is tested against).
     """
 
     def __init__(
@@ -68,7 +62,6 @@ class Probe:
         T: np.ndarray,
         signs: tuple[int, ...],
         wrapped: bool = True,
-        compiled: bool = True,
     ):
         self.solver, self.objective, self.T, self.signs = solver, objective, T, signs
         arm = solver.arm
@@ -79,18 +72,16 @@ class Probe:
         self._centre = (lower + upper) / 2.0
         # (where every joint is cyclic, or centred, no np.where picks between the two)
         self._all_cyclic, self._all_centred = all(self._cyclic.tolist()), all(self._centred.tolist())
-        self._work = None  # the compiled follow's arrays: a 7-DOF arm's only
-        if compiled and arm.dof == 7:
-            self._work = _core.FollowWork(
-                solver.kernel,
-                np.ascontiguousarray(T, dtype=float),
-                np.array(signs, dtype=np.int64),
-                self._cyclic.astype(np.uint8),
-                self._centred.astype(np.uint8),
-                np.ascontiguousarray(self._centre, dtype=float),
-                np.empty(7),
-                np.empty(7),
-            )
+        self._work = _core.FollowWork(  # the compiled follow's arrays
+            solver.kernel,
+            np.ascontiguousarray(T, dtype=float),
+            np.array(signs, dtype=np.int64),
+            self._cyclic.astype(np.uint8),
+            self._centred.astype(np.uint8),
+            np.ascontiguousarray(self._centre, dtype=float),
+            np.empty(7),
+            np.empty(7),
+        )
 
     def step(self, a: np.ndarray, b: np.ndarray) -> float:
         """The largest joint step max_i |b_i - a_i| between joint vectors a and b (float64,
@@ -102,10 +93,6 @@ class Probe:
     def cyclic(self) -> np.ndarray:
         """(dof,) bool: the joints that :meth:`step` compares modulo 2 pi."""
         return self._cyclic
-
-    def _delta(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        d = b - a
-        return wrap_angles(d) if self._all_cyclic else np.where(self._cyclic, wrap_angles(d), d)
 
     def point(self, psi: float | np.ndarray, q: np.ndarray, solution: Solution | None = None) -> Point:
         """The point of solution q at psi, q at its representative (see the class)."""
@@ -149,106 +136,38 @@ class Probe:
                 points[k] = point
         return points
 
-    def at(self, psi: float | np.ndarray, hint: np.ndarray) -> Point | None:
-        """The solution at psi nearest ``hint``, if there is one."""
-        sol = self._solve(psi, hint)
-        return self.point(psi, sol.q, sol) if sol.ok else None
-
-    def _solve(self, psi: float | np.ndarray, hint: np.ndarray) -> Solution:
-        return self.solver.solve(self.T, Configuration(self.signs, tuple(np.atleast_1d(psi))), q_hint=hint)
-
-    def continues(self, point: Point, other: Point) -> bool:
-        r"""Whether ``other`` continues point's path: its joints moved at most :data:`JUMP` and
-        as the path's tangent predicts to first order,
-        :math:`|\Delta q - (dq/d\psi)\,\Delta\psi|_\infty \le \frac12 |\Delta q|_\infty`. (A
-        solution on another path, however near, is off by the paths' separation, which no
-        shorter step of psi shrinks.)"""
-        return self._continues(point, other.psi, other.q)
-
-    def _continues(self, point: Point, psi: float | np.ndarray, q: np.ndarray) -> bool:
-        moved = self._delta(point.q, q)
-        return bool(_continuing(moved, moved - point.tangent @ np.atleast_1d(psi - point.psi)))
-
-    def next(self, point: Point, psi: float | np.ndarray) -> Point | None:
-        """The solution at psi nearest point, if it continues point's path (the objective
-        evaluated only then): one attempt of :meth:`follow`'s loop."""
-        if self._work is not None and psi != point.psi:
-            found = self._follow_compiled(point, psi, abs(psi - point.psi))
-            if found is not None:
-                return found[0] if found[1] else None
-        sol = self._solve(psi, point.q)
-        if not sol.ok:
-            return None
-        q = self._represent(sol.q)
-        return self._point(psi, q, sol) if self._continues(point, psi, q) else None
+    def next(self, point: Point, psi: float) -> Point | None:
+        """The solution at psi nearest point, if it continues point's path (:meth:`follow`'s
+        test; the objective evaluated only then): one attempt of its loop, the climb's trial
+        step."""
+        reached, arrived = self._follow(point, psi, abs(psi - point.psi))
+        return reached if arrived else None
 
     def follow(self, start: Point, psi: float) -> tuple[Point, bool]:
-        """Continue start's path towards psi (module docstring). Where the secant of an end
-        measure (:meth:`_end_measures`) through the last two points predicts the path's end
-        short of the next step, the step aims :data:`_AIM` of the way there instead (at
-        least 1.5 :data:`END_TOLERANCE`): the end is approached in a few successful steps
-        rather than by halving, whose failing attempts beyond the end are the costliest.
+        """Continue start's path towards psi (module docstring) in one ``_core.follow`` call.
+        Where the secant of an end measure (1 / |dq/dpsi|^2 at a fold, a branch quantity's
+        distance beyond :data:`~om_redundant.ik.solver.BRANCH_BAND`) through the last two
+        points predicts the path's end short of the next step, the step aims
+        ``_core.FOLLOW_AIM`` of the way there instead (at least 1.5 :data:`END_TOLERANCE`):
+        the end is approached in a few successful steps rather than by halving, whose failing
+        attempts beyond the end are the costliest.
 
         Returns:
             The point reached and whether it is at psi. When the path ends on the way the
             point is its end, to :data:`END_TOLERANCE`.
+
+        Raises:
+            SingularSelfMotion: The follow stalled: the path runs within rounding of a
+                singular set.
         """
-        if self._work is not None:
-            reached = self._follow_compiled(start, psi)
-            if reached is not None:
-                return reached
-        point, step = start, psi - start.psi
-        ends, behind = self._end_measures(point), None  # behind: (psi, end measures) of the point before
-        crawled = 0  # accepted steps in a row shorter than CRAWL
-        for attempts in itertools.count():
-            if point.psi == psi:
-                break
-            if abs(step) < END_TOLERANCE:
-                return point, False
-            if attempts == MAX_ATTEMPTS or crawled == CRAWL_STEPS:
-                _stalled(point.psi, point.q)
-            x = psi if abs(psi - point.psi) <= abs(step) else point.psi + step
-            aim = math.inf
-            if behind is not None:
-                ahead = _predicted_end(behind[1], ends, abs(point.psi - behind[0]))
-                aim = max(_AIM * ahead, 1.5 * END_TOLERANCE)
-            if aim < abs(x - point.psi):
-                x = point.psi + math.copysign(aim, step)
-            nxt = self.next(point, x)
-            if nxt is None:  # (halved from x, not from step: psi nearer than step is not tried again)
-                step = 0.5 * (x - point.psi)
-            else:
-                crawled = crawled + 1 if abs(x - point.psi) < CRAWL else 0
-                step = 2.0 * (x - point.psi)
-                behind, point = (point.psi, ends), nxt
-                ends = self._end_measures(point)
-        return point, True
+        return self._follow(start, psi, END_TOLERANCE)
 
-    def _end_measures(self, point: Point) -> list[float]:
-        """What ends a path, as functions of its point that fall to zero there linearly in
-        psi: 1 / |dq/dpsi|^2 at a fold (q - q_f ~ (psi_f - psi)^(1/2)), and s_i b_i +
-        BRANCH_BAND where branch quantity b_i leaves its sign s_i beyond the band."""
-        branch, redundancy = np.empty(len(self.signs)), np.empty(1)
-        self.solver.kernel.configuration_values(np.ascontiguousarray(point.q), branch, redundancy)
-        tt = 0.0
-        for v in point.tangent[:, 0].tolist():  # (summed in order, as csrc/follow.c does)
-            tt += v * v
-        return [1.0 / tt] + [
-            float(s) * b + BRANCH_BAND for s, b in zip(self.signs, branch.tolist(), strict=True)
-        ]
-
-    def _follow_compiled(
-        self, start: Point, psi: float, min_step: float = END_TOLERANCE
-    ) -> tuple[Point, bool] | None:
-        """:meth:`follow` in one ``_core.follow`` call, ending where the step falls below
-        ``min_step``; None where it met a point without a tangent (a fold met exactly: the
-        Python loop then decides)."""
+    def _follow(self, start: Point, psi: float, min_step: float) -> tuple[Point, bool]:
+        """:meth:`follow`, ending where the step falls below ``min_step``."""
         work = self._work
         work.q[:] = start.q
         work.t[:] = start.tangent[:, 0]
         reached, status, steps = _core.follow(work, float(start.psi), float(psi), float(min_step))
-        if status == _SINGULAR:
-            return None
         if status == _STALLED:
             _stalled(reached, work.q)
         if steps == 0:
@@ -256,20 +175,16 @@ class Probe:
         q, tangent = work.q.copy(), work.t.copy()[:, None]
         return Point(reached, q, tangent, PointTerms(self.objective, q, tangent)), status == _ARRIVED
 
-    def link(self, psi: np.ndarray, roots: list[list[Point]]) -> list[tuple[list[Point], int]] | None:
+    def link(self, psi: np.ndarray, roots: list[list[Point]]) -> list[tuple[list[Point], int]]:
         """The paths through the solutions ``roots[k]`` at the increasing grid psi[k] (within a
-        turn) that :func:`~om_redundant.redundancy.paths.linking._link`'s loop finds, in one
-        ``_core.link_paths`` call (``csrc/link.c``: the same follows, in the same order, and
-        the same decisions): each path's points and turns. Python builds only the points that
-        following added. None where the solver is not a 7-DOF arm's compiled one or where a
-        follow met a fold exactly (:meth:`_follow_compiled`): the loop then decides. (Room for
+        turn), in one ``_core.link_paths`` call (``csrc/link.c``; the rule in
+        :mod:`~om_redundant.redundancy.paths.linking`'s docstring): each path's points and
+        turns. Python builds only the points that following added. (Room for
         two added points per root and one per grid psi: paths start only at listed roots and
         end once on each side, and a root that the bounded search did not list, which a
         follow arrives at, is rare; where following adds more, the call is made again with
         twice the room: its follows and decisions are the same, only their rows more.)"""
         work = self._work
-        if work is None:
-            return None
         flat = [p for points in roots for p in points]
         counts = np.array([len(points) for points in roots], dtype=np.int64)
         q = np.array([p.q for p in flat], dtype=float).reshape(len(flat), 7)
@@ -284,8 +199,6 @@ class Probe:
             if found.status != _core.LINK_FULL:
                 break
             capacity = 2 * capacity + 1  # (the same follows and decisions again, with room for their rows)
-        if found.status != _core.LINK_DONE:
-            return None
         new = slice(0, found.added)
         for x, qk, tk in zip(added.psi[new].tolist(), added.q[new], added.t[new, :, None], strict=True):
             flat.append(Point(x, qk, tk, PointTerms(self.objective, qk, tk)))
@@ -305,18 +218,3 @@ def _stalled(psi: float, q: np.ndarray) -> None:
         f"the self-motion crawls at psi = {psi:+.6f}, q = {np.round(q, 6).tolist()}: the pose is "
         "within rounding of one where the arm's joint axes align (e.g. q2 = q6 = 0)"
     )
-
-
-def _predicted_end(before: list[float], now: list[float], moved: float) -> float:
-    """The distance in psi ahead of a point (end measures ``now``) to the nearest end that
-    the secant of a measure falling towards zero predicts, from the point ``moved`` behind
-    (measures ``before``); inf where none falls."""
-    ahead = [moved * f / (b - f) for b, f in zip(before, now, strict=True) if 0.0 < f < b]
-    return min(ahead, default=math.inf)
-
-
-def _continuing(moved: np.ndarray, error: np.ndarray) -> np.ndarray:
-    """The rule of :meth:`Probe.continues` on the last axis: the joint step |moved|_inf at
-    most JUMP and the first-order prediction's error within half of it (plus SAME)."""
-    jump = np.abs(moved).max(axis=-1)
-    return (jump <= JUMP) & (np.abs(error).max(axis=-1) <= 0.5 * jump + SAME)
