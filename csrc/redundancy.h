@@ -10,7 +10,8 @@
 
 /* ------------------------------------------------------------------------------------ */
 /* box_qp.c: maximise phi(delta) = sum_g w_g min(cap_g, min_{j in g} v_j + a_j delta) - b delta^2 / 2
- * over [lo, hi] where every group with a floor keeps its minimum >= floor. */
+ * over [lo, hi] where every group with a floor keeps its minimum >= floor (the climb's QP and
+ * the tracking step's). */
 
 /* G groups of pieces concatenated: group g's pieces are ends[g] .. ends[g + 1] - 1 (at least
  * one each; ends[0] = 0), each group's weight, floor (-inf: none) and cap. */
@@ -20,14 +21,11 @@ typedef struct {
     ptrdiff_t G;
 } om_qp_groups;
 
-enum { OM_QP_NONE = 0, OM_QP_FOUND = 1, OM_QP_NO_MEMORY = -1, OM_QP_EMPTY_GROUP = -2 };
-/* The maximiser into *delta and the n pieces' multipliers into z: OM_QP_FOUND, OM_QP_NONE where
- * the floors leave no delta, OM_QP_NO_MEMORY. */
-int om_qp_maximise(const om_qp_groups *q, double b, double lo, double hi, double *delta, double *z);
-/* The climb's step: om_qp_maximise of the pieces that can be their group's least somewhere in
- * the box, *gain the model's gain model(delta) - b delta^2 / 2 - model(0) over all pieces, z every
- * piece's multiplier (0 for those left out); OM_QP_EMPTY_GROUP where a group keeps no piece (a
- * piece or a bound not a number). */
+enum { OM_QP_NONE = 0, OM_QP_FOUND = 1, OM_QP_NO_MEMORY = -1 };
+/* The maximiser into *delta; unless NULL, every piece's multiplier into z (0 for a piece that
+ * cannot be its group's least within the box) and the model's gain model(delta) - b delta^2 / 2
+ * - model(0) into *gain: OM_QP_FOUND, OM_QP_NONE where the floors leave no delta,
+ * OM_QP_NO_MEMORY. The pieces and b are numbers (b > 0), lo <= hi. */
 int om_qp_step(const om_qp_groups *q, double b, double lo, double hi, double *delta, double *gain, double *z);
 
 /* ------------------------------------------------------------------------------------ */

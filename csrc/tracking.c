@@ -10,16 +10,13 @@
  * null vector of the 6 x 7 Jacobian J by cofactors, n_i = (-1)^i det J_{-i} (smooth in q, no
  * factorisation to pick a sign). The step maximises the concave model
  *     phi(d) = sum_g w_g min(cap_g, min_j v_j + a_j d) - b d^2 / 2
- * over the box |d| <= radius intersected with the floors v_j + a_j d >= floor_g: phi's right
- * derivative is non-increasing, and bisection on its sign gives the maximiser to rounding.
- * (box_qp.c maximises the same model by its breakpoints, for the climb: taken here, it moves
- * the tracked arm angles by a few ulps and costs ~1.5 us a step, so the bisection stays.) */
+ * over the box |d| <= radius intersected with the floors v_j + a_j d >= floor_g (box_qp.c,
+ * the climb's QP). */
 #include <string.h>
 
 #include "redundancy.h"
 
 #define MAX_PIECES OM_TRACK_MAX_PIECES
-#define BISECTIONS 80
 #define HALVINGS 6
 #define MIN_CURVATURE 1e-3
 #define MAX_CURVATURE 1e3
@@ -75,70 +72,14 @@ static void pieces_at(const tracking *tr, const double *q, const double *t, piec
     P->n = n;
 }
 
-/* The right derivative of the model phi at d. */
-static double slope(const tracking *tr, const pieces *P, double b, double d) {
-    double low[3] = {INFINITY, INFINITY, INFINITY}, rate[3] = {0.0, 0.0, 0.0};
-    for (int j = 0; j < P->n; j++) {
-        int g = P->group[j];
-        double v = P->v[j] + P->a[j] * d;
-        if (v < low[g] || (v == low[g] && P->a[j] < rate[g])) low[g] = v, rate[g] = P->a[j];
-    }
-    double D = -b * d;
-    for (int g = 0; g < 3; g++)
-        if (low[g] < tr->cap[g] || (low[g] == tr->cap[g] && rate[g] < 0.0)) D += tr->weight[g] * rate[g];
-    return D;
-}
-
-/* The pieces of P that can be their group's smallest somewhere in [lo, hi], into Q. A piece is
- * left out where its least value there exceeds the least of the group's greatest values (each
- * at an end: the pieces are linear) by more than the rounding of v + a d can make up (at most
- * 2^-52 (|v| + |a d|) each, so 1e-12 of both pieces' magnitudes is ample): the computed v_j(d)
- * then exceeds that other piece's at every d of [lo, hi], and slope's minima, its tie-breaks
- * and so its every value are P's. */
-static void contenders(const pieces *P, double lo, double hi, pieces *Q) {
-    double reach = fmax(fabs(lo), fabs(hi)), least_top[3] = {INFINITY, INFINITY, INFINITY}, size[3] = {0.0, 0.0, 0.0};
-    for (int j = 0; j < P->n; j++) {
-        int g = P->group[j];
-        double top = fmax(P->v[j] + P->a[j] * lo, P->v[j] + P->a[j] * hi);
-        if (top < least_top[g]) least_top[g] = top, size[g] = fabs(P->v[j]) + fabs(P->a[j]) * reach;
-    }
-    int n = 0;
-    for (int j = 0; j < P->n; j++) {
-        int g = P->group[j];
-        double bottom = fmin(P->v[j] + P->a[j] * lo, P->v[j] + P->a[j] * hi);
-        double slack = 1e-12 * (1.0 + fabs(P->v[j]) + fabs(P->a[j]) * reach + size[g]);
-        if (bottom - least_top[g] > slack) continue; /* (NaN: kept) */
-        Q->v[n] = P->v[j], Q->a[n] = P->a[j], Q->group[n++] = g;
-    }
-    Q->n = n;
-}
-
-/* The maximiser of the model over the box and the floors; false if they leave nothing. The
- * bisection reads only the pieces that can bind (contenders). */
-static bool box_step(const tracking *tr, const pieces *all, double b, double radius, double *step) {
-    double lo = -radius, hi = radius;
-    for (int j = 0; j < all->n; j++) {
-        double floor = tr->floor[all->group[j]], a = all->a[j], gap = floor - all->v[j];
-        if (floor == -INFINITY) continue;
-        if (a > 0.0) lo = fmax(lo, gap / a);
-        else if (a < 0.0) hi = fmin(hi, gap / a);
-        else if (gap > 0.0) return false;
-    }
-    if (!(lo <= hi)) return false;
-    static pieces contending; /* (the GIL is held: one call at a time) */
-    const pieces *P = &contending;
-    contenders(all, lo, hi, &contending);
-    if (slope(tr, P, b, lo) <= 0.0) return *step = lo, true;
-    double left = lo, right = hi;
-    if (slope(tr, P, b, hi) >= 0.0) return *step = hi, true;
-    for (int k = 0; k < BISECTIONS && right - left > 0.0; k++) {
-        double mid = 0.5 * (left + right);
-        if (mid == left || mid == right) break;
-        if (slope(tr, P, b, mid) > 0.0) left = mid;
-        else right = mid;
-    }
-    *step = left; /* the right derivative is positive at left and not at right: the kink or stationary point */
-    return true;
+/* The maximiser of the model over the box |d| <= radius and the floors (om_qp_step); false if
+ * they leave nothing. pieces_at lists the groups' pieces group by group. */
+static bool box_step(const tracking *tr, const pieces *P, double b, double radius, double *step) {
+    int64_t ends[4] = {0, 0, 0, 0};
+    for (int j = 0; j < P->n; j++) ends[P->group[j] + 1]++;
+    for (int g = 0; g < 3; g++) ends[g + 1] += ends[g];
+    om_qp_groups q = {P->v, P->a, tr->weight, tr->floor, tr->cap, ends, 3};
+    return om_qp_step(&q, b, -radius, radius, step, NULL, NULL) == OM_QP_FOUND;
 }
 
 /* Each exact solve's root is taken without the windowed scan for a nearer one where it

@@ -99,7 +99,6 @@ def recorded_calls() -> dict[str, tuple[Callable[..., Any], tuple[Any, ...]]]:
         "redundancy_values": (2, data.params, q, np.zeros(1)),
         "jacobian": (data.real_table, np.eye(4), np.eye(4), q, np.zeros((6, 7))),
         "flange_target": (T, data.T_base_root, data.T_tool_flange, np.zeros(9), np.zeros(3)),
-        "maximise_1d": seen["step_1d"],
         "model_ik": (
             _core.FamilyModel(2, data.params, data.model_table),
             _core.FlangeTarget(R.reshape(3, 3), p, signs, psi),

@@ -326,7 +326,7 @@ def test_the_bindings_refuse_indices_out_of_range(panda):
 
 
 def test_the_climb_bindings_refuse_groups_and_indices_out_of_range():
-    """maximise_1d and step_1d read the pieces of each group between its ends: ends that do not
+    """step_1d reads the pieces of each group between its ends: ends that do not
     start at 0, end at the pieces' count and increase are a ValueError, with no groups too;
     start_bound reads the samples a..b of its start k: k, a and b out of order or out of
     range, a group column out of range, or a reach that is not >= 0, are a ValueError; start_cones
@@ -336,8 +336,7 @@ def test_the_climb_bindings_refuse_groups_and_indices_out_of_range():
 
     def groups(ends, w=one, n=5):
         pieces = _core.Pieces(v[:n], a[:n], np.array(ends, dtype=np.int64), w, -w, w)
-        for kernel in (_core.maximise_1d, _core.step_1d):
-            kernel(pieces, 1.0, -1.0, 1.0, z[:n])
+        _core.step_1d(pieces, 1.0, -1.0, 1.0, z[:n])
 
     groups([0, 5])
     groups([0], none, 0)

@@ -27,17 +27,6 @@ from tests.reference import start_bounds as start_bounds_numpy
 from tests.reference.self_motion import self_motion_tangents as reference_tangents
 
 
-def maximise_1d(
-    groups: list[Group], curvature: float, lower: float, upper: float
-) -> tuple[float, list[np.ndarray]] | None:
-    """``_core.maximise_1d`` of the groups' pieces: delta and each group's multipliers, or None
-    when the floors leave no delta (tests/reference/box_qp.py's maximise_1d, compiled)."""
-    pieces = Pieces.of(groups)
-    z = np.empty(len(pieces.values))
-    delta = _core.maximise_1d(pieces, curvature, lower, upper, z)
-    return None if delta is None else (delta, pieces.split(z))
-
-
 @functools.cache
 def optimizer_of(name: str, count: int) -> om.RedundancyOptimizer:
     """The arm's optimiser with count obstacles about its home hand (cached)."""
@@ -177,52 +166,6 @@ def test_a_probe_step_is_the_largest_joint_step(seed, name, wrapped):
     assert probe.step(z, turned) == pytest.approx(0.5 * np.pi if cyclic[0] else 1.5 * np.pi, abs=1e-15)
 
 
-@settings(max_examples=40, deadline=None)
-@given(
-    seed=st.integers(0, 2**32 - 1),
-    pieces=st.integers(1, 6),
-    curvature=st.floats(1e-3, 1e3),
-    reach=st.floats(1e-4, 1.0),
-)
-def test_the_one_variable_qp_step_is_the_models_maximiser(seed, pieces, curvature, reach):
-    """box_qp.maximise_1d, from a point within the floors as the climb's: a delta within the
-    box and the floors whose model value no point of a dense grid of the feasible interval
-    beats, and multipliers in [0, w_g] per group; compiled exactly as numpy computes it,
-    also from points below the floors (where they may leave no delta)."""
-    rng = np.random.default_rng(seed)
-    groups = random_groups(rng, 1, lambda floor: rng.uniform(max(floor, 0.0), 1.5, pieces))
-    lower, upper = -reach * rng.uniform(), reach * rng.uniform()
-    grid = np.linspace(lower, upper, 20001)
-    pieces_at = [g.values[None, :] + g.jacobian[None, :, 0] * grid[:, None] for g in groups]
-    floors_kept = np.all([p.min(axis=1) >= g.floor for g, p in zip(groups, pieces_at, strict=True)], axis=0)
-    model = sum(
-        (g.weight * np.minimum(g.cap, p.min(axis=1)) for g, p in zip(groups, pieces_at, strict=True)),
-        start=-0.5 * curvature * grid**2,
-    )
-    delta, multipliers = maximise_1d(groups, curvature, lower, upper)
-    reference = box_qp_numpy.maximise_1d(groups, curvature, lower, upper)
-    assert delta == reference[0]
-    for z, want in zip(multipliers, reference[1], strict=True):
-        np.testing.assert_array_equal(z, want)
-    below = [Group(g.kind, g.weight, g.floor, g.cap, g.values - 0.5, g.jacobian) for g in groups]
-    found, want = (m(below, curvature, lower, upper) for m in (maximise_1d, box_qp_numpy.maximise_1d))
-    assert (found is None) == (want is None)  # (the floors may leave no delta)
-    if found is not None:
-        assert found[0] == want[0]
-        for z, w in zip(found[1], want[1], strict=True):
-            np.testing.assert_array_equal(z, w)
-    assert lower <= delta <= upper
-    at = [g.values + g.jacobian[:, 0] * delta for g in groups]
-    assert all(v.min() >= g.floor - 1e-12 for g, v in zip(groups, at, strict=True))
-    value = sum(
-        (g.weight * min(g.cap, v.min()) for g, v in zip(groups, at, strict=True)), -0.5 * curvature * delta**2
-    )
-    assert value >= model[floors_kept].max(initial=-np.inf) - 1e-12
-    assert all(
-        (z >= 0.0).all() and z.sum() <= g.weight + 1e-12 for g, z in zip(groups, multipliers, strict=True)
-    )
-
-
 @settings(max_examples=60, deadline=None)
 @given(
     seed=st.integers(0, 2**32 - 1),
@@ -231,53 +174,50 @@ def test_the_one_variable_qp_step_is_the_models_maximiser(seed, pieces, curvatur
     reach=st.floats(1e-4, 1.0),
     spread=st.floats(0.0, 3.0),
 )
-def test_the_climbs_one_variable_step_compiled_is_numpys(seed, pieces, curvature, reach, spread):
-    """box_qp.step_1d: ckernels.step_1d gives numpy's delta, gain and multipliers exactly,
-    with pieces spread so that some cannot be their group's minimum within the box (left
-    out: multiplier 0); its delta is maximise_1d's of the pieces kept, and its gain the
-    model's rise to it. Pieces.at: another point's pieces of the same groups."""
+def test_the_one_variable_qp_step_is_the_models_maximiser(seed, pieces, curvature, reach, spread):
+    """box_qp.step_1d, from a point within the floors as the climb's: a delta within the box
+    and the floors whose model value no point of a dense grid of the feasible interval beats,
+    the breakpoints' maximiser (tests/reference/box_qp.py; phi is strictly concave, so one)
+    to rounding, its gain the model's rise to it, multipliers in [0, w_g] per group, those of
+    the reference, 0 for pieces spread out of reach of their group's least; from points below
+    the floors, None exactly where the reference finds no delta."""
     rng = np.random.default_rng(seed)
-    groups = random_groups(rng, 1, lambda floor: rng.uniform(0.0, spread, pieces) + 0.3)
+    groups = random_groups(rng, 1, lambda floor: rng.uniform(0.0, spread, pieces) + max(floor, 0.0) + 0.3)
     lower, upper = -reach * rng.uniform(), reach * rng.uniform()
-    found, want = (s(Pieces.of(groups), curvature, lower, upper) for s in (step_1d, box_qp_numpy.step_1d))
-    assert (found is None) == (want is None)
-    if found is None:
-        return
-    assert found[:2] == want[:2]
-    np.testing.assert_array_equal(found[2], want[2])
-    delta, gain, z = found
-    r = max(-lower, upper)
-    kept = [
-        g.values - np.abs(g.jacobian[:, 0]) * r <= (g.values + np.abs(g.jacobian[:, 0]) * r).min()
-        for g in groups
-    ]
-    alone = maximise_1d(
-        [replace(g, values=g.values[k], jacobian=g.jacobian[k]) for g, k in zip(groups, kept, strict=True)],
-        curvature,
-        lower,
-        upper,
-    )
-    assert delta == alone[0]
-    for z_g, k, z_kept in zip(Pieces.of(groups).split(z), kept, alone[1], strict=True):
-        np.testing.assert_array_equal(z_g[k], z_kept)
-        assert (z_g[~k] == 0.0).all()
-    concatenated, model = Pieces.of(groups), box_qp_numpy.model
+    concatenated = Pieces.of(groups)
+    delta, gain, z = step_1d(concatenated, curvature, lower, upper)
+    want_delta, _, want_z = box_qp_numpy.step_1d(concatenated, curvature, lower, upper)
+    assert delta == pytest.approx(want_delta, abs=1e-12)
+    np.testing.assert_allclose(z, want_z, atol=1e-9)
+    model = box_qp_numpy.model
     assert gain == model(concatenated, delta) - 0.5 * delta * curvature * delta - model(concatenated, 0.0)
+    assert lower <= delta <= upper
+    at = [g.values + g.jacobian[:, 0] * delta for g in groups]
+    assert all(v.min() >= g.floor - 1e-12 for g, v in zip(groups, at, strict=True))
+    grid = np.linspace(lower, upper, 20001)
+    pieces_at = [g.values[None, :] + g.jacobian[None, :, 0] * grid[:, None] for g in groups]
+    floors_kept = np.all([p.min(axis=1) >= g.floor for g, p in zip(groups, pieces_at, strict=True)], axis=0)
+    phi = sum(
+        (g.weight * np.minimum(g.cap, p.min(axis=1)) for g, p in zip(groups, pieces_at, strict=True)),
+        start=-0.5 * curvature * grid**2,
+    )
+    value = sum(
+        (g.weight * min(g.cap, v.min()) for g, v in zip(groups, at, strict=True)), -0.5 * curvature * delta**2
+    )
+    assert value >= phi[floors_kept].max(initial=-np.inf) - 1e-12
+    for g, z_g in zip(groups, concatenated.split(z), strict=True):
+        assert (z_g >= 0.0).all() and z_g.sum() <= g.weight + 1e-12
+    below = Pieces.of([replace(g, values=g.values - 0.5) for g in groups])
+    found, want = (s(below, curvature, lower, upper) for s in (step_1d, box_qp_numpy.step_1d))
+    assert (found is None) == (want is None)  # (the floors may leave no delta)
     moved = [replace(g, values=g.values + 0.1, jacobian=-g.jacobian) for g in groups]
-    for mine, fresh in zip(Pieces.of(groups).at(moved), Pieces.of(moved), strict=True):
+    for mine, fresh in zip(concatenated.at(moved), Pieces.of(moved), strict=True):
         np.testing.assert_array_equal(mine, fresh)  # (another point's pieces, the structure shared)
     with pytest.raises(ValueError, match="pieces where"):
-        Pieces.of(groups).at(groups[:2])
-    broken = [
-        replace(groups[0], values=np.where(np.arange(pieces) == 0, np.nan, groups[0].values)),
-        *groups[1:],
-    ]
-    for step in (
-        step_1d,
-        box_qp_numpy.step_1d,
-    ):  # (a piece that is not a number: no piece of its group is kept)
-        with pytest.raises(ValueError):
-            step(Pieces.of(broken), curvature, lower, upper)
+        concatenated.at(groups[:2])
+    broken = concatenated._replace(values=np.where(np.arange(len(z)) == 0, np.nan, concatenated.values))
+    with pytest.raises(ValueError, match="a piece is not a number"):
+        step_1d(broken, curvature, lower, upper)
 
 
 @settings(max_examples=40, deadline=None)

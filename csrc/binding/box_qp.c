@@ -1,5 +1,5 @@
-/* The binding of the climb's QP in one variable (csrc/box_qp.c): maximise_1d and step_1d read
- * their pieces from a record (om_redundant._core.Pieces) by name. */
+/* The binding of the climb's QP in one variable (csrc/box_qp.c): step_1d reads its pieces from a
+ * record (om_redundant._core.Pieces) by name. */
 #include "binding.h"
 #include "redundancy.h"
 
@@ -41,26 +41,17 @@ static int get_problem(PyObject *const *args, Py_ssize_t nargs, PyObject *kwname
     int bad = views[P_RATES].len != n * 8 || views[P_ENDS].len != (G + 1) * 8 || views[P_FLOORS].len != G * 8 ||
               views[P_CAPS].len != G * 8 || views[P_N].len != n * 8 || q->ends[0] != 0 || q->ends[G] != n;
     for (Py_ssize_t g = 0; g < G && !bad; g++) bad = q->ends[g + 1] <= q->ends[g];
-    if (bad) {
+    const char *why = bad ? "sizes of the pieces, the groups and z disagree" : NULL;
+    for (Py_ssize_t j = 0; j < n && !why; j++)
+        if (!isfinite(q->v[j]) || !isfinite(q->a[j])) why = "a piece is not a number";
+    if (!why && !(*b > 0.0 && isfinite(*b))) why = "the curvature is not a positive number";
+    if (!why && !(*lo <= *hi && isfinite(*lo) && isfinite(*hi))) why = "the bounds are not numbers lower <= upper";
+    if (why) {
         release_buffers(views, P_N + 1);
-        PyErr_Format(PyExc_ValueError, "%s: sizes of the pieces, the groups and z disagree", what);
+        PyErr_Format(PyExc_ValueError, "%s: %s", what, why);
         return -1;
     }
     return 0;
-}
-
-/* maximise_1d(pieces, curvature, lower, upper, z) -> delta or None: z (in place) the pieces'
- * multipliers; None when the floors leave no delta. */
-static PyObject *om_maximise_1d_py(PyObject *mod, PyObject *const *args, Py_ssize_t nargs, PyObject *kwnames) {
-    Py_buffer v[P_N + 1];
-    om_qp_groups q;
-    double b, lo, hi, delta;
-    if (get_problem(args, nargs, kwnames, "maximise_1d", v, &q, &b, &lo, &hi) < 0) return NULL;
-    int found = om_qp_maximise(&q, b, lo, hi, &delta, v[P_N].buf);
-    release_buffers(v, P_N + 1);
-    if (found == OM_QP_NO_MEMORY) return PyErr_NoMemory();
-    if (found == OM_QP_NONE) Py_RETURN_NONE;
-    return PyFloat_FromDouble(delta);
 }
 
 /* step_1d(pieces, curvature, lower, upper, z) -> QPStep(delta, gain) or None: the climb's step
@@ -74,9 +65,6 @@ static PyObject *om_step_1d_py(PyObject *mod, PyObject *const *args, Py_ssize_t 
     release_buffers(v, P_N + 1);
     switch (found) {
     case OM_QP_NO_MEMORY: return PyErr_NoMemory();
-    case OM_QP_EMPTY_GROUP:
-        PyErr_SetString(PyExc_ValueError, "step_1d: a group keeps no piece (a piece or a bound is not a number)");
-        return NULL;
     case OM_QP_NONE: Py_RETURN_NONE;
     default: {
         PyObject *items[2] = {PyFloat_FromDouble(delta), PyFloat_FromDouble(gain)};
@@ -86,8 +74,6 @@ static PyObject *om_step_1d_py(PyObject *mod, PyObject *const *args, Py_ssize_t 
 }
 
 static PyMethodDef functions[] = {
-    {"maximise_1d", (PyCFunction)(void (*)(void))om_maximise_1d_py, METH_FASTCALL | METH_KEYWORDS,
-     "maximise_1d(pieces, curvature, lower, upper, z) -> delta or None"},
     {"step_1d", (PyCFunction)(void (*)(void))om_step_1d_py, METH_FASTCALL | METH_KEYWORDS,
      "step_1d(pieces, curvature, lower, upper, z) -> QPStep(delta, gain) or None"},
     {NULL, NULL, 0, NULL},

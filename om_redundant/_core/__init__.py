@@ -126,7 +126,6 @@ from ..ckernels import (
     jacobian,
     joint_step,
     link_paths,
-    maximise_1d,
     model_ik,
     model_ik_at_reach,
     model_ik_lifted,

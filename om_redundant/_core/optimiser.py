@@ -204,8 +204,8 @@ class Evaluations(NamedTuple):
 
 
 class Pieces(NamedTuple):
-    """Groups of pieces in one variable concatenated, as ``maximise_1d`` and ``step_1d`` read
-    them: group g's pieces are ``ends[g]`` to ``ends[g + 1] - 1``, each group has at least one.
+    """Groups of pieces in one variable concatenated, as ``step_1d`` reads them: group g's
+    pieces are ``ends[g]`` to ``ends[g + 1] - 1``, each group has at least one.
 
     Attributes:
         values: (n,) the pieces v_j.

@@ -1,5 +1,10 @@
-"""The climb's QP in one variable in numpy (:mod:`om_redundant.redundancy.choice.box_qp`): the oracle of
-``_core.maximise_1d`` and ``_core.step_1d`` (``csrc/box_qp.c``, the same operations in loops)."""
+r"""The QP in one variable in numpy (:mod:`om_redundant.redundancy.choice.box_qp`), solved another
+way than ``_core.step_1d`` (``csrc/box_qp.c``, a bisection on phi's slope): between its
+breakpoints (two pieces of a group crossing, a piece crossing its group's cap) phi is one
+quadratic, with slope :math:`D_k - b\delta` (:math:`D_k` the weighted rates of the uncapped
+groups' least pieces), so the maximiser is a breakpoint, an end, or a segment's stationary point
+:math:`D_k/b`: all of them are evaluated and the best taken. Over every piece (the kernel's
+leaves out those that cannot be least in the box)."""
 
 from __future__ import annotations
 
@@ -23,41 +28,23 @@ def model(pieces: Pieces, delta: float) -> float:
     return sum(terms.tolist())
 
 
-def kept(pieces: Pieces, keep: np.ndarray) -> Pieces:
-    """The pieces where ``keep`` (n,) holds, at least one per group."""
-    ends = np.concatenate([[0], np.cumsum(keep)[pieces.ends[1:] - 1]]).astype(np.int64)
-    return pieces._replace(values=pieces.values[keep], rates=pieces.rates[keep], ends=ends)
-
-
-def groups_of(pieces: Pieces) -> list[Group]:
-    """The groups of pieces, with jacobians (p_g, 1)."""
-    bounds = zip(pieces.ends[:-1].tolist(), pieces.ends[1:].tolist(), strict=True)
-    numbers = zip(pieces.weights.tolist(), pieces.floors.tolist(), pieces.caps.tolist(), strict=True)
-    return [
-        Group("", w, floor, cap, pieces.values[a:b], pieces.rates[a:b, None])
-        for (a, b), (w, floor, cap) in zip(bounds, numbers, strict=True)
-    ]
-
-
 def step_1d(
     pieces: Pieces, curvature: float, lower: float, upper: float
 ) -> tuple[float, float, np.ndarray] | None:
-    """:func:`om_redundant.redundancy.choice.box_qp.step_1d`: the pieces that can be their group's
-    minimum somewhere in the box maximised as by :func:`maximise_1d`, the model's gain, every
-    piece's multiplier (0 for those left out); None when the floors leave no delta."""
-    reach = max(-lower, upper)
-    change = np.abs(pieces.rates) * reach
-    keep = pieces.values - change <= np.repeat(least(pieces, pieces.values + change), np.diff(pieces.ends))
-    if not all(np.add.reduceat(keep, pieces.ends[:-1])):
-        raise ValueError("a group keeps no piece (a piece or a bound is not a number)")
-    found = maximise_1d(groups_of(kept(pieces, keep)), curvature, lower, upper)
+    """:func:`om_redundant.redundancy.choice.box_qp.step_1d` by the breakpoints: delta, the
+    model's gain, every piece's multiplier; None when the floors leave no delta."""
+    bounds = zip(pieces.ends[:-1].tolist(), pieces.ends[1:].tolist(), strict=True)
+    numbers = zip(pieces.weights.tolist(), pieces.floors.tolist(), pieces.caps.tolist(), strict=True)
+    groups = [
+        Group("", w, floor, cap, pieces.values[a:b], pieces.rates[a:b, None])
+        for (a, b), (w, floor, cap) in zip(bounds, numbers, strict=True)
+    ]
+    found = maximise_1d(groups, curvature, lower, upper)
     if found is None:
         return None
     delta, z = found
     gain = model(pieces, delta) - 0.5 * delta * curvature * delta - model(pieces, 0.0)
-    multipliers = np.zeros(len(keep))
-    multipliers[keep] = np.concatenate(z)
-    return delta, gain, multipliers
+    return delta, gain, np.concatenate(z)
 
 
 def maximise_1d(

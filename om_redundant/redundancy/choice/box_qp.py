@@ -1,4 +1,5 @@
-r"""The climb's QP (:mod:`om_redundant.redundancy.choice.climb`) in one redundancy variable, solved exactly.
+r"""The QP in one redundancy variable, of the climb (:mod:`om_redundant.redundancy.choice.climb`) and
+of the tracking step, solved exactly.
 
 With one variable the epigraph QP is the maximisation of the concave, piecewise quadratic
 
@@ -6,12 +7,12 @@ With one variable the epigraph QP is the maximisation of the concave, piecewise 
            - \tfrac12 b\,\delta^2
 
 over the interval where every group with a floor keeps :math:`\min_j v_j + a_j\delta \ge
-floor_g`, within the box [lower, upper]. Between its breakpoints (two pieces of a group
-crossing, a piece crossing its group's cap) phi is one quadratic, with slope
-:math:`D_k - b\delta` (:math:`D_k` the weighted rates of the uncapped groups' least pieces),
-so the maximiser is a breakpoint, an end, or a segment's stationary point :math:`D_k/b`:
-all of them are evaluated and the best taken (``_core.maximise_1d``, ``csrc/box_qp.c``; its
-numpy oracle is ``tests/reference/box_qp.py``). The multipliers of the pieces are those of the
+floor_g`, within the box [lower, upper]. phi is strictly concave (b > 0): its right
+derivative, :math:`-b\delta` plus each uncapped group's weight times its least piece's rate,
+falls through zero once, at the maximiser (a kink or a stationary point), which bisection on
+its sign finds to rounding (``_core.step_1d``, ``csrc/box_qp.c``, reading only the pieces that
+can be their group's least in the box; ``tests/reference/box_qp.py`` solves it by the
+breakpoints instead, the tests' oracle). The multipliers of the pieces are those of the
 epigraph's KKT conditions: each uncapped group's weight on its least piece, or at a kink split
 between the least and the most increasing of the pieces that meet there so that the slope
 balances :math:`b\delta`.
@@ -63,10 +64,8 @@ def _values_and_rates(groups: list[Group]) -> tuple[np.ndarray, np.ndarray]:
 def step_1d(
     pieces: Pieces, curvature: float, lower: float, upper: float
 ) -> tuple[float, float, np.ndarray] | None:
-    r"""The climb's QP step in one variable: the pieces that can be their group's minimum
-    somewhere in the box, :math:`v_j - |a_j| r \le \min_{i \in g} v_i + |a_i| r` with
-    r = max(-lower, upper) (the others' constraints are implied by the minimum's), maximised
-    as in the module docstring (``_core.step_1d``, ``csrc/box_qp.c``).
+    r"""The climb's QP step in one variable, maximised as in the module docstring
+    (``_core.step_1d``, ``csrc/box_qp.c``).
 
     Args:
         pieces: The groups' pieces.
@@ -75,7 +74,11 @@ def step_1d(
 
     Returns:
         (delta, the model's gain ``model(delta) - b delta^2 / 2 - model(0)``, every piece's
-        multiplier (n,), 0 for those left out), or None when the floors leave no delta.
+        multiplier (n,), 0 for those that cannot be their group's least in the box), or None
+        when the floors leave no delta.
+
+    Raises:
+        ValueError: A piece, the curvature or a bound is not a number (or b <= 0, lower > upper).
     """
     z = np.empty(len(pieces.values))
     found = _core.step_1d(pieces, curvature, lower, upper, z)
