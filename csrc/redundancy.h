@@ -126,11 +126,10 @@ typedef struct {
 /* The groups' weights (w_m, w_c, w_s), floors (0, clearance_floor = d_min / d_cap) and caps. */
 void om_tracking_groups(om_tracking *tr, double w_m, double w_c, double w_s, double clearance_floor);
 
-/* A step taken: the new psi, the step, the next curvature, each group's smallest piece at the
- * new joints (margin, singularity, clearance: normalised, the clearance linearised), the
- * second solve's errors, evaluations and within_limits. */
+/* A step taken: the new psi, the step, the next curvature, the second solve's errors,
+ * evaluations and within_limits (the objective at the new joints: objective.c's om_evaluate). */
 typedef struct {
-    double psi, step, curvature, margin, singularity, clearance, position_error, orientation_error;
+    double psi, step, curvature, position_error, orientation_error;
     int64_t evaluations;
     bool within_limits;
 } om_tracked;

@@ -156,9 +156,7 @@ int om_track(const om_tracking *tr, const double *T, const int64_t *signs, doubl
     for (int g = 0; g < 3; g++)
         if (active[g] >= 0 && low[g] < tr->cap[g]) y += tr->weight[g] * (P1.a[active[g]] - P0.a[active[g]]);
     if (fabs(d) > 1e-12 && isfinite(y)) b = fmin(fmax(-y / d, MIN_CURVATURE), MAX_CURVATURE);
-    /* low: each group's smallest piece, the margin, clearance and singularity reported */
-    *out = (om_tracked){psi1, d, b, low[0], low[2], low[1], r.position_error, r.orientation_error, r.evaluations,
-                        r.within_limits};
+    *out = (om_tracked){psi1, d, b, r.position_error, r.orientation_error, r.evaluations, r.within_limits};
     return OM_TRACK_OK;
 }
 

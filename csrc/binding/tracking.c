@@ -22,16 +22,13 @@ static PyStructSequence_Field step_fields[] = {
     {"psi", "the new arm angle (the rest: None unless TRACK_OK)"},
     {"step", "the step taken"},
     {"curvature", "the curvature the next step's model takes"},
-    {"margin", "the smallest margin piece at the new joints"},
-    {"singularity", "the smallest singularity piece there, normalised by s_cap"},
-    {"clearance", "the smallest clearance piece there, linearised and normalised by d_cap"},
     {"position_error", "the second solve's position error"},
     {"orientation_error", "its orientation error"},
     {"evaluations", "its residual evaluations"},
     {"within_limits", "its joints within the limits"},
     {NULL, NULL},
 };
-enum { N_STEP_FIELDS = 11 };
+enum { N_STEP_FIELDS = 8 };
 static PyStructSequence_Desc step_desc = {"om_redundant.ckernels.TrackingStep", "What track_step answers.",
                                           step_fields, N_STEP_FIELDS};
 static PyTypeObject *step_type;
@@ -44,11 +41,10 @@ static PyObject *tracking_step(int status, const om_tracked *out) {
         for (int i = 1; i < N_STEP_FIELDS; i++) items[i] = Py_NewRef(Py_None);
         return new_record(step_type, items, N_STEP_FIELDS);
     }
-    const double numbers[8] = {out->psi,         out->step,        out->curvature,      out->margin,
-                               out->singularity, out->clearance,   out->position_error, out->orientation_error};
-    for (int i = 0; i < 8; i++) items[1 + i] = PyFloat_FromDouble(numbers[i]);
-    items[9] = PyLong_FromLongLong(out->evaluations);
-    items[10] = PyBool_FromLong(out->within_limits);
+    const double numbers[5] = {out->psi, out->step, out->curvature, out->position_error, out->orientation_error};
+    for (int i = 0; i < 5; i++) items[1 + i] = PyFloat_FromDouble(numbers[i]);
+    items[6] = PyLong_FromLongLong(out->evaluations);
+    items[7] = PyBool_FromLong(out->within_limits);
     return new_record(step_type, items, N_STEP_FIELDS);
 }
 

@@ -184,17 +184,14 @@ class Tracker:
         if out.status != _core.TRACK_OK:
             return _REFUSED[out.status]
         q_new = work.q.copy()
-        margin = out.margin
-        clearance = math.inf
-        value = objective.margin_weight * margin if math.isfinite(margin) else 0.0
-        if work.singular_joints.size:
-            value += objective.singularity_weight * min(1.0, out.singularity)
+        distances = None
         if objective.clearance is not None:
             self._last = self._linearisation(q_new)
-            clearance = float(self._last.distances.min())
-            if clearance >= objective.clearance_reach:  # every pair beyond the reach: D itself, uncapped
-                clearance = objective.clearance.minimum(q_new)
-            value += objective.clearance_weight * min(1.0, clearance / objective.clearance_cap)
+            distances = self._last.distances
+        evaluation = objective.evaluate(q_new, distances)
+        clearance = evaluation.clearance
+        if distances is not None and clearance >= objective.clearance_reach:  # (all pairs beyond the reach)
+            clearance = objective.clearance.minimum(q_new)
         configuration = Configuration(signs, (wrap_angle(out.psi),))
         solution = Solution(
             q_new,
@@ -206,8 +203,9 @@ class Tracker:
             out.evaluations,
             out.within_limits,
         )
-        feasible = margin >= 0.0 and clearance >= objective.min_clearance
-        return Tracked(solution, margin, clearance, value, out.curvature, feasible)
+        return Tracked(
+            solution, evaluation.margin, clearance, evaluation.value, out.curvature, evaluation.feasible
+        )
 
     def _linearised_at(self, q: np.ndarray) -> Linearisation:
         """The clearances at q: the last step's where q is its result's joints and the
