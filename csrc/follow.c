@@ -28,7 +28,7 @@
 
 static void represent(int dof, const uint8_t *centred, const double *centre, double *q) {
     for (int i = 0; i < dof; i++)
-        if (centred[i]) q[i] = centre[i] + om_wrap_angle(q[i] - centre[i]);
+        if (centred[i]) q[i] = centre[i] + om_wrap(q[i] - centre[i]);
 }
 
 /* The largest joint move max_i |t_i d| of a step d along the tangent t. A root that continues the path
@@ -70,7 +70,7 @@ static om_root_verdict on_path(const double *x, void *context) {
     represent(p->dof, p->centred, p->centre, r);
     if (om_beyond_doubt(p->dof, p->q, r, p->t, p->d, p->cyclic)) return OM_ROOT_TAKE;
     for (int i = 0; i < p->dof; i++) {
-        double e = om_wrap_angle(r[i] - p->q[i]);
+        double e = om_wrap(r[i] - p->q[i]);
         d2 += e * e;
     }
     double reach = fmin(sqrt(d2), 1.0);

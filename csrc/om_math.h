@@ -16,12 +16,15 @@ typedef struct {
 
 #define OM_PI 3.141592653589793 /* np.pi */
 
-/* x wrapped into [-pi, pi): x - 2 pi floor((x + pi) / (2 pi)), which is x itself where the
- * floor is 0 (x - 0.0 == x, -0.0 included), so the floor is taken only otherwise. */
+/* The package's one angle wrap (om_redundant/angles.py's wrap_angle and wrap_angles, alike to
+ * the bit): x - k 2 pi in [-pi, pi), exactly (2 pi the double 2.0 * OM_PI). x itself in range
+ * (-0.0 included); else fmod, which is exact, and r -+ 2 pi for |r| in [pi, 2 pi), exact too
+ * (Sterbenz). NaN for an infinite x. */
 static inline double om_wrap(double x)
 {
-    double turns = (x + OM_PI) / (2.0 * OM_PI);
-    return turns >= 0.0 && turns < 1.0 ? x : x - 2.0 * OM_PI * floor(turns);
+    if (x >= -OM_PI && x < OM_PI) return x;
+    double r = fmod(x, 2.0 * OM_PI);
+    return r >= OM_PI ? r - 2.0 * OM_PI : r < -OM_PI ? r + 2.0 * OM_PI : r;
 }
 
 /* numpy's minimum and maximum of two floats: a NaN operand gives NaN (fmin and fmax drop it). */

@@ -11,9 +11,6 @@
  * coordinates; false where psi does not move along the self-motion, |Dpsi . n| <= tol |Dpsi|
  * |n| (or t is not finite). */
 bool om_self_motion_tangent(const om_solver_data *s, const double *q, double *t, double tol);
-/* x - 2 pi k in [-pi, pi), as numpy's remainder(x + pi, 2 pi) - pi rounds it (angles.py's
- * wrap_angles). */
-double om_wrap_angle(double x);
 /* Whether q1 (at psi + d) continues the self-motion from q0 with tangent t (paths.py's
  * Probe.continues): no joint moved more than 1 rad, and |dq - t d|_inf <= |dq|_inf / 2 + 1e-6;
  * t NULL: only that no joint jumped. cyclic (NULL: none): joints compared modulo 2 pi. */

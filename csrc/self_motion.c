@@ -84,12 +84,6 @@ bool om_self_motion_tangent(const om_solver_data *s, const double *q, double *t,
     return true;
 }
 
-double om_wrap_angle(double x) {
-    double r = fmod(x + OM_PI, 2.0 * OM_PI);
-    if (r != 0.0 && r < 0.0) r += 2.0 * OM_PI; /* numpy.remainder: the sign of the divisor */
-    return r - OM_PI;
-}
-
 /* The max-norm joint step |q1 - q0|_inf into *moved and the first-order prediction's error
  * |q1 - q0 - t d|_inf into *error (t NULL: 0), cyclic joints modulo 2 pi (om_continues' terms). */
 static void _continuation(int dof, const double *q0, const double *q1, const double *t, double d,
@@ -97,7 +91,7 @@ static void _continuation(int dof, const double *q0, const double *q1, const dou
     *moved = 0.0, *error = 0.0;
     for (int i = 0; i < dof; i++) {
         double m = q1[i] - q0[i];
-        if (cyclic && cyclic[i]) m = om_wrap_angle(m);
+        if (cyclic && cyclic[i]) m = om_wrap(m);
         *moved = fmax(*moved, fabs(m));
         *error = fmax(*error, t ? fabs(m - t[i] * d) : 0.0);
     }
@@ -113,7 +107,7 @@ double om_largest_joint_step(int dof, const double *q0, const double *q1, const 
     double largest = 0.0;
     for (int i = 0; i < dof; i++) {
         double m = q1[i] - q0[i];
-        if (cyclic && cyclic[i]) m = om_wrap_angle(m);
+        if (cyclic && cyclic[i]) m = om_wrap(m);
         m = fabs(m);
         if (isnan(m)) return m; /* (numpy's maximum: a NaN step is NaN) */
         if (m > largest) largest = m;

@@ -77,13 +77,13 @@ static bool _finish(om_problem *pb, const double *q, const double *hint, bool ha
     return inside;
 }
 
-/* The requested redundancy values as the kernels use them: angles reduced into [-pi, pi] by
- * the exact IEEE remainder, so that a huge psi (1e16) is one well-defined angle rather than
- * one whose rounding in every later subtraction exceeds the check's tolerance. */
+/* The requested redundancy values as the kernels use them: angles reduced into [-pi, pi)
+ * exactly (om_wrap), so that a huge psi (1e16) is one well-defined angle rather than one whose
+ * rounding in every later subtraction exceeds the check's tolerance. */
 static void _reduce(const om_solver_data *s, const double *redundancy, double *reduced)
 {
     for (int i = 0; i < s->n_redundancy; i++)
-        reduced[i] = remainder(redundancy[i], 2.0 * OM_PI);
+        reduced[i] = om_wrap(redundancy[i]);
 }
 
 /* The START_POINTS starts -pi + 2 pi (k + 1/2) / START_POINTS into order, the farthest from

@@ -9,7 +9,7 @@
 #define PSI_ROUNDING 4.440892098500626e-16
 #define SRS_ELBOW_SIGN 1    /* (SHOULDER, ELBOW, WRIST) */
 #define MAX_VALUES 16       /* branch values of a family (3 today) */
-#define HUGE_HINT 1e4       /* rad: a revolute joint's hint beyond it is reduced exactly (remainder) first */
+#define HUGE_HINT 1e4       /* rad: a revolute joint's hint beyond it is reduced exactly (om_wrap) first */
 
 /* How far psi computed at q can be from psi at the exact joint values (NaN: not finite):
  * |grad psi|_1 PSI_ROUNDING. Next to psi's singular half-line (the wrist centre straight
@@ -27,7 +27,7 @@ static double psi_rounding(const om_solver_data *s, const double *q)
     return sum * PSI_ROUNDING;
 }
 
-/* om_in_configuration for a requested psi already in [-pi, pi] (remainder leaves it as it is);
+/* om_in_configuration for a requested psi already in [-pi, pi) (om_wrap leaves it as it is);
  * trig not NULL (s->trig_shared): the real FK's cos and sin of q_j + theta_j, which are the
  * model's for joints 1-6, bit for bit, so they are not computed again. */
 static bool in_configuration(const om_solver_data *s, const double *q, const double *trig, const int64_t *signs,
@@ -53,7 +53,7 @@ static bool in_configuration(const om_solver_data *s, const double *q, const dou
 bool om_in_configuration(const om_solver_data *s, const double *q, const int64_t *signs, const double *redundancy)
 {
     /* reduced exactly first: a huge requested psi (1e16) is one well-defined angle */
-    return in_configuration(s, q, NULL, signs, s->family == OM_SRS ? remainder(redundancy[0], 2.0 * OM_PI) : 0.0);
+    return in_configuration(s, q, NULL, signs, s->family == OM_SRS ? om_wrap(redundancy[0]) : 0.0);
 }
 
 /* Whether the real chain's joints 1-6 turn by the S-R-S model's angles q_j + theta_j, bit for
@@ -162,5 +162,5 @@ bool om_representative(double *q, int dof, const uint8_t *revolute, const double
 void om_usable_hint(const om_solver_data *s, const double *hint, double *out)
 {
     for (int j = 0; j < s->dof; j++)
-        out[j] = s->revolute[j] && fabs(hint[j]) > HUGE_HINT ? remainder(hint[j], 2.0 * OM_PI) : hint[j];
+        out[j] = s->revolute[j] && fabs(hint[j]) > HUGE_HINT ? om_wrap(hint[j]) : hint[j];
 }

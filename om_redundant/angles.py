@@ -1,10 +1,5 @@
-"""Angles taken to one turn, the package's one place for it.
-
-Two roundings, each kept where answers are compared to the bit: :func:`wrap_angle` is exact
-(``math.remainder``) for one angle; :func:`wrap_angles` is numpy's ``remainder(x + pi, 2 pi) -
-pi`` for arrays, which the compiled core's ``om_wrap_angle`` rounds alike (the paths it follows
-and the ones Python checks must agree). They differ in the last bits only.
-"""
+"""Angles taken to one turn, the package's one place for it (the compiled core's ``om_wrap``,
+``csrc/om_math.h``, rounds alike: not at all)."""
 
 from __future__ import annotations
 
@@ -17,11 +12,18 @@ TURN = 2.0 * math.pi
 
 
 def wrap_angle(angle: float) -> float:
-    """The angle's representative in [-pi, pi) (``math.remainder`` gives [-pi, pi])."""
-    angle = math.remainder(angle, TURN)
-    return -math.pi if angle >= math.pi else angle
+    """The angle's representative in [-pi, pi): ``angle - k TURN``, exactly (``math.fmod`` is
+    exact, and so is r -+ TURN for |r| in [pi, TURN)); NaN for an infinite angle."""
+    if -math.pi <= angle < math.pi:
+        return angle
+    if not math.isfinite(angle):
+        return math.nan
+    r = math.fmod(angle, TURN)
+    return r - TURN if r >= math.pi else r + TURN if r < -math.pi else r
 
 
 def wrap_angles(angles: np.ndarray) -> np.ndarray:
-    """Each angle taken to [-pi, pi), as ``numpy.remainder(x + pi, 2 pi) - pi`` rounds it."""
-    return np.remainder(angles + math.pi, TURN) - math.pi
+    """:func:`wrap_angle` of each angle."""
+    with np.errstate(invalid="ignore"):  # (an infinite angle: NaN)
+        r = np.fmod(angles, TURN)
+    return np.where(r >= math.pi, r - TURN, np.where(r < -math.pi, r + TURN, r))

@@ -120,9 +120,13 @@ def random_groups(rng: np.random.Generator, r: int, values) -> list[Group]:
 def steps_numpy(cyclic: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """The reference of the largest joint step (``_core.joint_step``, ``Probe.step``) between
     the rows of a and b (M, dof): max_i |b_i - a_i|, the differences of the cyclic joints taken
-    to [-pi, pi) by np.remainder; numpy's maximum, so a NaN difference gives NaN."""
+    to one turn by the exact IEEE remainder (``math.remainder``, whose magnitude is the wrap's;
+    not a number where the difference is not finite); numpy's maximum, so a NaN gives NaN."""
     d = b - a
-    d = np.where(cyclic, np.remainder(d + math.pi, 2.0 * math.pi) - math.pi, d)
+    remainder = np.vectorize(
+        lambda x: math.remainder(x, 2.0 * math.pi) if math.isfinite(x) else math.nan, otypes=[float]
+    )
+    d = np.where(cyclic, remainder(d), d)
     return np.abs(d).max(axis=1, initial=0.0)
 
 

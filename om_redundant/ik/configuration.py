@@ -6,7 +6,7 @@ import math
 from dataclasses import dataclass
 from itertools import product
 
-from ..angles import TURN
+from ..angles import wrap_angle
 from ..validation import as_instance, as_number, as_redundancy, as_signs
 
 
@@ -48,7 +48,7 @@ class Configuration:
         # Each angle reduced first (exactly, as the solver does): a - b of a huge angle and a
         # small one would lose the small one's digits.
         return all(
-            abs(math.remainder(math.remainder(a, TURN) - math.remainder(b, TURN), TURN)) <= atol
+            abs(wrap_angle(wrap_angle(a) - wrap_angle(b))) <= atol
             for a, b in zip(self.redundancy, other.redundancy, strict=True)
         )
 

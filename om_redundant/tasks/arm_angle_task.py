@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import math
-
 import mujoco
 import numpy as np
 import numpy.typing as npt
@@ -11,7 +9,7 @@ from mink import Configuration as MinkConfiguration
 from mink import TargetNotSet
 from mink.exceptions import InvalidTarget
 
-from ..angles import TURN
+from ..angles import wrap_angle
 from ..exceptions import InvalidInput, UnreachableTarget
 from ..ik.configuration import Configuration
 from ..ik.solver import OMSolver
@@ -95,7 +93,7 @@ class ArmAngleTask(ArmTask):
     def compute_error(self, configuration: MinkConfiguration) -> np.ndarray:
         r"""The arm-angle error :math:`\mathrm{wrap}(\psi(q) - \psi^*)`, shape (1,)."""
         psi, _ = self._psi(configuration)
-        return np.array([math.remainder(psi - self.target_psi, TURN)])
+        return np.array([wrap_angle(psi - self.target_psi)])
 
     def compute_jacobian(self, configuration: MinkConfiguration) -> np.ndarray:
         r""":math:`\partial\psi/\partial q` in the arm's dof columns, (1, nv)."""

@@ -94,8 +94,10 @@ class GlobalChoice:
         turns = [None] if free is None else free.starts(T, hand)
         targets = [T if R is None else free.turned(T, R) for R in turns]
         at_once = signs is None or self._shared_search
-        first = self.branches if at_once else [signs]
-        swept = [self._sweep(target, first) for target in targets]
+        swept = [
+            self._sweep(target, self.branches) if at_once else [self._sweep_alone(target, signs)]
+            for target in targets
+        ]
         way = self._way(targets, swept, q_from, signs)
         note = ""
         if (way is None or not way[0].clear) and signs is not None:
