@@ -36,7 +36,7 @@ setup(
         Extension(
             "om_redundant.ckernels",
             sources=sorted(str(path) for path in Path("csrc").rglob("*.c")),
-            include_dirs=["csrc", "csrc/binding"],
+            include_dirs=["csrc/ik", "csrc/redundancy", "csrc/binding"],
             depends=sorted(str(path) for path in Path("csrc").rglob("*.h")),
         )
     ],

@@ -1,5 +1,5 @@
 """Angles taken to one turn, the package's one place for it (the compiled core's ``om_wrap``,
-``csrc/om_math.h``, rounds alike: not at all)."""
+``csrc/ik/om_math.h``, rounds alike: not at all)."""
 
 from __future__ import annotations
 

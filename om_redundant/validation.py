@@ -32,7 +32,7 @@ from . import _core
 from .exceptions import InvalidInput
 
 #: Largest accepted deviation max|R^T R - I| of a pose's rotation block (1e-9; defined in
-#: csrc/binding.h, where ``OMSolver.solve``'s one-call path checks poses too).
+#: csrc/binding/binding.h, where ``OMSolver.solve``'s one-call path checks poses too).
 ORTHONORMALITY_TOLERANCE: float = _core.ORTHONORMALITY_TOLERANCE
 #: A quaternion whose norm is below this is refused as zero (it has no direction to keep).
 MIN_QUATERNION_NORM = 1e-9

@@ -1,6 +1,7 @@
 """The compiled boundary's rules, read from the sources: one Python module imports the
-extension, and no kernel entry point takes more than six positional arguments (records cross
-by name: om_redundant/_core/)."""
+extension, no kernel entry point takes more than six positional arguments (records cross by
+name: om_redundant/_core/), and the C folders follow the data path: ik/ includes nothing of
+redundancy/ or binding/, redundancy/ nothing of binding/, and only binding/ includes Python.h."""
 
 from __future__ import annotations
 
@@ -27,6 +28,23 @@ def test_only_core_imports_the_extension():
             if any(name.split(".")[-1] == "ckernels" for name in names):
                 importers.append(path.relative_to(ROOT).as_posix())
     assert set(importers) == {"om_redundant/_core/__init__.py"}
+
+
+def test_the_c_folders_include_along_the_data_path():
+    folders = {path.name: {header.name for header in path.glob("*.h")} for path in (ROOT / "csrc").iterdir()}
+    assert set(folders) == {"ik", "redundancy", "binding"}
+    allowed = {
+        "ik": folders["ik"],
+        "redundancy": folders["ik"] | folders["redundancy"],
+        "binding": folders["ik"] | folders["redundancy"] | folders["binding"],
+    }
+    for folder, headers in allowed.items():
+        for path in sorted((ROOT / "csrc" / folder).glob("*.[ch]")):
+            source = path.read_text()
+            quoted = set(re.findall(r'#include "([^"]+)"', source))
+            assert quoted <= headers, (folder, path.name, quoted - headers)
+            python = "#include <Python.h>" in source
+            assert python == (folder == "binding" and path.name == "binding.h"), (folder, path.name)
 
 
 def test_no_entry_point_takes_more_than_six_positional_arguments():

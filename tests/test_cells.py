@@ -1,5 +1,5 @@
 """The compiled cell test of the global choose's solution paths (``_core.pieces``,
-``_core.surprise``, ``_core.joint_step`` and ``_core.cell_looks``, csrc/cells.c)
+``_core.surprise``, ``_core.joint_step`` and ``_core.cell_looks``, csrc/redundancy/cells.c)
 against the numpy it replaces (tests/reference/cells.py): the feasibility functions of the
 margin and clearance groups and their rates, where the cubic Hermite models of a cell
 predict a feasibility its ends do not explain, the largest joint step, and the first tests

@@ -1,7 +1,7 @@
-"""The compiled path following (``_core.follow``, csrc/follow.c) against the Python loop of
+"""The compiled path following (``_core.follow``, csrc/redundancy/follow.c) against the Python loop of
 tests/reference/follow.py: the same point reached, the same answer whether it arrived, on
 random poses and steps; and the compiled linking of a branch's grid roots into paths
-(``_core.link_paths``, csrc/link.c) against the reference's loop: the same paths, to the bit."""
+(``_core.link_paths``, csrc/redundancy/link.c) against the reference's loop: the same paths, to the bit."""
 
 from __future__ import annotations
 

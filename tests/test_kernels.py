@@ -487,7 +487,7 @@ def test_link_paths_refuses_grids_counts_and_outputs_that_disagree(panda):
 
 
 def test_the_parameter_layouts_fit_the_models_parameter_vectors():
-    """The families' layouts are written once, in C (csrc/om_kernels.h), and read from _core:
+    """The families' layouts are written once, in C (csrc/ik/om_kernels.h), and read from _core:
     every index lies within its vector, and each family's model has a vector of its size."""
     for prefix in ("SD_", "SRS_"):
         size = getattr(_core, prefix + "N_PARAMS")

@@ -1,6 +1,6 @@
 """Arms NEAR a closed-form family (issue 17, item 2): twists off 0/90/180 deg by 1e-8 ... 1e-3
 rad, reversed axes, fixed rows between joints; solved exactly through the nominal arm
-(ik/nominal.py, csrc/near.c), or refused at construction with a ModelError naming the cause."""
+(ik/nominal.py, csrc/ik/near.c), or refused at construction with a ModelError naming the cause."""
 
 from __future__ import annotations
 
@@ -192,7 +192,7 @@ def test_targets_at_a_branch_boundary_of_a_near_arm(branch, q):
     Doosan M1013): the ARM's (the wrist centre at the cylinder of the lateral offset about
     joint 1's axis), the ELBOW's (a folded elbow, an inner edge of reach). c may hold two real
     roots where the nominal arm has one in c and one in the neighbouring configuration, one
-    far away, or none at all: the corrected system's roots in c are the real ones (csrc/near.c).
+    far away, or none at all: the corrected system's roots in c are the real ones (csrc/ik/near.c).
     Each of these q was missed by the first near-family solver."""
     solver = bent_solver("ur5e", np.log10(2e-4), 0)
     q = np.array(q)
@@ -267,7 +267,7 @@ def test_targets_beside_a_fold_of_the_real_arms_roots(name, q):
     nominal root polishes to q, those nearest it stall where the exact chain's Jacobian is
     nearly singular (a fold of the real arm's roots that the nominal arm lacks, as on the
     Doosan M1013 at the shoulder's): a close
-    pair of zeros of the corrected system's residual, found by its search (csrc/near.c); the
+    pair of zeros of the corrected system's residual, found by its search (csrc/ik/near.c); the
     first near-family solver missed q."""
     arm = next(arm for arm in cases(0) if arm.name == name)
     solver = om.OMSolver(arm)

@@ -1,4 +1,4 @@
-"""The compiled kernel of an arm near a family (csrc/near.c): the OM system with the nominal
+"""The compiled kernel of an arm near a family (csrc/ik/near.c): the OM system with the nominal
 arm as the model's side. Its roots are every root an independent search finds; an arm whose
 axis is reversed answers as the arm itself through every compiled entry point (solves, the
 optimiser's global choice and tracking steps); micrometre offsets of rounded twists are the

@@ -1,4 +1,4 @@
-"""An arm near a family solves at about its family's cost (csrc/near.c, om_near_secant): the
+"""An arm near a family solves at about its family's cost (csrc/ik/near.c, om_near_secant): the
 local root is the nominal arm's, then Newton's steps on the exact chain from it, not the secant
 on G, each of whose evaluations is a fixed point of the correction. So an arm bent 1e-6 rad
 takes as many residual evaluations per solve as the exact arm it is near, and its answers are

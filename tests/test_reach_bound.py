@@ -1,11 +1,11 @@
 """The bounded search's proof that no island of reach lies between two samples of the circle
-that the model does not reach (``csrc/residual.c``, om_srs_reach_possible): the elbow's x(w)
+that the model does not reach (``csrc/ik/residual.c``, om_srs_reach_possible): the elbow's x(w)
 is a trigonometric polynomial of degree 2, so its curvature bounds how far it can come
 between two samples. A coarse search, whose cells hide many islands, still finds every root
 that a dense one finds; with the islands left unsearched it would not (the Panda then fails
 its own self-check at 16 points).
 
-Close roots inside one cell (``csrc/circle_runs.c``, _cell_roots): a cell is halved where the
+Close roots inside one cell (``csrc/ik/circle_runs.c``, _cell_roots): a cell is halved where the
 curvature of g estimated from the samples allows g to turn back to zero inside it, so a
 search at 16 points holds q where close pairs and triples share its cells."""
 

@@ -600,7 +600,7 @@ def test_the_last_false_no_next_to_the_half_line(name, q):
     candidates of another branch, and the Panda's loop folds back at 1e-11 rad from the line
     (psi turns by 2 pi there, unseen between points 0.05 rad apart). The configuration is now
     searched along the real arm's self-motion loops through its roots at other arm angles
-    (csrc/loop_search.c), where psi's crossings are bisected to the last bit. The two last
+    (csrc/ik/loop_search.c), where psi's crossings are bisected to the last bit. The two last
     Sawyer poses (the first full run with the loop search, seed 0) were "no" with it:
     the loop's pass by the line lay between the trace's last point and its start, where it
     closed, a step that was not searched."""

@@ -1,4 +1,4 @@
-"""The circle residual's shortcut (``csrc/srs.c``, om_srs_model_q7): q7 alone, without the
+"""The circle residual's shortcut (``csrc/ik/srs.c``, om_srs_model_q7): q7 alone, without the
 wrist's other Euler angles, equals the closed form's q7."""
 
 from __future__ import annotations

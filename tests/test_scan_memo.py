@@ -1,4 +1,4 @@
-"""The circle search's scan memo (csrc/circle_samples.c): a batch's scan cache keeps the model's parts at
+"""The circle search's scan memo (csrc/ik/circle_samples.c): a batch's scan cache keeps the model's parts at
 the scan's samples and edges of reach for its next scan of the same pose, so a row's answer must
 not depend on which rows the batch solved before it, to the last bit."""
 

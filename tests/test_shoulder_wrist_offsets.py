@@ -1,7 +1,7 @@
 """7-DOF arms with a shoulder offset a2 (the common normal of joints 2 and 3: Unitree G1 6.24 mm,
 TIAGo Pro 20 mm) or a wrist offset a5 (of joints 5 and 6: Baxter 10 mm), issue 32: the nominal
 arm zeroes them and the correction, on the left or the right, solves the OM system (9)
-(ik/nominal.py, csrc/near.c); every root exact, q among them and the hinted solve's answer."""
+(ik/nominal.py, csrc/ik/near.c); every root exact, q among them and the hinted solve's answer."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The torus search's certificate (csrc/contraction.c): its rate bounds hold for the map itself,
+"""The torus search's certificate (csrc/ik/contraction.c): its rate bounds hold for the map itself,
 and where it decides, it finds every root that the grid search finds, on random poses and
 next to the singular shoulder, the singular wrist, the straight and the folded elbow."""
 

@@ -1,4 +1,4 @@
-/* The binding of the climb's QP in one variable (csrc/box_qp.c): step_1d reads its pieces from a
+/* The binding of the climb's QP in one variable (csrc/redundancy/box_qp.c): step_1d reads its pieces from a
  * record (om_redundant._core.Pieces) by name. */
 #include "binding.h"
 #include "redundancy.h"

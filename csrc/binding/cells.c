@@ -1,4 +1,4 @@
-/* The binding of the cell test of the global choose's solution paths (csrc/cells.c): pieces,
+/* The binding of the cell test of the global choose's solution paths (csrc/redundancy/cells.c): pieces,
  * surprise, crossing, joint_step and cell_looks. Their records (om_redundant._core's
  * PieceRows, PieceLimits, CellModels, CellSamples) are read by name. */
 #include <string.h>

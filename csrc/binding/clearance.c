@@ -1,4 +1,4 @@
-/* The binding of the clearance kernels (csrc/clearance.c): the arm's links and the geoms' cores
+/* The binding of the clearance kernels (csrc/redundancy/clearance.c): the arm's links and the geoms' cores
  * are read from a record (om_redundant._core.ArmCores) by name, the distances written into the
  * named arrays of another (om_redundant._core.PairDistances). */
 #include <string.h>

@@ -10,7 +10,7 @@
 PyObject *om_status_names;
 
 static struct PyModuleDef module = {
-    PyModuleDef_HEAD_INIT, "ckernels", "om_redundant's compiled core (see csrc/om_kernels.h).", -1, om_kernel_functions,
+    PyModuleDef_HEAD_INIT, "ckernels", "om_redundant's compiled core (see csrc/ik/om_kernels.h).", -1, om_kernel_functions,
 };
 
 PyMODINIT_FUNC PyInit_ckernels(void) {

@@ -1,4 +1,4 @@
-/* The binding of the redundancy optimiser's objective (csrc/objective.c): evaluate reads the
+/* The binding of the redundancy optimiser's objective (csrc/redundancy/objective.c): evaluate reads the
  * objective's terms from a record (om_redundant._core.ObjectiveTerms) and writes each row's
  * evaluation into the named arrays of another (om_redundant._core.Evaluations). */
 #include "binding.h"

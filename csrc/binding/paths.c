@@ -1,4 +1,4 @@
-/* The binding of the solution paths' kernels (csrc/om_paths.h): follow (follow.c), link_paths
+/* The binding of the solution paths' kernels (csrc/redundancy/om_paths.h): follow (follow.c), link_paths
  * (link.c) and self_motion_tangents (tangents.c). Their records (om_redundant._core's
  * FollowWork, LinkRoots, LinkRows) are read by name; their results are named
  * (ckernels.Followed, Linked) or written into the records' arrays. */

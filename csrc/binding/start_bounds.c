@@ -1,4 +1,4 @@
-/* The binding of the bound of a climb's start (csrc/start_bounds.c): start_bound reads the runs'
+/* The binding of the bound of a climb's start (csrc/redundancy/start_bounds.c): start_bound reads the runs'
  * samples from a record (om_redundant._core.StartSamples) by name. */
 #include "binding.h"
 #include "redundancy.h"

@@ -1,4 +1,4 @@
-/* The binding of the tracking step (csrc/tracking.c): track_step reads the optimiser's work, the
+/* The binding of the tracking step (csrc/redundancy/tracking.c): track_step reads the optimiser's work, the
  * step's start and the clearances' linearisation from records (om_redundant._core.TrackingWork,
  * TrackingStart, Linearisation) by name, and answers a TrackingStep by name. */
 #include "binding.h"

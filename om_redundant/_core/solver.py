@@ -28,7 +28,7 @@ class SolverData(NamedTuple):
         scan_points: Grid points of the bounded search.
         position_tolerance, orientation_tolerance: Accepted errors (m, rad).
         nominal_table: For an arm near a family, its nominal arm's DH table (the model side of
-            system (9), whose correction ``csrc/near.c`` solves); real_table is then the arm's
+            system (9), whose correction ``csrc/ik/near.c`` solves); real_table is then the arm's
             exact chain and lower, upper its limits, in the nominal joint coordinates
             ``flip * q``. Empty (0 rows) for an arm in its family.
         flip: (dof,) +-1: the kernels' joint coordinates are ``flip * q`` (all +1 but a near
@@ -37,9 +37,9 @@ class SolverData(NamedTuple):
             arm's (:attr:`~om_redundant.ik.nominal.NominalArm.deviation`); 0 in its family.
         near_left: The correction on the left, in DH frame 0 (an arm whose nominal arm zeroes a
             shoulder offset, :attr:`~om_redundant.ik.nominal.NominalArm.shoulder_offset`, larger
-            than its wrist offset); False: on the right, in the flange frame (``csrc/near.c``).
+            than its wrist offset); False: on the right, in the flange frame (``csrc/ik/near.c``).
         near_mixed: The correction's translation mixed from its last two steps (an arm whose
-            nominal arm zeroes a shoulder or wrist offset; ``csrc/near.c``).
+            nominal arm zeroes a shoulder or wrist offset; ``csrc/ik/near.c``).
     """
 
     family: int

@@ -14,7 +14,7 @@ seen from the flange and depends on one wrist joint, :math:`w = q_J` (see
 and a root gives the real arm's joints :math:`q = \mathrm{IK}_{model}(\ldots)` with
 :math:`|p_{real}(q) - p_d| = |\delta(w) - \delta(q_J)| \le \Delta p_{max}\,|g(w)|`.
 A 6-DOF wrist with :math:`a_4 \ne 0` has the circle :math:`p_m = p_d + \Delta p(w)`,
-:math:`w = q_1`, instead (:mod:`om_redundant.ik.model`, ``csrc/wrist_offset.c``).
+:math:`w = q_1`, instead (:mod:`om_redundant.ik.model`, ``csrc/ik/wrist_offset.c``).
 
 Arms with shoulder offsets (Gen3, Sawyer) add :math:`a(q_1)`, so solutions lie on a torus
 :math:`(w_1, w_7) = (q_1, q_7)`: :math:`p_m = p_d + a(w_1) + R_d\,\delta(w_7)`. There the
@@ -36,9 +36,9 @@ singularities, which is where roots crowd; lifted, Newton's method converges the
   change is refined; near the edges of the model's reach, at local minima of |g| and on
   small islands of reach, where roots come in close pairs, 1-D extremum searches find
   them. On the torus, a grid of the lifted residual seeds Newton's method, with deflation
-  and a search along each root's fold direction for close pairs (``csrc/torus.c``);
+  and a search along each root's fold direction for close pairs (``csrc/ik/torus.c``);
   this is a thorough search rather than a proof. Before it, a certificate
-  (``csrc/contraction.c``) bounds how fast the model's q1 and q7 turn as the wrist centre
+  (``csrc/ik/contraction.c``) bounds how fast the model's q1 and q7 turn as the wrist centre
   moves over the ball that holds the torus: where the map w -> (q1, q7) contracts (in a
   weighted max norm), on the whole torus or on cells of it, Banach's theorem proves each
   cell's root unique, found by iterating the map, and cells where the residual cannot

@@ -27,7 +27,7 @@ joints. The nominal arm is the OM method's *model side* of such an arm:
   besides q1 and q7, where its bounded searches take a circle or a torus; with them zeroed
   the nominal arm is searched on the torus :math:`(q_1, q_7)`, and the correction (below) is
   that translation, the OM system (9) itself, solved at every model IK by the fixed point of
-  ``csrc/near.c``: with q1 and q7 given, it turns with q2 alone (taken on the left, in DH frame
+  ``csrc/ik/near.c``: with q1 and q7 given, it turns with q2 alone (taken on the left, in DH frame
   0) or q6 alone (on the right, in the flange frame), at a rate of about
   :math:`a / |W - S|` away from the model's singular set.
 
@@ -35,7 +35,7 @@ The real arm keeps its exact table: :attr:`NominalArm.exact` is the same chain a
 arm's, only re-expressed in the nominal joint coordinates :math:`q_n = f \odot q`
 (:attr:`NominalArm.flip`, the half turns moved but not snapped), so its FK at :math:`q_n`
 is the real arm's at q. The solver solves the OM system with the nominal arm as the model's
-side, the exact chain's difference from it corrected at every model IK (``csrc/near.c``).
+side, the exact chain's difference from it corrected at every model IK (``csrc/ik/near.c``).
 """
 
 from __future__ import annotations
@@ -57,7 +57,7 @@ NEAR_TWIST = 1e-3
 #: A DH length within this many metres per metre of the arm's reach of zero is zero in the
 #: nominal arm: rounding, and the common normal's shift by a twist rounded in the arm's source
 #: (an xArm7 URDF's rpy 1.5708 is 3.7e-6 rad off 90 deg and leaves d = 1.1e-6 m over 0.29 m),
-#: which the correction of ``csrc/near.c`` absorbs like the twist; it would otherwise make the
+#: which the correction of ``csrc/ik/near.c`` absorbs like the twist; it would otherwise make the
 #: nominal arm another family's (the shoulder offset d2 of the torus). Genuine offsets are
 #: millimetres (the Piper's d5 = 1.4e-3 m, 1.8e-3 per metre of its reach, is kept).
 NEAR_LENGTH = 1e-5
@@ -78,11 +78,11 @@ class NominalArm:
         differs: Whether the nominal arm's table differs from the real one.
         deviation: A bound (m, to first order) on how far the nominal arm's flange frame is
             from the real one's at any q, over the points within reach: the snapped angles'
-            changes times the reach plus the zeroed lengths, summed (``csrc/near.c``'s scale
+            changes times the reach plus the zeroed lengths, summed (``csrc/ik/near.c``'s scale
             of the correction).
         shoulder_offset: The 7-DOF shoulder offset a2 (m) the nominal arm zeroes; 0 if none.
             Where it is the larger of the two, the correction is taken on the left, in DH frame
-            0 (``csrc/near.c``): :math:`T_{nom}(q) = L(q) T_{real}(q)` with :math:`L` the
+            0 (``csrc/ik/near.c``): :math:`T_{nom}(q) = L(q) T_{real}(q)` with :math:`L` the
             translation by :math:`\Delta p(q_1, q_2)`, so that the model's target is the OM
             system's :math:`p_d + \Delta p` and the fixed point, with :math:`q_1` given on the
             torus, turns with :math:`q_2` alone.

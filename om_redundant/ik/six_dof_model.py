@@ -135,7 +135,7 @@ def wrist_offset(
     At a solution :math:`z_5 = R_d\,a_6` (:math:`a_6` joint 6's axis in the flange frame) is the
     target's, and where joints 2, 3 and 4 are parallel :math:`z_3 = C_0 + C_1 \cos q_1 + C_2
     \sin q_1`: the solutions of system (9) in a configuration lie on the circle
-    :math:`p_m = p_d + \Delta p(w)`, :math:`w = q_1` (``csrc/wrist_offset.c``), undefined only
+    :math:`p_m = p_d + \Delta p(w)`, :math:`w = q_1` (``csrc/ik/wrist_offset.c``), undefined only
     at the singular wrist :math:`\sin\varphi_5 = 0`.
 
     Raises:

@@ -134,7 +134,7 @@ class OMSolver(BatchSolves):
     def solver_data(self) -> _core.SolverData:
         """The fixed data of the compiled kernel (see :class:`~om_redundant._core.SolverData`):
         of the arm, or, for an arm near a family (:attr:`nominal`), of its nominal arm's model with
-        the arm's exact chain (``csrc/near.c``)."""
+        the arm's exact chain (``csrc/ik/near.c``)."""
         return kernel_data(self.model_arm, self.tolerances, self.scan_points, self.nominal)
 
     @property

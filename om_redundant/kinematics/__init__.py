@@ -1,4 +1,4 @@
-"""Kinematics of real arms: DH chains (:mod:`.chain`, with C kernels in ``csrc/kinematics.c``),
+"""Kinematics of real arms: DH chains (:mod:`.chain`, with C kernels in ``csrc/ik/kinematics.c``),
 arms (:mod:`.arm`), read from and written to arm files (:mod:`.arm_file`), and the poses
 those files hold (:mod:`.poses`)."""
 

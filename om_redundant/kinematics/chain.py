@@ -15,7 +15,7 @@ A table in the modified (Craig) convention,
 regroups into a fixed row :math:`T_x(a_0) R_x(\alpha_0)` followed by standard rows. One
 internal convention keeps one code path for FK, Jacobians and the OM model.
 
-The numeric kernels are C (``csrc/kinematics.c``, in :mod:`om_redundant.ckernels`);
+The numeric kernels are C (``csrc/ik/kinematics.c``, in :mod:`om_redundant.ckernels`);
 :class:`KinematicChain` is the typed front.
 """
 
@@ -39,7 +39,7 @@ class JointKind(StrEnum):
     FIXED = "fixed"
 
 
-#: A row's kind as the kernels' tables hold it (the codes are C's: csrc/om_kernels.h, OM_JOINT_*).
+#: A row's kind as the kernels' tables hold it (the codes are C's: csrc/ik/om_kernels.h, OM_JOINT_*).
 _KIND_CODE = {
     JointKind.REVOLUTE: _core.JOINT_REVOLUTE,
     JointKind.PRISMATIC: _core.JOINT_PRISMATIC,
@@ -103,7 +103,7 @@ class KinematicChain:
     table: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        # the kernels' table: its columns are C's (csrc/om_kernels.h, OM_DH_*), read from _core
+        # the kernels' table: its columns are C's (csrc/ik/om_kernels.h, OM_DH_*), read from _core
         rows = self.rows
         table = np.empty((len(rows), _core.DH_COLUMNS))
         table[:, _core.DH_A] = [r.a for r in rows]

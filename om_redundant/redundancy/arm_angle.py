@@ -33,7 +33,7 @@ W), :math:`\partial_j \hat w = (I - \hat w \hat w^T)\,\partial_j W / |w|`,
 :math:`\partial_j b = e\sigma(\partial_j z_4 \times \hat w + z_4 \times \partial_j \hat w)`.
 So psi depends on q1..q4 only. It jumps by pi where the ELBOW sign flips (the straight
 elbow), where this gradient is the one-sided derivative of either branch. The kernel is C
-(``om_arm_angle_gradient`` in ``csrc/srs.c``).
+(``om_arm_angle_gradient`` in ``csrc/ik/srs.c``).
 """
 
 from __future__ import annotations

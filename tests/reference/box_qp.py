@@ -1,5 +1,5 @@
 r"""The QP in one variable in numpy (:mod:`om_redundant.redundancy.choice.box_qp`), solved another
-way than ``_core.step_1d`` (``csrc/box_qp.c``, a bisection on phi's slope): between its
+way than ``_core.step_1d`` (``csrc/redundancy/box_qp.c``, a bisection on phi's slope): between its
 breakpoints (two pieces of a group crossing, a piece crossing its group's cap) phi is one
 quadratic, with slope :math:`D_k - b\delta` (:math:`D_k` the weighted rates of the uncapped
 groups' least pieces), so the maximiser is a breakpoint, an end, or a segment's stationary point

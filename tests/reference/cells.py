@@ -1,5 +1,5 @@
 """The numpy references of the cell test of the solution paths (``_core.surprise``,
-``_core.crossing`` and ``_core.cell_looks``, csrc/cells.c): every Hermite model at every
+``_core.crossing`` and ``_core.cell_looks``, csrc/redundancy/cells.c): every Hermite model at every
 point of a cell, where the compiled test skips what its bounds settle."""
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
-"""The Python loops of path following and linking (``_core.follow``, ``csrc/follow.c``;
-``_core.link_paths``, ``csrc/link.c``; the library's are
+"""The Python loops of path following and linking (``_core.follow``, ``csrc/redundancy/follow.c``;
+``_core.link_paths``, ``csrc/redundancy/link.c``; the library's are
 :meth:`~om_redundant.redundancy.paths.probe.Probe.follow`, ``next`` and ``link``): the same
 steps, tests and decisions written over the solver's public ``solve`` (its bounded search
 where the kernel solves locally) and numpy."""
@@ -81,7 +81,7 @@ def end_measures(probe: Probe, point: Point) -> list[float]:
     branch, redundancy = np.empty(len(probe.signs)), np.empty(1)
     probe.solver.kernel.configuration_values(np.ascontiguousarray(point.q), branch, redundancy)
     tt = 0.0
-    for v in point.tangent[:, 0].tolist():  # (summed in order, as csrc/follow.c does)
+    for v in point.tangent[:, 0].tolist():  # (summed in order, as csrc/redundancy/follow.c does)
         tt += v * v
     return [1.0 / tt] + [
         float(s) * b + BRANCH_BAND for s, b in zip(probe.signs, branch.tolist(), strict=True)

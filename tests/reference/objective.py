@@ -1,5 +1,5 @@
 """The objective's terms from its groups (:class:`~om_redundant.redundancy.objective.objective.Group`): the
-oracle of ``_core.evaluate`` (``csrc/objective.c``), which computes f and the slack at once."""
+oracle of ``_core.evaluate`` (``csrc/redundancy/objective.c``), which computes f and the slack at once."""
 
 from __future__ import annotations
 

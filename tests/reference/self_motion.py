@@ -1,5 +1,6 @@
 """The numpy reference of the self-motion tangents of many rows (``_core.self_motion_tangents``,
-``csrc/tangents.c``; the library's is :func:`om_redundant.redundancy.self_motion.self_motion_tangents`)."""
+``csrc/redundancy/tangents.c``; the library's is
+:func:`om_redundant.redundancy.self_motion.self_motion_tangents`)."""
 
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
 """The bounds of a climb's start in numpy (``start_bounds.StartBounds.cone`` and ``within``): the
-oracle of ``_core.start_cones`` and ``_core.start_bound`` (``csrc/start_bounds.c``, the same
+oracle of ``_core.start_cones`` and ``_core.start_bound`` (``csrc/redundancy/start_bounds.c``, the same
 operations in loops)."""
 
 from __future__ import annotations

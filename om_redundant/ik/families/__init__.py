@@ -6,7 +6,7 @@ redundancy values that define the configuration of a joint vector. The closed fo
 (``csrc/``); these modules hold their math and call them from Python (:mod:`.dispatch`).
 :mod:`om_redundant.ik.model` recognises the family of a model arm, and
 :mod:`~om_redundant.ik.six_dof_model` and :mod:`~om_redundant.ik.srs_model` pack its parameters.
-The family codes and the parameter layouts are written once, in ``csrc/om_kernels.h``, and
+The family codes and the parameter layouts are written once, in ``csrc/ik/om_kernels.h``, and
 read from :mod:`om_redundant._core` (the codes re-exported here).
 """
 

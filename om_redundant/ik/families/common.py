@@ -1,5 +1,5 @@
 r"""Pieces every family uses: the reach slack, and the angles of three revolute joints with
-intersecting axes (a spherical shoulder or wrist), computed in ``csrc/common.c``
+intersecting axes (a spherical shoulder or wrist), computed in ``csrc/ik/common.c``
 (``om_euler_zxzxz``, ``om_euler_zxzxz_given_first``).
 
 The rotation of such a triple is

@@ -1,6 +1,6 @@
 """Dispatch on the family code: one entry point per question the solver asks a family.
 
-The closed forms are C (``csrc/six_dof.c``, ``csrc/srs.c``, ``csrc/families.c``); these
+The closed forms are C (``csrc/ik/six_dof.c``, ``csrc/ik/srs.c``, ``csrc/ik/families.c``); these
 functions call them from Python on arrays, as the tests and the model's derivation do. The
 solver itself calls them inside its compiled kernels.
 """

@@ -33,8 +33,8 @@ At :math:`\sin\varphi_5 = 0` (rule 3 of the paper) :math:`q_4` keeps its previou
 likewise :math:`q_1` (rule 1) when the wrist centre is on the axis of joint 1. Every angle
 comes from atan2, never acos, so that precision holds near singular joints.
 
-The closed form is C (``csrc/six_dof.c``). The family codes and the parameter vector's layout
-are written once, in ``csrc/om_kernels.h``: Python reads them from :mod:`om_redundant._core`
+The closed form is C (``csrc/ik/six_dof.c``). The family codes and the parameter vector's layout
+are written once, in ``csrc/ik/om_kernels.h``: Python reads them from :mod:`om_redundant._core`
 (``_core.RRR_SPHERICAL_WRIST``, ``_core.SD_A1``, ... ``_core.SD_N_PARAMS``) where it uses them.
 """
 

@@ -1,7 +1,7 @@
 r"""7-DOF model arms: spherical shoulder, one elbow joint, spherical wrist (Hollerbach arms).
 
-The closed form is C (``csrc/srs.c``); this module holds its math. The family code and the
-parameter vector's layout are written once, in ``csrc/om_kernels.h``: Python reads them from
+The closed form is C (``csrc/ik/srs.c``); this module holds its math. The family code and the
+parameter vector's layout are written once, in ``csrc/ik/om_kernels.h``: Python reads them from
 :mod:`om_redundant._core` (``_core.SRS``, ``_core.SRS_THETA``, ... ``_core.SRS_N_PARAMS``) where it
 uses them.
 

@@ -10,7 +10,7 @@ over the interval where every group with a floor keeps :math:`\min_j v_j + a_j\d
 floor_g`, within the box [lower, upper]. phi is strictly concave (b > 0): its right
 derivative, :math:`-b\delta` plus each uncapped group's weight times its least piece's rate,
 falls through zero once, at the maximiser (a kink or a stationary point), which bisection on
-its sign finds to rounding (``_core.step_1d``, ``csrc/box_qp.c``, reading only the pieces that
+its sign finds to rounding (``_core.step_1d``, ``csrc/redundancy/box_qp.c``, reading only the pieces that
 can be their group's least in the box; ``tests/reference/box_qp.py`` solves it by the
 breakpoints instead, the tests' oracle). The multipliers of the pieces are those of the
 epigraph's KKT conditions: each uncapped group's weight on its least piece, or at a kink split
@@ -65,7 +65,7 @@ def step_1d(
     pieces: Pieces, curvature: float, lower: float, upper: float
 ) -> tuple[float, float, np.ndarray] | None:
     r"""The climb's QP step in one variable, maximised as in the module docstring
-    (``_core.step_1d``, ``csrc/box_qp.c``).
+    (``_core.step_1d``, ``csrc/redundancy/box_qp.c``).
 
     Args:
         pieces: The groups' pieces.

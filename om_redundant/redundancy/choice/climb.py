@@ -12,7 +12,7 @@ and the QP
 
 (the epigraph form of the max-min objective; the floors keep the linearised margins >= 0
 and clearances >= d_min) is solved exactly in its one variable
-(:func:`~om_redundant.redundancy.choice.box_qp.step_1d`, ``csrc/box_qp.c``). b is a damped BFGS
+(:func:`~om_redundant.redundancy.choice.box_qp.step_1d`, ``csrc/redundancy/box_qp.c``). b is a damped BFGS
 estimate of the curvature of the Lagrangian, from the QP's multipliers z_j:
 :math:`s = \delta`, :math:`y = -\sum_j z_j (a_j^{new} - a_j^{old})`. The step is solved
 exactly (the current q as hint); it is accepted when the exact point is feasible and gains

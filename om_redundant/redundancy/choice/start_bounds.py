@@ -58,7 +58,7 @@ class StartBounds:
     def cone(self, k: np.ndarray, reach: np.ndarray) -> np.ndarray:
         r"""(K,) the bounds from the starts' own cones: the smaller of :math:`f_k + L R` and
         :math:`\sum_g w_g \min(cap_g, \min_j (v_{jk} + L_j R))`, the groups summed in their
-        order (``_core.start_cones``, ``csrc/start_bounds.c``; its numpy oracle is
+        order (``_core.start_cones``, ``csrc/redundancy/start_bounds.c``; its numpy oracle is
         ``tests/reference/start_bounds.py``)."""
         bounds, reach = np.empty(len(k)), np.ascontiguousarray(reach, dtype=float)
         _core.start_cones(self._samples, np.ascontiguousarray(k, dtype=np.int64), reach, bounds)
@@ -71,7 +71,7 @@ class StartBounds:
         a cell that R cuts, or beyond the run's end, the last sample's cone reaches
         :math:`u_i + L r` (r the reach left). Per cell or cut cell the smaller of f's bound
         and the terms' (:meth:`cone`'s sum), the largest over the cells; at least f_k
-        (``_core.start_bound``, ``csrc/start_bounds.c``; its numpy oracle is
+        (``_core.start_bound``, ``csrc/redundancy/start_bounds.c``; its numpy oracle is
         ``tests/reference/start_bounds.py``).
 
         Args:

@@ -1,7 +1,7 @@
 r"""The tracking step: the optimiser's choice for the next pose of a path in one compiled call.
 
 From the previous choice (branch signs, psi, joints q'), :func:`_core.track_step
-<om_redundant.ckernels>` (``csrc/tracking.c``) does, for the new pose T:
+<om_redundant.ckernels>` (``csrc/redundancy/tracking.c``) does, for the new pose T:
 
 1. the exact solution :math:`q_0` at the previous psi, hinted by :math:`q'`;
 2. the self-motion tangent :math:`t = dq/d\psi = n / (D\psi(q_0)\,n)`, n the null vector of
@@ -54,7 +54,7 @@ from ...ik.solver import OMSolver, Solution
 from ..objective.objective import Objective
 from ..objective.terms import SINGULARITY_CAP
 
-#: Curvature b of the first tracking step's model (per rad^2), and its largest (csrc/tracking.c).
+#: Curvature b of the first tracking step's model (per rad^2), and its largest (csrc/redundancy/tracking.c).
 INITIAL_CURVATURE, MAX_CURVATURE = 0.1, 1e3
 #: Where nothing is feasible within max_step (the feasible range moved away faster), the step
 #: is tried again within this many times max_step: the joint step bounds it as before.
@@ -66,7 +66,7 @@ WIDER = 64.0
 #: approached in shorter steps, and then held.
 SHRINKS = 8
 _JOINT_STEP = 0.25  # rad: the step keeps the linearised joint motion within this
-#: Why _core.track_step refused, by its status (csrc/redundancy.h).
+#: Why _core.track_step refused, by its status (csrc/redundancy/redundancy.h).
 _REFUSED = {
     _core.TRACK_NO_SOLUTION: "no exact solution at the previous psi continues the previous joints",
     _core.TRACK_SINGULAR: "the self-motion folds there (psi does not move along it)",

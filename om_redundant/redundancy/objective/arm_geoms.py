@@ -18,7 +18,7 @@ from ... import _core
 from ...exceptions import InvalidInput, ModelMismatch
 from ...mujoco_io.arm_in_model import MATCH_TOLERANCE, ArmJoints
 
-#: ArmCores.kind: the cores that _core.arm_clearance computes (csrc/redundancy.h).
+#: ArmCores.kind: the cores that _core.arm_clearance computes (csrc/redundancy/redundancy.h).
 POINT, SEGMENT, BOX = _core.CORE_POINT, _core.CORE_SEGMENT, _core.CORE_BOX
 _CHECKS = 3  # random joint vectors at which the geoms' placement is checked against MuJoCo's
 #: What ``_core.arm_clearance`` reads: the arm's links and the geoms' cores (``_core.ArmCores``).
@@ -114,7 +114,7 @@ def lever_arms(model: mujoco.MjModel, cores: ArmCores, arm_geoms: list[int], joi
 
 
 def _link_frames(table: np.ndarray, start: np.ndarray, slide: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """The (dof + 1, 4, 4) poses of links 0..dof at q, DH frame 0 at ``start`` (csrc/clearance.c):
+    """The (dof + 1, 4, 4) poses of links 0..dof at q, DH frame 0 at ``start`` (csrc/redundancy/clearance.c):
     ``_core.arm_geom_poses`` of a geom at the origin of every link."""
     links = np.arange(len(q) + 1, dtype=np.int64)
     identity = np.tile(np.concatenate([np.eye(3).ravel(), np.zeros(3)]), (len(links), 1))
@@ -173,7 +173,7 @@ def body_pose(data: mujoco.MjData, body: int) -> np.ndarray:
 
 
 def as_row(T: np.ndarray) -> np.ndarray:
-    """A pose (4, 4) as (12,): rotation row-major, then position (csrc/clearance.c)."""
+    """A pose (4, 4) as (12,): rotation row-major, then position (csrc/redundancy/clearance.c)."""
     return np.concatenate([T[:3, :3].ravel(), T[:3, 3]])
 
 

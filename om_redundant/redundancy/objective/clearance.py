@@ -9,7 +9,7 @@ over the pairs k of (arm geom :math:`A_k`, obstacle geom :math:`O_k`), negative 
 geoms overlap, capped at ``distmax``. The arm geoms are placed by the arm's DH chain
 (:mod:`~om_redundant.redundancy.objective.arm_geoms`: each at its offset in its link, checked against
 MuJoCo's ``mj_kinematics`` at set-up). One compiled call (``_core.arm_clearance``,
-``csrc/clearance.c``) places the geoms for every row of a batch of joint vectors and computes
+``csrc/redundancy/clearance.c``) places the geoms for every row of a batch of joint vectors and computes
 the pairs of a sphere or capsule arm geom and a sphere, capsule or box obstacle exactly
 (closest points of segments, and of a segment and a box, in closed form; overlapping where
 the cores do not touch), and ``mujoco.mj_geomDistance`` the rest (other kinds, cores

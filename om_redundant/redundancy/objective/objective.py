@@ -119,7 +119,8 @@ class Objective:
         )
         self._no_distances = np.zeros(0)  # _core.evaluate's without obstacles
         self._scratch = threading.local()  # each thread's record of one row for _core.evaluate
-        # what _core.pieces reads of the limits, and _core.evaluate of every term (csrc/objective.c)
+        # what _core.pieces reads of the limits, and _core.evaluate of every term
+        # (csrc/redundancy/objective.c)
         self._piece_limits = _core.PieceLimits(self._limited, self._lower, self._upper, self._half)
         self._terms = _core.ObjectiveTerms(
             self._dof,
@@ -199,7 +200,7 @@ class Objective:
     def evaluate(self, q: np.ndarray, distances: np.ndarray | None = None) -> Evaluation:
         """f(q), M(q), D(q), the feasibility slack and S(q): each group's minimum
         (the smallest of its pieces, :meth:`groups`) capped and weighted, summed in the
-        groups' order (``_core.evaluate``, ``csrc/objective.c``).
+        groups' order (``_core.evaluate``, ``csrc/redundancy/objective.c``).
 
         Args:
             q: (dof,) joint vector.
@@ -241,7 +242,7 @@ class Objective:
     ) -> tuple[np.ndarray, np.ndarray]:
         """The feasibility functions g_j at q (>= 0 iff feasible) and dg_j/dpsi: the
         :meth:`Group.constraints` of the margin and clearance groups chained through the
-        tangent (``_core.pieces``, ``csrc/cells.c``; the same numbers to rounding), at one
+        tangent (``_core.pieces``, ``csrc/redundancy/cells.c``; the same numbers to rounding), at one
         joint vector or at every row of q in one call.
 
         Args:

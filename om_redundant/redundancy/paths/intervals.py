@@ -251,7 +251,7 @@ def _newton(point: Point) -> float | None:
 
 def _modelled_end(inside: Point, outside: Point) -> float | None:
     """Where the first of the feasibility functions' cubic Hermite models between inside
-    (s = 0) and outside (s = 1) reaches zero (``_core.crossing``, ``csrc/cells.c``): the
+    (s = 0) and outside (s = 1) reaches zero (``_core.crossing``, ``csrc/redundancy/cells.c``): the
     first of the _MODEL_POINTS points of the cell where one is negative, refined by that
     model's secant from the point before; None where none is negative there."""
     (ga, da), (gb, db) = inside.pieces(), outside.pieces()

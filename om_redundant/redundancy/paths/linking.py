@@ -255,7 +255,7 @@ def _surprise(a: Point, b: Point) -> float | None:
     """Where, as a fraction of the cell, the pieces' cubic models predict a feasibility that
     the ends do not explain: more changes between feasible and infeasible than the ends'
     (none if alike, one if not), at the _MODEL_POINTS points of the cell. Returns the middle
-    of the first unexplained stretch. (``_core.surprise``, ``csrc/cells.c``; a piece
+    of the first unexplained stretch. (``_core.surprise``, ``csrc/redundancy/cells.c``; a piece
     that the bound of ``_core.cell_looks`` keeps positive cannot change the pattern and
     is skipped.)"""
     (ga, da), (gb, db) = a.pieces(), b.pieces()

@@ -9,14 +9,14 @@ success; where the last two points predict the path's end short of the next step
 aims just short of it (:meth:`Probe.follow`). Below :data:`END_TOLERANCE` the path has *ended*: it folded
 back in psi, or left the branch or the reach (a solution exactly at a fold, where psi does not
 move along the self-motion, fails its step as any other: the path ends beside it). The loop
-runs in one call (``_core.follow``, ``csrc/follow.c``; the tangents of
-``csrc/self_motion.c``; its solves are the hinted solve's local part, so a failed local solve
+runs in one call (``_core.follow``, ``csrc/redundancy/follow.c``; the tangents of
+``csrc/redundancy/self_motion.c``; its solves are the hinted solve's local part, so a failed local solve
 is a failed step without the bounded search, a root within a quarter of its step of the
 first-order prediction is taken without the scan for a nearer one, and a step whose
 prediction moves a joint farther than any root as near as the local one could continue
 fails without it, as it would with it); Python builds only the point reached. The linking of
 a branch's grid roots into paths runs in one call too (:meth:`Probe.link`,
-``_core.link_paths``, ``csrc/link.c``). Both loops are written in Python in
+``_core.link_paths``, ``csrc/redundancy/link.c``). Both loops are written in Python in
 ``tests/reference/follow.py``, the oracle they are tested against.
 """
 
@@ -34,13 +34,14 @@ from ..objective.objective import Objective
 from ..self_motion import self_motion_tangent, self_motion_tangents
 from .points import Point, PointTerms, evaluated_terms
 
-#: rad, max-norm: the largest joint step between neighbouring solutions of one path (csrc/om_paths.h's).
+#: rad, max-norm: the largest joint step between neighbouring solutions of one path
+#: (csrc/redundancy/om_paths.h's).
 JUMP = _core.PATH_JUMP
-#: rad: a path whose following step falls below this has ended (one value with csrc/om_paths.h's).
+#: rad: a path whose following step falls below this has ended (csrc/redundancy/om_paths.h's).
 END_TOLERANCE = _core.END_TOLERANCE
-#: rad, max-norm: two solutions at one psi this close are one (csrc/link.c reads it there too).
+#: rad, max-norm: two solutions at one psi this close are one (csrc/redundancy/link.c reads it there too).
 SAME = _core.PATH_SAME
-# A follow stalls (csrc/om_paths.h: a path within rounding of a singular set advances by
+# A follow stalls (csrc/redundancy/om_paths.h: a path within rounding of a singular set advances by
 # ~1e-6 rad a step, FOLLOW_CRAWL_STEPS steps in a row, or takes FOLLOW_MAX_ATTEMPTS
 # attempts): then SingularSelfMotion.
 _ARRIVED, _STALLED = _core.FOLLOW_ARRIVED, _core.FOLLOW_STALLED
@@ -177,7 +178,7 @@ class Probe:
 
     def link(self, psi: np.ndarray, roots: list[list[Point]]) -> list[tuple[list[Point], int]]:
         """The paths through the solutions ``roots[k]`` at the increasing grid psi[k] (within a
-        turn), in one ``_core.link_paths`` call (``csrc/link.c``; the rule in
+        turn), in one ``_core.link_paths`` call (``csrc/redundancy/link.c``; the rule in
         :mod:`~om_redundant.redundancy.paths.linking`'s docstring): each path's points and
         turns. Python builds only the points that following added. (Room for
         two added points per root and one per grid psi: paths start only at listed roots and

@@ -1,7 +1,7 @@
 /* Distances between an arm's geoms and obstacle geoms, and their gradients, for many joint
  * vectors in one call (om_redundant/redundancy/objective/clearance.py).
  *
- * Placement: the arm's links are the frames of its DH chain (csrc/kinematics.c's rows) started
+ * Placement: the arm's links are the frames of its DH chain (csrc/ik/kinematics.c's rows) started
  * from the world pose of DH frame 0; link l (l = 0..dof) is the frame just before joint l+1's
  * row (the chain's end for l = dof), which joints 1..l move, and joint l+1 turns about its z
  * axis through its origin. A geom on link l sits at the fixed offset G in it, X = F_l(q) G,
