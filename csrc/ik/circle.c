@@ -164,11 +164,7 @@ int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool f
             start = k;
     if (full_circle && start < 0) { /* reachable everywhere: one cyclic run */
         n = om_run_roots(pb, &scan, POLE_DEPTH, ws, gs, n_pts, true, curvatures, q, cands, n, cap);
-        if (pb->s->nominal_table && !pb->wrist)
-            n = _near_singular(pb, samples, bs, n_pts, h, q, cands, n, cap);
-        free(buffer);
-        free(order);
-        return n;
+        goto near_singular;
     }
     if (full_circle) { /* rotate to start and end at the same unreachable sample */
         for (int i = 0; i < count; i++)
@@ -232,6 +228,7 @@ int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool f
     }
     if (L > 0) /* a run that reaches the end of the window */
         n = om_run_roots(pb, &scan, POLE_DEPTH, pw, pg, L, false, curvatures, q, cands, n, cap);
+near_singular:
     if (pb->s->nominal_table && !pb->wrist)
         n = _near_singular(pb, samples, bs, n_pts, h, q, cands, n, cap);
     free(buffer);
