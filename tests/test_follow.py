@@ -199,8 +199,8 @@ def test_a_path_within_rounding_of_a_singular_set_stalls_rather_than_crawls():
     solver = solver_of("panda")
     optimizer = om.RedundancyOptimizer(solver)
     alone = [optimizer._sweep_alone(T_PANDA_ZERO_ROUNDED, signs) for signs in optimizer.branches]
-    stalled = [branch.signs for branch in alone if branch.stalled]
-    assert stalled and all("the self-motion crawls" in b.stalled for b in alone if b.stalled)
+    stalled = [branch.signs for branch in alone if branch.unswept]
+    assert stalled and all("the self-motion crawls" in b.unswept for b in alone if b.unswept)
     for q_current in (np.zeros(7), None):
         choice = optimizer.choose(T_PANDA_ZERO_ROUNDED, q_current=q_current)
         assert choice.ok and choice.configuration.signs not in stalled

@@ -13,6 +13,7 @@ import numpy as np
 from ...angles import wrap_angle
 from ...exceptions import SingularSelfMotion
 from ...ik.configuration import Configuration
+from ...ik.reach_envelope import ReachEnvelope
 from ...ik.solver import OMSolver, Solution
 from ..free_rotation import FreeRotation
 from ..objective.objective import Objective
@@ -36,15 +37,26 @@ class GlobalChoice:
     branches: list[tuple[int, ...]]
     grid_points: int
     _shared_search: bool
+    _reach: ReachEnvelope
 
     def _sweep(self, T: np.ndarray, branches: list[tuple[int, ...]]) -> list[BranchRuns]:
         """Every branch's solution paths and feasible runs. Where a path runs within rounding
         of a singular set (SingularSelfMotion), the branches are swept one by one and those
-        that raise have none, the reason in their ``stalled``.
+        that raise have none, the reason in their ``unswept``; where T is proven out of reach
+        (:class:`~om_redundant.ik.reach_envelope.ReachEnvelope`), none is swept, and each says so.
 
         Raises:
             SingularSelfMotion: Every branch raised.
         """
+        beyond = self._reach.beyond(T)
+        if beyond is not None:
+            distance = f"{beyond:.4f} m" if beyond < 1e6 else "too far"
+            why = (
+                f"the target is out of reach: its wrist centre lies {distance} beyond where the arm's "
+                f"elbow reaches (more than the {self._reach.slack:.4f} m its offsets can make up), at every "
+                "arm angle and branch"
+            )
+            return [BranchRuns(signs, [], [], why) for signs in branches]
         probes = [self._probe(T, signs) for signs in branches]
         try:
             swept = sweep_circle(probes, self.grid_points)
@@ -52,7 +64,7 @@ class GlobalChoice:
             if len(branches) == 1:
                 raise
             alone = [self._sweep_alone(T, signs) for signs in branches]
-            if all(branch.stalled for branch in alone):
+            if all(branch.unswept for branch in alone):
                 raise singular
             return alone
         paths = [(probe, path) for probe, paths in zip(probes, swept, strict=True) for path in paths]
@@ -75,7 +87,7 @@ class GlobalChoice:
         swept = self._sweep(T, branches)
         runs = [run for branch in swept for run in branch.runs]
         if not runs:
-            why = "; ".join(self._why(branch) for branch in swept)
+            why = self._reasons(swept)
             return failed_choice((), f"no feasible arm angle: {why}")
         return self._result(T, self._climb_all(T, runs), runs)
 
@@ -102,10 +114,10 @@ class GlobalChoice:
         note = ""
         if (way is None or not way[0].clear) and signs is not None:
             own = [b for branches in swept for b in branches if b.signs == signs]
-            stalled = next((b.stalled for b in own if b.stalled), "")
+            unswept = next((b.unswept for b in own if b.unswept), "")
             ran = any(b.runs for b in own)
             note = f"branch {signs} has no {'clear way' if ran else 'feasible arm angle at this pose'}"
-            note = f"branch {signs} was not swept: {stalled}" if stalled else note
+            note = f"branch {signs} was not swept: {unswept}" if unswept else note
             if not at_once:
                 others = [b for b in self.branches if b != signs]
                 swept = [
@@ -116,7 +128,7 @@ class GlobalChoice:
         if way is not None and not way[0].clear:
             note = "; ".join(filter(None, [note, "no candidate has a clear way: the best is taken"]))
         if way is None:
-            why = "; ".join(self._why(branch) for branch in swept[0])
+            why = self._reasons(swept[0])
             return failed_choice((), f"no feasible arm angle: {why}")
         chosen, k = way
         intervals = tuple(run.interval for branch in swept[k] for run in branch.runs)
@@ -233,11 +245,19 @@ class GlobalChoice:
         values = (ev.margin, ev.clearance, ev.value)
         return RedundancyChoice(solution.ok, configuration, solution, *values, intervals, pose=T, **fields)
 
+    def _reasons(self, branches: list[BranchRuns]) -> str:
+        """Why the branches hold nothing feasible: the one reason all share (the target out
+        of reach), else each branch's."""
+        shared = {branch.unswept for branch in branches}
+        if len(shared) == 1 and (reason := shared.pop()):
+            return reason
+        return "; ".join(self._why(branch) for branch in branches)
+
     def _why(self, branch: BranchRuns) -> str:
         """Why a branch's solution paths hold nothing feasible."""
         signs = branch.signs
-        if branch.stalled:
-            return f"branch {signs}: not swept ({branch.stalled})"
+        if branch.unswept:
+            return f"branch {signs}: not swept ({branch.unswept})"
         points = [p for path in branch.paths for p in path.points]
         if not points:
             return f"branch {signs}: no solution at any of {self.grid_points} arm angles"

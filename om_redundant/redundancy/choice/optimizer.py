@@ -58,6 +58,7 @@ import mujoco
 import numpy as np
 
 from ...exceptions import InvalidInput
+from ...ik.reach_envelope import ReachEnvelope
 from ...ik.solver import OMSolver
 from ...validation import as_count, as_instance, as_joint_vector, as_number, as_pose, as_signs
 from ..free_rotation import FreeRotation
@@ -170,6 +171,7 @@ class RedundancyOptimizer(GlobalChoice):
         self._tracker = Tracker(solver, self.objective, self.max_step)
         # shoulder offsets (the torus): a batch's branches share their grid search
         self._shared_search = bool(np.any(solver.model_arm.shoulder))
+        self._reach = ReachEnvelope(solver)
 
     def __reduce__(self) -> tuple[Any, tuple[Any, ...]]:
         """Pickled as its solver, clearance and options (the tracking step's state is rebuilt)."""

@@ -61,14 +61,14 @@ class PsiInterval:
 
 
 class BranchRuns(NamedTuple):
-    """A branch's solution paths swept over the circle and their feasible runs; ``stalled``:
-    why it has none, where its sweep stalled (the SingularSelfMotion of a path within rounding
-    of a singular set), else ""."""
+    """A branch's solution paths swept over the circle and their feasible runs; ``unswept``:
+    why it has none without a sweep (its sweep stalled: the SingularSelfMotion of a path within
+    rounding of a singular set; the target out of reach), else ""."""
 
     signs: tuple[int, ...]
     paths: list[Path]
     runs: list[Run]
-    stalled: str = ""
+    unswept: str = ""
 
 
 @dataclass(frozen=True, eq=False)
