@@ -122,7 +122,7 @@ def recorded_calls() -> dict[str, tuple[Callable[..., Any], tuple[Any, ...]]]:
     m, roots = 3, _core.MAX_ROOTS
     Ts, rows, psis = np.stack([T] * m), np.stack([signs] * m), np.stack([psi] * m)
     methods = {
-        "solve": (T, c.signs, c.redundancy, None, np.zeros(7)),
+        "solve": (T, c.signs, c.redundancy, None, np.zeros(7), False),
         "solve_pose": (T, c),
         "solve_rows": (
             _core.SolveBatch(

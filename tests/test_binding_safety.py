@@ -36,7 +36,7 @@ def raises(kind, call, *args):
 
 
 def solves(call=kernel.solve):
-    assert call(T, c.signs, c.redundancy, None, np.zeros(7)).status == _core.OK
+    assert call(T, c.signs, c.redundancy, None, np.zeros(7), False).status == _core.OK
 """
 
 
@@ -58,7 +58,7 @@ def test_a_solver_is_initialised_once():
         fresh = _core.Solver.__new__(_core.Solver)
         raises(ValueError, fresh.__init__, data._replace(flip=np.ones(3)))
         raises(ValueError, fresh.__init__, data._replace(scan_points=3))
-        raises(RuntimeError, fresh.solve, T, c.signs, c.redundancy, None, np.zeros(7))
+        raises(RuntimeError, fresh.solve, T, c.signs, c.redundancy, None, np.zeros(7), False)
         fresh.__init__(data)
         solves(fresh.solve)
     """)
@@ -71,7 +71,7 @@ def test_an_uninitialised_solver_raises():
                    "bounded_search", "torus_bound", "holds"]
         for name in methods:
             raises(RuntimeError, getattr(bare, name))
-        raises(RuntimeError, bare.solve, T, (), (), None, np.zeros(0))
+        raises(RuntimeError, bare.solve, T, (), (), None, np.zeros(0), False)
         raises(RuntimeError, bare.solve_rows, None, 0, 0)
         raises(RuntimeError, _core.follow, _core.FollowWork(bare, *[None] * 7), 0.0, 0.0, 0.0)
         work, roots = _core.FollowWork(bare, *[None] * 7), _core.LinkRoots(*[None] * 4)
@@ -102,7 +102,7 @@ def test_lists_emptied_while_they_are_read():
         signs += [Clears(signs, s) for s in c.signs]
         redundancy = []
         redundancy.append(Clears(redundancy, c.redundancy[0]))
-        assert kernel.solve(T, signs, redundancy, None, np.zeros(7)).status == _core.OK
+        assert kernel.solve(T, signs, redundancy, None, np.zeros(7), False).status == _core.OK
         assert kernel.holds(Q, signs[:] or [Clears(signs, s) for s in c.signs], c.redundancy)
         psi, feasible = [], []
         psi += [Clears(psi, 0.0), 0.1, 0.2]
@@ -170,7 +170,7 @@ def test_batch_rows_refuse_signs_and_rows_out_of_range():
             raises(ValueError, kernel.solve_all_rows, all_rows(signs), start, stop)
         raises(OverflowError, kernel.solve_rows, rows(signs), 0, 2**70)
         raises(TypeError, kernel.solve_rows, (Ts, signs), 0, 2)  # (not a batch: no named fields)
-        raises(ValueError, kernel.solve, T, (1, 2, 1), c.redundancy, None, np.zeros(7))
+        raises(ValueError, kernel.solve, T, (1, 2, 1), c.redundancy, None, np.zeros(7), False)
     """)
 
 
@@ -226,7 +226,7 @@ def test_a_rotation_far_from_orthonormal_returns(name):
                 for value in [-1e16, 1e300, np.nan]:
                     bad = T.copy()
                     bad[i, j] = value
-                    kernel.solve(bad, c.signs, c.redundancy, None, np.zeros(dof))
+                    kernel.solve(bad, c.signs, c.redundancy, None, np.zeros(dof), False)
                     n = _core.MAX_ROOTS
                     roots = _core.Roots(np.zeros((n, dof)), np.zeros(n), np.zeros(n), np.zeros(n, dtype=bool))
                     kernel.solve_all(bad, c.signs, c.redundancy, roots)
@@ -234,7 +234,7 @@ def test_a_rotation_far_from_orthonormal_returns(name):
                     if j < 3 or not np.isfinite(value):  # (a finite position is a pose, out of reach)
                         raises(om.InvalidInput, solver.solve, bad, c)
         for psi in [np.nan, np.inf, 1e300] if dof == 7 else []:
-            kernel.solve(T, c.signs, (psi,), None, np.zeros(dof))
+            kernel.solve(T, c.signs, (psi,), None, np.zeros(dof), False)
     """,
         timeout=240,
     )

@@ -212,21 +212,21 @@ def test_the_binding_rejects_malformed_buffers_with_a_named_error(panda):
     kernel = _core.Solver(panda.solver_data())
     out = np.empty(7)
     with pytest.raises(TypeError, match="T must be float64"):
-        kernel.solve(T.astype(np.float32), c.signs, c.redundancy, None, out)
+        kernel.solve(T.astype(np.float32), c.signs, c.redundancy, None, out, False)
     with pytest.raises(TypeError, match="T must be a C-contiguous"):
-        kernel.solve(np.asfortranarray(T), c.signs, c.redundancy, None, out)
+        kernel.solve(np.asfortranarray(T), c.signs, c.redundancy, None, out, False)
     with pytest.raises(ValueError, match="T must have 16 entries"):
-        kernel.solve(T[:3], c.signs, c.redundancy, None, out)
+        kernel.solve(T[:3], c.signs, c.redundancy, None, out, False)
     with pytest.raises(ValueError, match="q_hint must have 7 entries"):
-        kernel.solve(T, c.signs, c.redundancy, np.zeros(6), out)
+        kernel.solve(T, c.signs, c.redundancy, np.zeros(6), out, False)
     with pytest.raises(TypeError, match="q_out must be a C-contiguous writable"):
         read_only = np.empty(7)
         read_only.flags.writeable = False
-        kernel.solve(T, c.signs, c.redundancy, None, read_only)
+        kernel.solve(T, c.signs, c.redundancy, None, read_only, False)
     with pytest.raises(ValueError, match="signs must be -1 or"):
-        kernel.solve(T, (1, 0, 1), c.redundancy, None, out)
+        kernel.solve(T, (1, 0, 1), c.redundancy, None, out, False)
     with pytest.raises(ValueError, match="redundancy must have 1 entries"):
-        kernel.solve(T, c.signs, (), None, out)
+        kernel.solve(T, c.signs, (), None, out, False)
 
     def batch(m: int, **changed: np.ndarray) -> _core.SolveBatch:
         rows = _core.SolveBatch(

@@ -75,12 +75,15 @@ void om_put_root_info(const double *info, Py_ssize_t at, double *position, doubl
     within[at] = info[2] != 0.0;
 }
 
-/* solve(T, signs, redundancy, hint, q_out) -> Solved(status, position_error,
- * orientation_error, evaluations, within_limits). hint None: no hint. */
+/* solve(T, signs, redundancy, hint, q_out, from_previous) -> Solved(status, position_error,
+ * orientation_error, evaluations, within_limits). hint None: no hint; from_previous true: the
+ * hint is the joints at the previous pose (om_solve_from). */
 PyObject *om_Solver_solve(om_Solver *self, PyObject *const *args, Py_ssize_t nargs) {
     const om_solver_data *s = om_solver_ready(self);
     configuration c;
-    if (!s || get_call(s, args, nargs, 5, "solve", &c) < 0) return NULL;
+    if (!s || get_call(s, args, nargs, 6, "solve", &c) < 0) return NULL;
+    int from_previous = PyObject_IsTrue(args[5]);
+    if (from_previous < 0) return NULL;
     int n = args[3] != Py_None ? 3 : 2; /* the hint last, if there is one */
     PyObject *objs[3] = {args[0], args[4], args[3]};
     buffer_spec specs[3] = {{F64, 16, 0, "T"}, {F64, s->dof, 1, "q_out"}, {F64, s->dof, 0, "q_hint"}};
@@ -89,7 +92,9 @@ PyObject *om_Solver_solve(om_Solver *self, PyObject *const *args, Py_ssize_t nar
     double T[16]; /* (the caller's array may change while the GIL is released: a copy) */
     memcpy(T, v[0].buf, sizeof T);
     om_result r;
-    Py_BEGIN_ALLOW_THREADS r = om_solve_one(s, T, c.signs, c.redundancy, n == 3 ? v[2].buf : NULL, v[1].buf, NULL, NULL);
+    const double *hint = n == 3 ? v[2].buf : NULL;
+    Py_BEGIN_ALLOW_THREADS r = hint && from_previous ? om_solve_from(s, T, c.signs, c.redundancy, hint, v[1].buf)
+                                                     : om_solve_one(s, T, c.signs, c.redundancy, hint, v[1].buf, NULL, NULL);
     Py_END_ALLOW_THREADS release_buffers(v, n);
     PyObject *items[5] = {PyLong_FromLong(r.status), PyFloat_FromDouble(r.position_error),
                           PyFloat_FromDouble(r.orientation_error), PyLong_FromLongLong(r.evaluations),

@@ -176,7 +176,7 @@ const om_solver_data *om_solver_ready(const om_Solver *self) {
 
 static PyMethodDef Solver_methods[] = {
     {"solve", (PyCFunction)(void (*)(void))om_Solver_solve, METH_FASTCALL,
-     "solve(T, signs, redundancy, hint, q_out) -> Solved: one solve; see om_redundant.ik.solver."},
+     "solve(T, signs, redundancy, hint, q_out, from_previous) -> Solved: one solve; see om_redundant.ik.solver."},
     {"solve_pose", (PyCFunction)(void (*)(void))om_solver_solve_pose, METH_FASTCALL,
      "solve_pose(T, configuration) -> Solution, or None: the whole unhinted solve in one call."},
     {"solve_rows", (PyCFunction)(void (*)(void))om_solver_solve_rows, METH_FASTCALL,

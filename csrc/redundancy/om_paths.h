@@ -20,6 +20,20 @@ bool om_continues(int dof, const double *q0, const double *q1, const double *t, 
  * another path is off by the paths' separation, which no shorter step shrinks; one that
  * merely continues (om_continues: within 1/2) may be the partner at a fold. */
 bool om_beyond_doubt(int dof, const double *q0, const double *q1, const double *t, double d, const uint8_t *cyclic);
+/* A step's prediction for om_on_step: q d ahead of q along t (dof joints). */
+typedef struct {
+    int dof;
+    const double *q, *t;
+    double d;
+} om_step_prediction;
+/* solve_from.c: an om_root_test (context: om_step_prediction) taking a root that continues the
+ * prediction beyond doubt, else asking for the scan. */
+om_root_verdict om_on_step(const double *x, void *context);
+/* solve_from.c: the solve from the joints q_prev at the previous pose: its local root taken
+ * where it continues them beyond doubt along the hand's motion, else the root nearest them
+ * (om_solve_one with the hint q_prev). */
+om_result om_solve_from(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
+                        const double *q_prev, double *q_out);
 /* The largest joint step |q1 - q0|_inf, cyclic joints (NULL: none) modulo 2 pi (Probe.step; numpy's
  * remainder and maximum: a NaN step is NaN). */
 double om_largest_joint_step(int dof, const double *q0, const double *q1, const uint8_t *cyclic);

@@ -82,54 +82,14 @@ static bool box_step(const tracking *tr, const pieces *P, double b, double radiu
     return om_qp_step(&q, b, -radius, radius, step, NULL, NULL) == OM_QP_FOUND;
 }
 
-/* Each exact solve's root is taken without the windowed scan for a nearer one where it
- * continues its path from the hint beyond doubt (om_beyond_doubt, as follow.c takes its
- * roots): the second solve's (at psi + d, hinted by q0) along the self-motion, the first
- * solve's (at psi, hinted by q_prev) along the hand's motion at fixed psi (pose_motion). Else
- * the scan decides, and where the local solve fails, the bounded search, as before. (Each scan
- * cost 12-15 us of the Panda's step.) The prediction: q d ahead of q along t. */
-typedef struct {
-    int dof;
-    const double *q, *t;
-    double d;
-} step_prediction;
-
-static om_root_verdict on_step(const double *x, void *context) {
-    const step_prediction *p = context;
-    return om_beyond_doubt(p->dof, p->q, x, p->t, p->d, NULL) ? OM_ROOT_TAKE : OM_ROOT_SCAN;
-}
-
-/* The first solve's prediction: the joints' first-order motion dq from q with psi held while
- * the flange moves from its pose (R, p) at q to the target's (R_d, p_d),
- *     [J(q); Dpsi(q)] dq = [p_d - p; omega; 0],
- * J the flange's geometric Jacobian [v; omega] and omega = vee((E - E^T) / 2), E = R_d R^T, the
- * rotation vector of E to first order (all in DH frame 0, as om_self_motion_null's J). False
- * where the 7 x 7 system is singular (a zero pivot, or dq not finite): no prediction, the scan decides. */
-static bool pose_motion(const om_solver_data *s, const double *T, const double *q, double *dq) {
-    double A[7 * 7], R[9], p[3];
-    om_solver_jacobian(s, q, A, R, p); /* rows 0-5 of A; the flange (R, p) */
-    om_solver_psi_gradient(s, q, A + 6 * 7);
-    mat3 Rd;
-    vec3 pd;
-    om_flange_target(T, s->T_base_root, s->T_tool_flange, &Rd, &pd);
-    mat3 E = m_mmt(Rd, m_load(R, 0));
-    double b[7] = {pd.x - p[0], pd.y - p[1], pd.z - p[2], 0.5 * (E.r2.y - E.r1.z), 0.5 * (E.r0.z - E.r2.x),
-                   0.5 * (E.r1.x - E.r0.y), 0.0};
-    if (!om_eliminate(A, b, 7, NULL)) return false;
-    for (int i = 0; i < 7; i++)
-        if (!isfinite(b[i])) return false;
-    memcpy(dq, b, sizeof b);
-    return true;
-}
-
 int om_track(const om_tracking *tr, const double *T, const int64_t *signs, double psi, const double *q_prev,
              double max_step, double curvature, double *q1, om_tracked *out) {
     const om_solver_data *s = tr->s;
     int dof = s->dof;
-    double q0[OM_MAX_DOF], t0[OM_MAX_DOF], t1[OM_MAX_DOF], dq[OM_MAX_DOF];
-    step_prediction moved = {dof, q_prev, dq, 1.0};
-    bool predicted = s->mode != OM_FIXED && pose_motion(s, T, q_prev, dq); /* (a fixed dp: no scan to spare) */
-    om_result r = om_solve_one(s, T, signs, &psi, q_prev, q0, predicted ? on_step : NULL, &moved);
+    double q0[OM_MAX_DOF], t0[OM_MAX_DOF], t1[OM_MAX_DOF];
+    /* each solve's root taken without the scan where it continues beyond doubt: the first's along
+     * the hand's motion (om_solve_from), the second's along the self-motion */
+    om_result r = om_solve_from(s, T, signs, &psi, q_prev, q0);
     if (r.status != OM_OK || !om_continues(dof, q_prev, q0, NULL, 0.0, NULL)) return OM_TRACK_NO_SOLUTION;
     if (!om_self_motion_tangent(s, q0, t0, SINGULAR_TANGENT)) return OM_TRACK_SINGULAR;
     static pieces P0, P1; /* (the GIL is held: one call at a time) */
@@ -141,8 +101,8 @@ int om_track(const om_tracking *tr, const double *T, const int64_t *signs, doubl
     double psi1 = psi + d;
     for (int k = 0;; k++) {
         psi1 = psi + d;
-        step_prediction p = {dof, q0, t0, d};
-        r = om_solve_one(s, T, signs, &psi1, q0, q1, on_step, &p);
+        om_step_prediction p = {dof, q0, t0, d};
+        r = om_solve_one(s, T, signs, &psi1, q0, q1, om_on_step, &p);
         if (r.status == OM_OK && om_continues(dof, q0, q1, t0, d, NULL) && om_self_motion_tangent(s, q1, t1, SINGULAR_TANGENT)) break;
         if (k == HALVINGS) return OM_TRACK_LEFT;
         d /= 2.0;

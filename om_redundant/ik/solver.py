@@ -234,8 +234,37 @@ class OMSolver(BatchSolves):
                 return solution
         T = as_pose(T)
         self.check_configuration(configuration)
+        return self._solved(T, configuration, self._hint(q_hint), False)
+
+    def solve_from(self, T: Any, configuration: Configuration, q_previous: np.ndarray) -> Solution:
+        """The joint vector the arm moves to from ``q_previous`` (its joints at the previous
+        pose) as its hand moves to T, in the given configuration: the root whose joints moved
+        as their first-order motion along the hand's predicts (each within a quarter of its
+        step), where one does beyond doubt; else the root nearest ``q_previous``
+        (:meth:`solve`'s with it as the hint). What a control loop asks each tick: the same
+        answer as the hinted solve but where two roots lie close (a fold, a singular wrist),
+        without the hinted solve's scan for a nearer root (on an arm with offsets that turn
+        with two joints, most of its time: ``csrc/redundancy/solve_from.c``).
+
+        Args:
+            T: Target pose of the end-effector frame in the root frame: 4x4 or ``mink.SE3``.
+            configuration: Branch signs (and redundancy values for redundant arms).
+            q_previous: (dof,) the arm's joints at the previous pose.
+
+        Returns:
+            A :class:`Solution`, as :meth:`solve`'s.
+        """
+        T = as_pose(T)
+        self.check_configuration(configuration)
+        q_previous = as_joint_vector(q_previous, self.arm.dof, "q_previous", stack=False)
+        return self._solved(T, configuration, q_previous, True)
+
+    def _solved(
+        self, T: np.ndarray, configuration: Configuration, hint: np.ndarray | None, from_previous: bool
+    ) -> Solution:
+        """One compiled solve (``_core.Solver.solve``) as a :class:`Solution`."""
         q = np.empty(self.arm.dof)
-        r = self._kernel.solve(T, configuration.signs, configuration.redundancy, self._hint(q_hint), q)
+        r = self._kernel.solve(T, configuration.signs, configuration.redundancy, hint, q, from_previous)
         return Solution(
             q,
             r.status == _core.OK,

@@ -86,12 +86,13 @@ class ArmTask(Task):
         self, T_root: np.ndarray, c: Configuration, hint: np.ndarray | None, who: str
     ) -> np.ndarray:
         """The exact solution of pose T_root in configuration c within the joint limits (the
-        tighter of the arm's and the model's), nearest the hint.
+        tighter of the arm's and the model's): the one the arm moves to from the hint (the
+        joints at the previous target, :meth:`~om_redundant.OMSolver.solve_from`).
 
         Raises:
             UnreachableTarget: None; the message says why (``who`` names the task).
         """
-        solution = self.solver.solve(T_root, c, q_hint=hint)
+        solution = self.solver.solve(T_root, c) if hint is None else self.solver.solve_from(T_root, c, hint)
         if not solution.ok:
             raise UnreachableTarget(f"{who}: {solution.status} for the target (configuration {c})")
         if self.joints.within_limits(solution.q):
