@@ -3,7 +3,8 @@
 Run: ``python -m benchmarks.near_timing [--n 300] [--dir DIR] [--json FILE] [--before FILE]``;
 writes ``results/near_timing.md``. For each arm, N random in-limit q (seed 1): T = fk(q), c its
 configuration; the median (and 90th percentile) wall time of ``solve(T, c)``, of the hinted
-``solve(T, c, q_hint)`` (q moved by N(0, 0.01) rad per joint) and of ``solve_all(T, c)``, one
+``solve(T, c, q_hint)`` (q moved by N(0, 0.01) rad per joint), of ``solve_from(T, c, q_hint)``
+(the same joints as the previous pose's, a control tick's) and of ``solve_all(T, c)``, one
 call at a time from Python. The arms: UR5e, Panda and iiwa14 with every joint row's twist bent
 by +-eps (``benchmarks.near_family.bent``, seed 0), eps = 1e-6 ... 1e-3; the Menagerie near arms
 (Piper, Lite6); with ``--dir`` the URDF arms that go through their nominal arm
@@ -32,7 +33,16 @@ from .report import write_page
 EXACT = ("ur5e", "panda", "iiwa14", "xarm7")
 BENT = tuple((name, eps) for name in ("ur5e", "panda", "iiwa14") for eps in (1e-6, 1e-5, 1e-4, 1e-3))
 MENAGERIE_NEAR = ("piper", "lite6")
-URDF_NEAR = ("xArm7", "Kinova Jaco2 (j2s6s200)", "TIAGo", "iCub (left)", "ANYmal B + Kinova")
+URDF_NEAR = (
+    "xArm7",
+    "Kinova Jaco2 (j2s6s200)",
+    "TIAGo",
+    "TIAGo Pro (left)",
+    "Unitree G1 (left)",
+    "Baxter (left)",
+    "iCub (left)",
+    "ANYmal B + Kinova",
+)
 
 
 def arms(folder: Path | None) -> dict[str, Callable[[], om.Arm]]:
@@ -58,16 +68,18 @@ def _timed(call: Callable[[], object]) -> float:
 
 
 def measure(arm: om.Arm, n: int) -> dict[str, float]:
-    """Median and 90th percentile (us) of solve, the hinted solve and solve_all over n targets."""
+    """Median and 90th percentile (us) of solve, the hinted solve, the solve from the same
+    joints taken as the previous pose's (a control tick's) and solve_all over n targets."""
     solver = om.OMSolver(arm)
     rng = np.random.default_rng(1)
-    times: dict[str, list[float]] = {"solve": [], "hinted": [], "solve_all": []}
+    times: dict[str, list[float]] = {"solve": [], "hinted": [], "from": [], "solve_all": []}
     for q in _random_q(arm, n, rng):
         T = arm.fk(q)
         c = solver.configuration_of(q)
         hint = q + rng.normal(0.0, 0.01, arm.dof)
         times["solve"].append(_timed(lambda T=T, c=c: solver.solve(T, c)))
         times["hinted"].append(_timed(lambda T=T, c=c, hint=hint: solver.solve(T, c, q_hint=hint)))
+        times["from"].append(_timed(lambda T=T, c=c, hint=hint: solver.solve_from(T, c, hint)))
         times["solve_all"].append(_timed(lambda T=T, c=c: solver.solve_all(T, c)))
     row = {"near": solver.nominal is not None}
     for key, values in times.items():
@@ -78,7 +90,7 @@ def measure(arm: om.Arm, n: int) -> dict[str, float]:
 
 def _cell(row: dict, key: str, before: dict | None) -> str:
     now = f"{row[key]:,.1f} ({row[f'{key} p90']:,.0f})"
-    if before is None:
+    if before is None or key not in before:
         return now
     return f"{before[key]:,.1f} ({before[f'{key} p90']:,.0f}) -> {now}"
 
@@ -98,7 +110,7 @@ def main() -> None:
         print(name, rows[name], flush=True)
     if args.json:
         args.json.write_text(json.dumps(rows, indent=1))
-    keys = ("solve", "hinted", "solve_all")
+    keys = ("solve", "hinted", "from", "solve_all")
     arrow = " (before -> now)" if before else ""
     lines = [
         f"# Time per solve near a closed-form family ({args.n} random targets per arm, seed 1)",
@@ -108,8 +120,9 @@ def main() -> None:
         "",
         "`" + " ".join(["python -m benchmarks.near_timing", *sys.argv[1:]]) + "`",
         "",
-        "| arm | through the nominal arm | solve | hinted solve | solve_all |",
-        "|---|---|---|---|---|",
+        "| arm | through the nominal arm | solve | hinted solve | solve from the hint as previous joints "
+        "| solve_all |",
+        "|---|---|---|---|---|---|",
     ]
     for name, row in rows.items():
         cells = [_cell(row, key, before.get(name)) for key in keys]
