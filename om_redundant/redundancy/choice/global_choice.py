@@ -30,20 +30,21 @@ from .start_bounds import CLIMB_ROUNDING, StartBounds
 
 class GlobalChoice:
     """The global choice of :class:`~om_redundant.RedundancyOptimizer` (its ``solver``,
-    ``objective``, ``branches``, ``grid_points`` and ``_shared_search``)."""
+    ``objective``, ``branches``, ``grid_points`` and ``_reach``)."""
 
     solver: OMSolver
     objective: Objective
     branches: list[tuple[int, ...]]
     grid_points: int
-    _shared_search: bool
     _reach: ReachEnvelope
 
-    def _sweep(self, T: np.ndarray, branches: list[tuple[int, ...]]) -> list[BranchRuns]:
+    def _sweep(self, T: np.ndarray, branches: list[tuple[int, ...]], quick: bool = False) -> list[BranchRuns]:
         """Every branch's solution paths and feasible runs. Where a path runs within rounding
         of a singular set (SingularSelfMotion), the branches are swept one by one and those
         that raise have none, the reason in their ``unswept``; where T is proven out of reach
         (:class:`~om_redundant.ik.reach_envelope.ReachEnvelope`), none is swept, and each says so.
+
+        ``quick``: the rows search no band (:func:`~om_redundant.redundancy.paths.linking.sweep_circle`).
 
         Raises:
             SingularSelfMotion: Every branch raised.
@@ -59,11 +60,11 @@ class GlobalChoice:
             return [BranchRuns(signs, [], [], why) for signs in branches]
         probes = [self._probe(T, signs) for signs in branches]
         try:
-            swept = sweep_circle(probes, self.grid_points)
+            swept = sweep_circle(probes, self.grid_points, quick)
         except SingularSelfMotion as singular:
             if len(branches) == 1:
                 raise
-            alone = [self._sweep_alone(T, signs) for signs in branches]
+            alone = [self._sweep_alone(T, signs, quick) for signs in branches]
             if all(branch.unswept for branch in alone):
                 raise singular
             return alone
@@ -74,9 +75,9 @@ class GlobalChoice:
             for signs, paths in zip(branches, swept, strict=True)
         ]
 
-    def _sweep_alone(self, T: np.ndarray, signs: tuple[int, ...]) -> BranchRuns:
+    def _sweep_alone(self, T: np.ndarray, signs: tuple[int, ...], quick: bool = False) -> BranchRuns:
         try:
-            return self._sweep(T, [signs])[0]
+            return self._sweep(T, [signs], quick)[0]
         except SingularSelfMotion as singular:
             return BranchRuns(signs, [], [], str(singular))
 
@@ -99,15 +100,17 @@ class GlobalChoice:
         free: FreeRotation | None,
     ) -> RedundancyChoice:
         """The fresh choice from the arm's joints (:mod:`~om_redundant.redundancy.choice.reachable`;
-        without them, the best scored): branch ``signs`` first (None: every allowed branch at
-        once); with a free rotation, over the turns it starts from. An arm whose branches share
-        their grid search in one batch (shoulder offsets: the torus) sweeps them all at once."""
+        without them, the best scored): a quick look at branch ``signs`` alone first (its grid
+        rows searching no band), then, where it has no clear way, every allowed branch at once
+        (None: at once from the start); with a free rotation, over the turns it starts from. (The
+        quick look costs a sweep of all branches at once a third to a half of it, whether it
+        finds a way or not: Gen3 4.2 ms median against 11.5, Sawyer 118 against 155.)"""
         hand = None if q_from is None else self.solver.arm.fk(q_from)
         turns = [None] if free is None else free.starts(T, hand)
         targets = [T if R is None else free.turned(T, R) for R in turns]
-        at_once = signs is None or self._shared_search
+        at_once = signs is None
         swept = [
-            self._sweep(target, self.branches) if at_once else [self._sweep_alone(target, signs)]
+            self._sweep(target, self.branches) if at_once else [self._sweep_alone(target, signs, quick=True)]
             for target in targets
         ]
         way = self._way(targets, swept, q_from, signs)
@@ -118,12 +121,8 @@ class GlobalChoice:
             ran = any(b.runs for b in own)
             note = f"branch {signs} has no {'clear way' if ran else 'feasible arm angle at this pose'}"
             note = f"branch {signs} was not swept: {unswept}" if unswept else note
-            if not at_once:
-                others = [b for b in self.branches if b != signs]
-                swept = [
-                    branch + self._sweep(target, others)
-                    for branch, target in zip(swept, targets, strict=True)
-                ]
+            if not at_once:  # (the branch again, with its neighbours: its band is theirs)
+                swept = [self._sweep(target, self.branches) for target in targets]
             way = self._way(targets, swept, q_from)
         if way is not None and not way[0].clear:
             note = "; ".join(filter(None, [note, "no candidate has a clear way: the best is taken"]))

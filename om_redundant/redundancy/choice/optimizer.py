@@ -169,8 +169,6 @@ class RedundancyOptimizer(GlobalChoice):
         if not self.travel_weight >= 0.0:
             raise InvalidInput(f"travel_weight must be >= 0, got {travel_weight}")
         self._tracker = Tracker(solver, self.objective, self.max_step)
-        # shoulder offsets (the torus): a batch's branches share their grid search
-        self._shared_search = bool(np.any(solver.model_arm.shoulder))
         self._reach = ReachEnvelope(solver)
 
     def __reduce__(self) -> tuple[Any, tuple[Any, ...]]:

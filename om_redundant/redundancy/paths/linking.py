@@ -77,11 +77,13 @@ class Path:
     turns: int = 0
 
 
-def sweep_circle(probes: list[Probe], n: int) -> list[list[Path]]:
+def sweep_circle(probes: list[Probe], n: int, quick: bool = False) -> list[list[Path]]:
     """The solution paths of each probe's branch over the whole circle, from the grid
     psi_k = -pi + 2 pi k / n (module docstring). The probes share one solver, objective and
     pose, and each follows its own branch's paths here and after (a probe keeps no state
-    between its answers)."""
+    between its answers). ``quick``: no grid row searches beyond its configuration's own roots
+    (:meth:`~om_redundant.OMSolver.solve_grid`'s band, as where every neighbouring branch is
+    swept too), for a first look at a branch alone; its "no" rows are then the cheap ones."""
     solver, T, branches = probes[0].solver, probes[0].T, [probe.signs for probe in probes]
     psi = -math.pi + TURN * np.arange(n) / n
     # Rows psi by psi, the branches that differ in the first sign alone next to each other:
@@ -93,7 +95,7 @@ def sweep_circle(probes: list[Probe], n: int) -> list[list[Path]]:
         np.repeat(T[None], n * len(branches), axis=0),
         np.tile([branches[b] for b in order], (n, 1)),
         np.repeat(psi, len(branches)),
-        np.tile([not _neighbours_swept(branches[b], branches, n) for b in order], n),
+        np.tile([not quick and not _neighbours_swept(branches[b], branches, n) for b in order], n),
     )
     swept = []
     for b, probe in enumerate(probes):
