@@ -7,11 +7,14 @@ import math
 from fractions import Fraction
 
 import numpy as np
+import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
 from om_redundant import _core
 from om_redundant.angles import TURN, wrap_angle, wrap_angles
+
+pytestmark = pytest.mark.sanitize  # also run under ASan and UBSan (.ci/sanitize)
 
 angles = st.one_of(
     st.floats(allow_nan=False, allow_infinity=False),

@@ -166,6 +166,7 @@ def test_a_probe_step_is_the_largest_joint_step(seed, name, wrapped):
     assert probe.step(z, turned) == pytest.approx(0.5 * np.pi if cyclic[0] else 1.5 * np.pi, abs=1e-15)
 
 
+@pytest.mark.sanitize  # also run under ASan and UBSan (.ci/sanitize)
 @settings(max_examples=60, deadline=None)
 @given(
     seed=st.integers(0, 2**32 - 1),

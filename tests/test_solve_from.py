@@ -16,6 +16,8 @@ import om_redundant as om
 from tests.test_shoulder_wrist_offsets import TIAGO_PRO_OFFSET
 from tests.test_shoulder_wrist_offsets import solver_of as offset_solver
 
+pytestmark = pytest.mark.sanitize  # also run under ASan and UBSan (.ci/sanitize)
+
 ARMS = ["panda", "iiwa14", "sawyer", "gen3", "ur5e", "tiago pro-like"]
 
 
