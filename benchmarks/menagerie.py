@@ -123,8 +123,10 @@ def measure(
         seed: Seed of those joint vectors.
         entry: Where the arm is; default ``REFERENCE[name]``.
         folder: The folder ``entry.path`` is under.
-        times: Also the median wall time of one ``solve_all(T, c)`` and of one hinted
-            ``solve(T, c, q_hint=q)`` over the n targets.
+        times: Also the median wall time of one ``solve_all(T, c)``, of one hinted
+            ``solve(T, c, q_hint=q)`` and of one control tick, ``solve_from(T, c, q_previous)``
+            from joints 0.002 rad back from q (a random direction), over the n targets; and how
+            often the tick returns q.
 
     Returns:
         The row: a column per quantity measured; an arm OMSolver refuses has its ModelError.
@@ -144,7 +146,8 @@ def measure(
     data = mujoco.MjData(model)
     among = hinted = nearer = wrong = roots_total = 0
     worst_position = worst_orientation = 0.0
-    all_times, solve_times = [], []
+    all_times, solve_times, tick_times, ticks = [], [], [], 0
+    directions = np.random.default_rng(seed + 1)  # (the ticks' own draws: the q are the same without them)
     start = time.perf_counter()
     for q in _random_q(arm, n, np.random.default_rng(seed)):
         T = frame_pose(model, data, arm, q)
@@ -173,6 +176,13 @@ def measure(
                 float(np.linalg.norm(sol.q - q))
                 <= min((float(np.linalg.norm(r.q - q)) for r in roots), default=np.inf) + 1e-9
             )
+        if times:
+            back = directions.normal(size=arm.dof)
+            q_previous = q - 0.002 * back / np.linalg.norm(back)
+            tic = time.perf_counter()
+            tick = solver.solve_from(T, c, q_previous)
+            tick_times.append(time.perf_counter() - tic)
+            ticks += tick.ok and joint_distance(arm, tick.q, q) < 1e-7
     row.update(
         {
             "q among solve_all": f"{100 * among / n:.3f} %",
@@ -186,6 +196,8 @@ def measure(
     )
     if times:
         row["solve (hinted), median"] = _duration(float(np.median(solve_times)))
+        row["a tick (solve_from), median"] = _duration(float(np.median(tick_times)))
+        row["the tick returns q"] = f"{100 * ticks / n:.3f} %"
         row["solve_all, median"] = _duration(float(np.median(all_times)))
     return row
 
