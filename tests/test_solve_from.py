@@ -5,25 +5,17 @@ a family with a shoulder offset, a 6-DOF arm)."""
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
-from tests.test_shoulder_wrist_offsets import TIAGO_PRO_OFFSET
-from tests.test_shoulder_wrist_offsets import solver_of as offset_solver
+from tests.test_reach_envelope import solver
 
 pytestmark = pytest.mark.sanitize  # also run under ASan and UBSan (.ci/sanitize)
 
 ARMS = ["panda", "iiwa14", "sawyer", "gen3", "ur5e", "tiago pro-like"]
-
-
-@functools.cache
-def solver(name: str) -> om.OMSolver:
-    return offset_solver(TIAGO_PRO_OFFSET) if name == "tiago pro-like" else om.OMSolver(name)
 
 
 @settings(max_examples=40, deadline=None)

@@ -232,9 +232,7 @@ class OMSolver(BatchSolves):
             solution = self._kernel.solve_pose(T, configuration)
             if solution is not None:
                 return solution
-        T = as_pose(T)
-        self.check_configuration(configuration)
-        return self._solved(T, configuration, self._hint(q_hint), False)
+        return self._solved(T, configuration, q_hint, False)
 
     def solve_from(self, T: Any, configuration: Configuration, q_previous: np.ndarray) -> Solution:
         """The joint vector the arm moves to from ``q_previous`` (its joints at the previous
@@ -254,15 +252,16 @@ class OMSolver(BatchSolves):
         Returns:
             A :class:`Solution`, as :meth:`solve`'s.
         """
-        T = as_pose(T)
-        self.check_configuration(configuration)
-        q_previous = as_joint_vector(q_previous, self.arm.dof, "q_previous", stack=False)
         return self._solved(T, configuration, q_previous, True)
 
-    def _solved(
-        self, T: np.ndarray, configuration: Configuration, hint: np.ndarray | None, from_previous: bool
-    ) -> Solution:
-        """One compiled solve (``_core.Solver.solve``) as a :class:`Solution`."""
+    def _solved(self, T: Any, configuration: Configuration, hint: Any, from_previous: bool) -> Solution:
+        """One compiled solve (``_core.Solver.solve``) as a :class:`Solution`, its pose,
+        configuration and hint (None: none; ``from_previous``: the previous joints) checked."""
+        T = as_pose(T)
+        self.check_configuration(configuration)
+        if hint is not None:
+            name = "q_previous" if from_previous else "q_hint"
+            hint = as_joint_vector(hint, self.arm.dof, name, stack=False)
         q = np.empty(self.arm.dof)
         r = self._kernel.solve(T, configuration.signs, configuration.redundancy, hint, q, from_previous)
         return Solution(
@@ -345,12 +344,6 @@ class OMSolver(BatchSolves):
                     f"model ({self.model_arm.family_name}) does not fit this arm"
                 )
         _SELF_CHECKED.setdefault(arm, set()).add(key)
-
-    def _hint(self, q_hint: np.ndarray | None) -> np.ndarray | None:
-        """The hint as the kernel takes it (None: no hint)."""
-        if q_hint is None:
-            return None
-        return as_joint_vector(q_hint, self.arm.dof, "q_hint", stack=False)
 
 
 def _rebuilt(arm: Arm, position_tolerance: float, orientation_tolerance: float, scan_points: int) -> OMSolver:

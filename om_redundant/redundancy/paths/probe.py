@@ -71,8 +71,7 @@ class Probe:
         # (inf + -inf of an unlimited joint would be NaN: only finite limits are added)
         lower, upper = np.where(self._centred, arm.lower, 0.0), np.where(self._centred, arm.upper, 0.0)
         self._centre = (lower + upper) / 2.0
-        # (where every joint is cyclic, or centred, no np.where picks between the two)
-        self._all_cyclic, self._all_centred = all(self._cyclic.tolist()), all(self._centred.tolist())
+        self._all_centred = all(self._centred.tolist())  # (then no np.where picks between the two)
         self._work = _core.FollowWork(  # the compiled follow's arrays
             solver.kernel,
             np.ascontiguousarray(T, dtype=float),
@@ -97,15 +96,13 @@ class Probe:
 
     def point(self, psi: float | np.ndarray, q: np.ndarray, solution: Solution | None = None) -> Point:
         """The point of solution q at psi, q at its representative (see the class)."""
-        return self._point(psi, self._represent(q), solution)
+        q = self._represent(q)
+        tangent = self_motion_tangent(self.solver, q)
+        return Point(psi, q, tangent, PointTerms(self.objective, q, tangent), solution)
 
     def _represent(self, q: np.ndarray) -> np.ndarray:
         centred = self._centre + wrap_angles(q - self._centre)
         return centred if self._all_centred else np.where(self._centred, centred, q)
-
-    def _point(self, psi: float | np.ndarray, q: np.ndarray, solution: Solution | None) -> Point:
-        tangent = self_motion_tangent(self.solver, q)
-        return Point(psi, q, tangent, PointTerms(self.objective, q, tangent), solution)
 
     def points(self, psi: np.ndarray, q: np.ndarray) -> list[Point | None]:
         """:meth:`point` for every psi and row of q (M, dof) of a 7-DOF arm, the tangents and
