@@ -111,7 +111,8 @@ typedef struct {
     double *q;
     int cap, count;
 } om_candidate_log;
-int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, double radius, om_candidate_log *log);
+int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, double radius, const double *found,
+                   om_candidate_log *log);
 /* contraction.c: bounds g1, g7 on the rates of q1 and q7 of the model IK per unit of the
  * shoulder-wrist vector x over the ball of radius rho about that of the hand position p (inf
  * where there is none: a singular shoulder or wrist, the edge of reach, psi's half-line), so

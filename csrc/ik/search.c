@@ -3,7 +3,7 @@
 #include "om_system.h"
 
 #define TORUS_SIDE 0.75  /* the torus grid has TORUS_SIDE * scan points nodes per side */
-#define WINDOW_POINTS 8  /* samples of the window searched around a hint */
+#define WINDOW_POINTS 8  /* samples of the window searched around a hint (on the circle) */
 #define START_POINTS 8   /* points of the dp circle tried when p_d is out of the model's reach */
 
 /* The roots from the circle's candidates cands[0 .. n), each polished and verified into roots
@@ -63,6 +63,15 @@ static int _torus_side(int n_scan)
     return side > 4 ? side : 4;
 }
 
+/* A window's grid on the torus (half-width radius): as fine as the whole torus' grid for n_scan
+ * scan points, and 4 nodes a side at least (the window's fold partners, sought across it, are
+ * its search's net, om_torus_roots). */
+static int _window_side(int n_scan, double radius)
+{
+    int side = (int)ceil((double)_torus_side(n_scan) * radius / OM_PI);
+    return side > 4 ? side : 4;
+}
+
 /* The torus grid search of the whole torus (om_torus_roots), its candidates taken from cache
  * where it holds this problem's, else searched and kept there: they are those of every
  * problem that differs in the SHOULDER and WRIST signs alone (torus.c, _candidate), and only
@@ -84,7 +93,7 @@ static int _torus_roots_cached(om_problem *pb, int n_scan, double *roots, om_sca
     }
     om_candidate_log log = {cache->candidates, cache->capacity / dof, 0};
     int64_t before = pb->counter;
-    count = om_torus_roots(pb, _torus_side(n_scan), roots, zeros, INFINITY, &log);
+    count = om_torus_roots(pb, _torus_side(n_scan), roots, zeros, INFINITY, NULL, &log);
     cache->valid = log.count <= log.cap; /* else not all kept */
     cache->count = log.count;
     cache->evaluations = pb->counter - before;
@@ -92,10 +101,10 @@ static int _torus_roots_cached(om_problem *pb, int n_scan, double *roots, om_sca
     return count;
 }
 
-/* Bounded search: every verified solution in this configuration into roots (OM_MAX_ROOTS x
- * dof); returns the count. With radius < pi, only roots whose scanned joints lie within
- * radius of the centre's are sought. */
-int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre, double radius)
+/* om_all_roots, with a root found already (its joints; NULL: none), which a window of the
+ * torus starts from (om_torus_roots). */
+static int _all_roots(om_problem *pb, int n_scan, double *roots, const double *centre, double radius,
+                      const double *found)
 {
     const om_solver_data *data = pb->s;
     double q[OM_MAX_DOF];
@@ -108,7 +117,8 @@ int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre
         int count;
         if (pb->certify && om_torus_certified_roots(pb, roots, &count, centre, radius))
             return count;
-        return om_torus_roots(pb, _torus_side(n_scan), roots, centre, radius, NULL);
+        int side = radius < OM_PI ? _window_side(pb->s->scan_points, radius) : _torus_side(n_scan);
+        return om_torus_roots(pb, side, roots, centre, radius, found, NULL);
     }
     int J = data->dp_joint, cap = OM_SCAN_CAPACITY(n_scan);
     double *cands = malloc((size_t)cap * sizeof(double));
@@ -125,6 +135,14 @@ int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre
     int count = _circle_roots(pb, cands, n, q, roots);
     free(cands);
     return count;
+}
+
+/* Bounded search: every verified solution in this configuration into roots (OM_MAX_ROOTS x
+ * dof); returns the count. With radius < pi, only roots whose scanned joints lie within
+ * radius of the centre's are sought. */
+int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre, double radius)
+{
+    return _all_roots(pb, n_scan, roots, centre, radius, NULL);
 }
 
 int om_all_roots_cached(om_problem *pb, int n_scan, double *roots, om_scan_cache *cache)
@@ -274,7 +292,7 @@ bool om_nearest_in_window(om_problem *pb, const double *hint, double *q)
     if (radius < 1e-12)
         return false;
     double roots[OM_MAX_ROOTS * OM_MAX_DOF];
-    int n = om_all_roots(pb, WINDOW_POINTS, roots, hint, radius);
+    int n = _all_roots(pb, WINDOW_POINTS, roots, hint, radius, q);
     bool replaced = false;
     for (int r = 0; r < n; r++) {
         double e2 = om_wrapped_distance2(roots + r * dof, hint, dof);

@@ -8,6 +8,11 @@
 #define NEAR_ROOT 0.1          /* on the whole torus, every node with a lifted residual below this starts Newton */
 #define PARTNER_CELLS 2.0      /* a root's fold partner is sought this many grid cells away at most */
 #define PARTNER_SAMPLES 8      /* samples each way along the fold direction */
+/* A window's fold partners are sought this many radii away at most: any other root of the window
+ * lies within 2 radii of a root found in each of w1, w7 and phi4 (both within a radius of the
+ * hint's joints), 2 sqrt(3) radii in all. */
+#define WINDOW_PARTNERS 3.5
+#define WINDOW_REACH 3.0 /* radii from the hint's (w1, w7) beyond which a window's Newton run gives up */
 
 /* Whether A (m x m) changes sign over the grid cell (i, j) (four reachable corners, no wrap). */
 static bool _crosses(const double *A, int m, int i, int j)
@@ -31,29 +36,45 @@ typedef struct {
     int cap;
 } known_roots;
 
-/* Newton's method from x, deflated by the known roots if deflate; a new root is appended
- * to known, with its model IK in q. Returns the number of known roots. */
-static int _new_root(om_problem *pb, vec3 x, bool deflate, known_roots *known, int n_known, double *q)
+/* One search's state: its known roots, candidates so far (into roots, logged as torus_candidate
+ * does), how far a root's fold partners are sought, and where its Newton runs give up. */
+typedef struct {
+    om_problem *pb;
+    known_roots known;
+    int n_known, count;
+    double *roots, *q; /* q: the model IK of the last Newton run's end */
+    om_candidate_log *log;
+    double partner_reach;
+    newton_limits limits; /* reach INFINITY on the whole torus */
+} torus_search;
+
+/* Newton's method from x, deflated by the known roots if deflate; a new root is appended to the
+ * known ones and handed to verification. Returns whether one was. */
+static bool _new_root(torus_search *t, vec3 x, bool deflate)
 {
     vec3 x_root;
-    double r = om_newton(pb, x, q, known->x, deflate ? n_known : 0, &x_root);
+    known_roots *known = &t->known;
+    t->limits.known = known->x, t->limits.n_known = t->n_known;
+    double r = om_lifted_newton(t->pb, NULL, x, t->q, known->x, deflate ? t->n_known : 0, &t->limits, &x_root);
     if (r > OM_ROOT_TOL)
-        return n_known;
-    for (int k = 0; k < n_known; k++)
+        return false;
+    for (int k = 0; k < t->n_known; k++)
         if (same_point(x_root, v_load(known->x, 3 * k)))
-            return n_known;
-    if (n_known >= known->cap) {
+            return false;
+    if (t->n_known >= known->cap) {
         int cap = 2 * known->cap;
         double *grown = realloc(known->x, (size_t)cap * 3 * sizeof(double));
         if (!grown)
-            return n_known; /* out of memory: not kept */
+            return false; /* out of memory: not kept */
         known->x = grown;
         known->cap = cap;
     }
-    known->x[3 * n_known] = x_root.x;
-    known->x[3 * n_known + 1] = x_root.y;
-    known->x[3 * n_known + 2] = x_root.z;
-    return n_known + 1;
+    known->x[3 * t->n_known] = x_root.x;
+    known->x[3 * t->n_known + 1] = x_root.y;
+    known->x[3 * t->n_known + 2] = x_root.z;
+    t->n_known++;
+    t->count = torus_candidate(t->pb, t->q, t->roots, t->count, t->log);
+    return true;
 }
 
 /* Unit vector nearest the null space of a nearly singular 3x3 matrix (given by rows):
@@ -121,14 +142,54 @@ static int _fold_partners(om_problem *pb, vec3 x, double reach, double *q, vec3 
     return n;
 }
 
+/* The fold partners of the known roots from first on, and of theirs (MAX_KNOWN roots in all). */
+static void _partners(torus_search *t, int first)
+{
+    vec3 partners[3];
+    for (int k = first; k < t->n_known && t->n_known < MAX_KNOWN; k++) {
+        vec3 root = v_load(t->known.x, 3 * k);
+        int n = _fold_partners(t->pb, root, t->partner_reach, t->q, partners);
+        for (int a = 0; a < n; a++)
+            if (!_new_root(t, partners[a], true)) /* the line bends away from the partner: halfway */
+                _new_root(t, v_scale(0.5, v_add(partners[a], root)), true);
+    }
+}
+
+/* The roots Newton finds from the start x (from the nearer edge of reach's elbow where it finds
+ * none), on the whole torus then from x again deflated until none, and their fold partners. */
+static void _roots_from(torus_search *t, vec3 x)
+{
+    int first = t->n_known;
+    if (!_new_root(t, x, false)) {
+        /* Near the edge of reach the elbow angle changes fastest: try once more
+         * from the nearer edge's (the straight or the folded elbow). */
+        double phi_star = t->pb->s->params[SRS_PHI_STAR];
+        double edge = cos(x.z - phi_star) > 0.0 ? phi_star : phi_star + OM_PI;
+        if (!_new_root(t, v3(x.x, x.y, edge), false))
+            return;
+    }
+    while (isinf(t->limits.reach) && t->n_known < MAX_KNOWN && _new_root(t, x, true))
+        ;
+    _partners(t, first);
+}
+
 /* Bounded search on the torus (w1, w7) of an arm with shoulder offsets; returns the count.
  * The lifted residual is sampled on an n x n grid (the square of half-width radius around
- * the centre's (q1, q7) when radius < pi); Newton starts from local minima of its norm and
- * from cells where the shoulder and wrist residuals change sign, with deflation and fold
- * partners; and around the points of psi's singular half-line, where the lifted residual
+ * the centre's (q1, q7) when radius < pi: a window); Newton starts from local minima of its
+ * norm and from cells where the shoulder and wrist residuals change sign, with deflation and
+ * fold partners; and around the points of psi's singular half-line, where the lifted residual
  * turns about a point, in their charts (om_half_line_roots). The candidates go to verification
- * in order, into log too (NULL: none). */
-int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, double radius, om_candidate_log *log)
+ * in order, into log too (NULL: none).
+ *
+ * Undeflated Newton runs give up within KNOWN_REACH of a known root, where they would end
+ * (newton_limits). A window seeks the roots nearer the centre than a root found already (found:
+ * its joints; NULL none), which it starts from; its runs give up beyond WINDOW_REACH radii of
+ * the centre, whose roots it does not seek; it does not deflate, and seeks each root's fold
+ * partners across the window (WINDOW_PARTNERS): a root of the window near one known is such a
+ * partner, and one farther from every known root has a local minimum of the norm of its own on
+ * the grid, as on the whole torus. */
+int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, double radius, const double *found,
+                   om_candidate_log *log)
 {
     double q[OM_MAX_DOF];
     nan_fill(q, OM_MAX_DOF); /* read as E where W = S at the first node: NaN */
@@ -147,11 +208,16 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
     int m = n + 1; /* on the whole torus the last row and column repeat the first */
     size_t mm = (size_t)m * (size_t)m;
     double *S = malloc(4 * mm * sizeof(double));
-    known_roots known = {malloc((size_t)MAX_KNOWN * 3 * sizeof(double)), MAX_KNOWN};
-    if (!S || !known.x) {
+    torus_search t = {pb, {malloc((size_t)MAX_KNOWN * 3 * sizeof(double)), MAX_KNOWN}, 0, 0, roots, q, log,
+                      PARTNER_CELLS * step, {centre[0], centre[6], INFINITY, NULL, 0}};
+    if (!S || !t.known.x) {
         free(S);
-        free(known.x);
+        free(t.known.x);
         return 0;
+    }
+    if (!whole) {
+        t.limits.reach = WINDOW_REACH * radius;
+        t.partner_reach = py_max(t.partner_reach, WINDOW_PARTNERS * radius);
     }
     double *W = S + mm, *F = W + mm, *E = F + mm;
     const double *P = pb->s->params;
@@ -164,10 +230,10 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
             F[i * m + j] = om_max_norm(r) < INFINITY ? om_max_norm(r) : INFINITY;
         }
     }
-    int count = 0;
-    int n_known = 0;
-    vec3 partners[3] = {{0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}};
-    double phi_star = P[SRS_PHI_STAR];
+    if (found && !whole) {
+        _new_root(&t, v3(found[0], found[6], found[3] + P[SRS_THETA + 3]), false);
+        _partners(&t, 0);
+    }
     for (int i = 0; i < m; i++) {
         for (int j = 0; j < m; j++) {
             for (int centre_of_cell = 0; centre_of_cell < 2; centre_of_cell++) {
@@ -185,47 +251,13 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
                     start = start || (whole && F[i * m + j] < NEAR_ROOT);
                     x = v3(lo1 + (double)i * step, lo7 + (double)j * step, E[i * m + j]);
                 }
-                if (!start || n_known == MAX_KNOWN)
-                    continue;
-                int first = n_known;
-                n_known = _new_root(pb, x, false, &known, n_known, q);
-                if (n_known == first) {
-                    /* Near the edge of reach the elbow angle changes fastest: try once more
-                     * from the nearer edge's (the straight or the folded elbow). */
-                    double edge = cos(x.z - phi_star) > 0.0 ? phi_star : phi_star + OM_PI;
-                    n_known = _new_root(pb, v3(x.x, x.y, edge), false, &known, n_known, q);
-                }
-                if (n_known == first)
-                    continue;
-                count = torus_candidate(pb, q, roots, count, log);
-                while (n_known < MAX_KNOWN) { /* deflated, from the same start */
-                    int found = n_known;
-                    n_known = _new_root(pb, x, true, &known, n_known, q);
-                    if (n_known == found)
-                        break;
-                    count = torus_candidate(pb, q, roots, count, log);
-                }
-                int k = first;
-                while (k < n_known && n_known < MAX_KNOWN) {
-                    vec3 root = v_load(known.x, 3 * k);
-                    k += 1;
-                    int n_partners = _fold_partners(pb, root, PARTNER_CELLS * step, q, partners);
-                    for (int a = 0; a < n_partners; a++) {
-                        int found = n_known;
-                        n_known = _new_root(pb, partners[a], true, &known, n_known, q);
-                        if (n_known == found) { /* the line bends away from the partner: halfway */
-                            vec3 halfway = v_scale(0.5, v_add(partners[a], root));
-                            n_known = _new_root(pb, halfway, true, &known, n_known, q);
-                        }
-                        if (n_known > found)
-                            count = torus_candidate(pb, q, roots, count, log);
-                    }
-                }
+                if (start && t.n_known < MAX_KNOWN)
+                    _roots_from(&t, x);
             }
         }
     }
-    count = om_half_line_roots(pb, lo1, lo7, step, m, q, roots, count, log);
+    int count = om_half_line_roots(pb, lo1, lo7, step, m, q, roots, t.count, log);
     free(S);
-    free(known.x);
+    free(t.known.x);
     return count;
 }

@@ -47,11 +47,24 @@ static inline int torus_candidate(om_problem *pb, const double *q, double *roots
     return om_add_candidate(pb, candidate, roots, count);
 }
 
+/* Where a torus search's damped Newton run gives up (om_torus_roots): where its iterate, undeflated,
+ * comes within KNOWN_REACH of one of the known roots (n_known x 3), where it would end, a root
+ * found already (a distinct root so near is a fold partner of it, which the search seeks), and,
+ * in a window, where it leaves the square of half-width reach about (w1, w7), whose roots the
+ * window does not seek (reach INFINITY: never). */
+#define KNOWN_REACH 1e-3 /* rad, each lifted coordinate */
+typedef struct {
+    double w1, w7, reach;
+    const double *known;
+    int n_known;
+} newton_limits;
+
 /* Damped Newton on the lifted system from x (chart not NULL: in its coordinates), deflated by
- * the first n_known rows of known; returns the residual's max norm at the end, *x_end the end
- * point (lifted), q the model IK there (om_newton: chart NULL). */
+ * the first n_known rows of known, within limits (NULL: none); returns the residual's
+ * max norm at the end (inf where the run gave up), *x_end the end point (lifted), q the model
+ * IK there (not written where the run gave up; om_newton: chart and limits NULL). */
 double om_lifted_newton(om_problem *pb, const half_line_chart *chart, vec3 x, double *q, const double *known,
-                        int n_known, vec3 *x_end);
+                        int n_known, const newton_limits *limits, vec3 *x_end);
 /* Roots next to the points of psi's half-line in the grid's square (lo1, lo7, step, m nodes a
  * side), candidates as torus_candidate's; returns the root count. */
 int om_half_line_roots(om_problem *pb, double lo1, double lo7, double step, int m, double *q, double *roots,

@@ -135,7 +135,7 @@ int om_half_line_roots(om_problem *pb, double lo1, double lo7, double step, int 
             vec3 y = v3(LINE_START, 2.0 * OM_PI * (double)k / (double)LINE_SEEDS, NAN), end;
             om_lifted_residual(pb, lifted_of(&charts[c], y), q);
             y.z = q[3] + pb->s->params[SRS_THETA + 3]; /* the elbow's root there */
-            if (om_lifted_newton(pb, &charts[c], y, q, NULL, 0, &end) > LINE_ROOT)
+            if (om_lifted_newton(pb, &charts[c], y, q, NULL, 0, NULL, &end) > LINE_ROOT)
                 continue;
             bool seen = false;
             for (int e = 0; e < n_ends; e++)

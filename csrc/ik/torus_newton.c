@@ -6,13 +6,27 @@
 #define MIN_STEP (1.0 / 256.0) /* the shortest damped Newton step, as a fraction of the full one */
 #define STALL 3                /* slow damped Newton steps in a row after which a run gives up */
 
+/* Whether a run at x (lifted) gives up within its limits (see newton_limits). */
+static bool _gives_up(const newton_limits *limits, vec3 x, bool deflated)
+{
+    if (py_max(fabs(om_wrap(x.x - limits->w1)), fabs(om_wrap(x.y - limits->w7))) > limits->reach)
+        return true;
+    for (int k = 0; k < limits->n_known && !deflated; k++) {
+        vec3 e = v_sub(x, v_load(limits->known, 3 * k));
+        if (py_max(py_max(fabs(om_wrap(e.x)), fabs(om_wrap(e.y))), fabs(om_wrap(e.z))) < KNOWN_REACH)
+            return true;
+    }
+    return false;
+}
+
 /* Damped Newton on the lifted system from x = (w1, w7, phi4) (chart not NULL: in its
  * coordinates, x and the steps there), forward-difference Jacobian, deflated by the first
- * n_known rows of known (n x 3). Returns the max norm of the (undeflated) residual at the end
- * (inf if not finite); the end point (lifted) in *x_end, q the model IK there (solved once, at
- * the end: the iterations need the residual alone). */
+ * n_known rows of known (n x 3), giving up within limits (NULL: none). Returns the max norm of
+ * the (undeflated) residual at the end (inf if not finite, or where the run gave up); the end
+ * point (lifted) in *x_end, q the model IK there (solved once, at the end: the iterations need
+ * the residual alone; not where the run gave up). */
 double om_lifted_newton(om_problem *pb, const half_line_chart *chart, vec3 x, double *q, const double *known,
-                        int n_known, vec3 *x_end)
+                        int n_known, const newton_limits *limits, vec3 *x_end)
 {
     vec3 F = om_deflated_residual(pb, lifted_of(chart, x), NULL, known, n_known);
     double r = om_max_norm(F);
@@ -48,6 +62,11 @@ double om_lifted_newton(om_problem *pb, const half_line_chart *chart, vec3 x, do
             break;
         x = v_add(x, v_scale(t, step));
         F = Fn;
+        if (limits && _gives_up(limits, lifted_of(chart, x), n_known > 0)) {
+            if (x_end)
+                *x_end = lifted_of(chart, x);
+            return INFINITY;
+        }
         slow = om_max_norm(F) > 0.9 * r ? slow + 1 : 0;
         r = om_max_norm(F);
     }
@@ -61,7 +80,7 @@ double om_lifted_newton(om_problem *pb, const half_line_chart *chart, vec3 x, do
 
 double om_newton(om_problem *pb, vec3 x, double *q, const double *known, int n_known, vec3 *x_end)
 {
-    return om_lifted_newton(pb, NULL, x, q, known, n_known, x_end);
+    return om_lifted_newton(pb, NULL, x, q, known, n_known, NULL, x_end);
 }
 
 /* Damped Newton on the lifted system in (q1, q7, phi4) from the joint vector start;
