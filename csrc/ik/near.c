@@ -58,7 +58,8 @@
  * zeros of G are those of the search of G itself, the exact family's argument (sign changes
  * bracket roots, extremum searches find close pairs, edges and islands of reach are searched),
  * with G read as g~ where both are far from zero. Above OM_NEAR_SCAN (where the windows would
- * take most of the circle) and on the torus the search is of G throughout. At a 6-DOF arm's
+ * take most of the circle) the search is of G throughout; on the torus its grid samples g~ and
+ * every Newton run from the grid's starts is on G (torus.c). At a 6-DOF arm's
  * aligned wrist the fixed point need not contract (the model splits the wrist by q_prev, the
  * real arm does not; the correction at the split moves by about delta / |sin q5|), and G's q6
  * need not be the real root's: within a multiple of delta of it the window is searched on the

@@ -221,6 +221,12 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
     }
     double *W = S + mm, *F = W + mm, *E = F + mm;
     const double *P = pb->s->params;
+    /* An arm near a family: the grid samples its nominal arm's system (g~ of near.c, one model IK
+     * a node instead of a fixed point of the correction), and Newton refines every start on G.
+     * |G - g~| <= |dg/dX| delta (near.c: 20 per metre away from the singular set, half a radian
+     * at the TIAGo Pro's 26 mm) stays below OM_PAIR_SEARCH: a root of G lies at a dip of |g~|,
+     * which the grid's starts take, as the circle's scan of g~ has it. */
+    pb->nominal = pb->s->nominal_table != NULL;
     for (int i = 0; i < m; i++) {
         for (int j = 0; j < m; j++) {
             vec3 r = om_lifted_residual(pb, v3(lo1 + (double)i * step, lo7 + (double)j * step, NAN), q);
@@ -230,6 +236,7 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
             F[i * m + j] = om_max_norm(r) < INFINITY ? om_max_norm(r) : INFINITY;
         }
     }
+    pb->nominal = false;
     if (found && !whole) {
         _new_root(&t, v3(found[0], found[6], found[3] + P[SRS_THETA + 3]), false);
         _partners(&t, 0);
