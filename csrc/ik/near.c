@@ -327,6 +327,14 @@ bool om_near_secant(om_problem *pb, double w, bool in_reach, double *q, double *
     return false;
 }
 
+bool om_near_lifted(om_problem *pb, const double *start, double *q, double *pos, double *ori)
+{
+    pb->nominal = true;
+    bool touched = om_lifted_solve(pb, start, q) < OM_TOUCH;
+    pb->nominal = false;
+    return touched && _newton(pb, q, pos, ori);
+}
+
 /* ------------------------------------------------------------------------------------ */
 /* The arm's own joint coordinates: q = flip * q_n, q_n the kernels' (a near arm's reversed
  * axes turn the other way in its nominal arm). */

@@ -51,6 +51,11 @@ static inline double om_near_ik(om_problem *pb, om_model_eval eval, const void *
  * other arm), the secant on G from the nominal root (from w where it touched no zero): false,
  * q its model IK at the end. */
 bool om_near_secant(om_problem *pb, double w, bool in_reach, double *q, double *pos, double *ori);
+/* near.c: a local root from start (every joint) on the torus of an arm near a family: the nominal
+ * arm's root (damped Newton on its lifted system, one model IK an evaluation) and Newton's steps
+ * on the exact chain from it, returning true with q that verified root (its errors into *pos,
+ * *ori); false where either fails (q as they left it). */
+bool om_near_lifted(om_problem *pb, const double *start, double *q, double *pos, double *ori);
 /* near.c: om_near_polish of a verified root q whose errors *pos, *ori hold (not verified again). */
 void om_near_finish(om_problem *pb, double *q, double *pos, double *ori);
 /* polish.c: `steps` Newton steps on the exact chain with the start's Jacobian (the chord

@@ -239,6 +239,8 @@ bool om_local_solve(om_problem *pb, double *start, bool *start_complete, double 
 {
     const om_solver_data *data = pb->s;
     if (data->mode == OM_TORUS) {
+        if (data->nominal_table && om_near_lifted(pb, start, q, pos, ori)) /* the nominal arm's root first */
+            return true;
         om_lifted_solve(pb, start, q);
         return om_verify(pb, q, pos, ori);
     }
