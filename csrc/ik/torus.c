@@ -32,7 +32,8 @@ static bool _crosses(const double *A, int m, int i, int j)
 /* The known roots (n x 3), grown as needed: the fold-partner search can add roots after the
  * first MAX_KNOWN, and must never write past the end. */
 typedef struct {
-    double *x; /* cap x 3 */
+    double *x;    /* cap x 3 */
+    double *near; /* cap: how near an undeflated Newton run gives up to each (newton_limits) */
     int cap;
 } known_roots;
 
@@ -54,7 +55,7 @@ static bool _new_root(torus_search *t, vec3 x, bool deflate)
 {
     vec3 x_root;
     known_roots *known = &t->known;
-    t->limits.known = known->x, t->limits.n_known = t->n_known;
+    t->limits.known = known->x, t->limits.near = known->near, t->limits.n_known = t->n_known;
     double r = om_lifted_newton(t->pb, NULL, x, t->q, known->x, deflate ? t->n_known : 0, &t->limits, &x_root);
     if (r > OM_ROOT_TOL)
         return false;
@@ -64,11 +65,15 @@ static bool _new_root(torus_search *t, vec3 x, bool deflate)
     if (t->n_known >= known->cap) {
         int cap = 2 * known->cap;
         double *grown = realloc(known->x, (size_t)cap * 3 * sizeof(double));
-        if (!grown)
+        if (grown)
+            known->x = grown;
+        double *near = grown ? realloc(known->near, (size_t)cap * sizeof(double)) : NULL;
+        if (!near)
             return false; /* out of memory: not kept */
-        known->x = grown;
+        known->near = near;
         known->cap = cap;
     }
+    known->near[t->n_known] = 0.0; /* until its fold partners are sought */
     known->x[3 * t->n_known] = x_root.x;
     known->x[3 * t->n_known + 1] = x_root.y;
     known->x[3 * t->n_known + 2] = x_root.z;
@@ -91,8 +96,9 @@ static vec3 _null_vector(const vec3 *rows)
 }
 
 /* Starts for the partners of the root x, if x is one of a close pair (a fold of the
- * lifted system): into starts (3); returns the count. */
-static int _fold_partners(om_problem *pb, vec3 x, double reach, double *q, vec3 *starts)
+ * lifted system): into starts (3); returns the count. *gap: the distance to the partner that the
+ * quadratic model along the fold direction predicts (inf: none). */
+static int _fold_partners(om_problem *pb, vec3 x, double reach, double *q, vec3 *starts, double *gap)
 {
     double eps = 1e-7;
     vec3 F = om_lifted_residual(pb, x, q);
@@ -118,6 +124,7 @@ static int _fold_partners(om_problem *pb, vec3 x, double reach, double *q, vec3 
     double d = 1e-4;
     double c = (v_dot(u, om_lifted_residual(pb, v_add(x, v_scale(d, v)), q)) - v_dot(u, F) - slope * d) / (d * d);
     double t = -slope / c;
+    *gap = isnan(t) ? INFINITY : fabs(t);
     if (fabs(t) < h) /* also not NaN */
         starts[n++] = v_add(x, v_scale(t, v));
     static const double directions[2] = {-1.0, 1.0};
@@ -142,13 +149,18 @@ static int _fold_partners(om_problem *pb, vec3 x, double reach, double *q, vec3 
     return n;
 }
 
-/* The fold partners of the known roots from first on, and of theirs (MAX_KNOWN roots in all). */
+/* The fold partners of the known roots from first on, and of theirs (MAX_KNOWN roots in all);
+ * each root's runs then give up within KNOWN_REACH of it, or a tenth of its predicted partner's
+ * distance where that is nearer (a near-double root's partner, which Newton may reach where
+ * the partner's own start fails). */
 static void _partners(torus_search *t, int first)
 {
     vec3 partners[3];
     for (int k = first; k < t->n_known && t->n_known < MAX_KNOWN; k++) {
         vec3 root = v_load(t->known.x, 3 * k);
-        int n = _fold_partners(t->pb, root, t->partner_reach, t->q, partners);
+        double gap;
+        int n = _fold_partners(t->pb, root, t->partner_reach, t->q, partners, &gap);
+        t->known.near[k] = py_min(KNOWN_REACH, 0.1 * gap);
         for (int a = 0; a < n; a++)
             if (!_new_root(t, partners[a], true)) /* the line bends away from the partner: halfway */
                 _new_root(t, v_scale(0.5, v_add(partners[a], root)), true);
@@ -208,11 +220,13 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
     int m = n + 1; /* on the whole torus the last row and column repeat the first */
     size_t mm = (size_t)m * (size_t)m;
     double *S = malloc(4 * mm * sizeof(double));
-    torus_search t = {pb, {malloc((size_t)MAX_KNOWN * 3 * sizeof(double)), MAX_KNOWN}, 0, 0, roots, q, log,
-                      PARTNER_CELLS * step, {centre[0], centre[6], INFINITY, NULL, 0}};
-    if (!S || !t.known.x) {
+    known_roots known = {malloc((size_t)MAX_KNOWN * 3 * sizeof(double)), malloc(MAX_KNOWN * sizeof(double)), MAX_KNOWN};
+    newton_limits limits = {centre[0], centre[6], INFINITY, NULL, NULL, 0};
+    torus_search t = {pb, known, 0, 0, roots, q, log, PARTNER_CELLS * step, limits};
+    if (!S || !t.known.x || !t.known.near) {
         free(S);
         free(t.known.x);
+        free(t.known.near);
         return 0;
     }
     if (!whole) {
@@ -266,5 +280,6 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
     int count = om_half_line_roots(pb, lo1, lo7, step, m, q, roots, t.count, log);
     free(S);
     free(t.known.x);
+    free(t.known.near);
     return count;
 }

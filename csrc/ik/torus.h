@@ -48,14 +48,15 @@ static inline int torus_candidate(om_problem *pb, const double *q, double *roots
 }
 
 /* Where a torus search's damped Newton run gives up (om_torus_roots): where its iterate, undeflated,
- * comes within KNOWN_REACH of one of the known roots (n_known x 3), where it would end, a root
- * found already (a distinct root so near is a fold partner of it, which the search seeks), and,
- * in a window, where it leaves the square of half-width reach about (w1, w7), whose roots the
- * window does not seek (reach INFINITY: never). */
+ * comes within near[k] of the known root k (n_known x 3), where it would end, a root found
+ * already (the search seeks a distinct root so near as a fold partner of it: near[k] is at most
+ * KNOWN_REACH, a tenth of the distance to the partner that the partner search predicts, and 0
+ * until it has), and, in a window, where it leaves the square of half-width reach about (w1,
+ * w7), whose roots the window does not seek (reach INFINITY: never). */
 #define KNOWN_REACH 1e-3 /* rad, each lifted coordinate */
 typedef struct {
     double w1, w7, reach;
-    const double *known;
+    const double *known, *near;
     int n_known;
 } newton_limits;
 

@@ -13,7 +13,7 @@ static bool _gives_up(const newton_limits *limits, vec3 x, bool deflated)
         return true;
     for (int k = 0; k < limits->n_known && !deflated; k++) {
         vec3 e = v_sub(x, v_load(limits->known, 3 * k));
-        if (py_max(py_max(fabs(om_wrap(e.x)), fabs(om_wrap(e.y))), fabs(om_wrap(e.z))) < KNOWN_REACH)
+        if (py_max(py_max(fabs(om_wrap(e.x)), fabs(om_wrap(e.y))), fabs(om_wrap(e.z))) < limits->near[k])
             return true;
     }
     return false;

@@ -1,0 +1,53 @@
+"""The bounded search on the torus (csrc/ik/torus.c): Newton runs that come next to a root found
+give up there (a root found already), except next to a near-double root, whose partner they may
+be the only ones to reach."""
+
+from __future__ import annotations
+
+import numpy as np
+
+import om_redundant as om
+from om_redundant.kinematics import KinematicChain
+from tests.conftest import distance
+
+RIGHT = np.pi / 2
+
+
+def talos_left_arm() -> om.Arm:
+    """PAL Talos's left arm (Menagerie's talos.xml from torso_2_link, DH rows to the micrometre,
+    no tool): shoulder offsets a1 and a3, a torus arm of the exact family."""
+    rows = (
+        om.DHRow(a=0.1365, alpha=RIGHT, d=0.27873, theta=RIGHT),
+        om.DHRow(a=0.0, alpha=-RIGHT, d=0.00493, theta=0.0),
+        om.DHRow(a=0.02, alpha=-RIGHT, d=-0.2782, theta=-RIGHT),
+        om.DHRow(a=-0.02, alpha=RIGHT, d=0.0, theta=0.0),
+        om.DHRow(a=0.0, alpha=RIGHT, d=-0.2643, theta=RIGHT),
+        om.DHRow(a=0.0, alpha=-RIGHT, d=0.0, theta=-RIGHT),
+        om.DHRow(a=0.0, alpha=0.0, d=0.0, theta=0.0),
+    )
+    base = np.eye(4)
+    base[1, 3] = 0.1575
+    return om.Arm(
+        name="talos-left",
+        chain=KinematicChain(rows, base, np.eye(4)),
+        joint_names=tuple(f"arm_left_{k}_joint" for k in range(1, 8)),
+        lower=np.array([-1.5708, 0.00872665, -2.42601, -2.23402, -2.51327, -1.37008, -0.680678]),
+        upper=np.array([0.785398, 2.87107, 2.42601, -0.00349066, 2.51327, 1.37008, 0.680678]),
+    )
+
+
+def test_a_near_double_root_keeps_its_partner():
+    """At a fold of the psi-constrained map (the Jacobian's smallest singular value 2.4e-4) two
+    roots of (T, c) lie 1.8e-5 rad apart; solve_all holds both, q among them (one of 10,000 random
+    q of menagerie_humanoids, which a run that gave up within 1e-3 of the first root lost)."""
+    arm = talos_left_arm()
+    solver = om.OMSolver(arm)
+    q = np.array([-0.9617817618013271, 0.14598407785564585, 0.1417183634924286, -0.0952348913133565])
+    q = np.concatenate([q, [0.9430376099057165, -1.0442774902846064, -0.4718165612312928]])
+    T, c = arm.fk(q), solver.configuration_of(q)
+    roots = solver.solve_all(T, c)
+    assert any(distance(arm, root.q, q) < 1e-7 for root in roots)
+    pair = [root for root in roots if distance(arm, root.q, q) < 1e-4]
+    assert len(pair) == 2
+    for root in pair:
+        assert np.abs(arm.fk(root.q) - T).max() <= 1e-10 and solver.holds(root.q, c)
