@@ -103,7 +103,6 @@ int om_wrist_offset_candidates(om_problem *pb, double lo, double hi, bool full_c
                                int cap);
 
 /* torus_newton.c */
-double om_newton(om_problem *pb, vec3 x, double *q, const double *known, int n_known, vec3 *x_end);
 double om_lifted_solve(om_problem *pb, const double *start, double *q);
 /* The candidates a torus search hands to verification, in order: q (dof each) of the first cap
  * of them, count in all (beyond cap: not all kept). */

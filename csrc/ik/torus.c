@@ -38,15 +38,15 @@ typedef struct {
 } known_roots;
 
 /* One search's state: its known roots, candidates so far (into roots, logged as torus_candidate
- * does), how far a root's fold partners are sought, and where its Newton runs give up. */
+ * does), how far a root's fold partners are sought, and a window's centre (w1, w7) and the
+ * reach beyond which its Newton runs give up (INFINITY on the whole torus). */
 typedef struct {
     om_problem *pb;
     known_roots known;
     int n_known, count;
     double *roots, *q; /* q: the model IK of the last Newton run's end */
     om_candidate_log *log;
-    double partner_reach;
-    newton_limits limits; /* reach INFINITY on the whole torus */
+    double partner_reach, w1, w7, reach;
 } torus_search;
 
 /* Newton's method from x, deflated by the known roots if deflate; a new root is appended to the
@@ -55,8 +55,8 @@ static bool _new_root(torus_search *t, vec3 x, bool deflate)
 {
     vec3 x_root;
     known_roots *known = &t->known;
-    t->limits.known = known->x, t->limits.near = known->near, t->limits.n_known = t->n_known;
-    double r = om_lifted_newton(t->pb, NULL, x, t->q, known->x, deflate ? t->n_known : 0, &t->limits, &x_root);
+    newton_limits limits = {t->w1, t->w7, t->reach, known->x, known->near, t->n_known};
+    double r = om_lifted_newton(t->pb, NULL, x, t->q, known->x, deflate ? t->n_known : 0, &limits, &x_root);
     if (r > OM_ROOT_TOL)
         return false;
     for (int k = 0; k < t->n_known; k++)
@@ -180,7 +180,7 @@ static void _roots_from(torus_search *t, vec3 x)
         if (!_new_root(t, v3(x.x, x.y, edge), false))
             return;
     }
-    while (isinf(t->limits.reach) && t->n_known < MAX_KNOWN && _new_root(t, x, true))
+    while (isinf(t->reach) && t->n_known < MAX_KNOWN && _new_root(t, x, true))
         ;
     _partners(t, first);
 }
@@ -221,8 +221,7 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
     size_t mm = (size_t)m * (size_t)m;
     double *S = malloc(4 * mm * sizeof(double));
     known_roots known = {malloc((size_t)MAX_KNOWN * 3 * sizeof(double)), malloc(MAX_KNOWN * sizeof(double)), MAX_KNOWN};
-    newton_limits limits = {centre[0], centre[6], INFINITY, NULL, NULL, 0};
-    torus_search t = {pb, known, 0, 0, roots, q, log, PARTNER_CELLS * step, limits};
+    torus_search t = {pb, known, 0, 0, roots, q, log, PARTNER_CELLS * step, centre[0], centre[6], INFINITY};
     if (!S || !t.known.x || !t.known.near) {
         free(S);
         free(t.known.x);
@@ -230,7 +229,7 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
         return 0;
     }
     if (!whole) {
-        t.limits.reach = WINDOW_REACH * radius;
+        t.reach = WINDOW_REACH * radius;
         t.partner_reach = py_max(t.partner_reach, WINDOW_PARTNERS * radius);
     }
     double *W = S + mm, *F = W + mm, *E = F + mm;

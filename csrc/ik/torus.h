@@ -24,10 +24,17 @@ static inline vec3 lifted_of(const half_line_chart *chart, vec3 y)
               y.z);
 }
 
-/* Whether two points (w1, w7, phi4) are one: each coordinate within OM_SAME_ROOT, modulo 2 pi. */
+/* The distance of two points (w1, w7, phi4): the largest of their coordinates' differences, each
+ * modulo 2 pi. */
+static inline double lifted_distance(vec3 a, vec3 b)
+{
+    return py_max(py_max(fabs(om_wrap(a.x - b.x)), fabs(om_wrap(a.y - b.y))), fabs(om_wrap(a.z - b.z)));
+}
+
+/* Whether two points (w1, w7, phi4) are one: within OM_SAME_ROOT. */
 static inline bool same_point(vec3 a, vec3 b)
 {
-    return py_max(py_max(fabs(om_wrap(a.x - b.x)), fabs(om_wrap(a.y - b.y))), fabs(om_wrap(a.z - b.z))) < OM_SAME_ROOT;
+    return lifted_distance(a, b) < OM_SAME_ROOT;
 }
 
 /* om_add_candidate of a copy of q, logged (log not NULL): the search's q stays as Newton left
@@ -63,7 +70,7 @@ typedef struct {
 /* Damped Newton on the lifted system from x (chart not NULL: in its coordinates), deflated by
  * the first n_known rows of known, within limits (NULL: none); returns the residual's
  * max norm at the end (inf where the run gave up), *x_end the end point (lifted), q the model
- * IK there (not written where the run gave up; om_newton: chart and limits NULL). */
+ * IK there (not written where the run gave up). */
 double om_lifted_newton(om_problem *pb, const half_line_chart *chart, vec3 x, double *q, const double *known,
                         int n_known, const newton_limits *limits, vec3 *x_end);
 /* Roots next to the points of psi's half-line in the grid's square (lo1, lo7, step, m nodes a

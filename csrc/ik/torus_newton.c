@@ -11,11 +11,9 @@ static bool _gives_up(const newton_limits *limits, vec3 x, bool deflated)
 {
     if (py_max(fabs(om_wrap(x.x - limits->w1)), fabs(om_wrap(x.y - limits->w7))) > limits->reach)
         return true;
-    for (int k = 0; k < limits->n_known && !deflated; k++) {
-        vec3 e = v_sub(x, v_load(limits->known, 3 * k));
-        if (py_max(py_max(fabs(om_wrap(e.x)), fabs(om_wrap(e.y))), fabs(om_wrap(e.z))) < limits->near[k])
+    for (int k = 0; k < limits->n_known && !deflated; k++)
+        if (lifted_distance(x, v_load(limits->known, 3 * k)) < limits->near[k])
             return true;
-    }
     return false;
 }
 
@@ -78,15 +76,10 @@ double om_lifted_newton(om_problem *pb, const half_line_chart *chart, vec3 x, do
     return r < INFINITY ? r : INFINITY;
 }
 
-double om_newton(om_problem *pb, vec3 x, double *q, const double *known, int n_known, vec3 *x_end)
-{
-    return om_lifted_newton(pb, NULL, x, q, known, n_known, NULL, x_end);
-}
-
 /* Damped Newton on the lifted system in (q1, q7, phi4) from the joint vector start;
  * returns the final residual, q holding the model IK there. */
 double om_lifted_solve(om_problem *pb, const double *start, double *q)
 {
     vec3 x = v3(start[0], start[6], start[3] + pb->s->params[SRS_THETA + 3]);
-    return om_newton(pb, x, q, NULL, 0, NULL);
+    return om_lifted_newton(pb, NULL, x, q, NULL, 0, NULL, NULL);
 }
