@@ -97,9 +97,10 @@ def _nearest_distance(roots: list[np.ndarray], hint: np.ndarray) -> float:
     offsets=st.sampled_from(OFFSETS[:3]), q_seed=st.integers(0, 2**32 - 1), sigma=st.sampled_from((0.01, 0.1))
 )
 def test_the_hinted_solve_returns_the_root_nearest_the_hint(offsets, q_seed, sigma):
-    """The hinted solve's window on the torus (csrc/ik/torus.c: a grid as fine as the whole
-    torus', fold partners sought across the window, Newton runs that give up beyond it or next
-    to a root found) returns a root at least as near the hint (wrapped Euclidean distance) as
+    """The hinted solve's window on the torus (csrc/ik/torus.c: the root found and its fold
+    partners sought across the window, a grid on the corrected system as fine as the whole
+    torus' where the window is wider than one of its cells, Newton runs that give up beyond it or
+    next to a root found) returns a root at least as near the hint (wrapped Euclidean distance) as
     every root of solve_all: at hints sigma from q (5 per example), and between the two roots of
     every close pair (within 0.15 rad), 0.3 and 0.45 of the way from one to the other."""
     solver = solver_of(*offsets)
@@ -123,6 +124,25 @@ def test_the_hinted_solve_returns_the_root_nearest_the_hint(offsets, q_seed, sig
                 q,
                 hint,
             )
+
+
+def test_a_wide_window_finds_a_root_between_two_others():
+    """Four roots of (T, c) strung along q1 on the arm with a wrist offset (0.16 to 1.4 rad apart):
+    a hint 0.45 of the way between the first and the third (by q1) lies 0.20 rad from the second,
+    q, and 0.26 from the first, which the local solve finds; the window about the hint returns q.
+    (A window whose grid sampled the nominal arm's system, whose dips lie off the real arm's roots
+    by more than the window's cells, kept the first.)"""
+    solver = solver_of(0.0, BAXTER_OFFSET)
+    arm = solver.arm
+    q = np.array([-0.29129871675560, 1.85170794627972, 1.54211434576463, 1.42754343156551, 1.09277912160636,
+                  -0.62652580525152, 1.04756876658342])  # fmt: skip
+    T, c = arm.fk(q), solver.configuration_of(q)
+    roots = sorted((root.q for root in solver.solve_all(T, c)), key=lambda root: root[0])
+    assert len(roots) == 4 and distance(arm, roots[1], q) < 1e-9
+    hint = roots[0] + 0.45 * wrap(roots[2] - roots[0])
+    hinted = solver.solve(T, c, q_hint=hint)
+    assert hinted.ok and distance(arm, hinted.q, q) < 1e-9
+    assert np.linalg.norm(wrap(hinted.q - hint)) <= _nearest_distance(roots, hint) + 1e-9
 
 
 def test_the_redundancy_optimiser_chooses_exactly_on_a_shoulder_offset_arm():

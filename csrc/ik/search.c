@@ -63,12 +63,18 @@ static int _torus_side(int n_scan)
     return side > 4 ? side : 4;
 }
 
-/* A window's grid on the torus (half-width radius): as fine as the whole torus' grid for n_scan
- * scan points, and 4 nodes a side at least (the window's fold partners, sought across it, are
- * its search's net, om_torus_roots). */
+/* A window's grid on the torus (half-width radius), about a root found: as fine as the whole
+ * torus' grid for n_scan scan points, and 4 nodes a side at least (the window's fold partners,
+ * sought across it, are its search's net, om_torus_roots); none (0) where the window is at most
+ * one cell of the whole grid wide, where every other root of the window lies within a cell of
+ * the root found, which the whole grid would not show as a dip of its own either: its fold
+ * partner search is the net there, as on the whole torus. */
 static int _window_side(int n_scan, double radius)
 {
-    int side = (int)ceil((double)_torus_side(n_scan) * radius / OM_PI);
+    int whole = _torus_side(n_scan);
+    if (2.0 * radius <= 2.0 * OM_PI / (double)whole)
+        return 0;
+    int side = (int)ceil((double)whole * radius / OM_PI);
     return side > 4 ? side : 4;
 }
 

@@ -49,6 +49,29 @@ typedef struct {
     double partner_reach, w1, w7, reach;
 } torus_search;
 
+/* The root x appended to the known ones; returns whether it was (out of memory: not). */
+static bool _keep(torus_search *t, vec3 x)
+{
+    known_roots *known = &t->known;
+    if (t->n_known >= known->cap) {
+        int cap = 2 * known->cap;
+        double *grown = realloc(known->x, (size_t)cap * 3 * sizeof(double));
+        if (grown)
+            known->x = grown;
+        double *near = grown ? realloc(known->near, (size_t)cap * sizeof(double)) : NULL;
+        if (!near)
+            return false; /* out of memory: not kept */
+        known->near = near;
+        known->cap = cap;
+    }
+    known->near[t->n_known] = 0.0; /* until its fold partners are sought */
+    known->x[3 * t->n_known] = x.x;
+    known->x[3 * t->n_known + 1] = x.y;
+    known->x[3 * t->n_known + 2] = x.z;
+    t->n_known++;
+    return true;
+}
+
 /* Newton's method from x, deflated by the known roots if deflate; a new root is appended to the
  * known ones and handed to verification. Returns whether one was. */
 static bool _new_root(torus_search *t, vec3 x, bool deflate)
@@ -62,22 +85,8 @@ static bool _new_root(torus_search *t, vec3 x, bool deflate)
     for (int k = 0; k < t->n_known; k++)
         if (same_point(x_root, v_load(known->x, 3 * k)))
             return false;
-    if (t->n_known >= known->cap) {
-        int cap = 2 * known->cap;
-        double *grown = realloc(known->x, (size_t)cap * 3 * sizeof(double));
-        if (grown)
-            known->x = grown;
-        double *near = grown ? realloc(known->near, (size_t)cap * sizeof(double)) : NULL;
-        if (!near)
-            return false; /* out of memory: not kept */
-        known->near = near;
-        known->cap = cap;
-    }
-    known->near[t->n_known] = 0.0; /* until its fold partners are sought */
-    known->x[3 * t->n_known] = x_root.x;
-    known->x[3 * t->n_known + 1] = x_root.y;
-    known->x[3 * t->n_known + 2] = x_root.z;
-    t->n_known++;
+    if (!_keep(t, x_root))
+        return false;
     t->count = torus_candidate(t->pb, t->q, t->roots, t->count, t->log);
     return true;
 }
@@ -199,7 +208,8 @@ static void _roots_from(torus_search *t, vec3 x)
  * the centre, whose roots it does not seek; it does not deflate, and seeks each root's fold
  * partners across the window (WINDOW_PARTNERS): a root of the window near one known is such a
  * partner, and one farther from every known root has a local minimum of the norm of its own on
- * the grid, as on the whole torus. */
+ * the grid, as on the whole torus. n = 0: a window without a grid (no wider than a cell of the
+ * whole torus' grid: search.c, _window_side), the root found and its fold partners alone. */
 int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, double radius, const double *found,
                    om_candidate_log *log)
 {
@@ -216,8 +226,9 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
         lo7 = centre[6] - radius;
         span = 2.0 * radius;
     }
-    double step = span / (double)n;
-    int m = n + 1; /* on the whole torus the last row and column repeat the first */
+    bool grid = n > 0; /* (a window without a grid: its square one cell, for psi's half-line) */
+    double step = span / (double)(grid ? n : 1);
+    int m = (grid ? n : 1) + 1; /* on the whole torus the last row and column repeat the first */
     size_t mm = (size_t)m * (size_t)m;
     double *S = malloc(4 * mm * sizeof(double));
     known_roots known = {malloc((size_t)MAX_KNOWN * 3 * sizeof(double)), malloc(MAX_KNOWN * sizeof(double)), MAX_KNOWN};
@@ -234,13 +245,15 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
     }
     double *W = S + mm, *F = W + mm, *E = F + mm;
     const double *P = pb->s->params;
-    /* An arm near a family: the grid samples its nominal arm's system (g~ of near.c, one model IK
-     * a node instead of a fixed point of the correction), and Newton refines every start on G.
-     * |G - g~| <= |dg/dX| delta (near.c: 20 per metre away from the singular set, half a radian
-     * at the TIAGo Pro's 26 mm) stays below OM_PAIR_SEARCH: a root of G lies at a dip of |g~|,
-     * which the grid's starts take, as the circle's scan of g~ has it. */
-    pb->nominal = pb->s->nominal_table != NULL;
-    for (int i = 0; i < m; i++) {
+    /* An arm near a family: the whole torus' grid samples its nominal arm's system (g~ of near.c,
+     * one model IK a node instead of a fixed point of the correction), and Newton refines every
+     * start on G. |G - g~| <= |dg/dX| delta (near.c: 20 per metre away from the singular set,
+     * half a radian at the TIAGo Pro's 26 mm) stays below OM_PAIR_SEARCH: a root of G lies at a
+     * dip of |g~|, which the grid's starts take, as the circle's scan of g~ has it. A window's
+     * grid samples G: its cells are finer than the nominal arm's roots lie from the real arm's
+     * (about the offsets over the arm's reach), so a dip of |g~| there need not be one of |G|. */
+    pb->nominal = whole && pb->s->nominal_table != NULL;
+    for (int i = 0; i < m && grid; i++) {
         for (int j = 0; j < m; j++) {
             vec3 r = om_lifted_residual(pb, v3(lo1 + (double)i * step, lo7 + (double)j * step, NAN), q);
             S[i * m + j] = r.x;
@@ -250,11 +263,11 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
         }
     }
     pb->nominal = false;
-    if (found && !whole) {
-        _new_root(&t, v3(found[0], found[6], found[3] + P[SRS_THETA + 3]), false);
+    if (found && !whole) { /* (a verified root: known as it is, the window's incumbent, not a candidate) */
+        _keep(&t, v3(found[0], found[6], found[3] + P[SRS_THETA + 3]));
         _partners(&t, 0);
     }
-    for (int i = 0; i < m; i++) {
+    for (int i = 0; i < m && grid; i++) {
         for (int j = 0; j < m; j++) {
             for (int centre_of_cell = 0; centre_of_cell < 2; centre_of_cell++) {
                 bool start;
