@@ -3,7 +3,6 @@
 #include "om_system.h"
 
 #define TORUS_SIDE 0.75  /* the torus grid has TORUS_SIDE * scan points nodes per side */
-#define WINDOW_POINTS 8  /* samples of the window searched around a hint (on the circle) */
 #define START_POINTS 8   /* points of the dp circle tried when p_d is out of the model's reach */
 
 /* The roots from the circle's candidates cands[0 .. n), each polished and verified into roots
@@ -76,6 +75,15 @@ static int _window_side(int n_scan, double radius)
         return 0;
     int side = (int)ceil((double)whole * radius / OM_PI);
     return side > 4 ? side : 4;
+}
+
+/* A window's samples on the circle (half-width radius): as fine as the whole circle's scan of
+ * n_scan points, and 3 at least (its ends and middle: the scan's curvature test then has a
+ * second difference to judge the window's two cells by, as every cell of the whole scan). */
+static int _window_points(int n_scan, double radius)
+{
+    int points = (int)ceil((double)n_scan * radius / OM_PI) + 1;
+    return points > 3 ? points : 3;
 }
 
 /* The torus grid search of the whole torus (om_torus_roots), its candidates taken from cache
@@ -300,7 +308,7 @@ bool om_nearest_in_window(om_problem *pb, const double *hint, double *q)
     if (radius < 1e-12)
         return false;
     double roots[OM_MAX_ROOTS * OM_MAX_DOF];
-    int n = _all_roots(pb, WINDOW_POINTS, roots, hint, radius, q);
+    int n = _all_roots(pb, _window_points(pb->s->scan_points, radius), roots, hint, radius, q);
     bool replaced = false;
     for (int r = 0; r < n; r++) {
         double e2 = om_wrapped_distance2(roots + r * dof, hint, dof);
