@@ -15,7 +15,7 @@
 static int _near_window(om_problem *pb, double a, double b, int points, double *q, double *out, int n, int cap)
 {
     pb->nominal = false;
-    n += om_circle_candidates(pb, a, b, points > NEAR_WINDOW ? points : NEAR_WINDOW, false, q, out + n, cap - n);
+    n += om_circle_candidates(pb, a, b, points > NEAR_WINDOW ? points : NEAR_WINDOW, false, NAN, q, out + n, cap - n);
     pb->nominal = true;
     return n;
 }
@@ -93,7 +93,7 @@ static int _wrist_window(om_problem *pb, double a, double b, int points, double 
 {
     bool nominal = pb->nominal;
     pb->nominal = false, pb->wrist = true;
-    n += om_circle_candidates(pb, a, b, WRIST_SAMPLES * (points - 1) + 1, false, q, out + n, cap - n);
+    n += om_circle_candidates(pb, a, b, WRIST_SAMPLES * (points - 1) + 1, false, NAN, q, out + n, cap - n);
     pb->nominal = nominal, pb->wrist = false;
     return n;
 }
@@ -133,8 +133,8 @@ static bool _island_possible(om_problem *pb, om_reach_bound *bound, const double
 /* Candidate roots of g on [lo, hi] (the whole circle if full_circle) into cands (capacity
  * cap); returns the count. g and the reach margin are sampled at n_pts points; runs of
  * reach (extended to its edges) and islands of reach between samples are searched. */
-int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool full_circle, double *q,
-                         double *cands, int cap)
+int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool full_circle, double known,
+                         double *q, double *cands, int cap)
 {
     double h = (hi - lo) / (double)(full_circle ? n_pts : n_pts - 1);
     int count = full_circle ? n_pts + 1 : n_pts;
@@ -151,7 +151,7 @@ int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool f
     double *ws = buffer, *gs = ws + (n_pts + 1), *ms = gs + (n_pts + 1);
     double *rws = ms + (n_pts + 1), *rgs = rws + count, *rms = rgs + count;
     double *pw = rms + count, *pg = pw + (count + 2), *curvatures = pg + (count + 2), *bs = curvatures + (count + 2);
-    circle_scan scan = {om_pole_guard(pb, h), _near_window};
+    circle_scan scan = {om_pole_guard(pb, h), _near_window, known};
     int start = -1;
     scan_memo *memo = om_circle_sample(pb, lo, h, n_pts, ws, gs, ms, bs, q);
     /* (the samples in order, for a near arm's windows about its singular set: ws may be rotated

@@ -56,12 +56,14 @@ int om_pole_splits(const pole_guard *pole, double a, double b, double *split);
  * into out[n:]; returns the new count. */
 typedef int (*circle_window)(om_problem *pb, double a, double b, int points, double *q, double *out, int n, int cap);
 
-/* What a scan's runs are searched with: its guard at psi's half-line, and its near arm's window
- * of G (circle.c's, which scans the window as the circle: passed down to the runs, which do not
- * call up). */
+/* What a scan's runs are searched with: its guard at psi's half-line, its near arm's window of G
+ * (circle.c's, which scans the window as the circle: passed down to the runs, which do not call
+ * up), and a root known already (w, a hinted solve's window's incumbent; NaN: none), which a
+ * sign change of the scanned function on a cell that holds it alone is not refined to again. */
 typedef struct {
     pole_guard pole;
     circle_window window;
+    double known;
 } circle_scan;
 
 /* Add the roots on a run of reachable points (w ascending) to out[n:]; returns the count

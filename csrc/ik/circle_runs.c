@@ -34,7 +34,9 @@ static bool _near_miss(om_problem *pb, double w, double gw, double *q)
 }
 
 /* Add the root of g on [a, b] (both ends reachable) to out[n:]; returns the new count.
- * A sign change is one root; a wrap of g from about +pi to -pi is none. */
+ * A sign change is one root; a wrap of g from about +pi to -pi is none; a sign change of g
+ * itself (not of a near arm's g~, whose roots lie off G's) about the scan's known root is that
+ * root. */
 static int _bracket(om_problem *pb, const circle_scan *scan, double a, double ga, double b, double gb, double *q,
                     double *out, int n, int cap)
 {
@@ -69,6 +71,9 @@ static int _bracket(om_problem *pb, const circle_scan *scan, double a, double ga
     if (it == 60 && ga * gb < 0.0)
         return _put(out, n, cap, 0.5 * (a + b));
     if (fabs(ga - gb) > OM_PI)
+        return n;
+    double from_a = om_wrap(scan->known - a); /* (NaN: no root known) */
+    if (ga * gb < 0.0 && !pb->nominal && from_a >= 0.0 && from_a <= b - a) /* its one root, known */
         return n;
     if (ga * gb < 0.0)
         return _put(out, n, cap, om_refine_bracket(pb, a, ga, b, gb, q));

@@ -88,10 +88,11 @@ double om_wrist_secant(om_problem *pb, double w0, double *q);
 double om_extremum(om_problem *pb, double a, double b, double x0, double sign, bool of_margin, double *q,
                    double *g_out, double *margin_out);
 
-/* circle.c: candidates into cands (capacity cap); returns the count. On an S-R-S arm whose
- * dp turns with q7 the scan's samples take the model's parts from pb->memo where it holds
- * them, and keep them there (the same bits as computed). */
-int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool full_circle, double *q,
+/* circle.c: candidates into cands (capacity cap); returns the count; a root known at w = known
+ * (NaN: none) is not a candidate again (circle_scan). On an S-R-S arm whose dp turns with q7 the
+ * scan's samples take the model's parts from pb->memo where it holds them, and keep them there
+ * (the same bits as computed). */
+int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool full_circle, double known, double *q,
                          double *cands, int cap);
 /* circle_samples.c: a scan memo for the problems of solver s, none held yet (NULL: an arm whose scans keep none,
  * or out of memory); freed by om_scan_memo_free (NULL: nothing). */

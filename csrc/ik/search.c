@@ -142,7 +142,7 @@ static int _all_roots(om_problem *pb, int n_scan, double *roots, const double *c
     double lo = full_circle ? -OM_PI : centre[J] - radius;
     double hi = full_circle ? OM_PI : centre[J] + radius;
     pb->nominal = om_scans_nominal(data); /* an arm near a family: its nominal arm's g~ first (near.c) */
-    int n = om_circle_candidates(pb, lo, hi, n_scan, full_circle, q, cands, cap);
+    int n = om_circle_candidates(pb, lo, hi, n_scan, full_circle, found ? found[J] : NAN, q, cands, cap);
     if (data->family != OM_SRS && data->params[SD_WRIST_OFFSET] != 0.0) /* a4 != 0: the singular wrist's bands */
         n += om_wrist_offset_candidates(pb, lo, hi, full_circle, q, cands + n, cap - n);
     pb->nominal = false;
@@ -181,7 +181,7 @@ int om_all_roots_cached(om_problem *pb, int n_scan, double *roots, om_scan_cache
     } else {
         nan_fill(q, OM_MAX_DOF); /* as om_all_roots */
         int64_t before = pb->counter;
-        cache->count = om_circle_candidates(pb, -OM_PI, OM_PI, n_scan, true, q, cache->candidates, cache->capacity);
+        cache->count = om_circle_candidates(pb, -OM_PI, OM_PI, n_scan, true, NAN, q, cache->candidates, cache->capacity);
         cache->evaluations = pb->counter - before;
         memcpy(cache->q, q, sizeof q);
         memcpy(cache->key, key, sizeof key);

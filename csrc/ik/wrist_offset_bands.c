@@ -18,11 +18,11 @@ static int _bands(om_problem *pb, double w0, double width, double rho, double lo
             double u = w0 + side * 0.5 * x, v = w0 + side * x;
             double from = py_max(py_min(u, v), lo), to = py_min(py_max(u, v), hi);
             if (to > from)
-                n += om_circle_candidates(pb, from, to, BAND_POINTS, false, q, cands + n, cap - n);
+                n += om_circle_candidates(pb, from, to, BAND_POINTS, false, NAN, q, cands + n, cap - n);
         }
     double from = py_max(w0 - x, lo), to = py_min(w0 + x, hi);
     if (to > from)
-        n += om_circle_candidates(pb, from, to, BAND_POINTS, false, q, cands + n, cap - n);
+        n += om_circle_candidates(pb, from, to, BAND_POINTS, false, NAN, q, cands + n, cap - n);
     return n;
 }
 
