@@ -60,3 +60,25 @@ def test_a_near_double_root_keeps_its_partner():
     assert len(pair) == 2
     for root in pair:
         assert np.abs(arm.fk(root.q) - T).max() <= 1e-10 and solver.holds(root.q, c)
+
+
+def test_a_hint_next_to_a_near_double_root_gets_the_nearer_of_the_pair():
+    """The pair above, a hint 0.002 rad from q (a control tick of menagerie_humanoids) whose local
+    solve finds q's partner, 2.0e-3 + 1.1e-5 rad from the hint: the window's fold-partner search
+    reaches q (a deflated run that ends next to the partner, its residual's rounding lifted by
+    deflation above the tolerance, is finished undeflated), and the hinted solve and the tick
+    return it."""
+    arm = talos_left_arm()
+    solver = om.OMSolver(arm)
+    q = np.array(
+        [-0.96178176180133, 0.14598407785565, 0.14171836349243, -0.09523489131336, 0.94303760990572,
+         -1.04427749028461, -0.47181656123129]
+    )  # fmt: skip
+    hint = np.array(
+        [-0.96170099364626, 0.14546890135626, 0.14039532699437, -0.0945963326009, 0.94281500145288,
+         -1.0439861826986, -0.47061844928234]
+    )  # fmt: skip
+    T, c = arm.fk(q), solver.configuration_of(q)
+    assert len([root for root in solver.solve_all(T, c) if distance(arm, root.q, q) < 1e-4]) == 2
+    for answer in (solver.solve(T, c, q_hint=hint), solver.solve_from(T, c, hint)):
+        assert answer.ok and distance(arm, answer.q, q) < 1e-9

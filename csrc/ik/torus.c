@@ -6,6 +6,10 @@
 
 #define MAX_KNOWN 64           /* roots of the lifted torus system kept for deflation */
 #define NEAR_ROOT 0.1          /* on the whole torus, every node with a lifted residual below this starts Newton */
+/* A deflated run that ends with a residual below this, but not below OM_ROOT_TOL, is finished
+ * undeflated from its end: next to a known root deflation's factor, 1 + 1 / |x - x_k|^2 (3e9 at a
+ * near-double root's 1.8e-5), lifts the residual's rounding above the tolerance. */
+#define DEFLATED_END 1e-8
 #define PARTNER_CELLS 2.0      /* a root's fold partner is sought this many grid cells away at most */
 #define PARTNER_SAMPLES 8      /* samples each way along the fold direction */
 /* A window's fold partners are sought this many radii away at most: any other root of the window
@@ -80,6 +84,8 @@ static bool _new_root(torus_search *t, vec3 x, bool deflate)
     known_roots *known = &t->known;
     newton_limits limits = {t->w1, t->w7, t->reach, known->x, known->near, t->n_known};
     double r = om_lifted_newton(t->pb, NULL, x, t->q, known->x, deflate ? t->n_known : 0, &limits, &x_root);
+    if (deflate && r > OM_ROOT_TOL && r < DEFLATED_END) /* (not where the run gave up: inf) */
+        r = om_lifted_newton(t->pb, NULL, x_root, t->q, known->x, 0, &limits, &x_root);
     if (r > OM_ROOT_TOL)
         return false;
     for (int k = 0; k < t->n_known; k++)
