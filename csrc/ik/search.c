@@ -71,7 +71,7 @@ static int _torus_side(int n_scan)
 static int _window_side(int n_scan, double radius)
 {
     int whole = _torus_side(n_scan);
-    if (2.0 * radius <= 2.0 * OM_PI / (double)whole)
+    if (radius <= OM_PI / (double)whole) /* (2 radius: at most a cell, 2 pi / whole) */
         return 0;
     int side = (int)ceil((double)whole * radius / OM_PI);
     return side > 4 ? side : 4;
