@@ -156,7 +156,7 @@ PyObject *om_Solver_bounded_search(om_Solver *self, PyObject *const *args, Py_ss
     int n;
     Py_BEGIN_ALLOW_THREADS om_problem_init(&pb, s, T, c.signs, c.redundancy, psi, zeros);
     pb.certify = certify && pb.certify; /* (never for an arm near a family: om_problem_init) */
-    n = om_all_roots(&pb, s->scan_points, v[1].buf, zeros, INFINITY);
+    n = om_all_roots(&pb, s->scan_points, v[1].buf);
     for (int r = 0; r < n && s->flipped; r++)
         om_flip(s, (double *)v[1].buf + r * s->dof, (double *)v[1].buf + r * s->dof);
     Py_END_ALLOW_THREADS release_buffers(v, 2);

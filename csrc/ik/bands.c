@@ -242,7 +242,7 @@ int om_band_roots(om_problem *pb, double *roots, bool *neighbour_reached, om_sca
         if (!near[i])
             continue;
         om_problem other = neighbour(pb, i, signs, redundancy);
-        int n = om_all_roots(&other, s->scan_points, found, pb->q_prev, INFINITY);
+        int n = om_all_roots(&other, s->scan_points, found);
         pb->counter += other.counter;
         *neighbour_reached = *neighbour_reached || n > 0;
         for (int r = 0; r < n; r++) /* verified again in the problem's own configuration */

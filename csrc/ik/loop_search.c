@@ -181,7 +181,7 @@ int om_loop_roots(om_problem *pb, double *roots, int count, om_scan_cache *cache
     for (int i = 0; i < LOOP_STARTS - 1 && count == 0; i++) {
         double psi = om_wrap(pb->redundancy[0] + 2.0 * OM_PI * (double)order[i] / (double)LOOP_STARTS);
         om_problem other = om_problem_at(pb, pb->signs, &psi);
-        int n = om_all_roots(&other, s->scan_points, starts, pb->q_prev, INFINITY);
+        int n = om_all_roots(&other, s->scan_points, starts);
         pb->counter += other.counter;
         for (int r = 0; r < n; r++)
             if (!_seen(&ls, starts + 7 * r))

@@ -238,7 +238,7 @@ int om_loop_roots(om_problem *pb, double *roots, int count, om_scan_cache *cache
 bool om_loop_pass(om_problem *pb, double *q, double *pos, double *ori);
 
 /* search.c */
-int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre, double radius);
+int om_all_roots(om_problem *pb, int n_scan, double *roots);
 /* om_all_roots on the whole circle with the candidates taken from cache where it holds this
  * problem's, else searched and kept there (cache NULL: om_all_roots). */
 int om_all_roots_cached(om_problem *pb, int n_scan, double *roots, om_scan_cache *cache);

@@ -115,8 +115,9 @@ static int _torus_roots_cached(om_problem *pb, int n_scan, double *roots, om_sca
     return count;
 }
 
-/* om_all_roots, with a root found already (its joints; NULL: none), which a window of the
- * torus starts from (om_torus_roots). */
+/* om_all_roots, or with radius < pi the roots whose scanned joints lie within radius of the
+ * centre's (a window), with a root found already there (its joints; NULL: none), which the
+ * window starts from (om_torus_roots; on the circle, circle_scan.known). */
 static int _all_roots(om_problem *pb, int n_scan, double *roots, const double *centre, double radius,
                       const double *found)
 {
@@ -152,11 +153,12 @@ static int _all_roots(om_problem *pb, int n_scan, double *roots, const double *c
 }
 
 /* Bounded search: every verified solution in this configuration into roots (OM_MAX_ROOTS x
- * dof); returns the count. With radius < pi, only roots whose scanned joints lie within
- * radius of the centre's are sought. */
-int om_all_roots(om_problem *pb, int n_scan, double *roots, const double *centre, double radius)
+ * dof), on the whole circle or torus; returns the count. (A window about a hint:
+ * om_nearest_in_window.) */
+int om_all_roots(om_problem *pb, int n_scan, double *roots)
 {
-    return _all_roots(pb, n_scan, roots, centre, radius, NULL);
+    static const double anywhere[OM_MAX_DOF] = {0.0}; /* (the whole circle or torus has no centre) */
+    return _all_roots(pb, n_scan, roots, anywhere, INFINITY, NULL);
 }
 
 int om_all_roots_cached(om_problem *pb, int n_scan, double *roots, om_scan_cache *cache)
@@ -172,7 +174,7 @@ int om_all_roots_cached(om_problem *pb, int n_scan, double *roots, om_scan_cache
                    : _torus_roots_cached(pb, n_scan, roots, cache);
     if (!cache || data->mode != OM_CIRCLE || data->family != OM_SRS || data->dp_joint != 6 || data->nominal_table ||
         OM_SCAN_CAPACITY(n_scan) > cache->capacity)
-        return om_all_roots(pb, n_scan, roots, zeros, INFINITY);
+        return om_all_roots(pb, n_scan, roots);
     double key[OM_SCAN_KEY], q[OM_MAX_DOF];
     _scan_key(pb, n_scan, true, key);
     if (cache->valid && memcmp(key, cache->key, sizeof key) == 0) {
@@ -290,7 +292,7 @@ bool om_exists_other(om_problem *pb, bool skip_neighbours)
         om_problem with_signs = *pb;
         with_signs.signs = other;
         with_signs.counter = 0;
-        int n = om_all_roots(&with_signs, pb->s->scan_points, roots, pb->q_prev, INFINITY);
+        int n = om_all_roots(&with_signs, pb->s->scan_points, roots);
         pb->counter += with_signs.counter;
         if (n)
             return true;

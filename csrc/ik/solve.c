@@ -225,7 +225,7 @@ static om_result _solve(const om_solver_data *s, const double *T, const int64_t 
         }
     }
     double roots[OM_MAX_ROOTS * OM_MAX_DOF];
-    int n = om_all_roots(pb, s->scan_points, roots, hint, INFINITY);
+    int n = om_all_roots(pb, s->scan_points, roots);
     bool neighbour_reached = false;
     if (n == 0) /* the boundary contract: a neighbour's root in the band holds this configuration */
         n = om_band_roots(pb, roots, &neighbour_reached, NULL);

@@ -270,7 +270,7 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
     }
     pb->nominal = false;
     if (found && !whole) { /* (a verified root: known as it is, the window's incumbent, not a candidate) */
-        _keep(&t, v3(found[0], found[6], found[3] + P[SRS_THETA + 3]));
+        _keep(&t, lifted_point(P, found));
         _partners(&t, 0);
     }
     for (int i = 0; i < m && grid; i++) {

@@ -24,6 +24,13 @@ static inline vec3 lifted_of(const half_line_chart *chart, vec3 y)
               y.z);
 }
 
+/* The lifted point (w1, w7, phi4) of the joints q: q1, q7 and the elbow's DH angle (P: the
+ * solver's parameters). */
+static inline vec3 lifted_point(const double *P, const double *q)
+{
+    return v3(q[0], q[6], q[3] + P[SRS_THETA + 3]);
+}
+
 /* The distance of two points (w1, w7, phi4): the largest of their coordinates' differences, each
  * modulo 2 pi. */
 static inline double lifted_distance(vec3 a, vec3 b)
