@@ -11,6 +11,12 @@ from om_redundant.kinematics import KinematicChain
 from tests.conftest import distance
 
 RIGHT = np.pi / 2
+# One of a pair of roots 1.8e-5 rad apart on talos_left_arm (one of 10,000 random q of
+# menagerie_humanoids).
+NEAR_DOUBLE_Q = np.array(
+    [-0.96178176180133, 0.14598407785565, 0.14171836349243, -0.09523489131336, 0.94303760990572,
+     -1.04427749028461, -0.47181656123129]
+)  # fmt: skip
 
 
 def talos_left_arm() -> om.Arm:
@@ -38,21 +44,11 @@ def talos_left_arm() -> om.Arm:
 
 def test_a_near_double_root_keeps_its_partner():
     """At a fold of the psi-constrained map (the Jacobian's smallest singular value 2.4e-4) two
-    roots of (T, c) lie 1.8e-5 rad apart; solve_all holds both, q among them (one of 10,000 random
-    q of menagerie_humanoids, which a run that gave up within 1e-3 of the first root lost)."""
+    roots of (T, c) lie 1.8e-5 rad apart; solve_all holds both, q among them (a run that gave up
+    within 1e-3 of the first root lost the second)."""
     arm = talos_left_arm()
     solver = om.OMSolver(arm)
-    q = np.array(
-        [
-            -0.96178176180133,
-            0.14598407785565,
-            0.14171836349243,
-            -0.09523489131336,
-            0.94303760990572,
-            -1.04427749028461,
-            -0.47181656123129,
-        ]
-    )
+    q = NEAR_DOUBLE_Q
     T, c = arm.fk(q), solver.configuration_of(q)
     roots = solver.solve_all(T, c)
     assert any(distance(arm, root.q, q) < 1e-7 for root in roots)
@@ -70,10 +66,7 @@ def test_a_hint_next_to_a_near_double_root_gets_the_nearer_of_the_pair():
     return it."""
     arm = talos_left_arm()
     solver = om.OMSolver(arm)
-    q = np.array(
-        [-0.96178176180133, 0.14598407785565, 0.14171836349243, -0.09523489131336, 0.94303760990572,
-         -1.04427749028461, -0.47181656123129]
-    )  # fmt: skip
+    q = NEAR_DOUBLE_Q
     hint = np.array(
         [-0.96170099364626, 0.14546890135626, 0.14039532699437, -0.0945963326009, 0.94281500145288,
          -1.0439861826986, -0.47061844928234]
