@@ -146,6 +146,34 @@ def distance(arm: om.Arm, a: np.ndarray, b: np.ndarray) -> float:
     return float(np.abs(np.where(arm.revolute, wrap(a - b), a - b)).max())
 
 
+def nearest_distance(roots: list[np.ndarray], hint: np.ndarray) -> float:
+    """The wrapped Euclidean distance from the hint to the nearest of the roots."""
+    return min(float(np.linalg.norm(wrap(root - hint))) for root in roots)
+
+
+def check_hinted_nearest(
+    solver: om.OMSolver, q: np.ndarray, rng: np.random.Generator, sigma: float, within: float
+) -> None:
+    """The hinted solve at fk(q) in q's configuration returns a root at least as near the hint
+    (wrapped Euclidean distance) as every root of solve_all: at a hint sigma from q (N(0, sigma)
+    per joint), and 0.3 and 0.45 of the way from each root to each other root closer than within
+    (the largest joint difference)."""
+    T, c = solver.arm.fk(q), solver.configuration_of(q)
+    roots = [root.q for root in solver.solve_all(T, c)] + [q]
+    hints = [q + rng.normal(0.0, sigma, solver.arm.dof)]
+    hints += [
+        a + t * wrap(b - a)
+        for a in roots
+        for b in roots
+        for t in (0.3, 0.45)
+        if 0 < distance(solver.arm, a, b) < within
+    ]
+    for hint in hints:
+        hinted = solver.solve(T, c, q_hint=hint)
+        assert hinted.ok
+        assert np.linalg.norm(wrap(hinted.q - hint)) <= nearest_distance(roots, hint) + 1e-9, (q, hint)
+
+
 def check_exact(solver: om.OMSolver, q: np.ndarray, strict: bool) -> None:
     """Every root of solve_all(fk(q), c) reaches the pose (1e-10 m, 1e-10 rad) in c; where
     ``strict``, q is among them and the hinted solve returns it."""

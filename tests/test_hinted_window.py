@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 
 import om_redundant as om
 from benchmarks.near_family import bent
-from tests.conftest import distance, random_q, wrap
+from tests.conftest import check_hinted_nearest, random_q
 
 ARMS = (("ur5e", None), ("panda", None), ("xarm7", None), ("ur5e", 1e-3), ("panda", 1e-3))
 
@@ -33,18 +33,4 @@ def test_the_hinted_solve_returns_the_root_nearest_the_hint(arm, q_seed, sigma):
     solver = solver_of(*arm)
     rng = np.random.default_rng(q_seed)
     for q in random_q(solver.arm, 5, rng):
-        T, c = solver.arm.fk(q), solver.configuration_of(q)
-        roots = [root.q for root in solver.solve_all(T, c)] + [q]
-        hints = [q + rng.normal(0.0, sigma, solver.arm.dof)]
-        hints += [
-            a + t * wrap(b - a)
-            for a in roots
-            for b in roots
-            for t in (0.3, 0.45)
-            if 0 < distance(solver.arm, a, b) < 0.8
-        ]
-        for hint in hints:
-            hinted = solver.solve(T, c, q_hint=hint)
-            assert hinted.ok
-            nearest = min(float(np.linalg.norm(wrap(root - hint))) for root in roots)
-            assert np.linalg.norm(wrap(hinted.q - hint)) <= nearest + 1e-9, (q, hint)
+        check_hinted_nearest(solver, q, rng, sigma, within=0.8)

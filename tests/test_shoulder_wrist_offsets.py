@@ -16,7 +16,15 @@ import om_redundant as om
 from om_redundant import _core
 from om_redundant.ik import derive_model
 from om_redundant.kinematics import KinematicChain
-from tests.conftest import check_exact, distance, random_q, well_conditioned, wrap
+from tests.conftest import (
+    check_exact,
+    check_hinted_nearest,
+    distance,
+    nearest_distance,
+    random_q,
+    well_conditioned,
+    wrap,
+)
 
 G1_OFFSET, TIAGO_PRO_OFFSET, BAXTER_OFFSET = 0.00624, 0.02, 0.01
 #: (a2, a5): the G1's, TIAGo Pro's shoulder offset on the G1, Baxter's wrist offset on it, both.
@@ -88,10 +96,6 @@ def test_arms_with_shoulder_and_wrist_offsets_are_solved_exactly(offsets, q_seed
         check_exact(solver, q, strict=offsets == OFFSETS[0] or well_conditioned(solver, q))
 
 
-def _nearest_distance(roots: list[np.ndarray], hint: np.ndarray) -> float:
-    return min(float(np.linalg.norm(wrap(root - hint))) for root in roots)
-
-
 @settings(max_examples=12, deadline=None)
 @given(
     offsets=st.sampled_from(OFFSETS[:3]), q_seed=st.integers(0, 2**32 - 1), sigma=st.sampled_from((0.01, 0.1))
@@ -104,26 +108,9 @@ def test_the_hinted_solve_returns_the_root_nearest_the_hint(offsets, q_seed, sig
     every root of solve_all: at hints sigma from q (5 per example), and between the two roots of
     every close pair (within 0.15 rad), 0.3 and 0.45 of the way from one to the other."""
     solver = solver_of(*offsets)
-    arm = solver.arm
     rng = np.random.default_rng(q_seed)
-    for q in random_q(arm, 5, rng):
-        T, c = arm.fk(q), solver.configuration_of(q)
-        roots = [root.q for root in solver.solve_all(T, c)] + [q]
-        hints = [q + rng.normal(0.0, sigma, arm.dof)]
-        hints += [
-            a + t * wrap(b - a)
-            for a in roots
-            for b in roots
-            for t in (0.3, 0.45)
-            if 0 < distance(arm, a, b) < 0.15
-        ]
-        for hint in hints:
-            hinted = solver.solve(T, c, q_hint=hint)
-            assert hinted.ok
-            assert np.linalg.norm(wrap(hinted.q - hint)) <= _nearest_distance(roots, hint) + 1e-9, (
-                q,
-                hint,
-            )
+    for q in random_q(solver.arm, 5, rng):
+        check_hinted_nearest(solver, q, rng, sigma, within=0.15)
 
 
 def test_a_wide_window_finds_a_root_between_two_others():
@@ -142,7 +129,7 @@ def test_a_wide_window_finds_a_root_between_two_others():
     hint = roots[0] + 0.45 * wrap(roots[2] - roots[0])
     hinted = solver.solve(T, c, q_hint=hint)
     assert hinted.ok and distance(arm, hinted.q, q) < 1e-9
-    assert np.linalg.norm(wrap(hinted.q - hint)) <= _nearest_distance(roots, hint) + 1e-9
+    assert np.linalg.norm(wrap(hinted.q - hint)) <= nearest_distance(roots, hint) + 1e-9
 
 
 def test_the_redundancy_optimiser_chooses_exactly_on_a_shoulder_offset_arm():
