@@ -3,6 +3,7 @@ running the checkout's code in a fresh interpreter."""
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 import os
@@ -19,6 +20,7 @@ from hypothesis import strategies as st
 
 import om_redundant as om
 from om_redundant import _core
+from om_redundant.ik.kernel_data import flange_target
 from om_redundant.mujoco_io.loading import load_mujoco_model
 from om_redundant.redundancy.objective.terms import Group
 
@@ -141,6 +143,15 @@ def arm_without_a_model(tmp_path) -> Path:
     return path
 
 
+def with_offsets(arm: om.Arm, **changes: dict[str, float]) -> om.Arm:
+    """The arm with fields of joint rows changed: ``joint3={"a": 0.07}`` sets a4 (0-based joints)."""
+    rows = list(arm.chain.rows)
+    for key, fields in changes.items():
+        r = arm.chain.joint_rows[int(key.removeprefix("joint"))]
+        rows[r] = dataclasses.replace(rows[r], **fields)
+    return arm.with_chain(arm.chain.replace_rows(rows), f"{arm.name}-offset")
+
+
 def distance(arm: om.Arm, a: np.ndarray, b: np.ndarray) -> float:
     """Largest joint difference, revolute joints modulo 2 pi."""
     return float(np.abs(np.where(arm.revolute, wrap(a - b), a - b)).max())
@@ -172,6 +183,31 @@ def check_hinted_nearest(
         hinted = solver.solve(T, c, q_hint=hint)
         assert hinted.ok
         assert np.linalg.norm(wrap(hinted.q - hint)) <= nearest_distance(roots, hint) + 1e-9, (q, hint)
+
+
+#: Random starts of the independent search per target (polished_roots).
+STARTS = 400
+
+
+def polished_roots(solver: om.OMSolver, T: np.ndarray, psi: float, rng: np.random.Generator) -> list:
+    """The roots of T (and, on a 7-DOF arm, of the arm angle psi) that damped Gauss-Newton on the
+    arm's exact chain reaches from STARTS random joint vectors: a search that shares nothing with
+    the OM system but the chain and psi's definition. In the arm's own joint coordinates."""
+    nominal = solver.nominal
+    exact = solver.arm.chain if nominal is None else nominal.exact
+    flip = np.ones(solver.arm.dof) if nominal is None else nominal.flip
+    R, p = flange_target(T, np.linalg.inv(exact.T_root_base), np.linalg.inv(exact.T_flange_tool))
+    seven = solver.arm.dof == 7
+    arm_angle = _core.ArmAngleRow(solver.model_arm.params, solver.model.chain.table, psi) if seven else None
+    roots: list[np.ndarray] = []
+    for start in rng.uniform(-np.pi, np.pi, (STARTS, solver.arm.dof)):
+        q = np.ascontiguousarray(start)
+        if _core.polish(exact.table, R, p, q, 100, arm_angle) > 1e-13:
+            continue
+        q = flip * q
+        if not any(distance(solver.arm, q, r) < 1e-7 for r in roots):
+            roots.append(q)
+    return roots
 
 
 def check_exact(solver: om.OMSolver, q: np.ndarray, strict: bool) -> None:

@@ -12,31 +12,7 @@ import pytest
 import om_redundant as om
 from benchmarks.near_family import bent, reversed_joint
 from om_redundant import _core
-from om_redundant.ik.kernel_data import flange_target
-from tests.conftest import EXACT, distance, random_q
-
-#: Random starts of the independent search per target.
-STARTS = 400
-
-
-def polished_roots(solver: om.OMSolver, T: np.ndarray, psi: float, rng: np.random.Generator) -> list:
-    """The roots of T (and, on a 7-DOF arm, of the arm angle psi) that damped Gauss-Newton on the
-    arm's exact chain reaches from STARTS random joint vectors: a search that shares nothing with
-    the OM system but the chain and psi's definition. In the arm's own joint coordinates."""
-    nominal = solver.nominal
-    exact = nominal.exact
-    R, p = flange_target(T, np.linalg.inv(exact.T_root_base), np.linalg.inv(exact.T_flange_tool))
-    seven = solver.arm.dof == 7
-    arm_angle = _core.ArmAngleRow(solver.model_arm.params, solver.model.chain.table, psi) if seven else None
-    roots: list[np.ndarray] = []
-    for start in rng.uniform(-np.pi, np.pi, (STARTS, solver.arm.dof)):
-        q = np.ascontiguousarray(start)
-        if _core.polish(exact.table, R, p, q, 100, arm_angle) > 1e-13:
-            continue
-        q = nominal.flip * q
-        if not any(distance(solver.arm, q, r) < 1e-7 for r in roots):
-            roots.append(q)
-    return roots
+from tests.conftest import EXACT, distance, polished_roots, random_q
 
 
 @pytest.mark.parametrize(

@@ -16,10 +16,9 @@ import pytest
 
 import om_redundant as om
 from om_redundant.ik import LENGTH_ROUNDING, derive_model
-from om_redundant.ik.model import rounding_length
+from om_redundant.ik.model_conditions import rounding_length
 from om_redundant.kinematics import KinematicChain
-from tests.conftest import check_exact, random_q, well_conditioned
-from tests.test_wrist_offset import with_offsets
+from tests.conftest import check_exact, random_q, well_conditioned, with_offsets
 
 #: (arm, joint row (0-based joint), field, the rounding, the value it stands for); the old code
 #: gave each another method or a refusal.

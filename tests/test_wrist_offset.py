@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 
 import numpy as np
@@ -13,17 +12,7 @@ from hypothesis import strategies as st
 import om_redundant as om
 from benchmarks.near_family import bent, reversed_joint
 from om_redundant.ik import derive_model
-from tests.conftest import check_exact, random_q, well_conditioned
-
-
-def with_offsets(arm: om.Arm, **changes: dict[str, float]) -> om.Arm:
-    """The arm with fields of joint rows changed: ``joint3={"a": 0.07}`` sets a4 (0-based joints)."""
-    rows = list(arm.chain.rows)
-    for key, fields in changes.items():
-        r = arm.chain.joint_rows[int(key.removeprefix("joint"))]
-        rows[r] = dataclasses.replace(rows[r], **fields)
-    return arm.with_chain(arm.chain.replace_rows(rows), f"{arm.name}-offset")
-
+from tests.conftest import check_exact, random_q, well_conditioned, with_offsets
 
 offsets = st.tuples(
     st.sampled_from(["ur5e", "spherical"]),
@@ -160,21 +149,3 @@ def test_every_root_is_found_at_a_nearly_singular_wrist(a4, q5, side, flip, q_se
 @functools.cache
 def _offset_solver(a4: float) -> om.OMSolver:
     return om.OMSolver(with_offsets(om.load_arm("ur5e"), joint3={"a": a4}))
-
-
-def test_a_wrist_offset_whose_joint_4_turns_with_joint_2_is_refused():
-    """a4 != 0 with joint 4 perpendicular to joints 2 and 3 (a PUMA-like wrist, alpha_3 = 90
-    deg): dp turns with joints 5 and 6, which no bounded search here handles: a ModelError
-    naming a4, also at construction; the same arm without a4 is accepted."""
-    puma = with_offsets(om.load_arm("ur5e"), joint2={"alpha": np.pi / 2})
-    om.OMSolver(puma)
-    offset = with_offsets(puma, joint3={"a": 0.07})
-    cause = (
-        r"a4 = 0.07 != 0 \(the wrist offset from the axis of joint 4 \('wrist_1_joint'\) to that of joint 5 "
-        r"\('wrist_2_joint'\)\) makes dp depend on joint 5 \('wrist_2_joint'\), joint 6 \('wrist_3_joint'\).*"
-        r"joint 4's axis turns with joint 1 \('shoulder_pan_joint'\) alone"
-    )
-    with pytest.raises(om.ModelError, match=cause):
-        derive_model(offset)
-    with pytest.raises(om.ModelError, match=cause):
-        om.OMSolver(offset)

@@ -24,7 +24,11 @@ enum {
     SD_WRIST_OFFSET = 28, /* 3: the real arm's a4, d5, a5 */
     SD_AXIS4 = 31,        /* 9: joint 4's axis z3 = C0 + C1 cos q1 + C2 sin q1 in DH frame 0 (rows C0, C1, C2) */
     SD_AXIS6 = 40,        /* 3: joint 6's axis z5 in the flange frame */
-    SD_N_PARAMS = 43
+    /* a PUMA-like wrist with a4 != 0, joint 4 across joint 2 (zero otherwise; ik/six_dof_model.py's
+     * wrist_torus): dp seen from the flange, delta(q5, q6) = sum_ij C_ij t_i(q5) t_j(q6), t = (1,
+     * cos, sin); C_ij at 3 (3 i + j) */
+    SD_WRIST_TORUS = 43,  /* 27 */
+    SD_N_PARAMS = 70
 };
 
 /* The S-R-S family's parameter vector (_core.SRS_*; built by ik/srs_model.py's srs_model). */
@@ -68,6 +72,13 @@ void om_six_dof_branch_values(int family, const double *P, const double *q, doub
 double om_six_dof_model_ik_q6(int family, const double *P, const double *table, const om_target *t, vec3 p,
                               const int64_t *signs, const double *q_prev, double q6, double *q, double *residual);
 void om_six_dof_target(const double *P, om_target *t); /* fills RE and wrist from t->R */
+/* A PUMA-like wrist's torus (q5, q6): the lifted model IK with q5, q6 and the elbow angle gamma
+ * given (gamma NaN: the ELBOW branch's); returns the (wrist, joint 5, elbow) residuals. */
+vec3 om_six_dof_model_ik_lifted(const double *P, const double *table, const om_target *t, vec3 p,
+                                const int64_t *signs, const double *q_prev, double q5, double q6, double gamma,
+                                double *q);
+/* The model's hand position p_d + R delta(w5, w6) on that torus. */
+vec3 om_six_dof_torus_point(const double *P, const mat3 *R, vec3 p, double w5, double w6);
 /* wrist_offset.c: for a4 != 0 (P[SD_WRIST_OFFSET] != 0), the model's hand position
  * p_m = p_d + dp(w) on the circle w = q1 of the WRIST sign wrist (NaN at a singular wrist). */
 vec3 om_wrist_offset_point(const double *P, const om_target *t, vec3 p, double wrist, double w);

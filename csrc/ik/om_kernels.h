@@ -22,7 +22,7 @@
 
 #define OM_MAX_DOF 16  /* joints of an arm the kernels take (the binding checks) */
 #define OM_MAX_ROOTS 16 /* roots kept per configuration */
-#define OM_SCAN_KEY (3 + 9 + 1 + 2 + OM_MAX_DOF + 1) /* om_scan_cache's key */
+#define OM_SCAN_KEY (3 + 9 + 1 + 3 + OM_MAX_DOF + 1) /* om_scan_cache's key */
 #define OM_GATE_KEY 18 /* om_scan_cache's gate key: 6 vectors */
 
 /* ------------------------------------------------------------------------------------ */

@@ -208,10 +208,12 @@ double om_g(om_problem *pb, double w, double *q, bool all_joints)
     return om_g_margin(pb, w, q, all_joints, NULL);
 }
 
-/* The model's hand position on the torus, p_m = p_d + a(w1) + R delta(w7) (not counted as an
- * evaluation). */
+/* The model's hand position on the torus, p_m = p_d + a(w1) + R delta(w7) (a PUMA-like wrist's
+ * torus (w5, w6) = (q5, q6): p_d + R delta(w5, w6)) (not counted as an evaluation). */
 vec3 om_torus_point(const om_problem *pb, double w1, double w7)
 {
+    if (pb->s->family != OM_SRS)
+        return om_six_dof_torus_point(pb->s->params, &pb->t.R, pb->p, w1, w7);
     const double(*D)[3] = pb->s->D;
     const mat3 *R = &pb->t.R;
     vec3 p = pb->p;
@@ -222,7 +224,8 @@ vec3 om_torus_point(const om_problem *pb, double w1, double w7)
               p.z + D[3][2] + D[4][2] * c1 + D[5][2] * s1 + R->r2.x * d.x + R->r2.y * d.y + R->r2.z * d.z);
 }
 
-/* What om_lifted_residual solves: the point x = (w1, w7, phi4), and the residual there (out). */
+/* What om_lifted_residual solves: the point x = (w1, w7, phi4) (a PUMA-like wrist's: (q5, q6,
+ * gamma), om_six_dof_model_ik_lifted), and the residual there (out). */
 typedef struct {
     vec3 x, F;
 } lifted_ik;
@@ -236,7 +239,12 @@ static double _lifted_ik(om_problem *pb, const void *args, double *q, bool neare
     vec3 x = a->x;
     pb->counter++;
     vec3 pm = om_torus_point(pb, x.x, x.y);
-    a->F = om_srs_model_ik_lifted(pb->s->params, &pb->t, pm, pb->signs, x.x, x.y, x.z, q);
+    const om_solver_data *s = pb->s;
+    if (s->family == OM_SRS)
+        a->F = om_srs_model_ik_lifted(s->params, &pb->t, pm, pb->signs, x.x, x.y, x.z, q);
+    else
+        a->F = om_six_dof_model_ik_lifted(s->params, s->model_table, &pb->t, pm, pb->signs, pb->q_prev, x.x, x.y,
+                                          x.z, q);
     *residual = om_max_norm(a->F);
     return isnan(a->F.x) ? NAN : 0.0;
 }

@@ -39,7 +39,8 @@ static int _circle_roots(om_problem *pb, const double *cands, int n, double *q, 
 }
 
 /* What the circle's candidates of the problem depend on, but for its SHOULDER sign (and, with
- * wrist false, its WRIST sign: the torus search's; om_scan_cache). */
+ * wrist false, its WRIST sign: the torus search's; om_scan_cache). A 6-DOF arm's ARM sign, which
+ * its lifted model IK reads, is always part of it. */
 static void _scan_key(const om_problem *pb, int n_scan, bool wrist, double *key)
 {
     const mat3 *R = &pb->t.R;
@@ -49,6 +50,7 @@ static void _scan_key(const om_problem *pb, int n_scan, bool wrist, double *key)
     for (int i = 0; i < 3; i++)
         *k++ = rows[i].x, *k++ = rows[i].y, *k++ = rows[i].z;
     *k++ = pb->t.psi;
+    *k++ = pb->s->family == OM_SRS ? 0.0 : (double)pb->signs[0];
     *k++ = (double)pb->signs[1], *k++ = wrist ? (double)pb->signs[2] : 0.0;
     for (int j = 0; j < OM_MAX_DOF; j++)
         *k++ = j < pb->s->dof ? pb->q_prev[j] : 0.0;
@@ -88,7 +90,7 @@ static int _window_points(int n_scan, double radius)
 
 /* The torus grid search of the whole torus (om_torus_roots), its candidates taken from cache
  * where it holds this problem's, else searched and kept there: they are those of every
- * problem that differs in the SHOULDER and WRIST signs alone (torus.c, _candidate), and only
+ * problem that differs in the SHOULDER (7-DOF) and WRIST signs alone (torus.c, _candidate), and only
  * their verification, which refines and filters each in the problem's configuration, is the
  * problem's own. The same roots, in the same order, and evaluations, as the search. */
 static int _torus_roots_cached(om_problem *pb, int n_scan, double *roots, om_scan_cache *cache)

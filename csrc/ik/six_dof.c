@@ -3,17 +3,12 @@
 #include "om_kernels.h"
 
 
-/* Joints 1-3 for the flange pose (t->R, p) in DH frame 0 and the ARM and ELBOW signs, into q,
- * and the wrist's rotation M = Rz(phi4) Rx(alpha4) Rz(phi5) Rx(alpha5) Rz(phi6) into *M.
- * Returns the reach margin: below -OM_REACH_SLACK the pose is out of reach and neither is
- * written, unless nearest: then both are, with the square roots of the reach's conditions
- * held at zero (the shoulder's, the elbow's: the nearest pose the model reaches). */
-static double position_and_wrist(int family, const double *P, const double *table, const om_target *t, vec3 p,
-                                 const int64_t *signs, const double *q_prev, double *q, mat3 *M, bool nearest)
+/* Joint 1 for the wrist centre pw and the ARM sign, into q[0], and the wrist centre in the arm
+ * plane, (u, v) (six_dof.py). Returns the shoulder's reach margin (q[0], u, v not written below
+ * out_of_reach). */
+static double _shoulder(const double *P, vec3 pw, const int64_t *signs, const double *q_prev, double *q,
+                        double out_of_reach, double *u, double *v)
 {
-    double out_of_reach = nearest ? -INFINITY : -OM_REACH_SLACK;
-    vec3 pw = v_add(t->wrist, p);
-    /* Shoulder. */
     double h = P[SD_LATERAL];
     double r2 = pw.x * pw.x + pw.y * pw.y;
     double k = r2 - h * h;
@@ -27,39 +22,29 @@ static double position_and_wrist(int family, const double *P, const double *tabl
     else
         phi1 = atan2(pw.y, pw.x) - atan2(-P[SD_SIGMA1] * h, rho);
     q[0] = om_wrap(phi1 - P[SD_THETA1]);
-    double u = cos(phi1) * pw.x + sin(phi1) * pw.y - P[SD_A1];
-    double v = P[SD_SIGMA1] * (pw.z - P[SD_D1]);
-    double D = u * u + v * v;
-    double a2 = P[SD_A2];
-    double phi2;
-    if (family == OM_RRR_SPHERICAL_WRIST) {
-        double l3 = P[SD_ELL3];
-        double outer = fabs(a2) + l3, inner = fabs(a2) - l3; 
-        k = (outer * outer - D) * (D - inner * inner);
-        margin = py_min(margin, k / py_max(D * D, 1.0));
-        if (margin < out_of_reach)
-            return margin;
-        double gamma = atan2((double)signs[1] * sqrt(py_max(k, 0.0)), om_sign(a2) * (D - a2 * a2 - l3 * l3));
-        if (D < 1e-24) /* rule 2: wrist centre on joint 2's axis */
-            phi2 = q_prev[1] + P[SD_THETA2];
-        else
-            phi2 = atan2(v, u) - atan2(l3 * sin(gamma), a2 + l3 * cos(gamma));
-        q[1] = om_wrap(phi2 - P[SD_THETA2]);
-        q[2] = om_wrap(gamma - P[SD_BETA] - P[SD_THETA3]);
-    } else {
-        k = D - a2 * a2;
-        margin = py_min(margin, k / py_max(D, 1.0));
-        if (margin < out_of_reach)
-            return margin;
-        double t = (double)(-signs[1]) * sqrt(py_max(k, 0.0));
-        if (D < 1e-24)
-            phi2 = q_prev[1] + P[SD_THETA2];
-        else
-            phi2 = atan2(v, u) - atan2(t, a2);
-        q[1] = om_wrap(phi2 - P[SD_THETA2]);
-        q[2] = -P[SD_SIGMA2] * t - P[SD_D3];
-    }
-    /* Wrist: M = R_in^T R E^T, R_in the frame before joint 4's row. */
+    *u = cos(phi1) * pw.x + sin(phi1) * pw.y - P[SD_A1];
+    *v = P[SD_SIGMA1] * (pw.z - P[SD_D1]);
+    return margin;
+}
+
+/* Joint 2 of the RRR family for the arm plane's (u, v), D = u^2 + v^2, and the elbow angle
+ * gamma = phi3 + beta, into q[1]; joint 3 into q[2]. */
+static void _rrr_joints_2_3(const double *P, double u, double v, double D, double gamma, const double *q_prev,
+                            double *q)
+{
+    double l3 = P[SD_ELL3], phi2;
+    if (D < 1e-24) /* rule 2: wrist centre on joint 2's axis */
+        phi2 = q_prev[1] + P[SD_THETA2];
+    else
+        phi2 = atan2(v, u) - atan2(l3 * sin(gamma), P[SD_A2] + l3 * cos(gamma));
+    q[1] = om_wrap(phi2 - P[SD_THETA2]);
+    q[2] = om_wrap(gamma - P[SD_BETA] - P[SD_THETA3]);
+}
+
+/* The wrist's rotation M = R_in^T R E^T = Rz(phi4) Rx(alpha4) Rz(phi5) Rx(alpha5) Rz(phi6),
+ * R_in the frame before joint 4's row at joints 1-3 of q. */
+static mat3 _wrist_rotation(const double *P, const double *table, const om_target *t, const double *q)
+{
     double Rin[9], pin[3];
     for (int i = 0; i < 9; i++)
         Rin[i] = (i % 4 == 0) ? 1.0 : 0.0;
@@ -73,7 +58,47 @@ static double position_and_wrist(int family, const double *P, const double *tabl
             j++;
         }
     }
-    *M = m_mtm(m_load(Rin, 0), t->RE);
+    return m_mtm(m_load(Rin, 0), t->RE);
+}
+
+/* Joints 1-3 for the flange pose (t->R, p) in DH frame 0 and the ARM and ELBOW signs, into q,
+ * and the wrist's rotation M (_wrist_rotation) into *M. Returns the reach margin: below
+ * -OM_REACH_SLACK the pose is out of reach and neither is written, unless nearest: then both
+ * are, with the square roots of the reach's conditions held at zero (the shoulder's, the
+ * elbow's: the nearest pose the model reaches). */
+static double position_and_wrist(int family, const double *P, const double *table, const om_target *t, vec3 p,
+                                 const int64_t *signs, const double *q_prev, double *q, mat3 *M, bool nearest)
+{
+    double out_of_reach = nearest ? -INFINITY : -OM_REACH_SLACK;
+    double u, v;
+    double margin = _shoulder(P, v_add(t->wrist, p), signs, q_prev, q, out_of_reach, &u, &v);
+    if (margin < out_of_reach)
+        return margin;
+    double D = u * u + v * v;
+    double a2 = P[SD_A2], k;
+    if (family == OM_RRR_SPHERICAL_WRIST) {
+        double l3 = P[SD_ELL3];
+        double outer = fabs(a2) + l3, inner = fabs(a2) - l3;
+        k = (outer * outer - D) * (D - inner * inner);
+        margin = py_min(margin, k / py_max(D * D, 1.0));
+        if (margin < out_of_reach)
+            return margin;
+        double gamma = atan2((double)signs[1] * sqrt(py_max(k, 0.0)), om_sign(a2) * (D - a2 * a2 - l3 * l3));
+        _rrr_joints_2_3(P, u, v, D, gamma, q_prev, q);
+    } else {
+        k = D - a2 * a2;
+        margin = py_min(margin, k / py_max(D, 1.0));
+        if (margin < out_of_reach)
+            return margin;
+        double t = (double)(-signs[1]) * sqrt(py_max(k, 0.0)), phi2;
+        if (D < 1e-24)
+            phi2 = q_prev[1] + P[SD_THETA2];
+        else
+            phi2 = atan2(v, u) - atan2(t, a2);
+        q[1] = om_wrap(phi2 - P[SD_THETA2]);
+        q[2] = -P[SD_SIGMA2] * t - P[SD_D3];
+    }
+    *M = _wrist_rotation(P, table, t, q);
     return margin;
 }
 
@@ -120,6 +145,51 @@ double om_six_dof_model_ik_q6(int family, const double *P, const double *table, 
     q[5] = q6;
     *residual = neg.z;
     return margin;
+}
+
+/* The lifted model IK of the RRR family on the torus (q5, q6) of a PUMA-like wrist (the
+ * S-R-S one's: om_srs_model_ik_lifted), with q5, q6 and the elbow angle gamma = phi3 + beta given
+ * (gamma NaN: the elbow's root in the ELBOW branch, x clamped into [-1, 1]): joint 1 from the
+ * wrist centre (ARM), joints 2 and 3 from gamma, and joints 4 and 5 from the wrist's rotation
+ * with phi6 first (om_euler_zxzxz_given_first, smooth at the singular wrist). Returns the
+ * (wrist, joint 5, elbow) residuals, zero together iff q is the model's solution: the wrist's
+ * consistency N22, phi5 less q5's, and x - cos(gamma), x = (D - a2^2 - l3^2) / (2 a2 l3) the
+ * elbow's cosine that the wrist centre asks for (smooth where the closed form's square root
+ * is not: at the edge of reach); NaN beyond the shoulder's reach (q not written). Writes q
+ * (unless NULL), q6 as given. */
+vec3 om_six_dof_model_ik_lifted(const double *P, const double *table, const om_target *t, vec3 p,
+                                const int64_t *signs, const double *q_prev, double q5, double q6, double gamma,
+                                double *q)
+{
+    double joints[OM_MAX_DOF], u, v;
+    double *out = q ? q : joints;
+    if (_shoulder(P, v_add(t->wrist, p), signs, q_prev, out, -OM_REACH_SLACK, &u, &v) < -OM_REACH_SLACK)
+        return v3(NAN, NAN, NAN);
+    double D = u * u + v * v, a2 = P[SD_A2], l3 = P[SD_ELL3];
+    double x = (D - a2 * a2 - l3 * l3) / (2.0 * a2 * l3);
+    if (isnan(gamma)) {
+        double xc = py_min(py_max(x, -1.0), 1.0);
+        gamma = atan2((double)signs[1] * sqrt(1.0 - xc * xc), xc);
+    }
+    _rrr_joints_2_3(P, u, v, D, gamma, q_prev, out);
+    mat3 M = _wrist_rotation(P, table, t, out);
+    vec3 neg = om_euler_zxzxz_given_first(m_transpose(M), -P[SD_SIGMA5], 0.0, -P[SD_SIGMA4], -(q6 + P[SD_THETA6]));
+    out[3] = om_wrap(-neg.y - P[SD_THETA4]);
+    out[4] = om_wrap(-neg.x - P[SD_THETA5]);
+    out[5] = q6;
+    return v3(neg.z, om_wrap(out[4] - q5), x - cos(gamma));
+}
+
+/* The model's hand position on the torus of a PUMA-like wrist, p_m = p_d + R delta(w5, w6)
+ * (SD_WRIST_TORUS). */
+vec3 om_six_dof_torus_point(const double *P, const mat3 *R, vec3 p, double w5, double w6)
+{
+    const double t5[3] = {1.0, cos(w5), sin(w5)}, t6[3] = {1.0, cos(w6), sin(w6)};
+    vec3 delta = v3(0.0, 0.0, 0.0);
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            delta = v_add(delta, v_scale(t5[i] * t6[j], v_load(P, SD_WRIST_TORUS + 3 * (3 * i + j))));
+    return v_add(p, m_mv(*R, delta));
 }
 
 /* The quantities whose signs are (ARM, ELBOW, WRIST) at joint vector q, into out[0..2]. */

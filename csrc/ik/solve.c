@@ -120,7 +120,8 @@ void om_problem_init(om_problem *pb, const om_solver_data *s, const double *T, c
     pb->q_prev = q_prev;
     pb->counter = 0;
     pb->split_starts = true;
-    pb->certify = !s->nominal_table; /* (the certificate's bounds are the model's at the target, not G's) */
+    /* (the certificate's bounds are the model's at the target, not G's; and an S-R-S model's) */
+    pb->certify = !s->nominal_table && s->family == OM_SRS;
     pb->memo = NULL;
     pb->nominal = false;
     pb->wrist = false;

@@ -190,8 +190,8 @@ static void _roots_from(torus_search *t, vec3 x)
     if (!_new_root(t, x, false)) {
         /* Near the edge of reach the elbow angle changes fastest: try once more
          * from the nearer edge's (the straight or the folded elbow). */
-        double phi_star = t->pb->s->params[SRS_PHI_STAR];
-        double edge = cos(x.z - phi_star) > 0.0 ? phi_star : phi_star + OM_PI;
+        double straight = straight_elbow(t->pb->s);
+        double edge = cos(x.z - straight) > 0.0 ? straight : straight + OM_PI;
         if (!_new_root(t, v3(x.x, x.y, edge), false))
             return;
     }
@@ -228,8 +228,8 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
         lo7 = -OM_PI;
         span = 2.0 * OM_PI;
     } else {
-        lo1 = centre[0] - radius;
-        lo7 = centre[6] - radius;
+        lo1 = centre[torus_joint(pb->s, 0)] - radius;
+        lo7 = centre[torus_joint(pb->s, 1)] - radius;
         span = 2.0 * radius;
     }
     bool grid = n > 0; /* (a window without a grid: its square one cell, for psi's half-line) */
@@ -238,7 +238,8 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
     size_t mm = (size_t)m * (size_t)m;
     double *S = malloc(4 * mm * sizeof(double));
     known_roots known = {malloc((size_t)MAX_KNOWN * 3 * sizeof(double)), malloc(MAX_KNOWN * sizeof(double)), MAX_KNOWN};
-    torus_search t = {pb, known, 0, 0, roots, q, log, PARTNER_CELLS * step, centre[0], centre[6], INFINITY};
+    torus_search t = {pb,   known, 0, 0, roots, q, log, PARTNER_CELLS * step, centre[torus_joint(pb->s, 0)],
+                      centre[torus_joint(pb->s, 1)], INFINITY};
     if (!S || !t.known.x || !t.known.near) {
         free(S);
         free(t.known.x);
@@ -250,7 +251,6 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
         t.partner_reach = py_max(t.partner_reach, WINDOW_PARTNERS * radius);
     }
     double *W = S + mm, *F = W + mm, *E = F + mm;
-    const double *P = pb->s->params;
     /* An arm near a family: the whole torus' grid samples its nominal arm's system (g~ of near.c,
      * one model IK a node instead of a fixed point of the correction), and Newton refines every
      * start on G. |G - g~| <= |dg/dX| delta (near.c: 20 per metre away from the singular set,
@@ -264,13 +264,13 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
             vec3 r = om_lifted_residual(pb, v3(lo1 + (double)i * step, lo7 + (double)j * step, NAN), q);
             S[i * m + j] = r.x;
             W[i * m + j] = r.y;
-            E[i * m + j] = q[3] + P[SRS_THETA + 3];
+            E[i * m + j] = lifted_elbow(pb->s, q);
             F[i * m + j] = om_max_norm(r) < INFINITY ? om_max_norm(r) : INFINITY;
         }
     }
     pb->nominal = false;
     if (found && !whole) { /* (a verified root: known as it is, the window's incumbent, not a candidate) */
-        _keep(&t, lifted_point(P, found));
+        _keep(&t, lifted_point(pb->s, found));
         _partners(&t, 0);
     }
     for (int i = 0; i < m && grid; i++) {

@@ -24,11 +24,36 @@ static inline vec3 lifted_of(const half_line_chart *chart, vec3 y)
               y.z);
 }
 
-/* The lifted point (w1, w7, phi4) of the joints q: q1, q7 and the elbow's DH angle (P: the
- * solver's parameters). */
-static inline vec3 lifted_point(const double *P, const double *q)
+/* The joint whose angle is the torus' coordinate k (0: w1, 1: w7): q1 and q7 of a 7-DOF arm
+ * with shoulder offsets; q5 and q6 of a 6-DOF arm with a PUMA-like wrist, whose lifted point
+ * (w1, w7, phi4) is (q5, q6, gamma) throughout, gamma = phi3 + beta its elbow angle
+ * (om_six_dof_model_ik_lifted). */
+static inline int torus_joint(const om_solver_data *s, int k)
 {
-    return v3(q[0], q[6], q[3] + P[SRS_THETA + 3]);
+    if (s->family == OM_SRS)
+        return k ? 6 : 0;
+    return 4 + k;
+}
+
+/* The elbow's lifted angle (phi4; gamma) of the joints q. */
+static inline double lifted_elbow(const om_solver_data *s, const double *q)
+{
+    if (s->family == OM_SRS)
+        return q[3] + s->params[SRS_THETA + 3];
+    return q[2] + s->params[SD_THETA3] + s->params[SD_BETA];
+}
+
+/* The lifted point (w1, w7, phi4) of the joints q: the torus' joints and the elbow's angle. */
+static inline vec3 lifted_point(const om_solver_data *s, const double *q)
+{
+    return v3(q[torus_joint(s, 0)], q[torus_joint(s, 1)], lifted_elbow(s, q));
+}
+
+/* The elbow's lifted angle where the model's elbow is straight (its cosine x = 1; folded at
+ * this plus pi): the edges of reach. */
+static inline double straight_elbow(const om_solver_data *s)
+{
+    return s->family == OM_SRS ? s->params[SRS_PHI_STAR] : 0.0;
 }
 
 /* The distance of two points (w1, w7, phi4): the largest of their coordinates' differences, each
@@ -47,7 +72,8 @@ static inline bool same_point(vec3 a, vec3 b)
 /* om_add_candidate of a copy of q, logged (log not NULL): the search's q stays as Newton left
  * it, whatever the verification's refinement, which depends on the configuration's signs,
  * makes of the copy. So the candidates, in order, are those of every configuration that
- * differs in the SHOULDER and WRIST signs alone (om_srs_model_ik_lifted does not read them). */
+ * differs in the SHOULDER and WRIST signs alone (the lifted model IKs do not read them; a
+ * 6-DOF arm's reads its ARM sign). */
 static inline int torus_candidate(om_problem *pb, const double *q, double *roots, int count, om_candidate_log *log)
 {
     double candidate[OM_MAX_DOF];

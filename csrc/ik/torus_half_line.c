@@ -11,16 +11,57 @@
 #define LINE_NEWTON 30         /* Newton steps to a point of the half-line (h = 0) */
 
 /* x(w1, w7) = W - S = p_d + a(w1) + R delta(w7) + R w_F - S of the model on the torus, and
- * its derivatives in w1 and w7 (d1, d7). */
+ * its derivatives in w1 and w7 (d1, d7); of a 6-DOF arm (a PUMA-like wrist), the wrist centre
+ * p_d + R delta(w5, w6) + R w_F, whose q1 turns by 2 pi about joint 1's axis. */
 static vec3 _shoulder_wrist(om_problem *pb, double w1, double w7, vec3 *d1, vec3 *d7)
 {
     const double(*D)[3] = pb->s->D;
     const mat3 *R = &pb->t.R;
     double c1 = cos(w1), s1 = sin(w1), c7 = cos(w7), s7 = sin(w7);
+    if (pb->s->family != OM_SRS) {
+        const double t5[3] = {1.0, c1, s1}, t6[3] = {1.0, c7, s7}, dt5[3] = {0.0, -s1, c1}, dt6[3] = {0.0, -s7, c7};
+        vec3 delta = v3(0.0, 0.0, 0.0), e5 = delta, e6 = delta;
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++) {
+                vec3 C = v_load(pb->s->params, SD_WRIST_TORUS + 3 * (3 * i + j));
+                delta = v_add(delta, v_scale(t5[i] * t6[j], C));
+                e5 = v_add(e5, v_scale(dt5[i] * t6[j], C));
+                e6 = v_add(e6, v_scale(t5[i] * dt6[j], C));
+            }
+        *d1 = m_mv(*R, e5);
+        *d7 = m_mv(*R, e6);
+        return v_add(v_add(pb->p, pb->t.wrist), m_mv(*R, delta));
+    }
     vec3 a = v_add(v_load(D[3], 0), v_add(v_scale(c1, v_load(D[4], 0)), v_scale(s1, v_load(D[5], 0))));
     *d1 = v_sub(v_scale(c1, v_load(D[5], 0)), v_scale(s1, v_load(D[4], 0)));
     *d7 = m_mv(*R, v_sub(v_scale(c7, v_load(D[2], 0)), v_scale(s7, v_load(D[1], 0))));
     return v_add(v_add(pb->p, pb->t.wrist), v_add(a, m_mv(*R, om_delta(D, w7))));
+}
+
+/* What the search for the half-line's points needs of the arm: the axis (up) the singular line
+ * runs along, x's value at the torus' centre (its constant part, c0), and a bound on how far the
+ * rest takes it (the sum of its terms' lengths), which also bounds x's second derivatives. */
+typedef struct {
+    vec3 up, centre;
+    double reach;
+    bool below; /* only the half-line below the shoulder (the arm angle's): S-R-S */
+} singular_line;
+
+static singular_line _singular_line(const om_problem *pb)
+{
+    const om_solver_data *s = pb->s;
+    singular_line line = {v3(0.0, 0.0, 1.0), v3(0.0, 0.0, 0.0), 0.0, s->family == OM_SRS};
+    if (s->family != OM_SRS) { /* joint 1's axis, z of DH frame 0 */
+        line.centre = v_add(v_add(pb->p, pb->t.wrist), m_mv(pb->t.R, v_load(s->params, SD_WRIST_TORUS)));
+        for (int k = 3; k < 27; k += 3)
+            line.reach += v_norm(v_load(s->params, SD_WRIST_TORUS + k));
+        return line;
+    }
+    const double(*D)[3] = s->D;
+    line.up = v_load(s->params, SRS_UP);
+    line.centre = om_shoulder_wrist_centre(pb);
+    line.reach = v_norm(v_load(D[4], 0)) + v_norm(v_load(D[5], 0)) + v_norm(v_load(D[1], 0)) + v_norm(v_load(D[2], 0));
+    return line;
 }
 
 vec3 om_shoulder_wrist_centre(const om_problem *pb)
@@ -43,19 +84,18 @@ static void _across(vec3 x, vec3 b1, vec3 b2, double *h)
  * the shoulder, with h's Jacobian regular. */
 static int _half_line_points(om_problem *pb, double lo1, double lo7, double step, int m, half_line_chart *charts)
 {
-    vec3 up = v_load(pb->s->params, SRS_UP), d1, d7;
+    singular_line line = _singular_line(pb);
+    vec3 up = line.up, d1, d7;
     vec3 b1 = v_unit(v_cross(up, fabs(up.x) < 0.9 ? v3(1.0, 0.0, 0.0) : v3(0.0, 1.0, 0.0))), b2 = v_cross(up, b1);
-    const double(*D)[3] = pb->s->D;
-    double r1 = v_norm(v_load(D[4], 0)) + v_norm(v_load(D[5], 0));
-    double r7 = v_norm(v_load(D[1], 0)) + v_norm(v_load(D[2], 0));
     /* x = centre + (D4 cos w1 + D5 sin w1) + R (D1 cos w7 + D2 sin w7), the last two at most
-     * r1 and r7 long: no point where the centre's part across up, or its height, exceeds that */
-    vec3 centre = om_shoulder_wrist_centre(pb);
+     * line.reach long: no point where the centre's part across up, or its height, exceeds that
+     * (the 6-DOF's x the same with the terms of delta(w5, w6), whose mixed ones' second
+     * derivatives the bend's four times covers) */
     double h0[2];
-    _across(centre, b1, b2, h0);
-    if (hypot(h0[0], h0[1]) > r1 + r7 || v_dot(up, centre) > r1 + r7)
+    _across(line.centre, b1, b2, h0);
+    if (hypot(h0[0], h0[1]) > line.reach || (line.below && v_dot(up, line.centre) > line.reach))
         return 0;
-    double bend = (r1 + r7) * step * step;
+    double bend = (line.below ? 1.0 : 4.0) * line.reach * step * step;
     double *H = malloc(2 * (size_t)m * (size_t)m * sizeof(double));
     vec3 *rows = malloc(2 * (size_t)m * sizeof(vec3)), *cols = rows + m;
     if (!H || !rows) {
@@ -104,7 +144,8 @@ static int _half_line_points(om_problem *pb, double lo1, double lo7, double step
             }
             bool inside = fabs(w1 - lo1 - ((double)i + 0.5) * step) <= step &&
                           fabs(w7 - lo7 - ((double)j + 0.5) * step) <= step;
-            if (!(fabs(det) > 0.0) || !inside || !(v_dot(up, x) < 0.0) || hypot(h[0], h[1]) > 1e-12 * v_norm(x))
+            if (!(fabs(det) > 0.0) || !inside || (line.below && !(v_dot(up, x) < 0.0)) ||
+                hypot(h[0], h[1]) > 1e-12 * v_norm(x))
                 continue;
             bool seen = false;
             for (int k = 0; k < count; k++)
@@ -134,7 +175,7 @@ int om_half_line_roots(om_problem *pb, double lo1, double lo7, double step, int 
         for (int k = 0; k < LINE_SEEDS; k++) {
             vec3 y = v3(LINE_START, 2.0 * OM_PI * (double)k / (double)LINE_SEEDS, NAN), end;
             om_lifted_residual(pb, lifted_of(&charts[c], y), q);
-            y.z = q[3] + pb->s->params[SRS_THETA + 3]; /* the elbow's root there */
+            y.z = lifted_elbow(pb->s, q); /* the elbow's root there */
             if (om_lifted_newton(pb, &charts[c], y, q, NULL, 0, NULL, &end) > LINE_ROOT)
                 continue;
             bool seen = false;

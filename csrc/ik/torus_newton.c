@@ -80,5 +80,5 @@ double om_lifted_newton(om_problem *pb, const half_line_chart *chart, vec3 x, do
  * returns the final residual, q holding the model IK there. */
 double om_lifted_solve(om_problem *pb, const double *start, double *q)
 {
-    return om_lifted_newton(pb, NULL, lifted_point(pb->s->params, start), q, NULL, 0, NULL, NULL);
+    return om_lifted_newton(pb, NULL, lifted_point(pb->s, start), q, NULL, 0, NULL, NULL);
 }

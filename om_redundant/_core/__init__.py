@@ -69,6 +69,7 @@ from ..ckernels import (
     SD_WRIST_CENTRE,
     SD_WRIST_OFFSET,
     SD_WRIST_ROW,
+    SD_WRIST_TORUS,
     SRS,
     SRS_BEND,
     SRS_COS_BETA,

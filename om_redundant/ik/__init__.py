@@ -6,7 +6,8 @@ worker threads of :mod:`.threads`)."""
 
 from .batch import BatchRoots, BatchSolution
 from .configuration import Configuration
-from .model import ANGLE_ROUNDING, LENGTH_ROUNDING, ModelArm, derive_model
+from .model import ModelArm, derive_model
+from .model_conditions import ANGLE_ROUNDING, LENGTH_ROUNDING
 from .nominal import NEAR_LENGTH, NEAR_TWIST, NominalArm, nominal_arm
 from .solver import BRANCH_BAND, OMSolver, Solution
 

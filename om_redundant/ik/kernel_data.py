@@ -83,7 +83,8 @@ def kernel_data(
     # dp turns with q1 and q7: the torus (q1, q7); with a shoulder offset a2 or a wrist offset a5
     # zeroed by the nominal arm, q1 and q7 are given on the torus and the correction's fixed
     # point turns with q2 (on the left) or q6 (on the right) alone
-    if model_arm.shoulder.any() or shoulder or wrist:
+    # dp of a PUMA-like 6-DOF wrist turns with q5 and q6: the torus (q5, q6)
+    if model_arm.shoulder.any() or model_arm.wrist_torus is not None or shoulder or wrist:
         mode, dp_joint = _core.TORUS, 0
     elif model_arm.dp_joint >= 0:
         mode, dp_joint = _core.CIRCLE, model_arm.dp_joint

@@ -31,7 +31,6 @@ the OM system (9) then lie on a circle (a torus with shoulder offsets) in the ba
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -42,21 +41,10 @@ from ..kinematics.arm import Arm
 from ..kinematics.chain import KinematicChain
 from ..validation import as_instance
 from .joint_names import joint_name, joints_named, row_name
+from .model_conditions import LENGTH_ROUNDING, rounding_length
 from .model_frames import circle_fit, pose
 from .six_dof_model import six_dof_model
 from .srs_model import srs_model
-
-#: A DH length within this many metres per metre of the arm's reach of zero, or an angle within
-#: ``ANGLE_ROUNDING`` rad of a multiple of 90 deg, is the rounding of the value it is near, not
-#: geometry (a URDF written to 11 digits leaves offsets of 5e-13 m where the arm has none): it
-#: never changes the method an arm gets. :func:`derive_model` refuses an arm with a nonzero
-#: length within it, so that the arm is solved through its nominal arm
-#: (:func:`~om_redundant.ik.nominal.nominal_arm`), which has it zero, while its exact table
-#: verifies every answer.
-LENGTH_ROUNDING = 1e-9
-#: An angle (rad) within this of a multiple of 90 deg is the rounding of that multiple (see
-#: :data:`LENGTH_ROUNDING`).
-ANGLE_ROUNDING = 1e-9
 
 
 @dataclass(frozen=True, eq=False)
@@ -82,6 +70,11 @@ class ModelArm:
             :math:`A_0, A_1, A_2`: :math:`a(q_1) = A_0 + A_1 \\cos q_1 + A_2 \\sin q_1`; zero
             when joints 1-3 meet (every 6-DOF arm here, the Panda, FR3, iiwa14, xArm7).
         dp_max: A bound on :math:`|\\Delta p(q)|` in metres.
+        wrist_torus: (3, 3, 3) coefficients of dp seen from the flange of a PUMA-like 6-DOF wrist
+            (:math:`a_4 \\ne 0`, joint 4 across joint 2), which turns with q5 and q6
+            (:func:`~om_redundant.ik.six_dof_model.wrist_torus`): its solutions lie on the torus
+            :math:`(q_5, q_6)`; ``dp_joint`` is then -1 and ``delta`` and ``shoulder`` zero.
+            None for every other arm.
     """
 
     real: Arm
@@ -95,6 +88,7 @@ class ModelArm:
     delta: np.ndarray
     shoulder: np.ndarray
     dp_max: float
+    wrist_torus: np.ndarray | None = None
 
     def dp(self, q: np.ndarray) -> np.ndarray:
         """Position difference model minus real, in the root frame: (3,) or (M, 3)."""
@@ -117,11 +111,12 @@ def derive_model(arm: Arm) -> ModelArm:
     as_instance(arm, Arm, "arm")
     _refuse_rounding(arm)
     if arm.dof == 6:
-        model_chain, family, family_name, params = six_dof_model(arm)
+        model_chain, family, family_name, params, wrist_torus = six_dof_model(arm)
         shoulderless = arm.chain
         sign_names, redundancy_names = ("ARM", "ELBOW", "WRIST"), ()
     elif arm.dof == 7:
         model_chain, shoulderless, params = srs_model(arm)
+        wrist_torus = None
         family, family_name = _core.SRS, "S-R-S: spherical shoulder, elbow, spherical wrist"
         sign_names, redundancy_names = ("SHOULDER", "ELBOW", "WRIST"), ("psi",)
     else:
@@ -133,10 +128,12 @@ def derive_model(arm: Arm) -> ModelArm:
         )
         raise ModelError(f"arm '{arm.name}' has {arm.dof} joints; models exist for 6- and 7-DOF arms{above}")
     model = arm.with_chain(model_chain, f"{arm.name}-model")
-    if arm.dof == 6 and params[_core.SD_WRIST_OFFSET] != 0.0:  # dp turns with q1: see wrist_offset
-        a4, d5, a5 = params[_core.SD_WRIST_OFFSET : _core.SD_WRIST_OFFSET + 3]
-        dp_joint, delta, shoulder = 0, np.zeros((3, 3)), np.zeros((3, 3))
-        dp_max = float(np.hypot(a4, d5) + abs(a5))
+    if arm.dof == 6 and (params[_core.SD_WRIST_OFFSET] != 0.0 or wrist_torus is not None):
+        # a4 != 0: dp turns with q1 (see wrist_offset) or with q5 and q6 (see wrist_torus);
+        # dp = -(a4 x4 + d5 z4 + a5 x5), x4 normal to z4
+        rows, jr = arm.chain.rows, arm.chain.joint_rows
+        dp_joint, delta, shoulder = 0 if wrist_torus is None else -1, np.zeros((3, 3)), np.zeros((3, 3))
+        dp_max = float(np.hypot(rows[jr[3]].a, rows[jr[4]].d) + abs(rows[jr[4]].a))
     else:
         dp_joint = _dp_joint(arm, shoulderless, model_chain)
         delta = circle_fit(
@@ -163,18 +160,8 @@ def derive_model(arm: Arm) -> ModelArm:
         delta,
         shoulder,
         dp_max,
+        wrist_torus,
     )
-
-
-def reach(chain: KinematicChain) -> float:
-    """The chain's reach (m), the sum of its rows' :math:`|(a, d)|`: the scale of its lengths."""
-    return sum(math.hypot(row.a, row.d) for row in chain.rows)
-
-
-def rounding_length(chain: KinematicChain) -> float:
-    """The largest DH length (m) that is rounding of zero in this chain: :data:`LENGTH_ROUNDING`
-    times its reach."""
-    return LENGTH_ROUNDING * reach(chain)
 
 
 def _refuse_rounding(arm: Arm) -> None:

@@ -4,6 +4,8 @@ perpendicular twists, no fixed rows between the joints of a triple, concurrent a
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..exceptions import ModelError
@@ -18,6 +20,18 @@ PARALLEL_EPS = 1e-9
 #: the closed forms, which take it to be exact, absorb: the hand then moves by well under the
 #: solver's 1e-10 m per metre of reach.
 RIGHT_ANGLE_EPS = 1e-11
+
+#: A DH length within this many metres per metre of the arm's reach of zero, or an angle within
+#: ``ANGLE_ROUNDING`` rad of a multiple of 90 deg, is the rounding of the value it is near, not
+#: geometry (a URDF written to 11 digits leaves offsets of 5e-13 m where the arm has none): it
+#: never changes the method an arm gets. :func:`~om_redundant.ik.model.derive_model` refuses an
+#: arm with a nonzero length within it, so that the arm is solved through its nominal arm
+#: (:func:`~om_redundant.ik.nominal.nominal_arm`), which has it zero, while its exact table
+#: verifies every answer.
+LENGTH_ROUNDING = 1e-9
+#: An angle (rad) within this of a multiple of 90 deg is the rounding of that multiple (see
+#: :data:`LENGTH_ROUNDING`).
+ANGLE_ROUNDING = 1e-9
 
 
 def check_right_angle(arm: Arm, row: DHRow, j: int) -> None:
@@ -96,3 +110,14 @@ def check_concurrent(arm: Arm, chain: KinematicChain, what: str, joints: tuple[i
                     f"arm '{arm.name}': the model's {what} axes ({joints_named(arm, joints)}) do not meet "
                     "in one point"
                 )
+
+
+def reach(chain: KinematicChain) -> float:
+    """The chain's reach (m), the sum of its rows' :math:`|(a, d)|`: the scale of its lengths."""
+    return sum(math.hypot(row.a, row.d) for row in chain.rows)
+
+
+def rounding_length(chain: KinematicChain) -> float:
+    """The largest DH length (m) that is rounding of zero in this chain: :data:`LENGTH_ROUNDING`
+    times its reach."""
+    return LENGTH_ROUNDING * reach(chain)

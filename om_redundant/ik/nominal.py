@@ -7,9 +7,9 @@ joints. The nominal arm is the OM method's *model side* of such an arm:
 
 * every twist within :data:`NEAR_TWIST` of 0, +-90 or 180 deg is snapped to that value;
 * every length within :data:`NEAR_LENGTH` per metre of reach of zero (rounding of zero,
-  :data:`~om_redundant.ik.model.LENGTH_ROUNDING`, and the micrometres a rounded twist moves a
+  :data:`~om_redundant.ik.model_conditions.LENGTH_ROUNDING`, and the micrometres a rounded twist moves a
   common normal by) is zero, and every joint offset theta within
-  :data:`~om_redundant.ik.model.ANGLE_ROUNDING` of a multiple of 90 deg is that multiple:
+  :data:`~om_redundant.ik.model_conditions.ANGLE_ROUNDING` of a multiple of 90 deg is that multiple:
   rounding is not geometry, and never changes the method an arm gets;
 * a twist of (about) 180 deg becomes 0 and the next joint flips: since
   :math:`R_x(\pi) R_z(\theta + q) T_z(d) T_x(a) R_x(\alpha) =
@@ -50,7 +50,8 @@ from ..angles import wrap_angles
 from ..exceptions import ModelError
 from ..kinematics.arm import Arm
 from ..kinematics.chain import DHRow, JointKind, KinematicChain, row_transform
-from .model import ANGLE_ROUNDING, ModelArm, derive_model, reach
+from .model import ModelArm, derive_model
+from .model_conditions import ANGLE_ROUNDING, reach
 
 #: Largest deviation (rad) of a twist from 0, +-90 or 180 deg that the nominal arm snaps.
 NEAR_TWIST = 1e-3

@@ -1,6 +1,7 @@
 r"""The model of a 6-DOF arm (the paper's Theorem 2) and its closed form's parameters: a
 spherical wrist (:math:`a_4, a_5, d_5` zeroed), the position family of joints 1-3 (RRR with
-joints 2 and 3 parallel, or RRP), and the dp circle of a wrist with :math:`a_4 \ne 0`."""
+joints 2 and 3 parallel, or RRP), and where the solutions lie of a wrist with :math:`a_4 \ne 0`:
+a circle in q1 (joint 4 parallel to joints 2 and 3) or the torus (q5, q6) (a PUMA-like wrist)."""
 
 from __future__ import annotations
 
@@ -13,12 +14,24 @@ from ..exceptions import ModelError
 from ..kinematics.arm import Arm
 from ..kinematics.chain import DHRow, JointKind, KinematicChain
 from .joint_names import joint_name, joints_named
-from .model_conditions import RIGHT_ANGLE_EPS, check_right_angle, off_right_angle, refuse_fixed_rows
-from .model_frames import circle_fit, pose, tail_rotation
+from .model_conditions import (
+    RIGHT_ANGLE_EPS,
+    check_right_angle,
+    off_right_angle,
+    refuse_fixed_rows,
+    rounding_length,
+)
+from .model_frames import circle_fit, pose, tail_rotation, torus_fit
 
 
-def six_dof_model(arm: Arm) -> tuple[KinematicChain, int, str, np.ndarray]:
-    """Theorem 2: zero a4, a5, d5 for a spherical wrist."""
+def six_dof_model(arm: Arm) -> tuple[KinematicChain, int, str, np.ndarray, np.ndarray | None]:
+    """Theorem 2: zero a4, a5, d5 for a spherical wrist.
+
+    Returns:
+        The model's chain, its family code, name and parameters, and where the wrist's offsets
+        make dp turn with joints 5 and 6 (a PUMA-like wrist, :func:`wrist_torus`) the (3, 3, 3)
+        coefficients of dp seen from the flange, None otherwise.
+    """
     rows = list(arm.chain.rows)
     jr = arm.chain.joint_rows
     for j in (3, 4, 5):
@@ -43,10 +56,68 @@ def six_dof_model(arm: Arm) -> tuple[KinematicChain, int, str, np.ndarray]:
     _, o4 = pose(model_chain.table[: jr[3] + 1], q0[:4])
     R_fl, p_fl = pose(model_chain.table, q0)
     params[_core.SD_WRIST_CENTRE : _core.SD_WRIST_CENTRE + 3] = R_fl.T @ (o4 - p_fl)
-    if offsets[0] != 0.0:
+    if offsets[0] == 0.0:
+        return model_chain, family, family_name, params, None
+    if parallel_wrist(arm, model_chain):
         wrist_offset(arm, model_chain, offsets, params, R_fl)
-        family_name += ", wrist offset a4 (dp turns with q1)"
-    return model_chain, family, family_name, params
+        return model_chain, family, family_name + ", wrist offset a4 (dp turns with q1)", params, None
+    # The torus' lifted system takes the elbow's square root away, not the shoulder's: a lateral
+    # offset h puts the shoulder's edge of reach (the wrist centre h from joint 1's axis) where
+    # roots crowd; without it, that edge is the axis itself, where q1 turns about a point.
+    # (h's rounding, cos(90 deg) d4 = 1e-17 m, is not an offset)
+    lateral = params[_core.SD_LATERAL]
+    offset = abs(lateral) > rounding_length(arm.chain)
+    if family != _core.RRR_SPHERICAL_WRIST or offset:
+        cause = f"a lateral offset h = {lateral:g} m" if offset else f"the {family_name} family"
+        raise ModelError(
+            f"arm '{arm.name}': a4 = {offsets[0]:g} != 0 with {joint_name(arm, 3)} across "
+            f"{joint_name(arm, 1)} (a PUMA-like wrist: dp turns with {joints_named(arm, (4, 5))}) is "
+            f"solved on the torus for the RRR family of {joints_named(arm, (0, 1, 2))} without a lateral "
+            f"offset (d2 + d3 + d4 along the parallel axes), not with {cause}"
+        )
+    name = f"{family_name}, wrist offsets a4, d5, a5 (dp turns with q5 and q6: the torus)"
+    coefficients = wrist_torus(arm, model_chain)
+    params[_core.SD_WRIST_TORUS : _core.SD_WRIST_TORUS + 27] = coefficients.ravel()
+    return model_chain, family, name, params, coefficients
+
+
+def parallel_wrist(arm: Arm, model_chain: KinematicChain) -> bool:
+    """Whether joint 4's axis turns with q1 alone (parallel to joint 2's, as when joints 2, 3 and
+    4 are parallel): a wrist offset a4's dp then turns with q1 (:func:`wrist_offset`)."""
+    table, jr = model_chain.table, arm.chain.joint_rows
+    try:
+        circle_fit(arm, "joint 4's axis", 0, lambda q: pose(table[: jr[3]], q[:3])[0][:, 2])
+    except ModelError:
+        return False
+    return True
+
+
+def wrist_torus(arm: Arm, model_chain: KinematicChain) -> np.ndarray:
+    r"""dp seen from the flange of a PUMA-like wrist with :math:`a_4 \ne 0` (joint 4 across joint 2):
+    the (3, 3, 3) coefficients :math:`C_{ij}` of
+
+    .. math::
+
+        \delta(q_5, q_6) = R_{flange}^T (p_{model} - p_{real})
+        = \sum_{ij} C_{ij}\, t_i(q_5)\, t_j(q_6), \qquad t = (1, \cos, \sin).
+
+    Since :math:`A_i(q; a, d) = R_z(q) T_z(d) T_x(a) R_x(\alpha)` and :math:`T_z(d)` commutes
+    with :math:`R_z(q)`, the real arm is the model followed by a translation that the rotations
+    of joints 5 and 6 turn, :math:`T_{real}(q) = T_{model}(q)\,\mathrm{Trans}(-\delta(q_5, q_6))`.
+    At a solution :math:`p_{model} = p_d + R_d\,\delta(q_5, q_6)`: the solutions of system (9)
+    lie on the torus :math:`(w_5, w_6) = (q_5, q_6)`, lifted by the elbow angle (``csrc/ik/six_dof.c``,
+    ``om_six_dof_model_ik_lifted``).
+
+    Raises:
+        ModelError: dp seen from the flange does not turn with joints 5 and 6 alone.
+    """
+    real, model = arm.chain.table, model_chain.table
+
+    def delta(q: np.ndarray) -> np.ndarray:
+        R, p_real = pose(real, q)
+        return R.T @ (pose(model, q)[1] - p_real)
+
+    return torus_fit(arm, "dp seen from the flange", (4, 5), delta)
 
 
 def position_family(arm: Arm, rows: list[DHRow]) -> tuple[int, str, np.ndarray]:
@@ -139,21 +210,11 @@ def wrist_offset(
     at the singular wrist :math:`\sin\varphi_5 = 0`.
 
     Raises:
-        ModelError: Joint 4 is not parallel to joint 2 (dp would turn with two joints), or
-            the formula does not give the arm's dp (checked at random joint vectors).
+        ModelError: The formula does not give the arm's dp (checked at random joint vectors).
     """
     jr = arm.chain.joint_rows
     table = model_chain.table
-    try:
-        axis4 = circle_fit(arm, "joint 4's axis", 0, lambda q: pose(table[: jr[3]], q[:3])[0][:, 2])
-    except ModelError:
-        raise ModelError(
-            f"arm '{arm.name}': a4 = {offsets[0]:g} != 0 (the wrist offset from the axis of "
-            f"{joint_name(arm, 3)} to that of {joint_name(arm, 4)}) makes dp depend on "
-            f"{joints_named(arm, (4, 5))}; the bounded search handles a4 != 0 where joint 4's axis turns "
-            f"with {joint_name(arm, 0)} alone (parallel to joint 2's, as when joints 2, 3 and 4 are "
-            "parallel): dp then turns with joint 1"
-        ) from None
+    axis4 = circle_fit(arm, "joint 4's axis", 0, lambda q: pose(table[: jr[3]], q[:3])[0][:, 2])
     axis6 = R_fl.T @ pose(table[: jr[5]], np.zeros(5))[0][:, 2]  # R_fl: the flange's rotation at q = 0
     params[_core.SD_WRIST_OFFSET : _core.SD_WRIST_OFFSET + 3] = offsets
     params[_core.SD_AXIS4 : _core.SD_AXIS4 + 9] = axis4.ravel()

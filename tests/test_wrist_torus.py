@@ -1,0 +1,172 @@
+"""6-DOF arms with a PUMA-like wrist, a4 != 0 with joint 4 across joint 2 (Reach Bravo 7): dp turns
+with q5 and q6 (om.six_dof_model.wrist_torus), the solutions lie on the torus (q5, q6), lifted by
+the elbow angle (csrc/ik/six_dof.c, om_six_dof_model_ik_lifted), and are found exactly."""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import om_redundant as om
+from benchmarks.near_family import bent
+from om_redundant import _core
+from om_redundant.ik import derive_model
+from om_redundant.kinematics.chain import KinematicChain
+from tests.conftest import (
+    EXACT,
+    check_exact,
+    check_hinted_nearest,
+    distance,
+    polished_roots,
+    random_q,
+    well_conditioned,
+    with_offsets,
+)
+
+RIGHT = np.pi / 2
+
+
+@functools.cache
+def puma_wrist_arm(kind: str, a4: float, d5: float, a5: float, lateral: float = 0.0) -> om.Arm:
+    """A PUMA-like arm with the wrist offsets a4, d5, a5: "bravo", Reach Bravo 7's table (its URDF's
+    rows rounded to 0.1 mm; a4 = a5 = -0.0408 there), or "puma", a PUMA 560 (d4 = 0.36 m) with the
+    lateral offset d3 = lateral (0.15 m on the PUMA)."""
+    if kind == "bravo":
+        rows = (
+            om.DHRow(a=-0.046, alpha=RIGHT, d=-0.1454, theta=0.0),
+            om.DHRow(a=-0.2906, alpha=0.0, d=0.0, theta=-1.5529),
+            om.DHRow(a=0.0408, alpha=-RIGHT, d=0.0, theta=1.5529),
+            om.DHRow(a=a4, alpha=RIGHT, d=-0.16, theta=0.0),
+            om.DHRow(a=a5, alpha=-RIGHT, d=d5, theta=0.0),
+            om.DHRow(a=0.0, alpha=0.0, d=0.2616, theta=0.0),
+        )
+    else:
+        rows = (
+            om.DHRow(a=0.0, alpha=RIGHT, d=0.6718, theta=0.0),
+            om.DHRow(a=0.4318, alpha=0.0, d=0.0, theta=0.0),
+            om.DHRow(a=0.0203, alpha=-RIGHT, d=lateral, theta=0.0),
+            om.DHRow(a=a4, alpha=RIGHT, d=0.36, theta=0.0),
+            om.DHRow(a=a5, alpha=-RIGHT, d=d5, theta=0.0),
+            om.DHRow(a=0.0, alpha=0.0, d=0.05625, theta=0.0),
+        )
+    return om.Arm(
+        name=f"{kind}-wrist-{a4:g}-{d5:g}-{a5:g}",
+        chain=KinematicChain(rows, np.eye(4), np.eye(4)),
+        joint_names=tuple(f"joint{j}" for j in range(1, 7)),
+        lower=np.full(6, -np.pi),
+        upper=np.full(6, np.pi),
+    )
+
+
+BRAVO = ("bravo", -0.0408, 0.0, -0.0408)
+offsets = st.tuples(
+    st.sampled_from(["bravo", "puma"]),
+    st.floats(0.01, 0.08) | st.floats(-0.08, -0.01),
+    st.sampled_from([0.0, 0.02, -0.03]),
+    st.sampled_from([0.0, 0.04, -0.04]),
+)
+
+
+@functools.cache
+def solver_of(kind: str, a4: float, d5: float, a5: float) -> om.OMSolver:
+    return om.OMSolver(puma_wrist_arm(kind, a4, d5, a5))
+
+
+@settings(max_examples=20, deadline=None)
+@given(offsets=offsets, q_seed=st.integers(0, 2**32 - 1))
+def test_dp_of_a_puma_like_wrist_is_its_torus_fit_and_bounded_by_dp_max(offsets, q_seed):
+    """dp = R_flange delta(q5, q6) with delta = sum_ij C_ij t_i(q5) t_j(q6) (model.wrist_torus),
+    and |dp| <= dp_max = hypot(a4, d5) + |a5| (-(a4 x4 + d5 z4 + a5 x5), x4 normal to z4), at
+    random joint vectors."""
+    kind, a4, d5, a5 = offsets
+    model = derive_model(puma_wrist_arm(kind, a4, d5, a5))
+    assert model.wrist_torus is not None and model.dp_joint == -1 and "the torus" in model.family_name
+    assert model.dp_max == pytest.approx(np.hypot(a4, d5) + abs(a5), rel=1e-15)
+    for q in random_q(model.real, 16, np.random.default_rng(q_seed)):
+        t5, t6 = (np.array([1.0, np.cos(w), np.sin(w)]) for w in q[4:6])
+        delta = np.einsum("i,j,ijk->k", t5, t6, model.wrist_torus)
+        dp = model.dp(q)
+        np.testing.assert_allclose(dp, model.model.fk(q)[:3, :3] @ delta, rtol=0, atol=1e-15)
+        assert np.linalg.norm(dp) <= model.dp_max + 1e-15
+
+
+@settings(max_examples=20, deadline=None)
+@given(offsets=offsets, q_seed=st.integers(0, 2**32 - 1))
+def test_arms_with_a_puma_like_wrist_are_solved_exactly(offsets, q_seed):
+    """Accepted by OMSolver (its self-check passes) on the torus; every root exact and in c, and
+    away from the singular boundaries q among solve_all's roots and the hinted solve's answer."""
+    solver = solver_of(*offsets)
+    assert solver.nominal is None and solver.solver_data().mode == _core.TORUS
+    for q in random_q(solver.arm, 6, np.random.default_rng(q_seed)):
+        check_exact(solver, q, well_conditioned(solver, q))
+
+
+def test_q_is_among_solve_all_at_every_random_target_of_the_bravo():
+    """Not only away from the boundaries: at 300 random joint vectors of the Bravo's table, the
+    edge of reach and the wrist centre next to joint 1's axis (where q1 turns about a point, the
+    torus' half-line charts) included, q is among solve_all's roots in its configuration."""
+    solver = solver_of(*BRAVO)
+    for q in random_q(solver.arm, 300, np.random.default_rng(11)):
+        T = solver.arm.fk(q)
+        roots = solver.solve_all(T, solver.configuration_of(q))
+        assert any(distance(solver.arm, r.q, q) < 1e-7 for r in roots), q
+
+
+@pytest.mark.parametrize("offsets", [BRAVO, ("puma", 0.05, 0.02, -0.04)])
+def test_every_root_of_an_independent_search_is_found(offsets):
+    """At random targets every root that Gauss-Newton on the arm's chain reaches from 400 random
+    starts is among solve_all's roots in its configuration: "no root in c" is true."""
+    solver = solver_of(*offsets)
+    rng = np.random.default_rng(3)
+    found = 0
+    for q in random_q(solver.arm, 4, rng):
+        T = solver.arm.fk(q)
+        for root in polished_roots(solver, T, 0.0, rng):
+            assert np.abs(solver.arm.fk(root) - T).max() < EXACT
+            c = solver.configuration_of(root)
+            assert any(distance(solver.arm, s.q, root) < 1e-7 for s in solver.solve_all(T, c)), (q, root)
+            found += 1
+    assert found >= 8
+
+
+def test_the_hinted_solve_returns_the_root_nearest_its_hint():
+    """Hints near q and between roots up to 0.8 rad apart: the answer is at least as near the hint
+    as every root of solve_all (the torus window about the hint, csrc/ik/search.c)."""
+    solver = solver_of(*BRAVO)
+    rng = np.random.default_rng(5)
+    for q in random_q(solver.arm, 40, rng):
+        for sigma in (0.01, 0.3):
+            check_hinted_nearest(solver, q, rng, sigma, 0.8)
+
+
+@pytest.mark.parametrize("deviation", [1e-9, 1e-5])
+def test_a_puma_like_wrist_near_a_family_is_solved_exactly(deviation):
+    """The Bravo's twists bent by +-deviation (its URDF's are 4e-10 rad off): solved through the
+    nominal arm, on its torus, exactly."""
+    arm = bent(puma_wrist_arm(*BRAVO), deviation, np.random.default_rng(1))
+    solver = om.OMSolver(arm)
+    assert solver.nominal is not None and "the torus" in solver.model_arm.family_name
+    for q in random_q(solver.arm, 30, np.random.default_rng(5)):
+        check_exact(solver, q, well_conditioned(solver, q))
+
+
+def test_a_ur5e_turned_into_a_puma_like_wrist_is_solved_on_the_torus():
+    """The UR5e with joint 4 across joints 2 and 3 (alpha_3 = 90 deg: its d4 no longer lateral)
+    and a4 = 0.07: accepted on the torus and exact (refused before the torus existed)."""
+    puma = with_offsets(om.load_arm("ur5e"), joint2={"alpha": RIGHT})
+    solver = om.OMSolver(with_offsets(puma, joint3={"a": 0.07}))
+    assert "the torus" in solver.model_arm.family_name
+    for q in random_q(solver.arm, 20, np.random.default_rng(4)):
+        check_exact(solver, q, well_conditioned(solver, q))
+
+
+def test_a_puma_like_wrist_with_a_lateral_offset_is_refused_by_name():
+    """With a lateral offset h the shoulder's edge of reach is a cylinder about joint 1's axis,
+    where the torus' lifted system (which lifts the elbow) is not smooth: refused, naming the
+    joints and h."""
+    with pytest.raises(om.ModelError, match=r"joint 4 \('joint4'\) across joint 2.*lateral offset h = 0\.15"):
+        om.OMSolver(puma_wrist_arm("puma", 0.03, 0.0, 0.0, lateral=0.15))
