@@ -4,12 +4,14 @@ the elbow angle (csrc/ik/six_dof.c, om_six_dof_model_ik_lifted), and are found e
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
+from scipy.optimize import brentq
 
 import om_redundant as om
 from benchmarks.near_family import bent
@@ -34,7 +36,8 @@ RIGHT = np.pi / 2
 def puma_wrist_arm(kind: str, a4: float, d5: float, a5: float, lateral: float = 0.0) -> om.Arm:
     """A PUMA-like arm with the wrist offsets a4, d5, a5: "bravo", Reach Bravo 7's table (its URDF's
     rows rounded to 0.1 mm; a4 = a5 = -0.0408 there), or "puma", a PUMA 560 (d4 = 0.36 m) with the
-    lateral offset d3 = lateral (0.15 m on the PUMA)."""
+    lateral offset d3 = lateral (0.15 m on the PUMA: the shoulder's edge of reach is then a
+    cylinder of that radius about joint 1's axis)."""
     if kind == "bravo":
         rows = (
             om.DHRow(a=-0.046, alpha=RIGHT, d=-0.1454, theta=0.0),
@@ -63,17 +66,19 @@ def puma_wrist_arm(kind: str, a4: float, d5: float, a5: float, lateral: float = 
 
 
 BRAVO = ("bravo", -0.0408, 0.0, -0.0408)
+PUMA = ("puma", 0.03, 0.01, 0.02, 0.15)
 offsets = st.tuples(
     st.sampled_from(["bravo", "puma"]),
     st.floats(0.01, 0.08) | st.floats(-0.08, -0.01),
     st.sampled_from([0.0, 0.02, -0.03]),
     st.sampled_from([0.0, 0.04, -0.04]),
+    st.sampled_from([0.0, 0.15]),
 )
 
 
 @functools.cache
-def solver_of(kind: str, a4: float, d5: float, a5: float) -> om.OMSolver:
-    return om.OMSolver(puma_wrist_arm(kind, a4, d5, a5))
+def solver_of(kind: str, a4: float, d5: float, a5: float, lateral: float = 0.0) -> om.OMSolver:
+    return om.OMSolver(puma_wrist_arm(kind, a4, d5, a5, lateral))
 
 
 @settings(max_examples=20, deadline=None)
@@ -82,9 +87,9 @@ def test_dp_of_a_puma_like_wrist_is_its_torus_fit_and_bounded_by_dp_max(offsets,
     """dp = R_flange delta(q5, q6) with delta = sum_ij C_ij t_i(q5) t_j(q6) (model.wrist_torus),
     and |dp| <= dp_max = hypot(a4, d5) + |a5| (-(a4 x4 + d5 z4 + a5 x5), x4 normal to z4), at
     random joint vectors."""
-    kind, a4, d5, a5 = offsets
-    model = derive_model(puma_wrist_arm(kind, a4, d5, a5))
-    assert model.wrist_torus is not None and model.dp_joint == -1 and "the torus" in model.family_name
+    kind, a4, d5, a5, lateral = offsets
+    model = derive_model(puma_wrist_arm(kind, a4, d5, a5, lateral))
+    assert model.wrist_torus is not None and model.dp_joint == -1 and "on the torus" in model.family_name
     assert model.dp_max == pytest.approx(np.hypot(a4, d5) + abs(a5), rel=1e-15)
     for q in random_q(model.real, 16, np.random.default_rng(q_seed)):
         t5, t6 = (np.array([1.0, np.cos(w), np.sin(w)]) for w in q[4:6])
@@ -105,18 +110,49 @@ def test_arms_with_a_puma_like_wrist_are_solved_exactly(offsets, q_seed):
         check_exact(solver, q, well_conditioned(solver, q))
 
 
-def test_q_is_among_solve_all_at_every_random_target_of_the_bravo():
-    """Not only away from the boundaries: at 300 random joint vectors of the Bravo's table, the
-    edge of reach and the wrist centre next to joint 1's axis (where q1 turns about a point, the
-    torus' half-line charts) included, q is among solve_all's roots in its configuration."""
-    solver = solver_of(*BRAVO)
+@pytest.mark.parametrize("arm", [BRAVO, PUMA])
+def test_q_is_among_solve_all_at_every_random_target(arm):
+    """Not only away from the boundaries: at 300 random joint vectors of the Bravo's table and of a
+    PUMA 560 with wrist offsets, the edges of reach and the singular wrist included, q is among
+    solve_all's roots in its configuration."""
+    solver = solver_of(*arm)
     for q in random_q(solver.arm, 300, np.random.default_rng(11)):
         T = solver.arm.fk(q)
         roots = solver.solve_all(T, solver.configuration_of(q))
         assert any(distance(solver.arm, r.q, q) < 1e-7 for r in roots), q
 
 
-@pytest.mark.parametrize("offsets", [BRAVO, ("puma", 0.05, 0.02, -0.04)])
+def arm_value(solver: om.OMSolver, q: np.ndarray) -> float:
+    """The ARM branch quantity a1 + u at q: zero where the wrist centre is on joint 1's axis."""
+    values = np.empty(3)
+    _core.branch_values(solver.model_arm.family, solver.model_arm.params, q, values)
+    return float(values[0])
+
+
+@settings(max_examples=40, deadline=None)
+@given(arm=st.sampled_from([BRAVO, PUMA]), q_seed=st.integers(0, 2**32 - 1))
+def test_q_is_found_at_the_shoulders_edge(arm, q_seed):
+    """q2 set so that ARM = 0 (to rounding): the wrist centre on joint 1's axis (the Bravo), where q1
+    turns by 2 pi about a point of the torus, or h from it (a PUMA with h = 0.15 m), the shoulder's
+    edge of reach, where the lifted system's q1 has a square root: q is among solve_all's roots
+    in both ARM configurations it holds (the search about the axis, csrc/ik/torus_half_line.c;
+    without it the grid misses such roots)."""
+    solver = solver_of(*arm)
+    q = random_q(solver.arm, 1, np.random.default_rng(q_seed))[0]
+    grid = np.linspace(-np.pi, np.pi, 65)
+    values = [arm_value(solver, np.r_[q[:1], w, q[2:]]) for w in grid]
+    crossing = next((k for k in range(64) if values[k] * values[k + 1] < 0.0), None)
+    assume(crossing is not None)
+    arm_at = lambda w: arm_value(solver, np.r_[q[:1], w, q[2:]])  # noqa: E731
+    q[1] = brentq(arm_at, grid[crossing], grid[crossing + 1], xtol=1e-15)
+    assert abs(arm_value(solver, q)) < 1e-12
+    T, c = solver.arm.fk(q), solver.configuration_of(q)
+    for signs in (c.signs, (-c.signs[0], *c.signs[1:])):
+        roots = solver.solve_all(T, om.Configuration(signs, ()))
+        assert any(distance(solver.arm, r.q, q) < 1e-7 for r in roots), (q, signs)
+
+
+@pytest.mark.parametrize("offsets", [BRAVO, ("puma", 0.05, 0.02, -0.04), PUMA])
 def test_every_root_of_an_independent_search_is_found(offsets):
     """At random targets every root that Gauss-Newton on the arm's chain reaches from 400 random
     starts is among solve_all's roots in its configuration: "no root in c" is true."""
@@ -149,7 +185,7 @@ def test_a_puma_like_wrist_near_a_family_is_solved_exactly(deviation):
     nominal arm, on its torus, exactly."""
     arm = bent(puma_wrist_arm(*BRAVO), deviation, np.random.default_rng(1))
     solver = om.OMSolver(arm)
-    assert solver.nominal is not None and "the torus" in solver.model_arm.family_name
+    assert solver.nominal is not None and "on the torus" in solver.model_arm.family_name
     for q in random_q(solver.arm, 30, np.random.default_rng(5)):
         check_exact(solver, q, well_conditioned(solver, q))
 
@@ -159,14 +195,19 @@ def test_a_ur5e_turned_into_a_puma_like_wrist_is_solved_on_the_torus():
     and a4 = 0.07: accepted on the torus and exact (refused before the torus existed)."""
     puma = with_offsets(om.load_arm("ur5e"), joint2={"alpha": RIGHT})
     solver = om.OMSolver(with_offsets(puma, joint3={"a": 0.07}))
-    assert "the torus" in solver.model_arm.family_name
+    assert "on the torus" in solver.model_arm.family_name
     for q in random_q(solver.arm, 20, np.random.default_rng(4)):
         check_exact(solver, q, well_conditioned(solver, q))
 
 
-def test_a_puma_like_wrist_with_a_lateral_offset_is_refused_by_name():
-    """With a lateral offset h the shoulder's edge of reach is a cylinder about joint 1's axis,
-    where the torus' lifted system (which lifts the elbow) is not smooth: refused, naming the
-    joints and h."""
-    with pytest.raises(om.ModelError, match=r"joint 4 \('joint4'\) across joint 2.*lateral offset h = 0\.15"):
-        om.OMSolver(puma_wrist_arm("puma", 0.03, 0.0, 0.0, lateral=0.15))
+def test_a_puma_like_wrist_on_an_rrp_arm_is_refused_by_name():
+    """The paper's Spherical arm (RRP) with joint 4 turned across joint 2 and a4 = 0.03: the torus'
+    lifted system is the RRR family's, so refused, naming the joints and the family; without a4
+    the arm is accepted."""
+    arm = om.load_arm("spherical")
+    rows = list(arm.chain.rows)
+    rows[3] = dataclasses.replace(rows[3], alpha=0.0)  # the fixed row after joint 3
+    turned = arm.with_chain(arm.chain.replace_rows(rows), "spherical-turned")
+    om.OMSolver(turned)
+    with pytest.raises(om.ModelError, match=r"joint 4 \('q4'\) across joint 2.*not RRP \+ spherical wrist"):
+        om.OMSolver(with_offsets(turned, joint3={"a": 0.03}))

@@ -242,6 +242,9 @@ static double _lifted_ik(om_problem *pb, const void *args, double *q, bool neare
     const om_solver_data *s = pb->s;
     if (s->family == OM_SRS)
         a->F = om_srs_model_ik_lifted(s->params, &pb->t, pm, pb->signs, x.x, x.y, x.z, q);
+    else if (pb->about_axis)
+        a->F = om_six_dof_model_ik_about_axis(s->params, s->model_table, &pb->t, pm, pb->signs, pb->q_prev, x.x,
+                                              x.y, x.z, q);
     else
         a->F = om_six_dof_model_ik_lifted(s->params, s->model_table, &pb->t, pm, pb->signs, pb->q_prev, x.x, x.y,
                                           x.z, q);

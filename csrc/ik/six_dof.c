@@ -147,13 +147,27 @@ double om_six_dof_model_ik_q6(int family, const double *P, const double *table, 
     return margin;
 }
 
+/* Joints 4 and 5 of q from the wrist's rotation at joints 1-3 of q with q6 given (phi6 first,
+ * om_euler_zxzxz_given_first: smooth at the singular wrist), into q (q6 as given); returns the
+ * wrist's consistency N22 and phi5 less q5's: zero together iff q5, q6 fit the target. */
+static double _wrist_given_q5_q6(const double *P, const double *table, const om_target *t, double q5, double q6,
+                                 double *q, double *joint5)
+{
+    mat3 M = _wrist_rotation(P, table, t, q);
+    vec3 neg = om_euler_zxzxz_given_first(m_transpose(M), -P[SD_SIGMA5], 0.0, -P[SD_SIGMA4], -(q6 + P[SD_THETA6]));
+    q[3] = om_wrap(-neg.y - P[SD_THETA4]);
+    q[4] = om_wrap(-neg.x - P[SD_THETA5]);
+    q[5] = q6;
+    *joint5 = om_wrap(q[4] - q5);
+    return neg.z;
+}
+
 /* The lifted model IK of the RRR family on the torus (q5, q6) of a PUMA-like wrist (the
  * S-R-S one's: om_srs_model_ik_lifted), with q5, q6 and the elbow angle gamma = phi3 + beta given
  * (gamma NaN: the elbow's root in the ELBOW branch, x clamped into [-1, 1]): joint 1 from the
  * wrist centre (ARM), joints 2 and 3 from gamma, and joints 4 and 5 from the wrist's rotation
- * with phi6 first (om_euler_zxzxz_given_first, smooth at the singular wrist). Returns the
- * (wrist, joint 5, elbow) residuals, zero together iff q is the model's solution: the wrist's
- * consistency N22, phi5 less q5's, and x - cos(gamma), x = (D - a2^2 - l3^2) / (2 a2 l3) the
+ * (_wrist_given_q5_q6). Returns the (wrist, joint 5, elbow) residuals, zero together iff q is
+ * the model's solution: the wrist's, and x - cos(gamma), x = (D - a2^2 - l3^2) / (2 a2 l3) the
  * elbow's cosine that the wrist centre asks for (smooth where the closed form's square root
  * is not: at the edge of reach); NaN beyond the shoulder's reach (q not written). Writes q
  * (unless NULL), q6 as given. */
@@ -161,7 +175,7 @@ vec3 om_six_dof_model_ik_lifted(const double *P, const double *table, const om_t
                                 const int64_t *signs, const double *q_prev, double q5, double q6, double gamma,
                                 double *q)
 {
-    double joints[OM_MAX_DOF], u, v;
+    double joints[OM_MAX_DOF], u, v, joint5;
     double *out = q ? q : joints;
     if (_shoulder(P, v_add(t->wrist, p), signs, q_prev, out, -OM_REACH_SLACK, &u, &v) < -OM_REACH_SLACK)
         return v3(NAN, NAN, NAN);
@@ -172,12 +186,37 @@ vec3 om_six_dof_model_ik_lifted(const double *P, const double *table, const om_t
         gamma = atan2((double)signs[1] * sqrt(1.0 - xc * xc), xc);
     }
     _rrr_joints_2_3(P, u, v, D, gamma, q_prev, out);
-    mat3 M = _wrist_rotation(P, table, t, out);
-    vec3 neg = om_euler_zxzxz_given_first(m_transpose(M), -P[SD_SIGMA5], 0.0, -P[SD_SIGMA4], -(q6 + P[SD_THETA6]));
-    out[3] = om_wrap(-neg.y - P[SD_THETA4]);
-    out[4] = om_wrap(-neg.x - P[SD_THETA5]);
-    out[5] = q6;
-    return v3(neg.z, om_wrap(out[4] - q5), x - cos(gamma));
+    double wrist = _wrist_given_q5_q6(P, table, t, q5, q6, out, &joint5);
+    return v3(wrist, joint5, x - cos(gamma));
+}
+
+/* The same model IK about joint 1's axis, with q5, q6 and q1 given: where the wrist centre is on
+ * the axis the closed form's q1 (its azimuth) is any, and turns by pi as the centre crosses it;
+ * with q1 given the reach in the arm plane is the centre's signed part along phi1, rho (ARM its
+ * sign), smooth through the axis. Joints 2 and 3 from the elbow's closed form (ELBOW; NaN
+ * residuals beyond its reach, q not written), 4 and 5 as om_six_dof_model_ik_lifted's. Returns
+ * the (wrist, joint 5, shoulder) residuals, the shoulder's the centre's part across phi1 less
+ * the lateral offset's, -sigma1 h (m). */
+vec3 om_six_dof_model_ik_about_axis(const double *P, const double *table, const om_target *t, vec3 p,
+                                    const int64_t *signs, const double *q_prev, double q5, double q6, double q1,
+                                    double *q)
+{
+    double joints[OM_MAX_DOF], joint5;
+    double *out = q ? q : joints;
+    vec3 pw = v_add(t->wrist, p);
+    double phi1 = q1 + P[SD_THETA1], c1 = cos(phi1), s1 = sin(phi1);
+    double u = c1 * pw.x + s1 * pw.y - P[SD_A1], v = P[SD_SIGMA1] * (pw.z - P[SD_D1]);
+    double shoulder = -s1 * pw.x + c1 * pw.y + P[SD_SIGMA1] * P[SD_LATERAL];
+    double D = u * u + v * v, a2 = P[SD_A2], l3 = P[SD_ELL3];
+    double outer = fabs(a2) + l3, inner = fabs(a2) - l3;
+    double k = (outer * outer - D) * (D - inner * inner);
+    if (k / py_max(D * D, 1.0) < -OM_REACH_SLACK)
+        return v3(NAN, NAN, NAN);
+    double gamma = atan2((double)signs[1] * sqrt(py_max(k, 0.0)), om_sign(a2) * (D - a2 * a2 - l3 * l3));
+    out[0] = om_wrap(q1);
+    _rrr_joints_2_3(P, u, v, D, gamma, q_prev, out);
+    double wrist = _wrist_given_q5_q6(P, table, t, q5, q6, out, &joint5);
+    return v3(wrist, joint5, shoulder);
 }
 
 /* The model's hand position on the torus of a PUMA-like wrist, p_m = p_d + R delta(w5, w6)

@@ -110,5 +110,11 @@ double om_lifted_newton(om_problem *pb, const half_line_chart *chart, vec3 x, do
  * side), candidates as torus_candidate's; returns the root count. */
 int om_half_line_roots(om_problem *pb, double lo1, double lo7, double step, int m, double *q, double *roots,
                        int count, om_candidate_log *log);
+/* A 6-DOF arm's roots at the shoulder's edge of reach, the wrist centre h from joint 1's axis (h
+ * its lateral offset; none where h = 0): Newton about the axis (torus_half_line.c) from each
+ * cell of the grid (lo1, lo7, step, m nodes a side) that the edge crosses, some of its corners'
+ * lifted residuals F (m x m) beyond the shoulder's reach (inf). Returns the root count. */
+int om_shoulder_edge_roots(om_problem *pb, double lo1, double lo7, double step, int m, const double *F, double *q,
+                           double *roots, int count, om_candidate_log *log);
 
 #endif

@@ -44,13 +44,14 @@ static vec3 _shoulder_wrist(om_problem *pb, double w1, double w7, vec3 *d1, vec3
 typedef struct {
     vec3 up, centre;
     double reach;
-    bool below; /* only the half-line below the shoulder (the arm angle's): S-R-S */
+    bool below;     /* only the half-line below the shoulder (the arm angle's): S-R-S */
+    bool separable; /* x = x1(w1) + x7(w7): S-R-S (a 6-DOF arm's delta(w5, w6) has mixed terms) */
 } singular_line;
 
 static singular_line _singular_line(const om_problem *pb)
 {
     const om_solver_data *s = pb->s;
-    singular_line line = {v3(0.0, 0.0, 1.0), v3(0.0, 0.0, 0.0), 0.0, s->family == OM_SRS};
+    singular_line line = {v3(0.0, 0.0, 1.0), v3(0.0, 0.0, 0.0), 0.0, s->family == OM_SRS, s->family == OM_SRS};
     if (s->family != OM_SRS) { /* joint 1's axis, z of DH frame 0 */
         line.centre = v_add(v_add(pb->p, pb->t.wrist), m_mv(pb->t.R, v_load(s->params, SD_WRIST_TORUS)));
         for (int k = 3; k < 27; k += 3)
@@ -104,13 +105,16 @@ static int _half_line_points(om_problem *pb, double lo1, double lo7, double step
         return 0;
     }
     vec3 corner = _shoulder_wrist(pb, lo1, lo7, &d1, &d7);
-    for (int i = 0; i < m; i++) { /* x = rows[i] + cols[j] at node (i, j) */
+    for (int i = 0; i < m; i++) { /* x = rows[i] + cols[j] at node (i, j), where separable */
         rows[i] = _shoulder_wrist(pb, lo1 + (double)i * step, lo7, &d1, &d7);
         cols[i] = v_sub(_shoulder_wrist(pb, lo1, lo7 + (double)i * step, &d1, &d7), corner);
     }
     for (int i = 0; i < m; i++)
-        for (int j = 0; j < m; j++)
-            _across(v_add(rows[i], cols[j]), b1, b2, H + 2 * (i * m + j));
+        for (int j = 0; j < m; j++) {
+            vec3 x = line.separable ? v_add(rows[i], cols[j])
+                                    : _shoulder_wrist(pb, lo1 + (double)i * step, lo7 + (double)j * step, &d1, &d7);
+            _across(x, b1, b2, H + 2 * (i * m + j));
+        }
     free(rows);
     int count = 0;
     for (int i = 0; i + 1 < m && count < LINE_POINTS; i++) {
@@ -160,15 +164,81 @@ static int _half_line_points(om_problem *pb, double lo1, double lo7, double step
     return count;
 }
 
+/* Newton on a 6-DOF arm's system about joint 1's axis (om_six_dof_model_ik_about_axis: (w5, w6,
+ * q1), smooth where the wrist centre is on the axis or at the shoulder's edge of reach, h from
+ * it) from x; an end not in ends (n_ends of them, LINE_SEEDS at most) is a candidate, as
+ * torus_candidate's. Returns the root count. */
+static int _about_axis(om_problem *pb, vec3 x, vec3 *ends, int *n_ends, double *q, double *roots, int count,
+                       om_candidate_log *log)
+{
+    vec3 end;
+    pb->about_axis = true;
+    double r = om_lifted_newton(pb, NULL, x, q, NULL, 0, NULL, &end);
+    pb->about_axis = false;
+    if (r > OM_ROOT_TOL)
+        return count;
+    for (int e = 0; e < *n_ends; e++)
+        if (same_point(end, ends[e]))
+            return count;
+    if (*n_ends < LINE_SEEDS)
+        ends[(*n_ends)++] = end;
+    return torus_candidate(pb, q, roots, count, log);
+}
+
+/* A 6-DOF arm's roots next to the points where the wrist centre is on joint 1's axis, from each
+ * point with LINE_SEEDS values of q1 (_about_axis). Returns the root count. */
+static int _axis_roots(om_problem *pb, const half_line_chart *points, int n, double *q, double *roots, int count,
+                       om_candidate_log *log)
+{
+    vec3 ends[LINE_SEEDS];
+    for (int c = 0; c < n; c++) {
+        int n_ends = 0;
+        for (int k = 0; k < LINE_SEEDS; k++) {
+            vec3 x = v3(points[c].w1, points[c].w7, -OM_PI + 2.0 * OM_PI * (double)k / (double)LINE_SEEDS);
+            count = _about_axis(pb, x, ends, &n_ends, q, roots, count, log);
+        }
+    }
+    return count;
+}
+
+int om_shoulder_edge_roots(om_problem *pb, double lo1, double lo7, double step, int m, const double *F, double *q,
+                           double *roots, int count, om_candidate_log *log)
+{
+    const double *P = pb->s->params;
+    double h = P[SD_LATERAL];
+    for (int i = 0; i + 1 < m && h != 0.0; i++) {
+        for (int j = 0; j + 1 < m; j++) {
+            int out = 0;
+            for (int k = 0; k < 4; k++)
+                out += !(F[(i + k / 2) * m + j + k % 2] < INFINITY);
+            if (out == 0 || out == 4)
+                continue;
+            /* at the edge rho = 0: phi1 = azimuth - atan2(-sigma1 h, 0), both ARM branches' */
+            double w5 = lo1 + ((double)i + 0.5) * step, w6 = lo7 + ((double)j + 0.5) * step;
+            vec3 pw = v_add(pb->t.wrist, om_torus_point(pb, w5, w6));
+            double q1 = atan2(pw.y, pw.x) - atan2(-P[SD_SIGMA1] * h, 0.0) - P[SD_THETA1];
+            vec3 ends[LINE_SEEDS];
+            int n_ends = 0;
+            count = _about_axis(pb, v3(w5, w6, q1), ends, &n_ends, q, roots, count, log);
+        }
+    }
+    return count;
+}
+
 /* Roots next to the points of psi's half-line in the grid's square (_half_line_points):
  * Newton in each point's chart from LINE_SEEDS directions at r = LINE_START; an end whose
  * lifted residual is below LINE_ROOT (its rounding there is about 1e-16 / rho) is a candidate,
- * refined on the real arm and verified (torus_candidate). Returns the root count. */
+ * refined on the real arm and verified (torus_candidate). A 6-DOF arm's points, where the wrist
+ * centre is on joint 1's axis, are searched about the axis instead (_axis_roots): there the
+ * model's q1 turns by pi across the point, which no chart of the lifted system smooths. Returns
+ * the root count. */
 int om_half_line_roots(om_problem *pb, double lo1, double lo7, double step, int m, double *q, double *roots,
                        int count, om_candidate_log *log)
 {
     half_line_chart charts[LINE_POINTS];
     int n = _half_line_points(pb, lo1, lo7, step, m, charts);
+    if (pb->s->family != OM_SRS)
+        return _axis_roots(pb, charts, n, q, roots, count, log);
     vec3 ends[LINE_SEEDS];
     for (int c = 0; c < n; c++) {
         int n_ends = 0;

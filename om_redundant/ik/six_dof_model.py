@@ -19,7 +19,6 @@ from .model_conditions import (
     check_right_angle,
     off_right_angle,
     refuse_fixed_rows,
-    rounding_length,
 )
 from .model_frames import circle_fit, pose, tail_rotation, torus_fit
 
@@ -61,21 +60,13 @@ def six_dof_model(arm: Arm) -> tuple[KinematicChain, int, str, np.ndarray, np.nd
     if parallel_wrist(arm, model_chain):
         wrist_offset(arm, model_chain, offsets, params, R_fl)
         return model_chain, family, family_name + ", wrist offset a4 (dp turns with q1)", params, None
-    # The torus' lifted system takes the elbow's square root away, not the shoulder's: a lateral
-    # offset h puts the shoulder's edge of reach (the wrist centre h from joint 1's axis) where
-    # roots crowd; without it, that edge is the axis itself, where q1 turns about a point.
-    # (h's rounding, cos(90 deg) d4 = 1e-17 m, is not an offset)
-    lateral = params[_core.SD_LATERAL]
-    offset = abs(lateral) > rounding_length(arm.chain)
-    if family != _core.RRR_SPHERICAL_WRIST or offset:
-        cause = f"a lateral offset h = {lateral:g} m" if offset else f"the {family_name} family"
+    if family != _core.RRR_SPHERICAL_WRIST:
         raise ModelError(
             f"arm '{arm.name}': a4 = {offsets[0]:g} != 0 with {joint_name(arm, 3)} across "
             f"{joint_name(arm, 1)} (a PUMA-like wrist: dp turns with {joints_named(arm, (4, 5))}) is "
-            f"solved on the torus for the RRR family of {joints_named(arm, (0, 1, 2))} without a lateral "
-            f"offset (d2 + d3 + d4 along the parallel axes), not with {cause}"
+            f"solved on the torus for the RRR family of {joints_named(arm, (0, 1, 2))}, not {family_name}"
         )
-    name = f"{family_name}, wrist offsets a4, d5, a5 (dp turns with q5 and q6: the torus)"
+    name = f"{family_name}, wrist offsets a4, d5, a5 (dp turns with q5 and q6, on the torus)"
     coefficients = wrist_torus(arm, model_chain)
     params[_core.SD_WRIST_TORUS : _core.SD_WRIST_TORUS + 27] = coefficients.ravel()
     return model_chain, family, name, params, coefficients
