@@ -42,6 +42,7 @@ URDF_NEAR = (
     "Baxter (left)",
     "iCub (left)",
     "ANYmal B + Kinova",
+    "Reach Bravo 7",
 )
 
 

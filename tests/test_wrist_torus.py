@@ -29,6 +29,8 @@ from tests.conftest import (
     with_offsets,
 )
 
+pytestmark = pytest.mark.sanitize  # also run under ASan and UBSan (.ci/sanitize)
+
 RIGHT = np.pi / 2
 
 
@@ -211,3 +213,31 @@ def test_a_puma_like_wrist_on_an_rrp_arm_is_refused_by_name():
     om.OMSolver(turned)
     with pytest.raises(om.ModelError, match=r"joint 4 \('q4'\) across joint 2.*not RRP \+ spherical wrist"):
         om.OMSolver(with_offsets(turned, joint3={"a": 0.03}))
+
+
+@pytest.mark.parametrize("arm", [BRAVO, PUMA])
+def test_the_batches_and_the_control_tick_answer_as_the_single_calls(arm):
+    """solve_all_batch, each pose in all eight configurations in a row (ARM changing alone from
+    one to the next), finds as many roots per (pose, c) as solve_all (its search cache, shared by
+    the configurations of a pose, is keyed by the ARM sign, which the 6-DOF lifted system reads);
+    solve_batch hinted with q and the control tick from joints 0.002 rad back return q."""
+    solver = solver_of(*arm)
+    rng = np.random.default_rng(9)
+    qs = random_q(solver.arm, 40, rng)
+    every = np.array([(a, e, w) for e in (1, -1) for w in (1, -1) for a in (1, -1)])
+    T_all = np.repeat(solver.arm.fk(qs[:10]), len(every), axis=0)
+    signs_all = np.tile(every, (10, 1))
+    counts = solver.solve_all_batch(T_all, signs_all, None).count
+    expected = [
+        len(solver.solve_all(T, om.Configuration(tuple(c), ())))
+        for T, c in zip(T_all, signs_all, strict=True)
+    ]
+    assert list(counts) == expected and sum(expected) >= 10
+    T = solver.arm.fk(qs)
+    configurations = [solver.configuration_of(q) for q in qs]
+    signs = np.array([c.signs for c in configurations])
+    batch = solver.solve_batch(T, signs, None, q_hint=qs)
+    assert batch.ok.all() and max(distance(solver.arm, a, b) for a, b in zip(batch.q, qs, strict=True)) < 1e-9
+    for q, c in zip(qs, configurations, strict=True):
+        tick = solver.solve_from(solver.arm.fk(q), c, q + rng.normal(0.0, 0.002, 6))
+        assert tick.ok and distance(solver.arm, tick.q, q) < 1e-7

@@ -231,6 +231,9 @@ bool om_fixed_point_start(om_problem *pb, double *q, double *start)
         return true;
     if (s->family == OM_SRS && s->mode != OM_FIXED) /* the elbow held at the edge of reach */
         return om_srs_model_ik_at_reach(s->params, &pb->t, pb->p, signs, pb->q_prev, start);
+    if (s->mode == OM_TORUS) /* a 6-DOF arm's torus: the nearest pose the model reaches (NaN: none) */
+        return om_model_ik_nearest(s->family, s->params, s->model_table, &pb->t, pb->p, signs, pb->q_prev, start) >=
+               -INFINITY;
     if (s->mode != OM_CIRCLE)
         return false;
     bool found = false; /* the point of the dp circle the model reaches with the smallest residual */
