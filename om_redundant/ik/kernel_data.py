@@ -14,7 +14,9 @@ seen from the flange and depends on one wrist joint, :math:`w = q_J` (see
 and a root gives the real arm's joints :math:`q = \mathrm{IK}_{model}(\ldots)` with
 :math:`|p_{real}(q) - p_d| = |\delta(w) - \delta(q_J)| \le \Delta p_{max}\,|g(w)|`.
 A 6-DOF wrist with :math:`a_4 \ne 0` has the circle :math:`p_m = p_d + \Delta p(w)`,
-:math:`w = q_1`, instead (:mod:`om_redundant.ik.model`, ``csrc/ik/wrist_offset.c``).
+:math:`w = q_1`, instead (:mod:`om_redundant.ik.model`, ``csrc/ik/wrist_offset.c``), or, a
+PUMA-like wrist, the torus :math:`p_m = p_d + R_d\,\delta(q_5, q_6)` (below; lifted by the
+elbow angle, ``om_six_dof_model_ik_lifted``).
 
 Arms with shoulder offsets (Gen3, Sawyer) add :math:`a(q_1)`, so solutions lie on a torus
 :math:`(w_1, w_7) = (q_1, q_7)`: :math:`p_m = p_d + a(w_1) + R_d\,\delta(w_7)`. There the

@@ -22,7 +22,9 @@ iiwa14 has :math:`\delta = 0`). A 6-DOF wrist with :math:`a_4 \ne 0` (Menagerie'
 Unitree Z1, i2rt YAM) makes :math:`\delta` depend on joints 5 and 6; where joint 4's axis
 turns with q1 alone (joints 2, 3 and 4 parallel), dp at a solution is a function of q1 and
 the target's orientation instead (:func:`~om_redundant.ik.six_dof_model.wrist_offset`): the
-solutions again lie on a circle, in :math:`w = q_1`. The shoulder offsets' dp :math:`a(q_1)`, in DH frame 0,
+solutions again lie on a circle, in :math:`w = q_1`; where joint 4 lies across joint 2 (a
+PUMA-like wrist, the Reach Bravo 7) they lie on the torus :math:`(q_5, q_6)`
+(:func:`~om_redundant.ik.six_dof_model.wrist_torus`). The shoulder offsets' dp :math:`a(q_1)`, in DH frame 0,
 turns with joint 1 alone, because :math:`a_1` lies along :math:`x_1` and :math:`d_2` along
 joint 2's axis, both fixed in frame 1; it is zero when joints 1-3 meet. The solutions of
 the OM system (9) then lie on a circle (a torus with shoulder offsets) in the ball
