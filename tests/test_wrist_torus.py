@@ -27,6 +27,7 @@ from tests.conftest import (
     random_q,
     well_conditioned,
     with_offsets,
+    wrap,
 )
 
 pytestmark = pytest.mark.sanitize  # also run under ASan and UBSan (.ci/sanitize)
@@ -150,6 +151,22 @@ def test_q_is_found_at_the_shoulders_edge(arm, q_seed):
     assert abs(arm_value(solver, q)) < 1e-12
     T, c = solver.arm.fk(q), solver.configuration_of(q)
     for signs in (c.signs, (-c.signs[0], *c.signs[1:])):
+        roots = solver.solve_all(T, om.Configuration(signs, ()))
+        assert any(distance(solver.arm, r.q, q) < 1e-7 for r in roots), (q, signs)
+
+
+@settings(max_examples=30, deadline=None)
+@given(arm=st.sampled_from([BRAVO, PUMA]), folded=st.booleans(), q_seed=st.integers(0, 2**32 - 1))
+def test_q_is_found_at_the_elbows_edge(arm, folded, q_seed):
+    """q3 set so that the elbow is straight or folded (gamma = phi3 + beta = 0 or pi: ELBOW = 0),
+    the edge of reach, where the closed form's gamma has a square root and the lifted system
+    takes gamma as an unknown: q is among solve_all's roots in both ELBOW configurations."""
+    solver = solver_of(*arm)
+    params = solver.model_arm.params
+    q = random_q(solver.arm, 1, np.random.default_rng(q_seed))[0]
+    q[2] = wrap((np.pi if folded else 0.0) - params[_core.SD_BETA] - params[_core.SD_THETA3])
+    T, c = solver.arm.fk(q), solver.configuration_of(q)
+    for signs in (c.signs, (c.signs[0], -c.signs[1], c.signs[2])):
         roots = solver.solve_all(T, om.Configuration(signs, ()))
         assert any(distance(solver.arm, r.q, q) < 1e-7 for r in roots), (q, signs)
 
