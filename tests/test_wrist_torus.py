@@ -9,7 +9,7 @@ import functools
 
 import numpy as np
 import pytest
-from hypothesis import assume, given, settings
+from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
 from scipy.optimize import brentq
 
@@ -134,12 +134,14 @@ def arm_value(solver: om.OMSolver, q: np.ndarray) -> float:
 
 @settings(max_examples=40, deadline=None)
 @given(arm=st.sampled_from([BRAVO, PUMA]), q_seed=st.integers(0, 2**32 - 1))
+@example(arm=PUMA, q_seed=801794989)  # the edge touching the torus' reach from outside, between nodes
 def test_q_is_found_at_the_shoulders_edge(arm, q_seed):
     """q2 set so that ARM = 0 (to rounding): the wrist centre on joint 1's axis (the Bravo), where q1
     turns by 2 pi about a point of the torus, or h from it (a PUMA with h = 0.15 m), the shoulder's
     edge of reach, where the lifted system's q1 has a square root: q is among solve_all's roots
     in both ARM configurations it holds (the search about the axis, csrc/ik/torus_half_line.c;
-    without it the grid misses such roots)."""
+    without it the grid misses such roots; the example: the torus' wrist centres all beyond the
+    reach at the grid's nodes, the root where the reach touches between them)."""
     solver = solver_of(*arm)
     q = random_q(solver.arm, 1, np.random.default_rng(q_seed))[0]
     grid = np.linspace(-np.pi, np.pi, 65)
@@ -157,10 +159,12 @@ def test_q_is_found_at_the_shoulders_edge(arm, q_seed):
 
 @settings(max_examples=30, deadline=None)
 @given(arm=st.sampled_from([BRAVO, PUMA]), folded=st.booleans(), q_seed=st.integers(0, 2**32 - 1))
+@example(arm=PUMA, folded=True, q_seed=1024)  # the shoulder's edge 4 mm away (ARM 0.0037) as well
 def test_q_is_found_at_the_elbows_edge(arm, folded, q_seed):
     """q3 set so that the elbow is straight or folded (gamma = phi3 + beta = 0 or pi: ELBOW = 0),
     the edge of reach, where the closed form's gamma has a square root and the lifted system
-    takes gamma as an unknown: q is among solve_all's roots in both ELBOW configurations."""
+    takes gamma as an unknown: q is among solve_all's roots in both ELBOW configurations, also
+    where the shoulder's edge is near too (the system about joint 1's axis lifts both)."""
     solver = solver_of(*arm)
     params = solver.model_arm.params
     q = random_q(solver.arm, 1, np.random.default_rng(q_seed))[0]

@@ -77,11 +77,10 @@ void om_six_dof_target(const double *P, om_target *t); /* fills RE and wrist fro
 vec3 om_six_dof_model_ik_lifted(const double *P, const double *table, const om_target *t, vec3 p,
                                 const int64_t *signs, const double *q_prev, double q5, double q6, double gamma,
                                 double *q);
-/* The same about joint 1's axis: q5, q6 and q1 given; returns the (wrist, joint 5, shoulder)
- * residuals. */
-vec3 om_six_dof_model_ik_about_axis(const double *P, const double *table, const om_target *t, vec3 p,
-                                    const int64_t *signs, const double *q_prev, double q5, double q6, double q1,
-                                    double *q);
+/* The same about joint 1's axis: x = (q5, q6, q1, gamma) given (gamma NaN: the ELBOW branch's);
+ * writes q and the (wrist, joint 5, shoulder, elbow) residuals into F (4). */
+void om_six_dof_model_ik_about_axis(const double *P, const double *table, const om_target *t, vec3 p,
+                                    const int64_t *signs, const double *q_prev, const double *x, double *q, double *F);
 /* The model's hand position p_d + R delta(w5, w6) on that torus. */
 vec3 om_six_dof_torus_point(const double *P, const mat3 *R, vec3 p, double w5, double w6);
 /* wrist_offset.c: for a4 != 0 (P[SD_WRIST_OFFSET] != 0), the model's hand position

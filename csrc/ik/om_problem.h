@@ -86,10 +86,6 @@ typedef struct {
     /* A 6-DOF arm near a family scanned on its wrist residual (om_wrist_residual: om_g is it,
      * circle.c's windows at the singular wrist); false for every other evaluation. */
     bool wrist;
-    /* A 6-DOF arm's torus searched about joint 1's axis: the lifted point's third coordinate is
-     * q1, not the elbow angle (om_six_dof_model_ik_about_axis; torus_half_line.c); false for
-     * every other evaluation. */
-    bool about_axis;
 } om_problem;
 
 #endif

@@ -71,6 +71,10 @@ bool om_margin_may_reach(const double *ms, int i, int count, bool cyclic);
 /* The model's hand position at the torus point (w1, w7) (not counted as an evaluation). */
 vec3 om_torus_point(const om_problem *pb, double w1, double w7);
 vec3 om_lifted_residual(om_problem *pb, vec3 x, double *q);
+/* A 6-DOF arm's residual about joint 1's axis (om_six_dof_model_ik_about_axis) at x = (w5, w6, q1,
+ * gamma) for p_m = p_d + R delta(w5, w6), one evaluation: the model IK into q (every joint), the
+ * four residuals into F. */
+void om_axis_residual(om_problem *pb, const double *x, double *q, double *F);
 vec3 om_deflated_residual(om_problem *pb, vec3 x, double *q, const double *known, int n_known); /* known: n x 3 */
 double om_max_norm(vec3 F);
 /* 6-DOF circle arms: the wrist's consistency with q_J = w given (NaN out of reach). */

@@ -242,9 +242,6 @@ static double _lifted_ik(om_problem *pb, const void *args, double *q, bool neare
     const om_solver_data *s = pb->s;
     if (s->family == OM_SRS)
         a->F = om_srs_model_ik_lifted(s->params, &pb->t, pm, pb->signs, x.x, x.y, x.z, q);
-    else if (pb->about_axis)
-        a->F = om_six_dof_model_ik_about_axis(s->params, s->model_table, &pb->t, pm, pb->signs, pb->q_prev, x.x,
-                                              x.y, x.z, q);
     else
         a->F = om_six_dof_model_ik_lifted(s->params, s->model_table, &pb->t, pm, pb->signs, pb->q_prev, x.x, x.y,
                                           x.z, q);
@@ -262,6 +259,32 @@ vec3 om_lifted_residual(om_problem *pb, vec3 x, double *q)
     lifted_ik args = {x, v3(NAN, NAN, NAN)};
     om_near_ik(pb, _lifted_ik, &args, q || !pb->s->nominal_table ? q : scratch);
     return args.F;
+}
+
+/* What om_axis_residual solves: the point x = (w5, w6, q1, gamma), and the residual there (out). */
+typedef struct {
+    const double *x;
+    double F[4];
+} axis_ik;
+
+/* The model IK about joint 1's axis at x (om_model_eval; its residual the largest of the four;
+ * its margin 0: nothing out of reach). */
+static double _axis_ik(om_problem *pb, const void *args, double *q, bool nearest, double *residual)
+{
+    axis_ik *a = (axis_ik *)args;
+    const om_solver_data *s = pb->s;
+    pb->counter++;
+    vec3 pm = om_torus_point(pb, a->x[0], a->x[1]);
+    om_six_dof_model_ik_about_axis(s->params, s->model_table, &pb->t, pm, pb->signs, pb->q_prev, a->x, q, a->F);
+    *residual = py_max(py_max(fabs(a->F[0]), fabs(a->F[1])), py_max(fabs(a->F[2]), fabs(a->F[3])));
+    return 0.0;
+}
+
+void om_axis_residual(om_problem *pb, const double *x, double *q, double *F)
+{
+    axis_ik args = {x, {NAN, NAN, NAN, NAN}};
+    om_near_ik(pb, _axis_ik, &args, q);
+    memcpy(F, args.F, sizeof args.F);
 }
 
 /* The lifted residual times prod_k (1 + 1 / |x - x_k|^2) over the known roots x_k

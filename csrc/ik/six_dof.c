@@ -190,33 +190,31 @@ vec3 om_six_dof_model_ik_lifted(const double *P, const double *table, const om_t
     return v3(wrist, joint5, x - cos(gamma));
 }
 
-/* The same model IK about joint 1's axis, with q5, q6 and q1 given: where the wrist centre is on
- * the axis the closed form's q1 (its azimuth) is any, and turns by pi as the centre crosses it;
- * with q1 given the reach in the arm plane is the centre's signed part along phi1, rho (ARM its
- * sign), smooth through the axis. Joints 2 and 3 from the elbow's closed form (ELBOW; NaN
- * residuals beyond its reach, q not written), 4 and 5 as om_six_dof_model_ik_lifted's. Returns
- * the (wrist, joint 5, shoulder) residuals, the shoulder's the centre's part across phi1 less
- * the lateral offset's, -sigma1 h (m). */
-vec3 om_six_dof_model_ik_about_axis(const double *P, const double *table, const om_target *t, vec3 p,
-                                    const int64_t *signs, const double *q_prev, double q5, double q6, double q1,
-                                    double *q)
+/* The same model IK about joint 1's axis, with q5, q6, q1 and the elbow angle gamma given (x:
+ * these four; gamma NaN: the elbow's root in the ELBOW branch, as om_six_dof_model_ik_lifted's):
+ * where the wrist centre is on the axis, or h from it (the shoulder's edge of reach), the closed
+ * form's q1 turns about a point or has a square root; with q1 given, the reach in the arm plane
+ * is the centre's signed part along phi1, rho (ARM its sign), and nothing has a square root,
+ * the elbow's edge included. Joints 2 and 3 from gamma, 4 and 5 as om_six_dof_model_ik_lifted's.
+ * Writes q (q6 as given) and the (wrist, joint 5, shoulder, elbow) residuals into F, the
+ * shoulder's the centre's part across phi1 less the lateral offset's, -sigma1 h (m). */
+void om_six_dof_model_ik_about_axis(const double *P, const double *table, const om_target *t, vec3 p,
+                                    const int64_t *signs, const double *q_prev, const double *x, double *q, double *F)
 {
-    double joints[OM_MAX_DOF], joint5;
-    double *out = q ? q : joints;
     vec3 pw = v_add(t->wrist, p);
-    double phi1 = q1 + P[SD_THETA1], c1 = cos(phi1), s1 = sin(phi1);
+    double phi1 = x[2] + P[SD_THETA1], c1 = cos(phi1), s1 = sin(phi1);
     double u = c1 * pw.x + s1 * pw.y - P[SD_A1], v = P[SD_SIGMA1] * (pw.z - P[SD_D1]);
-    double shoulder = -s1 * pw.x + c1 * pw.y + P[SD_SIGMA1] * P[SD_LATERAL];
     double D = u * u + v * v, a2 = P[SD_A2], l3 = P[SD_ELL3];
-    double outer = fabs(a2) + l3, inner = fabs(a2) - l3;
-    double k = (outer * outer - D) * (D - inner * inner);
-    if (k / py_max(D * D, 1.0) < -OM_REACH_SLACK)
-        return v3(NAN, NAN, NAN);
-    double gamma = atan2((double)signs[1] * sqrt(py_max(k, 0.0)), om_sign(a2) * (D - a2 * a2 - l3 * l3));
-    out[0] = om_wrap(q1);
-    _rrr_joints_2_3(P, u, v, D, gamma, q_prev, out);
-    double wrist = _wrist_given_q5_q6(P, table, t, q5, q6, out, &joint5);
-    return v3(wrist, joint5, shoulder);
+    double elbow = (D - a2 * a2 - l3 * l3) / (2.0 * a2 * l3), gamma = x[3];
+    if (isnan(gamma)) {
+        double xc = py_min(py_max(elbow, -1.0), 1.0);
+        gamma = atan2((double)signs[1] * sqrt(1.0 - xc * xc), xc);
+    }
+    q[0] = om_wrap(x[2]);
+    _rrr_joints_2_3(P, u, v, D, gamma, q_prev, q);
+    F[0] = _wrist_given_q5_q6(P, table, t, x[0], x[1], q, &F[1]);
+    F[2] = -s1 * pw.x + c1 * pw.y + P[SD_SIGMA1] * P[SD_LATERAL];
+    F[3] = elbow - cos(gamma);
 }
 
 /* The model's hand position on the torus of a PUMA-like wrist, p_m = p_d + R delta(w5, w6)

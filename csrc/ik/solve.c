@@ -125,7 +125,6 @@ void om_problem_init(om_problem *pb, const om_solver_data *s, const double *T, c
     pb->memo = NULL;
     pb->nominal = false;
     pb->wrist = false;
-    pb->about_axis = false;
 }
 
 /* A hinted solve's local part (the hint is pb->q_prev, copied into start): the local solve

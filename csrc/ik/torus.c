@@ -297,7 +297,7 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
     }
     int count = om_half_line_roots(pb, lo1, lo7, step, m, q, roots, t.count, log);
     if (pb->s->family != OM_SRS && grid)
-        count = om_shoulder_edge_roots(pb, lo1, lo7, step, m, F, q, roots, count, log);
+        count = om_shoulder_edge_roots(pb, lo1, lo7, step, m, q, roots, count, log);
     free(S);
     free(t.known.x);
     free(t.known.near);

@@ -112,9 +112,10 @@ int om_half_line_roots(om_problem *pb, double lo1, double lo7, double step, int 
                        int count, om_candidate_log *log);
 /* A 6-DOF arm's roots at the shoulder's edge of reach, the wrist centre h from joint 1's axis (h
  * its lateral offset; none where h = 0): Newton about the axis (torus_half_line.c) from each
- * cell of the grid (lo1, lo7, step, m nodes a side) that the edge crosses, some of its corners'
- * lifted residuals F (m x m) beyond the shoulder's reach (inf). Returns the root count. */
-int om_shoulder_edge_roots(om_problem *pb, double lo1, double lo7, double step, int m, const double *F, double *q,
-                           double *roots, int count, om_candidate_log *log);
+ * cell of the grid (lo1, lo7, step, m nodes a side) that the edge crosses or may touch between
+ * its corners (where the two ARM branches' roots meet, the reach's margin at a minimum).
+ * Returns the root count. */
+int om_shoulder_edge_roots(om_problem *pb, double lo1, double lo7, double step, int m, double *q, double *roots,
+                           int count, om_candidate_log *log);
 
 #endif

@@ -164,19 +164,106 @@ static int _half_line_points(om_problem *pb, double lo1, double lo7, double step
     return count;
 }
 
-/* Newton on a 6-DOF arm's system about joint 1's axis (om_six_dof_model_ik_about_axis: (w5, w6,
- * q1), smooth where the wrist centre is on the axis or at the shoulder's edge of reach, h from
- * it) from x; an end not in ends (n_ends of them, LINE_SEEDS at most) is a candidate, as
+/* The largest of |F_i|, i < 4 (inf where one is not finite). */
+static double _norm4(const double *F)
+{
+    double most = 0.0;
+    for (int i = 0; i < 4; i++)
+        most = isfinite(F[i]) ? py_max(most, fabs(F[i])) : INFINITY;
+    return most;
+}
+
+/* The solution of the 4 x 4 system A s = b (A's rows with b appended: A[i][4]) into s, by
+ * Gaussian elimination with partial pivoting; false where A is singular. */
+static bool _solve4(double A[4][5], double *s)
+{
+    for (int c = 0; c < 4; c++) {
+        int pivot = c;
+        for (int i = c + 1; i < 4; i++)
+            if (fabs(A[i][c]) > fabs(A[pivot][c]))
+                pivot = i;
+        if (!(fabs(A[pivot][c]) > 0.0))
+            return false;
+        for (int k = 0; k < 5; k++) {
+            double t = A[c][k];
+            A[c][k] = A[pivot][k];
+            A[pivot][k] = t;
+        }
+        for (int i = c + 1; i < 4; i++) {
+            double f = A[i][c] / A[c][c];
+            for (int k = c; k < 5; k++)
+                A[i][k] -= f * A[c][k];
+        }
+    }
+    for (int i = 3; i >= 0; i--) {
+        double sum = A[i][4];
+        for (int k = i + 1; k < 4; k++)
+            sum -= A[i][k] * s[k];
+        s[i] = sum / A[i][i];
+    }
+    return true;
+}
+
+/* Damped Newton on a 6-DOF arm's system about joint 1's axis (om_axis_residual: x = (w5, w6, q1,
+ * gamma), no square root anywhere: smooth where the wrist centre is on the axis or at the
+ * shoulder's edge of reach, and at the elbow's edge too) from x (its gamma NaN: the ELBOW
+ * branch's root there), as om_lifted_newton's (forward-difference Jacobian, steps of at most
+ * 0.5 rad, halved down to AXIS_MIN_STEP until the residual falls, AXIS_STALL slow steps at
+ * most). x becomes the end, q the model IK there; returns the residual's max norm there. */
+#define AXIS_NEWTON 30
+#define AXIS_STALL 3
+#define AXIS_MIN_STEP (1.0 / 256.0)
+static double _axis_newton(om_problem *pb, double *x, double *q)
+{
+    double F[4], Fn[4], J[4][5], step[4], y[4], eps = 1e-7;
+    om_axis_residual(pb, x, q, F);
+    if (isnan(x[3]))
+        x[3] = lifted_elbow(pb->s, q);
+    double r = _norm4(F);
+    int slow = 0;
+    for (int it = 0; it < AXIS_NEWTON && r < INFINITY && r > 1e-15 && slow < AXIS_STALL; it++) {
+        for (int k = 0; k < 4; k++) {
+            memcpy(y, x, sizeof y);
+            y[k] += eps;
+            om_axis_residual(pb, y, q, Fn);
+            for (int i = 0; i < 4; i++)
+                J[i][k] = (Fn[i] - F[i]) / eps;
+        }
+        for (int i = 0; i < 4; i++)
+            J[i][4] = -F[i];
+        if (!_solve4(J, step))
+            break;
+        double size = py_max(py_max(fabs(step[0]), fabs(step[1])), py_max(fabs(step[2]), fabs(step[3])));
+        double t = size < 0.5 ? 1.0 : 0.5 / size, rn = INFINITY;
+        for (; t > AXIS_MIN_STEP; t *= 0.5) {
+            for (int k = 0; k < 4; k++)
+                y[k] = x[k] + t * step[k];
+            om_axis_residual(pb, y, q, Fn);
+            rn = _norm4(Fn);
+            if (rn < r)
+                break;
+        }
+        if (!(rn < r))
+            break;
+        memcpy(x, y, sizeof y);
+        memcpy(F, Fn, sizeof F);
+        slow = rn > 0.9 * r ? slow + 1 : 0;
+        r = rn;
+    }
+    om_axis_residual(pb, x, q, F); /* (q of the end) */
+    return _norm4(F);
+}
+
+/* Newton about joint 1's axis (_axis_newton) from (w5, w6, q1), gamma the ELBOW branch's; an end
+ * not in ends (n_ends of them, LINE_SEEDS at most; compared in w5, w6, q1) is a candidate, as
  * torus_candidate's. Returns the root count. */
-static int _about_axis(om_problem *pb, vec3 x, vec3 *ends, int *n_ends, double *q, double *roots, int count,
+static int _about_axis(om_problem *pb, vec3 start, vec3 *ends, int *n_ends, double *q, double *roots, int count,
                        om_candidate_log *log)
 {
-    vec3 end;
-    pb->about_axis = true;
-    double r = om_lifted_newton(pb, NULL, x, q, NULL, 0, NULL, &end);
-    pb->about_axis = false;
-    if (r > OM_ROOT_TOL)
+    double x[4] = {start.x, start.y, start.z, NAN};
+    if (_axis_newton(pb, x, q) > OM_ROOT_TOL)
         return count;
+    vec3 end = v3(x[0], x[1], x[2]);
     for (int e = 0; e < *n_ends; e++)
         if (same_point(end, ends[e]))
             return count;
@@ -201,27 +288,47 @@ static int _axis_roots(om_problem *pb, const half_line_chart *points, int n, dou
     return count;
 }
 
-int om_shoulder_edge_roots(om_problem *pb, double lo1, double lo7, double step, int m, const double *F, double *q,
-                           double *roots, int count, om_candidate_log *log)
+int om_shoulder_edge_roots(om_problem *pb, double lo1, double lo7, double step, int m, double *q, double *roots,
+                           int count, om_candidate_log *log)
 {
     const double *P = pb->s->params;
     double h = P[SD_LATERAL];
-    for (int i = 0; i + 1 < m && h != 0.0; i++) {
+    if (h == 0.0)
+        return count;
+    /* K = pw_x^2 + pw_y^2 - h^2 at the nodes: the reach's condition. pw = c + R delta terms, each
+     * at most line.reach long with its derivatives: |K''| <= 2 (|pw'|^2 + |pw| |pw''|), along
+     * any direction of a cell (mixed terms: 4x), within a cell's half-diagonal */
+    singular_line line = _singular_line(pb);
+    double size = hypot(line.centre.x, line.centre.y) + line.reach;
+    double bend = 8.0 * (line.reach * line.reach + size * line.reach) * step * step;
+    double *K = malloc((size_t)m * (size_t)m * sizeof(double));
+    if (!K)
+        return count;
+    vec3 d1, d7;
+    for (int i = 0; i < m; i++)
+        for (int j = 0; j < m; j++) {
+            vec3 pw = _shoulder_wrist(pb, lo1 + (double)i * step, lo7 + (double)j * step, &d1, &d7);
+            K[i * m + j] = pw.x * pw.x + pw.y * pw.y - h * h;
+        }
+    for (int i = 0; i + 1 < m; i++) {
         for (int j = 0; j + 1 < m; j++) {
-            int out = 0;
-            for (int k = 0; k < 4; k++)
-                out += !(F[(i + k / 2) * m + j + k % 2] < INFINITY);
-            if (out == 0 || out == 4)
+            double lo = INFINITY, hi = -INFINITY;
+            for (int k = 0; k < 4; k++) {
+                lo = py_min(lo, K[(i + k / 2) * m + j + k % 2]);
+                hi = py_max(hi, K[(i + k / 2) * m + j + k % 2]);
+            }
+            if (!(lo - bend <= 0.0 && 0.0 <= hi + bend)) /* the edge neither crosses the cell nor may touch it */
                 continue;
             /* at the edge rho = 0: phi1 = azimuth - atan2(-sigma1 h, 0), both ARM branches' */
             double w5 = lo1 + ((double)i + 0.5) * step, w6 = lo7 + ((double)j + 0.5) * step;
-            vec3 pw = v_add(pb->t.wrist, om_torus_point(pb, w5, w6));
+            vec3 pw = _shoulder_wrist(pb, w5, w6, &d1, &d7);
             double q1 = atan2(pw.y, pw.x) - atan2(-P[SD_SIGMA1] * h, 0.0) - P[SD_THETA1];
             vec3 ends[LINE_SEEDS];
             int n_ends = 0;
             count = _about_axis(pb, v3(w5, w6, q1), ends, &n_ends, q, roots, count, log);
         }
     }
+    free(K);
     return count;
 }
 

@@ -19,6 +19,7 @@ from .model_conditions import (
     check_right_angle,
     off_right_angle,
     refuse_fixed_rows,
+    rounding_length,
 )
 from .model_frames import circle_fit, pose, tail_rotation, torus_fit
 
@@ -151,7 +152,10 @@ def position_family(arm: Arm, rows: list[DHRow]) -> tuple[int, str, np.ndarray]:
                 f"arm '{arm.name}': a2 = 0 leaves {joint_name(arm, 1)} and {joint_name(arm, 2)} "
                 "without a link"
             )
-        P[_core.SD_LATERAL] = np.cos(r2.alpha) * r2.d + r3.d + r4.d * np.cos(r3.alpha)
+        lateral = np.cos(r2.alpha) * r2.d + r3.d + r4.d * np.cos(r3.alpha)
+        # (cos(90 deg) d4 = 1e-17 m is rounding, not an offset: the shoulder's edge of reach is
+        # then the axis itself, which the torus search of a PUMA-like wrist takes as such)
+        P[_core.SD_LATERAL] = 0.0 if abs(lateral) <= rounding_length(arm.chain) else lateral
         planar = np.array([r3.a, -r4.d * np.sin(r3.alpha)])
         P[_core.SD_ELL3] = np.linalg.norm(planar)
         P[_core.SD_BETA] = np.arctan2(planar[1], planar[0])
