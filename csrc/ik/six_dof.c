@@ -127,6 +127,17 @@ double om_six_dof_model_ik(int family, const double *P, const double *table, con
     return margin;
 }
 
+/* Joints 4 and 5 from the wrist's rotation M with q6 given, phi6 first: into q (q6 as given);
+ * returns the wrist's consistency N22 (om_six_dof_model_ik_q6). */
+static double _wrist_given_q6(const double *P, mat3 M, double q6, double *q)
+{
+    vec3 neg = om_euler_zxzxz_given_first(m_transpose(M), -P[SD_SIGMA5], 0.0, -P[SD_SIGMA4], -(q6 + P[SD_THETA6]));
+    q[3] = om_wrap(-neg.y - P[SD_THETA4]);
+    q[4] = om_wrap(-neg.x - P[SD_THETA5]);
+    q[5] = q6;
+    return neg.z;
+}
+
 /* The closed form with q6 given (as the S-R-S lifted system takes q7): joints 1-3 as in
  * om_six_dof_model_ik, joints 4 and 5 from M^T = Rz(-phi6) Rx(-alpha5) Rz(-phi5) Rx(-alpha4)
  * Rz(-phi4) with phi6 first (om_euler_zxzxz_given_first), which is smooth also at the wrist
@@ -139,27 +150,32 @@ double om_six_dof_model_ik_q6(int family, const double *P, const double *table, 
     double margin = position_and_wrist(family, P, table, t, p, signs, q_prev, q, &M, false);
     if (margin < -OM_REACH_SLACK)
         return margin;
-    vec3 neg = om_euler_zxzxz_given_first(m_transpose(M), -P[SD_SIGMA5], 0.0, -P[SD_SIGMA4], -(q6 + P[SD_THETA6]));
-    q[3] = om_wrap(-neg.y - P[SD_THETA4]);
-    q[4] = om_wrap(-neg.x - P[SD_THETA5]);
-    q[5] = q6;
-    *residual = neg.z;
+    *residual = _wrist_given_q6(P, M, q6, q);
     return margin;
 }
 
-/* Joints 4 and 5 of q from the wrist's rotation at joints 1-3 of q with q6 given (phi6 first,
- * om_euler_zxzxz_given_first: smooth at the singular wrist), into q (q6 as given); returns the
- * wrist's consistency N22 and phi5 less q5's: zero together iff q5, q6 fit the target. */
+/* The wrist's residuals at joints 1-3 of q with q5 and q6 given: joints 4 and 5 into q
+ * (_wrist_given_q6); returns the wrist's consistency N22, phi5 less q5's into *joint5: zero
+ * together iff q5 and q6 fit the target. */
 static double _wrist_given_q5_q6(const double *P, const double *table, const om_target *t, double q5, double q6,
                                  double *q, double *joint5)
 {
-    mat3 M = _wrist_rotation(P, table, t, q);
-    vec3 neg = om_euler_zxzxz_given_first(m_transpose(M), -P[SD_SIGMA5], 0.0, -P[SD_SIGMA4], -(q6 + P[SD_THETA6]));
-    q[3] = om_wrap(-neg.y - P[SD_THETA4]);
-    q[4] = om_wrap(-neg.x - P[SD_THETA5]);
-    q[5] = q6;
+    double wrist = _wrist_given_q6(P, _wrist_rotation(P, table, t, q), q6, q);
     *joint5 = om_wrap(q[4] - q5);
-    return neg.z;
+    return wrist;
+}
+
+/* The elbow's cosine x = (D - a2^2 - l3^2) / (2 a2 l3) that the wrist centre asks for (D the
+ * squared reach in the arm plane), into *x; returns gamma if given, else (NaN) the root of x =
+ * cos(gamma) in the ELBOW branch elbow, x clamped into [-1, 1]. */
+static double _elbow(const double *P, double D, double gamma, double elbow, double *x)
+{
+    double a2 = P[SD_A2], l3 = P[SD_ELL3];
+    *x = (D - a2 * a2 - l3 * l3) / (2.0 * a2 * l3);
+    if (!isnan(gamma))
+        return gamma;
+    double xc = py_min(py_max(*x, -1.0), 1.0);
+    return atan2(elbow * sqrt(1.0 - xc * xc), xc);
 }
 
 /* The lifted model IK of the RRR family on the torus (q5, q6) of a PUMA-like wrist (the
@@ -175,16 +191,12 @@ vec3 om_six_dof_model_ik_lifted(const double *P, const double *table, const om_t
                                 const int64_t *signs, const double *q_prev, double q5, double q6, double gamma,
                                 double *q)
 {
-    double joints[OM_MAX_DOF], u, v, joint5;
+    double joints[OM_MAX_DOF], u, v, joint5, x;
     double *out = q ? q : joints;
     if (_shoulder(P, v_add(t->wrist, p), signs, q_prev, out, -OM_REACH_SLACK, &u, &v) < -OM_REACH_SLACK)
         return v3(NAN, NAN, NAN);
-    double D = u * u + v * v, a2 = P[SD_A2], l3 = P[SD_ELL3];
-    double x = (D - a2 * a2 - l3 * l3) / (2.0 * a2 * l3);
-    if (isnan(gamma)) {
-        double xc = py_min(py_max(x, -1.0), 1.0);
-        gamma = atan2((double)signs[1] * sqrt(1.0 - xc * xc), xc);
-    }
+    double D = u * u + v * v;
+    gamma = _elbow(P, D, gamma, (double)signs[1], &x);
     _rrr_joints_2_3(P, u, v, D, gamma, q_prev, out);
     double wrist = _wrist_given_q5_q6(P, table, t, q5, q6, out, &joint5);
     return v3(wrist, joint5, x - cos(gamma));
@@ -204,12 +216,8 @@ void om_six_dof_model_ik_about_axis(const double *P, const double *table, const 
     vec3 pw = v_add(t->wrist, p);
     double phi1 = x[2] + P[SD_THETA1], c1 = cos(phi1), s1 = sin(phi1);
     double u = c1 * pw.x + s1 * pw.y - P[SD_A1], v = P[SD_SIGMA1] * (pw.z - P[SD_D1]);
-    double D = u * u + v * v, a2 = P[SD_A2], l3 = P[SD_ELL3];
-    double elbow = (D - a2 * a2 - l3 * l3) / (2.0 * a2 * l3), gamma = x[3];
-    if (isnan(gamma)) {
-        double xc = py_min(py_max(elbow, -1.0), 1.0);
-        gamma = atan2((double)signs[1] * sqrt(1.0 - xc * xc), xc);
-    }
+    double D = u * u + v * v, elbow;
+    double gamma = _elbow(P, D, x[3], (double)signs[1], &elbow);
     q[0] = om_wrap(x[2]);
     _rrr_joints_2_3(P, u, v, D, gamma, q_prev, q);
     F[0] = _wrist_given_q5_q6(P, table, t, x[0], x[1], q, &F[1]);
