@@ -81,6 +81,9 @@ vec3 om_six_dof_model_ik_lifted(const double *P, const double *table, const om_t
  * writes q and the (wrist, joint 5, shoulder, elbow) residuals into F (4). */
 void om_six_dof_model_ik_about_axis(const double *P, const double *table, const om_target *t, vec3 p,
                                     const int64_t *signs, const double *q_prev, const double *x, double *q, double *F);
+/* dp seen from the flange on that torus, delta(w5, w6) = sum_ij C_ij t_i(w5) t_j(w6)
+ * (SD_WRIST_TORUS), and (d5 not NULL) its derivatives in w5 and w6 into *d5, *d6. */
+vec3 om_six_dof_wrist_delta(const double *P, double w5, double w6, vec3 *d5, vec3 *d6);
 /* The model's hand position p_d + R delta(w5, w6) on that torus. */
 vec3 om_six_dof_torus_point(const double *P, const mat3 *R, vec3 p, double w5, double w6);
 /* wrist_offset.c: for a4 != 0 (P[SD_WRIST_OFFSET] != 0), the model's hand position

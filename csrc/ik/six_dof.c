@@ -225,16 +225,30 @@ void om_six_dof_model_ik_about_axis(const double *P, const double *table, const 
     F[3] = elbow - cos(gamma);
 }
 
+vec3 om_six_dof_wrist_delta(const double *P, double w5, double w6, vec3 *d5, vec3 *d6)
+{
+    double c5 = cos(w5), s5 = sin(w5), c6 = cos(w6), s6 = sin(w6);
+    const double t5[3] = {1.0, c5, s5}, t6[3] = {1.0, c6, s6}, dt5[3] = {0.0, -s5, c5}, dt6[3] = {0.0, -s6, c6};
+    vec3 delta = v3(0.0, 0.0, 0.0), e5 = delta, e6 = delta;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            vec3 C = v_load(P, SD_WRIST_TORUS + 3 * (3 * i + j));
+            delta = v_add(delta, v_scale(t5[i] * t6[j], C));
+            if (d5) {
+                e5 = v_add(e5, v_scale(dt5[i] * t6[j], C));
+                e6 = v_add(e6, v_scale(t5[i] * dt6[j], C));
+            }
+        }
+    if (d5)
+        *d5 = e5, *d6 = e6;
+    return delta;
+}
+
 /* The model's hand position on the torus of a PUMA-like wrist, p_m = p_d + R delta(w5, w6)
  * (SD_WRIST_TORUS). */
 vec3 om_six_dof_torus_point(const double *P, const mat3 *R, vec3 p, double w5, double w6)
 {
-    const double t5[3] = {1.0, cos(w5), sin(w5)}, t6[3] = {1.0, cos(w6), sin(w6)};
-    vec3 delta = v3(0.0, 0.0, 0.0);
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            delta = v_add(delta, v_scale(t5[i] * t6[j], v_load(P, SD_WRIST_TORUS + 3 * (3 * i + j))));
-    return v_add(p, m_mv(*R, delta));
+    return v_add(p, m_mv(*R, om_six_dof_wrist_delta(P, w5, w6, NULL, NULL)));
 }
 
 /* The quantities whose signs are (ARM, ELBOW, WRIST) at joint vector q, into out[0..2]. */

@@ -19,21 +19,13 @@ static vec3 _shoulder_wrist(om_problem *pb, double w1, double w7, vec3 *d1, vec3
 {
     const double(*D)[3] = pb->s->D;
     const mat3 *R = &pb->t.R;
-    double c1 = cos(w1), s1 = sin(w1), c7 = cos(w7), s7 = sin(w7);
     if (pb->s->family != OM_SRS) {
-        const double t5[3] = {1.0, c1, s1}, t6[3] = {1.0, c7, s7}, dt5[3] = {0.0, -s1, c1}, dt6[3] = {0.0, -s7, c7};
-        vec3 delta = v3(0.0, 0.0, 0.0), e5 = delta, e6 = delta;
-        for (int i = 0; i < 3; i++)
-            for (int j = 0; j < 3; j++) {
-                vec3 C = v_load(pb->s->params, SD_WRIST_TORUS + 3 * (3 * i + j));
-                delta = v_add(delta, v_scale(t5[i] * t6[j], C));
-                e5 = v_add(e5, v_scale(dt5[i] * t6[j], C));
-                e6 = v_add(e6, v_scale(t5[i] * dt6[j], C));
-            }
-        *d1 = m_mv(*R, e5);
-        *d7 = m_mv(*R, e6);
+        vec3 delta = om_six_dof_wrist_delta(pb->s->params, w1, w7, d1, d7);
+        *d1 = m_mv(*R, *d1);
+        *d7 = m_mv(*R, *d7);
         return v_add(v_add(pb->p, pb->t.wrist), m_mv(*R, delta));
     }
+    double c1 = cos(w1), s1 = sin(w1), c7 = cos(w7), s7 = sin(w7);
     vec3 a = v_add(v_load(D[3], 0), v_add(v_scale(c1, v_load(D[4], 0)), v_scale(s1, v_load(D[5], 0))));
     *d1 = v_sub(v_scale(c1, v_load(D[5], 0)), v_scale(s1, v_load(D[4], 0)));
     *d7 = m_mv(*R, v_sub(v_scale(c7, v_load(D[2], 0)), v_scale(s7, v_load(D[1], 0))));

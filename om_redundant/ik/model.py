@@ -44,7 +44,7 @@ from ..kinematics.chain import KinematicChain
 from ..validation import as_instance
 from .joint_names import joint_name, joints_named, row_name
 from .model_conditions import LENGTH_ROUNDING, rounding_length
-from .model_frames import circle_fit, pose
+from .model_frames import circle_fit, flange_delta, pose
 from .six_dof_model import six_dof_model
 from .srs_model import srs_model
 
@@ -139,7 +139,7 @@ def derive_model(arm: Arm) -> ModelArm:
     else:
         dp_joint = _dp_joint(arm, shoulderless, model_chain)
         delta = circle_fit(
-            arm, "dp seen from the flange", dp_joint, lambda q: _delta(shoulderless, model_chain, q)
+            arm, "dp seen from the flange", dp_joint, lambda q: flange_delta(shoulderless, model_chain, q)
         )
         shoulder = circle_fit(
             arm,
@@ -180,23 +180,17 @@ def _refuse_rounding(arm: Arm) -> None:
                 )
 
 
-def _delta(real: KinematicChain, model: KinematicChain, q: np.ndarray) -> np.ndarray:
-    R, p_real = pose(real.table, q)
-    _, p_model = pose(model.table, q)
-    return R.T @ (p_model - p_real)
-
-
 def _dp_joint(arm: Arm, real: KinematicChain, model: KinematicChain) -> int:
     """The joint that delta (dp in the flange frame) depends on; -1 if it is constant."""
     rng = np.random.default_rng(0)
     dependent = set()
     for _ in range(8):
         q = rng.uniform(-np.pi, np.pi, real.dof)
-        base = _delta(real, model, q)
+        base = flange_delta(real, model, q)
         for j in range(real.dof):
             moved = q.copy()
             moved[j] += rng.uniform(0.3, 2.0)
-            if np.abs(_delta(real, model, moved) - base).max() > 1e-12:
+            if np.abs(flange_delta(real, model, moved) - base).max() > 1e-12:
                 dependent.add(j)
     if len(dependent) > 1:
         zeroed = [

@@ -37,6 +37,14 @@ def tail_rotation(rows: list[DHRow], last: int) -> np.ndarray:
     return pose(KinematicChain(tuple(tail)).table, np.zeros(0))[0]
 
 
+def flange_delta(real: KinematicChain, model: KinematicChain, q: np.ndarray) -> np.ndarray:
+    """dp seen from the flange: the model's flange position less the real arm's, in the real
+    flange's frame, at q."""
+    R, p_real = pose(real.table, q)
+    _, p_model = pose(model.table, q)
+    return R.T @ (p_model - p_real)
+
+
 def _harmonics(at) -> np.ndarray:
     """C0, C1, C2 of f(w) = C0 + C1 cos w + C2 sin w from f at 0, 90, 180 and -90 deg."""
     d0, d1, d2, d3 = (at(w) for w in (0.0, np.pi / 2, np.pi, -np.pi / 2))

@@ -21,7 +21,7 @@ from .model_conditions import (
     refuse_fixed_rows,
     rounding_length,
 )
-from .model_frames import circle_fit, pose, tail_rotation, torus_fit
+from .model_frames import circle_fit, flange_delta, pose, tail_rotation, torus_fit
 
 
 def six_dof_model(arm: Arm) -> tuple[KinematicChain, int, str, np.ndarray, np.ndarray | None]:
@@ -58,8 +58,9 @@ def six_dof_model(arm: Arm) -> tuple[KinematicChain, int, str, np.ndarray, np.nd
     params[_core.SD_WRIST_CENTRE : _core.SD_WRIST_CENTRE + 3] = R_fl.T @ (o4 - p_fl)
     if offsets[0] == 0.0:
         return model_chain, family, family_name, params, None
-    if parallel_wrist(arm, model_chain):
-        wrist_offset(arm, model_chain, offsets, params, R_fl)
+    axis4 = joint_4_circle(arm, model_chain)
+    if axis4 is not None:
+        wrist_offset(arm, model_chain, offsets, params, R_fl, axis4)
         return model_chain, family, family_name + ", wrist offset a4 (dp turns with q1)", params, None
     if family != _core.RRR_SPHERICAL_WRIST:
         raise ModelError(
@@ -73,15 +74,15 @@ def six_dof_model(arm: Arm) -> tuple[KinematicChain, int, str, np.ndarray, np.nd
     return model_chain, family, name, params, coefficients
 
 
-def parallel_wrist(arm: Arm, model_chain: KinematicChain) -> bool:
-    """Whether joint 4's axis turns with q1 alone (parallel to joint 2's, as when joints 2, 3 and
-    4 are parallel): a wrist offset a4's dp then turns with q1 (:func:`wrist_offset`)."""
+def joint_4_circle(arm: Arm, model_chain: KinematicChain) -> np.ndarray | None:
+    """Joint 4's axis in DH frame 0 as C0 + C1 cos q1 + C2 sin q1 (rows C0, C1, C2) where it turns
+    with q1 alone (parallel to joint 2's, as when joints 2, 3 and 4 are parallel): a wrist offset
+    a4's dp then turns with q1 (:func:`wrist_offset`); None where it turns with more."""
     table, jr = model_chain.table, arm.chain.joint_rows
     try:
-        circle_fit(arm, "joint 4's axis", 0, lambda q: pose(table[: jr[3]], q[:3])[0][:, 2])
+        return circle_fit(arm, "joint 4's axis", 0, lambda q: pose(table[: jr[3]], q[:3])[0][:, 2])
     except ModelError:
-        return False
-    return True
+        return None
 
 
 def wrist_torus(arm: Arm, model_chain: KinematicChain) -> np.ndarray:
@@ -103,13 +104,9 @@ def wrist_torus(arm: Arm, model_chain: KinematicChain) -> np.ndarray:
     Raises:
         ModelError: dp seen from the flange does not turn with joints 5 and 6 alone.
     """
-    real, model = arm.chain.table, model_chain.table
-
-    def delta(q: np.ndarray) -> np.ndarray:
-        R, p_real = pose(real, q)
-        return R.T @ (pose(model, q)[1] - p_real)
-
-    return torus_fit(arm, "dp seen from the flange", (4, 5), delta)
+    return torus_fit(
+        arm, "dp seen from the flange", (4, 5), lambda q: flange_delta(arm.chain, model_chain, q)
+    )
 
 
 def position_family(arm: Arm, rows: list[DHRow]) -> tuple[int, str, np.ndarray]:
@@ -183,7 +180,12 @@ def position_family(arm: Arm, rows: list[DHRow]) -> tuple[int, str, np.ndarray]:
 
 
 def wrist_offset(
-    arm: Arm, model_chain: KinematicChain, offsets: tuple[float, ...], params: np.ndarray, R_fl: np.ndarray
+    arm: Arm,
+    model_chain: KinematicChain,
+    offsets: tuple[float, ...],
+    params: np.ndarray,
+    R_fl: np.ndarray,
+    axis4: np.ndarray,
 ) -> None:
     r"""The dp circle of a 6-DOF wrist with :math:`a_4 \ne 0`, into ``params`` (``SD_WRIST_OFFSET``).
 
@@ -209,7 +211,6 @@ def wrist_offset(
     """
     jr = arm.chain.joint_rows
     table = model_chain.table
-    axis4 = circle_fit(arm, "joint 4's axis", 0, lambda q: pose(table[: jr[3]], q[:3])[0][:, 2])
     axis6 = R_fl.T @ pose(table[: jr[5]], np.zeros(5))[0][:, 2]  # R_fl: the flange's rotation at q = 0
     params[_core.SD_WRIST_OFFSET : _core.SD_WRIST_OFFSET + 3] = offsets
     params[_core.SD_AXIS4 : _core.SD_AXIS4 + 9] = axis4.ravel()
