@@ -109,6 +109,7 @@ def recorded_calls() -> dict[str, tuple[Callable[..., Any], tuple[Any, ...]]]:
         "model_ik_at_reach": (data.params, _core.FlangeTarget(R, p, signs, psi), q, np.zeros(7)),
         "srs_model_q7": (data.params, _core.FlangeTarget(R, p, signs, psi), q, np.zeros(7)),
         "model_ik_lifted": (data.params, _core.FlangeTarget(R, p, signs, psi), q[0], q[6], 0.3, np.zeros(7)),
+        "model_lifted_terms": (data.params, _core.FlangeTarget(R, p, signs, psi), q[0], q[6]),
         "polish": (
             data.real_table,
             R,

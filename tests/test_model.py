@@ -302,3 +302,41 @@ def _row(row: om.DHRow, qi: float) -> np.ndarray:
             [0, 0, 0, 1],
         ]
     )
+
+
+@pytest.mark.parametrize("name", ["gen3", "sawyer"])
+@settings(max_examples=100, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1))
+def test_lifted_terms_give_the_lifted_residuals_at_every_arm_angle(name, seed):
+    """The torus memo's terms (model_lifted_terms), evaluated at an arm angle, are
+    model_ik_lifted's residuals there with phi4 the elbow's root, in either ELBOW branch, at a
+    random (q1, q7) and hand position (within and beyond the model's reach); and phi4 is the
+    root it solves."""
+    om_arm = derive_model(om.load_arm(name))
+    P = om_arm.params
+    rng = np.random.default_rng(seed)
+    q = random_q(om_arm.real, 1, rng)[0]
+    (R, p, signs, _), _, _ = _lifted_at(om_arm, q)
+    p = p * rng.uniform(0.5, 1.5)
+    q1, q7 = rng.uniform(-np.pi, np.pi, 2)
+    for elbow in (-1, 1):
+        signs = np.array([signs[0], elbow, signs[2]])
+        terms = srs.model_lifted_terms(P, R, p, signs, q1, q7)
+        for psi in rng.uniform(-np.pi, np.pi, 4):
+            out = np.empty(7)
+            residual = srs.model_ik_lifted(P, R, p, signs, psi, q1, q7, np.nan, out)
+            c, s = np.cos(psi), np.sin(psi)
+            shoulder = terms.shoulder[0] + terms.shoulder[1] * c + terms.shoulder[2] * s
+            wrist = terms.wrist[0] + terms.wrist[1] * c + terms.wrist[2] * s
+            np.testing.assert_allclose([shoulder, wrist, terms.elbow], residual, rtol=0, atol=1e-14)
+            assert abs(wrap(terms.phi4 - P[_core.SRS_THETA + 3] - out[3])) < 1e-14
+
+
+def test_lifted_terms_are_none_where_the_wrist_centre_is_the_shoulder():
+    om_arm = derive_model(om.load_arm("sawyer"))
+    P = om_arm.params
+    R = np.eye(3)
+    p = P[_core.SRS_SHOULDER : _core.SRS_SHOULDER + 3] - R @ P[_core.SRS_WRIST : _core.SRS_WRIST + 3]
+    signs = np.array([1, 1, 1])
+    assert srs.model_lifted_terms(P, R, p, signs, 0.0, 0.0) is None
+    assert np.isnan(srs.model_ik_lifted(P, R, p, signs, 0.0, 0.0, 0.0, np.nan, np.empty(7)).shoulder)

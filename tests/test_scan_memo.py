@@ -1,5 +1,6 @@
-"""The circle search's scan memo (csrc/ik/circle_samples.c): a batch's scan cache keeps the model's parts at
-the scan's samples and edges of reach for its next scan of the same pose, so a row's answer must
+"""The circle search's scan memo (csrc/ik/circle_samples.c) and the torus search's (csrc/ik/torus.c): a
+batch's scan cache keeps the model's parts at the scan's samples and edges of reach, and the lifted
+residual's terms at the torus' grid, for its next search of the same pose, so a row's answer must
 not depend on which rows the batch solved before it, to the last bit."""
 
 from __future__ import annotations
@@ -35,7 +36,8 @@ def _rows(batch: om.BatchRoots, order: np.ndarray) -> list[np.ndarray]:
     ]
 
 
-@pytest.mark.parametrize(("name", "seed"), [("panda", 4), ("xarm7", 1)])  # poses with 0, 1 and 2 roots
+# (poses with 0, 1 and 2 roots)
+@pytest.mark.parametrize(("name", "seed"), [("panda", 4), ("xarm7", 1), ("sawyer", 4)])
 def test_grid_rows_do_not_depend_on_the_rows_before(name, seed):
     """A sweep's grid in its own order (every scan after the first of a pose takes the memo's
     parts), in a random order (arm angles and branches mixed: other parts kept, others
@@ -90,12 +92,13 @@ def _solve_all_rows(solver: om.OMSolver, Ts: np.ndarray, signs: np.ndarray, psi:
     return np.stack([batch.count, batch.evaluations], axis=1)
 
 
-def test_a_pose_that_is_not_a_number_does_not_read_the_rows_before():
+@pytest.mark.parametrize("name", ["panda", "sawyer"])
+def test_a_pose_that_is_not_a_number_does_not_read_the_rows_before(name):
     """The kernel's rows of a pose with a NaN position (reached only past the library's checks)
     are out of the model's reach at every sample whatever the batch solved before: no root, and
     the same evaluations as alone (a memo's parts of the pose before must not stand in for the
     parts that a NaN hand has none of)."""
-    solver = om.OMSolver("panda")
+    solver = om.OMSolver(name)
     T = solver.arm.fk(random_q(solver.arm, 1, np.random.default_rng(4))[0])
     Ts, signs, psi = _grid(solver, T, 4)
     broken = T.copy()

@@ -135,9 +135,21 @@ static PyStructSequence_Field lifted_fields[] = {
 static PyStructSequence_Desc lifted_desc = {"om_redundant.ckernels.Lifted", "model_ik_lifted's residuals.",
                                             lifted_fields, 3};
 static PyTypeObject *lifted_type;
+static PyStructSequence_Field lifted_terms_fields[] = {
+    {"shoulder", "the shoulder's residual's terms in 1, cos psi and sin psi"},
+    {"wrist", "the wrist's residual's terms in 1, cos psi and sin psi"},
+    {"elbow", "the elbow equation's residual, x - cos(phi4 - phi*)"},
+    {"phi4", "the elbow's root"},
+    {NULL, NULL},
+};
+static PyStructSequence_Desc lifted_terms_desc = {"om_redundant.ckernels.LiftedTerms",
+                                                  "model_lifted_terms' terms (om_srs_lifted_terms).",
+                                                  lifted_terms_fields, 4};
+static PyTypeObject *lifted_terms_type;
 
 int om_closed_forms_init(PyObject *module) {
-    return add_record_type(module, &lifted_type, &lifted_desc, "Lifted");
+    if (add_record_type(module, &lifted_type, &lifted_desc, "Lifted") < 0) return -1;
+    return add_record_type(module, &lifted_terms_type, &lifted_terms_desc, "LiftedTerms");
 }
 
 /* model_ik_lifted(P, target, q1, q7, phi4, q) -> Lifted(shoulder, wrist, elbow): the residuals
@@ -156,6 +168,26 @@ static PyObject *k_model_ik_lifted(PyObject *mod, PyObject *const *args, Py_ssiz
     release_buffers(v, 6);
     PyObject *items[3] = {PyFloat_FromDouble(r.x), PyFloat_FromDouble(r.y), PyFloat_FromDouble(r.z)};
     return new_record(lifted_type, items, 3);
+}
+
+/* model_lifted_terms(P, target, q1, q7) -> LiftedTerms or None (W = S): model_ik_lifted's residuals
+ * with phi4 the elbow's root, in terms of the arm angle (target: a FlangeTarget, its psi not read). */
+static PyObject *k_model_lifted_terms(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 4, "model_lifted_terms") < 0) return NULL;
+    double q1 = PyFloat_AsDouble(args[2]), q7 = PyFloat_AsDouble(args[3]);
+    if (PyErr_Occurred()) return NULL;
+    Py_buffer v[5]; /* P, the target's R, p, signs, psi */
+    if (get_srs_call(args[0], args[1], NULL, 0, NULL, v, "model_lifted_terms") < 0) return NULL;
+    mat3 R = m_load(v[1].buf, 0);
+    om_target t = om_target_at(OM_SRS, v[0].buf, &R, v[4].buf);
+    om_srs_lifted_terms k;
+    bool ok = om_srs_lifted_terms_at(v[0].buf, &t, v_load(v[2].buf, 0), (double)((int64_t *)v[3].buf)[1], q1, q7, &k);
+    release_buffers(v, 5);
+    if (!ok) Py_RETURN_NONE;
+    PyObject *items[4] = {Py_BuildValue("(ddd)", k.shoulder[0], k.shoulder[1], k.shoulder[2]),
+                          Py_BuildValue("(ddd)", k.wrist[0], k.wrist[1], k.wrist[2]), PyFloat_FromDouble(k.elbow),
+                          PyFloat_FromDouble(k.phi4)};
+    return new_record(lifted_terms_type, items, 4);
 }
 
 /* branch_values(family, P, q, out) and redundancy_values(family, P, q, out). */
@@ -210,6 +242,7 @@ PyMethodDef om_closed_form_functions[] = {
     FAST(model_ik_at_reach, "model_ik_at_reach(P, target, q_prev, q) -> bool (target: a FlangeTarget)"),
     FAST(srs_model_q7, "srs_model_q7(P, target, q_prev, q) -> margin (target: a FlangeTarget)"),
     FAST(model_ik_lifted, "model_ik_lifted(P, target, q1, q7, phi4, q) -> Lifted (target: a FlangeTarget)"),
+    FAST(model_lifted_terms, "model_lifted_terms(P, target, q1, q7) -> LiftedTerms or None (target: a FlangeTarget)"),
     FAST(branch_values, "branch_values(family, P, q, out)"),
     FAST(redundancy_values, "redundancy_values(family, P, q, out)"),
     FAST(arm_angle_gradient, "arm_angle_gradient(P, table, q, grad) -> psi"),

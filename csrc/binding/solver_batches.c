@@ -138,10 +138,12 @@ PyObject *om_solver_solve_all_rows(om_Solver *self, PyObject *const *args, Py_ss
     uint8_t *within = v[8].buf;
     const uint8_t *band = v[9].buf;
     /* Neighbouring rows that differ in the SHOULDER sign alone share the circle's candidates,
-     * and the rows' scans of one pose the model's parts at their samples (the memo). */
+     * and the rows' scans of one pose the model's parts at their samples (the memo), the
+     * torus' grid the lifted residual's terms (the torus memo). */
     om_scan_cache cache = {.valid = false, .capacity = OM_SCAN_CAPACITY(s->scan_points)};
     Py_BEGIN_ALLOW_THREADS cache.candidates = malloc((size_t)cache.capacity * sizeof(double));
     cache.memo = om_scan_memo_new(s);
+    cache.torus_memo = om_torus_memo_new(s);
     for (Py_ssize_t i = start; i < stop; i++) {
         double info[OM_MAX_ROOTS * 3];
         count[i] = om_solve_all(s, Tb + 16 * i, signs + k * (i - start), rb + nr * i, roots + OM_MAX_ROOTS * dof * i,
@@ -150,6 +152,7 @@ PyObject *om_solver_solve_all_rows(om_Solver *self, PyObject *const *args, Py_ss
     }
     free(cache.candidates);
     om_scan_memo_free(cache.memo);
+    om_torus_memo_free(cache.torus_memo);
     Py_END_ALLOW_THREADS release_buffers(v, 10);
     PyMem_Free(signs);
     result = Py_NewRef(Py_None);

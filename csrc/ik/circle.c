@@ -1,6 +1,6 @@
 /* The bounded search on the circle: every root of g(w), the paper's guarantee: the scan's runs
  * of reach (their roots: circle_runs.c), the islands of reach between its samples, and a near
- * arm's windows of G (the method: om_redundant/ik/system.py). */
+ * arm's windows of G (the method: om_redundant/ik/kernel_data.py). */
 #include "circle.h"
 
 #define POLE_DEPTH 64            /* nested splits of a cell at psi's half-line: to the last bit */

@@ -1,7 +1,7 @@
 /* The guard of the circle's scan at psi's singular half-line (S-R-S arms): which scan cells
  * the wrist centre passes close below the shoulder in, where psi's reference, q_J and g turn
  * by up to 2 pi within a fraction of the cell, and where such a cell is split (see pole_guard
- * in circle.h; the method: om_redundant/ik/system.py). */
+ * in circle.h; the method: om_redundant/ik/kernel_data.py). */
 #include "circle.h"
 
 #define POLE_TURN (0.25 * OM_PI) /* rad: the most w_hat's azimuth about up turns in one cell below the shoulder */

@@ -1,7 +1,7 @@
 /* The roots of g on the runs of reach of the circle's scan: brackets of sign changes, cells
  * halved where g may hold more roots than their ends show, close pairs at the minima of |g|,
  * touches of zero, and cells split at psi's half-line (circle_pole.c); a near arm's windows of
- * G by its scan's callback (the method: om_redundant/ik/system.py). */
+ * G by its scan's callback (the method: om_redundant/ik/kernel_data.py). */
 #include "circle.h"
 
 #define CELL_SAFETY 4.0  /* the curvature of g taken as this multiple of its sampled second differences */

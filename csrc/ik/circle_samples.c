@@ -1,7 +1,7 @@
 /* The circle scan's samples: g and the reach margin at the scan's points and at the edges of
  * reach it meets, through the scan memo of an S-R-S arm whose dp turns with q7 (the model's
  * parts shared by the scans of one pose), and a near arm's branch quantities at the points
- * (the method: om_redundant/ik/system.py). */
+ * (the method: om_redundant/ik/kernel_data.py). */
 #include "circle.h"
 
 #define MEMO_POINTS 128 /* a scan of at most this many points shares its samples' model parts (scan_memo) */

@@ -1,6 +1,6 @@
 /* The torus search's certificate: where the OM fixed-point map contracts, on the whole torus or
  * on cells of it, its fixed points are the configuration's roots, each proved unique in its
- * cell, and cells where it cannot vanish are proved empty (the method: om_redundant/ik/system.py).
+ * cell, and cells where it cannot vanish are proved empty (the method: om_redundant/ik/kernel_data.py).
  *
  * On an arm with shoulder offsets every root of a configuration c is a fixed point of the map
  * G(w) = (q1, q7)(x(w)) on the torus w = (w1, w7): the model IK in c, at the target's

@@ -125,6 +125,26 @@ bool om_srs_model_ik_at_reach(const double *P, const om_target *t, vec3 p, const
 /* phi4 NaN: the elbow equation's root in the ELBOW branch. Returns (shoulder, wrist, elbow) residuals. */
 vec3 om_srs_model_ik_lifted(const double *P, const om_target *t, vec3 p, const int64_t *signs, double q1, double q7,
                             double phi4, double *q);
+/* om_srs_model_ik_lifted's residuals with phi4 the elbow's root, at every arm angle at once: with
+ * q1, q7 and the hand position given, the elbow's root and the frames of W - S do not depend on
+ * psi, and psi enters R03 = A^T B only through A's rows m = cos psi n + sin psi (w_hat x n) and
+ * w_hat x m, linearly; the shoulder's and wrist's residuals are linear in R03 (an entry of a
+ * fixed rotation of it), so each is [0] + [1] cos psi + [2] sin psi (om_srs_lifted_at). */
+typedef struct {
+    double shoulder[3], wrist[3]; /* the residuals' terms in 1, cos psi, sin psi */
+    double elbow;                 /* the elbow's residual, x - cos(phi4 - phi*) */
+    double phi4;                  /* the elbow's root */
+} om_srs_lifted_terms;
+/* The terms at (q1, q7) for the hand position p, target t (its psi not read) and ELBOW sign
+ * elbow into *out; false where W = S (om_srs_model_ik_lifted's NaN). */
+bool om_srs_lifted_terms_at(const double *P, const om_target *t, vec3 p, double elbow, double q1, double q7,
+                            om_srs_lifted_terms *out);
+/* The (shoulder, wrist, elbow) residuals of the terms k at the arm angle whose cos and sin are c, s. */
+static inline vec3 om_srs_lifted_at(const om_srs_lifted_terms *k, double c, double s)
+{
+    return v3(k->shoulder[0] + k->shoulder[1] * c + k->shoulder[2] * s,
+              k->wrist[0] + k->wrist[1] * c + k->wrist[2] * s, k->elbow);
+}
 void om_srs_target(const double *P, om_target *t); /* fills RE, wrist, cos_psi, sin_psi from t->R, t->psi */
 /* The arm angle's reference direction n(w_hat) into *n, and w_hat x n into *nw. */
 void om_srs_reference(const double *P, vec3 w_hat, vec3 *n, vec3 *nw);

@@ -53,6 +53,8 @@ typedef struct {
 
 /* What the circle scans of a batch's problems share (circle.c; om_scan_cache owns it). */
 typedef struct om_scan_memo om_scan_memo;
+/* What the whole-torus searches of a batch's problems share (torus.c; om_scan_cache owns it). */
+typedef struct om_torus_memo om_torus_memo;
 
 /* One target. */
 typedef struct {
@@ -74,6 +76,9 @@ typedef struct {
     /* the model's parts at the circle scan's samples, which the problem's scans (its own, its
      * neighbours') take from the scans before them and keep for those after (NULL: none) */
     om_scan_memo *memo;
+    /* the lifted residual's terms at the whole torus' grid, which the problem's searches take from
+     * the searches of its pose before them and keep for those after (NULL: none) */
+    om_torus_memo *torus_memo;
     /* The real arm's target, the flange pose in DH frame 0 (with the closed form's constants
      * for its orientation), against which every answer is verified (om_verify) and polished.
      * t and p above are the model's side of system (9): the goal itself, but for an arm near a

@@ -102,6 +102,10 @@ int om_circle_candidates(om_problem *pb, double lo, double hi, int n_pts, bool f
  * or out of memory); freed by om_scan_memo_free (NULL: nothing). */
 om_scan_memo *om_scan_memo_new(const om_solver_data *s);
 void om_scan_memo_free(om_scan_memo *memo);
+/* torus.c: a torus memo for the problems of solver s, none held yet (NULL: an arm whose torus
+ * grid has no terms, not S-R-S on the torus, or out of memory); freed by om_torus_memo_free. */
+om_torus_memo *om_torus_memo_new(const om_solver_data *s);
+void om_torus_memo_free(om_torus_memo *memo);
 /* wrist_offset_bands.c: candidates in the bands around the singular wrist of an arm with a4 != 0. */
 #define OM_WRIST_BAND_CANDIDATES 256 /* room for them */
 int om_wrist_offset_candidates(om_problem *pb, double lo, double hi, bool full_circle, double *q, double *cands,
@@ -199,6 +203,7 @@ typedef struct {
     bool gate_valid, gate;        /* the gate asked last, and its answer */
     double gate_key[OM_GATE_KEY]; /* what the gate reads of its pose */
     om_scan_memo *memo;           /* the problems' (om_problem.memo; NULL: none) */
+    om_torus_memo *torus_memo;    /* the problems' (om_problem.torus_memo; NULL: none) */
 } om_scan_cache;
 #define OM_SCAN_CAPACITY(n_scan) (8 * (n_scan) + 8 + OM_WRIST_BAND_CANDIDATES)
 

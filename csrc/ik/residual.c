@@ -1,5 +1,5 @@
 /* The residual of the OM system (9), reduced to the circle or lifted on the torus
- * (the method: om_redundant/ik/system.py). Each evaluation counts in pb->counter. */
+ * (the method: om_redundant/ik/kernel_data.py). Each evaluation counts in pb->counter. */
 #include "om_system.h"
 
 #define REACH_BOUND_SLACK 1e-9 /* of the elbow's x, for rounding (x itself is rounded to about 1e-16) */

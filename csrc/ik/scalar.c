@@ -1,5 +1,5 @@
 /* Root and extremum finders in one unknown w, on the residual g of the circle
- * (the method: om_redundant/ik/system.py). */
+ * (the method: om_redundant/ik/kernel_data.py). */
 #include "om_system.h"
 
 #define LAST_STEP 1e-8 /* a secant step (rad) below which the next iterate is evaluated with every joint */

@@ -1,5 +1,5 @@
 /* The solve strategies on one problem: local solve, bounded search, and what they answer
- * (the method: om_redundant/ik/system.py). */
+ * (the method: om_redundant/ik/kernel_data.py). */
 #include "om_system.h"
 
 #define TORUS_SIDE 0.75  /* the torus grid has TORUS_SIDE * scan points nodes per side */

@@ -1,5 +1,5 @@
 /* The entry points: one solve, and every root of one configuration
- * (the method: om_redundant/ik/system.py). */
+ * (the method: om_redundant/ik/kernel_data.py). */
 #include "om_system.h"
 
 #define START_POINTS 8 /* starts on the dp circle where a first root is out of limits */
@@ -123,6 +123,7 @@ void om_problem_init(om_problem *pb, const om_solver_data *s, const double *T, c
     /* (the certificate's bounds are the model's at the target, not G's; and an S-R-S model's) */
     pb->certify = !s->nominal_table && s->family == OM_SRS;
     pb->memo = NULL;
+    pb->torus_memo = NULL;
     pb->nominal = false;
     pb->wrist = false;
 }
@@ -334,6 +335,7 @@ int om_solve_all(const om_solver_data *s, const double *T, const int64_t *signs,
     om_problem problem;
     om_problem_init(&problem, s, T, signs, redundancy, psi, zeros);
     problem.memo = cache ? cache->memo : NULL;
+    problem.torus_memo = cache ? cache->torus_memo : NULL;
     int n = om_all_roots_cached(&problem, s->scan_points, roots, cache);
     bool neighbour_reached, complete = true;
     if (n == 0 && band) { /* the band's roots, and what solve finds: its local solve from the fixed-point start */

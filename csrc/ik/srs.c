@@ -265,6 +265,35 @@ bool om_srs_model_ik_at_reach(const double *P, const om_target *t, vec3 p, const
     return at_reach(P, t, p, signs, q_prev, q, true);
 }
 
+bool om_srs_lifted_terms_at(const double *P, const om_target *t, vec3 p, double elbow, double q1, double q7,
+                            om_srs_lifted_terms *out)
+{
+    vec3 w = v_add(p, t->wrist);
+    double L2 = v_dot(w, w);
+    if (!(L2 >= DEGENERATE))
+        return false;
+    double x = (L2 - P[SRS_K0]) / P[SRS_K];
+    elbow_cs e = elbow_root(P, x, elbow, &out->phi4);
+    vec3 w_hat, n, nw, zero = v3(0.0, 0.0, 0.0);
+    shoulder_wrist_triad(P, w, L2, &w_hat, &n, &nw);
+    mat3 B = elbow_triad(P, e.c4, e.s4, elbow);
+    mat3 X4 = m_rz_cs_times(e.c4, e.s4, m_load(P, SRS_X4));
+    /* A = {w_hat, m, w_hat x m} in parts: 1, cos psi, sin psi */
+    const mat3 A[3] = {{w_hat, zero, zero}, {zero, n, v_cross(w_hat, n)}, {zero, nw, v_cross(w_hat, nw)}};
+    const double *th = P + SRS_THETA;
+    double a1 = q1 + th[0], a7 = -(q7 + th[6]);
+    double c1 = cos(a1), s1 = sin(a1), c7 = cos(a7), s7 = sin(a7);
+    for (int k = 0; k < 3; k++) {
+        mat3 R03 = m_mtm(A[k], B);
+        mat3 shoulder = m_mmt(m_mtm(m_load(P, SRS_R_PRE), R03), m_load(P, SRS_X3));
+        mat3 wrist = m_transpose(m_mtm(m_mm(R03, X4), t->RE));
+        out->shoulder[k] = om_euler_given_first_residual(shoulder, P[SRS_SIGMA1], 0.0, c1, s1);
+        out->wrist[k] = om_euler_given_first_residual(wrist, -P[SRS_SIN_BETA], P[SRS_COS_BETA], c7, s7);
+    }
+    out->elbow = x - cos(out->phi4 - P[SRS_PHI_STAR]);
+    return true;
+}
+
 /* The model IK with q1, q7 and the elbow angle phi4 given (phi4 NaN: the elbow root in the ELBOW
  * branch); writes q (unless NULL: the residuals alone) and returns the (shoulder, wrist, elbow)
  * residuals (model_ik_lifted). */

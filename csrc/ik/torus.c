@@ -1,7 +1,7 @@
 /* The bounded search on the torus (w1, w7) of an arm with shoulder offsets: the lifted
  * residual on a grid, damped Newton (torus_newton.c) from its local minima and sign changes,
  * with deflation and fold partners, and at psi's half-line (torus_half_line.c)
- * (the method: om_redundant/ik/system.py). */
+ * (the method: om_redundant/ik/kernel_data.py). */
 #include "torus.h"
 
 #define MAX_KNOWN 64           /* roots of the lifted torus system kept for deflation */
@@ -17,6 +17,87 @@
  * hint's joints), 2 sqrt(3) radii in all. */
 #define WINDOW_PARTNERS 3.5
 #define WINDOW_REACH 3.0 /* radii from the hint's (w1, w7) beyond which a window's Newton run gives up */
+
+#define TERMS_KEY 13 /* the flange pose (R, p) and the grid's side */
+
+/* One ELBOW branch's terms at the whole torus' grid for the pose of its key. */
+typedef struct {
+    bool valid;
+    double key[TERMS_KEY];
+    om_srs_lifted_terms *terms; /* cap of them */
+    size_t cap;
+} terms_grid;
+
+/* An S-R-S arm's searches of the whole torus at one pose, in a grid of arm angles (solve_grid: each in 8
+ * branches), sample the same nodes again and again, and there the lifted residual is linear in cos psi
+ * and sin psi (om_srs_lifted_terms): a search whose pose is the last one's takes the terms and
+ * evaluates them at its psi. */
+struct om_torus_memo {
+    terms_grid branches[2]; /* ELBOW -1, +1 */
+};
+
+om_torus_memo *om_torus_memo_new(const om_solver_data *s)
+{
+    if (s->family != OM_SRS || s->mode != OM_TORUS)
+        return NULL;
+    om_torus_memo *memo = malloc(sizeof(om_torus_memo));
+    for (int b = 0; memo && b < 2; b++)
+        memo->branches[b] = (terms_grid){false, {0.0}, NULL, 0};
+    return memo;
+}
+
+void om_torus_memo_free(om_torus_memo *memo)
+{
+    if (memo) {
+        free(memo->branches[0].terms);
+        free(memo->branches[1].terms);
+    }
+    free(memo);
+}
+
+/* The lifted residual's terms at the m x m nodes (lo + step i, lo + step j) for pb's pose and
+ * ELBOW sign (NaN where W = S): the torus memo's where it holds this grid's, else computed, into
+ * the memo where the problem has one, else into *scratch (allocated; the caller frees it). NULL:
+ * out of memory. */
+static const om_srs_lifted_terms *_grid_terms(om_problem *pb, double lo, double step, int m,
+                                              om_srs_lifted_terms **scratch)
+{
+    const mat3 *R = &pb->t.R;
+    double key[TERMS_KEY] = {R->r0.x, R->r0.y, R->r0.z, R->r1.x, R->r1.y, R->r1.z, R->r2.x,
+                             R->r2.y, R->r2.z, pb->p.x, pb->p.y, pb->p.z, (double)m};
+    double elbow = (double)pb->signs[1];
+    terms_grid *grid = pb->torus_memo ? &pb->torus_memo->branches[elbow > 0.0] : NULL;
+    if (grid && grid->valid && memcmp(key, grid->key, sizeof key) == 0)
+        return grid->terms;
+    size_t mm = (size_t)m * (size_t)m;
+    om_srs_lifted_terms *terms;
+    if (grid) {
+        if (grid->cap < mm) {
+            grid->valid = false;
+            free(grid->terms);
+            grid->terms = malloc(mm * sizeof(om_srs_lifted_terms));
+            grid->cap = grid->terms ? mm : 0;
+        }
+        terms = grid->terms;
+    } else {
+        terms = *scratch = malloc(mm * sizeof(om_srs_lifted_terms));
+    }
+    if (!terms)
+        return NULL;
+    for (int i = 0; i < m; i++) {
+        for (int j = 0; j < m; j++) {
+            double w1 = lo + (double)i * step, w7 = lo + (double)j * step;
+            om_srs_lifted_terms *k = &terms[i * m + j];
+            if (!om_srs_lifted_terms_at(pb->s->params, &pb->t, om_torus_point(pb, w1, w7), elbow, w1, w7, k))
+                *k = (om_srs_lifted_terms){{NAN, NAN, NAN}, {NAN, NAN, NAN}, NAN, NAN};
+        }
+    }
+    if (grid) {
+        memcpy(grid->key, key, sizeof key);
+        grid->valid = true;
+    }
+    return terms;
+}
 
 /* Whether A (m x m) changes sign over the grid cell (i, j) (four reachable corners, no wrap). */
 static bool _crosses(const double *A, int m, int i, int j)
@@ -202,7 +283,9 @@ static void _roots_from(torus_search *t, vec3 x)
 
 /* Bounded search on the torus (w1, w7) of an arm with shoulder offsets; returns the count.
  * The lifted residual is sampled on an n x n grid (the square of half-width radius around
- * the centre's (q1, q7) when radius < pi: a window); Newton starts from local minima of its
+ * the centre's (q1, q7) when radius < pi: a window; an S-R-S arm's whole torus from the terms of
+ * its nodes, om_srs_lifted_terms, which the searches of one pose share at every arm angle through
+ * pb->torus_memo); Newton starts from local minima of its
  * norm and from cells where the shoulder and wrist residuals change sign, with deflation and
  * fold partners; and around the points of psi's singular half-line, where the lifted residual
  * turns about a point, in their charts (om_half_line_roots). The candidates go to verification
@@ -259,15 +342,35 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
      * grid samples G: its cells are finer than the nominal arm's roots lie from the real arm's
      * (about the offsets over the arm's reach), so a dip of |g~| there need not be one of |G|. */
     pb->nominal = whole && pb->s->nominal_table != NULL;
+    /* On an S-R-S arm's whole torus the nodes' residuals come from their terms (the same for every
+     * arm angle: the torus memo's), one evaluation each. */
+    om_srs_lifted_terms *scratch = NULL;
+    const om_srs_lifted_terms *terms = NULL;
+    if (whole && grid && pb->s->family == OM_SRS && !(terms = _grid_terms(pb, lo1, step, m, &scratch))) {
+        free(S);
+        free(t.known.x);
+        free(t.known.near);
+        return 0;
+    }
     for (int i = 0; i < m && grid; i++) {
         for (int j = 0; j < m; j++) {
-            vec3 r = om_lifted_residual(pb, v3(lo1 + (double)i * step, lo7 + (double)j * step, NAN), q);
+            vec3 r;
+            if (terms) {
+                const om_srs_lifted_terms *k = &terms[i * m + j];
+                pb->counter++;
+                r = om_srs_lifted_at(k, pb->t.cos_psi, pb->t.sin_psi);
+                double theta4 = pb->s->params[SRS_THETA + 3];
+                E[i * m + j] = om_wrap(k->phi4 - theta4) + theta4; /* (lifted_elbow's bits) */
+            } else {
+                r = om_lifted_residual(pb, v3(lo1 + (double)i * step, lo7 + (double)j * step, NAN), q);
+                E[i * m + j] = lifted_elbow(pb->s, q);
+            }
             S[i * m + j] = r.x;
             W[i * m + j] = r.y;
-            E[i * m + j] = lifted_elbow(pb->s, q);
             F[i * m + j] = om_max_norm(r) < INFINITY ? om_max_norm(r) : INFINITY;
         }
     }
+    free(scratch);
     pb->nominal = false;
     if (found && !whole) { /* (a verified root: known as it is, the window's incumbent, not a candidate) */
         _keep(&t, lifted_point(pb->s, found));

@@ -1,7 +1,7 @@
 /* The torus search at psi's singular half-line: the points of the grid's square where the
  * model's w_hat is -up (Newton on h = 0, the part of W - S across up), and Newton in each
  * point's chart from seeds around it, where the lifted residual turns about the point
- * (the method: om_redundant/ik/system.py). A PUMA-like 6-DOF wrist's torus is searched about
+ * (the method: om_redundant/ik/kernel_data.py). A PUMA-like 6-DOF wrist's torus is searched about
  * joint 1's axis instead, from the points where the wrist centre is on it and from the cells
  * at the shoulder's edge of reach, on the system with q1 and the elbow angle as unknowns. */
 #include "torus.h"

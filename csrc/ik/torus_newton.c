@@ -1,6 +1,6 @@
 /* Damped Newton on the lifted system (w1, w7, phi4) of an arm with shoulder offsets, deflated
  * by the known roots, in a chart around psi's half-line or not (the method:
- * om_redundant/ik/system.py). */
+ * om_redundant/ik/kernel_data.py). */
 #include "torus.h"
 
 #define MIN_STEP (1.0 / 256.0) /* the shortest damped Newton step, as a fraction of the full one */

@@ -1,5 +1,5 @@
 /* Every candidate checked with the REAL arm: pose errors, configuration, joint limits
- * (the method: om_redundant/ik/system.py). */
+ * (the method: om_redundant/ik/kernel_data.py). */
 #include "om_system.h"
 
 #define REDUNDANCY_TOL 1e-9 /* a solution's redundancy values (rad) must equal the requested ones */

@@ -39,7 +39,10 @@ singularities, which is where roots crowd; lifted, Newton's method converges the
   small islands of reach, where roots come in close pairs, 1-D extremum searches find
   them. On the torus, a grid of the lifted residual seeds Newton's method, with deflation
   and a search along each root's fold direction for close pairs (``csrc/ik/torus.c``);
-  this is a thorough search rather than a proof. Before it, a certificate
+  this is a thorough search rather than a proof. At a grid node the residual is linear in
+  :math:`\cos\psi` and :math:`\sin\psi`
+  (:func:`~om_redundant.ik.families.srs.model_lifted_terms`), so a batch's searches of one
+  pose at many arm angles (the optimiser's sweep) compute the nodes' terms once. Before it, a certificate
   (``csrc/ik/contraction.c``) bounds how fast the model's q1 and q7 turn as the wrist centre
   moves over the ball that holds the torus: where the map w -> (q1, q7) contracts (in a
   weighted max norm), on the whole torus or on cells of it, Banach's theorem proves each

@@ -89,6 +89,29 @@ def model_ik_lifted(
     return _core.model_ik_lifted(f64(P), flange_target(R, p, signs, psi), q1, q7, phi4, q)
 
 
+def model_lifted_terms(
+    P: np.ndarray, R: np.ndarray, p: np.ndarray, signs: np.ndarray, q1: float, q7: float
+) -> _core.LiftedTerms | None:
+    r""":func:`model_ik_lifted`'s residuals with phi4 the elbow's root, at every arm angle at once.
+
+    With q1, q7 and the hand position given, the elbow's root and the frames of
+    :math:`w = W - S` do not depend on :math:`\psi`; :math:`\psi` enters :math:`R_{03} = A^T B`
+    only through A's rows :math:`m = \cos\psi\, n + \sin\psi\, (\hat w \times n)` and
+    :math:`\hat w \times m`, linearly, and the shoulder's and wrist's residuals are entries of
+    fixed rotations of :math:`R_{03}`. So each is
+
+    .. math::  r(\psi) = r_0 + r_1 \cos\psi + r_2 \sin\psi,
+
+    and the torus search's grid, whose nodes (q1, q7) are the same at every arm angle of a
+    sweep, evaluates them once per pose (``csrc/ik/torus.c``, the torus memo).
+
+    Returns:
+        The terms ``shoulder`` and ``wrist`` (:math:`r_0, r_1, r_2` each), the elbow's residual
+        and its root phi4; None where W = S.
+    """
+    return _core.model_lifted_terms(f64(P), flange_target(R, p, signs, 0.0), q1, q7)
+
+
 def model_ik_at_reach(
     P: np.ndarray,
     R: np.ndarray,
