@@ -124,7 +124,7 @@ static int link_roots(linker *l, int64_t n, const double *grid, const int64_t *c
                 arrived = status == OM_FOLLOW_ARRIVED;
             }
             if (!arrived) {
-                if (reached == REACHED) {
+            if (reached == REACHED) {
                     int64_t r = add_reached(l);
                     if (r < 0) return OM_LINK_FULL;
                     append(l, i, r);
@@ -184,8 +184,8 @@ static int link_roots(linker *l, int64_t n, const double *grid, const int64_t *c
         bool loop = w->following[chain[n_chain - 1]] == chain[0];
         if (!loop) { /* _back_to_end: where it ends before its first grid sample */
             int64_t k = l->first[chain[0]], first_row = l->head[chain[0]];
-            int status = follow_from(l, first_row, k > 0 ? grid[k - 1] : grid[n - 1] - TURN, &reached);
-                if (reached == REACHED) {
+            follow_from(l, first_row, k > 0 ? grid[k - 1] : grid[n - 1] - TURN, &reached);
+            if (reached == REACHED) {
                 int64_t r = add_reached(l);
                 if (r < 0) return OM_LINK_FULL;
                 l->next[r] = first_row, l->head[chain[0]] = r;
