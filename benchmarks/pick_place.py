@@ -17,7 +17,7 @@ ticks where the task raised, fresh choices, the smallest clearance along the mot
 (MuJoCo's own ``mj_geomDistance`` over the pairs, every tick), the smallest joint-limit
 margin, branch flips, and the controller's time per tick (median, p99).
 
-Run: python -m benchmarks.pick_place [--arms panda iiwa14 gen3] [--modes step interpolated]
+Run: python -m benchmarks.pick_place [--arms panda fr3 iiwa14 gen3 xarm7 sawyer] [--modes step interpolated]
      [--waypoints 20] [--seed 0] [--out benchmarks/results/pick_place.md] [--video docs/pick_place.mp4]
 """
 
@@ -55,6 +55,7 @@ POLE = ([0.2, 0.45, 0.0], [0.2, 0.45, 0.9], 0.03)
 TABLE = dict(pos=[0.6, 0.0, -0.02], size=[0.3, 0.6, 0.04])  # its top 2 cm above the floor
 GRASP, ABOVE = 0.15, 0.32  # m: flange heights at and above a pick or place
 CAMERA = dict(lookat=[0.4, 0.0, 0.35], distance=1.7, azimuth=145.0, elevation=-22.0)
+ARMS = ("panda", "fr3", "iiwa14", "gen3", "xarm7", "sawyer")  # every shipped 7-DOF arm
 
 
 def scene(arm: om.Arm) -> mujoco.MjModel:
@@ -306,7 +307,7 @@ def video(name: str, poses: list[np.ndarray], q_start: np.ndarray, file: Path, f
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--arms", nargs="+", default=["panda", "iiwa14", "gen3"])
+    parser.add_argument("--arms", nargs="+", default=list(ARMS))
     parser.add_argument(
         "--modes", nargs="+", default=["step", "interpolated"], choices=["step", "interpolated"]
     )
