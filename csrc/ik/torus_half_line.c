@@ -13,22 +13,28 @@
 #define LINE_NEWTON 30         /* Newton steps to a point of the half-line (h = 0) */
 
 /* x(w1, w7) = W - S = p_d + a(w1) + R delta(w7) + R w_F - S of the model on the torus, and
- * its derivatives in w1 and w7 (d1, d7); of a 6-DOF arm (a PUMA-like wrist), the wrist centre
- * p_d + R delta(w5, w6) + R w_F, whose q1 turns by 2 pi about joint 1's axis. */
+ * its derivatives in w1 and w7 (d1, d7; NULL: not wanted); of a 6-DOF arm (a PUMA-like
+ * wrist), the wrist centre p_d + R delta(w5, w6) + R w_F, whose q1 turns by 2 pi about joint
+ * 1's axis. */
 static vec3 _shoulder_wrist(om_problem *pb, double w1, double w7, vec3 *d1, vec3 *d7)
 {
     const double(*D)[3] = pb->s->D;
     const mat3 *R = &pb->t.R;
     if (pb->s->family != OM_SRS) {
         vec3 delta = om_six_dof_wrist_delta(pb->s->params, w1, w7, d1, d7);
-        *d1 = m_mv(*R, *d1);
-        *d7 = m_mv(*R, *d7);
+        if (d1) {
+            *d1 = m_mv(*R, *d1);
+            *d7 = m_mv(*R, *d7);
+        }
         return v_add(v_add(pb->p, pb->t.wrist), m_mv(*R, delta));
     }
-    double c1 = cos(w1), s1 = sin(w1), c7 = cos(w7), s7 = sin(w7);
+    double c1 = cos(w1), s1 = sin(w1);
     vec3 a = v_add(v_load(D[3], 0), v_add(v_scale(c1, v_load(D[4], 0)), v_scale(s1, v_load(D[5], 0))));
-    *d1 = v_sub(v_scale(c1, v_load(D[5], 0)), v_scale(s1, v_load(D[4], 0)));
-    *d7 = m_mv(*R, v_sub(v_scale(c7, v_load(D[2], 0)), v_scale(s7, v_load(D[1], 0))));
+    if (d1) {
+        double c7 = cos(w7), s7 = sin(w7);
+        *d1 = v_sub(v_scale(c1, v_load(D[5], 0)), v_scale(s1, v_load(D[4], 0)));
+        *d7 = m_mv(*R, v_sub(v_scale(c7, v_load(D[2], 0)), v_scale(s7, v_load(D[1], 0))));
+    }
     return v_add(v_add(pb->p, pb->t.wrist), v_add(a, m_mv(*R, om_delta(D, w7))));
 }
 
@@ -98,15 +104,15 @@ static int _half_line_points(om_problem *pb, double lo1, double lo7, double step
         free(rows);
         return 0;
     }
-    vec3 corner = _shoulder_wrist(pb, lo1, lo7, &d1, &d7);
+    vec3 corner = _shoulder_wrist(pb, lo1, lo7, NULL, NULL);
     for (int i = 0; i < m; i++) { /* x = rows[i] + cols[j] at node (i, j), where separable */
-        rows[i] = _shoulder_wrist(pb, lo1 + (double)i * step, lo7, &d1, &d7);
-        cols[i] = v_sub(_shoulder_wrist(pb, lo1, lo7 + (double)i * step, &d1, &d7), corner);
+        rows[i] = _shoulder_wrist(pb, lo1 + (double)i * step, lo7, NULL, NULL);
+        cols[i] = v_sub(_shoulder_wrist(pb, lo1, lo7 + (double)i * step, NULL, NULL), corner);
     }
     for (int i = 0; i < m; i++)
         for (int j = 0; j < m; j++) {
             vec3 x = line.separable ? v_add(rows[i], cols[j])
-                                    : _shoulder_wrist(pb, lo1 + (double)i * step, lo7 + (double)j * step, &d1, &d7);
+                                    : _shoulder_wrist(pb, lo1 + (double)i * step, lo7 + (double)j * step, NULL, NULL);
             _across(x, b1, b2, H + 2 * (i * m + j));
         }
     free(rows);
@@ -298,10 +304,9 @@ int om_shoulder_edge_roots(om_problem *pb, double lo1, double lo7, double step, 
     double *K = malloc((size_t)m * (size_t)m * sizeof(double));
     if (!K)
         return count;
-    vec3 d1, d7;
     for (int i = 0; i < m; i++)
         for (int j = 0; j < m; j++) {
-            vec3 pw = _shoulder_wrist(pb, lo1 + (double)i * step, lo7 + (double)j * step, &d1, &d7);
+            vec3 pw = _shoulder_wrist(pb, lo1 + (double)i * step, lo7 + (double)j * step, NULL, NULL);
             K[i * m + j] = pw.x * pw.x + pw.y * pw.y - h * h;
         }
     for (int i = 0; i + 1 < m; i++) {
@@ -315,7 +320,7 @@ int om_shoulder_edge_roots(om_problem *pb, double lo1, double lo7, double step, 
                 continue;
             /* at the edge rho = 0: phi1 = azimuth - atan2(-sigma1 h, 0), both ARM branches' */
             double w5 = lo1 + ((double)i + 0.5) * step, w6 = lo7 + ((double)j + 0.5) * step;
-            vec3 pw = _shoulder_wrist(pb, w5, w6, &d1, &d7);
+            vec3 pw = _shoulder_wrist(pb, w5, w6, NULL, NULL);
             double q1 = atan2(pw.y, pw.x) - atan2(-P[SD_SIGMA1] * h, 0.0) - P[SD_THETA1];
             vec3 ends[LINE_SEEDS];
             int n_ends = 0;
