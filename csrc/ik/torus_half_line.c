@@ -173,37 +173,6 @@ static double _norm4(const double *F)
     return most;
 }
 
-/* The solution of the 4 x 4 system A s = b (A's rows with b appended: A[i][4]) into s, by
- * Gaussian elimination with partial pivoting; false where A is singular. */
-static bool _solve4(double A[4][5], double *s)
-{
-    for (int c = 0; c < 4; c++) {
-        int pivot = c;
-        for (int i = c + 1; i < 4; i++)
-            if (fabs(A[i][c]) > fabs(A[pivot][c]))
-                pivot = i;
-        if (!(fabs(A[pivot][c]) > 0.0))
-            return false;
-        for (int k = 0; k < 5; k++) {
-            double t = A[c][k];
-            A[c][k] = A[pivot][k];
-            A[pivot][k] = t;
-        }
-        for (int i = c + 1; i < 4; i++) {
-            double f = A[i][c] / A[c][c];
-            for (int k = c; k < 5; k++)
-                A[i][k] -= f * A[c][k];
-        }
-    }
-    for (int i = 3; i >= 0; i--) {
-        double sum = A[i][4];
-        for (int k = i + 1; k < 4; k++)
-            sum -= A[i][k] * s[k];
-        s[i] = sum / A[i][i];
-    }
-    return true;
-}
-
 /* Damped Newton on a 6-DOF arm's system about joint 1's axis (om_axis_residual: x = (w5, w6, q1,
  * gamma), no square root anywhere: smooth where the wrist centre is on the axis or at the
  * shoulder's edge of reach, and at the elbow's edge too) from x (its gamma NaN: the ELBOW
@@ -215,7 +184,7 @@ static bool _solve4(double A[4][5], double *s)
 #define AXIS_MIN_STEP (1.0 / 256.0)
 static double _axis_newton(om_problem *pb, double *x, double *q)
 {
-    double F[4], Fn[4], J[4][5], step[4], y[4], eps = 1e-7;
+    double F[4], Fn[4], J[16], step[4], y[4], eps = 1e-7;
     om_axis_residual(pb, x, q, F);
     if (isnan(x[3]))
         x[3] = lifted_elbow(pb->s, q);
@@ -227,11 +196,11 @@ static double _axis_newton(om_problem *pb, double *x, double *q)
             y[k] += eps;
             om_axis_residual(pb, y, q, Fn);
             for (int i = 0; i < 4; i++)
-                J[i][k] = (Fn[i] - F[i]) / eps;
+                J[4 * i + k] = (Fn[i] - F[i]) / eps;
         }
         for (int i = 0; i < 4; i++)
-            J[i][4] = -F[i];
-        if (!_solve4(J, step))
+            step[i] = -F[i];
+        if (!om_eliminate(J, step, 4, NULL))
             break;
         double size = py_max(py_max(fabs(step[0]), fabs(step[1])), py_max(fabs(step[2]), fabs(step[3])));
         double t = size < 0.5 ? 1.0 : 0.5 / size, rn = INFINITY;
