@@ -157,14 +157,26 @@ static bool _keep(torus_search *t, vec3 x)
     return true;
 }
 
+/* Whether x lies where an undeflated run gives up next to a known root (newton_limits). */
+static bool _at_known(const torus_search *t, vec3 x)
+{
+    for (int k = 0; k < t->n_known; k++)
+        if (lifted_distance(x, v_load(t->known.x, 3 * k)) < t->known.near[k])
+            return true;
+    return false;
+}
+
 /* Newton's method from x, deflated by the known roots if deflate; a new root is appended to the
- * known ones and handed to verification. Returns whether one was. */
-static bool _new_root(torus_search *t, vec3 x, bool deflate)
+ * known ones and handed to verification. Returns whether one was; *converging (unless NULL):
+ * whether the run gave up next to a known root instead, on its way there. */
+static bool _new_root(torus_search *t, vec3 x, bool deflate, bool *converging)
 {
     vec3 x_root;
     known_roots *known = &t->known;
     newton_limits limits = {t->w1, t->w7, t->reach, known->x, known->near, t->n_known};
     double r = om_lifted_newton(t->pb, NULL, x, t->q, known->x, deflate ? t->n_known : 0, &limits, &x_root);
+    if (converging)
+        *converging = !deflate && isinf(r) && _at_known(t, x_root);
     if (deflate && r > OM_ROOT_TOL && r < DEFLATED_END) /* (not where the run gave up: inf) */
         r = om_lifted_newton(t->pb, NULL, x_root, t->q, known->x, 0, &limits, &x_root);
     if (r > OM_ROOT_TOL)
@@ -258,25 +270,29 @@ static void _partners(torus_search *t, int first)
         int n = _fold_partners(t->pb, root, t->partner_reach, t->q, partners, &gap);
         t->known.near[k] = py_min(KNOWN_REACH, 0.1 * gap);
         for (int a = 0; a < n; a++)
-            if (!_new_root(t, partners[a], true)) /* the line bends away from the partner: halfway */
-                _new_root(t, v_scale(0.5, v_add(partners[a], root)), true);
+            if (!_new_root(t, partners[a], true, NULL)) /* the line bends away from the partner: halfway */
+                _new_root(t, v_scale(0.5, v_add(partners[a], root)), true, NULL);
     }
 }
 
-/* The roots Newton finds from the start x (from the nearer edge of reach's elbow where it finds
- * none), on the whole torus then from x again deflated until none, and their fold partners. */
+/* The roots Newton finds from the start x (from the nearer edge of reach's elbow where its run
+ * stalls), on the whole torus then from x again deflated until none, and their fold partners. */
 static void _roots_from(torus_search *t, vec3 x)
 {
     int first = t->n_known;
-    if (!_new_root(t, x, false)) {
-        /* Near the edge of reach the elbow angle changes fastest: try once more
-         * from the nearer edge's (the straight or the folded elbow). */
+    bool converging;
+    if (!_new_root(t, x, false, &converging)) {
+        /* Near the edge of reach the elbow angle changes fastest: a run that stalls tries once
+         * more from the nearer edge's (the straight or the folded elbow). One that gave up next
+         * to a known root was converging to it: x lies in that root's basin, not at the edge. */
+        if (converging)
+            return;
         double straight = straight_elbow(t->pb->s);
         double edge = cos(x.z - straight) > 0.0 ? straight : straight + OM_PI;
-        if (!_new_root(t, v3(x.x, x.y, edge), false))
+        if (!_new_root(t, v3(x.x, x.y, edge), false, NULL))
             return;
     }
-    while (isinf(t->reach) && t->n_known < MAX_KNOWN && _new_root(t, x, true))
+    while (isinf(t->reach) && t->n_known < MAX_KNOWN && _new_root(t, x, true, NULL))
         ;
     _partners(t, first);
 }
