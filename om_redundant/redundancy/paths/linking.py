@@ -86,17 +86,24 @@ def sweep_circle(probes: list[Probe], n: int, quick: bool = False) -> list[list[
     swept too), for a first look at a branch alone; its "no" rows are then the cheap ones."""
     solver, T, branches = probes[0].solver, probes[0].T, [probe.signs for probe in probes]
     psi = -math.pi + TURN * np.arange(n) / n
-    # Rows psi by psi, the branches that differ in the first sign alone next to each other:
-    # the solver shares their circle search where it is the same (S-R-S: the SHOULDER sign).
+    # Rows by ELBOW sign, then psi by psi, the branches that differ in the first sign alone next
+    # to each other: the solver shares a search of one psi where it is the same (S-R-S: across
+    # the SHOULDER sign; on the torus the WRIST sign too), and the parts of its samples that do
+    # not depend on psi across the rows of one ELBOW sign (its memos).
     order = sorted(range(len(branches)), key=lambda b: (branches[b][1:], branches[b][0]))
     rows = np.empty((len(branches), n), dtype=int)  # the batch row of each branch and grid psi
-    rows[order] = np.arange(n * len(branches)).reshape(n, len(branches)).T
-    batch = solver.solve_grid(
-        np.repeat(T[None], n * len(branches), axis=0),
-        np.tile([branches[b] for b in order], (n, 1)),
-        np.repeat(psi, len(branches)),
-        np.tile([not quick and not _neighbours_swept(branches[b], branches, n) for b in order], n),
-    )
+    first = 0
+    for elbow in sorted({branches[b][1] for b in order}):
+        group = [b for b in order if branches[b][1] == elbow]
+        rows[group] = first + np.arange(n * len(group)).reshape(n, len(group)).T
+        first += n * len(group)
+    signs, band = np.empty((first, len(branches[0])), dtype=int), np.empty(first, dtype=bool)
+    for b, signs_b in enumerate(branches):
+        signs[rows[b]] = signs_b
+        band[rows[b]] = not quick and not _neighbours_swept(signs_b, branches, n)
+    grid_psi = np.empty(first)
+    grid_psi[rows] = psi
+    batch = solver.solve_grid(np.repeat(T[None], first, axis=0), signs, grid_psi, band)
     swept = []
     for b, probe in enumerate(probes):
         grid, distinct = _distinct(probe, batch.q[rows[b]], batch.count[rows[b]])
