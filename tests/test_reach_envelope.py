@@ -12,7 +12,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
-from om_redundant.ik.reach_envelope import ReachEnvelope
+from om_redundant import _core
+from om_redundant.ik.reach_envelope import COARSE, ReachEnvelope
 from tests.test_shoulder_wrist_offsets import BAXTER_OFFSET, TIAGO_PRO_OFFSET
 from tests.test_shoulder_wrist_offsets import solver_of as offset_solver
 
@@ -56,6 +57,24 @@ def test_a_refused_pose_has_no_solution_anywhere(name, seed, push):
         assert s.solve_all(T, om.Configuration(signs, (float(psi),))) == []
     choice = om.RedundancyOptimizer(s).choose(T)
     assert not choice.ok and "out of reach" in choice.reason and choice.intervals == ()
+
+
+@settings(max_examples=40, deadline=None)
+@given(name=st.sampled_from(ARMS), seed=st.integers(0, 2**32 - 1), push=st.floats(0.0, 1.5))
+def test_the_coarse_look_answers_as_every_node_does(name, seed, push):
+    """beyond looks at every COARSE-th node first; its answer is the whole grid's, reachable
+    poses and poses pushed out alike (the whole grid's gap is at most the coarse one's)."""
+    s = solver(name)
+    envelope = ReachEnvelope(s)
+    T = s.arm.fk(random_q(s.arm, seed))
+    direction = np.random.default_rng(seed).normal(size=3)
+    T[:3, 3] += push * direction / np.linalg.norm(direction)
+    R, p = np.empty(9), np.empty(3)
+    data = s.solver_data()
+    _core.flange_target(np.ascontiguousarray(T), data.T_base_root, data.T_tool_flange, R, p)
+    gap = envelope.gap(R.reshape(3, 3), p)
+    assert gap <= envelope.gap(R.reshape(3, 3), p, COARSE)
+    assert envelope.beyond(T) == (gap if gap > envelope.slack else None)
 
 
 def test_a_pose_far_out_is_refused_on_every_arm_and_the_sweep_agrees(monkeypatch):
