@@ -124,7 +124,7 @@ static int link_roots(linker *l, int64_t n, const double *grid, const int64_t *c
                 arrived = status == OM_FOLLOW_ARRIVED;
             }
             if (!arrived) {
-            if (reached == REACHED) {
+                if (reached == REACHED) {
                     int64_t r = add_reached(l);
                     if (r < 0) return OM_LINK_FULL;
                     append(l, i, r);
