@@ -157,15 +157,6 @@ static bool _keep(torus_search *t, vec3 x)
     return true;
 }
 
-/* Whether x lies where an undeflated run gives up next to a known root (newton_limits). */
-static bool _at_known(const torus_search *t, vec3 x)
-{
-    for (int k = 0; k < t->n_known; k++)
-        if (lifted_distance(x, v_load(t->known.x, 3 * k)) < t->known.near[k])
-            return true;
-    return false;
-}
-
 /* Newton's method from x, deflated by the known roots if deflate; a new root is appended to the
  * known ones and handed to verification. Returns whether one was; *converging (unless NULL):
  * whether the run gave up next to a known root instead, on its way there. */
@@ -176,7 +167,7 @@ static bool _new_root(torus_search *t, vec3 x, bool deflate, bool *converging)
     newton_limits limits = {t->w1, t->w7, t->reach, known->x, known->near, t->n_known};
     double r = om_lifted_newton(t->pb, NULL, x, t->q, known->x, deflate ? t->n_known : 0, &limits, &x_root);
     if (converging)
-        *converging = !deflate && isinf(r) && _at_known(t, x_root);
+        *converging = !deflate && isinf(r) && near_known(&limits, x_root);
     if (deflate && r > OM_ROOT_TOL && r < DEFLATED_END) /* (not where the run gave up: inf) */
         r = om_lifted_newton(t->pb, NULL, x_root, t->q, known->x, 0, &limits, &x_root);
     if (r > OM_ROOT_TOL)

@@ -100,6 +100,15 @@ typedef struct {
     int n_known;
 } newton_limits;
 
+/* Whether x (lifted) lies next to one of limits' known roots, where an undeflated run gives up. */
+static inline bool near_known(const newton_limits *limits, vec3 x)
+{
+    for (int k = 0; k < limits->n_known; k++)
+        if (lifted_distance(x, v_load(limits->known, 3 * k)) < limits->near[k])
+            return true;
+    return false;
+}
+
 /* Damped Newton on the lifted system from x (chart not NULL: in its coordinates), deflated by
  * the first n_known rows of known, within limits (NULL: none); returns the residual's
  * max norm at the end (inf where the run gave up), *x_end the end point (lifted), q the model

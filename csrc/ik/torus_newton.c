@@ -11,10 +11,7 @@ static bool _gives_up(const newton_limits *limits, vec3 x, bool deflated)
 {
     if (py_max(fabs(om_wrap(x.x - limits->w1)), fabs(om_wrap(x.y - limits->w7))) > limits->reach)
         return true;
-    for (int k = 0; k < limits->n_known && !deflated; k++)
-        if (lifted_distance(x, v_load(limits->known, 3 * k)) < limits->near[k])
-            return true;
-    return false;
+    return !deflated && near_known(limits, x);
 }
 
 /* Damped Newton on the lifted system from x = (w1, w7, phi4) (chart not NULL: in its
