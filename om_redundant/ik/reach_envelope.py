@@ -24,6 +24,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import _core
+from .kernel_data import flange_target
 from .solver import OMSolver
 
 GRID = 128  # nodes per side of the torus grid
@@ -68,10 +69,7 @@ class ReachEnvelope:
         the arm is not S-R-S)."""
         if not self.applies:
             return None
-        data = self._data
-        R, p = np.empty(9), np.empty(3)
-        _core.flange_target(np.ascontiguousarray(T, dtype=float), data.T_base_root, data.T_tool_flange, R, p)
-        R = R.reshape(3, 3)
+        R, p = flange_target(T, self._data.T_base_root, self._data.T_tool_flange)
         # One node within the slack settles it (the usual answer): on the torus (both offsets
         # turning, GRID x GRID nodes), every COARSE-th node a side first.
         torus = len(self._a) > 1 and len(self._delta) > 1
