@@ -11,7 +11,6 @@ from om_redundant import _core
 from om_redundant._core import MAX_ROOTS
 from om_redundant.ik.kernel_data import flange_target
 from tests.conftest import EXACT, random_q, solver_of, wrap
-from tests.test_kernels import _assert_rows_are_solve_all
 
 TORUS_ARMS = ["gen3", "sawyer"]
 #: The share of the random problems below that the certificate decides, at least: the Gen3's offsets
@@ -139,10 +138,12 @@ def test_hinted_solve_is_at_least_as_near_as_every_grid_root(name):
 
 
 @pytest.mark.parametrize("name", TORUS_ARMS)
-def test_rows_that_share_the_grid_search_are_solve_all(name):
+def test_rows_that_share_the_grid_search_are_rows_alone(name):
     """A batch's rows in the sweep's order (the four SHOULDER and WRIST signs of an ELBOW sign
-    next to each other, which share the torus grid search's candidates, om_scan_cache) are
-    solve_all's row by row: the same roots in the same order, bit for bit, and evaluations."""
+    next to each other, which share the torus search's candidates, om_scan_cache) are the rows
+    of batches of one row each: the same roots in the same order, bit for bit, and evaluations.
+    (A batch's whole-torus searches start from the traced self-motion, torus_trace.c, and
+    solve_all's from the grid: test_torus_trace.py compares those.)"""
     solver = solver_of(name)
     T = solver.arm.fk(random_q(solver.arm, 2, np.random.default_rng(8)))
     branches = sorted((c.signs for c in solver.configurations()), key=lambda s: (s[1:], s[0]))
@@ -150,4 +151,7 @@ def test_rows_that_share_the_grid_search_are_solve_all(name):
     Ts, signs, redundancy = (np.array(column) for column in zip(*rows, strict=True))
     batch = solver.solve_all_batch(Ts, signs, redundancy, threads=1)
     assert (batch.count > 0).any()
-    _assert_rows_are_solve_all(solver, Ts, signs, redundancy, batch)
+    for i in range(len(Ts)):
+        alone = solver.solve_all_batch(Ts[i : i + 1], signs[i : i + 1], redundancy[i : i + 1])
+        for field in ("q", "count", "position_error", "orientation_error", "iterations", "within_limits"):
+            np.testing.assert_array_equal(getattr(batch, field)[i], getattr(alone, field)[0])

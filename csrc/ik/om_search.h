@@ -222,6 +222,9 @@ void om_self_motion_null(const om_solver_data *s, const double *q, double *n);
 /* det A (n x n row-major, destroyed) into *det (NULL: not wanted) by elimination with partial
  * pivoting and, b not NULL, x of A x = b into b; false where a pivot is zero (*det = 0). */
 bool om_eliminate(double *A, double *b, int n, double *det);
+/* The null vector of the m x (m + 1) matrix J (row-major, m <= 6) by cofactors into n (m + 1):
+ * n_c = (-1)^c det J_{-c}, J without column c (not normalised; 0 where J's rank is short). */
+void om_null_vector(const double *J, int m, double *n);
 /* boundary.c: om_add_root of q, polished first where it fails verification near the boundary. */
 int om_add_candidate(om_problem *pb, double *q, double *roots, int count);
 /* problem.c: pb's pose in another configuration (signs, redundancy: kept by the caller), its target's

@@ -18,6 +18,7 @@
 #define WINDOW_PARTNERS 3.5
 #define WINDOW_REACH 3.0 /* radii from the hint's (w1, w7) beyond which a window's Newton run gives up */
 
+#define TRACE_STARTS 1024 /* starts of one search from the traced self-motion (a handful a root) */
 #define TERMS_KEY 13 /* the flange pose (R, p) and the grid's side */
 
 /* One ELBOW branch's terms at the whole torus' grid for the pose of its key. */
@@ -26,6 +27,8 @@ typedef struct {
     double key[TERMS_KEY];
     om_srs_lifted_terms *terms; /* cap of them */
     size_t cap;
+    om_trace *trace;            /* the self-motion traced at the pose of key (NULL: not yet) */
+    bool untraced;              /* where om_trace_new failed: the grid's starts instead */
 } terms_grid;
 
 /* An S-R-S arm's searches of the whole torus at one pose, in a grid of arm angles (solve_grid: each in 8
@@ -42,7 +45,7 @@ om_torus_memo *om_torus_memo_new(const om_solver_data *s)
         return NULL;
     om_torus_memo *memo = malloc(sizeof(om_torus_memo));
     for (int b = 0; memo && b < 2; b++)
-        memo->branches[b] = (terms_grid){false, {0.0}, NULL, 0};
+        memo->branches[b] = (terms_grid){false, {0.0}, NULL, 0, NULL, false};
     return memo;
 }
 
@@ -51,6 +54,8 @@ void om_torus_memo_free(om_torus_memo *memo)
     if (memo) {
         free(memo->branches[0].terms);
         free(memo->branches[1].terms);
+        om_trace_free(memo->branches[0].trace);
+        om_trace_free(memo->branches[1].trace);
     }
     free(memo);
 }
@@ -72,6 +77,9 @@ static const om_srs_lifted_terms *_grid_terms(om_problem *pb, double lo, double 
     size_t mm = (size_t)m * (size_t)m;
     om_srs_lifted_terms *terms;
     if (grid) {
+        om_trace_free(grid->trace);
+        grid->trace = NULL;
+        grid->untraced = false;
         if (grid->cap < mm) {
             grid->valid = false;
             free(grid->terms);
@@ -97,6 +105,18 @@ static const om_srs_lifted_terms *_grid_terms(om_problem *pb, double lo, double 
         grid->valid = true;
     }
     return terms;
+}
+
+/* The self-motion at the pose and ELBOW sign of the torus memo's terms (those of pb's, computed by
+ * _grid_terms), traced on first use; NULL where that failed (om_trace_new). */
+static const om_trace *_grid_trace(om_problem *pb, const om_srs_lifted_terms *terms, double lo, double step, int m)
+{
+    terms_grid *grid = &pb->torus_memo->branches[pb->signs[1] > 0];
+    if (!grid->trace && !grid->untraced) {
+        grid->trace = om_trace_new(pb, terms, lo, step, m);
+        grid->untraced = !grid->trace;
+    }
+    return grid->trace;
 }
 
 /* Whether A (m x m) changes sign over the grid cell (i, j) (four reachable corners, no wrap). */
@@ -359,7 +379,10 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
         free(t.known.near);
         return 0;
     }
-    for (int i = 0; i < m && grid; i++) {
+    /* A batch's searches of one pose (the torus memo's) start from its traced self-motion instead of
+     * the grid's starts: one start a root (an arm near a family: the grid's, its Newton on G). */
+    const om_trace *trace = terms && pb->torus_memo && !pb->s->nominal_table ? _grid_trace(pb, terms, lo1, step, m) : NULL;
+    for (int i = 0; i < m && grid && !trace; i++) {
         for (int j = 0; j < m; j++) {
             vec3 r;
             if (terms) {
@@ -383,7 +406,19 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
         _keep(&t, lifted_point(pb->s, found));
         _partners(&t, 0);
     }
-    for (int i = 0; i < m && grid; i++) {
+    if (trace) {
+        pb->counter += om_trace_evaluations(trace);
+        vec3 starts[TRACE_STARTS];
+        bool fold[TRACE_STARTS];
+        int n_starts = om_trace_starts(trace, pb->t.psi, starts, fold, TRACE_STARTS);
+        for (int k = 0; k < n_starts && t.n_known < MAX_KNOWN; k++) {
+            if (fold[k])
+                _roots_from(&t, starts[k]);
+            else
+                _new_root(&t, starts[k], false, NULL);
+        }
+    }
+    for (int i = 0; i < m && grid && !trace; i++) {
         for (int j = 0; j < m; j++) {
             for (int centre_of_cell = 0; centre_of_cell < 2; centre_of_cell++) {
                 bool start;

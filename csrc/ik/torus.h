@@ -127,4 +127,16 @@ int om_half_line_roots(om_problem *pb, double lo1, double lo7, double step, int 
 int om_shoulder_edge_roots(om_problem *pb, double lo1, double lo7, double step, int m, double *q, double *roots,
                            int count, om_candidate_log *log);
 
+/* The self-motion of pb's pose and ELBOW sign traced (torus_trace.c), from the terms at the whole
+ * torus' grid (lo, step, m nodes a side); NULL where a component's trace could not finish (out
+ * of memory, or MAX_STEPS). Its evaluations are not counted in pb's (om_trace_evaluations: each
+ * search that takes its starts counts them). */
+typedef struct om_trace om_trace;
+om_trace *om_trace_new(om_problem *pb, const om_srs_lifted_terms *terms, double lo, double step, int m);
+void om_trace_free(om_trace *trace);
+int64_t om_trace_evaluations(const om_trace *trace);
+/* The starts of a search at psi (at most cap): where the trace crosses psi, into starts, and
+ * each fold within FOLD_NEAR of psi, flagged in fold (its pair of roots sought from it). */
+int om_trace_starts(const om_trace *trace, double psi, vec3 *starts, bool *fold, int cap);
+
 #endif

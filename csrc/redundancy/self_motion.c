@@ -51,18 +51,23 @@ bool om_eliminate(double *A, double *b, int n, double *det) {
     return true;
 }
 
-void om_self_motion_null(const om_solver_data *s, const double *q, double *n) {
-    static const double eye[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-    double J[6 * 7], M[36];
-    om_jacobian(s->real_table, s->n_real_rows, eye, eye, q, 7, J, NULL, NULL);
-    for (int c = 0; c < 7; c++) {
-        for (int i = 0; i < 6; i++)
-            for (int j = 0, k = 0; j < 7; j++)
-                if (j != c) M[i * 6 + k++] = J[i * 7 + j];
+void om_null_vector(const double *J, int m, double *n) {
+    double M[36];
+    for (int c = 0; c <= m; c++) {
+        for (int i = 0; i < m; i++)
+            for (int j = 0, k = 0; j <= m; j++)
+                if (j != c) M[i * m + k++] = J[i * (m + 1) + j];
         double d;
-        om_eliminate(M, NULL, 6, &d);
+        om_eliminate(M, NULL, m, &d);
         n[c] = (c % 2 ? -1.0 : 1.0) * d;
     }
+}
+
+void om_self_motion_null(const om_solver_data *s, const double *q, double *n) {
+    static const double eye[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    double J[6 * 7];
+    om_jacobian(s->real_table, s->n_real_rows, eye, eye, q, 7, J, NULL, NULL);
+    om_null_vector(J, 6, n);
 }
 
 bool om_self_motion_tangent(const om_solver_data *s, const double *q, double *t, double tol) {

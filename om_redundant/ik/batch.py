@@ -12,7 +12,7 @@ from .. import _core
 from ..exceptions import InvalidInput
 from ..kinematics import Arm
 from ..validation import as_count, as_joint_vector, as_poses, as_redundancy, as_signs
-from .threads import run_rows
+from .threads import BATCH_CHUNK, run_rows
 
 #: Most worker threads ``solve_batch`` accepts (it uses at most one per core).
 MAX_THREADS = 1024
@@ -148,7 +148,12 @@ class BatchSolves:
 
         Returns:
             A :class:`BatchRoots` with M rows, each row's solutions those of
-            ``solve_all(T[i], Configuration(signs[i], redundancy[i]))``.
+            ``solve_all(T[i], Configuration(signs[i], redundancy[i]))``. On an arm whose
+            search covers the whole torus (shoulder offsets that do not contract: the Sawyer),
+            the rows of one pose start from its traced self-motion (``csrc/ik/torus_trace.c``):
+            the same roots within the joint limits, in their own order; beyond them, where the
+            folded elbow puts the wrist centre on the shoulder, either may hold roots the
+            other lacks. A row's answer never depends on the other rows.
 
         Raises:
             InvalidInput: A malformed argument, or one whose rows do not match the M poses.
@@ -156,7 +161,13 @@ class BatchSolves:
         return self.solve_grid(T, signs, redundancy, None, threads)
 
     def solve_grid(
-        self, T: Any, signs: Any, redundancy: Any, band: np.ndarray | None, threads: int | None = None
+        self,
+        T: Any,
+        signs: Any,
+        redundancy: Any,
+        band: np.ndarray | None,
+        threads: int | None = None,
+        chunk: int = BATCH_CHUNK,
     ) -> BatchRoots:
         """:meth:`solve_all_batch`, where a row whose ``band`` is False returns its
         configuration's own roots (the bounded search's) and nothing else: where it has none,
@@ -169,6 +180,9 @@ class BatchSolves:
         Args:
             T, signs, redundancy, threads: As :meth:`solve_all_batch` takes them.
             band: (M,) bool, or None: every row searches as :meth:`~om_redundant.OMSolver.solve_all` does.
+            chunk: Rows a thread takes at a time. A thread's rows of one pose share its memos
+                (the torus' terms and traced self-motion, one per ELBOW sign), so a caller whose
+                rows come grouped by pose and ELBOW sign passes a group's size.
 
         Returns:
             A :class:`BatchRoots` with M rows.
@@ -199,7 +213,7 @@ class BatchSolves:
         def solve_range(start: int, stop: int) -> None:
             kernel.solve_all_rows(batch, start, stop)
 
-        run_rows(solve_range, m, threads)
+        run_rows(solve_range, m, threads, chunk)
         return BatchRoots(
             batch.q,
             batch.count,

@@ -42,7 +42,16 @@ singularities, which is where roots crowd; lifted, Newton's method converges the
   this is a thorough search rather than a proof. At a grid node the residual is linear in
   :math:`\cos\psi` and :math:`\sin\psi`
   (:func:`~om_redundant.ik.families.srs.model_lifted_terms`), so a batch's searches of one
-  pose at many arm angles (the optimiser's sweep) compute the nodes' terms once. Before it, a certificate
+  pose at many arm angles (the optimiser's sweep) compute the nodes' terms once, and start
+  not from the grid but from the pose's self-motion, traced once per ELBOW sign
+  (``csrc/ik/torus_trace.c``): with psi a fourth unknown the lifted residual's roots form
+  curves, each traced by predictor-corrector continuation from seeds the grid's starts would
+  take at some psi, and a search at psi starts Newton's method where they cross it (and from
+  a fold near it, for the fold's pair): one start a root instead of the grid's many. Within
+  the joint limits it finds what the grid's starts find (``tests/test_torus_trace.py``; 600
+  Sawyer poses at 512 arm angles and branches each); where the folded elbow puts the wrist
+  centre on the shoulder (W = S), beyond the Sawyer's limits, either may hold roots the other
+  lacks. Before it, a certificate
   (``csrc/ik/contraction.c``) bounds how fast the model's q1 and q7 turn as the wrist centre
   moves over the ball that holds the torus: where the map w -> (q1, q7) contracts (in a
   weighted max norm), on the whole torus or on cells of it, Banach's theorem proves each

@@ -25,8 +25,11 @@ def _forget_the_pool() -> None:
 os.register_at_fork(after_in_child=_forget_the_pool)
 
 
-def run_rows(solve_range: Callable[[int, int], None], rows: int, threads: int | None = None) -> None:
-    """Run ``solve_range(start, stop)`` over ``range(rows)`` in chunks, on ``threads`` threads.
+def run_rows(
+    solve_range: Callable[[int, int], None], rows: int, threads: int | None = None, chunk: int = BATCH_CHUNK
+) -> None:
+    """Run ``solve_range(start, stop)`` over ``range(rows)`` in chunks of ``chunk`` rows (fewer,
+    to give every thread one), on ``threads`` threads.
 
     The kernels release the GIL, so threads run them in parallel; each thread takes the next
     chunk as it comes free, which balances targets of unequal cost. The calling thread is one
@@ -39,13 +42,13 @@ def run_rows(solve_range: Callable[[int, int], None], rows: int, threads: int | 
     global _pool
     cores = _CORES
     workers = cores if threads is None else min(cores, threads)
-    if rows <= BATCH_CHUNK or workers == 1:
+    if rows <= chunk or workers == 1:
         solve_range(0, rows)
         return
     with _pool_lock:
         if _pool is None:
             _pool = ThreadPoolExecutor(cores, thread_name_prefix="om_redundant")
-    chunk = max(1, min(BATCH_CHUNK, -(-rows // workers)))
+    chunk = max(1, min(chunk, -(-rows // workers)))
     starts, lock, stop = iter(range(0, rows, chunk)), threading.Lock(), threading.Event()
 
     def drain() -> None:

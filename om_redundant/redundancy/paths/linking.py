@@ -103,7 +103,9 @@ def sweep_circle(probes: list[Probe], n: int, quick: bool = False) -> list[list[
         band[rows[b]] = not quick and not _neighbours_swept(signs_b, branches, n)
     grid_psi = np.empty(first)
     grid_psi[rows] = psi
-    batch = solver.solve_grid(np.repeat(T[None], first, axis=0), signs, grid_psi, band)
+    # (a chunk of rows per ELBOW sign: a thread's rows share the traced self-motion)
+    chunk = max(n * sum(1 for b in branches if b[1] == e) for e in {b[1] for b in branches})
+    batch = solver.solve_grid(np.repeat(T[None], first, axis=0), signs, grid_psi, band, chunk=chunk)
     swept = []
     for b, probe in enumerate(probes):
         grid, distinct = _distinct(probe, batch.q[rows[b]], batch.count[rows[b]])
