@@ -45,6 +45,7 @@ import numpy as np
 
 from ... import _core
 from ...angles import TURN
+from ...ik.threads import run_rows
 from .points import Point, evaluate_points
 from .probe import END_TOLERANCE, SAME, Probe
 
@@ -106,15 +107,21 @@ def sweep_circle(probes: list[Probe], n: int, quick: bool = False) -> list[list[
     # (a chunk of rows per ELBOW sign: a thread's rows share the traced self-motion)
     chunk = max(n * sum(1 for b in branches if b[1] == e) for e in {b[1] for b in branches})
     batch = solver.solve_grid(np.repeat(T[None], first, axis=0), signs, grid_psi, band, chunk=chunk)
-    swept = []
+    roots: list[list[list[Point]]] = []
     for b, probe in enumerate(probes):
         grid, distinct = _distinct(probe, batch.q[rows[b]], batch.count[rows[b]])
-        roots: list[list[Point]] = [[] for _ in range(n)]
+        roots.append([[] for _ in range(n)])
         if len(grid):
             for k, point in zip(grid.tolist(), probe.points(psi[grid], distinct), strict=True):
                 if point is not None:
-                    roots[k].append(point)
-        swept.append([(probe, Path(points, turns)) for points, turns in probe.link(psi, roots)])
+                    roots[b][k].append(point)
+    swept: list[list[tuple[Probe, Path]]] = [[] for _ in probes]
+
+    def link(start: int, stop: int) -> None:  # (each branch's link_paths call releases the GIL)
+        for b in range(start, stop):
+            swept[b] = [(probes[b], Path(points, turns)) for points, turns in probes[b].link(psi, roots[b])]
+
+    run_rows(link, len(probes), chunk=1)
     filled = iter(_with_hidden([path for paths in swept for path in paths]))  # (every branch's at once)
     return [[next(filled) for _ in paths] for paths in swept]
 
