@@ -29,6 +29,8 @@ typedef struct {
     size_t cap;
     om_trace *trace;            /* the self-motion traced at the pose of key (NULL: not yet) */
     bool untraced;              /* where om_trace_new failed: the grid's starts instead */
+    half_line_chart charts[LINE_POINTS]; /* psi's half-line's points in the grid (n_charts; -1: not yet) */
+    int n_charts;
 } terms_grid;
 
 /* An S-R-S arm's searches of the whole torus at one pose, in a grid of arm angles (solve_grid: each in 8
@@ -45,7 +47,7 @@ om_torus_memo *om_torus_memo_new(const om_solver_data *s)
         return NULL;
     om_torus_memo *memo = malloc(sizeof(om_torus_memo));
     for (int b = 0; memo && b < 2; b++)
-        memo->branches[b] = (terms_grid){false, {0.0}, NULL, 0, NULL, false};
+        memo->branches[b] = (terms_grid){.valid = false, .n_charts = -1};
     return memo;
 }
 
@@ -80,6 +82,7 @@ static const om_srs_lifted_terms *_grid_terms(om_problem *pb, double lo, double 
         om_trace_free(grid->trace);
         grid->trace = NULL;
         grid->untraced = false;
+        grid->n_charts = -1;
         if (grid->cap < mm) {
             grid->valid = false;
             free(grid->terms);
@@ -440,7 +443,13 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
             }
         }
     }
-    int count = om_half_line_roots(pb, lo1, lo7, step, m, q, roots, t.count, log);
+    /* (psi's half-line's points: the torus memo's, where the grid's terms are) */
+    half_line_chart own[LINE_POINTS];
+    terms_grid *memo = terms && pb->torus_memo ? &pb->torus_memo->branches[pb->signs[1] > 0] : NULL;
+    if (memo && memo->n_charts < 0)
+        memo->n_charts = om_half_line_points(pb, lo1, lo7, step, m, memo->charts);
+    int n_charts = memo ? memo->n_charts : om_half_line_points(pb, lo1, lo7, step, m, own);
+    int count = om_half_line_roots(pb, memo ? memo->charts : own, n_charts, q, roots, t.count, log);
     if (pb->s->family != OM_SRS && grid)
         count = om_shoulder_edge_roots(pb, lo1, lo7, step, m, q, roots, count, log);
     free(S);

@@ -115,10 +115,15 @@ static inline bool near_known(const newton_limits *limits, vec3 x)
  * IK there (not written where the run gave up). */
 double om_lifted_newton(om_problem *pb, const half_line_chart *chart, vec3 x, double *q, const double *known,
                         int n_known, const newton_limits *limits, vec3 *x_end);
-/* Roots next to the points of psi's half-line in the grid's square (lo1, lo7, step, m nodes a
- * side), candidates as torus_candidate's; returns the root count. */
-int om_half_line_roots(om_problem *pb, double lo1, double lo7, double step, int m, double *q, double *roots,
-                       int count, om_candidate_log *log);
+#define LINE_POINTS 8 /* points of psi's half-line kept per search */
+/* The points of the grid's square (lo1, lo7, step, m nodes a side) where the model's w_hat is -up,
+ * psi's singular half-line (the same at every arm angle of a pose), into charts (LINE_POINTS);
+ * returns the count. */
+int om_half_line_points(om_problem *pb, double lo1, double lo7, double step, int m, half_line_chart *charts);
+/* Roots next to the points of psi's half-line (charts, n of them), candidates as torus_candidate's;
+ * returns the root count. */
+int om_half_line_roots(om_problem *pb, const half_line_chart *charts, int n, double *q, double *roots, int count,
+                       om_candidate_log *log);
 /* A 6-DOF arm's roots at the shoulder's edge of reach, the wrist centre h from joint 1's axis (h
  * its lateral offset; none where h = 0): Newton about the axis (torus_half_line.c) from each
  * cell of the grid (lo1, lo7, step, m nodes a side) that the edge crosses or may touch between

@@ -9,7 +9,6 @@
 #define LINE_SEEDS 16          /* directions phi around a point of psi's half-line from which Newton starts */
 #define LINE_START 1e-6        /* m: the seeds' r (the lifted residual is about linear in r there) */
 #define LINE_ROOT 1e-6         /* lifted residual under which a chart's end is a candidate (rounding: 1e-16 / rho) */
-#define LINE_POINTS 8          /* points of the half-line kept per search */
 #define LINE_NEWTON 30         /* Newton steps to a point of the half-line (h = 0) */
 
 /* x(w1, w7) = W - S = p_d + a(w1) + R delta(w7) + R w_F - S of the model on the torus, and
@@ -83,7 +82,7 @@ static void _across(vec3 x, vec3 b1, vec3 b2, double *h)
  * from each cell where both parts of h may change sign (their range over the corners widened
  * by what the cell's curvature may hide); a point is kept if Newton converges there, below
  * the shoulder, with h's Jacobian regular. */
-static int _half_line_points(om_problem *pb, double lo1, double lo7, double step, int m, half_line_chart *charts)
+int om_half_line_points(om_problem *pb, double lo1, double lo7, double step, int m, half_line_chart *charts)
 {
     singular_line line = _singular_line(pb);
     vec3 up = line.up, d1, d7;
@@ -300,18 +299,16 @@ int om_shoulder_edge_roots(om_problem *pb, double lo1, double lo7, double step, 
     return count;
 }
 
-/* Roots next to the points of psi's half-line in the grid's square (_half_line_points):
+/* Roots next to the points of psi's half-line (charts, n of them: om_half_line_points):
  * Newton in each point's chart from LINE_SEEDS directions at r = LINE_START; an end whose
  * lifted residual is below LINE_ROOT (its rounding there is about 1e-16 / rho) is a candidate,
  * refined on the real arm and verified (torus_candidate). A 6-DOF arm's points, where the wrist
  * centre is on joint 1's axis, are searched about the axis instead (_axis_roots): there the
  * model's q1 turns by pi across the point, which no chart of the lifted system smooths. Returns
  * the root count. */
-int om_half_line_roots(om_problem *pb, double lo1, double lo7, double step, int m, double *q, double *roots,
-                       int count, om_candidate_log *log)
+int om_half_line_roots(om_problem *pb, const half_line_chart *charts, int n, double *q, double *roots, int count,
+                       om_candidate_log *log)
 {
-    half_line_chart charts[LINE_POINTS];
-    int n = _half_line_points(pb, lo1, lo7, step, m, charts);
     if (pb->s->family != OM_SRS)
         return _axis_roots(pb, charts, n, q, roots, count, log);
     vec3 ends[LINE_SEEDS];
