@@ -384,7 +384,8 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
     }
     /* A batch's searches of one pose (the torus memo's) start from its traced self-motion instead of
      * the grid's starts: one start a root (an arm near a family: the grid's, its Newton on G). */
-    const om_trace *trace = terms && pb->torus_memo && !pb->s->nominal_table ? _grid_trace(pb, terms, lo1, step, m) : NULL;
+    bool traced = terms && pb->torus_memo && !pb->s->nominal_table;
+    const om_trace *trace = traced ? _grid_trace(pb, terms, lo1, step, m) : NULL;
     for (int i = 0; i < m && grid && !trace; i++) {
         for (int j = 0; j < m; j++) {
             vec3 r;

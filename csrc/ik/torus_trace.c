@@ -379,7 +379,8 @@ static bool _covered(const om_trace *tr, const double *y)
     int side = tr->side, ci = _cell_of(tr, y[0]), cj = _cell_of(tr, y[1]);
     for (int di = -2; di <= 2; di++)
         for (int dj = -2; dj <= 2; dj++)
-            for (int i = tr->head[((ci + di + side) % side) * side + (cj + dj + side) % side]; i >= 0; i = tr->next[i]) {
+            for (int i = tr->head[((ci + di + side) % side) * side + (cj + dj + side) % side]; i >= 0;
+                 i = tr->next[i]) {
                 const double *v = tr->v[i].y;
                 if ((i > 0 && !isnan(tr->v[i - 1].y[3]) && _on_segment(tr->v[i - 1].y, v, y, COVER_TOL)) ||
                     (i + 1 < tr->n && !isnan(tr->v[i + 1].y[3]) && _on_segment(v, tr->v[i + 1].y, y, COVER_TOL)))
@@ -408,12 +409,13 @@ static bool _seed(om_trace *tr, om_problem *pb, double elbow, double *y, double 
 
 /* Phi at a node's terms, normalised into [-1, 1] (the shoulder's and wrist's residuals
  * s0 + s1 cos psi + s2 sin psi and w0 + w1 cos psi + w2 sin psi vanish at one psi iff
- * N1^2 + N2^2 = D^2), and that psi (D's sign decides between psi and psi + pi). */
+ * N1^2 + N2^2 = D^2), and (psi not NULL) that psi (D's sign decides between psi and psi + pi). */
 static double _phi(const om_srs_lifted_terms *k, double *psi)
 {
     const double *s = k->shoulder, *w = k->wrist;
     double D = s[1] * w[2] - s[2] * w[1], N1 = s[2] * w[0] - s[0] * w[2], N2 = s[0] * w[1] - s[1] * w[0];
-    *psi = D < 0.0 ? atan2(-N2, -N1) : atan2(N2, N1);
+    if (psi)
+        *psi = D < 0.0 ? atan2(-N2, -N1) : atan2(N2, N1);
     return (N1 * N1 + N2 * N2 - D * D) / (N1 * N1 + N2 * N2 + D * D);
 }
 
@@ -460,11 +462,11 @@ static bool _trace_seeds(om_trace *tr, om_problem *pb, const om_srs_lifted_terms
         cs[a][0] = cos(-OM_PI + 2.0 * OM_PI * (double)a / PSI_SAMPLES);
         cs[a][1] = sin(-OM_PI + 2.0 * OM_PI * (double)a / PSI_SAMPLES);
     }
-    double *Phi = malloc((size_t)m * (size_t)m * 2 * sizeof(double)), *psi = Phi + (size_t)m * (size_t)m;
+    double *Phi = malloc((size_t)m * (size_t)m * sizeof(double));
     if (!Phi)
         return false;
     for (int i = 0; i < m * m; i++)
-        Phi[i] = _phi(&terms[i], &psi[i]);
+        Phi[i] = _phi(&terms[i], NULL);
     bool ok = true;
     /* Phi's sign changes along an edge not crossed yet (beyond the reach at both ends, where the
      * elbow's root is clamped, they mean nothing) */
@@ -472,8 +474,9 @@ static bool _trace_seeds(om_trace *tr, om_problem *pb, const om_srs_lifted_terms
         for (int i = 0; i < side && ok; i++)
             for (int j = 0; j < side && ok; j++) {
                 int a = i * m + j, b = c ? (i + 1) * m + j : i * m + j + 1; /* c 0: along w7 */
-                if (!(isfinite(Phi[a]) && isfinite(Phi[b])) || (Phi[a] < 0.0) == (Phi[b] < 0.0) || tr->crossed[((size_t)c * side + (c ? j : i)) * side + (c ? i : j)] ||
-                    (fabs(terms[a].elbow) > 1e-9 && fabs(terms[b].elbow) > 1e-9))
+                bool crossed = tr->crossed[((size_t)c * side + (c ? j : i)) * side + (c ? i : j)] > 0;
+                bool beyond = fabs(terms[a].elbow) > 1e-9 && fabs(terms[b].elbow) > 1e-9;
+                if (!(isfinite(Phi[a]) && isfinite(Phi[b])) || (Phi[a] < 0.0) == (Phi[b] < 0.0) || crossed || beyond)
                     continue;
                 double u = Phi[a] / (Phi[a] - Phi[b]);
                 vec3 x = v3(lo + step * (c ? i + u : i), lo + step * (c ? j : j + u),
@@ -525,7 +528,7 @@ static bool _trace_seeds(om_trace *tr, om_problem *pb, const om_srs_lifted_terms
                     continue;
                 double u = fa / (fa - fb);
                 bool straight_edge = xa + xb > 0.0;
-                double phi4 = (straight_edge ? straight : straight + OM_PI) + (straight_edge ? elbow : -elbow) * EDGE_INTO;
+                double phi4 = straight_edge ? straight + elbow * EDGE_INTO : straight + OM_PI - elbow * EDGE_INTO;
                 ok = _seed_at(tr, pb, elbow, v3(a1 + u * (b1 - a1), a7 + u * (b7 - a7), phi4), SEED_REACH, false);
             }
     return ok;
