@@ -48,7 +48,7 @@ singularities, which is where roots crowd; lifted, Newton's method converges the
   curves, each traced by predictor-corrector continuation from seeds the grid's starts would
   take at some psi, and a search at psi starts Newton's method where they cross it (and from
   a fold near it, for the fold's pair): one start a root instead of the grid's many. Within
-  the joint limits it finds what the grid's starts find (``tests/test_torus_trace.py``; 600
+  the joint limits it finds what the grid's starts find (``tests/test_torus_trace.py``; 780
   Sawyer poses at 512 arm angles and branches each); where the folded elbow puts the wrist
   centre on the shoulder (W = S), beyond the Sawyer's limits, either may hold roots the other
   lacks. Before it, a certificate
