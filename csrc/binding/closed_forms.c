@@ -181,7 +181,7 @@ static PyObject *k_model_lifted_terms(PyObject *mod, PyObject *const *args, Py_s
     mat3 R = m_load(v[1].buf, 0);
     om_target t = om_target_at(OM_SRS, v[0].buf, &R, v[4].buf);
     om_srs_lifted_terms k;
-    bool ok = om_srs_lifted_terms_at(v[0].buf, &t, v_load(v[2].buf, 0), (double)((int64_t *)v[3].buf)[1], q1, q7, &k);
+    bool ok = om_srs_lifted_terms_at(v[0].buf, &t, v_load(v[2].buf, 0), (double)((int64_t *)v[3].buf)[1], q1, q7, NAN, &k);
     release_buffers(v, 5);
     if (!ok) Py_RETURN_NONE;
     PyObject *items[4] = {Py_BuildValue("(ddd)", k.shoulder[0], k.shoulder[1], k.shoulder[2]),

@@ -135,13 +135,11 @@ typedef struct {
     double elbow;                 /* the elbow's residual, x - cos(phi4 - phi*) */
     double phi4;                  /* the elbow's root */
 } om_srs_lifted_terms;
-/* The terms at (q1, q7) for the hand position p, target t (its psi not read) and ELBOW sign
- * elbow into *out; false where W = S (om_srs_model_ik_lifted's NaN). */
+/* The terms at (q1, q7) for the hand position p, target t (its psi not read), ELBOW sign elbow and
+ * the elbow angle phi4 (NaN: the elbow's root in the ELBOW branch, its residual then 0) into *out;
+ * false where W = S (om_srs_model_ik_lifted's NaN). */
 bool om_srs_lifted_terms_at(const double *P, const om_target *t, vec3 p, double elbow, double q1, double q7,
-                            om_srs_lifted_terms *out);
-/* The terms at (q1, q7, phi4): the elbow angle given, not its root (its residual then not 0). */
-bool om_srs_lifted_terms_with(const double *P, const om_target *t, vec3 p, double elbow, double q1, double q7,
-                              double phi4, om_srs_lifted_terms *out);
+                            double phi4, om_srs_lifted_terms *out);
 /* The (shoulder, wrist, elbow) residuals of the terms k at the arm angle whose cos and sin are c, s. */
 static inline vec3 om_srs_lifted_at(const om_srs_lifted_terms *k, double c, double s)
 {

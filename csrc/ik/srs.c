@@ -265,11 +265,23 @@ bool om_srs_model_ik_at_reach(const double *P, const om_target *t, vec3 p, const
     return at_reach(P, t, p, signs, q_prev, q, true);
 }
 
-/* The terms at (q1, q7) for W - S = w (|w|^2 = L2, the elbow's reach argument x) with the elbow
- * angle phi4 (cos c4, sin s4) in the ELBOW branch elbow. */
-static void lifted_terms(const double *P, const om_target *t, vec3 w, double L2, double x, double elbow, double q1,
-                         double q7, double c4, double s4, om_srs_lifted_terms *out)
+bool om_srs_lifted_terms_at(const double *P, const om_target *t, vec3 p, double elbow, double q1, double q7,
+                            double phi4, om_srs_lifted_terms *out)
 {
+    vec3 w = v_add(p, t->wrist);
+    double L2 = v_dot(w, w);
+    if (!(L2 >= DEGENERATE))
+        return false;
+    double x = (L2 - P[SRS_K0]) / P[SRS_K], c4, s4;
+    if (isnan(phi4)) {
+        elbow_cs e = elbow_root(P, x, elbow, &out->phi4);
+        c4 = e.c4;
+        s4 = e.s4;
+    } else {
+        out->phi4 = phi4;
+        c4 = cos(phi4);
+        s4 = sin(phi4);
+    }
     vec3 w_hat, n, nw, zero = v3(0.0, 0.0, 0.0);
     shoulder_wrist_triad(P, w, L2, &w_hat, &n, &nw);
     mat3 B = elbow_triad(P, c4, s4, elbow);
@@ -287,30 +299,6 @@ static void lifted_terms(const double *P, const om_target *t, vec3 w, double L2,
         out->wrist[k] = om_euler_given_first_residual(wrist, -P[SRS_SIN_BETA], P[SRS_COS_BETA], c7, s7);
     }
     out->elbow = x - cos(out->phi4 - P[SRS_PHI_STAR]);
-}
-
-bool om_srs_lifted_terms_at(const double *P, const om_target *t, vec3 p, double elbow, double q1, double q7,
-                            om_srs_lifted_terms *out)
-{
-    vec3 w = v_add(p, t->wrist);
-    double L2 = v_dot(w, w);
-    if (!(L2 >= DEGENERATE))
-        return false;
-    double x = (L2 - P[SRS_K0]) / P[SRS_K];
-    elbow_cs e = elbow_root(P, x, elbow, &out->phi4);
-    lifted_terms(P, t, w, L2, x, elbow, q1, q7, e.c4, e.s4, out);
-    return true;
-}
-
-bool om_srs_lifted_terms_with(const double *P, const om_target *t, vec3 p, double elbow, double q1, double q7,
-                              double phi4, om_srs_lifted_terms *out)
-{
-    vec3 w = v_add(p, t->wrist);
-    double L2 = v_dot(w, w);
-    if (!(L2 >= DEGENERATE))
-        return false;
-    out->phi4 = phi4;
-    lifted_terms(P, t, w, L2, (L2 - P[SRS_K0]) / P[SRS_K], elbow, q1, q7, cos(phi4), sin(phi4), out);
     return true;
 }
 

@@ -99,7 +99,7 @@ static const om_srs_lifted_terms *_grid_terms(om_problem *pb, double lo, double 
         for (int j = 0; j < m; j++) {
             double w1 = lo + (double)i * step, w7 = lo + (double)j * step;
             om_srs_lifted_terms *k = &terms[i * m + j];
-            if (!om_srs_lifted_terms_at(pb->s->params, &pb->t, om_torus_point(pb, w1, w7), elbow, w1, w7, k))
+            if (!om_srs_lifted_terms_at(pb->s->params, &pb->t, om_torus_point(pb, w1, w7), elbow, w1, w7, NAN, k))
                 *k = (om_srs_lifted_terms){{NAN, NAN, NAN}, {NAN, NAN, NAN}, NAN, NAN};
         }
     }
@@ -110,13 +110,12 @@ static const om_srs_lifted_terms *_grid_terms(om_problem *pb, double lo, double 
     return terms;
 }
 
-/* The self-motion at the pose and ELBOW sign of the torus memo's terms (those of pb's, computed by
+/* The self-motion at the pose and ELBOW sign of the torus memo's grid (its terms, computed by
  * _grid_terms), traced on first use; NULL where that failed (om_trace_new). */
-static const om_trace *_grid_trace(om_problem *pb, const om_srs_lifted_terms *terms, double lo, double step, int m)
+static const om_trace *_grid_trace(om_problem *pb, terms_grid *grid, double lo, double step, int m)
 {
-    terms_grid *grid = &pb->torus_memo->branches[pb->signs[1] > 0];
     if (!grid->trace && !grid->untraced) {
-        grid->trace = om_trace_new(pb, terms, lo, step, m);
+        grid->trace = om_trace_new(pb, grid->terms, lo, step, m);
         grid->untraced = !grid->trace;
     }
     return grid->trace;
@@ -382,10 +381,11 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
         free(t.known.near);
         return 0;
     }
-    /* A batch's searches of one pose (the torus memo's) start from its traced self-motion instead of
-     * the grid's starts: one start a root (an arm near a family: the grid's, its Newton on G). */
-    bool traced = terms && pb->torus_memo && !pb->s->nominal_table;
-    const om_trace *trace = traced ? _grid_trace(pb, terms, lo1, step, m) : NULL;
+    /* A batch's searches of one pose (the torus memo's, holding its grid's terms) start from its
+     * traced self-motion instead of the grid's starts: one start a root (an arm near a family: the
+     * grid's, its Newton on G); and find psi's half-line's points once. */
+    terms_grid *memo = terms && pb->torus_memo ? &pb->torus_memo->branches[pb->signs[1] > 0] : NULL;
+    const om_trace *trace = memo && !pb->s->nominal_table ? _grid_trace(pb, memo, lo1, step, m) : NULL;
     for (int i = 0; i < m && grid && !trace; i++) {
         for (int j = 0; j < m; j++) {
             vec3 r;
@@ -444,9 +444,7 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
             }
         }
     }
-    /* (psi's half-line's points: the torus memo's, where the grid's terms are) */
     half_line_chart own[LINE_POINTS];
-    terms_grid *memo = terms && pb->torus_memo ? &pb->torus_memo->branches[pb->signs[1] > 0] : NULL;
     if (memo && memo->n_charts < 0)
         memo->n_charts = om_half_line_points(pb, lo1, lo7, step, m, memo->charts);
     int n_charts = memo ? memo->n_charts : om_half_line_points(pb, lo1, lo7, step, m, own);

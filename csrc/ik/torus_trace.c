@@ -74,12 +74,11 @@ static bool _residual(om_problem *pb, double elbow, const double *y, double *F, 
 {
     om_srs_lifted_terms k;
     pb->counter++;
-    if (!om_srs_lifted_terms_with(pb->s->params, &pb->t, om_torus_point(pb, y[0], y[1]), elbow, y[0], y[1], y[2], &k))
+    if (!om_srs_lifted_terms_at(pb->s->params, &pb->t, om_torus_point(pb, y[0], y[1]), elbow, y[0], y[1], y[2], &k))
         return false;
     double c = cos(y[3]), s = sin(y[3]);
-    F[0] = k.shoulder[0] + k.shoulder[1] * c + k.shoulder[2] * s;
-    F[1] = k.wrist[0] + k.wrist[1] * c + k.wrist[2] * s;
-    F[2] = k.elbow;
+    vec3 r = om_srs_lifted_at(&k, c, s);
+    F[0] = r.x, F[1] = r.y, F[2] = r.z;
     if (!(isfinite(F[0]) && isfinite(F[1]) && isfinite(F[2])))
         return false;
     if (!J)
@@ -126,20 +125,6 @@ static bool _min_norm_step(const double *J, const double *F, double *d)
     return isfinite(d[0] + d[1] + d[2] + d[3]);
 }
 
-static double _max3(const double *F)
-{
-    return py_max(py_max(fabs(F[0]), fabs(F[1])), fabs(F[2]));
-}
-
-/* The largest of two points' coordinate differences, each modulo 2 pi. */
-static double _distance(const double *a, const double *b)
-{
-    double d = 0.0;
-    for (int i = 0; i < 4; i++)
-        d = py_max(d, fabs(om_wrap(a[i] - b[i])));
-    return d;
-}
-
 /* y moved onto C (to tol) by Newton's minimal-norm steps, the Jacobian kept while the residual
  * falls fourfold a step; false where that does not converge within reach of the start. */
 static bool _project(om_problem *pb, double elbow, double *y, double reach, double tol)
@@ -149,7 +134,7 @@ static bool _project(om_problem *pb, double elbow, double *y, double reach, doub
         bool fresh = it == 0;
         if (!_residual(pb, elbow, z, F, fresh ? J : NULL))
             return false;
-        double r = _max3(F);
+        double r = om_max_norm(v_load(F, 0));
         if (r < tol) {
             memcpy(y, z, sizeof z);
             return true;
@@ -163,7 +148,7 @@ static bool _project(om_problem *pb, double elbow, double *y, double reach, doub
         double f = size > 0.5 ? 0.5 / size : 1.0;
         for (int i = 0; i < 4; i++)
             z[i] += f * d[i];
-        if (_distance(z, y) > reach)
+        if (om_wrapped_distance_max(z, y, 4) > reach)
             return false;
     }
     return false;
@@ -206,7 +191,7 @@ static bool _fold_between(om_problem *pb, double elbow, const double *x, double 
             u = 0.5 * (lo + hi);
         for (int i = 0; i < 4; i++)
             p[i] = x[i] + u * chord[i];
-        if (!_project(pb, elbow, p, 0.5 * _distance(x, z) + 1e-9, VERTEX_TOL) || !_residual(pb, elbow, p, F, J) ||
+        if (!_project(pb, elbow, p, 0.5 * om_wrapped_distance_max(x, z, 4) + 1e-9, VERTEX_TOL) || !_residual(pb, elbow, p, F, J) ||
             !_tangent(J, t))
             break;
         double along = t[0] * chord[0] + t[1] * chord[1] + t[2] * chord[2] + t[3] * chord[3];
@@ -276,7 +261,7 @@ static trace_end _trace_from(om_trace *tr, om_problem *pb, double elbow, const d
         for (it = 0; it < 8; it++) {
             if (!_residual(pb, elbow, z, F, J))
                 break;
-            double r = _max3(F);
+            double r = om_max_norm(v_load(F, 0));
             if ((converged = r < VERTEX_TOL) || !(r < 0.5 * last) || !_min_norm_step(J, F, d))
                 break;
             last = r;
@@ -299,7 +284,7 @@ static trace_end _trace_from(om_trace *tr, om_problem *pb, double elbow, const d
         length += h;
         memcpy(x, z, sizeof x);
         memcpy(t, tz, sizeof t);
-        if (length > 3.0 * STEP_MAX && _distance(x, y0) < 1.5 * h &&
+        if (length > 3.0 * STEP_MAX && om_wrapped_distance_max(x, y0, 4) < 1.5 * h &&
             t[0] * t0[0] + t[1] * t0[1] + t[2] * t0[2] + t[3] * t0[3] > 0.5) { /* back at y0 */
             double close[4], t_close[4];
             for (int i = 0; i < 4; i++)
@@ -325,6 +310,16 @@ static void _file(om_trace *tr, int first)
     }
 }
 
+/* v[lo, hi) reversed in place. */
+static void _reverse(trace_vertex *v, int lo, int hi)
+{
+    for (hi--; lo < hi; lo++, hi--) {
+        trace_vertex swap = v[lo];
+        v[lo] = v[hi];
+        v[hi] = swap;
+    }
+}
+
 /* The component of C through y0, appended (a loop from y0 back to it; a path from its one end to
  * its other), then a break; false where a trace failed. */
 static bool _trace_component(om_trace *tr, om_problem *pb, double elbow, const double *y0)
@@ -335,21 +330,12 @@ static bool _trace_component(om_trace *tr, om_problem *pb, double elbow, const d
     trace_end end = _trace_from(tr, pb, elbow, y0, 1.0);
     if (end == TRACE_FAILED)
         return false;
-    if (end == TRACE_ENDED) { /* the other way too, in front, reversed */
+    if (end == TRACE_ENDED) { /* the other way too, in front, reversed: reverse(A B) then A again */
         int middle = tr->n;
         if (_trace_from(tr, pb, elbow, y0, -1.0) == TRACE_FAILED)
             return false;
-        int count = tr->n - first;
-        trace_vertex *ordered = malloc((size_t)count * sizeof(trace_vertex));
-        if (!ordered)
-            return false;
-        int k = 0;
-        for (int i = tr->n - 1; i >= middle; i--)
-            ordered[k++] = tr->v[i];
-        for (int i = first; i < middle; i++)
-            ordered[k++] = tr->v[i];
-        memcpy(tr->v + first, ordered, (size_t)count * sizeof(trace_vertex));
-        free(ordered);
+        _reverse(tr->v, first, tr->n);
+        _reverse(tr->v, tr->n - (middle - first), tr->n);
     }
     _file(tr, first);
     double between[4] = {NAN, NAN, NAN, NAN};
@@ -423,7 +409,7 @@ static double _phi(const om_srs_lifted_terms *k, double *psi)
 static bool _seed_at(om_trace *tr, om_problem *pb, double elbow, vec3 x, double reach, bool mirrored)
 {
     om_srs_lifted_terms k;
-    if (!om_srs_lifted_terms_with(pb->s->params, &pb->t, om_torus_point(pb, x.x, x.y), elbow, x.x, x.y, x.z, &k))
+    if (!om_srs_lifted_terms_at(pb->s->params, &pb->t, om_torus_point(pb, x.x, x.y), elbow, x.x, x.y, x.z, &k))
         return true;
     double y[4] = {x.x, x.y, x.z, 0.0};
     _phi(&k, &y[3]);
@@ -446,11 +432,13 @@ static double _least(const om_srs_lifted_terms *k, const double (*cs)[2], double
     return best;
 }
 
-/* The elbow's reach argument x at (w1, w7): the model's elbow reaches W - S where |x| <= 1. */
+/* The elbow's reach argument x at (w1, w7) (om_srs_reach; NaN where W = S): the model's elbow
+ * reaches W - S where |x| <= 1. */
 static double _reach_x(om_problem *pb, double w1, double w7)
 {
-    vec3 w = v_add(om_torus_point(pb, w1, w7), pb->t.wrist);
-    return (v_dot(w, w) - pb->s->params[SRS_K0]) / pb->s->params[SRS_K];
+    double x = NAN;
+    om_srs_reach(pb->s->params, &pb->t, om_torus_point(pb, w1, w7), &x);
+    return x;
 }
 
 /* The components from the seeds (the file's docstring), in order. */

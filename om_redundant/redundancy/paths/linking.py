@@ -93,19 +93,18 @@ def sweep_circle(probes: list[Probe], n: int, quick: bool = False) -> list[list[
     # not depend on psi across the rows of one ELBOW sign (its memos).
     order = sorted(range(len(branches)), key=lambda b: (branches[b][1:], branches[b][0]))
     rows = np.empty((len(branches), n), dtype=int)  # the batch row of each branch and grid psi
-    first = 0
+    first = chunk = 0  # chunk: a group's rows, a thread's (they share the traced self-motion)
     for elbow in sorted({branches[b][1] for b in order}):
         group = [b for b in order if branches[b][1] == elbow]
         rows[group] = first + np.arange(n * len(group)).reshape(n, len(group)).T
         first += n * len(group)
+        chunk = max(chunk, n * len(group))
     signs, band = np.empty((first, len(branches[0])), dtype=int), np.empty(first, dtype=bool)
     for b, signs_b in enumerate(branches):
         signs[rows[b]] = signs_b
         band[rows[b]] = not quick and not _neighbours_swept(signs_b, branches, n)
     grid_psi = np.empty(first)
     grid_psi[rows] = psi
-    # (a chunk of rows per ELBOW sign: a thread's rows share the traced self-motion)
-    chunk = max(n * sum(1 for b in branches if b[1] == e) for e in {b[1] for b in branches})
     batch = solver.solve_grid(np.repeat(T[None], first, axis=0), signs, grid_psi, band, chunk=chunk)
     roots: list[list[list[Point]]] = []
     for b, probe in enumerate(probes):
