@@ -254,7 +254,7 @@ def test_the_binding_rejects_malformed_buffers_with_a_named_error(panda):
 
 
 def test_the_bindings_refuse_indices_out_of_range(panda):
-    """pieces and evaluate (limited and singularity joints), arm_geom_poses and arm_clearance
+    """pieces, evaluate and linearise (limited and singularity joints), arm_geom_poses and arm_clearance
     (the geoms' links, the pairs' arm geoms and obstacles) check every index they read arrays
     at against its range: the values at either end of it are read, those just outside are a
     ValueError naming the sizes, never a read past an end."""
@@ -266,12 +266,20 @@ def test_the_bindings_refuse_indices_out_of_range(panda):
         rows = _core.PieceRows(q, q, np.empty((1, 0)), np.empty((1, 0, 7)))
         _core.pieces(7, rows, _core.PieceLimits(limited, lower, upper, half), numbers, g, g)
 
-    def evaluate(limited, joints):
-        q, out, one = np.zeros((1, 7)), _core.Evaluations(*np.empty((5, 1))), np.ones(1)
+    def terms(limited, joints):
+        one = np.ones(1)
         weights = dict(margin_weight=1.0, clearance_weight=1.0, singularity_weight=1.0)
         caps = dict(clearance_cap=0.1, min_clearance=0.03, singularity_cap=0.1)
-        terms = _core.ObjectiveTerms(7, limited, one - 1.0, one, one, joints, one, **weights, **caps)
-        _core.evaluate(terms, q, np.empty((1, 0)), out)
+        return _core.ObjectiveTerms(7, limited, one - 1.0, one, one, joints, one, **weights, **caps)
+
+    def evaluate(limited, joints):
+        q, out = np.zeros((1, 7)), _core.Evaluations(*np.empty((5, 1)))
+        _core.evaluate(terms(limited, joints), q, np.empty((1, 0)), out)
+
+    def linearise(limited, joints):
+        q, pieces = np.zeros((1, 7)), np.empty((2, 1, 3))
+        rows = _core.PieceRows(q, q, np.empty((1, 0)), np.empty((1, 0, 7)))
+        _core.linearise(terms(limited, joints), rows, *pieces)
 
     clearance = om.Clearance.for_arm(panda.arm, [om.Sphere([0.4, 0.1, 0.5], 0.05)])
     cores = clearance._cores
@@ -299,13 +307,21 @@ def test_the_bindings_refuse_indices_out_of_range(panda):
         return pairs
 
     pieces_sizes = "pieces: sizes of q, t, the pairs, the joints and g disagree"
-    evaluate_sizes = "evaluate: sizes of q, the distances, the joints and out disagree"
+    terms_sizes = "{}: sizes of the limits or the singularities' joints disagree"
     chain_sizes = "{}: sizes of the chain, geoms and joint vectors disagree"
     pair_sizes = "arm_clearance: sizes of the geoms, pairs and outputs disagree"
     refused = [
         *[(pieces, (index(k),), pieces_sizes) for k in (-1, 7)],
-        *[(evaluate, (index(k), index(0)), evaluate_sizes) for k in (-1, 7)],
-        *[(evaluate, (index(0), index(k)), evaluate_sizes) for k in (-1, 7)],
+        *[
+            (call, (index(k), index(0)), terms_sizes.format(call.__name__))
+            for call in (evaluate, linearise)
+            for k in (-1, 7)
+        ],
+        *[
+            (call, (index(0), index(k)), terms_sizes.format(call.__name__))
+            for call in (evaluate, linearise)
+            for k in (-1, 7)
+        ],
         *[(poses, (link_at(k),), chain_sizes.format("arm_geom_poses")) for k in (-1, 8)],
         *[(clear, (link_at(k), cores.pairs), chain_sizes.format("arm_clearance")) for k in (-1, 8)],
         *[(clear, (cores.link, pair_at(0, k)), pair_sizes) for k in (-1, n_arm)],
@@ -313,7 +329,7 @@ def test_the_bindings_refuse_indices_out_of_range(panda):
     ]
     for call, args in [
         *[(pieces, (index(k),)) for k in (0, 6)],
-        *[(evaluate, (index(k), index(j))) for k in (0, 6) for j in (0, 6)],
+        *[(call, (index(k), index(j))) for call in (evaluate, linearise) for k in (0, 6) for j in (0, 6)],
         *[(poses, (link_at(k),)) for k in (0, 7)],
         *[(clear, (link_at(k), cores.pairs)) for k in (0, 7)],
         *[(clear, (cores.link, pair_at(0, k))) for k in (0, n_arm - 1)],

@@ -15,8 +15,9 @@ import om_redundant as om
 from benchmarks.control_rate import HOMES, MIN_CLEARANCE, obstacles
 from om_redundant import _core
 from om_redundant.redundancy import self_motion_tangent
-from om_redundant.redundancy.choice.box_qp import Pieces, step_1d
+from om_redundant.redundancy.choice.box_qp import step_1d
 from om_redundant.redundancy.choice.start_bounds import StartBounds
+from om_redundant.redundancy.objective.objective import Objective
 from om_redundant.redundancy.objective.terms import Evaluation, Group
 from om_redundant.redundancy.paths.probe import Probe
 from om_redundant.redundancy.self_motion import self_motion_tangents
@@ -131,12 +132,49 @@ def test_batched_pieces_and_points_equal_the_single_ones(seed, name, count):
         assert point.evaluation == alone.evaluation
         for batched, single in zip(point.pieces(), alone.pieces(), strict=True):
             np.testing.assert_array_equal(batched, single)
-        # the groups from the pairs' gradients the batch computed (objective.pairs: the near
-        # pairs' only), chained through the tangent, are those computed afresh and chained here
+        # the pieces from the pairs' gradients the batch computed (objective.pairs: the near
+        # pairs' only), along the tangent, are the groups computed afresh and chained here
         fresh = [along(g, point.tangent) for g in objective.groups(point.q, jacobian=True)]
-        for batched, single in zip(point.groups, fresh, strict=True):
-            np.testing.assert_array_equal(batched.values, single.values)
-            np.testing.assert_array_equal(batched.jacobian, single.jacobian)
+        values, rates = point.linearised
+        want = np.concatenate([g.jacobian[:, 0] for g in fresh])
+        np.testing.assert_array_equal(values, np.concatenate([g.values for g in fresh]))
+        np.testing.assert_allclose(rates, want, rtol=1e-13, atol=1e-14 * max(1.0, np.abs(want).max()))
+
+
+@settings(max_examples=12, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    name=st.sampled_from([*HOMES, "gen3"]),
+    count=st.sampled_from([0, 1, 3]),
+    singular=st.booleans(),
+)
+def test_the_linearised_pieces_are_the_groups_along_psi(seed, name, count, singular):
+    """Objective.linearised (one compiled call) is Objective.groups with the tangent,
+    concatenated in the groups' order: the values exactly, the rates to rounding (numpy chains
+    the jacobians by a matrix product); its layout has the groups' sizes, weights, floors and
+    caps. With and without the singularity term, from the pairs of objective.pairs (a near
+    pair's gradients only, the far ones at the reach) and with no obstacle; Gen3's continuous
+    joints have no margin pieces."""
+    solver = om.OMSolver(name)
+    shapes = obstacles(solver.arm.fk(HOMES.get(name, np.zeros(7)))[:3, 3], count)
+    clearance = om.Clearance.for_arm(solver.arm, shapes) if shapes else None
+    singularity = om.Singularity.of(solver.model_arm, solver.flip) if singular else None
+    objective = Objective(solver.arm, clearance, singularity, min_clearance=MIN_CLEARANCE)
+    arm, layout = solver.arm, objective.layout
+    lower = np.where(np.isfinite(arm.lower), arm.lower - 0.3, -4.0)
+    upper = np.where(np.isfinite(arm.upper), arm.upper + 0.3, 4.0)
+    q = np.random.default_rng(seed).uniform(lower, upper, (20, 7))
+    for row, tangent in zip(q, self_motion_tangents(solver, q), strict=True):
+        pairs = objective.pairs(row)
+        groups = objective.groups(row, pairs=pairs, tangent=tangent)
+        values, rates = objective.linearised(row, tangent, pairs)
+        np.testing.assert_array_equal(values, np.concatenate([g.values for g in groups]))
+        want = np.concatenate([g.jacobian[:, 0] for g in groups])
+        np.testing.assert_allclose(rates, want, rtol=1e-13, atol=1e-14 * max(1.0, np.abs(want).max()))
+        assert np.diff(layout.ends).tolist() == [len(g.values) for g in groups]
+        assert layout.weights.tolist() == [g.weight for g in groups]
+        assert layout.floors.tolist() == [g.floor for g in groups]
+        assert layout.caps.tolist() == [g.cap for g in groups]
 
 
 @settings(max_examples=10, deadline=None)
@@ -185,7 +223,7 @@ def test_the_one_variable_qp_step_is_the_models_maximiser(seed, pieces, curvatur
     rng = np.random.default_rng(seed)
     groups = random_groups(rng, 1, lambda floor: rng.uniform(0.0, spread, pieces) + max(floor, 0.0) + 0.3)
     lower, upper = -reach * rng.uniform(), reach * rng.uniform()
-    concatenated = Pieces.of(groups)
+    concatenated = box_qp_numpy.concatenated(groups)
     delta, gain, z = step_1d(concatenated, curvature, lower, upper)
     want_delta, _, want_z = box_qp_numpy.step_1d(concatenated, curvature, lower, upper)
     assert delta == pytest.approx(want_delta, abs=1e-12)
@@ -208,14 +246,9 @@ def test_the_one_variable_qp_step_is_the_models_maximiser(seed, pieces, curvatur
     assert value >= phi[floors_kept].max(initial=-np.inf) - 1e-12
     for g, z_g in zip(groups, concatenated.split(z), strict=True):
         assert (z_g >= 0.0).all() and z_g.sum() <= g.weight + 1e-12
-    below = Pieces.of([replace(g, values=g.values - 0.5) for g in groups])
+    below = box_qp_numpy.concatenated([replace(g, values=g.values - 0.5) for g in groups])
     found, want = (s(below, curvature, lower, upper) for s in (step_1d, box_qp_numpy.step_1d))
     assert (found is None) == (want is None)  # (the floors may leave no delta)
-    moved = [replace(g, values=g.values + 0.1, jacobian=-g.jacobian) for g in groups]
-    for mine, fresh in zip(concatenated.at(moved), Pieces.of(moved), strict=True):
-        np.testing.assert_array_equal(mine, fresh)  # (another point's pieces, the structure shared)
-    with pytest.raises(ValueError, match="pieces where"):
-        concatenated.at(groups[:2])
     broken = concatenated._replace(values=np.where(np.arange(len(z)) == 0, np.nan, concatenated.values))
     with pytest.raises(ValueError, match="a piece is not a number"):
         step_1d(broken, curvature, lower, upper)

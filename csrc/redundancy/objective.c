@@ -5,7 +5,8 @@
  * S = min_k |sin(q_{j_k} + c_k)|, and
  *   f = w_m M + w_c min(1, D/d_cap) + w_s min(1, S/s_cap),  slack = min(M, (D - d_min)/d_cap),
  * each sum and quotient in the order objective.py's numpy reference rounds them. No limited joint
- * (L = 0), no obstacle (P = 0) or no singularity (K = 0): no such term. */
+ * (L = 0), no obstacle (P = 0) or no singularity (K = 0): no such term. And the pieces of those
+ * terms with their rates along the self-motion, which the climb's QP linearises (om_linearise). */
 #include "redundancy.h"
 
 om_evaluation om_evaluate(const om_objective_terms *o, const double *q, const double *d, ptrdiff_t P) {
@@ -34,4 +35,32 @@ om_evaluation om_evaluate(const om_objective_terms *o, const double *q, const do
         singular = scaled * o->singularity_cap;
     }
     return (om_evaluation){value, margin, clearance, slack, singular};
+}
+
+void om_linearise(const om_objective_terms *o, ptrdiff_t dof, const double *q, const double *t, const double *d,
+                  const double *grad, ptrdiff_t P, double *v, double *a) {
+    ptrdiff_t n = 0;
+    for (ptrdiff_t i = 0; i < o->L; i++) { /* (1/h) t_i: objective.py's (e_i / h) . t */
+        double h = o->half[i], x = q[o->limited[i]], inv = 1.0 / h;
+        v[n] = (x - o->lower[i]) / h, a[n] = inv * t[o->limited[i]];
+        v[o->L + n] = (o->upper[i] - x) / h, a[o->L + n] = -inv * t[o->limited[i]];
+        n++;
+    }
+    n = 2 * o->L;
+    double cap = o->clearance_cap, reach = 2.0 * cap, least = INFINITY;
+    for (ptrdiff_t k = 0; k < P; k++) least = isnan(least) || d[k] >= least ? least : d[k]; /* (NaN stays) */
+    for (ptrdiff_t k = 0; k < P; k++, n++) {
+        if (least < reach && !(d[k] < reach)) { /* beyond the reach where a pair is within it */
+            v[n] = reach / cap, a[n] = 0.0;
+            continue;
+        }
+        double rate = 0.0;
+        for (ptrdiff_t i = 0; i < dof; i++) rate += (grad[k * dof + i] / cap) * t[i];
+        v[n] = d[k] / cap, a[n] = rate;
+    }
+    for (ptrdiff_t k = 0; k < o->K; k++, n++) {
+        double x = q[o->joints[k]] + o->offsets[k], sine = sin(x), slope = cos(x);
+        if (sine < 0.0) slope = -slope; /* sign(sin x) cos x; +cos x where sin x = 0 */
+        v[n] = fabs(sine) / o->singularity_cap, a[n] = (slope / o->singularity_cap) * t[o->joints[k]];
+    }
 }

@@ -65,6 +65,14 @@ typedef struct {
 
 /* The objective at q (dof) with the P pairs' distances d (P = 0: no obstacles). */
 om_evaluation om_evaluate(const om_objective_terms *o, const double *q, const double *d, ptrdiff_t P);
+/* The pieces v_j of the objective's groups at q (dof) and their rates a_j = dv_j/dq . t along
+ * t (objective.py's Objective.groups with the tangent, concatenated in the groups' order), into
+ * v and a (2L + P + K): the L limited joints' (q_i - l_i)/h_i, then their (u_i - q_i)/h_i; the
+ * P pairs' d_k/d_cap with the rate grad_k . t / d_cap (grad: P x dof), a pair at 2 d_cap or
+ * more taken there with rate 0 where some pair is nearer; the K singularities'
+ * |sin x_k|/s_cap with the rate sign(sin x_k) cos x_k t_{j_k} / s_cap. */
+void om_linearise(const om_objective_terms *o, ptrdiff_t dof, const double *q, const double *t, const double *d,
+                  const double *grad, ptrdiff_t P, double *v, double *a);
 
 /* ------------------------------------------------------------------------------------ */
 /* clearance.c: distances of an arm's geoms and obstacle geoms. */

@@ -127,6 +127,7 @@ from ..ckernels import (
     follow,
     jacobian,
     joint_step,
+    linearise,
     link_paths,
     model_ik,
     model_ik_at_reach,

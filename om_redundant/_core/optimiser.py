@@ -160,7 +160,7 @@ class GeomPose(NamedTuple):
 
 
 class ObjectiveTerms(NamedTuple):
-    """The objective's terms, as ``evaluate`` reads them
+    """The objective's terms, as ``evaluate`` and ``linearise`` read them
     (:class:`~om_redundant.redundancy.objective.objective.Objective`).
 
     Attributes:

@@ -111,7 +111,8 @@ class CellSamples(NamedTuple):
 
 
 class PieceRows(NamedTuple):
-    """The M joint vectors at which ``pieces`` computes the feasibility functions.
+    """The M joint vectors at which ``pieces`` computes the feasibility functions, and
+    ``linearise`` the objective's pieces with their rates.
 
     Attributes:
         q: (M, dof) the joints.

@@ -16,6 +16,15 @@ from om_redundant.redundancy.objective.terms import Group
 _TIE = 1e-12  # pieces within this of their group's minimum meet there
 
 
+def concatenated(groups: list[Group]) -> Pieces:
+    """The pieces of groups with jacobians (p_g, 1), as the climb's QP reads them."""
+    ends = np.cumsum([0] + [len(g.values) for g in groups], dtype=np.int64)
+    weights, floors, caps = np.array([(g.weight, g.floor, g.cap) for g in groups], dtype=float).T.copy()
+    values = np.concatenate([g.values for g in groups])
+    rates = np.concatenate([g.jacobian[:, 0] for g in groups])
+    return Pieces(values, rates, ends, weights, floors, caps)
+
+
 def least(pieces: Pieces, values: np.ndarray) -> np.ndarray:
     """(G,) each group's smallest of ``values`` (n,), one per piece."""
     return np.minimum.reduceat(values, pieces.ends[:-1])

@@ -25,7 +25,7 @@ import itertools
 import numpy as np
 
 from ... import _core
-from ..objective.terms import Group
+from ..paths.points import Point
 
 
 class Pieces(_core.Pieces):
@@ -36,29 +36,14 @@ class Pieces(_core.Pieces):
     __slots__ = ()
 
     @classmethod
-    def of(cls, groups: list[Group]) -> Pieces:
-        """The pieces of groups with jacobians (p_g, 1)."""
-        ends = np.cumsum([0] + [len(g.values) for g in groups], dtype=np.int64)
-        weights, floors, caps = np.array([(g.weight, g.floor, g.cap) for g in groups], dtype=float).T.copy()
-        values, rates = _values_and_rates(groups)
-        return cls(values, rates, ends, weights, floors, caps)
-
-    def at(self, groups: list[Group]) -> Pieces:
-        """The pieces of groups of the same sizes, weights, floors and caps as these (the same
-        objective's at another point), which share these' ends and numbers."""
-        values, rates = _values_and_rates(groups)
-        if len(values) != self.ends[-1]:
-            raise ValueError(f"{len(values)} pieces where these groups have {self.ends[-1]}")
-        return self._replace(values=values, rates=rates)
+    def at(cls, point: Point) -> Pieces:
+        """The pieces of the objective's groups at a point and their rates along psi
+        (:attr:`Point.linearised <om_redundant.redundancy.paths.points.Point.linearised>`)."""
+        return cls(*point.linearised, *point.terms.objective.layout)
 
     def split(self, z: np.ndarray) -> list[np.ndarray]:
         """(n,) per piece into one array per group (views)."""
         return [z[a:b] for a, b in itertools.pairwise(self.ends.tolist())]
-
-
-def _values_and_rates(groups: list[Group]) -> tuple[np.ndarray, np.ndarray]:
-    """The groups' pieces v_j and rates a_j (jacobians (p_g, 1)), concatenated."""
-    return np.concatenate([g.values for g in groups]), np.concatenate([g.jacobian[:, 0] for g in groups])
 
 
 def step_1d(

@@ -46,8 +46,8 @@ def maximise(probe: Probe, start: Point, lower: float, upper: float, radius: flo
 
     The trust radius Delta is also kept below ``_JOINT_STEP / max_i |dq_i/dpsi|``, so that no
     step moves a joint by more than 0.25 rad to first order (near a fold of the solution path
-    dq/dpsi is large and the linearisation holds only briefly). The pieces of a point are
-    concatenated once (:class:`~om_redundant.redundancy.choice.box_qp.Pieces`).
+    dq/dpsi is large and the linearisation holds only briefly). A point's pieces come
+    concatenated from one compiled call (:class:`~om_redundant.redundancy.choice.box_qp.Pieces`).
 
     Args:
         probe: Exact solutions on the branch at the pose.
@@ -58,10 +58,10 @@ def maximise(probe: Probe, start: Point, lower: float, upper: float, radius: flo
     Returns:
         The best feasible point found.
     """
-    if not start.groups:  # nothing to maximise: f is constant
+    if not len(probe.objective.layout.weights):  # nothing to maximise: f is constant
         return start
     point, x, b = start, float(start.psi), _INITIAL_CURVATURE
-    pieces = Pieces.of(point.groups)
+    pieces = Pieces.at(point)
     for _ in range(_MAX_CLIMB):
         radius = min(radius, _JOINT_STEP / max(float(np.abs(point.tangent).max()), 1e-12))
         if radius <= STEP_TOLERANCE:
@@ -76,7 +76,7 @@ def maximise(probe: Probe, start: Point, lower: float, upper: float, radius: flo
         if trial is None or not trial.evaluation.feasible or gain < _ACCEPT * model_gain:
             radius = size / 4.0
             continue
-        moved = pieces.at(trial.groups)
+        moved = Pieces.at(trial)
         rise = moved.rates - pieces.rates  # y = -sum_j z_j (a_j^new - a_j^old), group by group
         y = -sum(z_g @ rise_g for z_g, rise_g in zip(pieces.split(z), pieces.split(rise), strict=True))
         b = _bfgs(b, delta, y)

@@ -42,7 +42,7 @@ from __future__ import annotations
 
 import math
 import threading
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -65,6 +65,21 @@ from .terms import (
 )
 
 
+class GroupLayout(NamedTuple):
+    """The groups of :meth:`Objective.groups` as the climb's QP reads their concatenated pieces
+    (:meth:`Objective.linearised`; ``_core.Pieces``' other fields).
+
+    Attributes:
+        ends: (G + 1,) int64: group g's pieces are ``ends[g]`` to ``ends[g + 1] - 1``.
+        weights, floors, caps: (G,) per group.
+    """
+
+    ends: np.ndarray
+    weights: np.ndarray
+    floors: np.ndarray
+    caps: np.ndarray
+
+
 class Objective:
     """The objective f and the feasibility test of the module docstring.
 
@@ -78,6 +93,9 @@ class Objective:
         singularity_weight: w_s >= 0 (ignored without ``singularity``).
         clearance_cap: d_cap > 0 (m): clearance beyond it earns nothing more.
         min_clearance: d_min (m), 0 <= d_min < d_cap: the clearance every choice must keep.
+
+    Attributes:
+        layout: Its groups' sizes, weights, floors and caps (:class:`GroupLayout`).
     """
 
     def __init__(
@@ -139,6 +157,17 @@ class Objective:
         )
         eye = np.eye(self._dof)[self._limited] / self._half[:, None]
         self._margin_jacobian = np.vstack([eye, -eye])  # pieces (q - l)/h, then (u - q)/h
+        sizes, numbers = [], []  # the groups of :meth:`groups`: their pieces, weights, floors, caps
+        if len(self._limited):
+            sizes.append(2 * len(self._limited)), numbers.append((self.margin_weight, 0.0, math.inf))
+        if clearance is not None:
+            floor = self.min_clearance / self.clearance_cap
+            sizes.append(len(clearance.pairs)), numbers.append((self.clearance_weight, floor, 1.0))
+        if singularity is not None:
+            sizes.append(len(joints)), numbers.append((self.singularity_weight, -math.inf, 1.0))
+        weights, floors, caps = np.array(numbers, dtype=float).reshape(-1, 3).T.copy()
+        self.layout = GroupLayout(np.cumsum([0, *sizes], dtype=np.int64), weights, floors, caps)
+        self._no_pairs = np.zeros((0,)), np.zeros((0, self._dof))
 
     def groups(
         self,
@@ -179,6 +208,28 @@ class Objective:
         if self.clearance is not None:
             groups.append(self._clearance(q, jacobian, pairs, tangent))
         return groups
+
+    def linearised(
+        self, q: np.ndarray, tangent: np.ndarray, pairs: tuple[np.ndarray, np.ndarray] | None
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The pieces v_j of :meth:`groups` at q with the tangent, concatenated in the groups'
+        order (:attr:`layout`), and their rates dv_j/dpsi: what the climb's QP linearises
+        (``_core.linearise``, ``csrc/redundancy/objective.c``; the same numbers to rounding).
+
+        Args:
+            q: (dof,) joint vector.
+            tangent: (dof, 1) dq/dpsi at q.
+            pairs: The pairs' distances (P,) and gradients (P, dof) at q (:meth:`pairs`); None
+                without obstacles.
+
+        Returns:
+            (n,) values and (n,) rates, n = ``layout.ends[-1]``.
+        """
+        d, grad = self._no_pairs if pairs is None else pairs
+        values, rates = np.empty((2, int(self.layout.ends[-1])))
+        rows = _core.PieceRows(q, tangent[:, 0], d, grad)
+        _core.linearise(self._terms, rows, values, rates)
+        return values, rates
 
     def pairs(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
         """The clearance's pair distances at q and the gradients that :meth:`groups` and

@@ -11,14 +11,14 @@ import numpy as np
 
 from ...ik.solver import Solution
 from ..objective.objective import Objective
-from ..objective.terms import Evaluation, Group
+from ..objective.terms import Evaluation
 
 
 class PointTerms:
     """The objective at a point, computed when first asked for (a path's following steps
     need only the joints and the tangent), or given by a batch (:func:`evaluate_points`):
     the clearance's pair distances and gradients (one ``_core.arm_clearance`` call), from
-    which the groups with their rates, the evaluation and the feasibility functions. Shared
+    which the groups' pieces with their rates, the evaluation and the feasibility functions. Shared
     by the copies of a point at other representatives of psi. (Slots, the arrays of a pair
     each in its own: the sweep keeps hundreds of terms per pose, and each container they
     hold would count towards the garbage collector's next pass.)
@@ -28,7 +28,7 @@ class PointTerms:
         g, dg: The feasibility functions and their rates, or None.
     """
 
-    __slots__ = ("d", "dg", "evaluation", "g", "grad", "groups", "objective", "q", "tangent")
+    __slots__ = ("d", "dg", "evaluation", "g", "grad", "linear", "objective", "q", "tangent")
 
     def __init__(
         self,
@@ -43,7 +43,7 @@ class PointTerms:
     ):
         self.objective, self.q, self.tangent, self.evaluation = objective, q, tangent, evaluation
         self.g, self.dg, self.d, self.grad = g, dg, d, grad
-        self.groups: list[Group] | None = None
+        self.linear: tuple[np.ndarray, np.ndarray] | None = None
 
     def get_pairs(self) -> tuple[np.ndarray, np.ndarray] | None:
         """The clearance's pair distances and gradients at q (:meth:`Objective.pairs`); None
@@ -67,11 +67,11 @@ class PointTerms:
             self.g, self.dg = self.objective.pieces(self.q, self.tangent, self.get_pairs())
         return self.g, self.dg
 
-    def get_groups(self) -> list[Group]:
-        """The groups at q, their jacobians by psi (:meth:`Objective.groups` with the tangent)."""
-        if self.groups is None:
-            self.groups = self.objective.groups(self.q, pairs=self.get_pairs(), tangent=self.tangent)
-        return self.groups
+    def get_linearised(self) -> tuple[np.ndarray, np.ndarray]:
+        """The groups' pieces at q and their rates along psi (:meth:`Objective.linearised`)."""
+        if self.linear is None:
+            self.linear = self.objective.linearised(self.q, self.tangent, self.get_pairs())
+        return self.linear
 
 
 def evaluate_points(objective: Objective, points: list[Point]) -> None:
@@ -109,7 +109,7 @@ class Point:
         q: The joints.
         tangent: dq/dpsi (dof, r).
         terms: The objective at q, evaluated when first asked for (:attr:`evaluation`,
-            :attr:`groups`).
+            :attr:`linearised`).
         solution: The solver's Solution of it, when solved singly (its q may differ from
             ``q`` by turns of revolute joints); None for a batch sample.
     """
@@ -132,9 +132,10 @@ class Point:
         return self.terms.get_evaluation() if evaluation is None else evaluation
 
     @property
-    def groups(self) -> list[Group]:
-        """The objective's groups at q, their jacobians by psi (p_g, r)."""
-        return self.terms.get_groups()
+    def linearised(self) -> tuple[np.ndarray, np.ndarray]:
+        """The objective's groups' pieces at q and their rates along psi (a one-variable
+        psi; :meth:`Objective.linearised`)."""
+        return self.terms.get_linearised()
 
     def pieces(self) -> tuple[np.ndarray, np.ndarray]:
         """The feasibility functions g_j (all >= 0 iff feasible; see
