@@ -20,8 +20,6 @@ balances :math:`b\delta`.
 
 from __future__ import annotations
 
-import itertools
-
 import numpy as np
 
 from ... import _core
@@ -40,10 +38,6 @@ class Pieces(_core.Pieces):
         """The pieces of the objective's groups at a point and their rates along psi
         (:attr:`Point.linearised <om_redundant.redundancy.paths.points.Point.linearised>`)."""
         return cls(*point.linearised, *point.terms.objective.layout)
-
-    def split(self, z: np.ndarray) -> list[np.ndarray]:
-        """(n,) per piece into one array per group (views)."""
-        return [z[a:b] for a, b in itertools.pairwise(self.ends.tolist())]
 
 
 def step_1d(

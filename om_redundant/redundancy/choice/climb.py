@@ -77,8 +77,7 @@ def maximise(probe: Probe, start: Point, lower: float, upper: float, radius: flo
             radius = size / 4.0
             continue
         moved = Pieces.at(trial)
-        rise = moved.rates - pieces.rates  # y = -sum_j z_j (a_j^new - a_j^old), group by group
-        y = -sum(z_g @ rise_g for z_g, rise_g in zip(pieces.split(z), pieces.split(rise), strict=True))
+        y = -float(z @ (moved.rates - pieces.rates))  # y = -sum_j z_j (a_j^new - a_j^old)
         b = _bfgs(b, delta, y)
         if gain > 0.75 * model_gain and size >= 0.9 * radius:
             radius *= 2.0
