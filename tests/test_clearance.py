@@ -17,6 +17,7 @@ from hypothesis import strategies as st
 import om_redundant as om
 from om_redundant import _core
 from om_redundant.exceptions import ModelMismatch
+from om_redundant.ik.threads import BATCH_CHUNK, run_rows
 from tests.conftest import in_threads, random_q
 
 KINDS = {
@@ -189,6 +190,27 @@ def test_threads_sharing_a_clearance_get_its_answers():
     for (d, g), (d_shared, g_shared) in zip(alone, shared, strict=True):
         np.testing.assert_array_equal(d, d_shared)
         np.testing.assert_array_equal(g, g_shared)
+
+
+def test_a_batch_split_across_the_pool_is_its_rows_one_by_one():
+    """A batch of rows is split across the pool's threads in chunks (the pairs the kernel
+    leaves to MuJoCo filled after): it gives exactly each row's answer alone, the same batch
+    made inside a pool thread's chunk (run there in one call, its helpers never queued behind
+    it) too."""
+    arm = om.load_arm("gen3")
+    clearance = mounted(arm)
+    Q = within_limits(arm, np.random.default_rng(1), 300)
+    d, g = clearance.distances_and_gradients(Q)
+    assert len(Q) > 2 * BATCH_CHUNK  # (split)
+    for k, q in enumerate(Q):
+        alone = clearance.distances_and_gradients(q)
+        np.testing.assert_array_equal(d[k], alone[0])
+        np.testing.assert_array_equal(g[k], alone[1])
+    inside = []
+    run_rows(lambda start, stop: inside.append(clearance.distances_and_gradients(Q)), 2 * BATCH_CHUNK + 1)
+    for d_inside, g_inside in inside:
+        np.testing.assert_array_equal(d_inside, d)
+        np.testing.assert_array_equal(g_inside, g)
 
 
 SHIPPED = om.arm_names()  # every 7-DOF arm, and a 6-DOF one with a prismatic joint

@@ -12,6 +12,7 @@ BATCH_CHUNK = 64
 
 _pool: ThreadPoolExecutor | None = None
 _pool_lock = threading.Lock()
+_PREFIX = "om_redundant"  # the pool threads' names
 _CORES = os.cpu_count() or 1  # read once: os.cpu_count() reads a file (~30 us a call on Linux)
 
 
@@ -35,19 +36,21 @@ def run_rows(
     chunk as it comes free, which balances targets of unequal cost. The calling thread is one
     of them (it would only wait otherwise; on a busy machine a pool thread may be slow to
     wake, and then the caller takes its chunks). ``threads`` None: one per core (at most that
-    many in any case); 1: every row on the calling thread, in one call. An exception in the
+    many in any case); 1: every row on the calling thread, in one call, as from a pool thread
+    itself (a chunk that runs a batch of its own: its helpers could wait behind it in the
+    pool's queue). An exception in the
     calling thread (Ctrl-C: KeyboardInterrupt, raised between its chunks) stops every thread
     after its current chunk, and is raised at once.
     """
     global _pool
     cores = _CORES
     workers = cores if threads is None else min(cores, threads)
-    if rows <= chunk or workers == 1:
+    if rows <= chunk or workers == 1 or threading.current_thread().name.startswith(_PREFIX):
         solve_range(0, rows)
         return
     with _pool_lock:
         if _pool is None:
-            _pool = ThreadPoolExecutor(cores, thread_name_prefix="om_redundant")
+            _pool = ThreadPoolExecutor(cores, thread_name_prefix=_PREFIX)
     chunk = max(1, min(chunk, -(-rows // workers)))
     starts, lock, stop = iter(range(0, rows, chunk)), threading.Lock(), threading.Event()
 

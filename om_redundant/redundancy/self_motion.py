@@ -7,6 +7,7 @@ import numpy as np
 from .. import _core
 from ..exceptions import SingularSelfMotion
 from ..ik.solver import OMSolver
+from ..ik.threads import run_rows
 from ..validation import as_joint_vector
 from .arm_angle import arm_angle_and_gradient, check_arm_angle
 
@@ -81,5 +82,9 @@ def self_motion_tangents(solver: OMSolver, q: np.ndarray) -> np.ndarray:
     check_arm_angle(solver)
     q = as_joint_vector(q, solver.arm.dof).reshape(-1, solver.arm.dof)
     tangent = np.empty((len(q), 7))
-    _core.self_motion_tangents(solver.kernel, q, tangent)
+
+    def chunk(start: int, stop: int) -> None:  # (the kernel releases the GIL: threads share a batch)
+        _core.self_motion_tangents(solver.kernel, q[start:stop], tangent[start:stop])
+
+    run_rows(chunk, len(q))
     return tangent[:, :, None]

@@ -60,6 +60,7 @@ import numpy as np
 
 from ... import _core
 from ...exceptions import InvalidInput
+from ...ik.threads import run_rows
 from ...kinematics.arm import Arm
 from ...mujoco_io.arm_in_model import ArmJoints
 from ...mujoco_io.mjcf import arm_mjcf
@@ -374,10 +375,19 @@ class Clearance:
         dist, fromto = np.empty(shape), np.empty((*shape, 6))
         grad = np.empty((*shape, self._dof)) if gradient else None
         cores = self._cores
-        if _core.arm_clearance(cores, q, reach, near, _core.PairDistances(dist, fromto, grad), False):
-            self._mujoco.fill(
-                cores, q.reshape(-1, self._dof), reach, near, dist.reshape(-1, self._n_pairs), fromto, grad
-            )
+        rows = q.reshape(-1, self._dof)
+        out = _core.PairDistances(
+            *(a if a is None else a.reshape(len(rows), *a.shape[q.ndim - 1 :]) for a in (dist, fromto, grad))
+        )
+        left = []  # (whether a chunk left pairs to MuJoCo)
+
+        def chunk(start: int, stop: int) -> None:  # (the kernel releases the GIL: threads share a batch)
+            part = _core.PairDistances(*(a if a is None else a[start:stop] for a in out))
+            left.append(_core.arm_clearance(cores, rows[start:stop], reach, near, part, False))
+
+        run_rows(chunk, len(rows))
+        if any(left):
+            self._mujoco.fill(cores, rows, reach, near, out.dist, out.fromto, out.grad)
         return dist, grad
 
 

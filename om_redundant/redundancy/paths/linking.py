@@ -106,14 +106,15 @@ def sweep_circle(probes: list[Probe], n: int, quick: bool = False) -> list[list[
     grid_psi = np.empty(first)
     grid_psi[rows] = psi
     batch = solver.solve_grid(np.repeat(T[None], first, axis=0), signs, grid_psi, band, chunk=chunk)
-    roots: list[list[list[Point]]] = []
-    for b, probe in enumerate(probes):
-        grid, distinct = _distinct(probe, batch.q[rows[b]], batch.count[rows[b]])
-        roots.append([[] for _ in range(n)])
-        if len(grid):
-            for k, point in zip(grid.tolist(), probe.points(psi[grid], distinct), strict=True):
-                if point is not None:
-                    roots[b][k].append(point)
+    # every branch's distinct roots, their points in one batch (a point is the same on any branch)
+    found = [_distinct(probe, batch.q[rows[b]], batch.count[rows[b]]) for b, probe in enumerate(probes)]
+    grid = np.concatenate([k for k, _ in found])
+    branch = np.repeat(np.arange(len(probes)), [len(k) for k, _ in found])
+    points = probes[0].points(psi[grid], np.concatenate([q for _, q in found]))
+    roots: list[list[list[Point]]] = [[[] for _ in range(n)] for _ in probes]
+    for b, k, point in zip(branch.tolist(), grid.tolist(), points, strict=True):
+        if point is not None:
+            roots[b][k].append(point)
     swept: list[list[tuple[Probe, Path]]] = [[] for _ in probes]
 
     def link(start: int, stop: int) -> None:  # (each branch's link_paths call releases the GIL)
