@@ -368,27 +368,27 @@ class Clearance:
     ) -> tuple[np.ndarray, np.ndarray | None]:
         """Distances capped at reach and, if asked (else None), their gradients (only the
         pairs nearer than ``near`` where one is: :meth:`distances_and_gradients`) at a joint
-        vector or the rows of q: one ``_core.arm_clearance`` call, then
-        ``mj_geomDistance`` for the pairs it leaves (:class:`~.mujoco_pairs.MujocoPairs`)."""
+        vector or the rows of q: ``_core.arm_clearance`` (a batch split across the pool's
+        threads), then ``mj_geomDistance`` for the pairs it leaves
+        (:class:`~.mujoco_pairs.MujocoPairs`)."""
         q = as_joint_vector(q, self._dof)
-        shape = (*q.shape[:-1], self._n_pairs)
-        dist, fromto = np.empty(shape), np.empty((*shape, 6))
-        grad = np.empty((*shape, self._dof)) if gradient else None
-        cores = self._cores
-        rows = q.reshape(-1, self._dof)
-        out = _core.PairDistances(
-            *(a if a is None else a.reshape(len(rows), *a.shape[q.ndim - 1 :]) for a in (dist, fromto, grad))
-        )
-        left = []  # (whether a chunk left pairs to MuJoCo)
+        rows, P, dof = q.reshape(-1, self._dof), self._n_pairs, self._dof
+        M = len(rows)
+        dist, fromto = np.empty((M, P)), np.empty((M, P, 6))
+        grad = np.empty((M, P, dof)) if gradient else None
+        cores, left = self._cores, []  # left: whether a chunk left pairs to MuJoCo
 
         def chunk(start: int, stop: int) -> None:  # (the kernel releases the GIL: threads share a batch)
-            part = _core.PairDistances(*(a if a is None else a[start:stop] for a in out))
+            part = _core.PairDistances(
+                dist[start:stop], fromto[start:stop], None if grad is None else grad[start:stop]
+            )
             left.append(_core.arm_clearance(cores, rows[start:stop], reach, near, part, False))
 
-        run_rows(chunk, len(rows))
+        run_rows(chunk, M)
         if any(left):
-            self._mujoco.fill(cores, rows, reach, near, out.dist, out.fromto, out.grad)
-        return dist, grad
+            self._mujoco.fill(cores, rows, reach, near, dist, fromto, grad)
+        shape = (*q.shape[:-1], P)
+        return dist.reshape(shape), None if grad is None else grad.reshape(*shape, dof)
 
 
 def _restored(
