@@ -64,10 +64,11 @@ def self_motion_tangent(solver: OMSolver, q: np.ndarray) -> np.ndarray:
 
 def self_motion_tangents(solver: OMSolver, q: np.ndarray) -> np.ndarray:
     r"""dq/dpsi of a 7-DOF arm (one redundancy variable) at every row of q, as
-    :func:`self_motion_tangent` computes it, by the arm's compiled solver in one call
-    (``_core.self_motion_tangents``, ``csrc/redundancy/tangents.c``: the cofactors of the real arm's
-    Jacobian in its base frame, the same null vector, and the tangents of ``_core.follow``),
-    NaN rows where psi does not move along the self-motion.
+    :func:`self_motion_tangent` computes it, by the arm's compiled solver
+    (``_core.self_motion_tangents``, ``csrc/redundancy/tangents.c``: the cofactors of the real
+    arm's Jacobian in its base frame, the same null vector, and the tangents of
+    ``_core.follow``; calls of up to :data:`~om_redundant.ik.threads.BATCH_CHUNK` rows on the
+    pool's threads), NaN rows where psi does not move along the self-motion.
 
     Args:
         solver: The solver of a 7-DOF arm.

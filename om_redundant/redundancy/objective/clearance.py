@@ -226,8 +226,9 @@ class Clearance:
 
     def distances_and_gradients(self, q: np.ndarray, near: float = math.inf) -> tuple[np.ndarray, np.ndarray]:
         """d_k(q) and their gradients dd_k/dq (module docstring): (P,) and (P, dof) for a
-        joint vector q (dof,), (M, P) and (M, P, dof) for the rows of q (M, dof), all rows
-        in one ``_core.arm_clearance`` call.
+        joint vector q (dof,), (M, P) and (M, P, dof) for the rows of q (M, dof), the rows
+        in ``_core.arm_clearance`` calls of up to :data:`~om_redundant.ik.threads.BATCH_CHUNK`
+        rows each, on the pool's threads.
 
         Args:
             q: (dof,) joint vector, or (M, dof) rows.

@@ -17,7 +17,7 @@ from ..objective.terms import Evaluation
 class PointTerms:
     """The objective at a point, computed when first asked for (a path's following steps
     need only the joints and the tangent), or given by a batch (:func:`evaluate_points`):
-    the clearance's pair distances and gradients (one ``_core.arm_clearance`` call), from
+    the clearance's pair distances and gradients (:meth:`Objective.pairs`), from
     which the groups' pieces with their rates, the evaluation and the feasibility functions. Shared
     by the copies of a point at other representatives of psi. (Slots, the arrays of a pair
     each in its own: the sweep keeps hundreds of terms per pose, and each container they
