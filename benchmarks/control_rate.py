@@ -196,18 +196,52 @@ def run(name: str, count: int, ticks: int) -> Run:
     )
 
 
-def global_times(name: str, poses: int, ticks: int) -> tuple[np.ndarray, np.ndarray]:
-    """Wall and CPU times (ms) of the global choose(T) with 3 obstacles on poses of the path."""
+def global_times(name: str, poses: int, ticks: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Wall and CPU times (ms) of the global choose(T) with 3 obstacles on poses of the path,
+    and each wall time in plain mink's ticks (:func:`plain_ticks`) timed just before it: the
+    machine's speed drifts within minutes, and the ratio moves less with it."""
     solver = om.OMSolver(name)
     T_home = solver.arm.fk(ARM_HOMES[name])
     optimizer = om.RedundancyOptimizer(solver, obstacles(T_home[:3, 3], 3), min_clearance=MIN_CLEARANCE)
-    walls, cpus = [], []
+    tick = plain_ticks(solver, ticks)
+    walls, cpus, in_ticks = [], [], []
     for k in np.linspace(0, ticks, poses, endpoint=False).astype(int):
         T = figure_eight(T_home, int(k), ticks)
+        yardstick = tick(YARDSTICK_TICKS)
         _, wall, cpu = timed(lambda T=T: optimizer.choose(T))
         walls.append(wall)
         cpus.append(cpu)
-    return np.array(walls) * 1e3, np.array(cpus) * 1e3
+        in_ticks.append(wall / yardstick)
+    return np.array(walls) * 1e3, np.array(cpus) * 1e3, np.array(in_ticks)
+
+
+def plain_ticks(solver: om.OMSolver, ticks: int) -> Callable[[int], float]:
+    """A plain mink loop on the arm's figure eight (FrameTask + PostureTask +
+    ConfigurationLimit, daqp, as in :func:`run`): a call runs n ticks on along the path and
+    returns their median wall time (s)."""
+    arm = solver.arm
+    model = om.arm_model(arm)
+    configuration = mink.Configuration(model)
+    home = ARM_HOMES[arm.name]
+    configuration.update(home.copy())
+    hand = mink.FrameTask(arm.frame_name, "site", position_cost=1.0, orientation_cost=1.0, lm_damping=1.0)
+    posture = mink.PostureTask(model, cost=1e-2)
+    posture.set_target(home)
+    limits = [mink.ConfigurationLimit(model)]
+    T_home, at = arm.fk(home), [0]
+
+    def run_ticks(n: int) -> float:
+        walls = []
+        for _ in range(n):
+            hand.set_target(mink.SE3.from_matrix(figure_eight(T_home, at[0] % ticks, ticks)))
+            at[0] += 1
+            wall = time.perf_counter()
+            v = mink.solve_ik(configuration, [hand, posture], DT, SOLVER, damping=DAMPING, limits=limits)
+            configuration.integrate_inplace(v, DT)
+            walls.append(time.perf_counter() - wall)
+        return float(np.median(walls))
+
+    return run_ticks
 
 
 def converged_gap(optimizer: om.RedundancyOptimizer, q: np.ndarray) -> tuple[float, float] | None:
@@ -262,13 +296,15 @@ def quality(name: str, n: int, seed: int) -> tuple[int, int, float, float]:
     return checked, bad, worst_gap, worst_gain
 
 
-GLOBAL_HEADER = ["| arm | poses | wall | CPU |", "|---|---|---|---|"]
+GLOBAL_HEADER = ["| arm | poses | wall | CPU | wall in plain mink ticks |", "|---|---|---|---|---|"]
+YARDSTICK_TICKS = 25  # plain mink ticks timed before each global choose
 
 
 def global_row(name: str, poses: int, ticks: int) -> str:
     """One arm's row of the global choose's table (:func:`global_times`), printed as well."""
-    walls, cpus = global_times(name, poses, ticks)
-    row = f"| {name} | {len(walls)} | {_stats(walls)} | {_stats(cpus)} |"
+    walls, cpus, in_ticks = global_times(name, poses, ticks)
+    in_mink = f"{np.median(in_ticks):.0f} / {np.percentile(in_ticks, 99):.0f}"
+    row = f"| {name} | {len(walls)} | {_stats(walls)} | {_stats(cpus)} | {in_mink} |"
     print(row, flush=True)
     return row
 
@@ -283,7 +319,8 @@ def global_page(arms: list[str], poses: int, ticks: int) -> str:
             "",
             f"CPU: {cpu_model()}; load average {load[0]:.1f} at the start, "
             f"{os.getloadavg()[0]:.1f} at the end. Global `choose(T)`, 3 obstacles, "
-            f"min_clearance {MIN_CLEARANCE} m, poses of the path (ms, median / p99):",
+            f"min_clearance {MIN_CLEARANCE} m, poses of the path (ms, median / p99; and each "
+            f"wall time over the median of {YARDSTICK_TICKS} plain mink ticks timed just before it):",
             "",
             *GLOBAL_HEADER,
             *rows,
