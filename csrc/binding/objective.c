@@ -50,6 +50,20 @@ static int get_terms(PyObject *terms, const char *what, om_objective_terms *o, P
     return 0;
 }
 
+/* A call's arguments (spec: the terms first) into a, its terms into o, *dof and tv (as
+ * get_terms), and the fields names[0:n] of its argument a[record] into fields (as get_fields,
+ * named `what`); -1 with an error, nothing held. */
+static int get_call(PyObject *const *args, Py_ssize_t nargs, PyObject *kwnames, const arg_spec *spec, PyObject **a,
+                    om_objective_terms *o, Py_ssize_t *dof, Py_buffer *tv, int record, const char *const *names, int n,
+                    PyObject **fields, const char *what) {
+    if (bind_args(args, nargs, kwnames, spec, a) < 0 || get_terms(a[0], spec->function, o, dof, tv) < 0) return -1;
+    if (get_fields(a[record], names, n, fields, what) < 0) {
+        release_buffers(tv, N_TERM_VIEWS);
+        return -1;
+    }
+    return 0;
+}
+
 /* evaluate(terms, q, distances, out) -> None: out's arrays (M,) the evaluation (value, margin,
  * clearance, slack, singularity) at the M rows of q (M x terms.dof) with the pairs' distances
  * (M x P; P = 0 without obstacles). */
@@ -61,12 +75,8 @@ static PyObject *om_evaluate_py(PyObject *mod, PyObject *const *args, Py_ssize_t
     Py_buffer tv[N_TERM_VIEWS], v[N_VIEWS];
     Py_ssize_t dof;
     om_objective_terms o;
-    if (bind_args(args, nargs, kwnames, &spec, a) < 0) return NULL;
-    if (get_terms(a[0], "evaluate", &o, &dof, tv) < 0) return NULL;
-    if (get_fields(a[3], out_names, E_N, e, "evaluate's out") < 0) {
-        release_buffers(tv, N_TERM_VIEWS);
+    if (get_call(args, nargs, kwnames, &spec, a, &o, &dof, tv, 3, out_names, E_N, e, "evaluate's out") < 0)
         return NULL;
-    }
     PyObject *result = NULL;
     PyObject *const objs[N_VIEWS] = {a[1], a[2], e[0], e[1], e[2], e[3], e[4]};
     const buffer_spec sp[N_VIEWS] = {{F64, -1, 0, "q"},     {F64, -1, 0, "distances"}, {F64, -1, 1, "value"},
@@ -112,12 +122,8 @@ static PyObject *om_linearise_py(PyObject *mod, PyObject *const *args, Py_ssize_
     Py_buffer tv[N_TERM_VIEWS], v[N_VIEWS];
     Py_ssize_t dof;
     om_objective_terms o;
-    if (bind_args(args, nargs, kwnames, &spec, a) < 0) return NULL;
-    if (get_terms(a[0], "linearise", &o, &dof, tv) < 0) return NULL;
-    if (get_fields(a[1], row_names, R_N, f, "linearise's rows") < 0) {
-        release_buffers(tv, N_TERM_VIEWS);
+    if (get_call(args, nargs, kwnames, &spec, a, &o, &dof, tv, 1, row_names, R_N, f, "linearise's rows") < 0)
         return NULL;
-    }
     f[R_N] = Py_NewRef(a[2]), f[R_N + 1] = Py_NewRef(a[3]);
     PyObject *result = NULL;
     const buffer_spec sp[N_VIEWS] = {{F64, -1, 0, "q"},         {F64, -1, 0, "t"},      {F64, -1, 0, "distances"},
