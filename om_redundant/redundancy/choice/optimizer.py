@@ -289,7 +289,8 @@ class RedundancyOptimizer(GlobalChoice):
             curvature = min(4.0 * step.curvature, MAX_CURVATURE)
             return replace(previous, curvature=curvature, reason="", rechosen=False, branch_flipped=False)
         if isinstance(step, Tracked):
-            choice = RedundancyChoice(
+            travel = math.nan if q_current is None else float(np.linalg.norm(step.solution.q - q_current))
+            return RedundancyChoice(
                 True,
                 step.solution.configuration,
                 step.solution,
@@ -300,10 +301,8 @@ class RedundancyOptimizer(GlobalChoice):
                 curvature=step.curvature,
                 turn=turn,
                 pose=target,
+                travel=travel,
             )
-            if q_current is not None:
-                choice = replace(choice, travel=float(np.linalg.norm(step.solution.q - q_current)))
-            return choice
         start = q_previous if q_current is None else q_current
         chosen = self._from_joints(T, start, signs, free)
         if not chosen.ok:
