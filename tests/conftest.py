@@ -22,7 +22,7 @@ import om_redundant as om
 from om_redundant import _core
 from om_redundant.ik.kernel_data import flange_target
 from om_redundant.mujoco_io.loading import load_mujoco_model
-from om_redundant.redundancy.objective.terms import Group
+from tests.reference.objective import Group
 
 # The suite's property tests draw the same examples on every run, so that CI answers for the
 # code and not for the draw; HYPOTHESIS_PROFILE=explore draws new ones (run it to hunt bugs:

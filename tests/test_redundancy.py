@@ -13,6 +13,7 @@ import pytest
 import om_redundant as om
 from om_redundant.redundancy import self_motion_tangent
 from tests.conftest import random_q, wrap
+from tests.reference import objective as objective_numpy
 
 DENSE = 10_000  # psi values per branch of the brute-force sweep
 DENSE_STEP = 2.0 * math.pi / DENSE
@@ -283,9 +284,9 @@ def test_derivatives_match_finite_differences_of_exact_solutions(name, request):
         np.testing.assert_allclose(grad[near] @ direction, differences[near], atol=1e-6)
 
         for group, ahead_group, behind_group in zip(
-            objective.groups(q, tangent=tangent[:, None]),
-            objective.groups(ahead),
-            objective.groups(behind),
+            objective_numpy.groups(objective, q, tangent=tangent[:, None]),
+            objective_numpy.groups(objective, ahead),
+            objective_numpy.groups(objective, behind),
             strict=True,
         ):
             slopes = group.jacobian[:, 0]

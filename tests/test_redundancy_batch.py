@@ -18,13 +18,14 @@ from om_redundant.redundancy import self_motion_tangent
 from om_redundant.redundancy.choice.box_qp import step_1d
 from om_redundant.redundancy.choice.start_bounds import StartBounds
 from om_redundant.redundancy.objective.objective import Objective
-from om_redundant.redundancy.objective.terms import Evaluation, Group
+from om_redundant.redundancy.objective.terms import Evaluation
 from om_redundant.redundancy.paths.probe import Probe
 from om_redundant.redundancy.self_motion import self_motion_tangents
 from tests.conftest import random_groups, steps_numpy
 from tests.reference import box_qp as box_qp_numpy
 from tests.reference import objective as objective_numpy
 from tests.reference import start_bounds as start_bounds_numpy
+from tests.reference.objective import Group
 from tests.reference.self_motion import self_motion_tangents as reference_tangents
 
 
@@ -63,7 +64,10 @@ def test_batched_evaluations_equal_the_single_ones(seed, name, count):
     objective = optimizer.objective
     assert objective.evaluations(q) == [objective.evaluate(row) for row in q]
     for row in q[:5]:  # the groups' minima, capped, weighted and summed (C's sin or numpy's)
-        evaluation, groups = objective.evaluate(row), {g.kind: g for g in objective.groups(row)}
+        evaluation, groups = (
+            objective.evaluate(row),
+            {g.kind: g for g in objective_numpy.groups(objective, row)},
+        )
         terms = [objective_numpy.term(g) for g in groups.values()]
         assert evaluation.value == pytest.approx(sum(terms), rel=0, abs=1e-15)
         assert evaluation.margin == groups["margin"].values.min()
@@ -118,8 +122,10 @@ def test_batched_pieces_and_points_equal_the_single_ones(seed, name, count):
             mine = objective.clearance.distances_and_gradients(row)
             np.testing.assert_array_equal(mine[0], pairs[0][k])
             np.testing.assert_array_equal(mine[1], pairs[1][k])
-            groups = [along(g, tangents[k]) for g in objective.groups(row, jacobian=True)]
-            for batched, fresh in zip(objective.groups(row, jacobian=True, pairs=mine), groups, strict=True):
+            groups = [along(g, tangents[k]) for g in objective_numpy.groups(objective, row, jacobian=True)]
+            for batched, fresh in zip(
+                objective_numpy.groups(objective, row, jacobian=True, pairs=mine), groups, strict=True
+            ):
                 np.testing.assert_array_equal(batched.values, fresh.values)
                 np.testing.assert_array_equal(along(batched, tangents[k]).jacobian, fresh.jacobian)
         one = objective.pieces(row, tangents[k], mine)
@@ -134,7 +140,7 @@ def test_batched_pieces_and_points_equal_the_single_ones(seed, name, count):
             np.testing.assert_array_equal(batched, single)
         # the pieces from the pairs' gradients the batch computed (objective.pairs: the near
         # pairs' only), along the tangent, are the groups computed afresh and chained here
-        fresh = [along(g, point.tangent) for g in objective.groups(point.q, jacobian=True)]
+        fresh = [along(g, point.tangent) for g in objective_numpy.groups(objective, point.q, jacobian=True)]
         values, rates = point.linearised
         want = np.concatenate([g.jacobian[:, 0] for g in fresh])
         np.testing.assert_array_equal(values, np.concatenate([g.values for g in fresh]))
@@ -166,7 +172,7 @@ def test_the_linearised_pieces_are_the_groups_along_psi(seed, name, count, singu
     q = np.random.default_rng(seed).uniform(lower, upper, (20, 7))
     for row, tangent in zip(q, self_motion_tangents(solver, q), strict=True):
         pairs = objective.pairs(row)
-        groups = objective.groups(row, pairs=pairs, tangent=tangent)
+        groups = objective_numpy.groups(objective, row, pairs=pairs, tangent=tangent)
         values, rates = objective.linearised(row, tangent, pairs)
         np.testing.assert_array_equal(values, np.concatenate([g.values for g in groups]))
         want = np.concatenate([g.jacobian[:, 0] for g in groups])

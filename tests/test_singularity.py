@@ -14,6 +14,7 @@ from hypothesis import strategies as st
 import om_redundant as om
 from om_redundant.redundancy import Objective, self_motion_tangent
 from om_redundant.redundancy.objective.terms import SINGULARITY_CAP
+from tests.reference import objective as objective_numpy
 
 ARMS = ("panda", "iiwa14", "gen3", "sawyer", "ur5e", "spherical")
 H = 1e-6  # finite-difference step (rad)
@@ -85,7 +86,9 @@ def test_the_objective_group_along_psi_matches_finite_differences(solvers, name)
             solver.solve(T, om.Configuration(c.signs, (c.redundancy[0] + s,)), q_hint=q).q for s in (H, -H)
         )
         tangent = self_motion_tangent(solver, q)
-        (group,) = [g for g in objective.groups(q, tangent=tangent) if g.kind == "singularity"]
+        (group,) = [
+            g for g in objective_numpy.groups(objective, q, tangent=tangent) if g.kind == "singularity"
+        ]
         slopes = group.jacobian[:, 0] * SINGULARITY_CAP
         differences = (singularity.distances(ahead) - singularity.distances(behind)) / (2 * H)
         np.testing.assert_allclose(slopes, differences, atol=1e-5)

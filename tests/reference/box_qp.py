@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from om_redundant.redundancy.choice.box_qp import Pieces
-from om_redundant.redundancy.objective.terms import Group
+from tests.reference.objective import Group
 
 _TIE = 1e-12  # pieces within this of their group's minimum meet there
 

@@ -42,7 +42,7 @@ from __future__ import annotations
 
 import math
 import threading
-from typing import Any, NamedTuple
+from typing import NamedTuple
 
 import numpy as np
 
@@ -58,7 +58,6 @@ from .terms import (
     DEFAULT_SINGULARITY_WEIGHT,
     SINGULARITY_CAP,
     Evaluation,
-    Group,
     check_weights,
     evaluation_of_row,
     limit_distances,
@@ -66,7 +65,7 @@ from .terms import (
 
 
 class GroupLayout(NamedTuple):
-    """The groups of :meth:`Objective.groups` as the climb's QP reads their concatenated pieces
+    """The objective's groups (module docstring) as the climb's QP reads their concatenated pieces
     (:meth:`Objective.linearised`; ``_core.Pieces``' other fields).
 
     Attributes:
@@ -155,9 +154,7 @@ class Objective:
             min_clearance=self.min_clearance,
             singularity_cap=SINGULARITY_CAP,
         )
-        eye = np.eye(self._dof)[self._limited] / self._half[:, None]
-        self._margin_jacobian = np.vstack([eye, -eye])  # pieces (q - l)/h, then (u - q)/h
-        sizes, numbers = [], []  # the groups of :meth:`groups`: their pieces, weights, floors, caps
+        sizes, numbers = [], []  # the groups (module docstring): their pieces, weights, floors, caps
         if len(self._limited):
             sizes.append(2 * len(self._limited)), numbers.append((self.margin_weight, 0.0, math.inf))
         if clearance is not None:
@@ -169,52 +166,16 @@ class Objective:
         self.layout = GroupLayout(np.cumsum([0, *sizes], dtype=np.int64), weights, floors, caps)
         self._no_pairs = np.zeros((0,)), np.zeros((0, self._dof))
 
-    def groups(
-        self,
-        q: np.ndarray,
-        jacobian: bool = False,
-        pairs: tuple[np.ndarray, np.ndarray] | None = None,
-        tangent: np.ndarray | None = None,
-    ) -> list[Group]:
-        """The groups at q (module docstring): margin (if any joint is limited), clearance
-        (if there are obstacles), then singularity (if given); their jacobians by q if asked.
-
-        Args:
-            q: (dof,) joint vector.
-            jacobian: Also the jacobians.
-            pairs: The clearance's pair distances (P,) and gradients (P, dof) at q if
-                already computed (:meth:`Clearance.distances_and_gradients
-                <om_redundant.Clearance.distances_and_gradients>`): the same groups from them.
-            tangent: (dof, r) dq/dpsi at q: the jacobians chained through it, by psi
-                (J_q dq/dpsi; implies ``jacobian``).
-        """
-        jacobian = jacobian or tangent is not None
-        groups = self.constrained_groups(q, jacobian, pairs, tangent)
-        if self.singularity is not None:
-            groups.append(self._singularity(q, jacobian, tangent))
-        return groups
-
-    def constrained_groups(
-        self,
-        q: np.ndarray,
-        jacobian: bool = False,
-        pairs: tuple[np.ndarray, np.ndarray] | None = None,
-        tangent: np.ndarray | None = None,
-    ) -> list[Group]:
-        """The groups of :meth:`groups` that have a floor (margin, clearance): those whose
-        :meth:`Group.constraints` define feasibility."""
-        jacobian = jacobian or tangent is not None
-        groups = [self._margin(q, jacobian, tangent)] if len(self._limited) else []
-        if self.clearance is not None:
-            groups.append(self._clearance(q, jacobian, pairs, tangent))
-        return groups
-
     def linearised(
         self, q: np.ndarray, tangent: np.ndarray, pairs: tuple[np.ndarray, np.ndarray] | None
     ) -> tuple[np.ndarray, np.ndarray]:
-        """The pieces v_j of :meth:`groups` at q with the tangent, concatenated in the groups'
-        order (:attr:`layout`), and their rates dv_j/dpsi: what the climb's QP linearises
-        (``_core.linearise``, ``csrc/redundancy/objective.c``; the same numbers to rounding).
+        """The pieces v_j of the groups (module docstring) at q, concatenated in the groups'
+        order (:attr:`layout`), and their rates dv_j/dpsi along the tangent: what the climb's
+        QP linearises (``_core.linearise``, ``csrc/redundancy/objective.c``;
+        ``tests/reference/objective.py`` builds the groups in numpy, the same numbers to
+        rounding). The margin's pieces are the limited joints' (q_i - l_i)/h_i, then their
+        (u_i - q_i)/h_i; the clearance's the pairs' d_k/d_cap, those at 2 d_cap or farther
+        taken there with rate 0 where some pair is nearer; the singularity's s_k/s_cap.
 
         Args:
             q: (dof,) joint vector.
@@ -232,8 +193,8 @@ class Objective:
         return values, rates
 
     def pairs(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
-        """The clearance's pair distances at q and the gradients that :meth:`groups`,
-        :meth:`pieces` and :meth:`linearised` read: where some pair is nearer than
+        """The clearance's pair distances at q and the gradients that :meth:`pieces` and
+        :meth:`linearised` read: where some pair is nearer than
         :attr:`clearance_reach`, every pair's distance capped there and the gradients of
         those below it (:meth:`Clearance.distances_within
         <om_redundant.Clearance.distances_within>`, which skips the pairs whose bounding
@@ -261,7 +222,7 @@ class Objective:
 
     def evaluate(self, q: np.ndarray, distances: np.ndarray | None = None) -> Evaluation:
         """f(q), M(q), D(q), the feasibility slack and S(q): each group's minimum
-        (the smallest of its pieces, :meth:`groups`) capped and weighted, summed in the
+        (the smallest of its pieces, module docstring) capped and weighted, summed in the
         groups' order (``_core.evaluate``, ``csrc/redundancy/objective.c``).
 
         Args:
@@ -302,10 +263,12 @@ class Objective:
     def pieces(
         self, q: np.ndarray, tangent: np.ndarray, pairs: tuple[np.ndarray, np.ndarray] | None
     ) -> tuple[np.ndarray, np.ndarray]:
-        """The feasibility functions g_j at q (>= 0 iff feasible) and dg_j/dpsi: the
-        :meth:`Group.constraints` of the margin and clearance groups chained through the
-        tangent (``_core.pieces``, ``csrc/redundancy/cells.c``; the same numbers to rounding), at one
-        joint vector or at every row of q in one call.
+        """The feasibility functions g_j at q (>= 0 iff feasible) and dg_j/dpsi along the
+        tangent: each limited joint's margin, the smaller of its two pieces (continuous also
+        where a revolute joint is taken modulo 2 pi nearest mid-range), then each pair's
+        d_k/d_cap - d_min/d_cap (``_core.pieces``, ``csrc/redundancy/cells.c``; the numpy
+        groups' of ``tests/reference/objective.py`` to rounding), at one joint vector or at
+        every row of q in one call.
 
         Args:
             q: (dof,) joint vector, or (M, dof) rows.
@@ -340,7 +303,7 @@ class Objective:
             distances: (M, P) the pairs' distances d_k(q) (m) (None without obstacles).
 
         Returns:
-            [(w_g, cap_g, (M, p_g) values)] in the order of :meth:`groups`.
+            [(w_g, cap_g, (M, p_g) values)] in the groups' order (:attr:`layout`).
         """
         groups = []
         if len(self._limited):
@@ -355,71 +318,3 @@ class Objective:
     def _margins(self, q: np.ndarray) -> np.ndarray:
         """The limited joints' margins m_i at the rows of q (M, dof): (M, limited)."""
         return np.minimum(*limit_distances(q[:, self._limited], self._lower, self._upper, self._half))
-
-    def _margin(self, q: np.ndarray, jacobian: bool, tangent: np.ndarray | None) -> Group:
-        lim = self._limited
-        pieces = np.concatenate(limit_distances(q[lim], self._lower, self._upper, self._half))
-        rates = _chained(self._margin_jacobian, tangent) if jacobian else None
-        return Group("margin", self.margin_weight, 0.0, math.inf, pieces, rates)
-
-    def _clearance(
-        self,
-        q: np.ndarray,
-        jacobian: bool,
-        pairs: tuple[np.ndarray, np.ndarray] | None,
-        tangent: np.ndarray | None,
-    ) -> Group:
-        """The clearance pieces d_k / d_cap, computed only for the pairs within 2 d_cap (the
-        others report 2 with zero gradient: beyond the cap they change neither the term,
-        the slack's minimum nor, far above the floor, a feasibility model); all of them
-        exactly when no pair is that near, so that D(q) is exact. From ``pairs`` (the pairs'
-        distances and gradients, every gradient or only the near ones': :meth:`pairs`) the
-        same pieces, capped here."""
-        floor, cap, reach = self.min_clearance / self.clearance_cap, self.clearance_cap, self.clearance_reach
-        if pairs is not None:
-            d, grad = pairs
-            if np.minimum.reduce(d) < reach:
-                near = d < reach
-                d = np.where(near, d, reach)
-                grad = np.where(near[:, None], grad, 0.0) if jacobian else None
-            rates = _chained(grad / cap, tangent) if jacobian else None
-            return Group("clearance", self.clearance_weight, floor, 1.0, d / cap, rates)
-        d, grad = self.clearance.distances_within(q, reach, gradient=jacobian)
-        if np.minimum.reduce(d) < reach:
-            rates = _chained(grad / cap, tangent) if jacobian else None
-            return Group("clearance", self.clearance_weight, floor, 1.0, d / cap, rates)
-        return _capped("clearance", self.clearance_weight, floor, self.clearance, cap, q, jacobian, tangent)
-
-    def _singularity(self, q: np.ndarray, jacobian: bool, tangent: np.ndarray | None = None) -> Group:
-        return _capped(
-            "singularity",
-            self.singularity_weight,
-            -math.inf,
-            self.singularity,
-            SINGULARITY_CAP,
-            q,
-            jacobian,
-            tangent,
-        )
-
-
-def _capped(
-    kind: str,
-    weight: float,
-    floor: float,
-    source: Any,
-    cap: float,
-    q: np.ndarray,
-    jacobian: bool,
-    tangent: np.ndarray | None = None,
-) -> Group:
-    """The group of distances capped at ``cap``: ``source.distances(q) / cap``, cap 1."""
-    if jacobian:
-        d, grad = source.distances_and_gradients(q)
-        return Group(kind, weight, floor, 1.0, d / cap, _chained(grad / cap, tangent))
-    return Group(kind, weight, floor, 1.0, source.distances(q) / cap)
-
-
-def _chained(jacobian: np.ndarray, tangent: np.ndarray | None) -> np.ndarray:
-    """The jacobian by q, or by psi through dq/dpsi = tangent: J_q dq/dpsi."""
-    return jacobian if tangent is None else jacobian @ tangent

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -66,46 +65,6 @@ def check_weights(
         raise InvalidInput(
             f"min_clearance must be >= 0 and below clearance_cap ({clearance_cap} m), got {min_clearance}"
         )
-
-
-@dataclass(slots=True)
-class Group:
-    """One term of the objective: ``weight * min(cap, min_j values_j)``, feasible if
-    ``min_j values_j >= floor``. (Not frozen, but never changed: a frozen dataclass is built
-    several times slower, and each step of a climb builds the groups of its point.)
-
-    Attributes:
-        kind: ``"margin"``, ``"clearance"`` or ``"singularity"``.
-        weight: w >= 0.
-        floor: Feasibility bound on the minimum; -inf for none (no constraint).
-        cap: Upper cap of the term (inf for none).
-        values: (p,) the pieces v_j.
-        jacobian: (p, n) their derivatives by n variables (q, or the redundancy variables),
-            or None when not asked for.
-    """
-
-    kind: str
-    weight: float
-    floor: float
-    cap: float
-    values: np.ndarray
-    jacobian: np.ndarray | None = None
-
-    def constraints(self) -> tuple[np.ndarray, np.ndarray]:
-        """The group's feasibility functions, >= 0 where feasible, and their derivatives
-        (by the first variable of the jacobian). A joint's two margin pieces count as one
-        function, the smaller: 1 - |q_i - c_i| / h_i about mid-range c_i, continuous also
-        where a revolute joint's angle is taken modulo 2 pi at the representative nearest c_i.
-        A group without a floor has none.
-        """
-        if self.floor == -math.inf:
-            return np.zeros(0), np.zeros(0)
-        v, d = self.values - self.floor, self.jacobian[:, 0]
-        if self.kind != "margin":
-            return v, d
-        half = len(v) // 2
-        lower = v[:half] <= v[half:]
-        return np.where(lower, v[:half], v[half:]), np.where(lower, d[:half], d[half:])
 
 
 class Evaluation(NamedTuple):

@@ -138,6 +138,7 @@ class Point:
         return self.terms.get_linearised()
 
     def pieces(self) -> tuple[np.ndarray, np.ndarray]:
-        """The feasibility functions g_j (all >= 0 iff feasible; see
-        :meth:`~om_redundant.redundancy.objective.terms.Group.constraints`) and dg_j/dpsi."""
+        """The feasibility functions g_j (all >= 0 iff feasible;
+        :meth:`Objective.pieces <om_redundant.redundancy.objective.objective.Objective.pieces>`)
+        and dg_j/dpsi."""
         return self.terms.get_pieces()
