@@ -183,37 +183,6 @@ def test_the_linearised_pieces_are_the_groups_along_psi(seed, name, count, singu
         assert layout.caps.tolist() == [g.cap for g in groups]
 
 
-@settings(max_examples=8, deadline=None)
-@given(seed=st.integers(0, 2**32 - 1), name=st.sampled_from(list(HOMES)), far=st.floats(0.0, 0.4))
-def test_the_objective_reads_the_pairs_within_its_reach(seed, name, far):
-    """Objective.pairs of rows at once and of each row: where some pair is nearer than
-    clearance_reach, every distance is the exact one capped there and the gradients are the
-    exact ones of the pairs below it, zero for the others; where none is, every distance and
-    gradient is the exact one (D(q) exact). The obstacles moved ``far`` away from the home hand
-    give rows of either kind."""
-    optimizer = optimizer_of(name, 3)
-    arm = optimizer.solver.arm
-    shapes = obstacles(arm.fk(HOMES[name])[:3, 3] + np.array([0.0, 0.0, far]), 3)
-    clearance = om.Clearance.for_arm(arm, shapes)
-    objective = Objective(arm, clearance, min_clearance=MIN_CLEARANCE)
-    reach = objective.clearance_reach
-    q = joints(optimizer, seed, 12)
-    d, grad = objective.pairs(q)
-    exact, exact_grad = clearance.distances_and_gradients(q)
-    for k, row in enumerate(q):
-        one = objective.pairs(row)
-        np.testing.assert_array_equal(one[0], d[k])
-        np.testing.assert_array_equal(one[1], grad[k])
-        if exact[k].min() < reach:
-            below = exact[k] < reach
-            np.testing.assert_array_equal(d[k], np.minimum(exact[k], reach))
-            np.testing.assert_array_equal(grad[k][below], exact_grad[k][below])
-            assert not grad[k][~below].any()
-        else:
-            np.testing.assert_array_equal(d[k], exact[k])
-            np.testing.assert_array_equal(grad[k], exact_grad[k])
-
-
 @settings(max_examples=10, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1), name=st.sampled_from(list(HOMES)), wrapped=st.booleans())
 def test_a_probe_step_is_the_largest_joint_step(seed, name, wrapped):
