@@ -4,9 +4,10 @@
  * distances, computed by MuJoCo and clearance.c), the singularity distance
  * S = min_k |sin(q_{j_k} + c_k)|, and
  *   f = w_m M + w_c min(1, D/d_cap) + w_s min(1, S/s_cap),  slack = min(M, (D - d_min)/d_cap),
- * each sum and quotient in the order objective.py's numpy reference rounds them. No limited joint
- * (L = 0), no obstacle (P = 0) or no singularity (K = 0): no such term. And the pieces of those
- * terms with their rates along the self-motion, which the climb's QP linearises (om_linearise). */
+ * each sum and quotient in the order the numpy groups of tests/reference/objective.py round
+ * them. No limited joint (L = 0), no obstacle (P = 0) or no singularity (K = 0): no such term.
+ * And the pieces of those terms with their rates along the self-motion, which the climb's QP
+ * linearises (om_linearise). */
 #include "redundancy.h"
 
 om_evaluation om_evaluate(const om_objective_terms *o, const double *q, const double *d, ptrdiff_t P) {
@@ -39,14 +40,12 @@ om_evaluation om_evaluate(const om_objective_terms *o, const double *q, const do
 
 void om_linearise(const om_objective_terms *o, ptrdiff_t dof, const double *q, const double *t, const double *d,
                   const double *grad, ptrdiff_t P, double *v, double *a) {
-    ptrdiff_t n = 0;
-    for (ptrdiff_t i = 0; i < o->L; i++) { /* (1/h) t_i: objective.py's (e_i / h) . t */
+    for (ptrdiff_t i = 0; i < o->L; i++) { /* (1/h) t_i: the numpy groups' (e_i / h) . t */
         double h = o->half[i], x = q[o->limited[i]], inv = 1.0 / h;
-        v[n] = (x - o->lower[i]) / h, a[n] = inv * t[o->limited[i]];
-        v[o->L + n] = (o->upper[i] - x) / h, a[o->L + n] = -inv * t[o->limited[i]];
-        n++;
+        v[i] = (x - o->lower[i]) / h, a[i] = inv * t[o->limited[i]];
+        v[o->L + i] = (o->upper[i] - x) / h, a[o->L + i] = -inv * t[o->limited[i]];
     }
-    n = 2 * o->L;
+    ptrdiff_t n = 2 * o->L;
     double cap = o->clearance_cap, reach = 2.0 * cap, least = INFINITY;
     for (ptrdiff_t k = 0; k < P; k++) least = isnan(least) || d[k] >= least ? least : d[k]; /* (NaN stays) */
     for (ptrdiff_t k = 0; k < P; k++, n++) {
