@@ -149,6 +149,35 @@ def test_a_ball_moving_into_the_arm_is_seen_every_tick(panda, unclear_ways, monk
     assert clearance.minimum(configuration.q[:7]) >= MIN_CLEARANCE - 2e-3  # the arm made room
 
 
+def test_tracking_at_a_held_pose_weighs_each_step_where_the_obstacles_are_now(panda):
+    """The hand held at one pose while a ball comes at the elbow, 1 mm a tick: every tracked
+    choice is weighed in the world as it is at that call (its clearance D(q*) where the ball
+    is now, at least min_clearance). A step that loses value at the same pose is refused only
+    where the obstacles have not moved: the previous choice's value was of a world gone (it
+    held psi while the ball came within 4.8 mm of q*)."""
+    model = ball_scene(panda.arm)
+    clearance = om.Clearance(model, panda.arm, ["ball", "rod"])
+    optimizer = om.RedundancyOptimizer(panda, clearance, min_clearance=MIN_CLEARANCE, max_step=0.005)
+    data = mujoco.MjData(model)
+    data.qpos[:7] = Q_PANDA
+    mujoco.mj_kinematics(model, data)
+    elbow = data.xpos[model.body("link4").id].copy()
+    start = elbow + np.array([0.0, 0.4, 0.0])
+    T = panda.arm.fk(Q_PANDA)
+    choice, psi = None, []
+    for k in range(401):
+        data.mocap_pos[0] = start + (elbow - start) * k / 400
+        mujoco.mj_kinematics(model, data)
+        clearance.update(data)
+        q = Q_PANDA if choice is None else choice.solution.q
+        choice = optimizer.choose(T, previous=choice, q_current=q)
+        assert choice.ok and choice.clearance_version == clearance.version
+        assert choice.clearance == pytest.approx(clearance.minimum(choice.solution.q), abs=1e-12)
+        assert choice.clearance >= MIN_CLEARANCE - 1e-9
+        psi.append(choice.configuration.redundancy[0])
+    assert np.ptp(psi) > 0.5  # (the elbow made way)
+
+
 def two_arms(arm: om.Arm) -> mujoco.MjModel:
     """Two copies of the arm facing each other 1.1 m apart, joints prefixed l_ and r_."""
     spec = mujoco.MjSpec()

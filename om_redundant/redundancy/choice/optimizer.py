@@ -240,11 +240,13 @@ class RedundancyOptimizer(GlobalChoice):
             raise InvalidInput(f"previous must be a RedundancyChoice, got {type(previous).__name__}")
         if free is not None:
             as_instance(free, FreeRotation, "free")
+        version = self._clearance_version()  # (read first: an update meanwhile is seen next call)
         if previous is None or not previous.ok:
             if q_current is None and free is None:
-                return self._best_anywhere(T, self.branches)
+                return self._stamped(self._best_anywhere(T, self.branches), version)
             signs = None if q_current is None else self.solver.configuration_of(q_current).signs
-            return self._from_joints(T, q_current, signs if signs in self.branches else None, free)
+            chosen = self._from_joints(T, q_current, signs if signs in self.branches else None, free)
+            return self._stamped(chosen, version)
         if previous.configuration.signs not in self.branches:
             raise InvalidInput(
                 f"previous branch {previous.configuration.signs} is not among the allowed branches"
@@ -253,9 +255,18 @@ class RedundancyOptimizer(GlobalChoice):
             raise InvalidInput(
                 "previous was chosen with another free rotation: choose afresh (previous=None)"
             )
-        return self._track(T, previous, q_current, free)
+        return self._stamped(self._track(T, previous, q_current, free, version), version)
 
     # -----------------------------------------------------------------------------------
+
+    def _clearance_version(self) -> int:
+        clearance = self.objective.clearance
+        return 0 if clearance is None else clearance.version
+
+    @staticmethod
+    def _stamped(choice: RedundancyChoice, version: int) -> RedundancyChoice:
+        """The choice with the clearance's version it was weighed in."""
+        return choice if choice.clearance_version == version else replace(choice, clearance_version=version)
 
     def _track(
         self,
@@ -263,6 +274,7 @@ class RedundancyOptimizer(GlobalChoice):
         previous: RedundancyChoice,
         q_current: np.ndarray | None,
         free: FreeRotation | None,
+        version: int,
     ) -> RedundancyChoice:
         signs, (psi,) = previous.configuration.signs, previous.configuration.redundancy
         q_previous = previous.solution.q
@@ -283,9 +295,11 @@ class RedundancyOptimizer(GlobalChoice):
             isinstance(step, Tracked)
             and step.value < previous.value
             and np.array_equal(target, previous.pose)
+            and previous.clearance_version == version
         ):
-            # at the same pose a step may only climb: one that loses (the model's kink or curvature
-            # overshot the optimum, a step back and forth about it) is not taken
+            # at the same pose, obstacles unmoved, a step may only climb: one that loses (the
+            # model's kink or curvature overshot the optimum, a step back and forth about it) is
+            # not taken (obstacles that moved change the values: the step is the choice)
             curvature = min(4.0 * step.curvature, MAX_CURVATURE)
             return replace(previous, curvature=curvature, reason="", rechosen=False, branch_flipped=False)
         if isinstance(step, Tracked):
@@ -302,6 +316,7 @@ class RedundancyOptimizer(GlobalChoice):
                 turn=turn,
                 pose=target,
                 travel=travel,
+                clearance_version=version,
             )
         start = q_previous if q_current is None else q_current
         chosen = self._from_joints(T, start, signs, free)

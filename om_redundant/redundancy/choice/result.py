@@ -48,6 +48,9 @@ class RedundancyChoice:
             solution reaches, :meth:`FreeRotation.turned(T, R)
             <om_redundant.FreeRotation.turned>`; None without.
         pose: The end-effector pose the solution reaches (T, or T turned); None if not ok.
+        clearance_version: The optimiser's :attr:`Clearance.version
+            <om_redundant.Clearance.version>` the choice was weighed in: where the obstacles
+            were (0 without a clearance).
     """
 
     ok: bool
@@ -66,6 +69,7 @@ class RedundancyChoice:
     way_clear: bool = True
     turn: np.ndarray | None = None
     pose: np.ndarray | None = None
+    clearance_version: int = 0
 
 
 def failed_choice(intervals: tuple[PsiInterval, ...], reason: str) -> RedundancyChoice:
