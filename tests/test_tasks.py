@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from types import SimpleNamespace
+from unittest import mock
 
 import mink
 import mujoco
@@ -130,6 +131,28 @@ def test_optimizer_choice_is_reached(panda, panda_model):
         assert max(hand_error(configuration, "attachment_site", T)) < 1e-9
         assert panda.configuration_of(configuration.q).isclose(panda.configuration_of(q), 1e-6)
     assert optimizer.previous[0] is None and optimizer.previous[1] is not None
+
+
+def test_without_a_lead_a_fresh_choice_is_the_target_at_once(panda, panda_model):
+    """``lead=None``: no aims and no joint-space way, q* of the target itself from the first
+    tick (it raised TypeError on the first fresh choice), and mink reaches it."""
+    task = om.ExactPoseTask(panda, panda_model, optimizer=om.RedundancyOptimizer(panda), lead=None)
+    frame = frame_task()
+    limits = [mink.ConfigurationLimit(panda_model)]
+    configuration = mink.Configuration(panda_model, Q_PANDA)
+    task.set_target_from_configuration(configuration)
+    for q in random_joints(panda.arm, 3, np.random.default_rng(5)):
+        T = panda.arm.fk(q)
+        task.reset_choice()
+        task.set_target(T)
+        frame.set_target(mink.SE3.from_matrix(T))
+        assert task.choice.ok and task._way is None
+        np.testing.assert_allclose(panda.arm.fk(task.joint_target), T, atol=1e-12)
+        for _ in range(1000):
+            step(configuration, [frame, task], limits)
+            if max(hand_error(configuration, "attachment_site", T)) < 1e-9:
+                break
+        assert max(hand_error(configuration, "attachment_site", T)) < 1e-9
 
 
 @pytest.mark.parametrize("with_frame_task", [False, True])
@@ -381,6 +404,47 @@ def test_tracking_a_moving_target_keeps_branch_and_psi_continuous(panda, panda_m
     assert max(errors) < 1e-5  # the hand is on its moving target at every tick (measured ~1e-7)
     if mode == "fixed configuration":
         assert np.abs(np.array(psi) - psi0).max() < 1e-5
+
+
+@pytest.mark.parametrize("given", ["array", "SE3"])
+def test_a_target_is_solved_once_per_tick_and_an_array_changed_in_place_is_a_new_target(
+    panda, panda_model, given
+):
+    """set_target solves; mink's compute_error and compute_jacobian of the same world ask the
+    optimiser nothing more (an SE3 made of an array does not give it back bit for bit: a
+    target read back from it was solved again, a second tracking step in the same tick). A
+    caller's one array changed in place is the target when given again, not before, and
+    does as fresh arrays do, a jump included."""
+    c0 = panda.configuration_of(Q_PANDA)
+    T0 = panda.arm.fk(Q_PANDA)
+    frame, limits = frame_task(), [mink.ConfigurationLimit(panda_model)]
+    runs = []
+    for in_place in (True, False):
+        optimizer = SwingElbow(panda, c0.signs, c0.redundancy[0])
+        task = om.ExactPoseTask(panda, panda_model, optimizer=optimizer)
+        configuration = mink.Configuration(panda_model, Q_PANDA)
+        task.set_target_from_configuration(configuration)
+        T, targets = T0.copy(), []
+        with mock.patch.object(optimizer, "choose", wraps=optimizer.choose) as choose:
+            for tick in range(1, 41):
+                pose = path(T0, 0.02 * tick)
+                if tick == 40:  # a jump: the task leads the hand there
+                    pose[:3, 3] += [0.0, 0.0, 0.15]
+                if in_place:
+                    T[:] = pose
+                else:
+                    T = pose.copy()
+                task.set_target(T if given == "array" else mink.SE3.from_matrix(T))
+                targets.append(task.joint_target)
+                calls = choose.call_count
+                frame.set_target(mink.SE3.from_matrix(pose))
+                T[:3, 3] += 1.0  # (changed after it was given: not the target until given again)
+                step(configuration, [frame, task], limits)
+                assert choose.call_count == calls  # the error and Jacobian took the target as solved
+        hand = panda.arm.fk(task.joint_target)
+        assert 0.01 < np.linalg.norm(hand[:3, 3] - pose[:3, 3]) < 0.15  # led: q* of an aim on the way
+        runs.append(np.array(targets))
+    np.testing.assert_array_equal(runs[0], runs[1])
 
 
 # ---------------------------------------------------------------------------------------

@@ -244,7 +244,7 @@ class LeadsToJumpedTargets:
             return False
         if self.transform_target_to_world is None:
             return True
-        distance, angle = pose_gap(self.transform_target_to_world.as_matrix(), T_world)
+        distance, angle = pose_gap(self._target_matrix(), T_world)
         return distance > self.lead[0] or (self.free is None and angle > self.lead[1])
 
     def _jump(self, T_world: np.ndarray, root_pose: np.ndarray) -> None:
@@ -296,7 +296,8 @@ class LeadsToJumpedTargets:
         self._q_target, self.choice, self._root_pose = q, choice, root_pose
         if self._clearance is not None:
             self._seen = self._clearance.version
-        if (fresh or choice.rechosen) and self._data is not None:  # q* jumped: a joint-space way there
+        if (fresh or choice.rechosen) and self._data is not None and self.lead is not None:
+            # q* jumped: a joint-space way there (no lead: q* at once)
             start = self.joints.q(self._data.qpos)
             floor = -np.inf  # (a way the optimiser could not find clear is not re-checked: it
             # would be "blocked" by what it already passes, and chosen again, tick after tick)

@@ -14,7 +14,7 @@ from typing import Any
 import mujoco
 import numpy as np
 import numpy.typing as npt
-from mink import SE3, TargetNotSet, TaskDefinitionError
+from mink import SE3, Objective, TargetNotSet, TaskDefinitionError
 from mink import Configuration as MinkConfiguration
 
 from ..exceptions import InvalidInput, UnreachableTarget
@@ -152,6 +152,9 @@ class ExactPoseTask(ArmTask, LeadsToJumpedTargets):
         if arm_configuration is not None:
             solver.check_configuration(arm_configuration)  # raises InvalidInput naming the problem
         self.transform_target_to_world: SE3 | None = None
+        # the matrix of the target given to set_target: an SE3 made of it does not give it back
+        # bit for bit, and a target that differs in its last bit is solved again
+        self._given: tuple[SE3 | None, np.ndarray | None] = (None, None)
         self.choice: Any = None
         self._q_target: np.ndarray | None = None
         self._root_pose: np.ndarray | None = None
@@ -194,7 +197,8 @@ class ExactPoseTask(ArmTask, LeadsToJumpedTargets):
             InvalidInput: A malformed pose or configuration.
             TaskDefinitionError: A configuration given to a task that uses an optimiser.
         """
-        T = as_pose(transform_target_to_world, "transform_target_to_world")
+        # (a copy: the task keeps it, and a caller's array may change in place before the next)
+        T = as_pose(transform_target_to_world, "transform_target_to_world").copy()
         if arm_configuration is None:
             arm_configuration = self.arm_configuration
         elif self.optimizer is not None:
@@ -218,6 +222,7 @@ class ExactPoseTask(ArmTask, LeadsToJumpedTargets):
         # (an SE3 given is kept as it is: SE3.from_matrix costs as much as the tracking step)
         given = transform_target_to_world
         self.transform_target_to_world = given if isinstance(given, SE3) else SE3.from_matrix(T)
+        self._given = (self.transform_target_to_world, T)
         self.arm_configuration = arm_configuration
 
     def set_target_from_configuration(self, configuration: MinkConfiguration) -> None:
@@ -230,6 +235,7 @@ class ExactPoseTask(ArmTask, LeadsToJumpedTargets):
         self._unsolved_fallback = None
         self.arm_configuration = c
         self.transform_target_to_world = SE3.from_matrix(T)
+        self._given = (self.transform_target_to_world, T)
 
     def reset_choice(self) -> None:
         """Forget the optimiser's last choice: the next solve chooses afresh (from the arm's
@@ -250,6 +256,29 @@ class ExactPoseTask(ArmTask, LeadsToJumpedTargets):
 
     def compute_error(self, configuration: MinkConfiguration) -> np.ndarray:
         r"""The joint error :math:`e(q) = q_{arm} - \tilde q^*` (dof,)."""
+        return self._pull(configuration)[0]
+
+    def compute_jacobian(self, configuration: MinkConfiguration) -> np.ndarray:
+        """The identity in the arm's dof columns (on a joint-space way, scaled as the error),
+        (dof, nv)."""
+        q, q_target = self._joint_target(configuration)
+        return self._scaled_jacobian(self._pull_to(q, q_target)[1])
+
+    def compute_qp_residual(self, configuration: MinkConfiguration) -> tuple[np.ndarray, np.ndarray, float]:
+        """mink's weighted residual (``mink.Task.compute_qp_residual``), the world read once
+        for the error and the Jacobian both."""
+        error, weight = self._pull(configuration)
+        return self._weighted_residual(error, self._scaled_jacobian(weight))
+
+    def compute_qp_objective(self, configuration: MinkConfiguration) -> Objective:
+        """mink's QP objective (``mink.Task.compute_qp_objective``), the world read once for
+        the error and the Jacobian both."""
+        error, weight = self._pull(configuration)
+        return self._assemble_qp(error, self._scaled_jacobian(weight), configuration._eye_nv)
+
+    def _pull(self, configuration: MinkConfiguration) -> tuple[np.ndarray, float]:
+        """The error and its scale (:meth:`_pull_to`), choosing afresh where the arm is held
+        short of q* or its way is blocked."""
         q, q_target = self._joint_target(configuration)
         aim, weight = self._pull_to(q, q_target)
         if self.optimizer is not None and (
@@ -259,7 +288,7 @@ class ExactPoseTask(ArmTask, LeadsToJumpedTargets):
             self.reset_choice()  # held short of q*, or its way blocked: choose afresh
             q, q_target = self._joint_target(configuration, resolve=True)
             aim, weight = self._pull_to(q, q_target)
-        return weight * (q - aim)
+        return weight * (q - aim), weight
 
     def _pull_to(self, q: np.ndarray, q_target: np.ndarray) -> tuple[np.ndarray, float]:
         """What the error pulls the arm's joints to, and the error's scale: :math:`\tilde q^*`
@@ -274,11 +303,7 @@ class ExactPoseTask(ArmTask, LeadsToJumpedTargets):
             self._way = None
         return self.joints.nearest_turn(q_target, q), 1.0
 
-    def compute_jacobian(self, configuration: MinkConfiguration) -> np.ndarray:
-        """The identity in the arm's dof columns (on a joint-space way, scaled as the error),
-        (dof, nv)."""
-        q, q_target = self._joint_target(configuration)
-        _, weight = self._pull_to(q, q_target)
+    def _scaled_jacobian(self, weight: float) -> np.ndarray:
         return self._jacobian if weight == 1.0 else weight * self._jacobian
 
     # -----------------------------------------------------------------------------------
@@ -299,7 +324,7 @@ class ExactPoseTask(ArmTask, LeadsToJumpedTargets):
         if self._clearance is not None:
             self._clearance.update(configuration.data)
             moved = moved or self._clearance.version != self._seen
-        T = self.transform_target_to_world.as_matrix()
+        T = self._target_matrix()
         blind = lead and self._blind and self.lead is not None  # chosen before the arm was seen
         moved = moved or resolve
         if not (moved or blind):  # the aim moved on?
@@ -320,6 +345,13 @@ class ExactPoseTask(ArmTask, LeadsToJumpedTargets):
             self._unsolved_fallback = None
         assert self._q_target is not None
         return q, self._q_target
+
+    def _target_matrix(self) -> np.ndarray:
+        """The target as a (4, 4) matrix: the one given to :meth:`set_target` while it is the
+        target."""
+        given, T = self._given
+        target = self.transform_target_to_world
+        return T if target is given else target.as_matrix()
 
     def _arm_q(self, configuration: MinkConfiguration) -> np.ndarray:
         """The arm's joints (checked as :meth:`arm_q`); remembers where the world is."""
