@@ -155,6 +155,37 @@ def test_without_a_lead_a_fresh_choice_is_the_target_at_once(panda, panda_model)
         assert max(hand_error(configuration, "attachment_site", T)) < 1e-9
 
 
+def test_the_residual_and_objective_read_once_are_minks_of_the_error_and_jacobian(panda, panda_model):
+    """compute_qp_residual and compute_qp_objective (the world read once) equal mink's own,
+    assembled from compute_error and compute_jacobian, on a joint-space way (the error and
+    Jacobian scaled) and at its end."""
+    task = om.ExactPoseTask(panda, panda_model, optimizer=om.RedundancyOptimizer(panda))
+    configuration = mink.Configuration(panda_model, Q_PANDA)
+    task.set_target_from_configuration(configuration)
+    q_to = random_joints(panda.arm, 1, np.random.default_rng(11))[0]
+    task.reset_choice()
+    task.set_target(panda.arm.fk(q_to))
+    limits = [
+        mink.ConfigurationLimit(panda_model),
+        mink.VelocityLimit(panda_model, dict.fromkeys(panda.arm.joint_names, 2.0)),
+    ]
+    weights = set()
+    for _ in range(1500):
+        residual = task.compute_qp_residual(configuration)
+        expected = mink.Task.compute_qp_residual(task, configuration)
+        for got, want in zip(residual, expected, strict=True):
+            np.testing.assert_array_equal(got, want)
+        objective, want = (
+            task.compute_qp_objective(configuration),
+            mink.Task.compute_qp_objective(task, configuration),
+        )
+        np.testing.assert_array_equal(objective.H, want.H)
+        np.testing.assert_array_equal(objective.c, want.c)
+        weights.add(float(np.abs(task.compute_jacobian(configuration)).max()))
+        step(configuration, [task], limits)
+    assert len(weights) > 2 and 1.0 in weights  # (scaled on the way, then 1 at its end)
+
+
 @pytest.mark.parametrize("with_frame_task", [False, True])
 def test_a_fresh_choice_is_reached_along_its_joint_space_way(panda, panda_model, with_frame_task):
     """A choice made afresh is reached along the straight joint-space way the optimiser

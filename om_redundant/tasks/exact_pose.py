@@ -105,7 +105,7 @@ class ExactPoseTask(ArmTask, LeadsToJumpedTargets):
         lm_damping: Levenberg-Marquardt damping (see ``mink.Task``).
         lead: With an optimiser, how far the aims run ahead on the way to a target that
             jumped: the hand's (m, rad) and the joints' (rad, max-norm); None: no aims, the
-            target at once.
+            target (and a fresh choice's q*, no joint-space way) at once.
         free: With an optimiser, a rotation of the target it may choose:
             ``"tool_axis"`` (any turn about the frame's z axis: a tool to point, as
             ``mink.FrameTask(..., orientation_cost=[1, 1, 0])`` asks) or ``"orientation"``
