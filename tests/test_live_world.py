@@ -18,7 +18,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
-from tests.conftest import random_q
+from tests.conftest import random_q, solver_of
 
 DT = 0.002
 MIN_CLEARANCE = 0.03
@@ -218,6 +218,37 @@ def test_a_second_arm_moving_toward_the_first_is_seen_every_tick(panda):
     loop(configuration, [frame, task], limits, 400, move, check)
     assert max(errors) < 1e-9
     assert clearance.version > 300  # every move was read
+
+
+@settings(max_examples=6, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), name=st.sampled_from(["panda", "sawyer"]))
+def test_a_pose_swept_again_after_the_obstacles_moved_answers_as_a_fresh_sweep(seed, name):
+    """The optimiser keeps a swept pose's linked paths (they depend on the pose alone): a
+    pose chosen again after the ball and the rod moved, from the paths it kept, chooses
+    exactly as an optimiser that never saw the pose (its intervals, psi and joints bit for
+    bit), globally and from the arm's joints."""
+    solver = solver_of(name)
+    rng = np.random.default_rng(seed)
+    model = ball_scene(solver.arm)
+    clearances = [om.Clearance(model, solver.arm, ["ball", "rod"]) for _ in range(2)]
+    kept, fresh = (om.RedundancyOptimizer(solver, c, min_clearance=MIN_CLEARANCE) for c in clearances)
+    q = random_q(solver.arm, 2, rng)
+    T = solver.arm.fk(q[0])
+    kept.choose(T), kept.choose(T, q_current=q[1])  # (the obstacles at the model's qpos0)
+    data = mujoco.MjData(model)
+    hand = T[:3, 3]
+    data.mocap_pos[:] = hand + rng.uniform(-0.3, 0.3, (2, 3))  # (near the hand, where they matter)
+    mujoco.mj_kinematics(model, data)
+    for clearance in clearances:
+        clearance.update(data)
+    for q_current in (None, q[1]):
+        again, first = (o.choose(T, q_current=q_current) for o in (kept, fresh))
+        assert again.ok == first.ok and again.reason == first.reason
+        assert again.intervals == first.intervals
+        if first.ok:
+            assert again.configuration == first.configuration
+            np.testing.assert_array_equal(again.solution.q, first.solution.q)
+            assert again.value == first.value
 
 
 def test_the_arms_own_mobile_base_is_followed_by_the_clearance(panda):

@@ -19,6 +19,7 @@ from om_redundant.redundancy.choice.box_qp import step_1d
 from om_redundant.redundancy.choice.start_bounds import StartBounds
 from om_redundant.redundancy.objective.objective import Objective
 from om_redundant.redundancy.objective.terms import Evaluation
+from om_redundant.redundancy.paths.points import evaluate_points
 from om_redundant.redundancy.paths.probe import Probe
 from om_redundant.redundancy.self_motion import self_motion_tangents
 from tests.conftest import random_groups, steps_numpy
@@ -133,7 +134,9 @@ def test_batched_pieces_and_points_equal_the_single_ones(seed, name, count):
         np.testing.assert_array_equal(one[1], dg[k])
     probe = Probe(solver, objective, solver.arm.fk(q[0]), optimizer.branches[0])
     psi = np.linspace(-1.0, 1.0, len(q))
-    for point in probe.points(psi, q):
+    points = probe.points(psi, q)
+    evaluate_points(objective, points)  # (in one batch, as the sweep does)
+    for point in points:
         alone = Probe(solver, objective, probe.T, probe.signs).point(point.psi, point.q)
         assert point.evaluation == alone.evaluation
         for batched, single in zip(point.pieces(), alone.pieces(), strict=True):

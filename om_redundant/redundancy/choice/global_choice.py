@@ -19,7 +19,7 @@ from ..free_rotation import FreeRotation
 from ..objective.objective import Objective
 from ..objective.terms import Evaluation
 from ..paths.intervals import BranchRuns, PsiInterval, Run, feasible_runs
-from ..paths.linking import sweep_circle
+from ..paths.linking import LinkedMemo, sweep_circle
 from ..paths.points import Point
 from ..paths.probe import Probe
 from .climb import maximise
@@ -30,13 +30,15 @@ from .start_bounds import CLIMB_ROUNDING, StartBounds
 
 class GlobalChoice:
     """The global choice of :class:`~om_redundant.RedundancyOptimizer` (its ``solver``,
-    ``objective``, ``branches``, ``grid_points`` and ``_reach``)."""
+    ``objective``, ``branches``, ``grid_points``, ``_reach`` and ``_linked``: the paths of the
+    poses swept last, which a pose swept again takes while the obstacles move)."""
 
     solver: OMSolver
     objective: Objective
     branches: list[tuple[int, ...]]
     grid_points: int
     _reach: ReachEnvelope
+    _linked: LinkedMemo
 
     def _sweep(self, T: np.ndarray, branches: list[tuple[int, ...]], quick: bool = False) -> list[BranchRuns]:
         """Every branch's solution paths and feasible runs. Where a path runs within rounding
@@ -60,7 +62,7 @@ class GlobalChoice:
             return [BranchRuns(signs, [], [], why) for signs in branches]
         probes = [self._probe(T, signs) for signs in branches]
         try:
-            swept = sweep_circle(probes, self.grid_points, quick)
+            swept = sweep_circle(probes, self.grid_points, quick, self._linked)
         except SingularSelfMotion as singular:
             if len(branches) == 1:
                 raise

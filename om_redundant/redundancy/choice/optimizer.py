@@ -73,6 +73,7 @@ from ..objective.terms import (
     check_weights,
 )
 from ..paths.intervals import PsiInterval
+from ..paths.linking import LinkedMemo
 from .global_choice import GlobalChoice
 from .reachable import DEFAULT_TRAVEL_WEIGHT
 from .result import RedundancyChoice
@@ -170,6 +171,7 @@ class RedundancyOptimizer(GlobalChoice):
             raise InvalidInput(f"travel_weight must be >= 0, got {travel_weight}")
         self._tracker = Tracker(solver, self.objective, self.max_step)
         self._reach = ReachEnvelope(solver)
+        self._linked = LinkedMemo()
 
     def __reduce__(self) -> tuple[Any, tuple[Any, ...]]:
         """Pickled as its solver, clearance and options (the tracking step's state is rebuilt)."""

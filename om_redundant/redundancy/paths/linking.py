@@ -23,7 +23,10 @@ elbow), so the solutions of a branch are organised as *paths*:
   Each solution is followed to the next grid psi and linked to the
   solution it arrives at; solutions not arrived at start new paths, followed backwards to
   where they end; paths are joined across +-pi, and close into loops (one
-  ``_core.link_paths`` call per branch, :meth:`Probe.link`).
+  ``_core.link_paths`` call per branch, :meth:`Probe.link`). The linked paths depend on the
+  pose and the branch alone, not on the obstacles: a sweep of the same pose again (a target
+  held while the obstacles move) takes them as they were linked (``traced``), its points'
+  objective evaluated afresh, and does only what follows.
 * **Cells.** Between neighbouring samples of a path where a joint moves more than
   :data:`FINE_STEP`, samples are inserted. Every sample carries its feasibility functions
   :math:`g_j` (each joint's margin, each clearance minus d_min, normalised; feasible iff all
@@ -37,6 +40,8 @@ elbow), so the solutions of a branch are organised as *paths*:
 from __future__ import annotations
 
 import math
+import threading
+from collections import OrderedDict
 from collections.abc import Generator
 from dataclasses import dataclass
 from typing import Any
@@ -57,6 +62,9 @@ _HERMITE = np.array(
     [2 * _T**3 - 3 * _T**2 + 1, _T**3 - 2 * _T**2 + _T, -2 * _T**3 + 3 * _T**2, _T**3 - _T**2]
 )
 _BOUND_SLACK = 1e-9  # covers the rounding of the Hermite models in cell_looks' bounds
+#: Sweeps whose linked paths a :class:`LinkedMemo` keeps: a fresh choice's (each turn of a
+#: free rotation, the quick look and the sweep of every branch).
+MEMO_SWEEPS = 16
 
 #: What a process of :func:`lockstep` asks for: follow from the point towards psi on the
 #: probe's branch (:meth:`Probe.follow`).
@@ -78,13 +86,70 @@ class Path:
     turns: int = 0
 
 
-def sweep_circle(probes: list[Probe], n: int, quick: bool = False) -> list[list[Path]]:
+class LinkedMemo:
+    """The linked paths of the last :data:`MEMO_SWEEPS` sweeps (:func:`sweep_circle`), by
+    pose, branches, grid and ``quick``: what a sweep of the same pose again takes instead of
+    solving and linking. Shared by threads."""
+
+    def __init__(self) -> None:
+        self._entries: OrderedDict[tuple[Any, ...], list[list[Path]]] = OrderedDict()
+        self._lock = threading.Lock()
+
+    def get(self, key: tuple[Any, ...]) -> list[list[Path]] | None:
+        with self._lock:
+            linked = self._entries.get(key)
+            if linked is not None:
+                self._entries.move_to_end(key)
+            return linked
+
+    def put(self, key: tuple[Any, ...], linked: list[list[Path]]) -> None:
+        with self._lock:
+            self._entries[key] = linked
+            self._entries.move_to_end(key)
+            while len(self._entries) > MEMO_SWEEPS:
+                self._entries.popitem(last=False)
+
+
+def sweep_circle(
+    probes: list[Probe], n: int, quick: bool = False, memo: LinkedMemo | None = None
+) -> list[list[Path]]:
     """The solution paths of each probe's branch over the whole circle, from the grid
     psi_k = -pi + 2 pi k / n (module docstring). The probes share one solver, objective and
     pose, and each follows its own branch's paths here and after (a probe keeps no state
     between its answers). ``quick``: no grid row searches beyond its configuration's own roots
     (:meth:`~om_redundant.OMSolver.solve_grid`'s band, as where every neighbouring branch is
-    swept too), for a first look at a branch alone; its "no" rows are then the cheap ones."""
+    swept too), for a first look at a branch alone; its "no" rows are then the cheap ones.
+    ``memo``: where the linked paths of a sweep of the same pose, branches, n and ``quick``
+    are kept and taken from (the objective evaluated afresh: the obstacles may have moved).
+
+    Returns:
+        Each branch's paths, with the samples inserted where a cell hides a feature.
+    """
+    key = (probes[0].T.tobytes(), tuple(probe.signs for probe in probes), n, quick)
+    kept = None if memo is None else memo.get(key)
+    if kept is None:
+        linked = _linked(probes, n, quick)
+        if memo is not None:
+            memo.put(key, _renewed(linked))
+    else:
+        linked = _renewed(kept)
+    swept = [[(probe, path) for path in paths] for probe, paths in zip(probes, linked, strict=True)]
+    filled = iter(_with_hidden([path for paths in swept for path in paths]))  # (every branch's at once)
+    return [[next(filled) for _ in paths] for paths in swept]
+
+
+def _renewed(linked: list[list[Path]]) -> list[list[Path]]:
+    """The paths with their points' objective unevaluated (:meth:`Point.renewed`): what a
+    :class:`LinkedMemo` keeps and hands out (a sweep evaluates its points where the obstacles
+    are then, and their terms would hold megabytes)."""
+    renewals: dict = {}
+    return [
+        [Path([p.renewed(renewals) for p in path.points], path.turns) for path in paths] for paths in linked
+    ]
+
+
+def _linked(probes: list[Probe], n: int, quick: bool) -> list[list[Path]]:
+    """Each probe's branch's linked paths (:func:`sweep_circle`, before the looks inside the cells)."""
     solver, T, branches = probes[0].solver, probes[0].T, [probe.signs for probe in probes]
     psi = -math.pi + TURN * np.arange(n) / n
     # Rows by ELBOW sign, then psi by psi, the branches that differ in the first sign alone next
@@ -115,15 +180,14 @@ def sweep_circle(probes: list[Probe], n: int, quick: bool = False) -> list[list[
     for b, k, point in zip(branch.tolist(), grid.tolist(), points, strict=True):
         if point is not None:
             roots[b][k].append(point)
-    swept: list[list[tuple[Probe, Path]]] = [[] for _ in probes]
+    linked: list[list[Path]] = [[] for _ in probes]
 
     def link(start: int, stop: int) -> None:  # (each branch's link_paths call releases the GIL)
         for b in range(start, stop):
-            swept[b] = [(probes[b], Path(points, turns)) for points, turns in probes[b].link(psi, roots[b])]
+            linked[b] = [Path(points, turns) for points, turns in probes[b].link(psi, roots[b])]
 
     run_rows(link, len(probes), chunk=1)
-    filled = iter(_with_hidden([path for paths in swept for path in paths]))  # (every branch's at once)
-    return [[next(filled) for _ in paths] for paths in swept]
+    return linked
 
 
 def _distinct(probe: Probe, q: np.ndarray, count: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -32,7 +32,7 @@ from ...exceptions import SingularSelfMotion
 from ...ik.solver import OMSolver, Solution
 from ..objective.objective import Objective
 from ..self_motion import self_motion_tangent, self_motion_tangents
-from .points import Point, PointTerms, evaluated_terms
+from .points import Point, PointTerms
 
 #: rad, max-norm: the largest joint step between neighbouring solutions of one path
 #: (csrc/redundancy/om_paths.h's).
@@ -105,10 +105,11 @@ class Probe:
         return centred if self._all_centred else np.where(self._centred, centred, q)
 
     def points(self, psi: np.ndarray, q: np.ndarray) -> list[Point | None]:
-        """:meth:`point` for every psi and row of q (M, dof) of a 7-DOF arm, the tangents and
-        the objective (:func:`evaluate_points`) computed for all rows at once; None for a row
-        exactly where psi does not move along the self-motion (a fold met by the grid itself,
-        a straight or folded elbow): the paths end beside it, as at any fold.
+        """:meth:`point` for every psi and row of q (M, dof) of a 7-DOF arm, the tangents
+        computed for all rows at once and the objective not yet (:func:`evaluate_points`
+        computes it for many points at once); None for a row exactly where psi does not move
+        along the self-motion (a fold met by the grid itself, a straight or folded elbow): the
+        paths end beside it, as at any fold.
 
         Raises:
             SingularSelfMotion: psi moves along the self-motion at none of the rows (the arm
@@ -123,13 +124,7 @@ class Probe:
         if good.any():
             q, tangents, at = q[good], tangents[good], np.flatnonzero(good).tolist()
             rows, rates = list(q), list(tangents)  # (each row's views, shared by its point and terms)
-            terms = map(
-                PointTerms,
-                itertools.repeat(self.objective),
-                rows,
-                rates,
-                *evaluated_terms(self.objective, q, tangents),
-            )
+            terms = map(PointTerms, itertools.repeat(self.objective), rows, rates)
             for k, point in zip(at, map(Point, psi[good].tolist(), rows, rates, terms), strict=True):
                 points[k] = point
         return points
