@@ -101,7 +101,7 @@ class PickConfigurationOf:
     def __init__(self, solver):
         self.solver, self.q, self.previous = solver, None, []
 
-    def choose(self, T, previous=None, *, q_current=None, free=None):
+    def choose(self, T, previous=None, *, q_current=None, free=None, rechoose=True):
         self.previous.append(previous)
         c = self.solver.configuration_of(self.q)
         sol = self.solver.solve(T, c, q_hint=self.q)
@@ -387,7 +387,7 @@ class SwingElbow:
     def __init__(self, solver, signs, psi):
         self.solver, self.signs, self.psi = solver, signs, psi
 
-    def choose(self, T, previous=None, *, q_current=None, free=None):
+    def choose(self, T, previous=None, *, q_current=None, free=None, rechoose=True):
         c = om.Configuration(self.signs if previous is None else previous.configuration.signs, (self.psi,))
         sol = self.solver.solve(T, c, q_hint=None if previous is None else previous.solution.q)
         return SimpleNamespace(

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 import sys
+from unittest import mock
 
 import numpy as np
 import pytest
@@ -263,3 +264,27 @@ def test_tracking_holds_a_maximum_where_the_path_ends():
     q = np.array([2.88593761, -1.32943195, 4.56384435, 2.03828794, -2.51689649, 0.35053673, -5.92731425])
     gap, gain = converged_gap(optimizer, q)
     assert gap < 1e-6 and gain < 1e-6
+
+
+def test_without_rechoose_tracking_that_stops_says_so_and_sweeps_nothing(optimizers):
+    """choose(..., rechoose=False): where tracking from the previous choice cannot follow a
+    target that jumped, a choice that is not ok, saying why, without the fresh choice's sweep;
+    where it can, the same choice as with rechoose."""
+    optimizer = optimizers["panda"]
+    T = optimizer.solver.arm.fk(HOMES["panda"])
+    previous = optimizer.choose(T)
+    jumped = T.copy()
+    jumped[:3, 3] += [0.0, 0.3, -0.2]
+    with mock.patch.object(type(optimizer), "_from_joints", side_effect=AssertionError("swept")):
+        stopped = optimizer.choose(jumped, previous=previous, rechoose=False)
+        near = T.copy()
+        near[:3, 3] += [0.0, 0.001, 0.0]
+        tracked = optimizer.choose(near, previous=previous, rechoose=False)
+    signs = previous.configuration.signs
+    assert not stopped.ok and stopped.reason.startswith(f"tracking from branch {signs}")
+    assert stopped.intervals == () and stopped.solution is None
+    again = optimizer.choose(jumped, previous=previous)
+    assert again.ok and again.rechosen and again.reason.startswith(stopped.reason)
+    with_rechoose = optimizer.choose(near, previous=previous)
+    assert tracked.ok and not tracked.rechosen
+    np.testing.assert_array_equal(tracked.solution.q, with_rechoose.solution.q)

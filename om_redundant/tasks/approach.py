@@ -273,9 +273,9 @@ class LeadsToJumpedTargets:
             aim = lead_pose(aim, T_world, self.lead)
             q = previous.solution.q
             previous = self.optimizer.choose(
-                self.root.in_root(aim, root_pose), previous=previous, q_current=q
+                self.root.in_root(aim, root_pose), previous=previous, q_current=q, rechoose=False
             )
-            if not (previous.ok and not previous.rechosen and previous.way_clear):
+            if not (previous.ok and previous.way_clear):  # (not ok: tracking stopped)
                 return False
         return True
 

@@ -13,8 +13,10 @@ class Chooser(Protocol):
     """What :class:`ExactPoseTask` needs of a redundancy optimiser (duck-typed, as
     :class:`~om_redundant.RedundancyOptimizer`).
 
-    ``choose(T, previous, q_current=q)`` takes a pose in the arm's root frame, the previous
-    choice (or None) and the arm's joints now (or None), and returns an object with ``ok``
+    ``choose(T, previous, q_current=q, free=f, rechoose=r)`` takes a pose in the arm's root
+    frame, the previous choice (or None), the arm's joints now (or None), a free rotation (or
+    None) and whether to choose afresh where tracking from ``previous`` stops (else a choice
+    that is not ok), and returns an object with ``ok``
     (bool), ``solution`` (an om :class:`~om_redundant.Solution`), ``configuration`` (its
     :class:`~om_redundant.Configuration`), ``reason`` (str, why when not ok), ``rechosen``
     (bool: chosen afresh where tracking could not continue) and ``way_clear`` (bool: the
@@ -26,7 +28,15 @@ class Chooser(Protocol):
     clearance: Any
     min_clearance: float
 
-    def choose(self, T: np.ndarray, previous: Any = None, *, q_current: Any = None) -> Any: ...
+    def choose(
+        self,
+        T: np.ndarray,
+        previous: Any = None,
+        *,
+        q_current: Any = None,
+        free: Any = None,
+        rechoose: bool = True,
+    ) -> Any: ...
 
 
 def live_clearance(optimizer: Chooser | None, model: mujoco.MjModel, root: Any) -> Any:

@@ -76,7 +76,7 @@ from ..paths.intervals import PsiInterval
 from ..paths.linking import LinkedMemo
 from .global_choice import GlobalChoice
 from .reachable import DEFAULT_TRAVEL_WEIGHT
-from .result import RedundancyChoice
+from .result import RedundancyChoice, failed_choice
 from .tracking import MAX_CURVATURE, Tracked, Tracker
 
 #: Tracking with a free rotation: a turn is taken where it gains more than this.
@@ -211,6 +211,7 @@ class RedundancyOptimizer(GlobalChoice):
         *,
         q_current: Any = None,
         free: FreeRotation | None = None,
+        rechoose: bool = True,
     ) -> RedundancyChoice:
         """The best configuration for pose T; with ``previous``, the best near it; with the
         arm's joints ``q_current``, one the arm can reach from where it is.
@@ -225,6 +226,9 @@ class RedundancyOptimizer(GlobalChoice):
             free: Rotations of T left free (a tool axis to point, or a position to reach):
                 the optimiser picks the turn too (:mod:`~om_redundant.redundancy.free_rotation`),
                 reported as the choice's ``turn``.
+            rechoose: Where tracking from ``previous`` cannot continue, choose afresh (the
+                choice ``rechosen``); False: a choice that is not ok, the reason saying why
+                tracking stopped (to learn whether tracking continues, without a sweep).
 
         Returns:
             A :class:`RedundancyChoice`; ``ok`` is False, with the reason, only when no
@@ -257,7 +261,7 @@ class RedundancyOptimizer(GlobalChoice):
             raise InvalidInput(
                 "previous was chosen with another free rotation: choose afresh (previous=None)"
             )
-        return self._stamped(self._track(T, previous, q_current, free, version), version)
+        return self._stamped(self._track(T, previous, q_current, free, version, rechoose), version)
 
     # -----------------------------------------------------------------------------------
 
@@ -277,6 +281,7 @@ class RedundancyOptimizer(GlobalChoice):
         q_current: np.ndarray | None,
         free: FreeRotation | None,
         version: int,
+        rechoose: bool,
     ) -> RedundancyChoice:
         signs, (psi,) = previous.configuration.signs, previous.configuration.redundancy
         q_previous = previous.solution.q
@@ -320,14 +325,16 @@ class RedundancyOptimizer(GlobalChoice):
                 travel=travel,
                 clearance_version=version,
             )
+        stopped = f"tracking from branch {signs} at psi = {psi:+.4f} stopped: {step}"
+        if not rechoose:
+            return failed_choice((), stopped)
         start = q_previous if q_current is None else q_current
         chosen = self._from_joints(T, start, signs, free)
         if not chosen.ok:
             return chosen
         flipped = chosen.configuration.signs != signs
         reason = (
-            f"tracking from branch {signs} at psi = {psi:+.4f} stopped: {step}; chose afresh from the "
-            f"arm's joints: branch {chosen.configuration.signs} at psi = "
+            f"{stopped}; chose afresh from the arm's joints: branch {chosen.configuration.signs} at psi = "
             f"{chosen.configuration.redundancy[0]:+.4f}, {chosen.travel:.3f} rad of joint travel"
         )
         if chosen.reason:
