@@ -1,7 +1,7 @@
 """The clearance's compiled kernel (``_core.arm_clearance``): the arm geoms placed by the arm's
 DH chain against MuJoCo's ``mj_kinematics``, the distances (sphere and capsule arm geoms against
-sphere, capsule and box obstacles) against MuJoCo's ``mj_geomDistance``, and their gradients
-against finite differences."""
+sphere, capsule and box obstacles, box arm geoms against sphere and capsule obstacles) against
+MuJoCo's ``mj_geomDistance``, and their gradients against finite differences."""
 
 from __future__ import annotations
 
@@ -36,10 +36,12 @@ def panda() -> om.OMSolver:
 def scene(
     arm: om.Arm, kind: str, size: list[float], position: list[float], quat: list[float]
 ) -> om.Clearance:
-    """The project's MJCF of the arm, a sphere on link 4 (an arm geom that is no capsule) and
-    one obstacle in the world."""
+    """The project's MJCF of the arm, a sphere on link 4 and a box on link 7 (arm geoms that
+    are no capsule: a gripper's pad) and one obstacle in the world."""
     spec = mujoco.MjSpec.from_string(om.arm_mjcf(arm))
     spec.body("link4").add_geom(name="knob", type=KINDS["sphere"], size=[0.05, 0, 0], pos=[0.05, 0.0, 0.1])
+    pad = dict(size=[0.04, 0.01, 0.03], pos=[0.0, 0.03, 0.1], quat=[0.9, 0.1, 0.3, 0.2])
+    spec.body("link7").add_geom(name="pad", type=KINDS["box"], **pad)
     spec.worldbody.add_geom(name="obstacle", type=KINDS[kind], size=size, pos=position, quat=quat)
     return om.Clearance(spec.compile(), arm, ["obstacle"])
 
@@ -82,23 +84,23 @@ def check_against_mujoco(
 ):
     """found is mj_geomDistance's distance of arm geom a and obstacle o (capped at reach),
     except where MuJoCo says a sphere or capsule is apart from a box that its core overlaps
+    (either of them the arm's)
     (test_a_capsule_through_a_thin_box_overlaps): there the core's distance from the box less
     the radius where the core stays outside, else at most minus the radius (the core inside)."""
     expected = mujoco.mj_geomDistance(model, data, a, o, reach, None)
-    cored = (
-        model.geom_type[a] in (int(KINDS["sphere"]), int(KINDS["capsule"]))
-        and model.geom_type[o] == KINDS["box"]
-    )
-    if cored and expected > 0.0 and (gap := _core_box_gap(model, data, a, o)) <= 0.0:
-        radius = model.geom_size[a][0]
+    round_kinds = (int(KINDS["sphere"]), int(KINDS["capsule"]))
+    core, box = (a, o) if model.geom_type[o] == KINDS["box"] else (o, a)  # (an arm box: a pad)
+    cored = model.geom_type[core] in round_kinds and model.geom_type[box] == KINDS["box"]
+    if cored and expected > 0.0 and (gap := _core_box_gap(model, data, core, box)) <= 0.0:
+        radius = model.geom_size[core][0]
         assert found == pytest.approx(gap, abs=1e-6) if gap > -radius else found <= -radius + 1e-15
     else:
         assert found == pytest.approx(expected, abs=1e-12)
 
 
 def _core_box_gap(model: mujoco.MjModel, data: mujoco.MjData, a: int, o: int, points: int = 20001) -> float:
-    """The distance of arm geom a's core (a capsule's segment, a sphere's centre) from box o,
-    less a's radius, by sampling the core: <= 0 where they overlap."""
+    """The distance of geom a's core (a capsule's segment, a sphere's centre) from box o, less
+    a's radius, by sampling the core: <= 0 where they overlap."""
     R, half = data.geom_xmat[o].reshape(3, 3), model.geom_size[o]
     axis = data.geom_xmat[a].reshape(3, 3)[:, 2] * (
         model.geom_size[a][1] if model.geom_type[a] == KINDS["capsule"] else 0.0
@@ -141,6 +143,57 @@ def test_a_capsule_through_a_thin_box_overlaps(panda):
     depth = overlaps(np.vstack([R.T, np.cross(u, R.T)])).min()
     assert found == pytest.approx(-(depth + radius), abs=1e-12)
     assert depth <= overlaps(np.random.default_rng(0).normal(size=(200_000, 3))).min() + 1e-12
+
+
+def test_an_arm_box_pierced_by_a_capsule_is_the_capsule_through_a_box_turned_round(panda):
+    """The scene above with the roles swapped: the thin box on link 5 (a gripper's pad) where
+    it was, and the capsule fixed in the world where link 5 put it. The kernel computes an
+    arm box against a sphere or capsule (the obstacle's core against the box), and where the
+    core overlaps the box, MuJoCo's positive distance is replaced by the exact depth, as for
+    the capsule through the box: the same distance to rounding. Moved apart, the kernel's
+    distance is MuJoCo's and its gradient that of central differences (the nearest points
+    turned round: the arm's first)."""
+    arm = panda.arm
+    clearance = scene(arm, "box", [0.25, 0.03125, 0.25], [0.0, 0.1875, 0.5], [0.0, 0.0, 0.5, 0.375])
+    q = arm.lower + np.array([0.0, 0.625, 0.0, 0.0, 0.0, 0.0, 0.0]) * (arm.upper - arm.lower)
+    model, data = clearance.model, mujoco.MjData(clearance.model)
+    data.qpos[:] = q
+    mujoco.mj_kinematics(model, data)
+    a, o = (mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, n) for n in ("link5_capsule1", "obstacle"))
+    link5 = model.geom_bodyid[a]
+    R5, p5 = data.xmat[link5].reshape(3, 3), data.xpos[link5]
+    quat = np.empty(4)
+    mujoco.mju_mat2Quat(quat, (R5.T @ data.geom_xmat[o].reshape(3, 3)).ravel())
+    spec = mujoco.MjSpec.from_string(om.arm_mjcf(arm))
+    spec.body("link5").add_geom(
+        name="plate",
+        type=KINDS["box"],
+        size=model.geom_size[o],
+        pos=R5.T @ (data.geom_xpos[o] - p5),
+        quat=quat,
+    )
+    mujoco.mju_mat2Quat(quat, data.geom_xmat[a])
+    rod = dict(size=model.geom_size[a], pos=data.geom_xpos[a], quat=quat)
+    spec.worldbody.add_geom(name="rod", type=KINDS["capsule"], **rod)
+    turned = om.Clearance(spec.compile(), arm, ["rod"])
+    d = clearance.distances(q)
+    d_turned = turned.distances(q)
+    k, k_turned = clearance.pairs.index(("link5_capsule1", "obstacle")), turned.pairs.index(("plate", "rod"))
+    turned_data = mujoco.MjData(turned.model)
+    turned_data.qpos[:] = q
+    mujoco.mj_kinematics(turned.model, turned_data)
+    plate, rod_id = (mujoco.mj_name2id(turned.model, mujoco.mjtObj.mjOBJ_GEOM, n) for n in ("plate", "rod"))
+    assert mujoco.mj_geomDistance(turned.model, turned_data, plate, rod_id, 0.05, None) > 0.0  # (MuJoCo's)
+    assert d[k] < 0.0 and d_turned[k_turned] == pytest.approx(d[k], abs=1e-12)
+    q_apart = q + np.array([0.0, 0.0, 2.0, 0.0, 0.0, 0.0, 0.0])  # (joint 3 turned: the plate off the rod)
+    d_apart, grad_apart = turned.distances_and_gradients(q_apart)
+    assert d_apart[k_turned] > 0.01
+    turned_data.qpos[:] = q_apart
+    mujoco.mj_kinematics(turned.model, turned_data)
+    check_against_mujoco(turned.model, turned_data, plate, rod_id, turned.distmax, d_apart[k_turned])
+    h, direction = 1e-7, np.random.default_rng(1).normal(size=arm.dof)
+    ahead, behind = (turned.distances(q_apart + s * direction)[k_turned] for s in (h, -h))
+    assert grad_apart[k_turned] @ direction == pytest.approx((ahead - behind) / (2 * h), abs=1e-6)
 
 
 @pytest.mark.parametrize(

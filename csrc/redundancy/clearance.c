@@ -247,6 +247,15 @@ static long distances(const int64_t *kind, const double *radius, const double *h
         else if ((kind[g1] == CORE_POINT || kind[g1] == CORE_SEGMENT) && kind[g2] != CORE_MUJOCO) {
             double d = pair_distance(kind, radius, half, xpos, xmat, g1, g2, ft);
             dist[k] = d < reach ? d : isnan(d) ? d : reach;
+        } else if (kind[g1] == CORE_BOX && (kind[g2] == CORE_POINT || kind[g2] == CORE_SEGMENT)) {
+            /* an arm box (a gripper's pad) and a sphere or capsule: the obstacle's core against
+             * the box, its nearest points turned round (the arm's first) */
+            double d = pair_distance(kind, radius, half, xpos, xmat, g2, g1, ft);
+            for (int i = 0; i < 3; i++) {
+                double t = ft[i];
+                ft[i] = ft[3 + i], ft[3 + i] = t;
+            }
+            dist[k] = d < reach ? d : isnan(d) ? d : reach;
         } else
             dist[k] = NAN;
         left += isnan(dist[k]);

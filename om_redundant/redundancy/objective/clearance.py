@@ -10,10 +10,11 @@ geoms overlap, capped at ``distmax``. The arm geoms are placed by the arm's DH c
 (:mod:`~om_redundant.redundancy.objective.arm_geoms`: each at its offset in its link, checked against
 MuJoCo's ``mj_kinematics`` at set-up). One compiled call (``_core.arm_clearance``,
 ``csrc/redundancy/clearance.c``) places the geoms for every row of a batch of joint vectors and computes
-the pairs of a sphere or capsule arm geom and a sphere, capsule or box obstacle exactly
-(closest points of segments, and of a segment and a box, in closed form; overlapping where
-the cores do not touch), and ``mujoco.mj_geomDistance`` the rest (other kinds, cores
-touching, boxes touched), the arm geoms placed as the kernel places them;
+the pairs of a sphere or capsule arm geom and a sphere, capsule or box obstacle, and of a box
+arm geom (a gripper's pad) and a sphere or capsule obstacle, exactly (closest points of
+segments, and of a segment and a box, in closed form; overlapping where the cores do not
+touch), and ``mujoco.mj_geomDistance`` the rest (other kinds, two boxes, cores touching,
+boxes touched; a row's arm geoms placed once, as the kernel places them);
 ``tests/test_clearance.py`` checks both against MuJoCo. Where MuJoCo says a sphere or capsule
 is apart from a box that its core overlaps (its box-capsule distance is positive for about
 0.3 % of such pairs, up to 0.09 m, a capsule through a thin box), the exact signed distance is
