@@ -18,7 +18,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
-from tests.conftest import random_q, solver_of
+from tests.conftest import in_threads, random_q, solver_of
 
 DT = 0.002
 MIN_CLEARANCE = 0.03
@@ -249,6 +249,34 @@ def test_a_pose_swept_again_after_the_obstacles_moved_answers_as_a_fresh_sweep(s
             assert again.configuration == first.configuration
             np.testing.assert_array_equal(again.solution.q, first.solution.q)
             assert again.value == first.value
+
+
+def test_threads_sharing_an_optimiser_take_its_kept_paths_as_one(panda):
+    """Four threads choose among the same poses again and again (their linked paths taken
+    from the optimiser's memo, and put there, at once): every answer is the one an optimiser
+    alone gives."""
+    model = ball_scene(panda.arm)
+    shared, alone = (
+        om.RedundancyOptimizer(
+            panda, om.Clearance(model, panda.arm, ["ball", "rod"]), min_clearance=MIN_CLEARANCE
+        )
+        for _ in range(2)
+    )
+    poses = [panda.arm.fk(q) for q in random_q(panda.arm, 3, np.random.default_rng(2))]
+    expected = [alone.choose(T) for T in poses]
+    cases = [k % len(poses) for k in range(24)]
+    found: list = [None] * len(cases)
+
+    def work(rows: range) -> None:
+        for k in rows:
+            found[k] = shared.choose(poses[cases[k]])
+
+    in_threads(work, len(cases))
+    for k, choice in enumerate(found):
+        want = expected[cases[k]]
+        assert choice.ok == want.ok and choice.intervals == want.intervals
+        if want.ok:
+            np.testing.assert_array_equal(choice.solution.q, want.solution.q)
 
 
 def test_the_arms_own_mobile_base_is_followed_by_the_clearance(panda):
