@@ -143,6 +143,19 @@ def test_a_capsule_through_a_thin_box_overlaps(panda):
     depth = overlaps(np.vstack([R.T, np.cross(u, R.T)])).min()
     assert found == pytest.approx(-(depth + radius), abs=1e-12)
     assert depth <= overlaps(np.random.default_rng(0).normal(size=(200_000, 3))).min() + 1e-12
+    assert_overlap_gradient(clearance, q, k)
+
+
+def assert_overlap_gradient(clearance: om.Clearance, q: np.ndarray, k: int) -> None:
+    """Pair k's gradient at q is that of central differences of its distance along random
+    directions: for a depth across an edge of the box (the axis u x e_j, on which the whole
+    core projects to one point), from the core's point nearest that edge (an end of the core
+    gave a gradient off by 5x: 0.015 against 0.217)."""
+    grad = clearance.distances_and_gradients(q)[1][k]
+    h = 1e-7
+    for direction in np.random.default_rng(3).normal(size=(5, len(q))):
+        ahead, behind = (clearance.distances(q + s * direction)[k] for s in (h, -h))
+        assert grad @ direction == pytest.approx((ahead - behind) / (2 * h), abs=1e-6)
 
 
 def test_an_arm_box_pierced_by_a_capsule_is_the_capsule_through_a_box_turned_round(panda):
@@ -150,9 +163,9 @@ def test_an_arm_box_pierced_by_a_capsule_is_the_capsule_through_a_box_turned_rou
     it was, and the capsule fixed in the world where link 5 put it. The kernel computes an
     arm box against a sphere or capsule (the obstacle's core against the box), and where the
     core overlaps the box, MuJoCo's positive distance is replaced by the exact depth, as for
-    the capsule through the box: the same distance to rounding. Moved apart, the kernel's
-    distance is MuJoCo's and its gradient that of central differences (the nearest points
-    turned round: the arm's first)."""
+    the capsule through the box: the same distance to rounding, its gradient that of central
+    differences. Moved apart, the kernel's distance is MuJoCo's and its gradient that of
+    central differences (the nearest points turned round: the arm's first)."""
     arm = panda.arm
     clearance = scene(arm, "box", [0.25, 0.03125, 0.25], [0.0, 0.1875, 0.5], [0.0, 0.0, 0.5, 0.375])
     q = arm.lower + np.array([0.0, 0.625, 0.0, 0.0, 0.0, 0.0, 0.0]) * (arm.upper - arm.lower)
@@ -185,6 +198,7 @@ def test_an_arm_box_pierced_by_a_capsule_is_the_capsule_through_a_box_turned_rou
     plate, rod_id = (mujoco.mj_name2id(turned.model, mujoco.mjtObj.mjOBJ_GEOM, n) for n in ("plate", "rod"))
     assert mujoco.mj_geomDistance(turned.model, turned_data, plate, rod_id, 0.05, None) > 0.0  # (MuJoCo's)
     assert d[k] < 0.0 and d_turned[k_turned] == pytest.approx(d[k], abs=1e-12)
+    assert_overlap_gradient(turned, q, k_turned)
     q_apart = q + np.array([0.0, 0.0, 2.0, 0.0, 0.0, 0.0, 0.0])  # (joint 3 turned: the plate off the rod)
     d_apart, grad_apart = turned.distances_and_gradients(q_apart)
     assert d_apart[k_turned] > 0.01

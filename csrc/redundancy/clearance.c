@@ -163,7 +163,8 @@ static double pair_distance(const int64_t *kind, const double *radius, const dou
  * the box: the least, over the separating axes n of a segment and a box (the box's axes e_i and
  * u x e_i for the segment's direction u: the normals of their Minkowski difference's faces), of
  * how far the core must move along +-n to leave the box; the arm point is the core's point
- * deepest along that escape direction, less r, the box point where it leaves the box. */
+ * deepest along that escape direction (across an edge, its point nearest the edge), less r,
+ * the box point where it leaves the box: the points whose motion moves the depth. */
 static double overlap_with_box(const double *p, const double *q, double r, const double *pos, const double *R,
                                const double *h, double *fromto) {
     double a[3], b[3], k1[3] = {0.0}, k2[3] = {0.0}, v[3], arm[3], box[3], distance;
@@ -175,8 +176,9 @@ static double overlap_with_box(const double *p, const double *q, double r, const
         for (int i = 0; i < 3; i++) arm[i] = k1[i] + r * v[i] / length, box[i] = k2[i];
         distance = length - r;
     } else {
-        double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, depth = INFINITY, escape[3] = {0.0};
-        const double *deepest = a;
+        double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, depth = INFINITY, escape[3] = {0.0}, deepest[3];
+        const double *end = a;
+        int axis = 0;
         for (int m = 0; m < 6; m++) {
             double n[3] = {0.0, 0.0, 0.0};
             if (m < 3)
@@ -192,11 +194,24 @@ static double overlap_with_box(const double *p, const double *q, double r, const
             for (int side = -1; side <= 1; side += 2) { /* escaping along side n: the overlap to clear */
                 double overlap = side < 0 ? fmax(sa, sb) + extent : extent - fmin(sa, sb);
                 if (overlap < depth) {
-                    depth = overlap;
+                    depth = overlap, axis = m;
                     for (int i = 0; i < 3; i++) escape[i] = side * n[i];
-                    deepest = side * (sa - sb) < 0.0 ? a : b;
+                    end = side * (sa - sb) < 0.0 ? a : b;
                 }
             }
+        }
+        memcpy(deepest, end, sizeof deepest);
+        if (axis >= 3) {
+            /* across an edge of the box along e_j: the whole core projects to one point on u x e_j,
+             * and the deepest point is the core's nearest that edge (the one the box's support
+             * along the escape direction runs along), where a turn of the core moves the depth */
+            int j = axis - 3, j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+            double c[3], w[3];
+            c[j] = 0.0, c[j1] = copysign(h[j1], escape[j1]), c[j2] = copysign(h[j2], escape[j2]);
+            for (int i = 0; i < 3; i++) w[i] = a[i] - c[i];
+            double t = (u[j] * w[j] - dot3(u, w)) / (dot3(u, u) - u[j] * u[j]);
+            t = fmin(1.0, fmax(0.0, t));
+            for (int i = 0; i < 3; i++) deepest[i] = a[i] + t * u[i];
         }
         for (int i = 0; i < 3; i++) box[i] = deepest[i] + depth * escape[i], arm[i] = deepest[i] - r * escape[i];
         distance = -(depth + r);
