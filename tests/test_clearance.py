@@ -18,6 +18,7 @@ import om_redundant as om
 from om_redundant import _core
 from om_redundant.exceptions import ModelMismatch
 from om_redundant.ik.threads import BATCH_CHUNK, run_rows
+from om_redundant.redundancy.objective.arm_geoms import find_geom
 from tests.conftest import in_threads, random_q
 
 KINDS = {
@@ -510,6 +511,33 @@ def test_an_arm_without_collision_geoms_is_named(panda):
     )
     with pytest.raises(om.InvalidInput, match=r"carry no collision geoms .* om\.arm_model"):
         om.Clearance(spec.compile(), panda.arm, ["ball"])
+
+
+@pytest.mark.parametrize("discard", [True, False])
+def test_an_obstacle_a_urdf_dropped_is_named_with_why(tmp_path, discard):
+    """A URDF's scene: MuJoCo's compiler drops the geoms that take no contacts (its
+    discardvisual, on for a URDF), so a mocap ball added without contacts, an obstacle mink
+    should not push, is gone: the error says that its body has no geom, and why. With
+    discardvisual off the geom is there."""
+    urdf = tmp_path / "arm.urdf"
+    urdf.write_text(
+        '<robot name="r"><link name="base"/><link name="l1"><collision><geometry><sphere radius="0.05"/>'
+        '</geometry></collision></link><joint name="j1" type="revolute"><parent link="base"/>'
+        '<child link="l1"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/>'
+        "</joint></robot>"
+    )
+    spec = mujoco.MjSpec.from_file(str(urdf))
+    spec.compiler.discardvisual = discard
+    ball = spec.worldbody.add_body(name="ball", mocap=True, pos=[0.5, 0.0, 0.5])
+    ball.add_geom(name="ball", type=KINDS["sphere"], size=[0.05, 0, 0], contype=0, conaffinity=0)
+    model = spec.compile()
+    if discard:
+        with pytest.raises(
+            om.InvalidInput, match=r"no geom named 'ball': body 'ball' has none .*discardvisual"
+        ):
+            find_geom(model, "ball")
+    else:
+        assert model.geom(find_geom(model, "ball")).name == "ball"
 
 
 def test_unnamed_geoms_are_named_by_their_body_and_pairs_go_to_mink(panda):

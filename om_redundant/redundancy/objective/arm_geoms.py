@@ -202,10 +202,19 @@ MAX_EXTENT = 1e6
 
 
 def find_geom(model: mujoco.MjModel, name: str) -> int:
-    """The id of the model's geom named ``name``; InvalidInput if there is none."""
+    """The id of the model's geom named ``name``; InvalidInput if there is none (saying so
+    where a body of that name has no geom: a URDF's, whose geoms without contacts MuJoCo's
+    compiler drops)."""
     index = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, name)
     if index < 0:
-        raise InvalidInput(f"the MuJoCo model has no geom named '{name}'")
+        body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name)
+        hint = ""
+        if body >= 0 and model.body_geomnum[body] == 0:
+            hint = (
+                f": body '{name}' has none (a model compiled from a URDF drops the geoms that take "
+                "no contacts unless its compiler's discardvisual is off)"
+            )
+        raise InvalidInput(f"the MuJoCo model has no geom named '{name}'{hint}")
     return index
 
 
