@@ -25,8 +25,8 @@ elbow), so the solutions of a branch are organised as *paths*:
   where they end; paths are joined across +-pi, and close into loops (one
   ``_core.link_paths`` call per branch, :meth:`Probe.link`). The linked paths depend on the
   pose and the branch alone, not on the obstacles: a sweep of the same pose again (a target
-  held while the obstacles move) takes them as they were linked (``traced``), its points'
-  objective evaluated afresh, and does only what follows.
+  held while the obstacles move) takes them as they were linked (a :class:`LinkedMemo`), its
+  points' objective evaluated afresh, and does only what follows.
 * **Cells.** Between neighbouring samples of a path where a joint moves more than
   :data:`FINE_STEP`, samples are inserted. Every sample carries its feasibility functions
   :math:`g_j` (each joint's margin, each clearance minus d_min, normalised; feasible iff all
@@ -51,7 +51,8 @@ import numpy as np
 from ... import _core
 from ...angles import TURN
 from ...ik.threads import run_rows
-from .points import Point, evaluate_points
+from ..objective.objective import Objective
+from .points import Point, PointTerms, evaluate_points
 from .probe import END_TOLERANCE, SAME, Probe
 
 FINE_STEP = 0.25  # rad: cells in which a joint moves further get samples in between
@@ -86,23 +87,42 @@ class Path:
     turns: int = 0
 
 
+class Kept:
+    """A linked path as a :class:`LinkedMemo` keeps it: its samples' psi, joints, tangents
+    and solutions, without their objective (hundreds of terms per sweep, evaluated where the
+    obstacles were then)."""
+
+    __slots__ = ("samples", "turns")
+
+    def __init__(self, path: Path):
+        self.samples = [(p.psi, p.q, p.tangent, p.solution) for p in path.points]
+        self.turns = path.turns
+
+    def unevaluated(self, objective: Objective) -> Path:
+        """The path again, its points' objective computed when asked for."""
+        points = [
+            Point(psi, q, t, PointTerms(objective, q, t), solution) for psi, q, t, solution in self.samples
+        ]
+        return Path(points, self.turns)
+
+
 class LinkedMemo:
     """The linked paths of the last :data:`MEMO_SWEEPS` sweeps (:func:`sweep_circle`), by
     pose, branches, grid and ``quick``: what a sweep of the same pose again takes instead of
     solving and linking. Shared by threads."""
 
     def __init__(self) -> None:
-        self._entries: OrderedDict[tuple[Any, ...], list[list[Path]]] = OrderedDict()
+        self._entries: OrderedDict[tuple[Any, ...], list[list[Kept]]] = OrderedDict()
         self._lock = threading.Lock()
 
-    def get(self, key: tuple[Any, ...]) -> list[list[Path]] | None:
+    def get(self, key: tuple[Any, ...]) -> list[list[Kept]] | None:
         with self._lock:
             linked = self._entries.get(key)
             if linked is not None:
                 self._entries.move_to_end(key)
             return linked
 
-    def put(self, key: tuple[Any, ...], linked: list[list[Path]]) -> None:
+    def put(self, key: tuple[Any, ...], linked: list[list[Kept]]) -> None:
         with self._lock:
             self._entries[key] = linked
             self._entries.move_to_end(key)
@@ -129,23 +149,13 @@ def sweep_circle(
     kept = None if memo is None else memo.get(key)
     if kept is None:
         linked = _linked(probes, n, quick)
-        if memo is not None:
-            memo.put(key, _renewed(linked))
+        if memo is not None:  # (the solutions alone: a sweep evaluates its points where the obstacles are)
+            memo.put(key, [[Kept(path) for path in paths] for paths in linked])
     else:
-        linked = _renewed(kept)
+        linked = [[path.unevaluated(probes[0].objective) for path in paths] for paths in kept]
     swept = [[(probe, path) for path in paths] for probe, paths in zip(probes, linked, strict=True)]
     filled = iter(_with_hidden([path for paths in swept for path in paths]))  # (every branch's at once)
     return [[next(filled) for _ in paths] for paths in swept]
-
-
-def _renewed(linked: list[list[Path]]) -> list[list[Path]]:
-    """The paths with their points' objective unevaluated (:meth:`Point.renewed`): what a
-    :class:`LinkedMemo` keeps and hands out (a sweep evaluates its points where the obstacles
-    are then, and their terms would hold megabytes)."""
-    renewals: dict = {}
-    return [
-        [Path([p.renewed(renewals) for p in path.points], path.turns) for path in paths] for paths in linked
-    ]
 
 
 def _linked(probes: list[Probe], n: int, quick: bool) -> list[list[Path]]:

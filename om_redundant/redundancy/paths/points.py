@@ -137,15 +137,6 @@ class Point:
         psi; :meth:`Objective.linearised`)."""
         return self.terms.get_linearised()
 
-    def renewed(self, renewals: dict[PointTerms, PointTerms]) -> Point:
-        """The point with its objective unevaluated (terms computed again when asked for:
-        where the obstacles have moved since), its copies at other representatives of psi
-        sharing their new terms through ``renewals`` (old terms to new)."""
-        terms = renewals.get(self.terms)
-        if terms is None:
-            terms = renewals[self.terms] = PointTerms(self.terms.objective, self.q, self.tangent)
-        return Point(self.psi, self.q, self.tangent, terms, self.solution)
-
     def pieces(self) -> tuple[np.ndarray, np.ndarray]:
         """The feasibility functions g_j (all >= 0 iff feasible;
         :meth:`Objective.pieces <om_redundant.redundancy.objective.objective.Objective.pieces>`)
