@@ -110,7 +110,8 @@ def test_lists_emptied_while_they_are_read():
         q = [Q.copy() for _ in range(3)]
         pieces = [(np.ones(1), np.zeros(1))] * 3
         first = np.zeros(3)
-        samples = _core.CellSamples(q, psi, pieces, feasible, np.array([0, 3]), np.zeros(7, dtype=bool))
+        tangents, bounds, cyclic = [np.ones(7)] * 3, np.array([0, 3]), np.zeros(7, dtype=bool)
+        samples = _core.CellSamples(q, tangents, psi, pieces, feasible, bounds, cyclic)
         _core.cell_looks(samples, 1.0, 0.0, np.zeros((4, 3)), first)
     """)
 

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import om_redundant as om
+from benchmarks.control_rate import MIN_CLEARANCE, obstacles
 from om_redundant.redundancy import self_motion_tangent
 from tests.conftest import random_q, wrap
 from tests.reference import objective as objective_numpy
@@ -175,6 +176,34 @@ def assert_intervals_match(intervals, sweep):
             covered = sum(i.contains(end) for i in mine) > 1
             narrow = np.sort(np.abs(wrap(ends - end)))[1] <= DENSE_STEP if len(ends) > 1 else False
             assert covered or narrow or feasible[k] != feasible[(k + 1) % DENSE], (signs, end)
+
+
+@pytest.mark.parametrize("seed, pose, count", [(0, 48, 0), (7, 67, 1)])
+def test_a_maximum_next_to_a_fold_is_climbed_to(seed, pose, count):
+    """FR3, the poses of benchmarks.global_choose's draws where a run ends at a fold (its
+    path turns back in psi) and the objective's maximum lies inside the cell between the
+    fold and the run's next sample: seed 0's 49th pose, where the fold is the best sample (a
+    climb from it cannot move: no follow leaves a fold), and seed 7's 68th with 1 obstacle,
+    where a climb from inside the cell stepped past the maximum onto the fold, gaining, and
+    was stuck there. The choice is at least as good as every feasible solution of its branch
+    (every root, solve_all) sampled every 2e-5 rad next to it."""
+    solver = om.OMSolver("fr3")
+    q = np.random.default_rng(seed).uniform(solver.arm.lower, solver.arm.upper, (pose + 1, 7))[pose]
+    T = solver.arm.fk(q)
+    optimizer = om.RedundancyOptimizer(
+        solver, obstacles(T[:3, 3], count) or None, min_clearance=MIN_CLEARANCE
+    )
+    choice = optimizer.choose(T)
+    assert choice.ok, choice.reason
+    signs, psi = choice.configuration.signs, choice.configuration.redundancy[0]
+    sampled = -math.inf
+    for x in psi + np.arange(-0.01, 0.01, 2e-5):
+        for root in solver.solve_all(T, om.Configuration(signs, (x,))):
+            evaluation = optimizer.objective.evaluate(root.q)
+            if evaluation.feasible:
+                sampled = max(sampled, evaluation.value)
+    assert math.isfinite(sampled)
+    assert choice.value >= sampled - 1e-12, (choice.value, sampled)
 
 
 def test_a_sphere_at_the_elbow_of_psi_zero_is_avoided_exactly(panda):

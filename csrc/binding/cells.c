@@ -59,8 +59,8 @@ done:
 }
 
 /* The fields of a cell's models (om_redundant._core.CellModels). */
-enum { M_GA, M_DA, M_GB, M_DB, M_SPAN, M_HERMITE, M_N };
-static const char *const model_names[M_N] = {"ga", "da", "gb", "db", "span", "hermite"};
+enum { M_GA, M_DA, M_GB, M_DB, M_SPAN_A, M_SPAN_B, M_HERMITE, M_N };
+static const char *const model_names[M_N] = {"ga", "da", "gb", "db", "span_a", "span_b", "hermite"};
 
 /* The record models' buffers of ga, da, gb, db and hermite into v (released by the caller on
  * success) and c; -1 with a TypeError or ValueError naming `name` where a field is missing or
@@ -68,7 +68,7 @@ static const char *const model_names[M_N] = {"ga", "da", "gb", "db", "span", "he
 static int cell_models(PyObject *models, const char *name, Py_buffer v[5], om_cell_models *c) {
     PyObject *f[M_N];
     if (get_fields(models, model_names, M_N, f, name) < 0) return -1;
-    double span = PyFloat_AsDouble(f[M_SPAN]);
+    double span_a = PyFloat_AsDouble(f[M_SPAN_A]), span_b = PyErr_Occurred() ? 0.0 : PyFloat_AsDouble(f[M_SPAN_B]);
     const buffer_spec sp[5] = {{F64, -1, 0, "ga"}, {F64, -1, 0, "da"}, {F64, -1, 0, "gb"}, {F64, -1, 0, "db"},
                                {F64, -1, 0, "hermite"}};
     PyObject *const objs[5] = {f[M_GA], f[M_DA], f[M_GB], f[M_DB], f[M_HERMITE]};
@@ -81,12 +81,12 @@ static int cell_models(PyObject *models, const char *name, Py_buffer v[5], om_ce
         PyErr_Format(PyExc_ValueError, "%s: sizes of the pieces or the basis disagree", name);
         return -1;
     }
-    *c = (om_cell_models){v[0].buf, v[1].buf, v[2].buf, v[3].buf, v[4].buf, span, n, N};
+    *c = (om_cell_models){v[0].buf, v[1].buf, v[2].buf, v[3].buf, v[4].buf, span_a, span_b, n, N};
     return 0;
 }
 
 /* surprise(models, feasible_a, feasible_b, slack) -> fraction or None: the models (CellModels)
- * m_j(s) = ga_j H0(s) + span da_j H1(s) + gb_j H2(s) + span db_j H3(s) at the N points s of
+ * m_j(s) = ga_j H0(s) + span_a da_j H1(s) + gb_j H2(s) + span_b db_j H3(s) at the N points s of
  * hermite (4 x N, the basis there); the pattern (feasible_a, all_j m_j >= 0 at each point,
  * feasible_b); None if it changes no more often than its ends (0 times if alike, once if
  * not), else the middle of the first stretch between changes as a fraction of the pattern. A
@@ -152,6 +152,32 @@ static PyObject *om_joint_step(PyObject *mod, PyObject *const *args, Py_ssize_t 
     return PyFloat_FromDouble(step);
 }
 
+/* cell_spans(cyclic, qa, ta, qb, tb) -> (span_a, span_b): dpsi/ds at the ends a and b of a
+ * cell of a path (joints qa, qb and tangents dq/dpsi ta, tb, dof entries each; the cyclic
+ * (bool, dof) joints compared modulo 2 pi) for the parameter s in [0, 1] along the cell's
+ * chord: the joints move at the chord's length |qb - qa|_2 at both ends, so span = that length
+ * over |t|_2 (0 where t = 0, whose rates along psi are 0). Where the path is smooth in psi, to
+ * first order in the cell both are psi_b - psi_a. */
+static PyObject *om_cell_spans(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    if (check_nargs(nargs, 5, "cell_spans") < 0) return NULL;
+    Py_buffer v[5];
+    const buffer_spec sp[5] = {
+        {U8, -1, 0, "cyclic"}, {F64, -1, 0, "qa"}, {F64, -1, 0, "ta"}, {F64, -1, 0, "qb"}, {F64, -1, 0, "tb"}};
+    if (get_buffers(args, v, sp, 5) < 0) return NULL;
+    Py_ssize_t dof = v[0].len;
+    int bad = dof < 1 || dof > OM_MAX_DOF;
+    for (int i = 1; i < 5; i++) bad = bad || v[i].len != dof * 8;
+    if (bad) {
+        release_buffers(v, 5);
+        PyErr_SetString(PyExc_ValueError, "cell_spans: sizes of cyclic, qa, ta, qb and tb disagree");
+        return NULL;
+    }
+    double spans[2];
+    om_chord_spans((int)dof, v[0].buf, v[1].buf, v[2].buf, v[3].buf, v[4].buf, spans);
+    release_buffers(v, 5);
+    return Py_BuildValue("(dd)", spans[0], spans[1]);
+}
+
 /* Row m of rows (M x n) from obj, a float64 array of n entries (-1 with a TypeError or
  * ValueError naming what, as get_buffer's). */
 static int row(PyObject *obj, double *rows, Py_ssize_t m, Py_ssize_t n, const char *what) {
@@ -162,22 +188,23 @@ static int row(PyObject *obj, double *rows, Py_ssize_t m, Py_ssize_t n, const ch
     return 0;
 }
 
-/* The M samples' joints (M x dof), psi, feasibility functions and rates (M x n each) and
- * feasibility from cell_looks' tuples (each of M items: q, psi, pieces, feasible) into the
- * arrays of s; -1 with an error where an item is not what cell_looks takes. */
+/* The M samples' joints and tangents (M x dof each), psi, feasibility functions and rates (M x
+ * n each) and feasibility from cell_looks' tuples (each of M items: q, tangent, psi, pieces,
+ * feasible) into the arrays of s; -1 with an error where an item is not what cell_looks takes. */
 static int read_samples(PyObject *const *lists, Py_ssize_t M, Py_ssize_t dof, Py_ssize_t n, om_cell_samples *s) {
     for (Py_ssize_t m = 0; m < M; m++) {
-        PyObject *pieces = PyTuple_GET_ITEM(lists[2], m);
+        PyObject *pieces = PyTuple_GET_ITEM(lists[3], m);
         if (!PyTuple_Check(pieces) || PyTuple_GET_SIZE(pieces) != 2) {
             PyErr_SetString(PyExc_TypeError, "cell_looks: each pieces item must be a tuple (g, dg)");
             return -1;
         }
         if (row(PyTuple_GET_ITEM(lists[0], m), s->q, m, dof, "q") < 0 ||
+            row(PyTuple_GET_ITEM(lists[1], m), s->t, m, dof, "tangent") < 0 ||
             row(PyTuple_GET_ITEM(pieces, 0), s->g, m, n, "g") < 0 ||
             row(PyTuple_GET_ITEM(pieces, 1), s->dg, m, n, "dg") < 0)
             return -1;
-        s->psi[m] = PyFloat_AsDouble(PyTuple_GET_ITEM(lists[1], m));
-        int f = PyObject_IsTrue(PyTuple_GET_ITEM(lists[3], m));
+        s->psi[m] = PyFloat_AsDouble(PyTuple_GET_ITEM(lists[2], m));
+        int f = PyObject_IsTrue(PyTuple_GET_ITEM(lists[4], m));
         if (f < 0 || PyErr_Occurred()) return -1;
         s->feasible[m] = (uint8_t)f;
     }
@@ -185,28 +212,29 @@ static int read_samples(PyObject *const *lists, Py_ssize_t M, Py_ssize_t dof, Py
 }
 
 /* The fields of cell_looks' samples (om_redundant._core.CellSamples). */
-enum { S_Q, S_PSI, S_PIECES, S_FEASIBLE, S_BOUNDS, S_CYCLIC, S_N };
-static const char *const sample_names[S_N] = {"q", "psi", "pieces", "feasible", "bounds", "cyclic"};
+enum { S_Q, S_TANGENT, S_PSI, S_PIECES, S_FEASIBLE, S_BOUNDS, S_CYCLIC, S_N };
+static const char *const sample_names[S_N] = {"q", "tangent", "psi", "pieces", "feasible", "bounds", "cyclic"};
 
 /* cell_looks(samples, fine_step, slack, hermite, first) -> None: the first tests of the cells
  * between neighbouring samples of paths (paths.py's _with_hidden). The M samples of every
- * path, path after path (CellSamples), as sequences of M items: their joints q (float64
- * arrays (dof,)), psi (floats), pieces ((g, dg), float64 arrays (n,): the feasibility
+ * path, path after path (CellSamples), as sequences of M items: their joints q and tangents
+ * dq/dpsi (float64 arrays of dof entries), psi (floats), pieces ((g, dg), float64 arrays (n,): the feasibility
  * functions and their rates, Point.pieces) and feasibility (bools); bounds (int64, P + 1) each
  * path's first sample, then M; cyclic (bool, P x dof) each path's joints compared modulo 2 pi.
  * Cell k lies between samples k and k + 1 of one path; into first (M,) where _hidden first
  * samples it: NaN where it does not look inside, the cell being calm (no joint_step above
  * fine_step, and the bounds of its cubic models quiet), or where surprise finds nothing; 1/2
- * where a step is above fine_step; else surprise's fraction. A path's last sample's entry is
+ * where a step is above fine_step; else surprise's fraction. The models are along the cell's
+ * chord (cell_spans). A path's last sample's entry is
  * NaN. Quiet: on [0, 1] the Hermite basis functions of the values are >= 0 and sum to 1 and
- * those of the slopes stay within 4/27 in size, so a model lies within (4/27) |span| (|g'_a| +
- * |g'_b|) (+ slack, for rounding) of the ends' range: both ends feasible and every model stays
+ * those of the slopes stay within 4/27 in size, so a model lies within (4/27) (|span_a g'_a| +
+ * |span_b g'_b|) (+ slack, for rounding) of the ends' range: both ends feasible and every model stays
  * > 0, or both infeasible and one function's model stays < 0; then surprise finds no change
  * (it skips the pieces that this bound keeps positive). */
 static PyObject *om_cell_looks(PyObject *mod, PyObject *const *args, Py_ssize_t nargs, PyObject *kwnames) {
     static const char *const names[] = {"samples", "fine_step", "slack", "hermite", "first"};
     static const arg_spec spec = {"cell_looks", names, 5, 5};
-    PyObject *a[5], *f[S_N], *lists[4] = {NULL, NULL, NULL, NULL}, *result = NULL;
+    PyObject *a[5], *f[S_N], *lists[5] = {NULL, NULL, NULL, NULL, NULL}, *result = NULL;
     if (bind_args(args, nargs, kwnames, &spec, a) < 0) return NULL;
     double fine = PyFloat_AsDouble(a[1]), slack = PyFloat_AsDouble(a[2]);
     if (PyErr_Occurred()) return NULL;
@@ -215,8 +243,8 @@ static PyObject *om_cell_looks(PyObject *mod, PyObject *const *args, Py_ssize_t 
     const buffer_spec sp[4] = {
         {I64, -1, 0, "bounds"}, {U8, -1, 0, "cyclic"}, {F64, -1, 0, "hermite"}, {F64, -1, 1, "first"}};
     PyObject *const objs[4] = {f[S_BOUNDS], f[S_CYCLIC], a[3], a[4]};
-    for (int i = 0; i < 4; i++) {
-        lists[i] = get_tuple(f[S_Q + i], -1, "cell_looks: q, psi, pieces and feasible each");
+    for (int i = 0; i < 5; i++) {
+        lists[i] = get_tuple(f[S_Q + i], -1, "cell_looks: q, tangent, psi, pieces and feasible each");
         if (!lists[i]) goto lists_fail;
     }
     if (get_buffers(objs, v, sp, 4) < 0) goto lists_fail;
@@ -225,7 +253,7 @@ static PyObject *om_cell_looks(PyObject *mod, PyObject *const *args, Py_ssize_t 
     Py_ssize_t dof = P > 0 ? v[1].len / P : 0, n = 0;
     int bad = P < 0 || v[1].len != P * dof || v[2].len != N * 32 || v[3].len != M * 8 ||
               (P > 0 && (dof < 1 || dof > OM_MAX_DOF));
-    for (int i = 1; i < 4; i++) bad = bad || PyTuple_GET_SIZE(lists[i]) != M;
+    for (int i = 1; i < 5; i++) bad = bad || PyTuple_GET_SIZE(lists[i]) != M;
     bad = bad || bounds[0] != 0 || bounds[P] != M; /* each path's first sample, from 0 to M, increasing */
     for (Py_ssize_t p = 1; p <= P && !bad; p++) bad = bounds[p] < bounds[p - 1];
     if (bad) {
@@ -233,11 +261,11 @@ static PyObject *om_cell_looks(PyObject *mod, PyObject *const *args, Py_ssize_t 
         goto fail;
     }
     if (M) { /* the pieces' count from the first sample's */
-        PyObject *pieces = PyTuple_GET_ITEM(lists[2], 0);
+        PyObject *pieces = PyTuple_GET_ITEM(lists[3], 0);
         if (PyTuple_Check(pieces) && PyTuple_GET_SIZE(pieces) == 2) n = PyObject_Length(PyTuple_GET_ITEM(pieces, 0));
         if (n < 0) goto fail;
     }
-    double *store = PyMem_Malloc((M * (dof + 1 + 2 * n) + 1) * sizeof(double));
+    double *store = PyMem_Malloc((M * (2 * dof + 1 + 2 * n) + 1) * sizeof(double));
     uint8_t *feasible = PyMem_Malloc(M + 1);
     ptrdiff_t *live = PyMem_Malloc((n + 1) * sizeof(ptrdiff_t));
     if (!store || !feasible || !live) {
@@ -245,7 +273,8 @@ static PyObject *om_cell_looks(PyObject *mod, PyObject *const *args, Py_ssize_t 
         PyErr_NoMemory();
         goto fail;
     }
-    om_cell_samples s = {store, store + M * dof, store + M * (dof + 1), store + M * (dof + 1 + n), feasible};
+    double *t = store + M * dof, *psi = t + M * dof, *g = psi + M, *dg = g + M * n;
+    om_cell_samples s = {store, t, psi, g, dg, feasible};
     int ok = read_samples(lists, M, dof, n, &s) == 0;
     const uint8_t *cyclic = v[1].buf;
     for (Py_ssize_t p = 0; p < P && ok; p++)
@@ -256,7 +285,7 @@ static PyObject *om_cell_looks(PyObject *mod, PyObject *const *args, Py_ssize_t 
 fail:
     release_buffers(v, 4);
 lists_fail:
-    for (int i = 0; i < 4; i++) Py_XDECREF(lists[i]);
+    for (int i = 0; i < 5; i++) Py_XDECREF(lists[i]);
     release_fields(f, S_N);
     return result;
 }
@@ -269,6 +298,8 @@ PyMethodDef om_cell_functions[] = {
     {"crossing", (PyCFunction)(void (*)(void))om_crossing_binding, METH_FASTCALL | METH_KEYWORDS,
      "crossing(models) -> fraction or None"},
     {"joint_step", (PyCFunction)(void (*)(void))om_joint_step, METH_FASTCALL, "joint_step(cyclic, a, b) -> float"},
+    {"cell_spans", (PyCFunction)(void (*)(void))om_cell_spans, METH_FASTCALL,
+     "cell_spans(cyclic, qa, ta, qb, tb) -> (span_a, span_b)"},
     {"cell_looks", (PyCFunction)(void (*)(void))om_cell_looks, METH_FASTCALL | METH_KEYWORDS,
      "cell_looks(samples, fine_step, slack, hermite, first) -> None"},
     {NULL, NULL, 0, NULL},

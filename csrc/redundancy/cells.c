@@ -2,7 +2,17 @@
  * _surprise): the feasibility functions g_j of a point and their rates along psi, and where
  * their cubic Hermite models between two neighbouring points predict a feasibility that the
  * ends do not explain. (Its binding: csrc/binding/cells.c, whose docstrings say what each
- * answers.) */
+ * answers.)
+ *
+ * The looks model each g_j along the cell's chord (om_chord_spans), not psi: at a fold, where a
+ * path turns back in psi, q - q_f ~ (psi_f - psi)^(1/2), and a model in psi takes the end's
+ * rate, about 1e4-1e10, as a cubic's slope, which swings by 4/27 of the rate times the span
+ * inside the cell: a surprise in nearly every cell that ends at a fold, which was halved
+ * towards the fold until shorter than END_TOLERANCE, a follow per half (on the Sawyer, 85 of
+ * the 128 looks a pose that took a sample). Along the chord the joints move at the chord's length at both ends, a
+ * fold's too (s, the chord's parameter, goes as (psi_f - psi)^(1/2) there); where the path is
+ * smooth in psi its speed is |dq/dpsi| to first order in the cell, so there the models are
+ * those in psi to that order. */
 #include "om_paths.h"
 
 enum { P_REACH, P_CAP, P_FLOOR, P_N }; /* clearance: 2 d_cap, d_cap, d_min / d_cap */
@@ -47,19 +57,39 @@ void om_pieces(ptrdiff_t dof, ptrdiff_t M, ptrdiff_t L, ptrdiff_t P, const doubl
                    numbers, g + m * (L + P), dg + m * (L + P));
 }
 
+/* (om_paths.h) */
+void om_chord_spans(int dof, const uint8_t *cyclic, const double *qa, const double *ta, const double *qb,
+                    const double *tb, double spans[2]) {
+    double chord = 0.0, speed_a = 0.0, speed_b = 0.0;
+    for (int i = 0; i < dof; i++) {
+        double m = qb[i] - qa[i];
+        if (cyclic[i]) m = om_wrap(m);
+        chord += m * m, speed_a += ta[i] * ta[i], speed_b += tb[i] * tb[i];
+    }
+    chord = sqrt(chord);
+    spans[0] = speed_a > 0.0 ? chord / sqrt(speed_a) : 0.0;
+    spans[1] = speed_b > 0.0 ? chord / sqrt(speed_b) : 0.0;
+}
+
 /* Piece j's model at the basis point k. */
 static inline double _model(const om_cell_models *c, ptrdiff_t j, ptrdiff_t k)
 {
     ptrdiff_t N = c->N;
-    return c->ga[j] * c->H[k] + c->da[j] * c->span * c->H[N + k] + c->gb[j] * c->H[2 * N + k] +
-           c->db[j] * c->span * c->H[3 * N + k];
+    return c->ga[j] * c->H[k] + c->da[j] * c->span_a * c->H[N + k] + c->gb[j] * c->H[2 * N + k] +
+           c->db[j] * c->span_b * c->H[3 * N + k];
 }
 
-/* Whether piece j's model stays above `slack` over the cell by cell_looks' quiet bound
- * (min(ga, gb) - 4/27 span (|da| + |db|)). */
+/* Piece j's largest move of a model from the ends' range over the cell: 4/27 (|span_a da| +
+ * |span_b db|) (binding/cells.c: cell_looks' quiet bound). */
+static inline double _spread(const om_cell_models *c, ptrdiff_t j)
+{
+    return 4.0 / 27.0 * (fabs(c->span_a * c->da[j]) + fabs(c->span_b * c->db[j]));
+}
+
+/* Whether piece j's model stays above `slack` over the cell by cell_looks' quiet bound. */
 static inline bool _calm(const om_cell_models *c, ptrdiff_t j, double slack)
 {
-    return fmin(c->ga[j], c->gb[j]) - 4.0 / 27.0 * fabs(c->span) * (fabs(c->da[j]) + fabs(c->db[j])) > slack;
+    return fmin(c->ga[j], c->gb[j]) - _spread(c, j) > slack;
 }
 
 /* (om_paths.h) The pattern's surprise (binding/cells.c: surprise) of the cell c with ends feasible
@@ -90,8 +120,7 @@ static bool _quiet(const om_cell_models *c, int fa, int fb, double slack)
 {
     if (fa != fb) return false;
     for (ptrdiff_t j = 0; j < c->n; j++) {
-        double ga = c->ga[j], gb = c->gb[j];
-        double spread = 4.0 / 27.0 * fabs(c->span) * (fabs(c->da[j]) + fabs(c->db[j])) + slack;
+        double ga = c->ga[j], gb = c->gb[j], spread = _spread(c, j) + slack;
         if (fa && !(om_least(ga, gb) - spread > 0.0)) return false; /* a model may dip */
         if (!fa && om_most(ga, gb) + spread < 0.0) return true;    /* one stays below */
     }
@@ -105,10 +134,12 @@ void om_path_looks(const om_cell_samples *s, ptrdiff_t a, ptrdiff_t b, ptrdiff_t
                         double *first, ptrdiff_t *live)
 {
     for (ptrdiff_t k = a; k + 1 < b; k++) {
-        const double *g = s->g, *dg = s->dg;
-        om_cell_models c = {g + k * n, dg + k * n, g + (k + 1) * n, dg + (k + 1) * n, H, s->psi[k + 1] - s->psi[k], n, N};
+        const double *g = s->g, *dg = s->dg, *q = s->q + k * dof, *t = s->t + k * dof;
+        double spans[2];
+        om_chord_spans((int)dof, cyclic, q, t, q + dof, t + dof, spans);
+        om_cell_models c = {g + k * n, dg + k * n, g + (k + 1) * n, dg + (k + 1) * n, H, spans[0], spans[1], n, N};
         int fa = s->feasible[k], fb = s->feasible[k + 1];
-        double step = om_largest_joint_step((int)dof, s->q + k * dof, s->q + (k + 1) * dof, cyclic);
+        double step = om_largest_joint_step((int)dof, q, q + dof, cyclic);
         if (step <= fine && _quiet(&c, fa, fb, slack))
             first[k] = NAN;
         else if (step > fine)

@@ -107,13 +107,21 @@ int om_link_paths(const om_link_job *job, int64_t *added, int64_t *n_paths);
 void om_pieces(ptrdiff_t dof, ptrdiff_t M, ptrdiff_t L, ptrdiff_t P, const double *q, const double *t,
                const double *d, const double *grad, const int64_t *limited, const double *lower,
                const double *upper, const double *half, const double *numbers, double *g, double *dg);
-/* The Hermite models of a cell's n pieces between its ends a and b, span apart in psi: their
- * values ga, gb and rates da, db, and the basis H (4 x N) at the cell's N points. */
+/* The Hermite models of a cell's n pieces between its ends a and b over a parameter s of the
+ * cell (0 at a, 1 at b): their values ga, gb, their rates along psi da, db, dpsi/ds at a and b
+ * (span_a, span_b: both psi_b - psi_a for models in psi; om_chord_spans' for models along the
+ * chord), and the basis H (4 x N) at the cell's N points. */
 typedef struct {
     const double *ga, *da, *gb, *db, *H;
-    double span;
+    double span_a, span_b;
     ptrdiff_t n, N;
 } om_cell_models;
+/* dpsi/ds at the ends a and b of a cell of a path (joints qa, qb, tangents dq/dpsi ta, tb;
+ * the cyclic joints compared modulo 2 pi) for the parameter s that moves the joints at the
+ * cell's chord length |qb - qa|_2 at both ends: that length over |t|_2 at each (0 where t = 0,
+ * whose rates are 0) (binding/cells.c: cell_spans). */
+void om_chord_spans(int dof, const uint8_t *cyclic, const double *qa, const double *ta, const double *qb,
+                    const double *tb, double spans[2]);
 /* The fraction of the cell where its models predict a feasibility that ends feasible fa, fb do
  * not explain (binding/cells.c: surprise), or -1 where there is none; live: room for c->n
  * piece indices. */
@@ -121,10 +129,10 @@ double om_surprise(const om_cell_models *c, int fa, int fb, double slack, ptrdif
 /* The fraction of the cell where the first of the models reaches zero from a feasible end a
  * (binding/cells.c: crossing), or -1 where none does. */
 double om_crossing(const om_cell_models *c);
-/* The samples of paths: M of them, each's joints q (M x dof), psi, feasibility functions g and
- * rates dg (M x n), and feasibility. */
+/* The samples of paths: M of them, each's joints q and tangent t (M x dof each), psi,
+ * feasibility functions g and rates dg (M x n), and feasibility. */
 typedef struct {
-    double *q, *psi, *g, *dg;
+    double *q, *t, *psi, *g, *dg;
     uint8_t *feasible;
 } om_cell_samples;
 /* The first looks into the cells of one path, samples a .. b - 1 of s (cell k: samples k,

@@ -119,6 +119,7 @@ from ..ckernels import (
     box_overlap,
     branch_values,
     cell_looks,
+    cell_spans,
     crossing,
     evaluate,
     fk,

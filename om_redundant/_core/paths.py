@@ -72,13 +72,14 @@ class LinkRows(NamedTuple):
 
 
 class CellModels(NamedTuple):
-    """The cubic Hermite models of a cell's n feasibility functions between its ends a and b
-    (``surprise``, ``crossing``).
+    """The cubic Hermite models of a cell's n feasibility functions between its ends a and b,
+    over a parameter s of the cell, 0 at a and 1 at b (``surprise``, ``crossing``).
 
     Attributes:
         ga, da: (n,) the functions and their rates along psi at a.
         gb, db: (n,) the same at b.
-        span: psi_b - psi_a.
+        span_a, span_b: dpsi/ds at a and b: both psi_b - psi_a for models in psi; along the
+            cell's chord, ``cell_spans``'.
         hermite: (4, N) the Hermite basis at the cell's N points.
     """
 
@@ -86,7 +87,8 @@ class CellModels(NamedTuple):
     da: np.ndarray
     gb: np.ndarray
     db: np.ndarray
-    span: float
+    span_a: float
+    span_b: float
     hermite: np.ndarray
 
 
@@ -94,7 +96,8 @@ class CellSamples(NamedTuple):
     """The M samples of P paths, path after path, whose cells ``cell_looks`` tests.
 
     Attributes:
-        q: M joint vectors (float64, (dof,) each).
+        q: M joint vectors (float64, dof entries each).
+        tangent: M tangents dq/dpsi (float64, dof entries each).
         psi: M floats.
         pieces: M pairs (g, dg) of float64 arrays (n,): the feasibility functions and rates.
         feasible: M bools.
@@ -103,6 +106,7 @@ class CellSamples(NamedTuple):
     """
 
     q: Sequence[np.ndarray]
+    tangent: Sequence[np.ndarray]
     psi: Sequence[float]
     pieces: Sequence[tuple[np.ndarray, np.ndarray]]
     feasible: Sequence[bool]

@@ -39,6 +39,8 @@ _MAX_CLIMB = 60  # QPs per climb
 _ACCEPT = 0.1  # accepted steps gain this fraction of the model's gain
 _INITIAL_CURVATURE = 0.1  # b at the first QP of a climb
 _JOINT_STEP = 0.25  # rad: the trust radius keeps the linearised joint motion within this
+_FOLD_TRIALS = 10  # golden-section trials in a path's end cell (its bracket 0.618^9 ~ 1.3 % of the cell in s)
+_GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
 
 
 def maximise(probe: Probe, start: Point, lower: float, upper: float, radius: float) -> Point:
@@ -83,6 +85,56 @@ def maximise(probe: Probe, start: Point, lower: float, upper: float, radius: flo
             radius *= 2.0
         point, x, pieces = trial, x + delta, moved
     return point.at(x)
+
+
+def maximise_from_path_end(probe: Probe, end: Point, neighbour: Point, lower: float, upper: float) -> Point:
+    r"""The best point found in a path's end cell: from ``end``, where the path ends (a fold,
+    where it turns back in psi, or the branch's or the reach's edge), to its neighbour sample.
+
+    At a fold :math:`q - q_f \sim (\psi - \psi_f)^{1/2}`: no follow leaves the end, so
+    :func:`maximise` cannot, and its model along psi, whose rates are about 1e4-1e10 there,
+    fails within the cell (a climb from inside it that steps onto the end, gaining, is
+    stuck there). The path is smooth in :math:`s = ((\psi - \psi_e) / (\psi_n - \psi_e))^{1/2}`
+    instead. Where the end's model promises a gain into the cell (the sign of its rates, which
+    its tangent gives), a golden-section search over s in [0, 1], its trials followed from the
+    neighbour (the one sheet between them), brackets the best to :data:`_FOLD_TRIALS` trials,
+    and :func:`maximise` climbs from the best trial within its bracket, where the end, worse
+    than that trial, is never taken.
+
+    Args:
+        probe: Exact solutions on the branch at the pose.
+        end, neighbour: The path's end sample and the next, both feasible.
+        lower, upper: Bounds of psi (the feasible interval).
+
+    Returns:
+        The best feasible point found: ``end`` where nothing in the cell beats it.
+    """
+    span = neighbour.psi - end.psi
+    into = step_1d(Pieces.at(end), _INITIAL_CURVATURE, min(span, 0.0), max(span, 0.0))
+    if into is None or into[1] <= GAIN_TOLERANCE:
+        return end
+
+    def trial(s: float) -> tuple[Point, float]:
+        point, arrived = probe.follow(neighbour, end.psi + span * s * s)
+        return point, point.evaluation.value if arrived and point.evaluation.feasible else -math.inf
+
+    a, b = 0.0, 1.0  # the bracket in s, and its inner trials c < d
+    c, d = b - _GOLDEN * (b - a), a + _GOLDEN * (b - a)
+    (pc, fc), (pd, fd) = trial(c), trial(d)
+    for _ in range(_FOLD_TRIALS - 2):
+        if fc >= fd:
+            b, d, pd, fd = d, c, pc, fc
+            c = b - _GOLDEN * (b - a)
+            pc, fc = trial(c)
+        else:
+            a, c, pc, fc = c, d, pd, fd
+            d = a + _GOLDEN * (b - a)
+            pd, fd = trial(d)
+    best, value = (pc, fc) if fc >= fd else (pd, fd)
+    if value <= end.evaluation.value:
+        return end
+    lo, hi = sorted((end.psi + span * a * a, end.psi + span * b * b))
+    return maximise(probe, best, max(lo, lower), min(hi, upper), hi - lo)
 
 
 def _bfgs(b: float, s: float, y: float) -> float:

@@ -21,8 +21,8 @@ from ..objective.terms import Evaluation
 from ..paths.intervals import BranchRuns, PsiInterval, Run, feasible_runs
 from ..paths.linking import LinkedMemo, sweep_circle
 from ..paths.points import Point
-from ..paths.probe import Probe
-from .climb import maximise
+from ..paths.probe import END_TOLERANCE, Probe
+from .climb import maximise, maximise_from_path_end
 from .reachable import Way, candidates, clear_way
 from .result import RedundancyChoice, failed_choice
 from .start_bounds import CLIMB_ROUNDING, StartBounds
@@ -203,12 +203,12 @@ class GlobalChoice:
             least = best + CLIMB_ROUNDING  # what a climb must reach
             if bound < least or bounds.within(j, 2.0 * gap) < least:  # (the cheap bound first)
                 continue
-            run, start = runs[owner[j]], points[j]
+            run = runs[owner[j]]
             lo, hi = (-math.inf, math.inf) if run.interval.closed else (run.interval.lo, run.interval.hi)
             signs = run.interval.signs
             if signs not in probes:
                 probes[signs] = self._probe(T, signs)
-            point = maximise(probes[signs], start, lo, hi, max(gap, 1e-6))
+            point = _climb(probes[signs], run, j - first[j], lo, hi, max(gap, 1e-6))
             found.append((run, point))
             best = max(best, point.evaluation.value)
         return next((run, point) for run, point in found if point.evaluation.value == best)
@@ -271,3 +271,22 @@ class GlobalChoice:
             f"branch {signs}: clearance below {self.objective.min_clearance} m wherever within the limits "
             f"(best {best:.4f} m)"
         )
+
+
+def _climb(probe: Probe, run: Run, k: int, lower: float, upper: float, radius: float) -> Point:
+    """The climb from sample k of the run (:func:`~.climb.maximise`, within [lower, upper], its
+    first trust radius ``radius``), and where it starts or ends at an end of the run where
+    the path ends (:attr:`~om_redundant.redundancy.paths.intervals.Run.path_ends`), the search
+    of that end's cell (:func:`~.climb.maximise_from_path_end`: at a fold no climb leaves the
+    end); the best point found."""
+    points = run.points
+    ends = [(e, n) for e, n, ends in ((0, 1, run.path_ends[0]), (-1, -2, run.path_ends[1])) if ends]
+    ends = ends if len(points) > 1 else []
+    start = points[k]
+    at_end = any(points[e] is start for e, _ in ends)
+    point = start if at_end else maximise(probe, start, lower, upper, radius)
+    for e, n in ends:
+        if abs(point.psi - points[e].psi) <= END_TOLERANCE:
+            found = maximise_from_path_end(probe, points[e], points[n], lower, upper)
+            point = found if found.evaluation.value > point.evaluation.value else point
+    return point

@@ -73,10 +73,20 @@ class BranchRuns(NamedTuple):
 
 @dataclass(frozen=True, eq=False)
 class Run:
-    """A feasible interval with its feasible samples and refined ends, ordered by psi."""
+    """A feasible interval with its feasible samples and refined ends, ordered by psi.
+
+    Attributes:
+        interval: The interval.
+        points: The samples, its refined ends included.
+        path_ends: Whether its first and its last sample are where the path ends (not a
+            refined end): at a fold, where the path turns back in psi and no follow leaves
+            the sample (:func:`~om_redundant.redundancy.paths.linking._hidden`), or where it
+            leaves the branch or the reach.
+    """
 
     interval: PsiInterval
     points: list[Point]
+    path_ends: tuple[bool, bool] = (False, False)
 
 
 def feasible_runs(paths: Sequence[tuple[Probe, Path]]) -> list[list[Run]]:
@@ -178,7 +188,9 @@ def _run(probe: Probe, span: _Span, lo: Point | None, hi: Point | None) -> Run:
     lo_psi = wrap_angle(points[0].psi)
     shift = lo_psi - points[0].psi
     points = [p.at(p.psi + shift) for p in points] if shift else points
-    return Run(PsiInterval(probe.signs, lo_psi, points[-1].psi), points)
+    return Run(
+        PsiInterval(probe.signs, lo_psi, points[-1].psi), points, (span.before is None, span.after is None)
+    )
 
 
 def _refined(probe: Probe, inside: Point, outside: Point) -> Generator[Follow, tuple[Point, bool], Point]:
@@ -256,5 +268,5 @@ def _modelled_end(inside: Point, outside: Point) -> float | None:
     model's secant from the point before; None where none is negative there."""
     (ga, da), (gb, db) = inside.pieces(), outside.pieces()
     span = outside.psi - inside.psi
-    s = _core.crossing(_core.CellModels(ga, da, gb, db, span, _HERMITE)) if len(ga) else None
+    s = _core.crossing(_core.CellModels(ga, da, gb, db, span, span, _HERMITE)) if len(ga) else None
     return None if s is None else inside.psi + span * s

@@ -32,9 +32,13 @@ elbow), so the solutions of a branch are organised as *paths*:
   :math:`g_j` (each joint's margin, each clearance minus d_min, normalised; feasible iff all
   :math:`g_j \ge 0`) and their rates :math:`dg_j/d\psi` (through dq/dpsi); between
   neighbours each :math:`g_j` is modelled by the cubic Hermite interpolant of those values
-  and rates, and where the models predict a feasible island or an infeasible dip that the
-  two samples do not show (two limits pinching, a joint turning through a limit), an exact
-  sample is inserted there, and the cell is checked again.
+  and rates along the cell's chord (the joints moving at the chord's length at both ends:
+  ``_core.cell_spans``; to first order the models in psi where the path is smooth in psi,
+  and smooth at a fold too, where a model in psi takes the end's rate, about 1e4-1e10, as a
+  cubic's slope and sees a dip in every cell that ends there), and where the models predict
+  a feasible island or an infeasible dip that the two samples do not show (two limits
+  pinching, a joint turning through a limit), an exact sample is inserted there, and the
+  cell is checked again.
 """
 
 from __future__ import annotations
@@ -279,6 +283,7 @@ def _with_hidden(paths: list[tuple[Probe, Path]]) -> list[Path]:
     first = np.empty(len(flat))  # cell a: between ends a, a + 1
     samples = _core.CellSamples(
         [p.q for p in flat],
+        [p.tangent for p in flat],
         [p.psi for p in flat],
         [p.pieces() for p in flat],
         [p.evaluation.feasible for p in flat],
@@ -340,11 +345,12 @@ def _look(cyclic: np.ndarray, a: Point, b: Point) -> float | None:
     """Where, as a fraction of the cell between a and b, :func:`_hidden` samples it: the
     middle where a joint moves more than :data:`FINE_STEP` (``cyclic``: the probe's joints
     compared modulo 2 pi, :meth:`Probe.step`), else :func:`_surprise`'s."""
-    return 0.5 if _core.joint_step(cyclic, a.q, b.q) > FINE_STEP else _surprise(a, b)
+    return 0.5 if _core.joint_step(cyclic, a.q, b.q) > FINE_STEP else _surprise(cyclic, a, b)
 
 
-def _surprise(a: Point, b: Point) -> float | None:
-    """Where, as a fraction of the cell, the pieces' cubic models predict a feasibility that
+def _surprise(cyclic: np.ndarray, a: Point, b: Point) -> float | None:
+    """Where, as a fraction of the cell, the pieces' cubic models along its chord (module
+    docstring; ``cyclic``: the joints compared modulo 2 pi) predict a feasibility that
     the ends do not explain: more changes between feasible and infeasible than the ends'
     (none if alike, one if not), at the _MODEL_POINTS points of the cell. Returns the middle
     of the first unexplained stretch. (``_core.surprise``, ``csrc/redundancy/cells.c``; a piece
@@ -353,5 +359,6 @@ def _surprise(a: Point, b: Point) -> float | None:
     (ga, da), (gb, db) = a.pieces(), b.pieces()
     if len(ga) == 0:
         return None
-    models = _core.CellModels(ga, da, gb, db, b.psi - a.psi, _HERMITE)
+    span_a, span_b = _core.cell_spans(cyclic, a.q, a.tangent, b.q, b.tangent)
+    models = _core.CellModels(ga, da, gb, db, span_a, span_b, _HERMITE)
     return _core.surprise(models, a.evaluation.feasible, b.evaluation.feasible, _BOUND_SLACK)
