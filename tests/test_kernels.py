@@ -360,7 +360,7 @@ def test_the_climb_bindings_refuse_groups_and_indices_out_of_range():
         with pytest.raises(ValueError, match="sizes of the pieces, the groups and z disagree"):
             groups(ends, w, n)
 
-    psi, values, slopes = np.linspace(0.0, 1.0, 4), np.zeros((4, 3)), np.ones(3)
+    psi, values, slopes = np.linspace(0.0, 1.0, 4), np.zeros((4, 3)), np.ones((4, 3))
 
     def bound(k, first, last, reach=0.5, columns=(1, 2)):
         group_columns = np.array(columns, dtype=np.int64)
@@ -416,7 +416,7 @@ def test_records_are_read_by_their_fields_names():
     order and from an object with those attributes; a subclass's property is what is read; a
     record without a field is a TypeError naming it."""
     psi, values = np.linspace(0.0, 1.0, 4), np.arange(12.0).reshape(4, 3)
-    fields = dict(psi=psi, values=values, slopes=np.ones(3), groups=np.array([1, 2]), weights=np.ones(2))
+    fields = dict(psi=psi, values=values, slopes=np.ones((4, 3)), groups=np.array([1, 2]), weights=np.ones(2))
     samples = _core.StartSamples(**fields, caps=np.full(2, 0.5))
     want = [_core.start_bound(samples, k, 0, 3, 0.4) for k in range(4)]
     for record in (

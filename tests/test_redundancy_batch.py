@@ -270,8 +270,8 @@ def test_the_climbs_start_bounds_hold_for_functions_within_their_slopes(seed, ru
     bound A omega; f's the weighted sum of its groups' largest) sampled on runs of uneven
     spacing: every start's bound is at least f anywhere within its reach (a dense grid), at
     least f at the start and at most the bound from its own cones (``cone``, the bound before);
-    compiled exactly as numpy computes it, also without terms; without slopes given, L is the
-    largest slope between neighbouring samples of a run."""
+    compiled exactly as numpy computes it, also without terms; without slopes given, L is
+    each run's largest slope between its neighbouring samples."""
     rng = np.random.default_rng(seed)
     groups = [(rng.uniform(0, 2), np.inf, rng.integers(1, 5)), (rng.uniform(0, 2), 1.0, rng.integers(1, 5))]
     waves = [rng.uniform([0.2, 0.0, 0.5, -3.0], [1.5, scale, 8.0, 3.0], (p, 4)) for _, _, p in groups]
@@ -300,10 +300,15 @@ def test_the_climbs_start_bounds_hold_for_functions_within_their_slopes(seed, ru
     bare = StartBounds(psi, f, [], first, last, slope, [])
     np.testing.assert_array_equal(bare.cone(first, reach), start_bounds_numpy.cone(bare, first, reach))
     columns = np.column_stack([f] + [v for _, _, v in terms])
-    pairs = [(i, i + 1) for i in range(len(psi) - 1) if first[i] == first[i + 1]]  # neighbours on a run
-    sampled = [
-        max((abs(c[j] - c[i]) / max(psi[j] - psi[i], 1e-12) for i, j in pairs), default=0.0)
-        for c in columns.T
+    sampled = [  # (each sample's run's)
+        [
+            max(
+                (abs(c[i + 1] - c[i]) / max(psi[i + 1] - psi[i], 1e-12) for i in range(first[k], last[k])),
+                default=0.0,
+            )
+            for c in columns.T
+        ]
+        for k in range(len(psi))
     ]
     np.testing.assert_array_equal(StartBounds(psi, f, terms, first, last)._slopes, sampled)  # (L sampled)
     assert (

@@ -16,10 +16,11 @@ static int get_samples(PyObject *record, Py_buffer *v, om_start_samples *s, cons
     int got = get_buffers(f, v, sp, S_N);
     release_fields(f, S_N);
     if (got < 0) return -1;
-    Py_ssize_t M = v[S_PSI].len / 8, C = v[S_SLOPES].len / 8, G = v[S_GROUPS].len / 8;
+    Py_ssize_t M = v[S_PSI].len / 8, C = M ? v[S_VALUES].len / 8 / M : 0, G = v[S_GROUPS].len / 8;
     *s = (om_start_samples){v[S_PSI].buf, v[S_VALUES].buf, v[S_SLOPES].buf, v[S_WEIGHTS].buf, v[S_CAPS].buf,
                             v[S_GROUPS].buf, C, G};
-    int bad = C < 1 || v[S_VALUES].len != M * C * 8 || v[S_WEIGHTS].len != G * 8 || v[S_CAPS].len != G * 8;
+    int bad = C < 1 || v[S_VALUES].len != M * C * 8 || v[S_SLOPES].len != M * C * 8 || v[S_WEIGHTS].len != G * 8 ||
+              v[S_CAPS].len != G * 8;
     for (Py_ssize_t g = 0; g < G && !bad; g++) /* each group's first column, increasing */
         bad = s->groups[g] < 1 || s->groups[g] >= C || (g && s->groups[g] <= s->groups[g - 1]);
     if (bad) {
@@ -31,7 +32,8 @@ static int get_samples(PyObject *record, Py_buffer *v, om_start_samples *s, cons
 }
 
 /* start_bound(samples, k, first, last, reach) -> float: samples.psi (M,) the runs' samples,
- * values (M, C) f and the groups' functions there, slopes (C,) their bounds L, groups (G,) int64
+ * values (M, C) f and the groups' functions there, slopes (M, C) their bounds L on each
+ * sample's run, groups (G,) int64
  * each group's first column, weights, caps (G,); sample k, its run's first and last samples,
  * the reach R (om_start_bound). */
 static PyObject *om_start_bound_py(PyObject *mod, PyObject *const *args, Py_ssize_t nargs, PyObject *kwnames) {

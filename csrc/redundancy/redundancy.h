@@ -31,8 +31,9 @@ int om_qp_step(const om_qp_groups *q, double b, double lo, double hi, double *de
 /* ------------------------------------------------------------------------------------ */
 /* start_bounds.c: what a climb from a start can reach. */
 
-/* M samples of runs: psi (M,), values (M, columns) f and the groups' functions, their slope
- * bounds (columns,), each group's first column (G, increasing, >= 1), weights and caps (G,). */
+/* M samples of runs: psi (M,), values (M, columns) f and the groups' functions, slopes (M,
+ * columns) their slope bounds on each sample's run, each group's first column (G, increasing,
+ * >= 1), weights and caps (G,). */
 typedef struct {
     const double *psi, *values, *slopes, *weights, *caps;
     const int64_t *groups;

@@ -228,7 +228,7 @@ class StartSamples(NamedTuple):
     Attributes:
         psi: (M,) the runs' samples, a run's in increasing psi.
         values: (M, C) f and every group's functions there.
-        slopes: (C,) their slope bounds L.
+        slopes: (M, C) their slope bounds L on each sample's run.
         groups: (G,) each group's first column (int64).
         weights, caps: (G,) per group.
     """

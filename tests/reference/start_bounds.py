@@ -27,14 +27,14 @@ def bound(bounds: StartBounds, values: np.ndarray) -> np.ndarray:
 
 def cone(bounds: StartBounds, k: np.ndarray, reach: np.ndarray) -> np.ndarray:
     """:meth:`StartBounds.cone`: (K,) the bounds of starts k from their own cones with reach R."""
-    return bound(bounds, bounds._values[k] + bounds._slopes * reach[:, None])
+    return bound(bounds, bounds._values[k] + bounds._slopes[k] * reach[:, None])
 
 
 def within(bounds: StartBounds, k: int, reach: float) -> float:
     """:meth:`StartBounds.within` of start k with reach R (its docstring), from the samples'
     arrays of ``bounds``."""
     a, b = int(bounds.first[k]), int(bounds.last[k])
-    values, slopes, psi = bounds._values, bounds._slopes, bounds.psi
+    values, slopes, psi = bounds._values, bounds._slopes[k], bounds.psi  # (its run's)
     at = psi.tolist()
     x = at[k]
     lo = bisect.bisect_left(at, x - reach, a, b + 1)  # the samples within reach: lo..hi

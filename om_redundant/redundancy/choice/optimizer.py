@@ -13,9 +13,10 @@ the exact OM solution in it:
    with refined ends (:mod:`om_redundant.redundancy.paths.intervals`).
 2. **Starts.** In each interval, the samples that are local maxima of f. A climb from a
    start is taken to end within R, twice the start's distance to its farther neighbour, and
-   each function to change at most by L, its largest slope between neighbouring samples
-   (over every interval). On each side of the start, such a function is below the cones of
-   slope L from the start's value u_0 and the neighbour's u_h (h away): below
+   each function to change at most by L, its largest slope between neighbouring samples of
+   the start's interval (a climb stays within it). On each side of the start, such a
+   function is below the cones of slope L from the start's value u_0 and the neighbour's
+   u_h (h away): below
    ``max((u_0 + u_h + L h) / 2, u_h + L (R - h))`` (:func:`_cone_bound`; at most
    ``u_0 + L R``). A start can only lead above the larger side's smaller of that bound of f
    and ``sum_g w_g min(cap_g, min_j bound_j)``, the second with each function v_j of each

@@ -21,8 +21,9 @@ class StartBounds:
         psi, f: (M,) the runs' samples, a run's in increasing psi, and f there.
         terms: :meth:`~om_redundant.redundancy.objective.objective.Objective.term_functions` at them.
         first, last: (M,) each sample's run's first and last sample.
-        slope, slopes: L of f and of each group's functions (p_g,); None: sampled, the
-            largest slope between neighbouring samples of a run (module docstring).
+        slope, slopes: L of f and of each group's functions (p_g,) on every run; None:
+            sampled, on each run the largest slope between its neighbouring samples (a climb
+            stays within its run: module docstring).
     """
 
     def __init__(
@@ -40,13 +41,16 @@ class StartBounds:
         self._values = np.ascontiguousarray(
             np.hstack([f[:, None]] + [v for _, _, v in terms])
         )  # (row by row)
-        if slope is None:
+        shape = self._values.shape
+        if slope is None:  # (per run, by its first sample; each sample then takes its run's)
             inner = first[1:] == first[:-1]  # neighbours on one run
             step = np.maximum(np.diff(psi), 1e-12)[inner]
             rise = np.abs(np.diff(self._values, axis=0)[inner])
-            self._slopes = np.max(rise / step[:, None], axis=0, initial=0.0)
+            largest = np.zeros(shape)
+            np.maximum.at(largest, first[1:][inner], rise / step[:, None])
+            self._slopes = np.ascontiguousarray(largest[first])
         else:
-            self._slopes = np.concatenate([[slope], *slopes])
+            self._slopes = np.ascontiguousarray(np.broadcast_to(np.concatenate([[slope], *slopes]), shape))
         # each group's first column
         self._groups = np.cumsum([1] + [v.shape[1] for _, _, v in terms[:-1]], dtype=np.int64)[: len(terms)]
         self._weights = np.array([w for w, _, _ in terms])
