@@ -1,6 +1,6 @@
 """A fuzz test of the compiled binding: every ``ckernels`` function and Solver method called
-with its arguments from a real use (a global choice and a tracking step past obstacles, and
-solves), then changed by hypothesis: an argument replaced (wrong types, None, huge integers,
+with its arguments from a real use (a global choice, a tracking step and a way's check past
+obstacles, and solves), then changed by hypothesis: an argument replaced (wrong types, None, huge integers,
 NaN, strings, arrays of any dtype and shape), an array's entries set to NaN, inf, huge or tiny
 values, cast to another dtype, made non-contiguous, read-only, longer or shorter, an argument
 dropped or added. Each call either returns or raises TypeError, ValueError, OverflowError,
@@ -48,8 +48,8 @@ def _snapshot(value: Any) -> Any:
 
 def recorded_calls() -> dict[str, tuple[Callable[..., Any], tuple[Any, ...]]]:
     """Each ckernels entry point with the arguments of one real call: the module functions
-    that a global choice and a tracking step of the Panda past three obstacles make (recorded
-    there), the rest and the Solver's methods written out here."""
+    that a global choice, a tracking step and a way's check of the Panda past three obstacles
+    make (recorded there), the rest and the Solver's methods written out here."""
     import om_redundant as om
     from benchmarks.control_rate import HOMES, MIN_CLEARANCE, figure_eight, obstacles
     from om_redundant import _core
@@ -78,6 +78,7 @@ def recorded_calls() -> dict[str, tuple[Callable[..., Any], tuple[Any, ...]]]:
         )
         choice = optimizer.choose(figure_eight(T_home, 0, 200))
         optimizer.choose(figure_eight(T_home, 1, 200), choice)
+        optimizer.objective.clearance.minimum_along(HOMES["panda"], choice.solution.q, 0.2)  # (a way's check)
     finally:
         for name, function in functions.items():
             setattr(_core, name, function)

@@ -6,6 +6,7 @@ MuJoCo's ``mj_geomDistance``, and their gradients against finite differences."""
 from __future__ import annotations
 
 import math
+from unittest import mock
 
 import mink
 import mujoco
@@ -18,8 +19,10 @@ import om_redundant as om
 from om_redundant import _core
 from om_redundant.exceptions import ModelMismatch
 from om_redundant.ik.threads import BATCH_CHUNK, run_rows
+from om_redundant.redundancy.objective import segment_clearance
 from om_redundant.redundancy.objective.arm_geoms import find_geom
 from tests.conftest import in_threads, random_q
+from tests.reference import segment_clearance as segment_numpy
 
 KINDS = {
     "sphere": mujoco.mjtGeom.mjGEOM_SPHERE,
@@ -478,6 +481,63 @@ def test_the_clearance_along_a_way_is_bounded_from_below(panda, seed, floor):
     assert clearance.minimum_along(q_a, q_b, floor, max_samples=10**6) == along
     with pytest.raises(om.InvalidInput, match="max_samples"):
         clearance.minimum_along(q_a, q_b, floor, max_samples=-1)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    kind=st.sampled_from(sorted(KINDS)),
+    floor=st.floats(-0.05, 0.15),
+    budget=st.sampled_from([math.inf, 0, 3, 128]),
+    room=st.sampled_from([1, 256]),
+)
+def test_the_compiled_way_check_is_the_references(panda, seed, kind, floor, budget, room):
+    """minimum_along (``_core.segment_minimum``, one call, its rounds' distances compiled)
+    gives the numpy bisection's answer to the bit (tests/reference/segment_clearance.py, on
+    the clearance's distances), with pairs MuJoCo computes (the box pad against a box), a
+    budget of samples (NaN alike where it runs out), and samples outgrowing the first call's
+    room (then called again with twice it)."""
+    rng = np.random.default_rng(seed)
+    position = [rng.uniform(0.2, 0.6), rng.uniform(-0.4, 0.4), rng.uniform(0.2, 0.8)]
+    clearance = scene(panda.arm, kind, [0.05, 0.08, 0.1], position, [1.0, 0.2, 0.0, 0.1])
+    q_a, q_b = random_q(panda.arm, 2, rng)
+    lipschitz = float(clearance._lever @ np.abs(q_b - q_a))
+    want = segment_numpy.segment_minimum(clearance.distances, q_a, q_b, lipschitz, floor, budget)
+    with mock.patch.object(segment_clearance, "_FIRST_ROOM", room):
+        got = clearance.minimum_along(q_a, q_b, floor, None if budget == math.inf else budget)
+    assert got == want or (math.isnan(got) and math.isnan(want))
+
+
+def test_the_compiled_way_check_refuses_what_it_cannot_read(panda):
+    """_core.segment_minimum: rows or outputs of other sizes, a negative budget and a fill that
+    is not callable are refused with the error named; a fill that raises raises through."""
+    clearance = scene(panda.arm, "box", [0.05, 0.08, 0.1], [0.3, 0.0, 0.6], [1.0, 0.0, 0.0, 0.0])
+    cores, P = clearance._cores, len(clearance.pairs)
+    q_a, q_b = random_q(panda.arm, 2, np.random.default_rng(3))
+
+    def check(rows=8, budget=math.inf, fill=lambda start, stop: None, q_to=q_b, pairs=P):
+        segment = _core.Segment(
+            q_a, q_to, np.empty((rows, 7)), np.empty((rows, pairs)), np.empty((rows, pairs, 6))
+        )
+        return _core.segment_minimum(cores, segment, _core.SegmentCheck(10.0, 1.0, budget, 2e-4, 1.0), fill)
+
+    assert check(rows=2) is None  # (the samples outgrow the rows: the caller gives more)
+    for bad in (dict(q_to=q_b[:6]), dict(pairs=P - 1), dict(budget=-1.0)):
+        with pytest.raises(ValueError, match="segment_minimum: sizes"):
+            check(**bad)
+    with pytest.raises(TypeError, match="fill must be callable"):
+        check(fill=None)
+
+    def broken(start, stop):
+        raise RuntimeError("fill failed")
+
+    with pytest.raises(RuntimeError, match="fill failed"):  # (the pad against the box: MuJoCo's)
+        _core.segment_minimum(
+            cores,
+            _core.Segment(q_a, q_a, np.empty((8, 7)), np.empty((8, P)), np.empty((8, P, 6))),
+            _core.SegmentCheck(0.0, -1.0, math.inf, 2e-4, 1.0),
+            broken,
+        )
 
 
 def test_lever_arms_bound_how_fast_the_geoms_move(panda):

@@ -43,6 +43,36 @@ static int check_links(const Py_buffer *v, const Py_buffer *q, om_arm_links *arm
     return 0;
 }
 
+/* The geoms' cores of the views v (C_N, the arm's links checked into *arm) checked into *geoms,
+ * with *work (PyMem_RawFree) holding the poses of all G geoms (12 G) and copies of the pairs
+ * and links, checked here with the GIL held: the kernels index by them with the GIL released,
+ * while the caller's arrays may change. -1 with a ValueError naming `what`, or MemoryError. */
+static int open_cores(const Py_buffer *v, om_arm_links *arm, om_geom_cores *geoms, double **work, const char *what) {
+    Py_ssize_t A = arm->A, G = v[C_KIND].len / 8, P = v[C_PAIRS].len / 16;
+    const int64_t *pairs = v[C_PAIRS].buf;
+    int bad = A > G || v[C_OBSTACLE_POS].len != (G - A) * 24 || v[C_OBSTACLE_MAT].len != (G - A) * 72 ||
+              v[C_RADIUS].len != G * 8 || v[C_HALF].len != G * 24 || v[C_PAIRS].len != P * 16 ||
+              v[C_BOUNDS].len != P * 8;
+    bad = bad || !indices_within(pairs, P, 2, 0, A) || !indices_within(pairs + 1, P, 2, A, G);
+    if (bad) {
+        PyErr_Format(PyExc_ValueError, "%s: sizes of the geoms, pairs and outputs disagree", what);
+        return -1;
+    }
+    *work = PyMem_RawMalloc(((size_t)G * 12 + (size_t)(2 * P + A)) * sizeof(double));
+    if (!*work) {
+        PyErr_NoMemory();
+        return -1;
+    }
+    int64_t *pairs_copy = (int64_t *)(*work + 12 * G), *link = pairs_copy + 2 * P;
+    memcpy(pairs_copy, pairs, (size_t)(2 * P) * sizeof(int64_t));
+    memcpy(link, arm->link, (size_t)A * sizeof(int64_t));
+    arm->link = link;
+    *geoms = (om_geom_cores){v[C_OBSTACLE_POS].buf, v[C_OBSTACLE_MAT].buf, v[C_RADIUS].buf, v[C_HALF].buf,
+                             v[C_BOUNDS].buf,       v[C_KIND].buf,         pairs_copy,      G,
+                             P};
+    return 0;
+}
+
 /* arm_geom_poses(links, q, xpos, xmat): the world poses (M, A, 3) and (M, A, 3, 3) of the arm's A
  * geoms at each of the M rows of q (M, dof); links: a record with the fields table, start, link,
  * offset and slide (an ArmCores, or an ArmLinks). */
@@ -115,31 +145,15 @@ static PyObject *om_arm_clearance_py(PyObject *mod, PyObject *const *args, Py_ss
     om_arm_links arm;
     Py_ssize_t M;
     if (check_links(v, &v[Q], &arm, &M, "arm_clearance") < 0) goto release;
-    Py_ssize_t A = arm.A, G = v[C_KIND].len / 8, P = v[C_PAIRS].len / 16;
-    const int64_t *pairs = v[C_PAIRS].buf;
-    int bad = A > G || v[C_OBSTACLE_POS].len != (G - A) * 24 || v[C_OBSTACLE_MAT].len != (G - A) * 72 ||
-              v[C_RADIUS].len != G * 8 || v[C_HALF].len != G * 24 || v[C_PAIRS].len != P * 16 ||
-              v[C_BOUNDS].len != P * 8 || v[DIST].len != M * P * 8 || v[FROMTO].len != M * P * 48 ||
-              (with_grad && v[GRAD].len != M * P * arm.dof * 8);
-    bad = bad || !indices_within(pairs, P, 2, 0, A) || !indices_within(pairs + 1, P, 2, A, G);
-    if (bad) {
+    om_geom_cores geoms;
+    double *work;
+    if (open_cores(v, &arm, &geoms, &work, "arm_clearance") < 0) goto release;
+    Py_ssize_t P = geoms.P;
+    if (v[DIST].len != M * P * 8 || v[FROMTO].len != M * P * 48 || (with_grad && v[GRAD].len != M * P * arm.dof * 8)) {
+        PyMem_RawFree(work);
         PyErr_SetString(PyExc_ValueError, "arm_clearance: sizes of the geoms, pairs and outputs disagree");
         goto release;
     }
-    /* the poses of all geoms; the pairs and links, checked above with the GIL held, copied: the
-     * kernels index by them with the GIL released, while the caller's arrays may change */
-    double *work = PyMem_RawMalloc(((size_t)G * 12 + (size_t)(2 * P + A)) * sizeof(double));
-    if (!work) {
-        PyErr_NoMemory();
-        goto release;
-    }
-    int64_t *pairs_copy = (int64_t *)(work + 12 * G), *link = pairs_copy + 2 * P;
-    memcpy(pairs_copy, pairs, (size_t)(2 * P) * sizeof(int64_t));
-    memcpy(link, arm.link, (size_t)A * sizeof(int64_t));
-    arm.link = link;
-    om_geom_cores geoms = {v[C_OBSTACLE_POS].buf, v[C_OBSTACLE_MAT].buf, v[C_RADIUS].buf, v[C_HALF].buf,
-                           v[C_BOUNDS].buf,       v[C_KIND].buf,         pairs_copy,      G,
-                           P};
     double *dist = v[DIST].buf, *fromto = v[FROMTO].buf, *grad = with_grad ? v[GRAD].buf : NULL;
     const double *q = v[Q].buf;
     long left;
@@ -150,6 +164,101 @@ release:
     release_buffers(v, n_views);
 done:
     release_fields(d, D_N);
+    return result;
+}
+
+/* The fields of a Segment record, and of a SegmentCheck record. */
+enum { S_FROM, S_TO, S_ROWS, S_DIST, S_FROMTO, S_N };
+static const char *const segment_names[S_N] = {"q_from", "q_to", "rows", "dist", "fromto"};
+enum { K_LIPSCHITZ, K_FLOOR, K_BUDGET, K_TOLERANCE, K_REACH, K_N };
+static const char *const check_names[K_N] = {"lipschitz", "floor", "budget", "tolerance", "reach"};
+
+/* What segment_minimum's distances read: the arm and geoms (open_cores), the distances' cap,
+ * the segment's rows and outputs, and the fill of the pairs left to MuJoCo. */
+typedef struct {
+    om_arm_links arm;
+    om_geom_cores geoms;
+    double *work, reach, *rows, *dist, *fromto;
+    PyObject *fill;
+} segment_context;
+
+/* om_segment's distances: rows start .. stop - 1 by om_arm_clearance (the GIL released), then
+ * fill(start, stop) where it left pairs (nan) to MuJoCo; -1 with the error. */
+static int segment_distances(void *context, ptrdiff_t start, ptrdiff_t stop) {
+    segment_context *c = context;
+    ptrdiff_t P = c->geoms.P, dof = c->arm.dof;
+    long left;
+    Py_BEGIN_ALLOW_THREADS left = om_arm_clearance(&c->arm, &c->geoms, stop - start, c->rows + start * dof, c->reach,
+                                                   INFINITY, c->dist + start * P, c->fromto + start * P * 6, NULL,
+                                                   false, c->work);
+    Py_END_ALLOW_THREADS if (left == 0) return 0;
+    PyObject *filled = PyObject_CallFunction(c->fill, "nn", (Py_ssize_t)start, (Py_ssize_t)stop);
+    if (!filled) return -1;
+    Py_DECREF(filled);
+    return 0;
+}
+
+/* segment_minimum(cores, segment, check, fill) -> float: the clearance along the segment from
+ * segment.q_from to segment.q_to (dof each) as far as it matters against check.floor
+ * (om_segment_minimum with check.lipschitz, check.tolerance; NaN where check.budget samples
+ * inside it left it undecided), the pairs' distances capped at check.reach; segment.rows (R, dof), dist (R, P) and
+ * fromto (R, P, 6) its samples' rows and outputs, the ends first (None where the samples
+ * outgrow them); fill(start, stop) fills the distances of rows start .. stop - 1 that
+ * arm_clearance left (nan) to MuJoCo. */
+static PyObject *om_segment_minimum_py(PyObject *mod, PyObject *const *args, Py_ssize_t nargs, PyObject *kwnames) {
+    static const char *const names[] = {"cores", "segment", "check", "fill"};
+    static const arg_spec spec = {"segment_minimum", names, 4, 4};
+    PyObject *a[4], *f[S_N], *k[K_N];
+    if (bind_args(args, nargs, kwnames, &spec, a) < 0) return NULL;
+    if (get_fields(a[2], check_names, K_N, k, "segment_minimum's check") < 0) return NULL;
+    double numbers[K_N];
+    for (int i = 0; i < K_N; i++) numbers[i] = PyFloat_AsDouble(k[i]);
+    release_fields(k, K_N);
+    if (PyErr_Occurred()) return NULL;
+    double lipschitz = numbers[K_LIPSCHITZ], floor = numbers[K_FLOOR], budget = numbers[K_BUDGET];
+    double tolerance = numbers[K_TOLERANCE], reach = numbers[K_REACH];
+    if (!PyCallable_Check(a[3])) {
+        PyErr_SetString(PyExc_TypeError, "segment_minimum: fill must be callable");
+        return NULL;
+    }
+    if (get_fields(a[1], segment_names, S_N, f, "segment_minimum's segment") < 0) return NULL;
+    Py_buffer v[C_N + S_N];
+    const buffer_spec sp[S_N] = {{F64, -1, 0, "q_from"}, {F64, -1, 0, "q_to"}, {F64, -1, 1, "rows"},
+                                 {F64, -1, 1, "dist"},   {F64, -1, 1, "fromto"}};
+    PyObject *result = NULL;
+    if (get_cores(a[0], v, C_N, "segment_minimum's cores") < 0) goto done;
+    if (get_buffers(f, v + C_N, sp, S_N) < 0) {
+        release_buffers(v, C_N);
+        goto done;
+    }
+    segment_context c = {.reach = reach, .fill = a[3]};
+    Py_ssize_t M;
+    if (check_links(v, &v[C_N + S_FROM], &c.arm, &M, "segment_minimum") < 0) goto release;
+    if (open_cores(v, &c.arm, &c.geoms, &c.work, "segment_minimum") < 0) goto release;
+    Py_ssize_t dof = c.arm.dof, P = c.geoms.P, R = v[C_N + S_ROWS].len / (dof * 8);
+    if (M != 1 || v[C_N + S_TO].len != dof * 8 || v[C_N + S_ROWS].len != R * dof * 8 ||
+        v[C_N + S_DIST].len != R * P * 8 || v[C_N + S_FROMTO].len != R * P * 48 || !(lipschitz >= 0.0) ||
+        !(budget >= 0.0) || !(tolerance >= 0.0)) {
+        PyMem_RawFree(c.work);
+        PyErr_SetString(PyExc_ValueError, "segment_minimum: sizes of the segment, its rows and outputs disagree");
+        goto release;
+    }
+    c.rows = v[C_N + S_ROWS].buf, c.dist = v[C_N + S_DIST].buf, c.fromto = v[C_N + S_FROMTO].buf;
+    om_segment segment = {(int)dof, P, R, v[C_N + S_FROM].buf, v[C_N + S_TO].buf, c.rows, c.dist,
+                          segment_distances, &c};
+    int status;
+    double least = om_segment_minimum(&segment, lipschitz, floor, budget, tolerance, &status);
+    PyMem_RawFree(c.work);
+    if (status == OM_SEGMENT_OK)
+        result = PyFloat_FromDouble(least);
+    else if (status == OM_SEGMENT_FULL)
+        result = Py_NewRef(Py_None);
+    else if (status == OM_SEGMENT_NO_MEMORY)
+        PyErr_NoMemory(); /* (OM_SEGMENT_FAILED: fill's error is set) */
+release:
+    release_buffers(v, C_N + S_N);
+done:
+    release_fields(f, S_N);
     return result;
 }
 
@@ -194,6 +303,8 @@ static PyMethodDef functions[] = {
      "arm_geom_poses(links, q, xpos, xmat)"},
     {"arm_clearance", (PyCFunction)(void (*)(void))om_arm_clearance_py, METH_FASTCALL | METH_KEYWORDS,
      "arm_clearance(cores, q, reach, near, out, given) -> pairs left to MuJoCo"},
+    {"segment_minimum", (PyCFunction)(void (*)(void))om_segment_minimum_py, METH_FASTCALL | METH_KEYWORDS,
+     "segment_minimum(cores, segment, check, fill) -> float or None"},
     {NULL, NULL, 0, NULL},
 };
 

@@ -108,6 +108,29 @@ void om_arm_geom_poses(const om_arm_links *arm, const double *q, double *xpos, d
 long om_arm_clearance(const om_arm_links *arm, const om_geom_cores *geoms, ptrdiff_t M, const double *q,
                       double reach, double near, double *dist, double *fromto, double *grad, bool given,
                       double *work);
+/* ------------------------------------------------------------------------------------ */
+/* segment_clearance.c: the clearance along a straight joint-space segment. */
+
+/* A segment from q_from to q_to (dof) and its samples' rows (capacity x dof: the ends, then a
+ * round's midpoints after another's) and their P pairs' distances (capacity x P), which
+ * distances(context, start, stop) computes for rows start .. stop - 1 (0, or -1 on an error). */
+typedef struct {
+    int dof;
+    ptrdiff_t pairs, capacity;
+    const double *q_from, *q_to;
+    double *rows, *dist;
+    int (*distances)(void *context, ptrdiff_t start, ptrdiff_t stop);
+    void *context;
+} om_segment;
+
+enum { OM_SEGMENT_OK = 0, OM_SEGMENT_FAILED = 1, OM_SEGMENT_FULL = 2, OM_SEGMENT_NO_MEMORY = -1 };
+/* The clearance along the segment as far as it matters against floor (segment_clearance.c: the
+ * rule), L = lipschitz, at most `budget` samples inside it, pieces within `tolerance` not split;
+ * *status OM_SEGMENT_OK, or FAILED (distances failed), FULL (more rows than capacity),
+ * NO_MEMORY, each with NaN. */
+double om_segment_minimum(const om_segment *s, double lipschitz, double floor, double budget, double tolerance,
+                          int *status);
+
 /* The signed distance of a sphere or capsule (pos, mat, half sizes (0, 0, l), radius) that
  * overlaps a box (box_pos, box_mat, box_half), its nearest points into fromto (6). */
 double om_box_overlap(const double *pos, const double *mat, const double *half, double radius,

@@ -143,6 +143,42 @@ class PairDistances(NamedTuple):
     grad: np.ndarray | None
 
 
+class Segment(NamedTuple):
+    """A straight joint-space segment and its samples, as ``segment_minimum`` reads and
+    writes them.
+
+    Attributes:
+        q_from, q_to: (dof,) its ends.
+        rows: (R, dof) the samples' joints, the ends first, then each round's midpoints.
+        dist: (R, P) their pairs' distances.
+        fromto: (R, P, 6) the pairs' nearest points.
+    """
+
+    q_from: np.ndarray
+    q_to: np.ndarray
+    rows: np.ndarray
+    dist: np.ndarray
+    fromto: np.ndarray
+
+
+class SegmentCheck(NamedTuple):
+    """How ``segment_minimum`` checks a segment.
+
+    Attributes:
+        lipschitz: L, the most any distance changes over the whole segment (m).
+        floor: The clearance it is checked against (m).
+        budget: The most joint vectors sampled inside it (inf: no limit).
+        tolerance: A piece whose bound is this close to its ends' is not split (m).
+        reach: Distances are capped here (m).
+    """
+
+    lipschitz: float
+    floor: float
+    budget: float
+    tolerance: float
+    reach: float
+
+
 class GeomPose(NamedTuple):
     """A geom placed in the world, as ``box_overlap`` reads it.
 

@@ -363,7 +363,12 @@ class Clearance:
         floor = as_number(floor, "floor")
         budget = math.inf if max_samples is None else as_count(max_samples, "max_samples", 0, 2**31)
         lipschitz = float(self._lever @ np.abs(q_to - q_from))
-        return segment_minimum(self.distances, q_from, q_to, lipschitz, floor, budget)
+        cores = self._cores  # (the world as read now, for every round)
+
+        def fill(q: np.ndarray, dist: np.ndarray, fromto: np.ndarray) -> None:
+            self._mujoco.fill(cores, q, self.distmax, math.inf, dist, fromto, None)
+
+        return segment_minimum(cores, fill, q_from, q_to, lipschitz, floor, budget, self.distmax)
 
     def _evaluate(
         self, q: np.ndarray, reach: float, gradient: bool, near: float = math.inf
