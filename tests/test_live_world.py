@@ -75,6 +75,25 @@ def test_update_refuses_data_of_another_model(panda):
         clearance.update(np.zeros(3))
 
 
+@pytest.mark.parametrize("where", [[np.nan, 0.0, 0.5], [2e6, 0.0, 0.5], [0.5, -np.inf, 0.5]])
+def test_update_refuses_an_obstacle_moved_out_of_the_world(panda, where):
+    """A mocap obstacle moved to NaN, infinity or beyond MAX_EXTENT is refused naming the
+    geom, and the world read before stays (no distance from it)."""
+    model = ball_scene(panda.arm)
+    clearance = om.Clearance(model, panda.arm, ["ball", "rod"])
+    data = mujoco.MjData(model)
+    data.mocap_pos[0] = [0.5, 0.0, 0.5]
+    mujoco.mj_kinematics(model, data)
+    clearance.update(data)
+    before, version = clearance.distances(Q_PANDA), clearance.version
+    data.mocap_pos[0] = where
+    mujoco.mj_kinematics(model, data)
+    with pytest.raises(om.InvalidInput, match="obstacle geom 'ball': its position and sizes must be within"):
+        clearance.update(data)
+    assert clearance.version == version
+    np.testing.assert_array_equal(clearance.distances(Q_PANDA), before)
+
+
 def loop(configuration, tasks, limits, ticks, move, check) -> None:
     """A mink loop: move the world, then a tick, then check; ticks times."""
     for k in range(ticks):

@@ -218,12 +218,15 @@ def find_geom(model: mujoco.MjModel, name: str) -> int:
     return index
 
 
-def check_extent(model: mujoco.MjModel, obstacles: list[int], position: np.ndarray) -> None:
-    """Every obstacle's position and sizes within :data:`MAX_EXTENT` (m)."""
-    for o, p in zip(obstacles, position, strict=True):
-        extent = max(np.abs(p).max(), model.geom_size[o].max())
-        if not extent <= MAX_EXTENT:
-            raise InvalidInput(
-                f"obstacle geom '{geom_label(model, o)}': its position and sizes must be within "
-                f"{MAX_EXTENT:g} m, got {extent:.3g} m"
-            )
+def check_extent(model: mujoco.MjModel, obstacles: np.ndarray, position: np.ndarray) -> None:
+    """Every obstacle's position (O, 3) and sizes within :data:`MAX_EXTENT` (m) (all at once:
+    :meth:`Clearance.update <om_redundant.Clearance.update>` checks them every tick)."""
+    sizes = model.geom_size[obstacles]
+    if np.abs(position).max(initial=0.0) <= MAX_EXTENT and sizes.max(initial=0.0) <= MAX_EXTENT:
+        return  # (NaN is not)
+    extent = np.maximum(np.abs(position).max(axis=1), sizes.max(axis=1))
+    k = int(np.flatnonzero(~(extent <= MAX_EXTENT))[0])
+    raise InvalidInput(
+        f"obstacle geom '{geom_label(model, int(obstacles[k]))}': its position and sizes must be "
+        f"within {MAX_EXTENT:g} m, got {extent[k]:.3g} m"
+    )

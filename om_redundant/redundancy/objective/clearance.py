@@ -315,13 +315,13 @@ class Clearance:
         start = cores.start
         if self._root_moves:
             start = as_row(body_pose(data, self._root) @ self._start_in_root)
-        if (
-            np.array_equal(position, cores.obstacle_pos)
-            and np.array_equal(rotation, cores.obstacle_mat)
-            and np.array_equal(start, cores.start)
+        if (  # (== and all: a third of np.array_equal's time, read every tick; NaN has moved)
+            (position == cores.obstacle_pos).all()
+            and (rotation == cores.obstacle_mat).all()
+            and (start == cores.start).all()
         ):
             return False
-        check_extent(self.model, ids.tolist(), position)
+        check_extent(self.model, ids, position)
         # (one assignment: a call in another thread reads the old poses or the new, whole)
         self._cores = cores._replace(
             start=np.ascontiguousarray(start),
