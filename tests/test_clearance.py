@@ -6,6 +6,7 @@ MuJoCo's ``mj_geomDistance``, and their gradients against finite differences."""
 from __future__ import annotations
 
 import math
+import warnings
 from unittest import mock
 
 import mink
@@ -634,5 +635,48 @@ def test_unnamed_geoms_are_named_by_their_body_and_pairs_go_to_mink(panda):
     # mink keeps every pair but those of the first link (a child of the world's weld, as the post is)
     first = model.body("link1").id
     assert pairs <= ours and {p for p in ours if first not in model.geom_bodyid[list(p)]} <= pairs
+    assert dropped_by_mink(model, clearance) == set(clearance.mink_drops)
     with pytest.raises(om.InvalidInput, match="moves with the arm"):
         om.Clearance(model, panda.arm, ["link4_capsule0"])
+
+
+def dropped_by_mink(model: mujoco.MjModel, clearance: om.Clearance) -> set[tuple[str, str]]:
+    """The clearance's pairs that mink's own CollisionAvoidanceLimit leaves out, by name."""
+    limit = mink.CollisionAvoidanceLimit(model, clearance.geom_pairs, minimum_distance_from_collisions=0.01)
+    kept = {tuple(sorted(p)) for p in limit.geom_id_pairs}
+    pairs = [(a, o) for arms, obstacles in clearance.geom_pairs for a in arms for o in obstacles]
+    return {(model.geom(a).name, model.geom(o).name) for a, o in pairs if tuple(sorted((a, o))) not in kept}
+
+
+@pytest.mark.parametrize("contype, conaffinity", [(0, 0), (2, 2), (1, 0)])
+def test_pairs_mink_leaves_out_are_named(panda, contype, conaffinity):
+    """A mocap ball whose contype and conaffinity cannot meet the arm's (a contact-free marker,
+    another collision group): mink's CollisionAvoidanceLimit leaves its pairs out, and the
+    clearance says so with a warning naming them; its mink_drops are exactly the pairs mink
+    leaves out (those of the first link and the world's table too, which warn of nothing)."""
+    spec = mujoco.MjSpec.from_string(om.scene_mjcf(panda.arm))
+    spec.worldbody.add_geom(
+        name="table", type=mujoco.mjtGeom.mjGEOM_BOX, size=[0.3, 0.4, 0.02], pos=[0.6, 0, 0]
+    )
+    ball = spec.worldbody.add_body(name="ball", mocap=True, pos=[0.5, 0.0, 0.6])
+    ball.add_geom(
+        name="ball",
+        type=mujoco.mjtGeom.mjGEOM_SPHERE,
+        size=[0.05, 0, 0],
+        contype=contype,
+        conaffinity=conaffinity,
+    )
+    model = spec.compile()
+    collides = bool(contype & 1 or conaffinity & 1)  # (the arm's geoms: contype = conaffinity = 1)
+    if collides:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            clearance = om.Clearance(model, panda.arm, ["table", "ball"])
+    else:
+        with pytest.warns(UserWarning, match=r"ignores \d+ of its pairs, \(link1_capsule0, ball\)") as caught:
+            clearance = om.Clearance(model, panda.arm, ["table", "ball"])
+        assert f"ignores {len(clearance.arm_geoms)} of its pairs" in str(
+            caught[0].message
+        )  # (every arm geom's)
+    assert set(clearance.mink_drops) == dropped_by_mink(model, clearance)
+    assert {o for _, o in clearance.mink_drops} == ({"table"} if collides else {"table", "ball"})

@@ -53,6 +53,7 @@ gripper's) stay at ``qpos0``.
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Sequence
 from typing import Any
 
@@ -103,7 +104,12 @@ class Clearance:
         pairs: (arm geom, obstacle) names of every pair, in the order of :meth:`distances`.
         geom_pairs: The same pairs as mink's ``CollisionAvoidanceLimit`` takes them (geom ids):
             ``mink.CollisionAvoidanceLimit(model, clearance.geom_pairs, ...)`` keeps mink's
-            steps clear of what the optimiser keeps its choices clear of.
+            steps clear of what the optimiser keeps its choices clear of, but for those in
+            ``mink_drops``.
+        mink_drops: (arm geom, obstacle) names of the pairs mink's limit ignores, as it
+            builds its pairs: bodies welded together or parent and child (the first link's
+            geoms and the world's, in every scene), and geoms whose ``contype`` and
+            ``conaffinity`` cannot collide (a warning names these).
         version: Counts the moves :meth:`update` has read.
 
     Raises:
@@ -179,6 +185,24 @@ class Clearance:
             (geom_label(model, a), geom_label(model, o)) for a, o, _ in pair_geoms
         )
         self.geom_pairs: list[tuple[list[int], list[int]]] = [(list(arm_geoms), list(obstacles))]
+        dropped = [(a, o, _mink_drops(model, a, o)) for a, o, _ in pair_geoms]
+        self.mink_drops: tuple[tuple[str, str], ...] = tuple(
+            (geom_label(model, a), geom_label(model, o)) for a, o, why in dropped if why
+        )
+        # (welded or parent and child: the first link's geoms and the world's, in every scene,
+        # which turn about the base's axis; geoms that cannot collide are the user's own choice)
+        apart = [(geom_label(model, a), geom_label(model, o)) for a, o, why in dropped if why == _APART]
+        if apart:
+            shown = ", ".join(f"({a}, {o})" for a, o in apart[:4])
+            more = f" and {len(apart) - 4} more" if len(apart) > 4 else ""
+            warnings.warn(
+                f"Clearance: mink's CollisionAvoidanceLimit ignores {len(apart)} of its pairs, "
+                f"{shown}{more}: their geoms cannot collide (neither's contype meets the other's "
+                "conaffinity). The "
+                "optimiser keeps them clear at its choices and on their ways, but no limit keeps mink's "
+                "steps clear of them; give the geoms a contype and conaffinity that collide",
+                stacklevel=2,
+            )
 
     @classmethod
     def for_arm(
@@ -396,6 +420,22 @@ class Clearance:
             self._mujoco.fill(cores, rows, reach, near, dist, fromto, grad)
         shape = (*q.shape[:-1], P)
         return dist.reshape(shape), None if grad is None else grad.reshape(*shape, dof)
+
+
+_APART, _JOINED = "cannot collide", "welded or parent and child"
+
+
+def _mink_drops(model: mujoco.MjModel, a: int, o: int) -> str:
+    """Why mink's ``CollisionAvoidanceLimit`` leaves out the pair of geoms a and o, as it
+    builds its pairs (``mink/limits/collision_avoidance_limit.py``), or "": geoms that cannot
+    collide (neither's ``contype`` meets the other's ``conaffinity``), or bodies welded
+    together, or whose welds are parent and child."""
+    contype, conaffinity = model.geom_contype, model.geom_conaffinity
+    if not (contype[a] & conaffinity[o] or contype[o] & conaffinity[a]):
+        return _APART
+    weld_a, weld_o = model.body_weldid[model.geom_bodyid[[a, o]]]
+    parent_a, parent_o = model.body_weldid[model.body_parentid[[weld_a, weld_o]]]
+    return _JOINED if weld_a in (weld_o, parent_o) or weld_o == parent_a else ""
 
 
 def _restored(
