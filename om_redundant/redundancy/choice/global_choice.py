@@ -280,8 +280,8 @@ def _climb(probe: Probe, run: Run, k: int, lower: float, upper: float, radius: f
     of that end's cell (:func:`~.climb.maximise_from_path_end`: at a fold no climb leaves the
     end); the best point found."""
     points = run.points
-    ends = [(e, n) for e, n, ends in ((0, 1, run.path_ends[0]), (-1, -2, run.path_ends[1])) if ends]
-    ends = ends if len(points) > 1 else []
+    sides = ((0, 1, run.path_ends[0]), (-1, -2, run.path_ends[1]))  # (its end, the sample next to it)
+    ends = [(e, n) for e, n, path_end in sides if path_end] if len(points) > 1 else []
     start = points[k]
     at_end = any(points[e] is start for e, _ in ends)
     point = start if at_end else maximise(probe, start, lower, upper, radius)
