@@ -526,9 +526,11 @@ def test_the_compiled_way_check_is_the_references(panda, seed, kind, floor, budg
     assert got == want or (math.isnan(got) and math.isnan(want))
 
 
+@pytest.mark.sanitize  # also run under ASan and UBSan (.ci/sanitize)
 def test_the_compiled_way_check_refuses_what_it_cannot_read(panda):
     """_core.segment_minimum: rows or outputs of other sizes, a negative budget and a fill that
-    is not callable are refused with the error named; a fill that raises raises through."""
+    is not callable are refused with the error named; a fill that raises raises through; rows
+    too few even for the ends (0 or 1) are answered None, nothing written past them."""
     clearance = scene(panda.arm, "box", [0.05, 0.08, 0.1], [0.3, 0.0, 0.6], [1.0, 0.0, 0.0, 0.0])
     cores, P = clearance._cores, len(clearance.pairs)
     q_a, q_b = random_q(panda.arm, 2, np.random.default_rng(3))
@@ -539,7 +541,8 @@ def test_the_compiled_way_check_refuses_what_it_cannot_read(panda):
         )
         return _core.segment_minimum(cores, segment, _core.SegmentCheck(10.0, 1.0, budget, 2e-4, 1.0), fill)
 
-    assert check(rows=2) is None  # (the samples outgrow the rows: the caller gives more)
+    for rows in (0, 1, 2):  # (the samples outgrow the rows: the caller gives more)
+        assert check(rows=rows) is None
     for bad in (dict(q_to=q_b[:6]), dict(pairs=P - 1), dict(budget=-1.0)):
         with pytest.raises(ValueError, match="segment_minimum: sizes"):
             check(**bad)

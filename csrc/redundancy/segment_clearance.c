@@ -12,8 +12,8 @@ typedef struct {
     double t0, t1, d0, d1;
 } piece;
 
-/* The least distance of a row of P pairs (numpy's minimum: a NaN is the answer). (py_min,
- * below: Python's min of two floats, the reference's.) */
+/* The least distance of a row of P pairs (numpy's minimum: a NaN is the answer; the pieces'
+ * minima below are py_min's, Python's min of two floats, as the reference takes them). */
 static double least_of(const double *d, ptrdiff_t P) {
     double r = INFINITY;
     for (ptrdiff_t k = 0; k < P; k++) r = om_least(r, d[k]);
@@ -26,11 +26,11 @@ double om_segment_minimum(const om_segment *s, double lipschitz, double floor, d
     ptrdiff_t P = s->pairs, used = 2; /* rows 0 and 1: the ends */
     double *rows = s->rows, delta[OM_MAX_DOF];
     *status = OM_SEGMENT_OK;
+    if (s->capacity < 2) return (*status = OM_SEGMENT_FULL, NAN); /* (before the ends are written) */
     for (int j = 0; j < dof; j++) {
         rows[j] = s->q_from[j], rows[dof + j] = s->q_to[j];
         delta[j] = s->q_to[j] - s->q_from[j];
     }
-    if (s->capacity < 2) return (*status = OM_SEGMENT_FULL, NAN);
     if (s->distances(s->context, 0, 2) < 0) return (*status = OM_SEGMENT_FAILED, NAN);
     /* each round's pieces (at most twice the rows that can be sampled, two per split), then the next's */
     ptrdiff_t room = 2 * s->capacity;
