@@ -185,22 +185,22 @@ class Clearance:
             (geom_label(model, a), geom_label(model, o)) for a, o, _ in pair_geoms
         )
         self.geom_pairs: list[tuple[list[int], list[int]]] = [(list(arm_geoms), list(obstacles))]
-        dropped = [(a, o, _mink_drops(model, a, o)) for a, o, _ in pair_geoms]
+        why = [_mink_drops(model, a, o) for a, o, _ in pair_geoms]  # (in the order of self.pairs)
         self.mink_drops: tuple[tuple[str, str], ...] = tuple(
-            (geom_label(model, a), geom_label(model, o)) for a, o, why in dropped if why
+            p for p, w in zip(self.pairs, why, strict=True) if w
         )
         # (welded or parent and child: the first link's geoms and the world's, in every scene,
         # which turn about the base's axis; geoms that cannot collide are the user's own choice)
-        apart = [(geom_label(model, a), geom_label(model, o)) for a, o, why in dropped if why == _APART]
+        apart = [p for p, w in zip(self.pairs, why, strict=True) if w == _APART]
         if apart:
             shown = ", ".join(f"({a}, {o})" for a, o in apart[:4])
             more = f" and {len(apart) - 4} more" if len(apart) > 4 else ""
             warnings.warn(
                 f"Clearance: mink's CollisionAvoidanceLimit ignores {len(apart)} of its pairs, "
                 f"{shown}{more}: their geoms cannot collide (neither's contype meets the other's "
-                "conaffinity). The "
-                "optimiser keeps them clear at its choices and on their ways, but no limit keeps mink's "
-                "steps clear of them; give the geoms a contype and conaffinity that collide",
+                "conaffinity). The optimiser keeps them clear at its choices and on their ways, but "
+                "no limit keeps mink's steps clear of them; give the geoms a contype and conaffinity "
+                "that collide",
                 stacklevel=2,
             )
 
