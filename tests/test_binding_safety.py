@@ -275,3 +275,40 @@ def test_a_pose_written_during_a_batch_is_solved_as_checked():
     """,
         timeout=300,
     )
+
+
+def test_kept_traces_are_checked_and_outlive_their_solver():
+    """torus_traces: None for an arm whose searches trace none, a capsule for the Sawyer that a
+    batch fills and follow and link_paths read; another object, or another solver's traces (one
+    the capsule alone keeps alive), are refused by name."""
+    run_case("""
+        import gc
+        raises(TypeError, _core.torus_traces, None)
+        raises(RuntimeError, _core.torus_traces, _core.Solver.__new__(_core.Solver))
+        assert _core.torus_traces(kernel) is None
+        sawyer = om.OMSolver("sawyer")
+        traces = _core.torus_traces(sawyer.kernel)
+        orphan = _core.torus_traces(om.OMSolver("sawyer").kernel)  # (its solver: the capsule's alone)
+        gc.collect()
+        q0 = np.array([0.1, -0.8, 0.2, 1.6, 0.1, 0.6, 1.5])
+        Ts, cs = sawyer.arm.fk(q0), sawyer.configuration_of(q0)
+        rows = [np.repeat(Ts[None], 8, 0), np.tile(cs.signs, (8, 1)), np.linspace(-3, 3, 8), np.ones(8, bool)]
+        for bad, kind in [(object(), TypeError), ("traces", TypeError), (orphan, ValueError)]:
+            raises(kind, sawyer.solve_grid, *rows, None, 64, bad)
+        sawyer.solve_grid(*rows, traces=traces)
+        t = np.zeros((1, 7))
+        _core.self_motion_tangents(sawyer.kernel, q0[None], t)
+        flags, signs = np.zeros(7, dtype=np.uint8), np.array(cs.signs, dtype=np.int64)
+        roots = _core.LinkRoots(np.zeros(1), np.zeros(1, dtype=np.int64), np.zeros((0, 7)), np.zeros((0, 7)))
+        pairs = np.zeros((1, 2), dtype=np.int64)
+        added = _core.LinkRows(np.zeros(1), np.zeros((1, 7)), np.zeros((1, 7)), pairs, pairs.copy())
+        psi = cs.redundancy[0]
+        for kept, kind in [(object(), TypeError), (orphan, ValueError), (traces, None), (None, None)]:
+            start = (q0.copy(), t[0].copy())
+            work = _core.FollowWork(sawyer.kernel, Ts, signs, flags, flags, np.zeros(7), *start, kept)
+            if kind is None:
+                _core.follow(work, psi, psi + 0.5, 1e-9)
+            else:
+                raises(kind, _core.follow, work, psi, psi + 0.5, 1e-9)
+                raises(kind, _core.link_paths, work, roots, added)
+    """)

@@ -6,12 +6,18 @@ They must find every root within the joint limits that the grid's starts find (a
 
 from __future__ import annotations
 
+from unittest import mock
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import om_redundant as om
+from benchmarks.control_rate import ARM_HOMES, MIN_CLEARANCE, obstacles
+from om_redundant.redundancy.paths import linking
+from om_redundant.redundancy.paths.linking import LinkedMemo, sweep_circle
+from om_redundant.redundancy.paths.probe import Probe
 from tests.conftest import distance, solver_of
 from tests.test_torus_search import NEAR_DOUBLE_Q, talos_left_arm
 
@@ -106,3 +112,54 @@ def test_a_batch_keeps_a_near_double_root_pair():
     assert len(pair) == 2
     for q in pair:
         assert np.abs(arm.fk(q) - T).max() <= 1e-10 and solver.holds(q, c)
+
+
+def _optimizer(name: str, count: int) -> om.RedundancyOptimizer:
+    """The arm's optimiser with count obstacles about its home hand (benchmarks.control_rate's)."""
+    solver = solver_of(name)
+    shapes = obstacles(solver.arm.fk(ARM_HOMES[name])[:3, 3], count)
+    return om.RedundancyOptimizer(solver, shapes, min_clearance=MIN_CLEARANCE)
+
+
+def _swept(optimizer: om.RedundancyOptimizer, T: np.ndarray, memo: LinkedMemo | None = None):
+    """Every branch's paths of pose T as the optimiser's sweep links them, and its probes."""
+    probes = [Probe(optimizer.solver, optimizer.objective, T, signs) for signs in optimizer.branches]
+    return sweep_circle(probes, GRID, memo=memo), probes
+
+
+@settings(max_examples=4, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_follows_from_the_kept_traces_link_what_the_windows_link(seed):
+    """A sweep's follows scan for a root nearer each step's start from the self-motion that the
+    grid's rows traced (kept in ``_core.torus_traces``) instead of sampling a window of the
+    torus: the same paths, the same samples (random poses, 3 obstacles)."""
+    optimizer = _optimizer("sawyer", 3)
+    T = _drawn_pose(optimizer.solver.arm, seed, 0)
+    (kept, probes) = _swept(optimizer, T)
+    assert all(probe._work.traces is not None for probe in probes)
+    with mock.patch.object(linking._core, "torus_traces", return_value=None):
+        (sampled, probes) = _swept(optimizer, T)
+    assert all(probe._work.traces is None for probe in probes)
+    assert [[len(path.points) for path in paths] for paths in kept] == [
+        [len(path.points) for path in paths] for paths in sampled
+    ]
+    for paths_a, paths_b in zip(kept, sampled, strict=True):
+        for a, b in zip(paths_a, paths_b, strict=True):
+            assert a.turns == b.turns
+            psi_a, psi_b = [p.psi for p in a.points], [p.psi for p in b.points]
+            np.testing.assert_allclose(psi_a, psi_b, rtol=0, atol=1e-12)
+            np.testing.assert_allclose([p.q for p in a.points], [p.q for p in b.points], rtol=0, atol=1e-9)
+
+
+def test_a_pose_swept_again_follows_from_the_traces_kept_with_its_paths():
+    """A sweep that takes its linked paths from the LinkedMemo (the pose held while the
+    obstacles move) takes the traces its first sweep kept too; a panda's sweep keeps none."""
+    optimizer = _optimizer("sawyer", 1)
+    T, memo = _drawn_pose(optimizer.solver.arm, 5, 0), LinkedMemo()
+    _, first = _swept(optimizer, T, memo)
+    _, again = _swept(optimizer, T, memo)
+    assert first[0]._work.traces is not None
+    assert all(probe._work.traces is first[0]._work.traces for probe in again)
+    panda = _optimizer("panda", 1)
+    _, probes = _swept(panda, panda.solver.arm.fk(ARM_HOMES["panda"]))
+    assert all(probe._work.traces is None for probe in probes)

@@ -151,5 +151,10 @@ extern PyMethodDef om_objective_functions[]; /* binding/objective.c: the redunda
 extern PyMethodDef om_cell_functions[];      /* binding/cells.c: the cell test of the solution paths (cells.c) */
 int om_box_qp_init(PyObject *module);         /* binding/box_qp.c: the climb's QP in one variable */
 extern PyMethodDef om_start_bound_functions[]; /* binding/start_bounds.c: what a climb from a start can reach */
+extern PyMethodDef om_traces_functions[];      /* binding/traces.c: torus_traces */
+/* binding/traces.c: the traces that obj (None, or a torus_traces(solver) capsule) keeps; NULL for
+ * None, and NULL with a TypeError or ValueError naming what where obj is neither, or another
+ * solver's (PyErr_Occurred tells the two apart). */
+om_torus_memo *om_traces_of(PyObject *obj, const om_solver_data *s, const char *what);
 
 #endif

@@ -55,6 +55,7 @@ PyMODINIT_FUNC PyInit_ckernels(void) {
     if (PyModule_AddFunctions(m, om_cell_functions) < 0) goto fail;
     if (om_box_qp_init(m) < 0) goto fail;
     if (PyModule_AddFunctions(m, om_start_bound_functions) < 0) goto fail;
+    if (PyModule_AddFunctions(m, om_traces_functions) < 0) goto fail;
     if (add_int_constants(m, constants, sizeof constants / sizeof constants[0]) < 0) goto fail;
     const struct {
         const char *name;

@@ -28,9 +28,10 @@ static PyStructSequence_Desc linked_desc = {"om_redundant.ckernels.Linked", "Wha
 static PyTypeObject *linked_type;
 
 /* The fields of the branch record (om_redundant._core.FollowWork) that follow and link_paths
- * read: the branch's (W_BRANCH of them: link_paths') and the point followed. */
-enum { W_KERNEL, W_T, W_SIGNS, W_CYCLIC, W_CENTRED, W_CENTRE, W_BRANCH, W_Q = W_BRANCH, W_T7, W_N };
-static const char *const work_names[W_N] = {"kernel", "T", "signs", "cyclic", "centred", "centre", "q", "t"};
+ * read: the branch's (W_BRANCH of them: link_paths'; the buffers from W_T on) and the point
+ * followed. */
+enum { W_KERNEL, W_TRACES, W_T, W_SIGNS, W_CYCLIC, W_CENTRED, W_CENTRE, W_BRANCH, W_Q = W_BRANCH, W_T7, W_N };
+static const char *const work_names[W_N] = {"kernel", "traces", "T", "signs", "cyclic", "centred", "centre", "q", "t"};
 
 /* follow(work, psi, target, min_step) -> Followed(psi, status, steps): work.q and work.t (7,
  * in place) become the point reached. */
@@ -48,12 +49,13 @@ static PyObject *om_follow(PyObject *mod, PyObject *const *args, Py_ssize_t narg
     const buffer_spec sp[7] = {{F64, 16, 0, "T"}, {I64, s ? s->n_signs : 0, 0, "signs"}, {U8, 7, 0, "cyclic"},
                                {U8, 7, 0, "centred"}, {F64, 7, 0, "centre"}, {F64, 7, 1, "q"},
                                {F64, 7, 1, "t"}};
-    if (s == NULL || get_buffers(w + W_T, v, sp, 7) < 0) goto done;
+    const om_torus_memo *traces = s ? om_traces_of(w[W_TRACES], s, "follow") : NULL;
+    if (s == NULL || PyErr_Occurred() || get_buffers(w + W_T, v, sp, 7) < 0) goto done;
     double T[16];
     int64_t signs[3];
     if (copy_pose_and_signs(&v[0], &v[1], s->n_signs, T, signs) == 0) {
         int steps = 0, status;
-        Py_BEGIN_ALLOW_THREADS status = om_follow_path(s, T, signs, v[2].buf, v[3].buf, v[4].buf, &psi,
+        Py_BEGIN_ALLOW_THREADS status = om_follow_path(s, T, signs, v[2].buf, v[3].buf, v[4].buf, traces, &psi,
                                                        v[5].buf, v[6].buf, target, min_step, &steps);
         Py_END_ALLOW_THREADS PyObject *items[3] = {PyFloat_FromDouble(psi), PyLong_FromLong(status),
                                                    PyLong_FromLong(steps)};
@@ -106,7 +108,7 @@ static PyObject *om_link(PyObject *mod, PyObject *const *args, Py_ssize_t nargs,
         return NULL;
     }
     const om_solver_data *s = om_srs7_solver(f[W_KERNEL], "link_paths");
-    enum { V = W_BRANCH - 1 + R_N + O_N }; /* the buffers: all but the kernel */
+    enum { V = W_BRANCH - W_T + R_N + O_N }; /* the buffers: all but the kernel and the traces */
     Py_buffer v[V];
     const buffer_spec sp[V] = {
         {F64, 16, 0, "T"},     {I64, s ? s->n_signs : 0, 0, "signs"}, {U8, 7, 0, "cyclic"},
@@ -115,8 +117,9 @@ static PyObject *om_link(PyObject *mod, PyObject *const *args, Py_ssize_t nargs,
         {F64, -1, 1, "psi"},   {F64, -1, 1, "q"},                     {F64, -1, 1, "t"},
         {I64, -1, 1, "members"}, {I64, -1, 1, "paths"},
     };
-    if (s == NULL || get_buffers(f + W_T, v, sp, V) < 0) goto done;
-    enum { GRID = W_BRANCH - 1, COUNTS, Q, T7, NEW_PSI, NEW_Q, NEW_T, MEMBERS, PATHS };
+    const om_torus_memo *traces = s ? om_traces_of(f[W_TRACES], s, "link_paths") : NULL;
+    if (s == NULL || PyErr_Occurred() || get_buffers(f + W_T, v, sp, V) < 0) goto done;
+    enum { GRID = W_BRANCH - W_T, COUNTS, Q, T7, NEW_PSI, NEW_Q, NEW_T, MEMBERS, PATHS };
     Py_ssize_t n = v[COUNTS].len / 8, m = v[Q].len / 8 / 7, capacity = v[NEW_PSI].len / 8, rows = m + capacity;
     bool ok = n >= 1 && v[GRID].len / 8 == n && v[Q].len == 8 * 7 * m && v[T7].len == v[Q].len;
     ok = ok && v[NEW_Q].len == 8 * 7 * capacity && v[NEW_T].len == v[NEW_Q].len &&
@@ -133,7 +136,7 @@ static PyObject *om_link(PyObject *mod, PyObject *const *args, Py_ssize_t nargs,
         ok = grid_holds(grid, counts, n, m);
         if (ok) {
             om_link_job job = {.s = s, .T = T, .centre = v[4].buf, .signs = signs, .cyclic = v[2].buf,
-                               .centred = v[3].buf, .n = n, .m = m, .grid = grid, .q = v[Q].buf, .t = v[T7].buf,
+                               .centred = v[3].buf, .traces = traces, .n = n, .m = m, .grid = grid, .q = v[Q].buf, .t = v[T7].buf,
                                .counts = counts, .capacity = capacity, .new_psi = v[NEW_PSI].buf,
                                .new_q = v[NEW_Q].buf, .new_t = v[NEW_T].buf, .members = v[MEMBERS].buf,
                                .paths = v[PATHS].buf};

@@ -102,17 +102,19 @@ done:
 
 /* The fields of solve_all_rows' batch (om_redundant._core.SolveAllBatch) it reads. */
 enum { SA_T, SA_SIGNS, SA_REDUNDANCY, SA_BAND, SA_Q, SA_COUNT, SA_EVALUATIONS, SA_POSITION, SA_ORIENTATION,
-       SA_WITHIN, SA_N };
+       SA_WITHIN, SA_TRACES, SA_N };
 static const char *const solve_all_batch_names[SA_N] = {"T", "signs", "redundancy", "band", "q", "count",
                                                         "evaluations", "position_error", "orientation_error",
-                                                        "within_limits"};
+                                                        "within_limits", "traces"};
 
 /* solve_all_rows(batch, start, stop): om_solve_all of rows start:stop of a batch
  * (om_redundant._core.SolveAllBatch): T (M, 4, 4), signs (M, k) int64, redundancy (M, r),
  * band (M,) bool (whether a row without a root of its own searches the band) in; q (M,
  * MAX_ROOTS, dof), count (M,) int64, evaluations (M,) int64, and per root position_error,
  * orientation_error (M, MAX_ROOTS) and within_limits (M, MAX_ROOTS) bool out, each row's as
- * solve_all's (the entries beyond a row's count left as they were). */
+ * solve_all's (the entries beyond a row's count left as they were); the self-motion the rows
+ * traced kept in traces (None: dropped), each ELBOW sign's last (om_torus_memo_take: the GIL
+ * held, so the calls of the batch's threads take turns). */
 PyObject *om_solver_solve_all_rows(om_Solver *self, PyObject *const *args, Py_ssize_t nargs) {
     const om_solver_data *s = om_solver_ready(self);
     PyObject *w[SA_N];
@@ -131,7 +133,8 @@ PyObject *om_solver_solve_all_rows(om_Solver *self, PyObject *const *args, Py_ss
     Py_ssize_t start, stop;
     int64_t *signs;
     PyObject *result = NULL;
-    if (get_rows(s, rows, outs, specs, 7, v, &start, &stop, &signs) < 0) goto done;
+    om_torus_memo *traces = om_traces_of(w[SA_TRACES], s, "solve_all_rows");
+    if (PyErr_Occurred() || get_rows(s, rows, outs, specs, 7, v, &start, &stop, &signs) < 0) goto done;
     const double *Tb = v[0].buf, *rb = v[2].buf;
     double *roots = v[3].buf, *position = v[6].buf, *orientation = v[7].buf;
     int64_t *count = v[4].buf, *evaluations = v[5].buf;
@@ -152,8 +155,9 @@ PyObject *om_solver_solve_all_rows(om_Solver *self, PyObject *const *args, Py_ss
     }
     free(cache.candidates);
     om_scan_memo_free(cache.memo);
+    Py_END_ALLOW_THREADS om_torus_memo_take(traces, cache.torus_memo);
     om_torus_memo_free(cache.torus_memo);
-    Py_END_ALLOW_THREADS release_buffers(v, 10);
+    release_buffers(v, 10);
     PyMem_Free(signs);
     result = Py_NewRef(Py_None);
 done:

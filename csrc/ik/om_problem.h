@@ -79,6 +79,10 @@ typedef struct {
     /* the lifted residual's terms at the whole torus' grid, which the problem's searches take from
      * the searches of its pose before them and keep for those after (NULL: none) */
     om_torus_memo *torus_memo;
+    /* the self-motion of the problem's pose traced by a batch's searches and kept for the
+     * follows after it (om_torus_memo_take), which its windows start from instead of their grid
+     * (torus.c; read only; NULL: none) */
+    const om_torus_memo *traces;
     /* The real arm's target, the flange pose in DH frame 0 (with the closed form's constants
      * for its orientation), against which every answer is verified (om_verify) and polished.
      * t and p above are the model's side of system (9): the goal itself, but for an arm near a

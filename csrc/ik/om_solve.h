@@ -48,9 +48,11 @@ om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *
  * hint's split of the singular joints alone (om_problem.split_starts), in the local solve and
  * in the scan (the model takes that split from the hint; the split starts begin 2 pi / 16 or
  * more from it in two joints, and cost a follow most of its time at an aligned wrist). result (NULL: not wanted): om_solve_one's
- * for the root. */
+ * for the root. traces (NULL: none): the pose's self-motion a batch traced and kept, which the
+ * scan's windows on the torus start from (om_problem.traces). */
 bool om_solve_near(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
-                   const double *hint, double *q_out, om_root_test as_is, void *context, om_result *result);
+                   const double *hint, double *q_out, om_root_test as_is, void *context, om_result *result,
+                   const om_torus_memo *traces);
 /* Every root (OM_MAX_ROOTS x dof) with per root (position error, orientation error, within limits)
  * in info (OM_MAX_ROOTS x 3). Returns the count; *evaluations the residual evaluations. */
 int om_solve_all(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,

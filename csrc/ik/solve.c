@@ -124,6 +124,7 @@ void om_problem_init(om_problem *pb, const om_solver_data *s, const double *T, c
     pb->certify = !s->nominal_table && s->family == OM_SRS;
     pb->memo = NULL;
     pb->torus_memo = NULL;
+    pb->traces = NULL;
     pb->nominal = false;
     pb->wrist = false;
 }
@@ -156,9 +157,11 @@ static bool _near_hint(om_problem *pb, double *start, bool *start_complete, doub
 
 /* One OM solve: the local solve (secant, or lifted Newton), then, with search, the bounded
  * search; without it a hinted solve ends where its local part fails (om_solve_near). hint
- * NULL: no hint. Writes q_out (dof; NaN when no solution). */
+ * NULL: no hint; traces: the pose's kept self-motion (om_problem.traces; NULL: none). Writes
+ * q_out (dof; NaN when no solution). */
 static om_result _solve(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
-                        const double *hint, double *q_out, om_root_test as_is, void *context, bool search)
+                        const double *hint, double *q_out, om_root_test as_is, void *context, bool search,
+                        const om_torus_memo *traces)
 {
     int family = s->family, mode = s->mode, dof = s->dof;
     const double *P = s->params;
@@ -173,6 +176,7 @@ static om_result _solve(const om_solver_data *s, const double *T, const int64_t 
     double psi[1];
     om_problem_init(&problem, s, T, signs, redundancy, psi, hint);
     problem.split_starts = search;
+    problem.traces = traces;
     om_problem *pb = &problem;
     double q[OM_MAX_DOF], start[OM_MAX_DOF];
     /* local_solve verifies q even where the secant's first point is out of reach and q was
@@ -288,17 +292,17 @@ static om_root_verdict _own_test(const double *q, void *context)
  * the hint in, q_out out, and the roots that as_is judges, flipped. */
 static om_result _solve_own(const om_solver_data *s, const double *T, const int64_t *signs,
                             const double *redundancy, const double *hint, double *q_out, om_root_test as_is,
-                            void *context, bool search)
+                            void *context, bool search, const om_torus_memo *traces)
 {
     if (!s->flipped)
-        return _solve(s, T, signs, redundancy, hint, q_out, as_is, context, search);
+        return _solve(s, T, signs, redundancy, hint, q_out, as_is, context, search, traces);
     double flipped[OM_MAX_DOF];
     if (hint) {
         om_flip(s, hint, flipped);
         hint = flipped;
     }
     own_test own = {s, as_is, context};
-    om_result r = _solve(s, T, signs, redundancy, hint, q_out, as_is ? _own_test : NULL, &own, search);
+    om_result r = _solve(s, T, signs, redundancy, hint, q_out, as_is ? _own_test : NULL, &own, search, traces);
     om_flip(s, q_out, q_out);
     return r;
 }
@@ -306,14 +310,15 @@ static om_result _solve_own(const om_solver_data *s, const double *T, const int6
 om_result om_solve_one(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
                        const double *hint, double *q_out, om_root_test as_is, void *context)
 {
-    return _solve_own(s, T, signs, redundancy, hint, q_out, as_is, context, true);
+    return _solve_own(s, T, signs, redundancy, hint, q_out, as_is, context, true, NULL);
 }
 
 /* The hinted solve's local part alone (see om_solve_near in om_kernels.h). */
 bool om_solve_near(const om_solver_data *s, const double *T, const int64_t *signs, const double *redundancy,
-                   const double *hint, double *q_out, om_root_test as_is, void *context, om_result *result)
+                   const double *hint, double *q_out, om_root_test as_is, void *context, om_result *result,
+                   const om_torus_memo *traces)
 {
-    om_result r = _solve_own(s, T, signs, redundancy, hint, q_out, as_is, context, false);
+    om_result r = _solve_own(s, T, signs, redundancy, hint, q_out, as_is, context, false, traces);
     if (r.status == OM_OK && result)
         *result = r;
     return r.status == OM_OK;

@@ -51,6 +51,22 @@ om_torus_memo *om_torus_memo_new(const om_solver_data *s)
     return memo;
 }
 
+void om_torus_memo_take(om_torus_memo *into, om_torus_memo *from)
+{
+    for (int b = 0; into && from && b < 2; b++) {
+        terms_grid *kept = &into->branches[b], *taken = &from->branches[b];
+        if (!taken->valid || !taken->trace)
+            continue;
+        free(kept->terms);
+        om_trace_free(kept->trace);
+        *kept = *taken;
+        *taken = (terms_grid){.valid = false, .n_charts = -1};
+        free(kept->terms); /* (the windows read the trace and its pose's key alone) */
+        kept->terms = NULL;
+        kept->cap = 0;
+    }
+}
+
 void om_torus_memo_free(om_torus_memo *memo)
 {
     if (memo) {
@@ -62,6 +78,28 @@ void om_torus_memo_free(om_torus_memo *memo)
     free(memo);
 }
 
+/* A grid's key: pb's pose (R, p) and the grid's nodes a side, m. */
+static void _grid_key(const om_problem *pb, int m, double *key)
+{
+    const mat3 *R = &pb->t.R;
+    double k[TERMS_KEY] = {R->r0.x, R->r0.y, R->r0.z, R->r1.x, R->r1.y, R->r1.z, R->r2.x,
+                           R->r2.y, R->r2.z, pb->p.x, pb->p.y, pb->p.z, (double)m};
+    memcpy(key, k, sizeof k);
+}
+
+/* The self-motion at pb's pose and ELBOW sign that pb->traces keeps traced (NULL: none; the
+ * trace does not depend on the grid it was seeded from: the key's pose alone is compared). */
+static const om_trace *_kept_trace(const om_problem *pb)
+{
+    if (!pb->traces)
+        return NULL;
+    const terms_grid *grid = &pb->traces->branches[pb->signs[1] > 0];
+    double key[TERMS_KEY];
+    _grid_key(pb, 0, key);
+    bool same = grid->valid && memcmp(key, grid->key, (TERMS_KEY - 1) * sizeof(double)) == 0;
+    return same ? grid->trace : NULL;
+}
+
 /* The lifted residual's terms at the m x m nodes (lo + step i, lo + step j) for pb's pose and
  * ELBOW sign (NaN where W = S): the torus memo's where it holds this grid's, else computed, into
  * the memo where the problem has one, else into *scratch (allocated; the caller frees it). NULL:
@@ -69,9 +107,8 @@ void om_torus_memo_free(om_torus_memo *memo)
 static const om_srs_lifted_terms *_grid_terms(om_problem *pb, double lo, double step, int m,
                                               om_srs_lifted_terms **scratch)
 {
-    const mat3 *R = &pb->t.R;
-    double key[TERMS_KEY] = {R->r0.x, R->r0.y, R->r0.z, R->r1.x, R->r1.y, R->r1.z, R->r2.x,
-                             R->r2.y, R->r2.z, pb->p.x, pb->p.y, pb->p.z, (double)m};
+    double key[TERMS_KEY];
+    _grid_key(pb, m, key);
     double elbow = (double)pb->signs[1];
     terms_grid *grid = pb->torus_memo ? &pb->torus_memo->branches[elbow > 0.0] : NULL;
     if (grid && grid->valid && memcmp(key, grid->key, sizeof key) == 0)
@@ -327,7 +364,10 @@ static void _roots_from(torus_search *t, vec3 x)
  * partners across the window (WINDOW_PARTNERS): a root of the window near one known is such a
  * partner, and one farther from every known root has a local minimum of the norm of its own on
  * the grid, as on the whole torus. n = 0: a window without a grid (no wider than a cell of the
- * whole torus' grid: search.c, _window_side), the root found and its fold partners alone. */
+ * whole torus' grid: search.c, _window_side), the root found and its fold partners alone. A
+ * window at a pose whose traced self-motion pb->traces keeps (a sweep's follows) starts from the
+ * trace's crossings within its reach instead of its grid and the fold partners of the root
+ * found, as the batch's searches of the whole torus started. */
 int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, double radius, const double *found,
                    om_candidate_log *log)
 {
@@ -386,6 +426,12 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
      * grid's, its Newton on G); and find psi's half-line's points once. */
     terms_grid *memo = terms && pb->torus_memo ? &pb->torus_memo->branches[pb->signs[1] > 0] : NULL;
     const om_trace *trace = memo && !pb->s->nominal_table ? _grid_trace(pb, memo, lo1, step, m) : NULL;
+    /* A window at a pose whose self-motion a batch traced and kept (pb->traces: a follow's scan
+     * for a root nearer its hint) starts from the trace's crossings within its reach instead of
+     * its grid's starts and the found root's fold partners: the starts of the batch's searches of
+     * the whole torus, a fold's pair of roots among them. */
+    const om_trace *kept = whole ? NULL : _kept_trace(pb);
+    grid = grid && !kept;
     for (int i = 0; i < m && grid && !trace; i++) {
         for (int j = 0; j < m; j++) {
             vec3 r;
@@ -408,14 +454,17 @@ int om_torus_roots(om_problem *pb, int n, double *roots, const double *centre, d
     pb->nominal = false;
     if (found && !whole) { /* (a verified root: known as it is, the window's incumbent, not a candidate) */
         _keep(&t, lifted_point(pb->s, found));
-        _partners(&t, 0);
+        if (!kept)
+            _partners(&t, 0);
     }
-    if (trace) {
-        pb->counter += om_trace_evaluations(trace);
+    if (trace || kept) {
+        pb->counter += trace ? om_trace_evaluations(trace) : 0;
         vec3 starts[TRACE_STARTS];
         bool fold[TRACE_STARTS];
-        int n_starts = om_trace_starts(trace, pb->t.psi, starts, fold, TRACE_STARTS);
+        int n_starts = om_trace_starts(trace ? trace : kept, pb->t.psi, starts, fold, TRACE_STARTS);
         for (int k = 0; k < n_starts && t.n_known < MAX_KNOWN; k++) {
+            if (py_max(fabs(om_wrap(starts[k].x - t.w1)), fabs(om_wrap(starts[k].y - t.w7))) > t.reach)
+                continue; /* (a window's runs give up there) */
             if (fold[k])
                 _roots_from(&t, starts[k]);
             else

@@ -31,6 +31,7 @@ typedef struct {
     const double *T, *centre;
     const int64_t *signs;
     const uint8_t *cyclic, *centred;
+    const om_torus_memo *traces;
     int64_t n_roots, n_rows, capacity; /* capacity: of the rows following adds */
     const double *root_psi, *root_q, *root_t;
     double *new_psi, *new_q, *new_t;
@@ -58,8 +59,8 @@ static int follow_from(linker *l, int64_t r, double target, int64_t *reached) {
     l->x_psi = row_psi(l, r);
     memcpy(l->x_q, row_q(l, r), sizeof(double) * 7);
     memcpy(l->x_t, row_t(l, r), sizeof(double) * 7);
-    int status = om_follow_path(l->s, l->T, l->signs, l->cyclic, l->centred, l->centre, &l->x_psi, l->x_q, l->x_t,
-                                target, OM_END_TOLERANCE, &steps);
+    int status = om_follow_path(l->s, l->T, l->signs, l->cyclic, l->centred, l->centre, l->traces, &l->x_psi, l->x_q,
+                                l->x_t, target, OM_END_TOLERANCE, &steps);
     *reached = steps == 0 ? r : REACHED;
     return status;
 }
@@ -213,7 +214,7 @@ int om_link_paths(const om_link_job *job, int64_t *added, int64_t *n_paths) {
     for (int64_t k = 0, r = 0; k < job->n; k++)
         for (int64_t c = 0; c < job->counts[k]; c++) root_psi[r++] = job->grid[k];
     linker l = {.s = job->s, .T = job->T, .signs = job->signs, .cyclic = job->cyclic, .centred = job->centred,
-                .centre = job->centre, .n_roots = m, .n_rows = m, .capacity = job->capacity, .root_psi = root_psi,
+                .centre = job->centre, .traces = job->traces, .n_roots = m, .n_rows = m, .capacity = job->capacity, .root_psi = root_psi,
                 .root_q = job->q, .root_t = job->t, .new_psi = job->new_psi, .new_q = job->new_q,
                 .new_t = job->new_t, .next = work, .n_paths = 0, .head = work + rows, .tail = work + 2 * rows,
                 .first = work + 3 * rows};

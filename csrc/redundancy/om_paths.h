@@ -64,10 +64,11 @@ enum { OM_FOLLOW_ARRIVED = 0, OM_FOLLOW_ENDED = 1, OM_FOLLOW_STALLED = 2 };
  * (the path ended on the way; a root without a tangent, a fold met exactly, fails its step as
  * any other, so the path ends beside it), OM_FOLLOW_STALLED after
  * OM_FOLLOW_MAX_ATTEMPTS attempts (the point reached: the last accepted). Revolute joints are
- * compared modulo 2 pi where cyclic, and taken nearest mid-range centre where centred. */
+ * compared modulo 2 pi where cyclic, and taken nearest mid-range centre where centred. traces
+ * (NULL: none): the pose's self-motion a batch traced and kept (om_problem.traces). */
 int om_follow_path(const om_solver_data *s, const double *T, const int64_t *signs, const uint8_t *cyclic,
-                   const uint8_t *centred, const double *centre, double *psi, double *q, double *t, double target,
-                   double min_step, int *steps);
+                   const uint8_t *centred, const double *centre, const om_torus_memo *traces, double *psi, double *q,
+                   double *t, double target, double min_step, int *steps);
 /* tangents.c: om_self_motion_tangent of each of the rows of q (rows x 7, row-major) into t,
  * a row of NaN where psi does not move along the self-motion. */
 void om_self_motion_tangents(const om_solver_data *s, const double *q, double *t, ptrdiff_t rows);
@@ -77,12 +78,14 @@ void om_self_motion_tangents(const om_solver_data *s, const double *q, double *t
 enum { OM_LINK_DONE = 0, OM_LINK_FULL = 1, OM_LINK_NO_MEMORY = 2 };
 /* A branch's grid roots to link into paths, and where the paths go (link.c's top comment). */
 typedef struct {
-    /* the branch: its solver (7-DOF, S-R-S), pose, signs and the joints follow compares
-     * modulo 2 pi (cyclic) and takes nearest mid-range centre (centred) */
+    /* the branch: its solver (7-DOF, S-R-S), pose, signs, the joints follow compares
+     * modulo 2 pi (cyclic) and takes nearest mid-range centre (centred), and the pose's kept
+     * self-motion (traces; NULL: none) */
     const om_solver_data *s;
     const double *T, *centre;
     const int64_t *signs;
     const uint8_t *cyclic, *centred;
+    const om_torus_memo *traces;
     /* the grid (n psi, increasing within a turn) and its roots: counts[k] of them at grid[k],
      * m in all, their joints q and tangents t (m x 7) */
     int64_t n, m;

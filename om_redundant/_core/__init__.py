@@ -145,6 +145,7 @@ from ..ckernels import (
     start_cones,
     step_1d,
     surprise,
+    torus_traces,
     track_step,
 )
 from .optimiser import (

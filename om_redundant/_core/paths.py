@@ -25,6 +25,9 @@ class FollowWork(NamedTuple):
         centred: (7,) joints taken at the turn nearest mid-range (uint8).
         centre: (7,) the mid-ranges (0 where not centred).
         q, t: (7,) the start's joints and tangent on entry, the point reached's on return.
+        traces: The pose's self-motion a batch of the kernel traced (``torus_traces``; the
+            batch's ``SolveAllBatch.traces``), which the scans for a root nearer a step's
+            start start from; None: none (a scan then samples its window).
     """
 
     kernel: Solver
@@ -35,6 +38,7 @@ class FollowWork(NamedTuple):
     centre: np.ndarray
     q: np.ndarray
     t: np.ndarray
+    traces: object | None = None
 
 
 class LinkRoots(NamedTuple):

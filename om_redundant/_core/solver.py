@@ -126,6 +126,9 @@ class SolveAllBatch(NamedTuple):
         position_error: (M, MAX_ROOTS) out: metres.
         orientation_error: (M, MAX_ROOTS) out: radians.
         within_limits: (M, MAX_ROOTS) bool out.
+        traces: Where the rows keep the self-motion they traced (an S-R-S arm with shoulder
+            offsets: each ELBOW sign's last; ``torus_traces(kernel)``), for the follows after
+            the batch (``FollowWork.traces``); None: not kept.
     """
 
     T: np.ndarray
@@ -138,6 +141,7 @@ class SolveAllBatch(NamedTuple):
     position_error: np.ndarray
     orientation_error: np.ndarray
     within_limits: np.ndarray
+    traces: object | None = None
 
 
 class FamilyModel(NamedTuple):

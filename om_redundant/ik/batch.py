@@ -168,6 +168,7 @@ class BatchSolves:
         band: np.ndarray | None,
         threads: int | None = None,
         chunk: int = BATCH_CHUNK,
+        traces: object | None = None,
     ) -> BatchRoots:
         """:meth:`solve_all_batch`, where a row whose ``band`` is False returns its
         configuration's own roots (the bounded search's) and nothing else: where it has none,
@@ -183,6 +184,9 @@ class BatchSolves:
             chunk: Rows a thread takes at a time. A thread's rows of one pose share its memos
                 (the torus' terms and traced self-motion, one per ELBOW sign), so a caller whose
                 rows come grouped by pose and ELBOW sign passes a group's size.
+            traces: Where the rows keep the self-motion they traced (``_core.torus_traces``
+                of this solver's kernel; each ELBOW sign's of the last pose traced), for
+                the follows of a sweep after them; None: not kept.
 
         Returns:
             A :class:`BatchRoots` with M rows.
@@ -207,6 +211,7 @@ class BatchSolves:
             position_error=np.full((m, n), np.nan),
             orientation_error=np.full((m, n), np.nan),
             within_limits=np.zeros((m, n), dtype=bool),
+            traces=traces,
         )
         kernel = self.kernel
 

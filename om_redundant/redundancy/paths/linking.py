@@ -19,14 +19,16 @@ elbow), so the solutions of a branch are organised as *paths*:
   compares the joints as they are (the path the joints can move along).
 * **Sweep** (:func:`sweep_circle`). Every solution of the branch at each psi of a grid
   (:meth:`~om_redundant.OMSolver.solve_all`; an offset model, ``dp_max > 0``, can have
-  several per psi) comes from one parallel batch (:meth:`~om_redundant.OMSolver.solve_all_batch`).
+  several per psi) comes from one parallel batch (:meth:`~om_redundant.OMSolver.solve_grid`;
+  on an arm with shoulder offsets its rows trace the pose's self-motion, which it keeps for
+  the follows after it: :meth:`Probe.use_traces`).
   Each solution is followed to the next grid psi and linked to the
   solution it arrives at; solutions not arrived at start new paths, followed backwards to
   where they end; paths are joined across +-pi, and close into loops (one
   ``_core.link_paths`` call per branch, :meth:`Probe.link`). The linked paths depend on the
   pose and the branch alone, not on the obstacles: a sweep of the same pose again (a target
-  held while the obstacles move) takes them as they were linked (a :class:`LinkedMemo`), its
-  points' objective evaluated afresh, and does only what follows.
+  held while the obstacles move) takes them as they were linked, and the traced self-motion
+  (a :class:`LinkedMemo`), its points' objective evaluated afresh, and does only what follows.
 * **Cells.** Between neighbouring samples of a path where a joint moves more than
   :data:`FINE_STEP`, samples are inserted. Every sample carries its feasibility functions
   :math:`g_j` (each joint's margin, each clearance minus d_min, normalised; feasible iff all
@@ -48,7 +50,7 @@ import threading
 from collections import OrderedDict
 from collections.abc import Generator
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -110,23 +112,36 @@ class Kept:
         return Path(points, self.turns)
 
 
+class KeptSweep(NamedTuple):
+    """A sweep as a :class:`LinkedMemo` keeps it.
+
+    Attributes:
+        paths: Each branch's linked paths.
+        traces: The self-motion its grid's rows traced (``_core.torus_traces``; None: none),
+            which the follows of a sweep of the pose again take too.
+    """
+
+    paths: list[list[Kept]]
+    traces: object | None
+
+
 class LinkedMemo:
     """The linked paths of the last :data:`MEMO_SWEEPS` sweeps (:func:`sweep_circle`), by
     pose, branches, grid and ``quick``: what a sweep of the same pose again takes instead of
     solving and linking. Shared by threads."""
 
     def __init__(self) -> None:
-        self._entries: OrderedDict[tuple[Any, ...], list[list[Kept]]] = OrderedDict()
+        self._entries: OrderedDict[tuple[Any, ...], KeptSweep] = OrderedDict()
         self._lock = threading.Lock()
 
-    def get(self, key: tuple[Any, ...]) -> list[list[Kept]] | None:
+    def get(self, key: tuple[Any, ...]) -> KeptSweep | None:
         with self._lock:
             linked = self._entries.get(key)
             if linked is not None:
                 self._entries.move_to_end(key)
             return linked
 
-    def put(self, key: tuple[Any, ...], linked: list[list[Kept]]) -> None:
+    def put(self, key: tuple[Any, ...], linked: KeptSweep) -> None:
         with self._lock:
             self._entries[key] = linked
             self._entries.move_to_end(key)
@@ -152,18 +167,23 @@ def sweep_circle(
     key = (probes[0].T.tobytes(), tuple(probe.signs for probe in probes), n, quick)
     kept = None if memo is None else memo.get(key)
     if kept is None:
-        linked = _linked(probes, n, quick)
+        traces = _core.torus_traces(probes[0].solver.kernel)  # (None: an arm whose searches trace none)
+        linked = _linked(probes, n, quick, traces)
         if memo is not None:  # (the solutions alone: a sweep evaluates its points where the obstacles are)
-            memo.put(key, [[Kept(path) for path in paths] for paths in linked])
+            memo.put(key, KeptSweep([[Kept(path) for path in paths] for paths in linked], traces))
     else:
-        linked = [[path.unevaluated(probes[0].objective) for path in paths] for paths in kept]
+        linked = [[path.unevaluated(probes[0].objective) for path in paths] for paths in kept.paths]
+        for probe in probes:
+            probe.use_traces(kept.traces)
     swept = [[(probe, path) for path in paths] for probe, paths in zip(probes, linked, strict=True)]
     filled = iter(_with_hidden([path for paths in swept for path in paths]))  # (every branch's at once)
     return [[next(filled) for _ in paths] for paths in swept]
 
 
-def _linked(probes: list[Probe], n: int, quick: bool) -> list[list[Path]]:
-    """Each probe's branch's linked paths (:func:`sweep_circle`, before the looks inside the cells)."""
+def _linked(probes: list[Probe], n: int, quick: bool, traces: object | None) -> list[list[Path]]:
+    """Each probe's branch's linked paths (:func:`sweep_circle`, before the looks inside the
+    cells); the self-motion the grid's rows trace kept in ``traces`` (``_core.torus_traces``),
+    which the probes' follows then use (:meth:`Probe.use_traces`)."""
     solver, T, branches = probes[0].solver, probes[0].T, [probe.signs for probe in probes]
     psi = -math.pi + TURN * np.arange(n) / n
     # Rows by ELBOW sign, then psi by psi, the branches that differ in the first sign alone next
@@ -184,7 +204,10 @@ def _linked(probes: list[Probe], n: int, quick: bool) -> list[list[Path]]:
         band[rows[b]] = not quick and not _neighbours_swept(signs_b, branches, n)
     grid_psi = np.empty(first)
     grid_psi[rows] = psi
-    batch = solver.solve_grid(np.repeat(T[None], first, axis=0), signs, grid_psi, band, chunk=chunk)
+    poses = np.repeat(T[None], first, axis=0)
+    batch = solver.solve_grid(poses, signs, grid_psi, band, chunk=chunk, traces=traces)
+    for probe in probes:
+        probe.use_traces(traces)
     # every branch's distinct roots, their points in one batch (a point is the same on any branch)
     found = [_distinct(probe, batch.q[rows[b]], batch.count[rows[b]]) for b, probe in enumerate(probes)]
     grid = np.concatenate([k for k, _ in found])

@@ -14,7 +14,10 @@ runs in one call (``_core.follow``, ``csrc/redundancy/follow.c``; the tangents o
 is a failed step without the bounded search, a root within a quarter of its step of the
 first-order prediction is taken without the scan for a nearer one, and a step whose
 prediction moves a joint farther than any root as near as the local one could continue
-fails without it, as it would with it); Python builds only the point reached. The linking of
+fails without it, as it would with it; on an arm with shoulder offsets the scan starts from
+where the self-motion that the sweep's batch traced crosses the step's psi, instead of from a
+grid over a window of the torus: :meth:`Probe.use_traces`); Python builds only the point
+reached. The linking of
 a branch's grid roots into paths runs in one call too (:meth:`Probe.link`,
 ``_core.link_paths``, ``csrc/redundancy/link.c``). Both loops are written in Python in
 ``tests/reference/follow.py``, the oracle they are tested against.
@@ -82,6 +85,14 @@ class Probe:
             np.empty(7),
             np.empty(7),
         )
+
+    def use_traces(self, traces: object | None) -> None:
+        """Follow with the pose's self-motion a batch traced (``_core.torus_traces``, kept by
+        :meth:`~om_redundant.OMSolver.solve_grid`): a follow's scan for a root nearer its
+        step's start then starts from where the trace crosses the step's psi instead of sampling
+        a window of the torus (an arm with shoulder offsets; the same roots, as the batch's
+        searches take them). None: sample the window."""
+        self._work = self._work._replace(traces=traces)
 
     def step(self, a: np.ndarray, b: np.ndarray) -> float:
         """The largest joint step max_i |b_i - a_i| between joint vectors a and b (float64,
