@@ -151,6 +151,7 @@ def test_follows_from_the_kept_traces_link_what_the_windows_link(seed):
             np.testing.assert_allclose([p.q for p in a.points], [p.q for p in b.points], rtol=0, atol=1e-9)
 
 
+@pytest.mark.sanitize
 def test_a_pose_swept_again_follows_from_the_traces_kept_with_its_paths():
     """A sweep that takes its linked paths from the LinkedMemo (the pose held while the
     obstacles move) takes the traces its first sweep kept too; a panda's sweep keeps none."""
@@ -163,3 +164,26 @@ def test_a_pose_swept_again_follows_from_the_traces_kept_with_its_paths():
     panda = _optimizer("panda", 1)
     _, probes = _swept(panda, panda.solver.arm.fk(ARM_HOMES["panda"]))
     assert all(probe._work.traces is None for probe in probes)
+
+
+@pytest.mark.sanitize
+def test_traces_of_another_pose_are_not_taken():
+    """A follow at a pose whose self-motion the traces do not hold (a batch of another pose
+    filled them first: they are written once) samples its windows, as without traces."""
+    optimizer = _optimizer("sawyer", 1)
+    solver, arm = optimizer.solver, optimizer.solver.arm
+    T_a, T_b = _drawn_pose(arm, 2, 0), _drawn_pose(arm, 3, 0)
+    stale = linking._core.torus_traces(solver.kernel)
+    with mock.patch.object(linking._core, "torus_traces", return_value=stale):
+        _swept(optimizer, T_a)  # (fills them at T_a)
+        (at_b, probes) = _swept(optimizer, T_b)  # (the batch at T_b finds them filled)
+    assert all(probe._work.traces is stale for probe in probes)
+    with mock.patch.object(linking._core, "torus_traces", return_value=None):
+        (sampled, _) = _swept(optimizer, T_b)
+    assert [[len(p.points) for p in paths] for paths in at_b] == [
+        [len(p.points) for p in paths] for paths in sampled
+    ]
+    for paths_a, paths_b in zip(at_b, sampled, strict=True):
+        for a, b in zip(paths_a, paths_b, strict=True):
+            assert [p.psi for p in a.points] == [p.psi for p in b.points]
+            assert all((p.q == r.q).all() for p, r in zip(a.points, b.points, strict=True))

@@ -113,7 +113,7 @@ static const char *const solve_all_batch_names[SA_N] = {"T", "signs", "redundanc
  * MAX_ROOTS, dof), count (M,) int64, evaluations (M,) int64, and per root position_error,
  * orientation_error (M, MAX_ROOTS) and within_limits (M, MAX_ROOTS) bool out, each row's as
  * solve_all's (the entries beyond a row's count left as they were); the self-motion the rows
- * traced kept in traces (None: dropped), each ELBOW sign's last (om_torus_memo_take: the GIL
+ * traced kept in traces (None: dropped), each ELBOW sign's first (om_torus_memo_take: the GIL
  * held, so the calls of the batch's threads take turns). */
 PyObject *om_solver_solve_all_rows(om_Solver *self, PyObject *const *args, Py_ssize_t nargs) {
     const om_solver_data *s = om_solver_ready(self);

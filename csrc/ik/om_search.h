@@ -106,9 +106,10 @@ void om_scan_memo_free(om_scan_memo *memo);
  * grid has no terms, not S-R-S on the torus, or out of memory); freed by om_torus_memo_free. */
 om_torus_memo *om_torus_memo_new(const om_solver_data *s);
 void om_torus_memo_free(om_torus_memo *memo);
-/* torus.c: each ELBOW sign's traced self-motion that from holds moved into into (what into held
- * for that sign freed; the grid's terms dropped), from left without it: a batch's traces kept for
- * the follows after it (om_problem.traces). */
+/* torus.c: each ELBOW sign's traced self-motion that from holds moved into into where into holds
+ * none for that sign yet (the grid's terms dropped), from left without it: a batch's traces kept
+ * for the follows after it (om_problem.traces). Write once: what into holds is never freed
+ * before into, so a follow on another thread can read it while a batch takes more. */
 void om_torus_memo_take(om_torus_memo *into, om_torus_memo *from);
 /* wrist_offset_bands.c: candidates in the bands around the singular wrist of an arm with a4 != 0. */
 #define OM_WRIST_BAND_CANDIDATES 256 /* room for them */

@@ -55,10 +55,8 @@ void om_torus_memo_take(om_torus_memo *into, om_torus_memo *from)
 {
     for (int b = 0; into && from && b < 2; b++) {
         terms_grid *kept = &into->branches[b], *taken = &from->branches[b];
-        if (!taken->valid || !taken->trace)
+        if (!taken->valid || !taken->trace || kept->valid)
             continue;
-        free(kept->terms);
-        om_trace_free(kept->trace);
         *kept = *taken;
         *taken = (terms_grid){.valid = false, .n_charts = -1};
         free(kept->terms); /* (the windows read the trace and its pose's key alone) */

@@ -127,8 +127,8 @@ class SolveAllBatch(NamedTuple):
         orientation_error: (M, MAX_ROOTS) out: radians.
         within_limits: (M, MAX_ROOTS) bool out.
         traces: Where the rows keep the self-motion they traced (an S-R-S arm with shoulder
-            offsets: each ELBOW sign's last; ``torus_traces(kernel)``), for the follows after
-            the batch (``FollowWork.traces``); None: not kept.
+            offsets: each ELBOW sign's first, kept until the traces go; ``torus_traces(kernel)``),
+            for the follows after the batch (``FollowWork.traces``); None: not kept.
     """
 
     T: np.ndarray

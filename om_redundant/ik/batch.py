@@ -185,8 +185,8 @@ class BatchSolves:
                 (the torus' terms and traced self-motion, one per ELBOW sign), so a caller whose
                 rows come grouped by pose and ELBOW sign passes a group's size.
             traces: Where the rows keep the self-motion they traced (``_core.torus_traces``
-                of this solver's kernel; each ELBOW sign's of the last pose traced), for
-                the follows of a sweep after them; None: not kept.
+                of this solver's kernel; each ELBOW sign's first, kept until the traces go),
+                for the follows of a sweep after them; None: not kept.
 
         Returns:
             A :class:`BatchRoots` with M rows.
