@@ -55,8 +55,8 @@ static PyObject *om_follow(PyObject *mod, PyObject *const *args, Py_ssize_t narg
     int64_t signs[3];
     if (copy_pose_and_signs(&v[0], &v[1], s->n_signs, T, signs) == 0) {
         int steps = 0, status;
-        Py_BEGIN_ALLOW_THREADS status = om_follow_path(s, T, signs, v[2].buf, v[3].buf, v[4].buf, traces, &psi,
-                                                       v[5].buf, v[6].buf, target, min_step, &steps);
+        om_branch branch = {s, T, v[4].buf, signs, v[2].buf, v[3].buf, traces};
+        Py_BEGIN_ALLOW_THREADS status = om_follow_path(&branch, &psi, v[5].buf, v[6].buf, target, min_step, &steps);
         Py_END_ALLOW_THREADS PyObject *items[3] = {PyFloat_FromDouble(psi), PyLong_FromLong(status),
                                                    PyLong_FromLong(steps)};
         result = new_record(followed_type, items, 3);
@@ -135,8 +135,8 @@ static PyObject *om_link(PyObject *mod, PyObject *const *args, Py_ssize_t nargs,
         memcpy(grid, v[GRID].buf, (size_t)n * sizeof(double));
         ok = grid_holds(grid, counts, n, m);
         if (ok) {
-            om_link_job job = {.s = s, .T = T, .centre = v[4].buf, .signs = signs, .cyclic = v[2].buf,
-                               .centred = v[3].buf, .traces = traces, .n = n, .m = m, .grid = grid, .q = v[Q].buf, .t = v[T7].buf,
+            om_link_job job = {.branch = {s, T, v[4].buf, signs, v[2].buf, v[3].buf, traces},
+                               .n = n, .m = m, .grid = grid, .q = v[Q].buf, .t = v[T7].buf,
                                .counts = counts, .capacity = capacity, .new_psi = v[NEW_PSI].buf,
                                .new_q = v[NEW_Q].buf, .new_t = v[NEW_T].buf, .members = v[MEMBERS].buf,
                                .paths = v[PATHS].buf};

@@ -111,9 +111,12 @@ static double predicted_end(int n, const double *f_prev, const double *f, double
  * two attempts, most of them failing beyond the end, where a failed local solve is the
  * costliest. A step of 1.5 min_step that fails ends the path as the halving would (below
  * min_step); an aimed step that fails is halved, one that succeeds doubled, as any other. */
-int om_follow_path(const om_solver_data *s, const double *T, const int64_t *signs, const uint8_t *cyclic,
-                   const uint8_t *centred, const double *centre, const om_torus_memo *traces, double *psi, double *q,
-                   double *t, double target, double min_step, int *steps) {
+int om_follow_path(const om_branch *branch, double *psi, double *q, double *t, double target, double min_step,
+                   int *steps) {
+    const om_solver_data *s = branch->s;
+    const int64_t *signs = branch->signs;
+    const uint8_t *cyclic = branch->cyclic, *centred = branch->centred;
+    const double *centre = branch->centre;
     int dof = s->dof, n_ends = 1 + s->n_signs;
     double step = target - *psi, x_q[OM_MAX_DOF], x_t[OM_MAX_DOF];
     double ends[4], ends_prev[4], moved = 0.0; /* moved: psi from the point before (0: none yet) */
@@ -127,7 +130,7 @@ int om_follow_path(const om_solver_data *s, const double *T, const int64_t *sign
         if (aim < fabs(x - *psi)) x = *psi + copysign(aim, step);
         prediction p = {dof, cyclic, centred, centre, q, t, x - *psi, farthest(dof, t, x - *psi)};
         bool ok = p.farthest <= FARTHEST_CONTINUED &&
-                  om_solve_near(s, T, signs, &x, q, x_q, on_path, &p, NULL, traces);
+                  om_solve_near(s, branch->T, signs, &x, q, x_q, on_path, &p, NULL, branch->traces);
         if (ok) { /* (a root without a tangent, a fold met exactly, fails as any other) */
             represent(dof, centred, centre, x_q);
             ok = om_continues(dof, q, x_q, t, x - *psi, cyclic) && om_self_motion_tangent(s, x_q, x_t, 0.0);

@@ -27,11 +27,7 @@
 
 /* The branch, the rows and the paths being linked. */
 typedef struct {
-    const om_solver_data *s;
-    const double *T, *centre;
-    const int64_t *signs;
-    const uint8_t *cyclic, *centred;
-    const om_torus_memo *traces;
+    om_branch branch;
     int64_t n_roots, n_rows, capacity; /* capacity: of the rows following adds */
     const double *root_psi, *root_q, *root_t;
     double *new_psi, *new_q, *new_t;
@@ -59,8 +55,7 @@ static int follow_from(linker *l, int64_t r, double target, int64_t *reached) {
     l->x_psi = row_psi(l, r);
     memcpy(l->x_q, row_q(l, r), sizeof(double) * 7);
     memcpy(l->x_t, row_t(l, r), sizeof(double) * 7);
-    int status = om_follow_path(l->s, l->T, l->signs, l->cyclic, l->centred, l->centre, l->traces, &l->x_psi, l->x_q,
-                                l->x_t, target, OM_END_TOLERANCE, &steps);
+    int status = om_follow_path(&l->branch, &l->x_psi, l->x_q, l->x_t, target, OM_END_TOLERANCE, &steps);
     *reached = steps == 0 ? r : REACHED;
     return status;
 }
@@ -93,7 +88,7 @@ static int64_t same(const linker *l, int64_t r, const int64_t *candidates, int64
     int64_t best = -1;
     double nearest = 0.0;
     for (int64_t j = 0; j < n; j++) {
-        double step = om_largest_joint_step(7, row_q(l, r), row_q(l, candidates[j]), l->cyclic);
+        double step = om_largest_joint_step(7, row_q(l, r), row_q(l, candidates[j]), l->branch.cyclic);
         if (best < 0 || step < nearest) best = j, nearest = step;
     }
     return best >= 0 && nearest <= OM_PATH_SAME ? best : -1;
@@ -117,7 +112,7 @@ static int link_roots(linker *l, int64_t n, const double *grid, const int64_t *c
         for (int64_t o = 0; o < n_ongoing; o++) {
             int64_t i = w->ongoing[o], last = l->tail[i], only = n_candidates == 1 ? w->candidates[0] : -1;
             bool arrived = only >= 0 && om_continues(7, row_q(l, last), row_q(l, only), row_t(l, last),
-                                                     row_psi(l, only) - row_psi(l, last), l->cyclic);
+                                                     row_psi(l, only) - row_psi(l, last), l->branch.cyclic);
             if (arrived) /* the only solution, and it continues the path */
                 reached = only;
             else {
@@ -213,8 +208,7 @@ int om_link_paths(const om_link_job *job, int64_t *added, int64_t *n_paths) {
     }
     for (int64_t k = 0, r = 0; k < job->n; k++)
         for (int64_t c = 0; c < job->counts[k]; c++) root_psi[r++] = job->grid[k];
-    linker l = {.s = job->s, .T = job->T, .signs = job->signs, .cyclic = job->cyclic, .centred = job->centred,
-                .centre = job->centre, .traces = job->traces, .n_roots = m, .n_rows = m, .capacity = job->capacity, .root_psi = root_psi,
+    linker l = {.branch = job->branch, .n_roots = m, .n_rows = m, .capacity = job->capacity, .root_psi = root_psi,
                 .root_q = job->q, .root_t = job->t, .new_psi = job->new_psi, .new_q = job->new_q,
                 .new_t = job->new_t, .next = work, .n_paths = 0, .head = work + rows, .tail = work + 2 * rows,
                 .first = work + 3 * rows};

@@ -58,17 +58,25 @@ enum { OM_FOLLOW_ARRIVED = 0, OM_FOLLOW_ENDED = 1, OM_FOLLOW_STALLED = 2 };
 #define OM_FOLLOW_CRAWL 1e-5
 #define OM_FOLLOW_CRAWL_STEPS 16
 #define OM_FOLLOW_MAX_ATTEMPTS 256
+/* A 7-DOF branch at one pose, as om_follow_path and om_link_paths follow its paths: its solver
+ * (S-R-S), pose, signs, the joints compared modulo 2 pi (cyclic) and taken nearest mid-range
+ * centre (centred), and the pose's self-motion a batch traced and kept (traces; NULL: none;
+ * om_problem.traces). */
+typedef struct {
+    const om_solver_data *s;
+    const double *T, *centre;
+    const int64_t *signs;
+    const uint8_t *cyclic, *centred;
+    const om_torus_memo *traces;
+} om_branch;
 /* A 7-DOF branch's solution path followed from (*psi, q, t) (t = dq/dpsi) towards target
  * (probe.py's Probe.follow), *psi, q and t updated in place to the point reached, *steps the
  * accepted steps: OM_FOLLOW_ARRIVED there, OM_FOLLOW_ENDED where the step fell below min_step
  * (the path ended on the way; a root without a tangent, a fold met exactly, fails its step as
  * any other, so the path ends beside it), OM_FOLLOW_STALLED after
- * OM_FOLLOW_MAX_ATTEMPTS attempts (the point reached: the last accepted). Revolute joints are
- * compared modulo 2 pi where cyclic, and taken nearest mid-range centre where centred. traces
- * (NULL: none): the pose's self-motion a batch traced and kept (om_problem.traces). */
-int om_follow_path(const om_solver_data *s, const double *T, const int64_t *signs, const uint8_t *cyclic,
-                   const uint8_t *centred, const double *centre, const om_torus_memo *traces, double *psi, double *q,
-                   double *t, double target, double min_step, int *steps);
+ * OM_FOLLOW_MAX_ATTEMPTS attempts (the point reached: the last accepted). */
+int om_follow_path(const om_branch *branch, double *psi, double *q, double *t, double target, double min_step,
+                   int *steps);
 /* tangents.c: om_self_motion_tangent of each of the rows of q (rows x 7, row-major) into t,
  * a row of NaN where psi does not move along the self-motion. */
 void om_self_motion_tangents(const om_solver_data *s, const double *q, double *t, ptrdiff_t rows);
@@ -78,14 +86,7 @@ void om_self_motion_tangents(const om_solver_data *s, const double *q, double *t
 enum { OM_LINK_DONE = 0, OM_LINK_FULL = 1, OM_LINK_NO_MEMORY = 2 };
 /* A branch's grid roots to link into paths, and where the paths go (link.c's top comment). */
 typedef struct {
-    /* the branch: its solver (7-DOF, S-R-S), pose, signs, the joints follow compares
-     * modulo 2 pi (cyclic) and takes nearest mid-range centre (centred), and the pose's kept
-     * self-motion (traces; NULL: none) */
-    const om_solver_data *s;
-    const double *T, *centre;
-    const int64_t *signs;
-    const uint8_t *cyclic, *centred;
-    const om_torus_memo *traces;
+    om_branch branch;
     /* the grid (n psi, increasing within a turn) and its roots: counts[k] of them at grid[k],
      * m in all, their joints q and tangents t (m x 7) */
     int64_t n, m;

@@ -166,15 +166,16 @@ def sweep_circle(
     """
     key = (probes[0].T.tobytes(), tuple(probe.signs for probe in probes), n, quick)
     kept = None if memo is None else memo.get(key)
+    # (new traces: filled by _linked's batch; None: an arm whose searches trace none)
+    traces = _core.torus_traces(probes[0].solver.kernel) if kept is None else kept.traces
+    for probe in probes:
+        probe.use_traces(traces)
     if kept is None:
-        traces = _core.torus_traces(probes[0].solver.kernel)  # (None: an arm whose searches trace none)
         linked = _linked(probes, n, quick, traces)
         if memo is not None:  # (the solutions alone: a sweep evaluates its points where the obstacles are)
             memo.put(key, KeptSweep([[Kept(path) for path in paths] for paths in linked], traces))
     else:
         linked = [[path.unevaluated(probes[0].objective) for path in paths] for paths in kept.paths]
-        for probe in probes:
-            probe.use_traces(kept.traces)
     swept = [[(probe, path) for path in paths] for probe, paths in zip(probes, linked, strict=True)]
     filled = iter(_with_hidden([path for paths in swept for path in paths]))  # (every branch's at once)
     return [[next(filled) for _ in paths] for paths in swept]
@@ -183,7 +184,7 @@ def sweep_circle(
 def _linked(probes: list[Probe], n: int, quick: bool, traces: object | None) -> list[list[Path]]:
     """Each probe's branch's linked paths (:func:`sweep_circle`, before the looks inside the
     cells); the self-motion the grid's rows trace kept in ``traces`` (``_core.torus_traces``),
-    which the probes' follows then use (:meth:`Probe.use_traces`)."""
+    which the probes' follows use from then on (:meth:`Probe.use_traces`)."""
     solver, T, branches = probes[0].solver, probes[0].T, [probe.signs for probe in probes]
     psi = -math.pi + TURN * np.arange(n) / n
     # Rows by ELBOW sign, then psi by psi, the branches that differ in the first sign alone next
@@ -206,8 +207,6 @@ def _linked(probes: list[Probe], n: int, quick: bool, traces: object | None) -> 
     grid_psi[rows] = psi
     poses = np.repeat(T[None], first, axis=0)
     batch = solver.solve_grid(poses, signs, grid_psi, band, chunk=chunk, traces=traces)
-    for probe in probes:
-        probe.use_traces(traces)
     # every branch's distinct roots, their points in one batch (a point is the same on any branch)
     found = [_distinct(probe, batch.q[rows[b]], batch.count[rows[b]]) for b, probe in enumerate(probes)]
     grid = np.concatenate([k for k, _ in found])
